@@ -1,0 +1,200 @@
+// External and internal forces of a body as generalized forces Q = Σ Jᵀ f (Eq. 4.20):
+// gravity (§4.7), mode potentials V = K γ² with damping (§4.7), springs holding a point
+// (Fig. 4.4), and the penalty ground of §4.9 (Eq. 4.24, 4.25) on a line of any slope.
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "wobble/body/body_model.h"
+#include "wobble/dynamics/kinematics.h"
+
+namespace wobble {
+
+// The ground line through `point` at angle `slope` (radians, counter-clockwise from +x).
+// World y points up, gravity is −y.
+struct Ground {
+  bool enabled = true;
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();
+  double slope = 0.0;
+  double stiffness = 4500.0;       // K_d of Eq. 4.24/4.25 (appendix C: grconst)
+  double normal_damping = 550.0;   // C_dam, damping along the normal (grdam)
+  double friction_damping = 50.0;  // FR_dam, damping along the tangent (frconst)
+  double friction_cap = 0.1;       // tan θ: |friction / normal force| never exceeds it
+  // A point deeper than this stops the run (runaway penetration). 0 means automatic: half
+  // the shorter lattice side of the body.
+  double max_penetration = 0.0;
+
+  Eigen::Vector2d tangent() const { return {std::cos(slope), std::sin(slope)}; }
+  Eigen::Vector2d normal() const { return {-std::sin(slope), std::cos(slope)}; }
+  // Signed height of x above the ground (negative below).
+  template <class T> T Height(const Vec2<T>& x) const {
+    return normal().cast<T>().dot(x - point.cast<T>());
+  }
+};
+
+// A damped spring from a world anchor to a point of a body given by lattice coordinates.
+struct Spring {
+  int body = 0;
+  Eigen::Vector2d lattice_coords = Eigen::Vector2d(0.5, 0.5);
+  Eigen::Vector2d anchor = Eigen::Vector2d::Zero();
+  double stiffness = 0.0, damping = 0.0, rest_length = 0.0;
+  // b0 and B of the held point, filled in by World::AddSpring.
+  Eigen::Vector2d rest_local = Eigen::Vector2d::Zero();
+  Mat2D<double> mode_matrix;
+};
+
+struct WorldParams {
+  bool gravity_on = true;
+  Eigen::Vector2d gravity = Eigen::Vector2d(0.0, -9.81);
+  Ground ground;
+  std::vector<Spring> springs;
+  // Runs stop when the estimated condition number of M exceeds this.
+  double max_condition = 1e12;
+};
+
+// A point below the ground is tied to its entry point `anchor` by the spring–damper unit of
+// Fig. 4.5(a) until it leaves the ground.
+template <class T> struct Contact {
+  int point;
+  Vec2<T> anchor;
+};
+
+// The mutable half of a body (MuJoCo's mjData): q = [tx, ty, θ, γ...], q̇, and its contacts
+// (sorted by point index).
+template <class T> struct BodyState {
+  VecQ<T> q, qd;
+  std::vector<Contact<T>> contacts;
+  double penetration = 0.0;  // deepest contact at the last contact update
+};
+
+template <class T> struct ForceBreakdown {
+  VecQ<T> gravity, modes, ground, springs, total;
+};
+
+// Ground force at a point x with velocity v tied to `anchor` (Eq. 4.24, 4.25 in the ground's
+// frame): f_n = −K_d Δn − C_dam v_n (never pulling), f_t = −K_d Δt − FR_dam v_t with
+// |f_t| ≤ tanθ f_n. Sets *slipping when the friction cap was hit.
+template <class T>
+Vec2<T> GroundForce(const Ground& g, const Vec2<T>& x, const Vec2<T>& v, const Vec2<T>& anchor, bool* slipping) {
+  const Vec2<T> n = g.normal().cast<T>(), tau = g.tangent().cast<T>();
+  const Vec2<T> dl = x - anchor;
+  T fn = -T(g.stiffness) * n.dot(dl) - T(g.normal_damping) * n.dot(v);
+  if (fn < T(0.0)) fn = T(0.0);
+  T ft = -T(g.stiffness) * tau.dot(dl) - T(g.friction_damping) * tau.dot(v);
+  const T cap = T(g.friction_cap) * fn;
+  *slipping = false;
+  if (ft > cap) {
+    ft = cap;
+    *slipping = true;
+  } else if (ft < -cap) {
+    ft = -cap;
+    *slipping = true;
+  }
+  return fn * n + ft * tau;
+}
+
+// Convex-hull test: true when every deformed control point is strictly above the ground, so no
+// point of the body can be below it (Bernstein and B-spline weights are a partition of unity).
+template <class T> bool ClearOfGround(const BodyModel& body, const Ground& g, const VecQ<T>& q) {
+  const int D = body.num_modes();
+  const Mat2<T> R = Rotation(q[2]);
+  const Vec2<T> t(q[0], q[1]);
+  const std::vector<Eigen::Vector2d>& rest = body.rest_control();
+  for (int c = 0; c < int(rest.size()); ++c) {
+    Vec2<T> local = rest[c].cast<T>();
+    for (int d = 0; d < D; ++d) local += body.modes()[d].displacement[c].cast<T>() * q[kRigidDofs + d];
+    if (!(ScalarValue(g.Height<T>(t + R * local)) > 0.0)) return false;
+  }
+  return true;
+}
+
+// Visits every mass point below the ground as f(k, l, x, v, anchor): l local, x world,
+// v velocity, anchor its contact's anchor (existing, or the entry point projected on the
+// ground for a new contact). Bodies clear of the ground by the hull test cost nothing.
+template <class T, class F>
+void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodyState<T>& s, F&& f) {
+  if (!g.enabled || ClearOfGround(body, g, s.q)) return;
+  const Vec2<T> n = g.normal().cast<T>();
+  auto existing = s.contacts.begin();
+  for (int k = 0; k < body.num_points(); ++k) {
+    const auto B = body.mode_matrix(k);
+    const Vec2<T> l = LocalPosition<T>(body.rest_local(k), B, s.q);
+    const Vec2<T> x = WorldFromLocal(s.q, l);
+    const T h = g.Height(x);
+    while (existing != s.contacts.end() && existing->point < k) ++existing;
+    if (!(ScalarValue(h) < 0.0)) continue;
+    const bool has_anchor = existing != s.contacts.end() && existing->point == k;
+    const Vec2<T> anchor = has_anchor ? existing->anchor : Vec2<T>(x - h * n);
+    f(k, l, x, PointVelocity(s.q, s.qd, l, B), anchor);
+  }
+}
+
+// All generalized forces on a body, by source.
+template <class T>
+void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index, const BodyState<T>& s,
+                    ForceBreakdown<T>* out) {
+  const int nq = body.num_q(), D = body.num_modes();
+  // gravity, exactly from the moments
+  if (w.gravity_on) {
+    GravityForce(body.moments(), s.q, w.gravity, &out->gravity);
+  } else {
+    out->gravity.setZero(nq);
+  }
+  // mode potentials V = K γ² → Q = −2Kγ, and damping −c γ̇ (§4.7)
+  out->modes.setZero(nq);
+  for (int d = 0; d < D; ++d) {
+    const DeformationMode& m = body.modes()[d];
+    out->modes[kRigidDofs + d] = -T(2.0 * m.stiffness) * s.q[kRigidDofs + d] - T(m.damping) * s.qd[kRigidDofs + d];
+  }
+  // penalty ground, only over points below it
+  out->ground.setZero(nq);
+  ForEachPointInContact(body, w.ground, s, [&](int k, const Vec2<T>& l, const Vec2<T>& x, const Vec2<T>& v,
+                                               const Vec2<T>& anchor) {
+    bool slipping;
+    AddGeneralizedForce(s.q, l, body.mode_matrix(k), GroundForce(w.ground, x, v, anchor, &slipping), &out->ground);
+  });
+  // springs holding a point
+  out->springs.setZero(nq);
+  for (const Spring& sp : w.springs) {
+    if (sp.body != body_index) continue;
+    const Vec2<T> l = LocalPosition<T>(sp.rest_local, sp.mode_matrix, s.q);
+    const Vec2<T> x = WorldFromLocal(s.q, l);
+    const Vec2<T> v = PointVelocity(s.q, s.qd, l, sp.mode_matrix);
+    const Vec2<T> delta = x - sp.anchor.cast<T>();
+    using std::sqrt;
+    const T len = sqrt(delta.squaredNorm() + T(1e-300));
+    const Vec2<T> dir = delta / len;
+    const Vec2<T> f = -(T(sp.stiffness) * (len - T(sp.rest_length)) + T(sp.damping) * dir.dot(v)) * dir;
+    AddGeneralizedForce(s.q, l, sp.mode_matrix, f, &out->springs);
+  }
+  out->total = out->gravity + out->modes + out->ground + out->springs;
+}
+
+// After a step is accepted: points that went below the ground get an anchor at their entry
+// point, points that left it lose theirs, and an anchor whose friction hit the cap slides
+// along the ground so the tangential spring holds exactly the capped force (Coulomb slip).
+template <class T> void UpdateContacts(const BodyModel& body, const Ground& g, BodyState<T>* s) {
+  // reuse storage across steps: no heap traffic while a body rests on the ground
+  thread_local std::vector<Contact<T>> next;
+  next.clear();
+  s->penetration = 0.0;
+  const Vec2<T> tau = g.tangent().cast<T>(), n = g.normal().cast<T>();
+  ForEachPointInContact(body, g, *s, [&](int k, const Vec2<T>&, const Vec2<T>& x, const Vec2<T>& v,
+                                         Vec2<T> anchor) {
+    bool slipping;
+    const Vec2<T> f = GroundForce(g, x, v, anchor, &slipping);
+    if (slipping) {
+      // choose Δt so that −K Δt − FR v_t equals the capped friction f·τ
+      const T dt = -(f.dot(tau) + T(g.friction_damping) * tau.dot(v)) / T(g.stiffness);
+      const Vec2<T> on_ground = x - g.Height(x) * n;
+      anchor = on_ground - dt * tau;
+    }
+    next.push_back({k, anchor});
+    s->penetration = std::max(s->penetration, -double(ScalarValue(g.Height(x))));
+  });
+  s->contacts.swap(next);
+}
+
+}  // namespace wobble
