@@ -3,6 +3,7 @@
 // (Fig. 4.4), and the penalty ground of §4.9 (Eq. 4.24, 4.25) on a line of any slope.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -110,31 +111,47 @@ template <class T> bool ClearOfGround(const BodyModel& body, const Ground& g, co
   return true;
 }
 
+// Which points the ground acts on during a force evaluation.
+enum class ContactSet {
+  kDetect,  // every point below the ground (explicit integrators)
+  kFrozen,  // exactly the listed contacts, even a point a little above the ground: implicit
+            // solves need a residual without the jump that a point crossing the surface (and
+            // its damping force) would add. A listed point above the ground feels only what
+            // damping pushes, never a pull (f_n >= 0).
+};
+
 // Visits every mass point below the ground as f(k, l, x, v, anchor): l local, x world,
 // v velocity, anchor its contact's anchor (existing, or the entry point projected on the
 // ground for a new contact). Bodies clear of the ground by the hull test cost nothing.
 template <class T, class F>
-void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodyState<T>& s, F&& f) {
-  if (!g.enabled || ClearOfGround(body, g, s.q)) return;
-  const Vec2<T> n = g.normal().cast<T>();
-  auto existing = s.contacts.begin();
-  for (int k = 0; k < body.num_points(); ++k) {
+void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodyState<T>& s, F&& f,
+                           ContactSet set = ContactSet::kDetect) {
+  if (!g.enabled) return;
+  auto visit = [&](int k, const Vec2<T>* anchor) {
     const auto B = body.mode_matrix(k);
     const Vec2<T> l = LocalPosition<T>(body.rest_local(k), B, s.q);
     const Vec2<T> x = WorldFromLocal(s.q, l);
     const T h = g.Height(x);
+    if (set == ContactSet::kDetect && !(ScalarValue(h) < 0.0)) return;
+    f(k, l, x, PointVelocity(s.q, s.qd, l, B), anchor ? *anchor : Vec2<T>(x - h * g.normal().cast<T>()));
+  };
+  if (set == ContactSet::kFrozen) {
+    for (const Contact<T>& c : s.contacts) visit(c.point, &c.anchor);
+    return;
+  }
+  if (ClearOfGround(body, g, s.q)) return;
+  auto existing = s.contacts.begin();
+  for (int k = 0; k < body.num_points(); ++k) {
     while (existing != s.contacts.end() && existing->point < k) ++existing;
-    if (!(ScalarValue(h) < 0.0)) continue;
     const bool has_anchor = existing != s.contacts.end() && existing->point == k;
-    const Vec2<T> anchor = has_anchor ? existing->anchor : Vec2<T>(x - h * n);
-    f(k, l, x, PointVelocity(s.q, s.qd, l, B), anchor);
+    visit(k, has_anchor ? &existing->anchor : nullptr);
   }
 }
 
 // All generalized forces on a body, by source.
 template <class T>
 void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index, const BodyState<T>& s,
-                    ForceBreakdown<T>* out) {
+                    ForceBreakdown<T>* out, ContactSet contact_set = ContactSet::kDetect) {
   const int nq = body.num_q(), D = body.num_modes();
   // gravity, exactly from the moments
   if (w.gravity_on) {
@@ -154,7 +171,7 @@ void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index,
                                                const Vec2<T>& anchor) {
     bool slipping;
     AddGeneralizedForce(s.q, l, body.mode_matrix(k), GroundForce(w.ground, x, v, anchor, &slipping), &out->ground);
-  });
+  }, contact_set);
   // springs holding a point
   out->springs.setZero(nq);
   for (const Spring& sp : w.springs) {
@@ -170,6 +187,23 @@ void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index,
     AddGeneralizedForce(s.q, l, sp.mode_matrix, f, &out->springs);
   }
   out->total = out->gravity + out->modes + out->ground + out->springs;
+}
+
+// Adds a contact for every point below the ground that has none (anchor: its projection on
+// the ground). Returns how many were added. Implicit steps call it to grow their active set.
+template <class T> int AddMissingContacts(const BodyModel& body, const Ground& g, BodyState<T>* s) {
+  std::vector<Contact<T>> added;
+  const BodyState<T>& view = *s;
+  ForEachPointInContact(body, g, view, [&](int k, const Vec2<T>&, const Vec2<T>&, const Vec2<T>&,
+                                            const Vec2<T>& anchor) {
+    for (const Contact<T>& c : view.contacts)
+      if (c.point == k) return;
+    added.push_back({k, anchor});
+  });
+  if (added.empty()) return 0;
+  s->contacts.insert(s->contacts.end(), added.begin(), added.end());
+  std::sort(s->contacts.begin(), s->contacts.end(), [](const Contact<T>& a, const Contact<T>& b) { return a.point < b.point; });
+  return int(added.size());
 }
 
 // After a step is accepted: points that went below the ground get an anchor at their entry

@@ -108,3 +108,31 @@ template <class T> T GravityEnergy(const MassMoments& mm, const VecQ<T>& q, cons
 }
 
 }  // namespace wobble
+
+namespace wobble {
+
+// ∂T/∂q at fixed q̇ = v, i.e. ½ vᵀ (∂M/∂q_j) v (the ∂L/∂q term of Eq. 4.5/4.12), from the
+// moments: M depends on θ through R in M_tθ, M_tγ and on γ through M_tθ, M_θθ, M_θγ.
+template <class T> void KineticGradient(const MassMoments& mm, const VecQ<T>& q, const VecQ<T>& v, VecQ<T>* out) {
+  const int D = int(mm.e0.size());
+  const auto gamma = q.tail(D);
+  const auto gd = v.tail(D);
+  const Mat2<T> R = Rotation(q[2]);
+  const Vec2<T> c = mm.c0.cast<T>() + mm.C.cast<T>() * gamma;
+  const Vec2<T> vt(v[0], v[1]);
+  const T thd = v[2];
+  out->setZero(kRigidDofs + D);
+  // θ: ∂M_tθ/∂θ = R S S c = −R c, ∂M_tγ/∂θ = R S C
+  const Vec2<T> Cgd = mm.C.cast<T>() * gd;
+  (*out)[2] = vt.dot(-(R * c) * thd + R * Perp(Cgd));
+  // γ_d: ∂M_tθ/∂γ_d = R S C_d, ∂M_θθ/∂γ_d = 2(e0 + Gγ)_d, ∂M_θγ_e/∂γ_d = P_ed
+  if (D == 0) return;
+  const VecD<T> e = mm.e0.cast<T>() + mm.G.cast<T>() * gamma;
+  const VecD<T> Pt_gd = mm.P.cast<T>().transpose() * gd;
+  for (int d = 0; d < D; ++d) {
+    const Vec2<T> Cd = mm.C.col(d).cast<T>();
+    (*out)[kRigidDofs + d] = vt.dot(R * Perp(Cd)) * thd + thd * thd * e[d] + thd * Pt_gd[d];
+  }
+}
+
+}  // namespace wobble

@@ -18,6 +18,7 @@ enum class Integrator {
   kSymplecticEuler,  // position first: q_{n+1} = q_n + Δt q̇_n, q̇_{n+1} = q̇_n + Δt q̈(q_{n+1}, q̇_n)
   kRK4,              // classical fourth-order Runge–Kutta
   kImplicitEuler,    // backward Euler, Newton on q̇_{n+1}: for stiff ground contact
+  kVariational,      // midpoint variational integrator: symplectic for any M(q)
 };
 std::string IntegratorName(Integrator integrator);
 bool ParseIntegrator(const std::string& text, Integrator* integrator);
@@ -35,14 +36,15 @@ std::string StatusCodeName(StepStatus::Code code);
 // (the squared ratio of its largest to smallest diagonal entry).
 template <class T>
 StepStatus Accelerations(const BodyModel& body, const WorldParams& w, int body_index, const BodyState<T>& s,
-                         VecQ<T>* qdd, ForceBreakdown<T>* forces = nullptr) {
+                         VecQ<T>* qdd, ForceBreakdown<T>* forces = nullptr,
+                         ContactSet contact_set = ContactSet::kDetect) {
   MatQ<T> M;
   VecQ<T> vel;
   ForceBreakdown<T> local;
   ForceBreakdown<T>& f = forces ? *forces : local;
   MassMatrix(body.moments(), s.q, &M);
   VelocityTerms(body.moments(), s.q, s.qd, &vel);
-  EvaluateForces(body, w, body_index, s, &f);
+  EvaluateForces(body, w, body_index, s, &f, contact_set);
   const Eigen::LLT<MatQ<T>> llt(M);
   if (llt.info() != Eigen::Success) return {StepStatus::Code::kSingularMass, 0.0};
   const auto diag = llt.matrixLLT().diagonal();
@@ -58,6 +60,46 @@ StepStatus Accelerations(const BodyModel& body, const WorldParams& w, int body_i
   return {};
 }
 
+// Newton's method with a forward-difference Jacobian and backtracking on |r|, for the implicit
+// integrators. x holds the initial guess and receives the solution.
+template <class T, class Residual> StepStatus SolveNewton(Residual&& residual, VecQ<T>* x) {
+  const int n = int(x->size());
+  auto norm = [](const VecQ<T>& r) {
+    double m = 0.0;
+    for (int i = 0; i < r.size(); ++i) m = std::max(m, std::abs(double(ScalarValue(r[i]))));
+    return m;
+  };
+  VecQ<T> r, r_probe, trial;
+  StepStatus st;
+  if (!(st = residual(*x, &r)).ok()) return st;
+  const double scale = 1.0 + norm(r);
+  for (int iter = 0; iter < 30; ++iter) {
+    const double r_norm = norm(r);
+    if (r_norm <= 1e-12 * scale) return {};
+    MatQ<T> jac(n, n);
+    for (int i = 0; i < n; ++i) {
+      const double eps = 1e-7 * std::max(1.0, std::abs(double(ScalarValue((*x)[i]))));
+      VecQ<T> xp = *x;
+      xp[i] += T(eps);
+      if (!(st = residual(xp, &r_probe)).ok()) return st;
+      jac.col(i) = (r_probe - r) / T(eps);
+    }
+    const VecQ<T> dx = jac.partialPivLu().solve(r);
+    // backtrack until the residual decreases (contact forces are only piecewise smooth)
+    double step = 1.0;
+    for (int k = 0; k < 12; ++k, step *= 0.5) {
+      trial = *x - T(step) * dx;
+      if (!(st = residual(trial, &r_probe)).ok()) return st;
+      if (norm(r_probe) < r_norm) break;
+    }
+    const double dx_norm = step * norm(dx);
+    *x = trial;
+    r = r_probe;
+    if (dx_norm <= 1e-13 * (1.0 + norm(*x))) return {};
+  }
+  return norm(r) <= 1e-8 * scale ? StepStatus{} : StepStatus{StepStatus::Code::kSolverFailed, norm(r)};
+}
+
 // Advances one body by dt with contacts held fixed, then updates its contacts.
 template <class T>
 StepStatus StepBody(const BodyModel& body, const WorldParams& w, int body_index, Integrator integrator, double dt,
@@ -65,9 +107,11 @@ StepStatus StepBody(const BodyModel& body, const WorldParams& w, int body_index,
   const T h(dt);
   VecQ<T> a;
   StepStatus st;
-  auto accel = [&](const VecQ<T>& q, const VecQ<T>& qd, VecQ<T>* out) {
-    BodyState<T> probe{q, qd, s->contacts};
-    return Accelerations(body, w, body_index, probe, out);
+  // stage evaluations reuse *s (q and q̇ overwritten, contacts kept): no copies, no heap
+  auto accel = [&](const VecQ<T>& q, const VecQ<T>& qd, VecQ<T>* out, ContactSet set = ContactSet::kDetect) {
+    s->q = q;
+    s->qd = qd;
+    return Accelerations(body, w, body_index, *s, out, static_cast<ForceBreakdown<T>*>(nullptr), set);
   };
   switch (integrator) {
     case Integrator::kThesis: {
@@ -100,42 +144,72 @@ StepStatus StepBody(const BodyModel& body, const WorldParams& w, int body_index,
       break;
     }
     case Integrator::kImplicitEuler: {
-      // solve r(v) = v − q̇_n − Δt q̈(q_n + Δt v, v) = 0 for v = q̇_{n+1} by Newton's method
-      // with a finite-difference Jacobian
-      const int nq = body.num_q();
+      // solve r(v) = v − q̇_n − Δt q̈(q_n + Δt v, v) = 0 for v = q̇_{n+1}
       const VecQ<T> q0 = s->q, v0 = s->qd;
-      auto residual = [&](const VecQ<T>& v, VecQ<T>* r) {
-        VecQ<T> acc;
-        const StepStatus rs = accel(q0 + h * v, v, &acc);
-        if (rs.ok()) *r = v - v0 - h * acc;
-        return rs;
-      };
-      VecQ<T> v = v0, r, r_probe;
       if (!(st = accel(q0, v0, &a)).ok()) return st;
-      v = v0 + h * a;  // explicit Euler guess
-      bool converged = false;
-      for (int iter = 0; iter < 20 && !converged; ++iter) {
-        if (!(st = residual(v, &r)).ok()) return st;
-        MatQ<T> jac(nq, nq);
-        for (int i = 0; i < nq; ++i) {
-          const double eps = 1e-7 * std::max(1.0, std::abs(double(ScalarValue(v[i]))));
-          VecQ<T> vp = v;
-          vp[i] += T(eps);
-          if (!(st = residual(vp, &r_probe)).ok()) return st;
-          jac.col(i) = (r_probe - r) / T(eps);
-        }
-        const VecQ<T> dv = jac.partialPivLu().solve(r);
-        v -= dv;
-        double dv_norm = 0.0, v_norm = 0.0;
-        for (int i = 0; i < nq; ++i) {
-          dv_norm = std::max(dv_norm, std::abs(double(ScalarValue(dv[i]))));
-          v_norm = std::max(v_norm, std::abs(double(ScalarValue(v[i]))));
-        }
-        converged = dv_norm <= 1e-10 * (1.0 + v_norm);
+      VecQ<T> v = v0 + h * a;  // explicit Euler guess
+      // active set: points that end the step below the ground join the contacts and the step
+      // is solved again, so contact forces act during the step a point enters the ground
+      for (int pass = 0; pass < 4; ++pass) {
+        st = SolveNewton<T>(
+            [&](const VecQ<T>& x, VecQ<T>* r) {
+              VecQ<T> acc;
+              const StepStatus rs = accel(q0 + h * x, x, &acc, ContactSet::kFrozen);
+              if (rs.ok()) *r = x - v0 - h * acc;
+              return rs;
+            },
+            &v);
+        if (!st.ok()) return st;
+        s->q = q0 + h * v;
+        s->qd = v;
+        if (AddMissingContacts(body, w.ground, s) == 0) break;
       }
-      if (!converged) return {StepStatus::Code::kSolverFailed, 0.0};
+      break;
+    }
+    case Integrator::kVariational: {
+      // Discrete Lagrangian L_d(q0, q1) = Δt L((q0+q1)/2, (q1−q0)/Δt) with the forces Q (gravity,
+      // modes, ground, springs) entering by the discrete Lagrange–d'Alembert principle at the
+      // midpoint. With p_n = M(q_n) q̇_n, solve for the mean velocity v:
+      //   M(m) v − ½Δt (∂T/∂q(m, v) + Q(m, v)) = p_n,   m = q_n + ½Δt v,
+      // then q_{n+1} = q_n + Δt v, p_{n+1} = M(m) v + ½Δt (∂T/∂q + Q), q̇_{n+1} = M(q_{n+1})⁻¹ p_{n+1}.
+      const VecQ<T> q0 = s->q;
+      MatQ<T> M0;
+      MassMatrix(body.moments(), q0, &M0);
+      const VecQ<T> p0 = M0 * s->qd;
+      auto momentum_parts = [&](const VecQ<T>& v, VecQ<T>* Mv, VecQ<T>* half_force) {
+        const VecQ<T> m = q0 + T(0.5) * h * v;
+        MatQ<T> Mm;
+        MassMatrix(body.moments(), m, &Mm);
+        VecQ<T> dT;
+        KineticGradient(body.moments(), m, v, &dT);
+        ForceBreakdown<T> f;
+        s->q = m;
+        s->qd = v;
+        EvaluateForces(body, w, body_index, *s, &f, ContactSet::kFrozen);
+        *Mv = Mm * v;
+        *half_force = T(0.5) * h * (dT + f.total);
+      };
+      VecQ<T> v = s->qd, Mv, half_force;
+      for (int pass = 0; pass < 4; ++pass) {  // active set, as for implicit Euler
+        st = SolveNewton<T>(
+            [&](const VecQ<T>& x, VecQ<T>* r) {
+              momentum_parts(x, &Mv, &half_force);
+              *r = Mv - half_force - p0;
+              return StepStatus{};
+            },
+            &v);
+        if (!st.ok()) return st;
+        s->q = q0 + h * v;
+        s->qd = v;
+        if (AddMissingContacts(body, w.ground, s) == 0) break;
+      }
+      momentum_parts(v, &Mv, &half_force);
       s->q = q0 + h * v;
-      s->qd = v;
+      MatQ<T> M1;
+      MassMatrix(body.moments(), s->q, &M1);
+      const Eigen::LLT<MatQ<T>> llt(M1);
+      if (llt.info() != Eigen::Success) return {StepStatus::Code::kSingularMass, 0.0};
+      s->qd = llt.solve(Mv + half_force);
       break;
     }
   }

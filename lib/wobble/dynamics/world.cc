@@ -12,12 +12,14 @@ std::string IntegratorName(Integrator integrator) {
     case Integrator::kSymplecticEuler: return "symplectic";
     case Integrator::kRK4: return "rk4";
     case Integrator::kImplicitEuler: return "implicit";
+    case Integrator::kVariational: return "variational";
   }
   return "?";
 }
 
 bool ParseIntegrator(const std::string& text, Integrator* integrator) {
-  for (Integrator i : {Integrator::kThesis, Integrator::kSymplecticEuler, Integrator::kRK4, Integrator::kImplicitEuler})
+  for (Integrator i : {Integrator::kThesis, Integrator::kSymplecticEuler, Integrator::kRK4, Integrator::kImplicitEuler,
+                               Integrator::kVariational})
     if (IntegratorName(i) == text) {
       *integrator = i;
       return true;
