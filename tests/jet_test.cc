@@ -1,0 +1,83 @@
+// The dynamics are templates on the scalar: with ceres::Jet they give exact derivatives of a
+// step (and so of a simulation) with respect to the state, checked here against central
+// differences of the double version.
+#include <ceres/jet.h>
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "test_bodies.h"
+#include "wobble/dynamics/step.h"
+
+namespace wobble {
+namespace {
+
+constexpr int kNq = 7;  // the table with 4 modes
+using Jet = ceres::Jet<double, 2 * kNq>;
+
+WorldParams GroundedParams() {
+  WorldParams p;
+  p.ground.point = Eigen::Vector2d(0, 0);
+  p.ground.slope = 0.1;
+  return p;
+}
+
+// State with one leg pushed into a sloped ground, turning and wobbling.
+BodyState<double> Start() {
+  BodyState<double> s;
+  s.q.resize(kNq);
+  s.qd.resize(kNq);
+  s.q << 10, 0.5, 0.05, 0.02, -0.01, 0.03, 0.01;
+  s.qd << 0.3, -2, 0.1, 0.05, 0.02, -0.04, 0.03;
+  return s;
+}
+
+template <class T> VecQ<T> Simulate(const BodyModel& body, const WorldParams& p, Integrator integrator,
+                                    const VecQ<T>& q0, const VecQ<T>& qd0, int steps) {
+  BodyState<T> s;
+  s.q = q0;
+  s.qd = qd0;
+  UpdateContacts(body, p.ground, &s);
+  for (int i = 0; i < steps; ++i) EXPECT_TRUE(StepBody(body, p, 0, integrator, 0.005, &s).ok());
+  VecQ<T> out(2 * kNq);
+  out << s.q, s.qd;
+  return out;
+}
+
+TEST(Jet, StepDerivativesMatchFiniteDifferences) {
+  const BodyModel body(testing::TableDef(), testing::TableModes(4e5, 1e4));
+  const WorldParams p = GroundedParams();
+  const BodyState<double> s0 = Start();
+  for (Integrator integrator : {Integrator::kThesis, Integrator::kRK4}) {
+    // contacts are created in the first step and kept: the same branch for every probe
+    VecQ<Jet> q(kNq), qd(kNq);
+    for (int i = 0; i < kNq; ++i) {
+      q[i] = Jet(s0.q[i], i);
+      qd[i] = Jet(s0.qd[i], kNq + i);
+    }
+    const VecQ<Jet> out = Simulate<Jet>(body, p, integrator, q, qd, 10);
+    for (int j = 0; j < 2 * kNq; ++j) {
+      const double h = 1e-6;
+      VecQ<double> qp = s0.q, qm = s0.q, vp = s0.qd, vm = s0.qd;
+      if (j < kNq) {
+        qp[j] += h;
+        qm[j] -= h;
+      } else {
+        vp[j - kNq] += h;
+        vm[j - kNq] -= h;
+      }
+      const VecQ<double> fd = (Simulate<double>(body, p, integrator, qp, vp, 10) -
+                               Simulate<double>(body, p, integrator, qm, vm, 10)) / (2 * h);
+      for (int i = 0; i < 2 * kNq; ++i)
+        EXPECT_NEAR(out[i].v[j], fd[i], 1e-5 * (1.0 + std::abs(fd[i])))
+            << IntegratorName(integrator) << ": d out" << i << " / d in" << j;
+    }
+    // and the values are those of the double simulation (up to rounding: Eigen vectorizes
+    // double arithmetic but not Jet arithmetic)
+    const VecQ<double> plain = Simulate<double>(body, p, integrator, s0.q, s0.qd, 10);
+    for (int i = 0; i < 2 * kNq; ++i) EXPECT_NEAR(out[i].a, plain[i], 1e-13 * (1.0 + std::abs(plain[i])));
+  }
+}
+
+}  // namespace
+}  // namespace wobble
