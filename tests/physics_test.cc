@@ -39,11 +39,12 @@ Eigen::VectorXd State(std::initializer_list<double> v) {
 std::pair<Eigen::Vector2d, double> Momenta(const World& w) {
   const BodyModel& b = w.body(0);
   const BodyState<double>& s = w.state(0);
+  const Frame<double> frame(s.q);
   Eigen::Vector2d p = Eigen::Vector2d::Zero();
   double L = 0;
   for (int k = 0; k < b.num_points(); ++k) {
     const Vec2<double> l = LocalPosition<double>(b.rest_local(k), b.mode_matrix(k), s.q);
-    const Vec2<double> x = WorldFromLocal(s.q, l), v = PointVelocity(s.q, s.qd, l, b.mode_matrix(k));
+    const Vec2<double> x = WorldFromLocal(frame, l), v = PointVelocity(frame, s.qd, l, b.mode_matrix(k));
     p += b.mass(k) * v;
     L += b.mass(k) * (x.x() * v.y() - x.y() * v.x());
   }

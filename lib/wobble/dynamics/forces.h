@@ -29,10 +29,14 @@ struct Ground {
 
   Eigen::Vector2d tangent() const { return {std::cos(slope), std::sin(slope)}; }
   Eigen::Vector2d normal() const { return {-std::sin(slope), std::cos(slope)}; }
+};
+
+// The ground's unit normal and tangent, computed once per evaluation rather than per point.
+struct GroundFrame {
+  explicit GroundFrame(const Ground& g) : point(g.point), n(g.normal()), tau(g.tangent()) {}
   // Signed height of x above the ground (negative below).
-  template <class T> T Height(const Vec2<T>& x) const {
-    return normal().cast<T>().dot(x - point.cast<T>());
-  }
+  template <class T> T Height(const Vec2<T>& x) const { return n.cast<T>().dot(x - point.cast<T>()); }
+  Eigen::Vector2d point, n, tau;
 };
 
 // A damped spring from a world anchor to a point of a body given by lattice coordinates.
@@ -78,8 +82,9 @@ template <class T> struct ForceBreakdown {
 // frame): f_n = −K_d Δn − C_dam v_n (never pulling), f_t = −K_d Δt − FR_dam v_t with
 // |f_t| ≤ tanθ f_n. Sets *slipping when the friction cap was hit.
 template <class T>
-Vec2<T> GroundForce(const Ground& g, const Vec2<T>& x, const Vec2<T>& v, const Vec2<T>& anchor, bool* slipping) {
-  const Vec2<T> n = g.normal().cast<T>(), tau = g.tangent().cast<T>();
+Vec2<T> GroundForce(const Ground& g, const GroundFrame& gf, const Vec2<T>& x, const Vec2<T>& v, const Vec2<T>& anchor,
+                    bool* slipping) {
+  const Vec2<T> n = gf.n.cast<T>(), tau = gf.tau.cast<T>();
   const Vec2<T> dl = x - anchor;
   T fn = -T(g.stiffness) * n.dot(dl) - T(g.normal_damping) * n.dot(v);
   if (fn < T(0.0)) fn = T(0.0);
@@ -100,13 +105,13 @@ Vec2<T> GroundForce(const Ground& g, const Vec2<T>& x, const Vec2<T>& v, const V
 // point of the body can be below it (Bernstein and B-spline weights are a partition of unity).
 template <class T> bool ClearOfGround(const BodyModel& body, const Ground& g, const VecQ<T>& q) {
   const int D = body.num_modes();
-  const Mat2<T> R = Rotation(q[2]);
-  const Vec2<T> t(q[0], q[1]);
+  const Frame<T> frame(q);
+  const GroundFrame gf(g);
   const std::vector<Eigen::Vector2d>& rest = body.rest_control();
   for (int c = 0; c < int(rest.size()); ++c) {
     Vec2<T> local = rest[c].cast<T>();
     for (int d = 0; d < D; ++d) local += body.modes()[d].displacement[c].cast<T>() * q[kRigidDofs + d];
-    if (!(ScalarValue(g.Height<T>(t + R * local)) > 0.0)) return false;
+    if (!(ScalarValue(gf.Height<T>(WorldFromLocal(frame, local))) > 0.0)) return false;
   }
   return true;
 }
@@ -127,13 +132,15 @@ template <class T, class F>
 void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodyState<T>& s, F&& f,
                            ContactSet set = ContactSet::kDetect) {
   if (!g.enabled) return;
+  const Frame<T> frame(s.q);
+  const GroundFrame gf(g);
   auto visit = [&](int k, const Vec2<T>* anchor) {
     const auto B = body.mode_matrix(k);
     const Vec2<T> l = LocalPosition<T>(body.rest_local(k), B, s.q);
-    const Vec2<T> x = WorldFromLocal(s.q, l);
-    const T h = g.Height(x);
+    const Vec2<T> x = WorldFromLocal(frame, l);
+    const T h = gf.Height(x);
     if (set == ContactSet::kDetect && !(ScalarValue(h) < 0.0)) return;
-    f(k, l, x, PointVelocity(s.q, s.qd, l, B), anchor ? *anchor : Vec2<T>(x - h * g.normal().cast<T>()));
+    f(k, l, x, PointVelocity(frame, s.qd, l, B), anchor ? *anchor : Vec2<T>(x - h * gf.n.cast<T>()));
   };
   if (set == ContactSet::kFrozen) {
     for (const Contact<T>& c : s.contacts) visit(c.point, &c.anchor);
@@ -166,25 +173,27 @@ void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index,
     out->modes[kRigidDofs + d] = -T(2.0 * m.stiffness) * s.q[kRigidDofs + d] - T(m.damping) * s.qd[kRigidDofs + d];
   }
   // penalty ground, only over points below it
+  const Frame<T> frame(s.q);
+  const GroundFrame gf(w.ground);
   out->ground.setZero(nq);
   ForEachPointInContact(body, w.ground, s, [&](int k, const Vec2<T>& l, const Vec2<T>& x, const Vec2<T>& v,
                                                const Vec2<T>& anchor) {
     bool slipping;
-    AddGeneralizedForce(s.q, l, body.mode_matrix(k), GroundForce(w.ground, x, v, anchor, &slipping), &out->ground);
+    AddGeneralizedForce(frame, l, body.mode_matrix(k), GroundForce(w.ground, gf, x, v, anchor, &slipping), &out->ground);
   }, contact_set);
   // springs holding a point
   out->springs.setZero(nq);
   for (const Spring& sp : w.springs) {
     if (sp.body != body_index) continue;
     const Vec2<T> l = LocalPosition<T>(sp.rest_local, sp.mode_matrix, s.q);
-    const Vec2<T> x = WorldFromLocal(s.q, l);
-    const Vec2<T> v = PointVelocity(s.q, s.qd, l, sp.mode_matrix);
+    const Vec2<T> x = WorldFromLocal(frame, l);
+    const Vec2<T> v = PointVelocity(frame, s.qd, l, sp.mode_matrix);
     const Vec2<T> delta = x - sp.anchor.cast<T>();
     using std::sqrt;
     const T len = sqrt(delta.squaredNorm() + T(1e-300));
     const Vec2<T> dir = delta / len;
     const Vec2<T> f = -(T(sp.stiffness) * (len - T(sp.rest_length)) + T(sp.damping) * dir.dot(v)) * dir;
-    AddGeneralizedForce(s.q, l, sp.mode_matrix, f, &out->springs);
+    AddGeneralizedForce(frame, l, sp.mode_matrix, f, &out->springs);
   }
   out->total = out->gravity + out->modes + out->ground + out->springs;
 }
@@ -214,19 +223,20 @@ template <class T> void UpdateContacts(const BodyModel& body, const Ground& g, B
   thread_local std::vector<Contact<T>> next;
   next.clear();
   s->penetration = 0.0;
-  const Vec2<T> tau = g.tangent().cast<T>(), n = g.normal().cast<T>();
+  const GroundFrame gf(g);
+  const Vec2<T> tau = gf.tau.cast<T>(), n = gf.n.cast<T>();
   ForEachPointInContact(body, g, *s, [&](int k, const Vec2<T>&, const Vec2<T>& x, const Vec2<T>& v,
                                          Vec2<T> anchor) {
     bool slipping;
-    const Vec2<T> f = GroundForce(g, x, v, anchor, &slipping);
+    const Vec2<T> f = GroundForce(g, gf, x, v, anchor, &slipping);
     if (slipping) {
       // choose Δt so that −K Δt − FR v_t equals the capped friction f·τ
       const T dt = -(f.dot(tau) + T(g.friction_damping) * tau.dot(v)) / T(g.stiffness);
-      const Vec2<T> on_ground = x - g.Height(x) * n;
+      const Vec2<T> on_ground = x - gf.Height(x) * n;
       anchor = on_ground - dt * tau;
     }
     next.push_back({k, anchor});
-    s->penetration = std::max(s->penetration, -double(ScalarValue(g.Height(x))));
+    s->penetration = std::max(s->penetration, -double(ScalarValue(gf.Height(x))));
   });
   s->contacts.swap(next);
 }

@@ -20,24 +20,30 @@ Vec2<T> LocalPosition(const Eigen::Vector2d& b0, const Eigen::MatrixBase<Derived
   return l;
 }
 
+// The rigid part of q: translation t and R(θ), computed once per evaluation (sin and cos
+// per point would dominate a step of a small body).
+template <class T> struct Frame {
+  explicit Frame(const VecQ<T>& q) : t(q[0], q[1]), R(Rotation(q[2])) {}
+  Vec2<T> t;
+  Mat2<T> R;
+};
+
 // World position x = t + R l (Eq. 4.2).
-template <class T> Vec2<T> WorldFromLocal(const VecQ<T>& q, const Vec2<T>& l) {
-  return Vec2<T>(q[0], q[1]) + Rotation(q[2]) * l;
-}
+template <class T> Vec2<T> WorldFromLocal(const Frame<T>& frame, const Vec2<T>& l) { return frame.t + frame.R * l; }
 
 // World velocity J q̇ = ṫ + R S l θ̇ + R B γ̇.
 template <class T, class Derived>
-Vec2<T> PointVelocity(const VecQ<T>& q, const VecQ<T>& qd, const Vec2<T>& l, const Eigen::MatrixBase<Derived>& B) {
+Vec2<T> PointVelocity(const Frame<T>& frame, const VecQ<T>& qd, const Vec2<T>& l, const Eigen::MatrixBase<Derived>& B) {
   Vec2<T> v_local = Perp(l) * qd[2];
   for (int d = 0; d < B.cols(); ++d) v_local += B.col(d).template cast<T>() * qd[kRigidDofs + d];
-  return Vec2<T>(qd[0], qd[1]) + Rotation(q[2]) * v_local;
+  return Vec2<T>(qd[0], qd[1]) + frame.R * v_local;
 }
 
 // Adds Jᵀ f (Eq. 4.20) for a world force f at a point with local position l and mode matrix B.
 template <class T, class Derived>
-void AddGeneralizedForce(const VecQ<T>& q, const Vec2<T>& l, const Eigen::MatrixBase<Derived>& B, const Vec2<T>& f,
-                         VecQ<T>* Q) {
-  const Vec2<T> f_local = Rotation(q[2]).transpose() * f;  // Rᵀ f
+void AddGeneralizedForce(const Frame<T>& frame, const Vec2<T>& l, const Eigen::MatrixBase<Derived>& B,
+                         const Vec2<T>& f, VecQ<T>* Q) {
+  const Vec2<T> f_local = frame.R.transpose() * f;  // Rᵀ f
   (*Q)[0] += f[0];
   (*Q)[1] += f[1];
   (*Q)[2] += Perp(l).dot(f_local);  // (R S l)·f = (S l)·(Rᵀ f)

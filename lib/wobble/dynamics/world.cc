@@ -128,7 +128,7 @@ Energies World::ComputeEnergies(int i) const {
   });
   for (const Spring& sp : p.springs) {
     if (sp.body != i) continue;
-    const Vec2<double> x = WorldFromLocal(s.q, LocalPosition<double>(sp.rest_local, sp.mode_matrix, s.q));
+    const Vec2<double> x = WorldFromLocal(Frame<double>(s.q), LocalPosition<double>(sp.rest_local, sp.mode_matrix, s.q));
     const double stretch = (x - sp.anchor).norm() - sp.rest_length;
     e.springs += 0.5 * sp.stiffness * stretch * stretch;
   }
@@ -151,8 +151,9 @@ Eigen::VectorXd World::Accelerations(int i) const {
 std::vector<Eigen::Vector2d> World::PointPositions(int i) const {
   const BodyModel& b = *bodies_[i];
   std::vector<Eigen::Vector2d> x(b.num_points());
+  const Frame<double> frame(states_[i].q);
   for (int k = 0; k < b.num_points(); ++k)
-    x[k] = WorldFromLocal(states_[i].q, LocalPosition<double>(b.rest_local(k), b.mode_matrix(k), states_[i].q));
+    x[k] = WorldFromLocal(frame, LocalPosition<double>(b.rest_local(k), b.mode_matrix(k), states_[i].q));
   return x;
 }
 

@@ -1,0 +1,491 @@
+// Object and deformation files: the data/ files of the thesis' bodies, the row/column
+// convention of §4.10.1's matrices, and a ParseError with the right line for every kind of
+// malformed input.
+// Suites are named io* so that `ctest -R io` runs all of them.
+#include <gtest/gtest.h>
+
+#include <Eigen/SVD>
+#include <functional>
+#include <sstream>
+
+#include "wobble/body/body_model.h"
+#include "wobble/io/deformation_file.h"
+#include "wobble/io/object_file.h"
+
+namespace wobble::io {
+namespace {
+
+const std::string kData = WOBBLE_DATA_DIR;
+
+// Displacement of a body-frame point under a mode: Σ_ij B_i(s) B_j(t) d_ij.
+Eigen::Vector2d ModeDisplacement(const Lattice& lattice, const DeformationMode& mode, const Eigen::Vector2d& p) {
+  const std::vector<double> w = lattice.Weights(lattice.LocalCoords(p));
+  Eigen::Vector2d d = Eigen::Vector2d::Zero();
+  for (int c = 0; c < lattice.size(); ++c) d += w[c] * mode.displacement[c];
+  return d;
+}
+
+// Smallest singular value of the stacked Jacobian [e_x, e_y, S b0_k, B_k] over all mass points,
+// columns scaled to unit length: > 0 iff no mode is a combination of the others and the rigid
+// motions on these points (else the mass matrix M = Σ m J_kᵀ J_k would be singular).
+double SmallestNormalizedSingularValue(const BodyModel& body) {
+  const int n = body.num_points(), q = body.num_q();
+  Eigen::MatrixXd J(2 * n, q);
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector2d& b0 = body.rest_local(k);
+    J.block(2 * k, 0, 2, 2).setIdentity();
+    J(2 * k, 2) = -b0.y();
+    J(2 * k + 1, 2) = b0.x();
+    J.block(2 * k, kRigidDofs, 2, body.num_modes()) = body.mode_matrix(k);
+  }
+  for (int c = 0; c < q; ++c) J.col(c).normalize();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(J);
+  return svd.singularValues()(q - 1);
+}
+
+void ExpectParseError(const std::function<void()>& parse, const std::string& file, int line,
+                      const std::string& message_part) {
+  try {
+    parse();
+    ADD_FAILURE() << "no ParseError; expected one on line " << line << " mentioning \"" << message_part << "\"";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), file);
+    EXPECT_EQ(e.line(), line) << e.what();
+    EXPECT_NE(std::string(e.what()).find(message_part), std::string::npos)
+        << "message \"" << e.what() << "\" does not mention \"" << message_part << "\"";
+    EXPECT_EQ(std::string(e.what()), file + ":" + std::to_string(line) + ": " + e.message());
+  }
+}
+
+void ExpectObjectError(const std::string& text, int line, const std::string& message_part) {
+  ExpectParseError(
+      [&] {
+        std::istringstream in(text);
+        ParseObject(in, "test.obj");
+      },
+      "test.obj", line, message_part);
+}
+
+void ExpectModesError(const std::string& text, int line, const std::string& message_part) {
+  ExpectParseError(
+      [&] {
+        std::istringstream in(text);
+        ParseDeformations(in, "test.def");
+      },
+      "test.def", line, message_part);
+}
+
+std::vector<DeformationMode> Modes(const std::string& text, const std::string& name = "test.def") {
+  std::istringstream in(text);
+  return ParseDeformations(in, name);
+}
+
+BodyDef Object(const std::string& text, const std::string& name = "test.obj") {
+  std::istringstream in(text);
+  return ParseObject(in, name);
+}
+
+// ---------------------------------------------------------------- data/ files
+
+TEST(ioDataFiles, EveryFileParsesAndFitsItsBody) {
+  const BodyDef table = ReadObjectFile(kData + "/table.obj");
+  for (const char* file : {"bend.def", "shear.def", "vsquash.def", "hsquash.def", "table_modes.def"}) {
+    SCOPED_TRACE(file);
+    EXPECT_NO_THROW(BodyModel body(table, ReadDeformationFile(kData + "/" + file)));
+  }
+  EXPECT_NO_THROW(BodyModel rod(ReadObjectFile(kData + "/rod.obj"), ReadDeformationFile(kData + "/rod_stretch.def")));
+  EXPECT_NO_THROW(BodyModel pot(ReadObjectFile(kData + "/pot.obj"), ReadDeformationFile(kData + "/def_pot")));
+}
+
+TEST(ioDataFiles, TableOfFigure12) {
+  const BodyDef table = ReadObjectFile(kData + "/table.obj");
+  EXPECT_EQ(table.name, "table");
+  EXPECT_EQ(table.lattice.num_s(), 4);
+  EXPECT_EQ(table.lattice.num_t(), 4);
+  EXPECT_EQ(table.lattice.basis(), BasisKind::kBernstein);
+  EXPECT_EQ(table.lattice.origin(), Eigen::Vector2d(0, 0));
+  EXPECT_EQ(table.lattice.axis_s(), Eigen::Vector2d(300, 0));
+  EXPECT_EQ(table.lattice.axis_t(), Eigen::Vector2d(0, 100));
+  ASSERT_EQ(table.masses.size(), 11u);
+  ASSERT_EQ(table.mass_positions.size(), 11u);
+  for (double m : table.masses) EXPECT_EQ(m, 50.0);
+  int top = 0, left = 0, right = 0;
+  for (const Eigen::Vector2d& p : table.mass_positions) {
+    top += p.y() == 100;
+    left += p.x() == 0 && p.y() < 100;
+    right += p.x() == 300 && p.y() < 100;
+  }
+  EXPECT_EQ(top, 5);
+  EXPECT_EQ(left, 3);
+  EXPECT_EQ(right, 3);
+  ASSERT_EQ(table.shapes.size(), 3u);
+  for (const Polyline& p : table.shapes) {
+    EXPECT_EQ(p.points.size(), 2u);
+    EXPECT_FALSE(p.closed);
+  }
+}
+
+TEST(ioDataFiles, BendRowsRunBottomToTopColumnsLeftToRight) {
+  const std::vector<DeformationMode> modes = ReadDeformationFile(kData + "/bend.def");
+  ASSERT_EQ(modes.size(), 1u);
+  const DeformationMode& bend = modes[0];
+  EXPECT_EQ(bend.name, "bend");
+  EXPECT_EQ(bend.num_s, 4);
+  EXPECT_EQ(bend.num_t, 4);
+  EXPECT_EQ(bend.stiffness, 0.0);
+  EXPECT_EQ(bend.damping, 0.0);
+  EXPECT_FALSE(bend.active);
+  const Lattice lattice;
+  EXPECT_EQ(bend.displacement[lattice.Index(0, 0)], Eigen::Vector2d(150, 0));     // first number of x:, y:
+  EXPECT_EQ(bend.displacement[lattice.Index(1, 3)], Eigen::Vector2d(-150, 100));  // last row, 2nd column
+  EXPECT_EQ(bend.displacement[lattice.Index(3, 0)], Eigen::Vector2d(-150, 0));    // first row, last column
+  EXPECT_EQ(bend.displacement[lattice.Index(0, 1)], Eigen::Vector2d(50, 0));      // second row, first column
+  EXPECT_EQ(bend.displacement[1 * 4 + 3], Eigen::Vector2d(-150, 100));            // flat index i*num_t + j
+}
+
+TEST(ioDataFiles, BendAtPointTwoArchesTheTable) {
+  const BodyDef table = ReadObjectFile(kData + "/table.obj");
+  const DeformationMode bend = ReadDeformationFile(kData + "/bend.def")[0];
+  const double gamma = 0.2;
+  const Eigen::Vector2d middle(150, 100), left_end(0, 100), right_end(300, 100);
+  const Eigen::Vector2d moved = middle + gamma * ModeDisplacement(table.lattice, bend, middle);
+  // Σ_i B_i(1/2) d_i3,y = 100 (3/8 + 3/8) = 75, so the middle of the top rises by 15
+  EXPECT_NEAR(moved.y(), 115.0, 1e-9);
+  EXPECT_NEAR(moved.x(), 150.0, 1e-9);
+  // the ends of the top stay at the height of the legs' tops: the top arches
+  EXPECT_NEAR(ModeDisplacement(table.lattice, bend, left_end).y(), 0.0, 1e-9);
+  EXPECT_NEAR(ModeDisplacement(table.lattice, bend, right_end).y(), 0.0, 1e-9);
+  // and the same through BodyModel's b0 + B γ for the top's middle mass point
+  const BodyModel body(table, {bend});
+  for (int k = 0; k < body.num_points(); ++k)
+    if (table.mass_positions[k] == middle) {
+      const Eigen::Vector2d p = body.rest_local(k) + body.mode_matrix(k) * Eigen::VectorXd::Constant(1, gamma);
+      EXPECT_NEAR(p.y(), 115.0, 1e-9);
+    }
+}
+
+TEST(ioDataFiles, TableModesFileHoldsTheFourSingleModeFiles) {
+  const std::vector<DeformationMode> modes = ReadDeformationFile(kData + "/table_modes.def");
+  ASSERT_EQ(modes.size(), 4u);
+  const char* names[] = {"bend", "shear", "vsquash", "hsquash"};
+  for (int d = 0; d < 4; ++d) {
+    SCOPED_TRACE(names[d]);
+    EXPECT_EQ(modes[d].name, names[d]);
+    EXPECT_GT(modes[d].stiffness, 0.0);
+    EXPECT_GT(modes[d].damping, 0.0);
+    EXPECT_EQ(modes[d].active, d < 2);  // chapter 5: bend and shear active, the squashes passive
+    const DeformationMode single = ReadDeformationFile(kData + "/" + names[d] + ".def")[0];
+    EXPECT_EQ(single.name, names[d]);
+    ASSERT_EQ(single.displacement.size(), 16u);
+    for (int c = 0; c < 16; ++c) EXPECT_EQ(modes[d].displacement[c], single.displacement[c]) << "control point " << c;
+  }
+  const BodyModel body(ReadObjectFile(kData + "/table.obj"), modes);
+  EXPECT_GT(SmallestNormalizedSingularValue(body), 0.05);
+}
+
+TEST(ioDataFiles, TableShapesOfTheSingleModes) {
+  const BodyDef table = ReadObjectFile(kData + "/table.obj");
+  const auto mode = [&](const char* name) { return ReadDeformationFile(kData + "/" + name)[0]; };
+  const DeformationMode shear = mode("shear.def"), vsquash = mode("vsquash.def"), hsquash = mode("hsquash.def");
+  // shear: the top slides right over the feet
+  EXPECT_NEAR(ModeDisplacement(table.lattice, shear, {150, 100}).x(), 150.0, 1e-9);
+  EXPECT_NEAR(ModeDisplacement(table.lattice, shear, {0, 0}).norm(), 0.0, 1e-9);
+  // vertical squash: the top comes down, the legs move out
+  EXPECT_NEAR(ModeDisplacement(table.lattice, vsquash, {150, 100}).y(), -100.0, 1e-9);
+  EXPECT_LT(ModeDisplacement(table.lattice, vsquash, {0, 50}).x(), 0.0);
+  EXPECT_GT(ModeDisplacement(table.lattice, vsquash, {300, 50}).x(), 0.0);
+  // horizontal squash: the legs come in, the top rises
+  EXPECT_GT(ModeDisplacement(table.lattice, hsquash, {0, 50}).x(), 0.0);
+  EXPECT_LT(ModeDisplacement(table.lattice, hsquash, {300, 50}).x(), 0.0);
+  EXPECT_GT(ModeDisplacement(table.lattice, hsquash, {150, 100}).y(), 0.0);
+}
+
+TEST(ioDataFiles, RodOfAppendixA) {
+  const BodyDef rod = ReadObjectFile(kData + "/rod.obj");
+  ASSERT_EQ(rod.masses.size(), 2u);
+  EXPECT_EQ(rod.masses[0], 50.0);
+  EXPECT_EQ(rod.masses[1], 50.0);
+  EXPECT_EQ(rod.lattice.axis_s(), Eigen::Vector2d(100, 0));
+  EXPECT_EQ(rod.lattice.axis_t(), Eigen::Vector2d(0, 300));
+  const std::vector<DeformationMode> modes = ReadDeformationFile(kData + "/rod_stretch.def");
+  ASSERT_EQ(modes.size(), 1u);
+  EXPECT_EQ(modes[0].name, "rod_stretch");  // no header: the file stem
+  const Lattice& lat = rod.lattice;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) EXPECT_EQ(modes[0].displacement[lat.Index(i, j)], Eigen::Vector2d(0, -100.0 * j));
+  // a = +1 brings the top point onto the bottom one; the bottom one stays
+  const BodyModel body(rod, modes);
+  const Eigen::VectorXd a = Eigen::VectorXd::Constant(1, 1.0);
+  const Eigen::Vector2d bottom = body.rest_local(0) + body.mode_matrix(0) * a;
+  const Eigen::Vector2d top = body.rest_local(1) + body.mode_matrix(1) * a;
+  EXPECT_NEAR((bottom - Eigen::Vector2d(50, 0)).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((top - Eigen::Vector2d(50, 0)).norm(), 0.0, 1e-9);
+}
+
+TEST(ioDataFiles, PotAndItsThreeIndependentModes) {
+  const BodyDef pot = ReadObjectFile(kData + "/pot.obj");
+  EXPECT_EQ(pot.name, "pot");
+  EXPECT_GE(pot.masses.size(), 12u);
+  EXPECT_LE(pot.masses.size(), 16u);
+  for (double m : pot.masses) EXPECT_EQ(m, 50.0);
+  ASSERT_FALSE(pot.shapes.empty());
+  EXPECT_TRUE(pot.shapes[0].closed);
+  const std::vector<DeformationMode> modes = ReadDeformationFile(kData + "/def_pot");
+  ASSERT_EQ(modes.size(), 3u);  // appendix C: assign 1, 2, 3
+  EXPECT_EQ(modes[0].name, "vsquash");
+  EXPECT_EQ(modes[1].name, "hsquash");
+  EXPECT_EQ(modes[2].name, "bend");
+  for (const DeformationMode& m : modes) EXPECT_GT(m.stiffness, 0.0);
+  const BodyModel body(pot, modes);
+  EXPECT_GT(SmallestNormalizedSingularValue(body), 0.05);
+  // the mass matrix over the modes is well conditioned too
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Eigen::MatrixXd(body.moments().G));
+  EXPECT_GT(svd.singularValues()(2), 1e-3 * svd.singularValues()(0));
+}
+
+// ---------------------------------------------------------------- deformation files
+
+TEST(ioDeformationFile, SeveralModesHeadersAndDefaults) {
+  const std::vector<DeformationMode> modes = Modes(
+      "# two modes on a 3 x 2 lattice\n"
+      "mode lift stiffness 4e5 damping 2.5e4 active\n"
+      "x: 1 2 3\n"
+      "   4 5 6\n"
+      "y: 7 8 9\n"
+      "   10 11 12\n"
+      "\n"
+      "mode drift passive damping 3   # options in any order\n"
+      "x:\n"
+      "  0 0 0\n"
+      "  1 1 1\n"
+      "y:\n"
+      "  0 0 0\n"
+      "  0 0 0\n");
+  ASSERT_EQ(modes.size(), 2u);
+  EXPECT_EQ(modes[0].name, "lift");
+  EXPECT_EQ(modes[0].stiffness, 4e5);
+  EXPECT_EQ(modes[0].damping, 2.5e4);
+  EXPECT_TRUE(modes[0].active);
+  EXPECT_EQ(modes[1].name, "drift");
+  EXPECT_EQ(modes[1].stiffness, 0.0);
+  EXPECT_EQ(modes[1].damping, 3.0);
+  EXPECT_FALSE(modes[1].active);
+  for (const DeformationMode& m : modes) {
+    EXPECT_EQ(m.num_s, 3);
+    EXPECT_EQ(m.num_t, 2);
+    EXPECT_EQ(m.displacement.size(), 6u);
+  }
+  // i*num_t + j: column i, row j (bottom row first)
+  EXPECT_EQ(modes[0].displacement[0 * 2 + 0], Eigen::Vector2d(1, 7));
+  EXPECT_EQ(modes[0].displacement[2 * 2 + 0], Eigen::Vector2d(3, 9));
+  EXPECT_EQ(modes[0].displacement[0 * 2 + 1], Eigen::Vector2d(4, 10));
+  EXPECT_EQ(modes[0].displacement[2 * 2 + 1], Eigen::Vector2d(6, 12));
+  EXPECT_EQ(modes[1].displacement[1 * 2 + 1], Eigen::Vector2d(1, 0));
+}
+
+TEST(ioDeformationFile, ModesWithoutHeaderAreNamedAfterTheFile) {
+  const std::string two_by_two = "x: 1 2\n 3 4\ny: 0 0\n 0 0\n";
+  const std::vector<DeformationMode> single = Modes(two_by_two, "some/dir/squish.def");
+  ASSERT_EQ(single.size(), 1u);
+  EXPECT_EQ(single[0].name, "squish");
+
+  const std::vector<DeformationMode> three = Modes(two_by_two + "mode named\n" + two_by_two + two_by_two, "anim.def");
+  ASSERT_EQ(three.size(), 3u);
+  EXPECT_EQ(three[0].name, "anim_1");
+  EXPECT_EQ(three[1].name, "named");
+  EXPECT_EQ(three[2].name, "anim_3");
+
+  const std::vector<DeformationMode> no_extension = Modes(two_by_two, "def_pot");
+  EXPECT_EQ(no_extension[0].name, "def_pot");
+}
+
+TEST(ioDeformationFile, ThesisLayoutGluedKeywordsCommentsAndCrLf) {
+  const std::vector<DeformationMode> modes = Modes(
+      "x:150 150 -150 -150 # the first row on the keyword's line\r\n"
+      "50 50 -50 -50\r\n"
+      "-50 -50 50 50\r\n"
+      "-150 -150 150 150\r\n"
+      "y:\r\n"
+      "0 100 100 0\r\n"
+      "0 100 100 0\r\n"
+      "0 100 100 0\r\n"
+      "0 100 100 0\r\n");
+  ASSERT_EQ(modes.size(), 1u);
+  EXPECT_EQ(modes[0].displacement[Lattice().Index(0, 0)], Eigen::Vector2d(150, 0));
+  EXPECT_EQ(modes[0].displacement[Lattice().Index(1, 3)], Eigen::Vector2d(-150, 100));
+}
+
+TEST(ioDeformationFileErrors, EmptyFile) {
+  ExpectModesError("", 0, "file is empty");
+  ExpectModesError("# only a comment\n\n   \n", 0, "file is empty");
+}
+
+TEST(ioDeformationFileErrors, WrongRowCount) {
+  // y: has fewer rows than x: -> the y: line
+  ExpectModesError("x: 1 2\n3 4\n5 6\ny: 0 0\n0 0\n", 4, "'y:' section of mode #1 has 2 rows but its 'x:' section");
+  // y: has more rows than x: -> the first extra row
+  ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\n0 0\n", 5, "more rows than its 'x:' section");
+  // a single row is no lattice
+  ExpectModesError("# c\nx: 1 2\ny: 0 0\n", 2, "at least 2 rows");
+}
+
+TEST(ioDeformationFileErrors, WrongColumnCount) {
+  ExpectModesError("x: 1 2 3\n4 5\ny: 0 0 0\n0 0 0\n", 2, "row 2 of the 'x:' section of mode #1 has 2 numbers but the first 'x:' row (line 1) has 3");
+  ExpectModesError("mode m\nx: 1 2\n3 4\ny: 0 0\n0 0 0\n", 5, "the 'x:' rows of mode 'm' have 2");
+  ExpectModesError("x: 1\n2\ny: 0\n0\n", 1, "at least 2 numbers");
+}
+
+TEST(ioDeformationFileErrors, NotANumber) {
+  ExpectModesError("mode m\nx: 1 2\n3 abc\ny: 0 0\n0 0\n", 3,
+                   "expected a number, got 'abc' (column 2 of row 2 of the 'x:' section of mode 'm')");
+  ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 nan\n", 4, "got 'nan'");
+  ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 1.5kg\n", 4, "got '1.5kg'");
+}
+
+TEST(ioDeformationFileErrors, MissingYSection) {
+  // at the end of the file: the x: line of the mode
+  ExpectModesError("mode m\n\nx: 1 2\n3 4\n", 3, "'x:' section of mode 'm' is not followed by a 'y:' section (found the end of the file");
+  // before the next mode: still the x: line, naming what came instead
+  ExpectModesError("mode a\nx: 1 2\n3 4\nmode b\nx: 1 2\n3 4\ny: 0 0\n0 0\n", 2, "found a 'mode' header on line 4");
+  ExpectModesError("x: 1 2\n3 4\nx: 1 2\n3 4\ny: 0 0\n0 0\n", 1, "found another 'x:' on line 3");
+}
+
+TEST(ioDeformationFileErrors, LatticeSizeDiffersFromTheFirstMode) {
+  const std::string first = "mode a\nx: 1 2 3\n4 5 6\ny: 0 0 0\n0 0 0\n";  // 3 x 2, lines 1-5
+  // fewer columns: the offending row
+  ExpectModesError(first + "mode b\nx: 1 2\n3 4\ny: 0 0\n0 0\n", 7, "the file's lattice is 3x2 (3 columns; fixed by the first mode, x: on line 2)");
+  // fewer rows: the x: line
+  ExpectModesError(first + "mode b\nx: 1 2 3\ny: 0 0 0\n", 7, "has 1 row but the file's lattice is 3x2");
+  // more rows: the first extra row
+  ExpectModesError(first + "mode b\nx: 1 2 3\n4 5 6\n7 8 9\ny: 0 0 0\n0 0 0\n0 0 0\n", 9, "has more than 2 rows but the file's lattice is 3x2");
+}
+
+TEST(ioDeformationFileErrors, UnknownKeywordAndHeaderOptions) {
+  ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\nz: 1 2\n", 5, "unknown keyword 'z:' (expected 'mode', 'x:', 'y:' or a row");
+  ExpectModesError("z: 1 2\n", 1, "unknown keyword 'z:' (expected 'mode', 'x:' or 'y:')");
+  ExpectModesError("\nmode m stiff 5\nx: 1 2\n3 4\ny: 0 0\n0 0\n", 2, "unknown mode option 'stiff'");
+  ExpectModesError("mode m stiffness\n", 1, "expected a number after 'stiffness'");
+  ExpectModesError("mode m damping x\n", 1, "expected a number after 'damping', got 'x'");
+  ExpectModesError("mode m stiffness -3\n", 1, "stiffness must be >= 0");
+  ExpectModesError("mode m active passive\n", 1, "given twice");
+  ExpectModesError("mode\n", 1, "expected a mode name after 'mode'");
+  ExpectModesError("mode stiffness 5\n", 1, "expected a mode name after 'mode', got 'stiffness'");
+  ExpectModesError("mode m\nx: 1 2\n3 4\ny: 0 0\n0 0\nmode m\n", 6, "mode name 'm' already used on line 1");
+}
+
+TEST(ioDeformationFileErrors, SectionsOutOfPlace) {
+  ExpectModesError("1 2\n3 4\n", 1, "numbers outside an x: or y: section");
+  ExpectModesError("y: 1 2\n", 1, "'y:' section before any 'x:' section");
+  ExpectModesError("mode m\ny: 1 2\n", 2, "'y:' section before any 'x:' section of mode 'm'");
+  ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\ny: 0 0\n", 5, "second 'y:' section");
+  ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\nmode lonely\n", 5, "mode 'lonely' has no 'x:' section");
+  ExpectModesError("mode a\nmode b\n", 1, "mode 'a' has no 'x:' section (found a 'mode' header on line 2)");
+  ExpectModesError("x:\ny: 0 0\n", 1, "has no rows");
+}
+
+TEST(ioDeformationFileErrors, GeneratedNameClashesWithAHeader) {
+  ExpectParseError(
+      [] { Modes("mode anim_2\nx: 1 2\n3 4\ny: 0 0\n0 0\nx: 1 2\n3 4\ny: 0 0\n0 0\n", "anim.def"); }, "anim.def", 6,
+      "named 'anim_2'");
+}
+
+TEST(ioDeformationFileErrors, MissingFile) {
+  const std::string path = kData + "/no_such_file.def";
+  ExpectParseError([&] { ReadDeformationFile(path); }, path, 0, "cannot open");
+  ExpectParseError([&] { ReadDeformationFile(kData); }, kData, 0, "directory");
+}
+
+// ---------------------------------------------------------------- object files
+
+TEST(ioObjectFile, AllStatements) {
+  const BodyDef def = Object(
+      "# a body\n"
+      "mass 1 2 3   # masses may come before the lattice\n"
+      "lattice -10 -20 40 50 5 4 bspline\n"
+      "polyline 0 0 10 0 10 10 closed\n"
+      "polyline -10 -20 30 30\n"
+      "mass 30 30 0.5\n",
+      "dir/thing.obj");
+  EXPECT_EQ(def.name, "thing");  // the file stem
+  EXPECT_EQ(def.lattice.num_s(), 5);
+  EXPECT_EQ(def.lattice.num_t(), 4);
+  EXPECT_EQ(def.lattice.basis(), BasisKind::kCubicBSpline);
+  EXPECT_EQ(def.lattice.origin(), Eigen::Vector2d(-10, -20));
+  EXPECT_EQ(def.lattice.axis_s(), Eigen::Vector2d(40, 0));
+  EXPECT_EQ(def.lattice.axis_t(), Eigen::Vector2d(0, 50));
+  ASSERT_EQ(def.masses.size(), 2u);
+  EXPECT_EQ(def.mass_positions[0], Eigen::Vector2d(1, 2));
+  EXPECT_EQ(def.masses[0], 3.0);
+  EXPECT_EQ(def.mass_positions[1], Eigen::Vector2d(30, 30));  // on the lattice's corner
+  ASSERT_EQ(def.shapes.size(), 2u);
+  EXPECT_TRUE(def.shapes[0].closed);
+  EXPECT_EQ(def.shapes[0].points.size(), 3u);
+  EXPECT_FALSE(def.shapes[1].closed);
+  EXPECT_EQ(def.shapes[1].points[1], Eigen::Vector2d(30, 30));
+
+  const BodyDef named = Object("name bob\nlattice 0 0 1 1\nmass 0.5 0.5 1\n");
+  EXPECT_EQ(named.name, "bob");
+  EXPECT_EQ(named.lattice.num_s(), 4);
+  EXPECT_EQ(named.lattice.basis(), BasisKind::kBernstein);
+}
+
+TEST(ioObjectFileErrors, EmptyFile) {
+  ExpectObjectError("", 0, "file is empty");
+  ExpectObjectError("  # nothing\n\n", 0, "file is empty");
+}
+
+TEST(ioObjectFileErrors, MissingStatements) {
+  ExpectObjectError("mass 0 0 1\npolyline 0 0 1 1\n", 0, "missing 'lattice' line");
+  ExpectObjectError("lattice 0 0 1 1\n", 0, "no 'mass' lines");
+}
+
+TEST(ioObjectFileErrors, GivenTwice) {
+  ExpectObjectError("\n\nlattice 0 0 1 1\nmass 0 0 1\nlattice 0 0 2 2\n", 5, "lattice given twice (first on line 3)");
+  ExpectObjectError("name a\nname b\n", 2, "name given twice (first on line 1)");
+}
+
+TEST(ioObjectFileErrors, MassOutsideLattice) {
+  ExpectObjectError("lattice 0 0 300 100\nmass 0 0 50\nmass 150 101 50\n", 3,
+                    "mass point (150, 101) lies outside the lattice");
+  ExpectObjectError("mass -1 50 50\nlattice 0 0 300 100\n", 1, "x in [0, 300], y in [0, 100]");
+  // on the boundary within 1e-9 is inside
+  EXPECT_NO_THROW(Object("lattice 0 0 300 100\nmass 300.0000000001 -0.0000000001 50\n"));
+}
+
+TEST(ioObjectFileErrors, BadMass) {
+  ExpectObjectError("lattice 0 0 1 1\nmass 0 0 -50\n", 2, "mass <m> must be > 0, got -50");
+  ExpectObjectError("lattice 0 0 1 1\nmass 0 0 0\n", 2, "must be > 0");
+  ExpectObjectError("lattice 0 0 1 1\nmass 0 0 abc\n", 2, "expected a number for <m>, got 'abc' (mass <x> <y> <m>)");
+  ExpectObjectError("lattice 0 0 1 1\nmass 0 0\n", 2, "expected 3 numbers after 'mass', got 2");
+}
+
+TEST(ioObjectFileErrors, BadLattice) {
+  ExpectObjectError("lattice 0 0 1\n", 1, "expected 4, 6 or 7 values after 'lattice', got 3");
+  ExpectObjectError("lattice 0 0 -1 1\n", 1, "<width> must be > 0");
+  ExpectObjectError("lattice 0 0 1 0\n", 1, "<height> must be > 0");
+  ExpectObjectError("lattice 0 0 1 1 4 4 nurbs\n", 1, "unknown lattice basis 'nurbs'");
+  ExpectObjectError("lattice 0 0 1 1 4.5 4\n", 1, "expected a whole number >= 2 for <num_s>, got '4.5'");
+  ExpectObjectError("lattice 0 0 1 1 4 1\n", 1, "for <num_t>");
+  ExpectObjectError("lattice 0 0 1 1 3 4 bspline\n", 1, "bad lattice: a cubic B-spline lattice dimension needs at least 4");
+  ExpectObjectError("lattice 0 zero 1 1\n", 1, "expected a number for <y0>, got 'zero'");
+}
+
+TEST(ioObjectFileErrors, BadPolylineAndUnknownKeyword) {
+  ExpectObjectError("lattice 0 0 1 1\npolyline 0 0 1\n", 2, "odd number of coordinates (3)");
+  ExpectObjectError("lattice 0 0 1 1\npolyline 0 0 closed\n", 2, "at least 2 points, got 1");
+  ExpectObjectError("lattice 0 0 1 1\npolyline 0 0 1 1 close\n", 2, "expected a number for <x3>, got 'close'");
+  ExpectObjectError("lattice 0 0 1 1\n\nmas 0 0 1\n", 3, "unknown keyword 'mas' (expected name, lattice, mass or polyline)");
+}
+
+TEST(ioObjectFileErrors, MissingFile) {
+  const std::string path = "/nonexistent/dir/table.obj";
+  ExpectParseError([&] { ReadObjectFile(path); }, path, 0, "cannot open file");
+  try {
+    ReadObjectFile(path);
+  } catch (const ParseError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(path + ":0: ", 0), 0u) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace wobble::io
