@@ -270,8 +270,11 @@ TEST(Status, RunawayPenetrationIsNamedWithStepAndTime) {
   EXPECT_GT(w.status().step, 1);
   EXPECT_NEAR(w.status().time, (w.status().step - 1) * 0.01, 1e-9);
   EXPECT_NE(w.status().message.find("below the ground"), std::string::npos);
-  // the last good state is kept, finite
+  // the last good state is kept: finite, and within the automatic limit (half the lattice's
+  // shorter side, 50)
   EXPECT_TRUE(w.state(0).q.allFinite());
+  EXPECT_LE(w.state(0).penetration, 50.0);
+  EXPECT_GT(w.state(0).penetration, 40.0);
 }
 
 TEST(Status, NonFiniteStateIsCaught) {

@@ -92,17 +92,19 @@ bool World::Step() {
     BodyState<double>& s = states_[i];
     const VecQ<double> q_before = s.q, qd_before = s.qd;
     const StepStatus st = StepBody(*bodies_[i], options_.params, i, options_.integrator, options_.dt, &s);
-    if (!st.ok() || !s.q.allFinite() || !s.qd.allFinite()) {
+    const bool finite = s.q.allFinite() && s.qd.allFinite();
+    if (!st.ok() || !finite || s.penetration > PenetrationLimit(i)) {
       // keep the last good state for whoever reports the failure
+      const double depth = s.penetration;
       s.q = q_before;
       s.qd = qd_before;
-      return Fail(i, st.ok() ? StepStatus{StepStatus::Code::kNonFinite, 0.0} : st);
-    }
-    if (s.penetration > PenetrationLimit(i)) {
+      UpdateContacts(*bodies_[i], options_.params.ground, &s);
+      if (!st.ok()) return Fail(i, st);
+      if (!finite) return Fail(i, {StepStatus::Code::kNonFinite, 0.0});
       std::ostringstream d;
-      d << "a point is " << s.penetration << " below the ground (limit " << PenetrationLimit(i)
+      d << "a point is " << depth << " below the ground (limit " << PenetrationLimit(i)
         << "); reduce dt, or use a stiffer ground with the implicit integrator";
-      return Fail(i, {StepStatus::Code::kPenetration, s.penetration}, d.str());
+      return Fail(i, {StepStatus::Code::kPenetration, depth}, d.str());
     }
   }
   ++steps_;

@@ -1,0 +1,110 @@
+# wobble — the two commands people need: `make demo` and `make test`.
+#
+#   make demo    install what is missing, build (Release), drop the table onto the ground
+#   make test    install, build, run every test (under Xvfb when available), then the unit
+#                tests again in an AddressSanitizer + UBSan debug build (make asan alone)
+#   make bench   build and run the benchmarks
+#   make build   configure and build only
+#   make deps    install the Debian packages that are missing (as root)
+#   make clean   remove the build folders and out/
+#
+# Build folders can be moved: make test BUILD=build-mine ASAN_BUILD=build-mine-asan
+
+SHELL := /bin/bash
+.ONESHELL:
+.SHELLFLAGS := -eu -o pipefail -c
+
+MAKEFLAGS  += --no-print-directory
+
+BUILD      ?= build
+ASAN_BUILD ?= build-asan
+JOBS       ?= 2
+OUT        ?= out/demo
+
+PACKAGES := libvtk9-dev libeigen3-dev libceres-dev libopenexr-dev libimath-dev \
+            libgtest-dev libgmock-dev libbenchmark-dev xvfb xauth libcli11-dev \
+            nlohmann-json3-dev cmake g++ make
+
+
+# The default scene: the table (lattice 300 x 100) dropped from 50 onto the ground
+# (thesis integrator, dt 0.01, 10 s).
+DEMO_OBJECT   ?= data/table.obj
+DEMO_MODES    ?= data/table_modes.def
+DEMO_ARGS     ?= --q "0 50 0 0 0 0 0" --integrator thesis --dt 0.01 --duration 10
+WOBBLE        := $(BUILD)/app/wobble
+
+.PHONY: all deps configure build demo-build demo test test-release asan bench clean
+
+all: build
+
+deps:
+	@missing=()
+	for p in $(PACKAGES); do
+	  if [ "$$(dpkg-query -W -f='$${Status}' "$$p" 2>/dev/null)" != "install ok installed" ]; then
+	    missing+=("$$p")
+	  fi
+	done
+	if [ $${#missing[@]} -eq 0 ]; then exit 0; fi
+	if [ "$$(id -u)" -eq 0 ]; then
+	  echo "installing missing packages: $${missing[*]}"
+	  apt-get update
+	  DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "$${missing[@]}"
+	else
+	  echo "wobble needs these Debian packages, which are not installed:" >&2
+	  echo "  sudo apt-get update && sudo apt-get install -y --no-install-recommends $${missing[*]}" >&2
+	  exit 1
+	fi
+
+configure: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DWOBBLE_SANITIZE=OFF \
+	  -DWOBBLE_BUILD_APP=ON -DWOBBLE_BUILD_TESTS=ON -DWOBBLE_BUILD_BENCH=ON
+
+build: configure
+	cmake --build $(BUILD) -j $(JOBS)
+
+# The demo needs only the command line, not the tests.
+demo-build: configure
+	cmake --build $(BUILD) -j $(JOBS) --target wobble_cli
+
+demo: demo-build
+	@mkdir -p $(OUT)
+	echo
+	echo '$$ $(WOBBLE) simulate --object $(DEMO_OBJECT) --modes $(DEMO_MODES) $(DEMO_ARGS) --out $(OUT)/table_drop.csv'
+	status=0
+	$(WOBBLE) simulate --object $(DEMO_OBJECT) --modes $(DEMO_MODES) $(DEMO_ARGS) --out $(OUT)/table_drop.csv || status=$$?
+	echo
+	echo "files:"
+	echo "  trajectory  $(OUT)/table_drop.csv  (t, q, q-dot, energies, contacts, penetration per step)"
+	echo "  command     $(WOBBLE)  (see $(WOBBLE) --help, and README.md)"
+	exit $$status
+
+test: test-release
+	$(MAKE) asan
+
+# Render tests need a display: ctest runs inside a virtual X server when there is one
+# (checked here, after deps may have installed it).
+test-release: build
+	cd $(BUILD)
+	if command -v xvfb-run >/dev/null 2>&1; then
+	  xvfb-run -a -s "-screen 0 1280x1024x24" ctest --output-on-failure -j $(JOBS)
+	else
+	  ctest --output-on-failure -j $(JOBS)
+	fi
+
+# Every test again with AddressSanitizer + UBSan. Debug keeps assertions on; -O1 keeps the
+# long physics runs (10^5 steps) to seconds instead of minutes. Without a display the render
+# tests skip.
+ASAN_CTEST_ARGS ?=
+asan: deps
+	cmake -S . -B $(ASAN_BUILD) -DWOBBLE_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" \
+	  -DWOBBLE_BUILD_BENCH=OFF \
+	  -DWOBBLE_BUILD_APP=ON -DWOBBLE_BUILD_TESTS=ON
+	cmake --build $(ASAN_BUILD) -j $(JOBS)
+	cd $(ASAN_BUILD) && env -u DISPLAY ctest --output-on-failure -j $(JOBS) $(ASAN_CTEST_ARGS)
+
+bench: configure
+	cmake --build $(BUILD) -j $(JOBS) --target wobble_bench
+	$(BUILD)/bench/wobble_bench
+
+clean:
+	rm -rf $(BUILD) $(ASAN_BUILD) out

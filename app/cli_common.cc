@@ -1,0 +1,129 @@
+#include "cli_common.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "wobble/io/deformation_file.h"
+#include "wobble/io/object_file.h"
+
+namespace wobble::app {
+
+void AddBodyFlags(CLI::App* cmd, BodyFiles* files) {
+  cmd->add_option("--object", files->object, "Object file: lattice, mass points, drawing")
+      ->required()
+      ->type_name("FILE");
+  cmd->add_option("--modes", files->modes, "Deformation files; the modes of all files, in order")
+      ->required()
+      ->delimiter(',')
+      ->type_name("FILE[,FILE...]");
+}
+
+std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files) {
+  BodyDef def = io::ReadObjectFile(files.object);
+  std::vector<DeformationMode> modes;
+  for (const std::string& path : files.modes) {
+    if (path.empty()) throw UsageError("--modes: empty file name in the list");
+    std::vector<DeformationMode> more = io::ReadDeformationFile(path);
+    modes.insert(modes.end(), more.begin(), more.end());
+  }
+  return std::make_shared<const BodyModel>(std::move(def), std::move(modes));
+}
+
+void AddWorldFlags(CLI::App* cmd, WorldFlags* f) {
+  cmd->add_flag("--no-gravity", f->no_gravity, "Switch gravity off (default: g = 9.81 along -y)");
+  cmd->add_flag("--no-ground", f->no_ground, "No ground at all");
+  cmd->add_option("--ground-height", f->ground_height, "Height of the ground line at x = 0")
+      ->type_name("Y")
+      ->capture_default_str();
+  cmd->add_option("--ground-slope", f->ground_slope_deg, "Slope of the ground line, degrees counter-clockwise")
+      ->type_name("DEG")
+      ->capture_default_str();
+  cmd->add_option("--ground-stiffness", f->ground_stiffness, "Penalty stiffness K_d (appendix C: grconst)")
+      ->type_name("K")
+      ->capture_default_str();
+  cmd->add_option("--ground-damping", f->ground_damping, "Damping along the ground normal (grdam)")
+      ->type_name("C")
+      ->capture_default_str();
+  cmd->add_option("--friction-damping", f->friction_damping, "Damping along the ground tangent (frconst)")
+      ->type_name("F")
+      ->capture_default_str();
+  cmd->add_option("--friction-cap", f->friction_cap, "Largest |friction / normal force| (frsin)")
+      ->type_name("TAN")
+      ->capture_default_str();
+}
+
+WorldParams MakeWorldParams(const WorldFlags& f) {
+  RequireFinite(f.ground_height, "--ground-height");
+  RequireFinite(f.ground_slope_deg, "--ground-slope");
+  if (std::abs(f.ground_slope_deg) >= 90.0) throw UsageError("--ground-slope must be between -90 and 90 degrees");
+  RequireNonNegative(f.ground_stiffness, "--ground-stiffness");
+  RequireNonNegative(f.ground_damping, "--ground-damping");
+  RequireNonNegative(f.friction_damping, "--friction-damping");
+  RequireNonNegative(f.friction_cap, "--friction-cap");
+  WorldParams p;
+  p.gravity_on = !f.no_gravity;
+  p.ground.enabled = !f.no_ground;
+  p.ground.point = Eigen::Vector2d(0.0, f.ground_height);
+  p.ground.slope = f.ground_slope_deg * M_PI / 180.0;
+  p.ground.stiffness = f.ground_stiffness;
+  p.ground.normal_damping = f.ground_damping;
+  p.ground.friction_damping = f.friction_damping;
+  p.ground.friction_cap = f.friction_cap;
+  return p;
+}
+
+std::string CoordinateNames(const BodyModel& body) {
+  std::string names = "tx ty theta";
+  for (int d = 1; d <= body.num_modes(); ++d) names += " g" + std::to_string(d);
+  return names;
+}
+
+Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& what, const BodyModel& body) {
+  const int expected_size = body.num_q();
+  std::vector<double> values;
+  std::string token;
+  auto flush = [&]() {
+    if (token.empty()) return;
+    errno = 0;
+    char* end = nullptr;
+    const double v = std::strtod(token.c_str(), &end);
+    if (end != token.c_str() + token.size())
+      throw UsageError(what + ": '" + token + "' is not a number (expected " + std::to_string(expected_size) +
+                       " numbers: " + CoordinateNames(body) + ")");
+    if (!std::isfinite(v) || errno == ERANGE)
+      throw UsageError(what + ": '" + token + "' is not a finite number");
+    values.push_back(v);
+    token.clear();
+  };
+  for (char c : text) {
+    if (c == ' ' || c == '\t' || c == ',' || c == '\n') {
+      flush();
+    } else {
+      token += c;
+    }
+  }
+  flush();
+  if (values.empty() && text.find_first_not_of(" \t,\n") == std::string::npos)
+    return Eigen::VectorXd::Zero(expected_size);
+  if (int(values.size()) != expected_size) {
+    std::ostringstream msg;
+    msg << what << ": got " << values.size() << " number" << (values.size() == 1 ? "" : "s") << " but body '"
+        << body.name() << "' has " << expected_size << " generalized coordinates (" << CoordinateNames(body) << ")";
+    throw UsageError(msg.str());
+  }
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), Eigen::Index(values.size()));
+}
+
+void RequireFinite(double value, const std::string& what) {
+  if (!std::isfinite(value)) throw UsageError(what + " must be a finite number");
+}
+void RequirePositive(double value, const std::string& what) {
+  if (!std::isfinite(value) || !(value > 0.0)) throw UsageError(what + " must be a positive number");
+}
+void RequireNonNegative(double value, const std::string& what) {
+  if (!std::isfinite(value) || value < 0.0) throw UsageError(what + " must be a non-negative number");
+}
+
+}  // namespace wobble::app

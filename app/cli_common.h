@@ -1,0 +1,68 @@
+// What the `wobble` subcommands share: loading a body from an object file and mode files,
+// parsing vectors given on the command line, and turning the ground/gravity flags into
+// WorldParams. Everything that can be wrong with user input ends as a UsageError (exit 2).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "wobble/body/body_model.h"
+#include "wobble/dynamics/world.h"
+
+namespace wobble::app {
+
+// Exit codes of the command.
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;     // anything unexpected
+constexpr int kExitBadInput = 2;    // a bad file or a bad command-line value
+constexpr int kExitSimStopped = 3;  // the world stopped with a status (numerical trouble)
+
+// A bad command-line value; what() is the whole message for people.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// The object file and its mode files (`--modes a.def,b.def`: modes of all files, in order).
+struct BodyFiles {
+  std::string object;
+  std::vector<std::string> modes;
+};
+void AddBodyFlags(CLI::App* cmd, BodyFiles* files);
+// Reads the files through wobble::io and builds the model. Throws io::ParseError for a bad
+// file and std::invalid_argument when the modes do not fit the object.
+std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files);
+
+// Gravity and ground flags, shared by simulate and inspect.
+struct WorldFlags {
+  bool no_gravity = false;
+  bool no_ground = false;
+  double ground_height = 0.0;
+  double ground_slope_deg = 0.0;
+  double ground_stiffness = Ground().stiffness;
+  double ground_damping = Ground().normal_damping;
+  double friction_damping = Ground().friction_damping;
+  double friction_cap = Ground().friction_cap;
+};
+void AddWorldFlags(CLI::App* cmd, WorldFlags* flags);
+// Validates the flags (finite, non-negative where it matters) and fills the params.
+WorldParams MakeWorldParams(const WorldFlags& flags);
+
+// Parses a generalized-coordinate vector given as "1 2.5 -3" (spaces and/or commas) with
+// one number per coordinate of the body. `what` names the flag in messages. An empty text
+// gives zeros. Throws UsageError on a non-number, a non-finite number or a wrong count.
+Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& what, const BodyModel& body);
+
+// "tx ty theta g1 .. gD" for a body.
+std::string CoordinateNames(const BodyModel& body);
+
+// Requires a finite number, optionally positive or non-negative.
+void RequireFinite(double value, const std::string& what);
+void RequirePositive(double value, const std::string& what);
+void RequireNonNegative(double value, const std::string& what);
+
+}  // namespace wobble::app

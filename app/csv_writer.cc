@@ -1,0 +1,81 @@
+#include "csv_writer.h"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+namespace wobble::app {
+
+std::string FormatDouble(double value) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof(buf), value);
+  return std::string(buf, res.ptr);
+}
+
+void CheckWritable(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  std::error_code ec;
+  if (fs::is_directory(target, ec)) throw std::runtime_error(path + ": is a directory");
+  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+  if (ec) throw std::runtime_error(path + ": cannot create its folder: " + ec.message());
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "w");
+  if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
+  std::fclose(f);
+  std::remove(tmp.c_str());
+}
+
+void WriteCsvAtomically(const std::string& path, const std::vector<std::string>& header,
+                        const std::vector<std::vector<double>>& rows) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  std::error_code ec;
+  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+  if (ec) throw std::runtime_error(path + ": cannot create its folder: " + ec.message());
+
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "w");
+  if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
+  std::string line;
+  for (size_t i = 0; i < header.size(); ++i) {
+    if (i) line += ',';
+    line += header[i];
+  }
+  line += '\n';
+  bool ok = std::fputs(line.c_str(), f) >= 0;
+  char buf[64];
+  for (const std::vector<double>& row : rows) {
+    line.clear();
+    for (size_t i = 0; i < row.size(); ++i) {
+      if (i) line += ',';
+      if (std::isfinite(row[i])) {
+        const auto res = std::to_chars(buf, buf + sizeof(buf), row[i]);
+        line.append(buf, res.ptr);
+      } else {
+        line += FormatDouble(row[i]);
+      }
+    }
+    line += '\n';
+    ok = ok && std::fputs(line.c_str(), f) >= 0;
+  }
+  const int saved_errno = errno;
+  ok = (std::fclose(f) == 0) && ok;
+  if (!ok) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(tmp + ": write failed: " + std::strerror(saved_errno));
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot rename " + tmp + " to it: " + ec.message());
+  }
+}
+
+}  // namespace wobble::app

@@ -1,0 +1,22 @@
+// Writes a table of numbers as CSV, atomically: to FILE.tmp in the same folder, then renamed
+// over FILE, so that a reader never sees half a file. Numbers are written in the shortest
+// form that reads back to the same double.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace wobble::app {
+
+// Throws std::runtime_error (with the path and the reason) when the file cannot be written.
+void WriteCsvAtomically(const std::string& path, const std::vector<std::string>& header,
+                        const std::vector<std::vector<double>>& rows);
+
+// Checks early that `path` can be written (creating its folder): throws std::runtime_error
+// with the reason if not. Leaves nothing behind but the folder.
+void CheckWritable(const std::string& path);
+
+// Shortest round-trip text of a double ("nan"/"inf" spelled out; never expected here).
+std::string FormatDouble(double value);
+
+}  // namespace wobble::app

@@ -1,0 +1,51 @@
+// The `wobble` command: parses the command line and hands over to a subcommand. All the work
+// is in libwobble; this file only maps failures to messages and exit codes:
+//   0 ok, 1 unexpected failure, 2 bad input (file or command line), 3 the simulation stopped.
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <stdexcept>
+
+#include "cli_common.h"
+#include "inspect.h"
+#include "simulate.h"
+#include "wobble/io/object_file.h"
+
+int main(int argc, char** argv) {
+  using namespace wobble::app;
+  CLI::App app("wobble: dynamic free-form deformation characters (Faloutsos 1995)", "wobble");
+  app.set_version_flag("--version", "wobble 0.1");
+  app.require_subcommand(1);
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return "wobble: " + std::string(e.what()) + "\nRun with --help for more information.\n";
+  });
+  SimulateArgs simulate_args;
+  InspectArgs inspect_args;
+  CLI::App* simulate = AddSimulateCommand(&app, &simulate_args);
+  CLI::App* inspect = AddInspectCommand(&app, &inspect_args);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version are "errors" with exit code 0; anything else is bad usage
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitBadInput;
+  }
+
+  try {
+    if (simulate->parsed()) return RunSimulate(simulate_args);
+    if (inspect->parsed()) return RunInspect(inspect_args);
+  } catch (const wobble::io::ParseError& e) {
+    std::cerr << e.what() << std::endl;  // already "FILE:LINE: message"
+    return kExitBadInput;
+  } catch (const UsageError& e) {
+    std::cerr << "wobble: " << e.what() << std::endl;
+    return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "wobble: " << e.what() << std::endl;  // the modes do not fit the object, ...
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << "wobble: " << e.what() << std::endl;
+    return kExitFailure;
+  }
+  return kExitFailure;
+}

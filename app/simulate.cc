@@ -1,0 +1,223 @@
+#include "simulate.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "csv_writer.h"
+
+namespace wobble::app {
+namespace {
+
+// Refuse runs whose CSV would not fit in memory comfortably.
+constexpr double kMaxRows = 2e7;
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.6g", v);
+  return buf;
+}
+
+std::string VectorText(const Eigen::VectorXd& v) {
+  std::string s = "[";
+  for (int i = 0; i < v.size(); ++i) s += (i ? " " : "") + Num(v[i]);
+  return s + "]";
+}
+
+std::vector<std::string> CsvHeader(int D) {
+  std::vector<std::string> h = {"t", "tx", "ty", "theta"};
+  for (int d = 1; d <= D; ++d) h.push_back("g" + std::to_string(d));
+  for (const char* name : {"dtx", "dty", "dtheta"}) h.push_back(name);
+  for (int d = 1; d <= D; ++d) h.push_back("dg" + std::to_string(d));
+  for (const char* name : {"kinetic", "gravity", "modes", "ground", "springs", "total", "contacts", "penetration"})
+    h.push_back(name);
+  return h;
+}
+
+// One CSV row of body 0 of `world` at time t.
+std::vector<double> CsvRow(const World& world, double t) {
+  const BodyState<double>& s = world.state(0);
+  const Energies e = world.ComputeEnergies(0);
+  std::vector<double> row;
+  row.reserve(1 + 2 * s.q.size() + 8);
+  row.push_back(t);
+  row.insert(row.end(), s.q.data(), s.q.data() + s.q.size());
+  row.insert(row.end(), s.qd.data(), s.qd.data() + s.qd.size());
+  for (double v : {e.kinetic, e.gravity, e.modes, e.ground, e.springs, e.total()}) row.push_back(v);
+  row.push_back(double(s.contacts.size()));
+  row.push_back(s.penetration);
+  return row;
+}
+
+// A one-line progress bar on stderr, redrawn when the percentage changes.
+class Progress {
+ public:
+  explicit Progress(bool enabled) : enabled_(enabled) {}
+  void Update(double fraction, double t) {
+    if (!enabled_) return;
+    const int percent = int(std::floor(100.0 * std::min(1.0, std::max(0.0, fraction))));
+    if (percent == last_) return;
+    last_ = percent;
+    const int width = 40, filled = percent * width / 100;
+    std::fprintf(stderr, "\r[%s%s] %3d%%  t = %-10.4g", std::string(filled, '#').c_str(),
+                 std::string(width - filled, '.').c_str(), percent, t);
+    std::fflush(stderr);
+  }
+  void Finish() {
+    if (enabled_ && last_ >= 0) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  bool enabled_;
+  int last_ = -1;
+};
+
+}  // namespace
+
+CLI::App* AddSimulateCommand(CLI::App* app, SimulateArgs* a) {
+  CLI::App* cmd = app->add_subcommand("simulate", "Simulate one body over the ground and write its trajectory as CSV");
+  AddBodyFlags(cmd, &a->files);
+  cmd->add_option("--q", a->q, "Initial q = \"tx ty theta g1 ..\" (default: at rest at the origin)")
+      ->type_name("\"NUMS\"");
+  cmd->add_option("--qdot", a->qdot, "Initial q-dot, same layout (default: zeros)")->type_name("\"NUMS\"");
+  cmd->add_option("--integrator", a->integrator, "thesis | symplectic | rk4 | implicit")
+      ->capture_default_str()
+      ->type_name("NAME");
+  cmd->add_option("--dt", a->dt, "Time step")->capture_default_str();
+  cmd->add_option("--duration", a->duration, "Simulated time")->capture_default_str();
+  cmd->add_option("--every", a->every, "Write every Nth step (the first and last states always)")
+      ->capture_default_str()
+      ->type_name("N");
+  AddWorldFlags(cmd, &a->world);
+  cmd->add_option("--out", a->out, "CSV file to write (atomically: FILE.tmp, then renamed)")->type_name("FILE.csv");
+  cmd->footer(
+      "Example:\n"
+      "  wobble simulate --object data/table.obj --modes data/table_modes.def \\\n"
+      "      --q \"0 50 0 0 0 0 0\" --duration 10 --out out/table_drop.csv");
+  return cmd;
+}
+
+int RunSimulate(const SimulateArgs& a) {
+  // check the numbers before reading any file
+  Integrator integrator;
+  if (!ParseIntegrator(a.integrator, &integrator)) {
+    std::string names;
+    for (const char* name : {"thesis", "symplectic", "rk4", "implicit", "variational"}) {
+      Integrator known;
+      if (ParseIntegrator(name, &known)) names += std::string(names.empty() ? "" : ", ") + name;
+    }
+    throw UsageError("--integrator: '" + a.integrator + "' is not one of " + names);
+  }
+  RequirePositive(a.dt, "--dt");
+  RequireNonNegative(a.duration, "--duration");
+  if (a.every < 1) throw UsageError("--every must be at least 1");
+  if (a.duration / a.dt / double(a.every) > kMaxRows)
+    throw UsageError("--duration / --dt / --every asks for more than " + Num(kMaxRows) +
+                     " rows; raise --every or --dt");
+
+  if (!a.out.empty()) {
+    try {
+      CheckWritable(a.out);
+    } catch (const std::runtime_error& e) {
+      throw UsageError(std::string("--out: ") + e.what());
+    }
+  }
+
+  // the body and its world
+  const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
+  const Eigen::VectorXd q0 = ParseCoordinates(a.q, "--q", *body);
+  const Eigen::VectorXd qd0 = ParseCoordinates(a.qdot, "--qdot", *body);
+  WorldOptions options;
+  options.params = MakeWorldParams(a.world);
+  options.integrator = integrator;
+  options.dt = a.dt;
+  World world(options);
+  world.AddBody(body);
+  world.SetState(0, q0, qd0);
+  const Energies e0 = world.ComputeEnergies(0);
+
+  // step, recording every Nth state and the deepest penetration
+  std::vector<std::vector<double>> rows;
+  rows.push_back(CsvRow(world, world.time()));
+  long last_recorded = 0;
+  BodyState<double> last_good = world.state(0);
+  double max_pen = world.state(0).penetration, max_pen_time = 0.0;
+  const long expected_steps = std::max(1L, long(std::llround(a.duration / a.dt)));
+  Progress progress(isatty(STDERR_FILENO) == 1);
+  const auto start = std::chrono::steady_clock::now();
+  const bool ok = world.RunUntil(a.duration, [&](const World& w) {
+    const double pen = w.state(0).penetration;
+    if (pen > max_pen) {
+      max_pen = pen;
+      max_pen_time = w.time();
+    }
+    if (w.steps() % a.every == 0) {
+      rows.push_back(CsvRow(w, w.time()));
+      last_recorded = w.steps();
+    }
+    last_good = w.state(0);
+    progress.Update(double(w.steps()) / double(expected_steps), w.time());
+  });
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  progress.Finish();
+  // a stopped world may hold the state of the failed step: report the last accepted one
+  // (a fresh world at that state; its contact anchors restart at the entry points)
+  std::unique_ptr<World> restored;
+  if (!ok && (world.state(0).q != last_good.q || world.state(0).qd != last_good.qd)) {
+    restored = std::make_unique<World>(options);
+    restored->AddBody(body);
+    restored->SetState(0, last_good.q, last_good.qd);
+  }
+  const World& final_world = restored ? *restored : world;
+  if (world.steps() != last_recorded) rows.push_back(CsvRow(final_world, world.time()));
+
+  // the trajectory, also when the run stopped: it shows what led there
+  if (!a.out.empty()) WriteCsvAtomically(a.out, CsvHeader(body->num_modes()), rows);
+
+  // the summary: one paragraph, a sentence per line
+  const BodyState<double>& s = final_world.state(0);
+  const Energies e = final_world.ComputeEnergies(0);
+  const Ground& g = options.params.ground;
+  std::ostringstream out;
+  out << body->name() << ": " << body->num_points() << " mass points, " << body->num_modes() << " modes; "
+      << IntegratorName(integrator) << " integrator, dt " << Num(a.dt) << "; gravity "
+      << (options.params.gravity_on ? "on" : "off") << "; ";
+  if (g.enabled) {
+    out << "ground through y = " << Num(g.point.y()) << " at " << Num(a.world.ground_slope_deg) << " deg.\n";
+  } else {
+    out << "no ground.\n";
+  }
+  if (!ok)
+    out << "The run STOPPED at step " << world.status().step << " (" << StatusCodeName(world.status().code) << ").\n";
+  out << "Simulated " << Num(world.time()) << " s in " << world.steps() << " steps: " << Num(wall)
+      << " s wall with recording, " << (wall > 0 ? Num(double(world.steps()) / wall) : std::string("-"))
+      << " steps/s.\n";
+  out << "Final state at t = " << Num(world.time()) << ": q = " << VectorText(s.q) << ",\n"
+      << "  qdot = " << VectorText(s.qd) << ".\n";
+  out << "Energies at the end: kinetic " << Num(e.kinetic) << ", gravity " << Num(e.gravity) << ", modes "
+      << Num(e.modes) << ", ground " << Num(e.ground) << ", springs " << Num(e.springs) << ", total "
+      << Num(e.total()) << " (" << Num(e0.total()) << " at the start).\n";
+  out << s.contacts.size() << " point" << (s.contacts.size() == 1 ? "" : "s")
+      << " in contact at the end; max penetration " << Num(max_pen);
+  if (max_pen > 0) out << " at t = " << Num(max_pen_time);
+  out << ".\n";
+  if (!a.out.empty()) {
+    out << "Wrote " << rows.size() << " rows to " << a.out << ".";
+  } else {
+    out << "No --out given: nothing written.";
+  }
+  std::cout << out.str() << std::endl;
+
+  if (!ok) {
+    std::cerr << "wobble: simulation stopped: " << world.status().message << std::endl;
+    return kExitSimStopped;
+  }
+  return kExitOk;
+}
+
+}  // namespace wobble::app

@@ -1,0 +1,203 @@
+// Benchmarks of the solver core.
+//
+// The table of Fig. 1.2 (11 mass points, 4 modes; data/table.obj and data/table_modes.def when
+// present, else the same table built here) resting on the ground and falling freely, the same
+// table resampled to 10,000 mass points (the step must not care: O(D²), not O(N), out of
+// contact), and the moment-based mass matrix against the per-point reference of Eq. 4.10.
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "wobble/dynamics/reference.h"
+#include "wobble/dynamics/world.h"
+#include "wobble/io/deformation_file.h"
+#include "wobble/io/object_file.h"
+
+namespace wobble {
+namespace {
+
+// ---- the table -------------------------------------------------------------------------
+
+// The table of Fig. 1.2 / Fig. 4.3 on a 300 x 100 lattice: a top and two legs, 11 points of 50.
+BodyDef TableInCode() {
+  BodyDef def;
+  def.name = "table";
+  def.lattice = Lattice({0, 0}, {300, 0}, {0, 100});
+  for (int i = 0; i < 5; ++i) def.mass_positions.push_back({75.0 * i, 100.0});
+  for (double x : {0.0, 300.0})
+    for (int j = 0; j < 3; ++j) def.mass_positions.push_back({x, 100.0 * j / 3});
+  def.masses.assign(def.mass_positions.size(), 50.0);
+  def.shapes = {{{{0, 100}, {300, 100}}, false}, {{{0, 0}, {0, 100}}, false}, {{{300, 0}, {300, 100}}, false}};
+  return def;
+}
+
+// A 4 x 4 mode from rows of x and y displacements (row j at t = j/3, column i at s = i/3).
+DeformationMode ModeFromRows(const std::string& name, const double (&x)[4][4], const double (&y)[4][4]) {
+  DeformationMode m;
+  m.name = name;
+  m.displacement.resize(16);
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) m.displacement[i * 4 + j] = {x[j][i], y[j][i]};
+  m.stiffness = 4e5;  // as in data/table_modes.def
+  m.damping = 2.5e4;
+  return m;
+}
+
+// The four modes of data/table_modes.def: the §4.10.1 bend, a shear, vertical and horizontal squash.
+std::vector<DeformationMode> TableModesInCode() {
+  const double zero[4][4] = {};
+  const double bend_x[4][4] = {
+      {150, 150, -150, -150}, {50, 50, -50, -50}, {-50, -50, 50, 50}, {-150, -150, 150, 150}};
+  const double bend_y[4][4] = {{0, 100, 100, 0}, {0, 100, 100, 0}, {0, 100, 100, 0}, {0, 100, 100, 0}};
+  const double shear_x[4][4] = {{0, 0, 0, 0}, {50, 50, 50, 50}, {100, 100, 100, 100}, {150, 150, 150, 150}};
+  const double vsq_x[4][4] = {{-75, -25, 25, 75}, {-75, -25, 25, 75}, {-75, -25, 25, 75}, {-75, -25, 25, 75}};
+  const double vsq_y[4][4] = {
+      {0, 0, 0, 0}, {-100. / 3, -100. / 3, -100. / 3, -100. / 3}, {-200. / 3, -200. / 3, -200. / 3, -200. / 3},
+      {-100, -100, -100, -100}};
+  const double hsq_x[4][4] = {{75, 25, -25, -75}, {75, 25, -25, -75}, {75, 25, -25, -75}, {75, 25, -25, -75}};
+  const double hsq_y[4][4] = {{0, 0, 0, 0}, {50. / 3, 50. / 3, 50. / 3, 50. / 3}, {100. / 3, 100. / 3, 100. / 3, 100. / 3},
+                              {50, 50, 50, 50}};
+  return {ModeFromRows("bend", bend_x, bend_y), ModeFromRows("shear", shear_x, zero),
+          ModeFromRows("vsquash", vsq_x, vsq_y), ModeFromRows("hsquash", hsq_x, hsq_y)};
+}
+
+const std::string kDataDir = WOBBLE_DATA_DIR;
+
+BodyDef TableDef() {
+  const std::string path = kDataDir + "/table.obj";
+  return std::filesystem::exists(path) ? io::ReadObjectFile(path) : TableInCode();
+}
+
+std::vector<DeformationMode> TableModes() {
+  const std::string path = kDataDir + "/table_modes.def";
+  return std::filesystem::exists(path) ? io::ReadDeformationFile(path) : TableModesInCode();
+}
+
+// The same body with `n` mass points spread evenly (by length) along its drawing's segments,
+// with the same total mass.
+BodyDef Resampled(const BodyDef& def, int n) {
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> segments;
+  for (const Polyline& p : def.shapes) {
+    for (size_t i = 0; i + 1 < p.points.size(); ++i) segments.push_back({p.points[i], p.points[i + 1]});
+    if (p.closed && p.points.size() > 2) segments.push_back({p.points.back(), p.points.front()});
+  }
+  if (segments.empty()) return Resampled(TableInCode(), n);
+  double length = 0.0, mass = 0.0;
+  for (const auto& s : segments) length += (s.second - s.first).norm();
+  for (double m : def.masses) mass += m;
+  BodyDef out = def;
+  out.mass_positions.clear();
+  for (int k = 0; k < n; ++k) {
+    // the point at arc length (k + 1/2) / n of the whole drawing
+    double a = (k + 0.5) / n * length;
+    for (const auto& s : segments) {
+      const double l = (s.second - s.first).norm();
+      if (a <= l || &s == &segments.back()) {
+        out.mass_positions.push_back(s.first + (s.second - s.first) * std::min(1.0, a / l));
+        break;
+      }
+      a -= l;
+    }
+  }
+  out.masses.assign(n, mass / n);
+  return out;
+}
+
+std::shared_ptr<const BodyModel> Table11() {
+  static const auto body = std::make_shared<const BodyModel>(TableDef(), TableModes());
+  return body;
+}
+
+std::shared_ptr<const BodyModel> Table10k() {
+  static const auto body = std::make_shared<const BodyModel>(Resampled(TableDef(), 10000), TableModes());
+  return body;
+}
+
+Eigen::VectorXd TableQ(const BodyModel& body, double ty) {
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(body.num_q());
+  q[1] = ty;
+  return q;
+}
+
+// Times World::Step(); items are steps.
+void TimeSteps(benchmark::State& state, World& world) {
+  for (auto _ : state) {
+    if (!world.Step()) {
+      state.SkipWithError(world.status().message.c_str());
+      break;
+    }
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["contacts"] = double(world.state(0).contacts.size());
+}
+
+// ---- benchmarks --------------------------------------------------------------------------
+
+// The table standing on the ground after a small drop: the steady state of most animations.
+void BM_TableRestingOnGround(benchmark::State& state) {
+  World world;  // thesis integrator, dt 0.01, gravity, ground y = 0
+  world.AddBody(Table11());
+  world.SetState(0, TableQ(*Table11(), 10.0), Eigen::VectorXd::Zero(Table11()->num_q()));
+  for (int i = 0; i < 2000; ++i)
+    if (!world.Step()) {
+      state.SkipWithError(world.status().message.c_str());
+      return;
+    }
+  TimeSteps(state, world);
+}
+BENCHMARK(BM_TableRestingOnGround);
+
+// Falling freely far above the ground (convex-hull test only), or with no ground at all.
+void OutOfContact(benchmark::State& state, std::shared_ptr<const BodyModel> body) {
+  WorldOptions options;
+  options.params.ground.enabled = state.range(0) != 0;
+  options.params.ground.point = Eigen::Vector2d(0.0, -1e12);
+  World world(options);
+  world.AddBody(body);
+  world.SetState(0, TableQ(*body, 0.0), Eigen::VectorXd::Zero(body->num_q()));
+  TimeSteps(state, world);
+}
+void BM_Table11OutOfContact(benchmark::State& state) { OutOfContact(state, Table11()); }
+void BM_Table10kOutOfContact(benchmark::State& state) { OutOfContact(state, Table10k()); }
+BENCHMARK(BM_Table11OutOfContact)->ArgName("ground")->Arg(1)->Arg(0);
+BENCHMARK(BM_Table10kOutOfContact)->ArgName("ground")->Arg(1)->Arg(0);
+
+// M(q) of the 11-point table: from the mass moments, and point by point (Eq. 4.10).
+Eigen::VectorXd SomeQ(const BodyModel& body) {
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(body.num_q());
+  q.head<3>() << 12.0, 34.0, 0.3;
+  for (int d = 0; d < body.num_modes(); ++d) q[kRigidDofs + d] = 0.1 * (d + 1) * (d % 2 ? -1 : 1);
+  return q;
+}
+
+void BM_MassMatrixMoments(benchmark::State& state) {
+  const BodyModel& body = *Table11();
+  const VecQ<double> q = SomeQ(body);
+  MatQ<double> M;
+  for (auto _ : state) {
+    MassMatrix(body.moments(), q, &M);
+    benchmark::DoNotOptimize(M.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_MassMatrixMoments);
+
+void BM_MassMatrixReference(benchmark::State& state) {
+  const BodyModel& body = *Table11();
+  const Eigen::VectorXd q = SomeQ(body);
+  for (auto _ : state) {
+    Eigen::MatrixXd M = reference::MassMatrix(body, q);
+    benchmark::DoNotOptimize(M.data());
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_MassMatrixReference);
+
+}  // namespace
+}  // namespace wobble
+
+BENCHMARK_MAIN();
