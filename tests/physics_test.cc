@@ -247,6 +247,31 @@ TEST(Ground, ImplicitEulerHandlesStiffContact) {
   }
 }
 
+// Fig. 4.4: a spring holding a point. A rigid table hung by a damped spring at its centre of
+// mass comes to rest with the spring stretched by m g / k, and does not turn.
+TEST(Spring, HoldsTheTableAtTheStaticStretch) {
+  World w(NoGround(Integrator::kRK4, 0.005));
+  auto body = std::make_shared<BodyModel>(TableDef(), std::vector<DeformationMode>{});
+  w.AddBody(body);
+  Spring sp;
+  sp.body = 0;
+  const Eigen::Vector2d com = body->moments().c0 / body->moments().m;
+  sp.lattice_coords = body->lattice().LocalCoords(com);
+  sp.anchor = Eigen::Vector2d(0, 500);
+  sp.stiffness = 2000;
+  sp.damping = 1500;
+  sp.rest_length = 100;
+  w.AddSpring(sp);
+  w.SetState(0, State({-com.x(), 300 - com.y(), 0}), State({0, 0, 0}));
+  ASSERT_TRUE(w.RunUntil(60.0, [](const World&) {})) << w.status().message;
+  const double m = body->moments().m;
+  const Eigen::Vector2d held(w.state(0).q[0] + com.x(), w.state(0).q[1] + com.y());
+  EXPECT_NEAR((sp.anchor - held).norm(), 100 + m * kG / 2000, 1e-6);
+  EXPECT_NEAR(held.x(), 0.0, 1e-9);
+  EXPECT_NEAR(w.state(0).q[2], 0.0, 1e-9);
+  EXPECT_NEAR(w.ComputeEnergies(0).springs, 0.5 * 2000 * std::pow(m * kG / 2000, 2), 1e-3);
+}
+
 TEST(Status, DuplicatedModeStopsTheRunAtTheFirstStep) {
   World w(NoGround(Integrator::kThesis, 0.01));
   w.AddBody(std::make_shared<BodyModel>(TableDef(), std::vector<DeformationMode>{testing::Bend(), testing::Bend()}));
