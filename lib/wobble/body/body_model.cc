@@ -1,5 +1,7 @@
 #include "wobble/body/body_model.h"
 
+#include "wobble/numeric/cholesky.h"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -58,6 +60,8 @@ BodyModel::BodyModel(BodyDef def, std::vector<DeformationMode> modes) : def_(std
     mm.G += m * B.transpose() * B;
     mm.P += m * B.transpose() * SB;
   }
+  mm.G_com_factor = mm.G - mm.C.transpose() * mm.C / mm.m;
+  mm.G_com_positive = CholeskyInPlace(&mm.G_com_factor);
 }
 
 void BodyModel::LocalBasis(const Eigen::Vector2d& st, Eigen::Vector2d* b0, Mat2D<double>* B) const {

@@ -34,12 +34,18 @@ struct BodyDef {
 // Mass moments of ARCHITECTURE.md: with l_k(γ) = b0_k + B_k γ the local position of point k,
 //   m = Σ m_k, c0 = Σ m_k b0_k, C = Σ m_k B_k, I0 = Σ m_k |b0_k|², e0 = Σ m_k B_kᵀ b0_k,
 //   G = Σ m_k B_kᵀ B_k, h0 = Σ m_k B_kᵀ S b0_k, P = Σ m_k B_kᵀ S B_k.
+//
+// About the centre of mass the mode block of M is G_com = G − CᵀC/m, which does not depend on
+// q at all (RᵀR = I): its Cholesky factor is made once here and every step reuses it
+// (SolveMassSystem in kinematics.h).
 struct MassMoments {
   double m = 0, I0 = 0;
   Eigen::Vector2d c0 = Eigen::Vector2d::Zero();
   Mat2D<double> C;
   VecD<double> e0, h0;
   MatD<double> G, P;
+  MatD<double> G_com_factor;  // CholeskyInPlace(G − CᵀC/m); valid when G_com_positive
+  bool G_com_positive = false;  // false: some mode combination moves no mass relative to the centre
 };
 
 class BodyModel {

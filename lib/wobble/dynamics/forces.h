@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "wobble/body/body_model.h"
@@ -29,6 +30,11 @@ struct Ground {
 
   Eigen::Vector2d tangent() const { return {std::cos(slope), std::sin(slope)}; }
   Eigen::Vector2d normal() const { return {-std::sin(slope), std::cos(slope)}; }
+  bool operator==(const Ground& o) const {
+    return enabled == o.enabled && point == o.point && slope == o.slope && stiffness == o.stiffness &&
+           normal_damping == o.normal_damping && friction_damping == o.friction_damping &&
+           friction_cap == o.friction_cap && max_penetration == o.max_penetration;
+  }
 };
 
 // The ground's unit normal and tangent, computed once per evaluation rather than per point.
@@ -72,7 +78,29 @@ template <class T> struct BodyState {
   VecQ<T> q, qd;
   std::vector<Contact<T>> contacts;
   double penetration = 0.0;  // deepest contact at the last contact update
+  // The generalized ground force of `contacts` at exactly (q, qd) under `ground`, left by
+  // UpdateContacts. The next explicit step evaluates forces at that same state, so it reuses
+  // this instead of visiting every point a second time (half the cost of a resting body).
+  // Keyed by value: any change of q, q̇ or the ground makes it miss, never go stale.
+  struct GroundForceCache {
+    bool valid = false;
+    VecQ<T> q, qd, force;
+    Ground ground;
+  } ground_cache;
 };
+
+// The cached ground force of s, when it was computed at s's current state on ground g.
+template <class T> const VecQ<T>* CachedGroundForce(const BodyState<T>& s, const Ground& g) {
+  if constexpr (!std::is_same_v<T, double>) {
+    return nullptr;  // derivative parts are not keyed; Jets always recompute
+  } else {
+    const auto& c = s.ground_cache;
+    if (!c.valid || !(c.ground == g) || c.q.size() != s.q.size()) return nullptr;
+    for (int i = 0; i < s.q.size(); ++i)
+      if (c.q[i] != s.q[i] || c.qd[i] != s.qd[i]) return nullptr;
+    return &c.force;
+  }
+}
 
 template <class T> struct ForceBreakdown {
   VecQ<T> gravity, modes, ground, springs, total;
@@ -103,9 +131,8 @@ Vec2<T> GroundForce(const Ground& g, const GroundFrame& gf, const Vec2<T>& x, co
 
 // Convex-hull test: true when every deformed control point is strictly above the ground, so no
 // point of the body can be below it (Bernstein and B-spline weights are a partition of unity).
-template <class T> bool ClearOfGround(const BodyModel& body, const Ground& g, const VecQ<T>& q) {
+template <class T> bool ClearOfGround(const BodyModel& body, const Ground& g, const VecQ<T>& q, const Frame<T>& frame) {
   const int D = body.num_modes();
-  const Frame<T> frame(q);
   const GroundFrame gf(g);
   const std::vector<Eigen::Vector2d>& rest = body.rest_control();
   for (int c = 0; c < int(rest.size()); ++c) {
@@ -128,11 +155,11 @@ enum class ContactSet {
 // Visits every mass point below the ground as f(k, l, x, v, anchor): l local, x world,
 // v velocity, anchor its contact's anchor (existing, or the entry point projected on the
 // ground for a new contact). Bodies clear of the ground by the hull test cost nothing.
+// `frame` is Frame(s.q), made once by the caller.
 template <class T, class F>
-void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodyState<T>& s, F&& f,
+void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodyState<T>& s, const Frame<T>& frame, F&& f,
                            ContactSet set = ContactSet::kDetect) {
   if (!g.enabled) return;
-  const Frame<T> frame(s.q);
   const GroundFrame gf(g);
   auto visit = [&](int k, const Vec2<T>* anchor) {
     const auto B = body.mode_matrix(k);
@@ -146,7 +173,7 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
     for (const Contact<T>& c : s.contacts) visit(c.point, &c.anchor);
     return;
   }
-  if (ClearOfGround(body, g, s.q)) return;
+  if (ClearOfGround(body, g, s.q, frame)) return;
   auto existing = s.contacts.begin();
   for (int k = 0; k < body.num_points(); ++k) {
     while (existing != s.contacts.end() && existing->point < k) ++existing;
@@ -156,13 +183,14 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
 }
 
 // All generalized forces on a body, by source.
+// `frame` is Frame(s.q), made once by the caller.
 template <class T>
 void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index, const BodyState<T>& s,
-                    ForceBreakdown<T>* out, ContactSet contact_set = ContactSet::kDetect) {
+                    const Frame<T>& frame, ForceBreakdown<T>* out, ContactSet contact_set = ContactSet::kDetect) {
   const int nq = body.num_q(), D = body.num_modes();
   // gravity, exactly from the moments
   if (w.gravity_on) {
-    GravityForce(body.moments(), s.q, w.gravity, &out->gravity);
+    GravityForce(body.moments(), s.q, frame.R, w.gravity, &out->gravity);
   } else {
     out->gravity.setZero(nq);
   }
@@ -173,14 +201,19 @@ void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index,
     out->modes[kRigidDofs + d] = -T(2.0 * m.stiffness) * s.q[kRigidDofs + d] - T(m.damping) * s.qd[kRigidDofs + d];
   }
   // penalty ground, only over points below it
-  const Frame<T> frame(s.q);
   const GroundFrame gf(w.ground);
-  out->ground.setZero(nq);
-  ForEachPointInContact(body, w.ground, s, [&](int k, const Vec2<T>& l, const Vec2<T>& x, const Vec2<T>& v,
-                                               const Vec2<T>& anchor) {
-    bool slipping;
-    AddGeneralizedForce(frame, l, body.mode_matrix(k), GroundForce(w.ground, gf, x, v, anchor, &slipping), &out->ground);
-  }, contact_set);
+  const VecQ<T>* cached = contact_set == ContactSet::kDetect ? CachedGroundForce(s, w.ground) : nullptr;
+  if (cached) {
+    out->ground = *cached;
+  } else {
+    out->ground.setZero(nq);
+    ForEachPointInContact(body, w.ground, s, frame, [&](int k, const Vec2<T>& l, const Vec2<T>& x, const Vec2<T>& v,
+                                                 const Vec2<T>& anchor) {
+      bool slipping;
+      AddGeneralizedForce(frame, l, body.mode_matrix(k), GroundForce(w.ground, gf, x, v, anchor, &slipping),
+                          &out->ground);
+    }, contact_set);
+  }
   // springs holding a point
   out->springs.setZero(nq);
   for (const Spring& sp : w.springs) {
@@ -197,13 +230,18 @@ void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index,
   }
   out->total = out->gravity + out->modes + out->ground + out->springs;
 }
+template <class T>
+void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index, const BodyState<T>& s,
+                    ForceBreakdown<T>* out, ContactSet contact_set = ContactSet::kDetect) {
+  EvaluateForces(body, w, body_index, s, Frame<T>(s.q), out, contact_set);
+}
 
 // Adds a contact for every point below the ground that has none (anchor: its projection on
 // the ground). Returns how many were added. Implicit steps call it to grow their active set.
 template <class T> int AddMissingContacts(const BodyModel& body, const Ground& g, BodyState<T>* s) {
   std::vector<Contact<T>> added;
   const BodyState<T>& view = *s;
-  ForEachPointInContact(body, g, view, [&](int k, const Vec2<T>&, const Vec2<T>&, const Vec2<T>&,
+  ForEachPointInContact(body, g, view, Frame<T>(view.q), [&](int k, const Vec2<T>&, const Vec2<T>&, const Vec2<T>&,
                                             const Vec2<T>& anchor) {
     for (const Contact<T>& c : view.contacts)
       if (c.point == k) return;
@@ -218,27 +256,37 @@ template <class T> int AddMissingContacts(const BodyModel& body, const Ground& g
 // After a step is accepted: points that went below the ground get an anchor at their entry
 // point, points that left it lose theirs, and an anchor whose friction hit the cap slides
 // along the ground so the tangential spring holds exactly the capped force (Coulomb slip).
+// The same pass sums the ground's generalized force at this state into s->ground_cache.
 template <class T> void UpdateContacts(const BodyModel& body, const Ground& g, BodyState<T>* s) {
   // reuse storage across steps: no heap traffic while a body rests on the ground
   thread_local std::vector<Contact<T>> next;
   next.clear();
   s->penetration = 0.0;
   const GroundFrame gf(g);
+  const Frame<T> frame(s->q);
   const Vec2<T> tau = gf.tau.cast<T>(), n = gf.n.cast<T>();
-  ForEachPointInContact(body, g, *s, [&](int k, const Vec2<T>&, const Vec2<T>& x, const Vec2<T>& v,
+  auto& cache = s->ground_cache;
+  cache.force.setZero(s->q.size());
+  ForEachPointInContact(body, g, *s, frame, [&](int k, const Vec2<T>& l, const Vec2<T>& x, const Vec2<T>& v,
                                          Vec2<T> anchor) {
     bool slipping;
-    const Vec2<T> f = GroundForce(g, gf, x, v, anchor, &slipping);
+    Vec2<T> f = GroundForce(g, gf, x, v, anchor, &slipping);
     if (slipping) {
       // choose Δt so that −K Δt − FR v_t equals the capped friction f·τ
       const T dt = -(f.dot(tau) + T(g.friction_damping) * tau.dot(v)) / T(g.stiffness);
       const Vec2<T> on_ground = x - gf.Height(x) * n;
       anchor = on_ground - dt * tau;
+      f = GroundForce(g, gf, x, v, anchor, &slipping);  // what the moved anchor exerts
     }
+    AddGeneralizedForce(frame, l, body.mode_matrix(k), f, &cache.force);
     next.push_back({k, anchor});
     s->penetration = std::max(s->penetration, -double(ScalarValue(gf.Height(x))));
   });
   s->contacts.swap(next);
+  cache.q = s->q;
+  cache.qd = s->qd;
+  cache.ground = g;
+  cache.valid = true;
 }
 
 }  // namespace wobble

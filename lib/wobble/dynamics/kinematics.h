@@ -9,6 +9,7 @@
 
 #include "wobble/body/body_model.h"
 #include "wobble/body/types.h"
+#include "wobble/numeric/cholesky.h"
 
 namespace wobble {
 
@@ -52,57 +53,115 @@ void AddGeneralizedForce(const Frame<T>& frame, const Vec2<T>& l, const Eigen::M
 
 // M(q) from the moments:
 //   M_tt = m I, M_tθ = R S (c0 + Cγ), M_tγ = R C, M_θθ = I0 + 2 e0ᵀγ + γᵀGγ, M_θγ = (h0 + Pγ)ᵀ, M_γγ = G.
-template <class T> void MassMatrix(const MassMoments& mm, const VecQ<T>& q, MatQ<T>* M) {
+// R = R(θ) is passed in so that one step computes sin and cos once, not once per term.
+template <class T> void MassMatrix(const MassMoments& mm, const VecQ<T>& q, const Mat2<T>& R, MatQ<T>* M) {
   const int D = int(mm.e0.size());
   const auto gamma = q.tail(D);
-  const Mat2<T> R = Rotation(q[2]);
-  const Vec2<T> c = mm.c0.cast<T>() + mm.C.cast<T>() * gamma;
+  const Vec2<T> c = mm.c0.cast<T>() + mm.C.cast<T>().lazyProduct(gamma);
   const Vec2<T> RSc = R * Perp(c);
   M->setZero(kRigidDofs + D, kRigidDofs + D);
   (*M)(0, 0) = (*M)(1, 1) = T(mm.m);
   M->template block<2, 1>(0, 2) = RSc;
   M->template block<1, 2>(2, 0) = RSc.transpose();
-  (*M)(2, 2) = T(mm.I0) + T(2.0) * mm.e0.cast<T>().dot(gamma) + gamma.dot(mm.G.cast<T>() * gamma);
+  const VecD<T> Ggamma = mm.G.cast<T>().lazyProduct(gamma);
+  (*M)(2, 2) = T(mm.I0) + T(2.0) * mm.e0.cast<T>().dot(gamma) + gamma.dot(Ggamma);
   if (D == 0) return;
-  const Mat2D<T> RC = R * mm.C.cast<T>();
+  const Mat2D<T> RC = R.lazyProduct(mm.C.cast<T>());
   M->block(0, kRigidDofs, 2, D) = RC;
   M->block(kRigidDofs, 0, D, 2) = RC.transpose();
-  const VecD<T> theta_gamma = mm.h0.cast<T>() + mm.P.cast<T>() * gamma;
+  const VecD<T> theta_gamma = mm.h0.cast<T>() + mm.P.cast<T>().lazyProduct(gamma);
   M->block(2, kRigidDofs, 1, D) = theta_gamma.transpose();
   M->block(kRigidDofs, 2, D, 1) = theta_gamma;
   M->block(kRigidDofs, kRigidDofs, D, D) = mm.G.cast<T>();
 }
+template <class T> void MassMatrix(const MassMoments& mm, const VecQ<T>& q, MatQ<T>* M) {
+  MassMatrix(mm, q, Rotation(q[2]), M);
+}
+
+// Solves M(q) q̈ = r exactly by block elimination about the centre of mass, without forming M.
+// Eliminating the translation (M_tt = m I) leaves, with c = c0 + Cγ, h = h0 + Pγ, r̂ = Rᵀ r_t:
+//   [ I_θθ − |c|²/m   uᵀ    ] [θ̈]   [ r_θ − (S c)·r̂/m ]
+//   [ u               G_com ] [γ̈] = [ r_γ − Cᵀ r̂/m    ],   u = h − Cᵀ S c / m,
+// whose mode block G_com = G − CᵀC/m is constant and factored once (MassMoments). Then
+// G_com y = ρ_γ, G_com z = u, θ̈ = (ρ_θ − u·y)/(s − u·z), γ̈ = y − z θ̈, and
+// ẗ = (r_t − R(S c θ̈ + C γ̈))/m. About half the work of a Cholesky factorization of M per step.
+// Returns false when M is singular. *cond_estimate receives the ratio of the largest to the
+// smallest elimination pivot (m, G_com's pivots, the θ pivot): a lower bound of cond₂(M).
+template <class T>
+bool SolveMassSystem(const MassMoments& mm, const VecQ<T>& q, const Mat2<T>& R, const VecQ<T>& r, VecQ<T>* qdd,
+                     double* cond_estimate) {
+  const int D = int(mm.e0.size());
+  if (D > 0 && !mm.G_com_positive) return false;
+  const auto gamma = q.tail(D);
+  const T inv_m = T(1.0 / mm.m);
+  const Vec2<T> c = mm.c0.cast<T>() + mm.C.cast<T>().lazyProduct(gamma);
+  const Vec2<T> Sc = Perp(c);
+  const Vec2<T> r_hat = R.transpose() * r.template head<2>();
+  const T I_theta = T(mm.I0) + T(2.0) * mm.e0.cast<T>().dot(gamma) + gamma.dot(mm.G.cast<T>().lazyProduct(gamma));
+  T pivot_theta = I_theta - c.squaredNorm() * inv_m;
+  T rho_theta = r[2] - Sc.dot(r_hat) * inv_m;
+  qdd->resize(kRigidDofs + D);
+  T theta_dd;
+  if (D == 0) {
+    if (!(ScalarValue(pivot_theta) > 0.0)) return false;
+    theta_dd = rho_theta / pivot_theta;
+  } else {
+    VecD<T> u = mm.h0.cast<T>() + mm.P.cast<T>().lazyProduct(gamma) - mm.C.cast<T>().transpose().lazyProduct(Sc) * inv_m;
+    VecD<T> y = r.tail(D) - mm.C.cast<T>().transpose().lazyProduct(r_hat) * inv_m;
+    VecD<T> z = u;
+    CholeskySolveInPlace(mm.G_com_factor, &y);
+    CholeskySolveInPlace(mm.G_com_factor, &z);
+    pivot_theta -= u.dot(z);
+    if (!(ScalarValue(pivot_theta) > 0.0)) return false;
+    theta_dd = (rho_theta - u.dot(y)) / pivot_theta;
+    qdd->tail(D) = y - z * theta_dd;
+  }
+  (*qdd)[2] = theta_dd;
+  const Vec2<T> local = Sc * theta_dd + mm.C.cast<T>().lazyProduct(qdd->tail(D));
+  qdd->template head<2>() = (r.template head<2>() - R * local) * inv_m;
+  double lo = std::min(mm.m, double(ScalarValue(pivot_theta))), hi = std::max(mm.m, double(ScalarValue(pivot_theta)));
+  if (D > 0) CholeskyPivotRange(mm.G_com_factor, &lo, &hi);
+  *cond_estimate = hi / lo;
+  return true;
+}
 
 // w = Σ m_k J_kᵀ J̇_k q̇, with J̇_k q̇ = R(−θ̇² l_k + 2 θ̇ S B_k γ̇):
 //   t-rows: R(−θ̇²(c0 + Cγ) + 2θ̇ S C γ̇), θ-row: 2θ̇ (e0 + Gγ)·γ̇, γ-rows: −θ̇²(e0 + Gγ) + 2θ̇ P γ̇.
-template <class T> void VelocityTerms(const MassMoments& mm, const VecQ<T>& q, const VecQ<T>& qd, VecQ<T>* w) {
+template <class T>
+void VelocityTerms(const MassMoments& mm, const VecQ<T>& q, const VecQ<T>& qd, const Mat2<T>& R, VecQ<T>* w) {
   const int D = int(mm.e0.size());
   const auto gamma = q.tail(D);
   const auto gamma_dot = qd.tail(D);
   const T thd = qd[2];
-  const Vec2<T> c = mm.c0.cast<T>() + mm.C.cast<T>() * gamma;
-  const Vec2<T> Cgd = mm.C.cast<T>() * gamma_dot;
+  const Vec2<T> c = mm.c0.cast<T>() + mm.C.cast<T>().lazyProduct(gamma);
+  const Vec2<T> Cgd = mm.C.cast<T>().lazyProduct(gamma_dot);
   w->resize(kRigidDofs + D);
-  w->template head<2>() = Rotation(q[2]) * (-thd * thd * c + T(2.0) * thd * Perp(Cgd));
+  w->template head<2>() = R * (-thd * thd * c + T(2.0) * thd * Perp(Cgd));
   if (D == 0) {
     (*w)[2] = T(0.0);
     return;
   }
-  const VecD<T> e = mm.e0.cast<T>() + mm.G.cast<T>() * gamma;
+  const VecD<T> e = mm.e0.cast<T>() + mm.G.cast<T>().lazyProduct(gamma);
   (*w)[2] = T(2.0) * thd * e.dot(gamma_dot);
-  w->tail(D) = -thd * thd * e + T(2.0) * thd * (mm.P.cast<T>() * gamma_dot);
+  w->tail(D) = -thd * thd * e + T(2.0) * thd * mm.P.cast<T>().lazyProduct(gamma_dot);
+}
+template <class T> void VelocityTerms(const MassMoments& mm, const VecQ<T>& q, const VecQ<T>& qd, VecQ<T>* w) {
+  VelocityTerms(mm, q, qd, Rotation(q[2]), w);
 }
 
 // Generalized gravity force Σ m_k J_kᵀ g = [m g ; (R S (c0 + Cγ))·g ; (R C)ᵀ g].
-template <class T> void GravityForce(const MassMoments& mm, const VecQ<T>& q, const Eigen::Vector2d& g, VecQ<T>* Q) {
+template <class T>
+void GravityForce(const MassMoments& mm, const VecQ<T>& q, const Mat2<T>& R, const Eigen::Vector2d& g, VecQ<T>* Q) {
   const int D = int(mm.e0.size());
-  const Mat2<T> R = Rotation(q[2]);
   const Vec2<T> gT = g.cast<T>();
-  const Vec2<T> c = mm.c0.cast<T>() + mm.C.cast<T>() * q.tail(D);
+  const Vec2<T> c = mm.c0.cast<T>() + mm.C.cast<T>().lazyProduct(q.tail(D));
   Q->resize(kRigidDofs + D);
   Q->template head<2>() = T(mm.m) * gT;
   (*Q)[2] = (R * Perp(c)).dot(gT);
-  if (D > 0) Q->tail(D) = (R * mm.C.cast<T>()).transpose() * gT;
+  if (D > 0) Q->tail(D) = mm.C.cast<T>().transpose().lazyProduct(R.transpose() * gT);  // (R C)ᵀ g = Cᵀ (Rᵀ g)
+}
+template <class T> void GravityForce(const MassMoments& mm, const VecQ<T>& q, const Eigen::Vector2d& g, VecQ<T>* Q) {
+  GravityForce(mm, q, Rotation(q[2]), g, Q);
 }
 
 // Potential energy of gravity, −Σ m_k g·x_k = −g·(m t + R(c0 + Cγ)).

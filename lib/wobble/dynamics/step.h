@@ -9,6 +9,7 @@
 #include <string>
 
 #include "wobble/dynamics/forces.h"
+#include "wobble/numeric/cholesky.h"
 
 namespace wobble {
 
@@ -31,65 +32,23 @@ struct StepStatus {
 };
 std::string StatusCodeName(StepStatus::Code code);
 
-// Cholesky factor M = L Lᵀ in place (L in the lower triangle). A plain loop: for the 7x7
-// systems of a typical body it is several times faster than Eigen's dynamic-size LLT, and it
-// works for any scalar. Returns false when M is not positive definite.
-template <class T> bool CholeskyInPlace(MatQ<T>* M) {
-  using std::sqrt;
-  MatQ<T>& A = *M;
-  const int n = int(A.rows());
-  for (int j = 0; j < n; ++j) {
-    T d = A(j, j);
-    for (int k = 0; k < j; ++k) d -= A(j, k) * A(j, k);
-    if (!(ScalarValue(d) > 0.0)) return false;
-    d = sqrt(d);
-    A(j, j) = d;
-    for (int i = j + 1; i < n; ++i) {
-      T v = A(i, j);
-      for (int k = 0; k < j; ++k) v -= A(i, k) * A(j, k);
-      A(i, j) = v / d;
-    }
-  }
-  return true;
-}
-
-// Solves L Lᵀ x = b in place, L from CholeskyInPlace.
-template <class T> void CholeskySolveInPlace(const MatQ<T>& L, VecQ<T>* b) {
-  VecQ<T>& x = *b;
-  const int n = int(L.rows());
-  for (int i = 0; i < n; ++i) {
-    for (int k = 0; k < i; ++k) x[i] -= L(i, k) * x[k];
-    x[i] /= L(i, i);
-  }
-  for (int i = n - 1; i >= 0; --i) {
-    for (int k = i + 1; k < n; ++k) x[i] -= L(k, i) * x[k];
-    x[i] /= L(i, i);
-  }
-}
-
-// q̈ of Eq. 4.21. Also returns a cheap lower bound of cond₂(M) from the Cholesky factor
-// (the squared ratio of its largest to smallest diagonal entry).
+// q̈ of Eq. 4.21, M q̈ = Q − w, solved about the centre of mass (SolveMassSystem). Fails with
+// kIllConditioned when the elimination's pivot ratio, a lower bound of cond₂(M), exceeds
+// w.max_condition.
 template <class T>
 StepStatus Accelerations(const BodyModel& body, const WorldParams& w, int body_index, const BodyState<T>& s,
                          VecQ<T>* qdd, ForceBreakdown<T>* forces = nullptr,
                          ContactSet contact_set = ContactSet::kDetect) {
-  MatQ<T> M;
   VecQ<T> vel;
   ForceBreakdown<T> local;
   ForceBreakdown<T>& f = forces ? *forces : local;
-  MassMatrix(body.moments(), s.q, &M);
-  VelocityTerms(body.moments(), s.q, s.qd, &vel);
-  EvaluateForces(body, w, body_index, s, &f, contact_set);
-  if (!CholeskyInPlace(&M)) return {StepStatus::Code::kSingularMass, 0.0};
-  double lo = ScalarValue(M(0, 0)), hi = lo;
-  for (int i = 1; i < M.rows(); ++i) {
-    lo = std::min(lo, double(ScalarValue(M(i, i))));
-    hi = std::max(hi, double(ScalarValue(M(i, i))));
-  }
-  const double cond_estimate = (hi / lo) * (hi / lo);
+  const Frame<T> frame(s.q);
+  VelocityTerms(body.moments(), s.q, s.qd, frame.R, &vel);
+  EvaluateForces(body, w, body_index, s, frame, &f, contact_set);
+  double cond_estimate = 0.0;
+  if (!SolveMassSystem(body.moments(), s.q, frame.R, VecQ<T>(f.total - vel), qdd, &cond_estimate))
+    return {StepStatus::Code::kSingularMass, 0.0};
   if (cond_estimate > w.max_condition) return {StepStatus::Code::kIllConditioned, cond_estimate};
-  *qdd = f.total - vel;
-  CholeskySolveInPlace(M, qdd);
   return {};
 }
 

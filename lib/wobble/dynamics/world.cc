@@ -124,7 +124,7 @@ Energies World::ComputeEnergies(int i) const {
   e.kinetic = 0.5 * s.qd.dot(M * s.qd);  // Eq. 4.9
   if (p.gravity_on) e.gravity = GravityEnergy(b.moments(), s.q, p.gravity);
   for (int d = 0; d < b.num_modes(); ++d) e.modes += b.modes()[d].stiffness * s.q[kRigidDofs + d] * s.q[kRigidDofs + d];
-  ForEachPointInContact(b, p.ground, s, [&](int, const Vec2<double>&, const Vec2<double>& x, const Vec2<double>&,
+  ForEachPointInContact(b, p.ground, s, Frame<double>(s.q), [&](int, const Vec2<double>&, const Vec2<double>& x, const Vec2<double>&,
                                             const Vec2<double>& anchor) {
     e.ground += 0.5 * p.ground.stiffness * (x - anchor).squaredNorm();
   });
