@@ -1,0 +1,271 @@
+#include "wobble/analysis/conditioning.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "wobble/dynamics/kinematics.h"
+
+namespace wobble::analysis {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kPi = 3.14159265358979323846;
+
+double RadToDeg(double a) { return a * 180.0 / kPi; }
+
+// σ_max/σ_min with the numerical-rank test of ConditionNumber.
+double CondFromSingularValues(const Eigen::VectorXd& sv, bool* singular) {
+  const double hi = sv.maxCoeff(), lo = sv.minCoeff();
+  *singular = !(lo > double(sv.size()) * std::numeric_limits<double>::epsilon() * hi);
+  return *singular ? kInf : hi / lo;
+}
+
+std::string Join(const std::vector<Participant>& parts) {
+  std::ostringstream out;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    if (i) out << (parts[i].weight < 0 ? " - " : " + ");
+    else if (parts[i].weight < 0) out << "-";
+    out << std::abs(parts[i].weight) << " '" << parts[i].dof << "'";
+  }
+  return out.str();
+}
+
+std::string Degrees(double deg) {
+  std::ostringstream out;
+  out.precision(deg < 0.1 ? 2 : 3);
+  out << deg << "°";
+  return out.str();
+}
+
+}  // namespace
+
+ConditionNumber Condition(const Eigen::MatrixXd& M) {
+  ConditionNumber c;
+  c.singular_values = Eigen::JacobiSVD<Eigen::MatrixXd>(M).singularValues();
+  c.cond = CondFromSingularValues(c.singular_values, &c.singular);
+  const Eigen::VectorXd diag = M.diagonal();
+  if ((diag.array() > 0.0).all()) {
+    const Eigen::VectorXd s = diag.array().rsqrt();
+    const Eigen::MatrixXd scaled = s.asDiagonal() * M * s.asDiagonal();
+    bool scaled_singular = false;
+    c.cond_scaled = CondFromSingularValues(Eigen::JacobiSVD<Eigen::MatrixXd>(scaled).singularValues(), &scaled_singular);
+  } else {
+    c.cond_scaled = kInf;
+  }
+  return c;
+}
+
+ConditionNumber MassMatrixCondition(const BodyModel& body, const Eigen::VectorXd& q) {
+  MatQ<double> M;
+  MassMatrix(body.moments(), VecQ<double>(q), &M);
+  return Condition(M);
+}
+
+double Cond1Estimate(const Eigen::MatrixXd& A) {
+  const int n = int(A.rows());
+  if (n == 0) return 1.0;
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(A);
+  const double norm_a = A.cwiseAbs().colwise().sum().maxCoeff();
+  auto solve = [&](const Eigen::VectorXd& b) { return Eigen::VectorXd(lu.solve(b)); };
+  auto solve_t = [&](const Eigen::VectorXd& b) { return Eigen::VectorXd(lu.transpose().solve(b)); };
+  auto sign = [](const Eigen::VectorXd& v) {
+    return Eigen::VectorXd(v.unaryExpr([](double x) { return x >= 0.0 ? 1.0 : -1.0; }));
+  };
+  // Hager (1984) as refined by Higham (1988): a gradient ascent of ‖A⁻¹x‖₁ over ‖x‖₁ = 1.
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(n, 1.0 / n);
+  Eigen::VectorXd y = solve(x);
+  if (!y.allFinite()) return kInf;
+  double estimate = y.lpNorm<1>();
+  Eigen::VectorXd xi = sign(y);
+  Eigen::VectorXd z = solve_t(xi);
+  for (int iter = 0; iter < 5; ++iter) {
+    Eigen::Index j;
+    const double z_max = z.cwiseAbs().maxCoeff(&j);
+    if (z_max <= z.dot(x)) break;
+    x.setZero();
+    x[j] = 1.0;
+    y = solve(x);
+    if (!y.allFinite()) return kInf;
+    const Eigen::VectorXd xi_new = sign(y);
+    const double next = y.lpNorm<1>();
+    if (next <= estimate) break;
+    estimate = next;
+    if (xi_new == xi) break;  // the same sign pattern again: converged
+    xi = xi_new;
+    z = solve_t(xi);
+  }
+  // Higham's safeguard against the iteration's blind spots: an alternating, growing vector.
+  Eigen::VectorXd alt(n);
+  for (int i = 0; i < n; ++i) alt[i] = (i % 2 ? -1.0 : 1.0) * (1.0 + (n > 1 ? double(i) / (n - 1) : 0.0));
+  const Eigen::VectorXd y_alt = solve(alt);
+  if (!y_alt.allFinite()) return kInf;
+  estimate = std::max(estimate, 2.0 * y_alt.lpNorm<1>() / (3.0 * n));
+  return norm_a * estimate;
+}
+
+DeformationMode SquashMode(const Lattice& lattice, double phi, const Squash& squash, const std::string& name) {
+  const Eigen::Rotation2Dd rot(phi);
+  const Eigen::Matrix2d R = rot.toRotationMatrix();
+  const Eigen::Matrix2d A = R * Eigen::Vector2d(-squash.compress, squash.expand).asDiagonal() * R.transpose();
+  const Eigen::Vector2d anchor =
+      lattice.origin() + squash.anchor_st.x() * lattice.axis_s() + squash.anchor_st.y() * lattice.axis_t();
+  DeformationMode mode;
+  mode.name = name;
+  mode.num_s = lattice.num_s();
+  mode.num_t = lattice.num_t();
+  for (const Eigen::Vector2d& p : lattice.RestPoints()) mode.displacement.push_back(A * (p - anchor));
+  return mode;
+}
+
+std::vector<SweepSample> AngleSweep(const BodyDef& def, const std::vector<double>& phis, const Squash& squash,
+                                    const Eigen::VectorXd& q) {
+  const DeformationMode vertical = SquashMode(def.lattice, kPi / 2, squash, "vsquash");
+  std::vector<SweepSample> out;
+  for (double phi : phis) {
+    const BodyModel body(def, {vertical, SquashMode(def.lattice, phi, squash, "squash(phi)")});
+    out.push_back({phi, MassMatrixCondition(body, q)});
+  }
+  return out;
+}
+
+std::string LevelName(ModeSetReport::Level level) {
+  switch (level) {
+    case ModeSetReport::Level::kOk: return "ok";
+    case ModeSetReport::Level::kWarning: return "warning";
+    case ModeSetReport::Level::kError: return "error";
+  }
+  return "?";
+}
+
+ModeSetReport CheckModeSet(const BodyModel& body, const Eigen::VectorXd& q_in, const ModeCheckOptions& options) {
+  const int D = body.num_modes(), nq = body.num_q();
+  const Eigen::VectorXd q = q_in.size() ? q_in : Eigen::VectorXd::Zero(nq);
+  ModeSetReport report;
+  report.dofs = {"translation x", "translation y", "rotation"};
+  for (const DeformationMode& m : body.modes()) report.dofs.push_back(m.name);
+  MatQ<double> Mq;
+  MassMatrix(body.moments(), VecQ<double>(q), &Mq);
+  const Eigen::MatrixXd M = Mq;
+  report.condition = Condition(M);
+
+  std::vector<std::string> errors, warnings;
+  // Visibility: what the mass points see of each mode's lattice motion (§4.10.3).
+  const MassMoments& mm = body.moments();
+  std::vector<bool> visible(nq, true);
+  report.modes.resize(D);
+  for (int d = 0; d < D; ++d) {
+    ModeFinding& f = report.modes[d];
+    f.mode = body.modes()[d].name;
+    double lattice_ms = 0.0;
+    for (const Eigen::Vector2d& u : body.modes()[d].displacement) lattice_ms += u.squaredNorm();
+    lattice_ms /= double(body.modes()[d].displacement.size());
+    if (!(lattice_ms > 0.0)) {
+      errors.push_back("mode '" + f.mode + "' is zero: it moves no lattice point");
+      visible[kRigidDofs + d] = false;
+      continue;
+    }
+    f.visibility = std::sqrt(std::max(0.0, mm.G(d, d)) / mm.m / lattice_ms);
+    if (f.visibility < 1e-9) {
+      errors.push_back("mode '" + f.mode + "' moves no mass point: the lattice region it moves holds no mass (" +
+                       "§4.10.3), so M is singular");
+      visible[kRigidDofs + d] = false;
+    } else if (f.visibility < options.warn_visibility) {
+      std::ostringstream w;
+      w << "mode '" << f.mode << "' barely moves the mass points (visibility " << f.visibility
+        << "): most of what it moves is lattice without mass";
+      warnings.push_back(w.str());
+    }
+  }
+  // Pairwise angles between the modes' fields, ⟨u, v⟩ = Σ m_k u_k·v_k = G.
+  report.pair_angle_deg = Eigen::MatrixXd::Zero(D, D);
+  for (int a = 0; a < D; ++a)
+    for (int b = 0; b < D; ++b) {
+      const double denom = std::sqrt(mm.G(a, a) * mm.G(b, b));
+      const double c = denom > 0 ? std::min(1.0, std::abs(mm.G(a, b)) / denom) : 1.0;
+      report.pair_angle_deg(a, b) = a == b ? 0.0 : RadToDeg(std::acos(c));
+    }
+
+  // Angle of each mode to the span of all other visible degrees of freedom, in the unit-free
+  // scaled Gram matrix N = S M S (M is the Gram matrix of the fields J_k columns).
+  std::vector<int> idx;
+  for (int i = 0; i < nq; ++i)
+    if (visible[i]) idx.push_back(i);
+  const int n = int(idx.size());
+  Eigen::MatrixXd N(n, n);
+  Eigen::VectorXd s(n);
+  for (int a = 0; a < n; ++a) s[a] = 1.0 / std::sqrt(M(idx[a], idx[a]));
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b) N(a, b) = s[a] * M(idx[a], idx[b]) * s[b];
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(N);
+  const double tol = double(n) * std::numeric_limits<double>::epsilon() * eig.eigenvalues().maxCoeff();
+  const bool dependent = eig.eigenvalues().minCoeff() <= tol;
+  Eigen::MatrixXd Ninv;
+  if (!dependent) Ninv = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+  for (int a = 0; a < n; ++a) {
+    const int dof = idx[a];
+    if (dof < kRigidDofs) continue;
+    ModeFinding& f = report.modes[dof - kRigidDofs];
+    Eigen::VectorXd combo = Eigen::VectorXd::Zero(n);  // mode ≈ Σ combo_b dof_b (scaled)
+    if (dependent) {
+      // the null vectors v (N v = 0) this mode takes part in: mode = −Σ_{b≠a} v_b/v_a dof_b
+      int best = -1;
+      double best_share = 0.0;
+      for (int k = 0; k < n; ++k) {
+        if (eig.eigenvalues()[k] > tol) continue;
+        const double share = std::abs(eig.eigenvectors()(a, k));
+        if (share > best_share) best_share = share, best = k;
+      }
+      if (best >= 0 && best_share > 1e-6) {
+        f.angle_to_others_deg = 0.0;
+        combo = -eig.eigenvectors().col(best) / eig.eigenvectors()(a, best);
+      } else {
+        f.angle_to_others_deg = 90.0;  // not part of the dependency; its own angle is undefined here
+      }
+    } else {
+      const double sin2 = std::clamp(1.0 / Ninv(a, a), 0.0, 1.0);
+      f.angle_to_others_deg = RadToDeg(std::asin(std::sqrt(sin2)));
+      combo = -Ninv.col(a) / Ninv(a, a);
+    }
+    combo[a] = 0.0;
+    const double biggest = combo.cwiseAbs().maxCoeff();
+    if (biggest > 0.0) {
+      for (int b = 0; b < n; ++b)
+        if (std::abs(combo[b]) >= 0.1 * biggest) f.closest_combination.push_back({report.dofs[idx[b]], combo[b] / biggest});
+      std::sort(f.closest_combination.begin(), f.closest_combination.end(),
+                [](const Participant& x, const Participant& y) { return std::abs(x.weight) > std::abs(y.weight); });
+    }
+    if (f.angle_to_others_deg < report.smallest_angle_deg) {
+      report.smallest_angle_deg = f.angle_to_others_deg;
+      report.smallest_mode = f.mode;
+    }
+  }
+  // Messages for the closest dependency (one per dependency, not once per member).
+  if (!report.smallest_mode.empty()) {
+    const ModeFinding* worst = nullptr;
+    for (const ModeFinding& f : report.modes)
+      if (f.mode == report.smallest_mode) worst = &f;
+    const std::string what = "mode '" + worst->mode + "' is " +
+                             (report.smallest_angle_deg == 0.0 ? std::string("a combination of ")
+                                                               : "within " + Degrees(report.smallest_angle_deg) + " of ") +
+                             Join(worst->closest_combination) + " (mass inner product)";
+    if (report.smallest_angle_deg == 0.0)
+      errors.push_back(what + ": the modes are dependent and M is singular");
+    else if (report.smallest_angle_deg < options.warn_angle_deg)
+      warnings.push_back(what + ": M is ill-conditioned (cond " + std::to_string(report.condition.cond) + ")");
+  }
+  if (report.condition.singular && errors.empty())
+    errors.push_back("the mass matrix is singular at this state");
+  report.messages = errors;
+  report.messages.insert(report.messages.end(), warnings.begin(), warnings.end());
+  report.level = !errors.empty() ? ModeSetReport::Level::kError
+                 : !warnings.empty() ? ModeSetReport::Level::kWarning
+                                     : ModeSetReport::Level::kOk;
+  return report;
+}
+
+}  // namespace wobble::analysis
