@@ -64,9 +64,13 @@ Ptr<vtkImageData> Grab(vtkContextView* view) {
   return image;
 }
 
+// VTK 9.1's log axes (vtkAxis::SetLogScale) left the lines of our charts undrawn, so a log
+// axis plots log10 of the values on a linear axis titled "log10 ...".
+double Axis(double v, bool log) { return log ? std::log10(v) : v; }
+std::string AxisTitle(const std::string& title, bool log) { return log ? "log10 " + title : title; }
+
 void StyleAxis(vtkAxis* axis, const std::string& title, bool log) {
-  axis->SetTitle(title);
-  axis->SetLogScale(log);
+  axis->SetTitle(AxisTitle(title, log));
   axis->GetTitleProperties()->SetFontSize(14);
   axis->GetLabelProperties()->SetFontSize(12);
 }
@@ -130,10 +134,10 @@ vtkSmartPointer<vtkImageData> RenderChart(const ChartSpec& spec) {
     y->SetName(s.name.empty() ? "y" : s.name.c_str());
     for (size_t i = 0; i < s.x.size(); ++i) {
       if (!Usable(s.x[i], spec.log_x) || !Usable(s.y[i], spec.log_y)) continue;
-      x->InsertNextValue(s.x[i]);
-      y->InsertNextValue(s.y[i]);
-      ylo = std::min(ylo, s.y[i]);
-      yhi = std::max(yhi, s.y[i]);
+      x->InsertNextValue(Axis(s.x[i], spec.log_x));
+      y->InsertNextValue(Axis(s.y[i], spec.log_y));
+      ylo = std::min(ylo, Axis(s.y[i], spec.log_y));
+      yhi = std::max(yhi, Axis(s.y[i], spec.log_y));
     }
     if (x->GetNumberOfValues() == 0) continue;  // nothing drawable (e.g. all zero on a log axis)
     table->AddColumn(x);
@@ -150,6 +154,24 @@ vtkSmartPointer<vtkImageData> RenderChart(const ChartSpec& spec) {
     plot->SetWidth(s.width);
     if (s.points) vtkPlotPoints::SafeDownCast(plot)->SetMarkerStyle(vtkPlotPoints::CIRCLE);
   }
+  // VTK 9.1 draws no line when a plot's y range is tiny next to its magnitude (e.g. log10
+  // cond(M) between 5.38 and 5.42): give such an axis a fixed, wider range: whole decades on
+  // a log axis, at least ±5% of the magnitude on a linear one
+  if (ylo <= yhi) {
+    double lo = ylo, hi = yhi;
+    if (spec.log_y) {
+      lo = std::floor(ylo);
+      hi = std::max(std::ceil(yhi), lo + 1.0);
+    } else if (hi - lo < 0.1 * std::max(std::abs(lo), std::abs(hi))) {
+      const double pad = 0.05 * std::max(std::abs(lo), std::abs(hi));
+      lo -= pad;
+      hi += pad;
+    }
+    if (lo != ylo || hi != yhi) {
+      chart->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::FIXED);
+      chart->GetAxis(vtkAxis::LEFT)->SetRange(lo, hi);
+    }
+  }
   // vertical markers: one dashed two-point line each, one legend entry for all of them
   if (!spec.markers.empty() && ylo <= yhi) {
     bool first = true;
@@ -160,8 +182,8 @@ vtkSmartPointer<vtkImageData> RenderChart(const ChartSpec& spec) {
       x->SetName("x");
       auto y = Ptr<vtkDoubleArray>::New();
       y->SetName(spec.markers_name.c_str());
-      x->InsertNextValue(mx);
-      x->InsertNextValue(mx);
+      x->InsertNextValue(Axis(mx, spec.log_x));
+      x->InsertNextValue(Axis(mx, spec.log_x));
       y->InsertNextValue(ylo);
       y->InsertNextValue(yhi);
       table->AddColumn(x);

@@ -22,7 +22,8 @@ struct ChartSeries {
 
 struct ChartSpec {
   std::string title, x_title, y_title;
-  bool log_x = false, log_y = false;  // log axes need positive values (others are skipped)
+  // Log axes plot log10 of the values (titled "log10 ..."); values <= 0 are skipped.
+  bool log_x = false, log_y = false;
   std::vector<ChartSeries> series;
   // Vertical dashed lines at these x (e.g. the times of contact events), named in the legend.
   std::vector<double> markers;

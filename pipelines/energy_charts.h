@@ -25,7 +25,7 @@ class RunRecorder {
   // kinetic, gravitational, each mode's potential, ground, springs, total (terms that stay
   // zero for the whole run are left out, except kinetic, gravity and total).
   ChartSpec EnergyChart(const std::string& title) const;
-  // cond₂(M) against time on a log axis, with the contact events as markers (Fig. 4.9).
+  // cond₂(M) against time, with the contact events as markers (Fig. 4.9).
   ChartSpec ConditionChart(const std::string& title) const;
 
  private:
