@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "wobble/io/atomic_file.h"
+
 namespace wobble::app {
 
 std::string FormatDouble(double value) {
@@ -34,48 +36,35 @@ void CheckWritable(const std::string& path) {
 
 void WriteCsvAtomically(const std::string& path, const std::vector<std::string>& header,
                         const std::vector<std::vector<double>>& rows) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  std::error_code ec;
-  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-  if (ec) throw std::runtime_error(path + ": cannot create its folder: " + ec.message());
-
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
-  std::string line;
-  for (size_t i = 0; i < header.size(); ++i) {
-    if (i) line += ',';
-    line += header[i];
-  }
-  line += '\n';
-  bool ok = std::fputs(line.c_str(), f) >= 0;
-  char buf[64];
-  for (const std::vector<double>& row : rows) {
-    line.clear();
-    for (size_t i = 0; i < row.size(); ++i) {
+  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+    std::FILE* f = std::fopen(tmp.c_str(), "w");
+    if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
+    std::string line;
+    for (size_t i = 0; i < header.size(); ++i) {
       if (i) line += ',';
-      if (std::isfinite(row[i])) {
-        const auto res = std::to_chars(buf, buf + sizeof(buf), row[i]);
-        line.append(buf, res.ptr);
-      } else {
-        line += FormatDouble(row[i]);
-      }
+      line += header[i];
     }
     line += '\n';
-    ok = ok && std::fputs(line.c_str(), f) >= 0;
-  }
-  const int saved_errno = errno;
-  ok = (std::fclose(f) == 0) && ok;
-  if (!ok) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(tmp + ": write failed: " + std::strerror(saved_errno));
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot rename " + tmp + " to it: " + ec.message());
-  }
+    bool ok = std::fputs(line.c_str(), f) >= 0;
+    char buf[64];
+    for (const std::vector<double>& row : rows) {
+      line.clear();
+      for (size_t i = 0; i < row.size(); ++i) {
+        if (i) line += ',';
+        if (std::isfinite(row[i])) {
+          const auto res = std::to_chars(buf, buf + sizeof(buf), row[i]);
+          line.append(buf, res.ptr);
+        } else {
+          line += FormatDouble(row[i]);
+        }
+      }
+      line += '\n';
+      ok = ok && std::fputs(line.c_str(), f) >= 0;
+    }
+    const int saved_errno = errno;
+    ok = (std::fclose(f) == 0) && ok;
+    if (!ok) throw std::runtime_error(tmp + ": " + std::strerror(saved_errno));
+  });
 }
 
 }  // namespace wobble::app

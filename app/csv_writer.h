@@ -1,4 +1,4 @@
-// Writes a table of numbers as CSV, atomically: to FILE.tmp in the same folder, then renamed
+// Writes a table of numbers as CSV, atomically (wobble/io/atomic_file.h): to FILE.tmp, then renamed
 // over FILE, so that a reader never sees half a file. Numbers are written in the shortest
 // form that reads back to the same double.
 #pragma once

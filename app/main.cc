@@ -7,6 +7,9 @@
 
 #include "cli_common.h"
 #include "inspect.h"
+#ifdef WOBBLE_HAVE_PIPELINES
+#include "render.h"
+#endif
 #include "simulate.h"
 #include "wobble/io/object_file.h"
 
@@ -22,6 +25,14 @@ int main(int argc, char** argv) {
   InspectArgs inspect_args;
   CLI::App* simulate = AddSimulateCommand(&app, &simulate_args);
   CLI::App* inspect = AddInspectCommand(&app, &inspect_args);
+#ifdef WOBBLE_HAVE_PIPELINES
+  const std::string render_what = "frames,filmstrip,charts", export_what = "vtp,exr,disp";
+  RenderArgs render_args, export_args;
+  CLI::App* render = AddRenderCommand(&app, "render", "Simulate and draw: PNG frames, a filmstrip, energy and cond(M) charts",
+                                      render_what, &render_args);
+  CLI::App* exporter = AddRenderCommand(&app, "export", "Simulate and export: .vtp/.pvd for ParaView, EXR frames and "
+                                        "displacement images", export_what, &export_args);
+#endif
 
   try {
     app.parse(argc, argv);
@@ -34,6 +45,10 @@ int main(int argc, char** argv) {
   try {
     if (simulate->parsed()) return RunSimulate(simulate_args);
     if (inspect->parsed()) return RunInspect(inspect_args);
+#ifdef WOBBLE_HAVE_PIPELINES
+    if (render->parsed()) return RunRender(render_args, render_what);
+    if (exporter->parsed()) return RunRender(export_args, export_what);
+#endif
   } catch (const wobble::io::ParseError& e) {
     std::cerr << e.what() << std::endl;  // already "FILE:LINE: message"
     return kExitBadInput;

@@ -1,0 +1,284 @@
+#include "pipelines/charts.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <stdexcept>
+#include <vtkAxis.h>
+#include <vtkChartHistogram2D.h>
+#include <vtkChartLegend.h>
+#include <vtkChartXY.h>
+#include <vtkColorTransferFunction.h>
+#include <vtkContextScene.h>
+#include <vtkContextView.h>
+#include <vtkDoubleArray.h>
+#include <vtkImageData.h>
+#include <vtkPen.h>
+#include <vtkPlot.h>
+#include <vtkPlotPoints.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkTable.h>
+#include <vtkTextProperty.h>
+#include <vtkWindowToImageFilter.h>
+
+#include "pipelines/exports.h"
+#include "pipelines/scene_view.h"
+#include "wobble/io/atomic_file.h"
+
+namespace wobble::pipelines {
+namespace {
+
+template <class T> using Ptr = vtkSmartPointer<T>;
+
+// A colour-blind-friendly palette (Okabe–Ito), then greys.
+constexpr unsigned char kPalette[][3] = {{0, 114, 178},  {213, 94, 0},   {0, 158, 115}, {204, 121, 167},
+                                         {230, 159, 0},  {86, 180, 233}, {0, 0, 0},     {120, 120, 120},
+                                         {240, 228, 66}, {160, 160, 160}};
+
+Ptr<vtkContextView> MakeView(int width, int height) {
+  if (!HasDisplay())
+    throw std::runtime_error("charts need an X display (VTK 9.1): run under xvfb-run -a -s \"-screen 0 1280x1024x24\"");
+  if (width < 32 || height < 32 || width > 8192 || height > 8192)
+    throw std::invalid_argument("chart size must be between 32 and 8192 pixels a side");
+  auto view = Ptr<vtkContextView>::New();
+  view->GetRenderWindow()->SetOffScreenRendering(1);
+  view->GetRenderWindow()->SetMultiSamples(0);
+  view->GetRenderWindow()->SetSize(width, height);
+  view->GetRenderer()->SetBackground(1.0, 1.0, 1.0);
+  return view;
+}
+
+Ptr<vtkImageData> Grab(vtkContextView* view) {
+  view->GetRenderWindow()->Render();
+  auto grab = Ptr<vtkWindowToImageFilter>::New();
+  grab->SetInput(view->GetRenderWindow());
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->ShouldRerenderOff();
+  grab->Update();
+  auto image = Ptr<vtkImageData>::New();
+  image->DeepCopy(grab->GetOutput());
+  return image;
+}
+
+// VTK 9.1's log axes (vtkAxis::SetLogScale) left the lines of our charts undrawn, so a log
+// axis plots log10 of the values on a linear axis titled "log10 ...".
+double Axis(double v, bool log) { return log ? std::log10(v) : v; }
+std::string AxisTitle(const std::string& title, bool log) { return log ? "log10 " + title : title; }
+
+void StyleAxis(vtkAxis* axis, const std::string& title, bool log) {
+  axis->SetTitle(AxisTitle(title, log));
+  axis->GetTitleProperties()->SetFontSize(14);
+  axis->GetLabelProperties()->SetFontSize(12);
+}
+
+void Validate(const ChartSpec& spec) {
+  if (spec.series.empty()) throw std::invalid_argument("chart '" + spec.title + "': no series");
+  for (const ChartSeries& s : spec.series)
+    if (s.x.size() != s.y.size())
+      throw std::invalid_argument("chart '" + spec.title + "': series '" + s.name + "' has " +
+                                  std::to_string(s.x.size()) + " x and " + std::to_string(s.y.size()) + " y values");
+}
+
+bool Usable(double v, bool log) { return std::isfinite(v) && (!log || v > 0.0); }
+
+void WriteText(const std::string& path, const std::string& text) {
+  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+    std::FILE* f = std::fopen(tmp.c_str(), "w");
+    if (!f) throw std::runtime_error("cannot open " + tmp);
+    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if ((std::fclose(f) != 0) || !ok) throw std::runtime_error("short write to " + tmp);
+  });
+}
+
+std::string Num(double v) {
+  if (std::isnan(v)) return "nan";
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.17g", v);
+  return buf;
+}
+
+std::string CsvField(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+}  // namespace
+
+vtkSmartPointer<vtkImageData> RenderChart(const ChartSpec& spec) {
+  Validate(spec);
+  auto view = MakeView(spec.width, spec.height);
+  auto chart = Ptr<vtkChartXY>::New();
+  view->GetScene()->AddItem(chart);
+  chart->SetTitle(spec.title);
+  chart->GetTitleProperties()->SetFontSize(16);
+  chart->SetShowLegend(true);
+  chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
+  chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
+  StyleAxis(chart->GetAxis(vtkAxis::BOTTOM), spec.x_title, spec.log_x);
+  StyleAxis(chart->GetAxis(vtkAxis::LEFT), spec.y_title, spec.log_y);
+
+  // the data range, for the marker lines
+  double ylo = std::numeric_limits<double>::infinity(), yhi = -ylo;
+  int palette = 0;
+  for (const ChartSeries& s : spec.series) {
+    auto table = Ptr<vtkTable>::New();
+    auto x = Ptr<vtkDoubleArray>::New();
+    x->SetName("x");
+    auto y = Ptr<vtkDoubleArray>::New();
+    y->SetName(s.name.empty() ? "y" : s.name.c_str());
+    for (size_t i = 0; i < s.x.size(); ++i) {
+      if (!Usable(s.x[i], spec.log_x) || !Usable(s.y[i], spec.log_y)) continue;
+      x->InsertNextValue(Axis(s.x[i], spec.log_x));
+      y->InsertNextValue(Axis(s.y[i], spec.log_y));
+      ylo = std::min(ylo, Axis(s.y[i], spec.log_y));
+      yhi = std::max(yhi, Axis(s.y[i], spec.log_y));
+    }
+    if (x->GetNumberOfValues() == 0) continue;  // nothing drawable (e.g. all zero on a log axis)
+    table->AddColumn(x);
+    table->AddColumn(y);
+    vtkPlot* plot = chart->AddPlot(s.points ? vtkChart::POINTS : vtkChart::LINE);
+    plot->SetInputData(table, 0, 1);
+    plot->SetLabel(s.name);
+    const unsigned char* c = kPalette[palette++ % (sizeof(kPalette) / sizeof(kPalette[0]))];
+    if (s.rgb[0] >= 0) {
+      plot->SetColor((unsigned char)s.rgb[0], (unsigned char)s.rgb[1], (unsigned char)s.rgb[2], 255);
+    } else {
+      plot->SetColor(c[0], c[1], c[2], 255);
+    }
+    plot->SetWidth(s.width);
+    if (s.points) vtkPlotPoints::SafeDownCast(plot)->SetMarkerStyle(vtkPlotPoints::CIRCLE);
+  }
+  // VTK 9.1 draws no line when a plot's y range is tiny next to its magnitude (e.g. log10
+  // cond(M) between 5.38 and 5.42): give such an axis a fixed, wider range: whole decades on
+  // a log axis, at least ±5% of the magnitude on a linear one
+  if (ylo <= yhi) {
+    double lo = ylo, hi = yhi;
+    if (spec.log_y) {
+      lo = std::floor(ylo);
+      hi = std::max(std::ceil(yhi), lo + 1.0);
+    } else if (hi - lo < 0.1 * std::max(std::abs(lo), std::abs(hi))) {
+      const double pad = 0.05 * std::max(std::abs(lo), std::abs(hi));
+      lo -= pad;
+      hi += pad;
+    }
+    if (lo != ylo || hi != yhi) {
+      chart->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::FIXED);
+      chart->GetAxis(vtkAxis::LEFT)->SetRange(lo, hi);
+    }
+  }
+  // vertical markers: one dashed two-point line each, one legend entry for all of them
+  if (!spec.markers.empty() && ylo <= yhi) {
+    bool first = true;
+    for (double mx : spec.markers) {
+      if (!Usable(mx, spec.log_x)) continue;
+      auto table = Ptr<vtkTable>::New();
+      auto x = Ptr<vtkDoubleArray>::New();
+      x->SetName("x");
+      auto y = Ptr<vtkDoubleArray>::New();
+      y->SetName(spec.markers_name.c_str());
+      x->InsertNextValue(Axis(mx, spec.log_x));
+      x->InsertNextValue(Axis(mx, spec.log_x));
+      y->InsertNextValue(ylo);
+      y->InsertNextValue(yhi);
+      table->AddColumn(x);
+      table->AddColumn(y);
+      vtkPlot* plot = chart->AddPlot(vtkChart::LINE);
+      plot->SetInputData(table, 0, 1);
+      plot->SetLabel(spec.markers_name);
+      plot->SetColor(150, 150, 150, 255);
+      plot->SetWidth(1.0f);
+      plot->GetPen()->SetLineType(vtkPen::DASH_LINE);
+      plot->SetLegendVisibility(first);
+      first = false;
+    }
+  }
+  return Grab(view);
+}
+
+void WriteChartCsv(const ChartSpec& spec, const std::string& csv_path) {
+  Validate(spec);
+  bool same_x = true;
+  for (const ChartSeries& s : spec.series) same_x = same_x && s.x == spec.series[0].x;
+  const std::string x_name = spec.x_title.empty() ? "x" : spec.x_title;
+  std::string text;
+  if (same_x) {
+    text = CsvField(x_name);
+    for (const ChartSeries& s : spec.series) text += "," + CsvField(s.name);
+    text += "\n";
+    for (size_t i = 0; i < spec.series[0].x.size(); ++i) {
+      text += Num(spec.series[0].x[i]);
+      for (const ChartSeries& s : spec.series) text += "," + Num(s.y[i]);
+      text += "\n";
+    }
+  } else {
+    text = "series," + CsvField(x_name) + "," + CsvField(spec.y_title.empty() ? "y" : spec.y_title) + "\n";
+    for (const ChartSeries& s : spec.series)
+      for (size_t i = 0; i < s.x.size(); ++i) text += CsvField(s.name) + "," + Num(s.x[i]) + "," + Num(s.y[i]) + "\n";
+  }
+  WriteText(csv_path, text);
+  if (!spec.markers.empty()) {
+    namespace fs = std::filesystem;
+    const fs::path p(csv_path);
+    std::string markers = CsvField(x_name) + "\n";
+    for (double m : spec.markers) markers += Num(m) + "\n";
+    WriteText((p.parent_path() / (p.stem().string() + "_markers.csv")).string(), markers);
+  }
+}
+
+void WriteChart(const ChartSpec& spec, const std::string& png_path, const std::string& csv_path) {
+  if (!csv_path.empty()) WriteChartCsv(spec, csv_path);
+  if (!png_path.empty()) WritePng(png_path, RenderChart(spec));
+}
+
+vtkSmartPointer<vtkImageData> RenderScalarField(const ScalarFieldSpec& spec) {
+  if (spec.nx < 1 || spec.ny < 1 || spec.values.size() != size_t(spec.nx) * spec.ny)
+    throw std::invalid_argument("scalar field '" + spec.title + "': values must be nx * ny");
+  // the field as an image in data coordinates, coloured through a transfer function
+  auto image = Ptr<vtkImageData>::New();
+  image->SetDimensions(spec.nx, spec.ny, 1);
+  image->SetOrigin(spec.x_min, spec.y_min, 0.0);
+  image->SetSpacing(spec.nx > 1 ? (spec.x_max - spec.x_min) / (spec.nx - 1) : 1.0,
+                    spec.ny > 1 ? (spec.y_max - spec.y_min) / (spec.ny - 1) : 1.0, 1.0);
+  image->AllocateScalars(VTK_DOUBLE, 1);
+  auto* v = static_cast<double*>(image->GetScalarPointer());
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (size_t i = 0; i < spec.values.size(); ++i) {
+    double value = spec.values[i];
+    if (spec.log_values) value = value > 0 ? std::log10(value) : std::numeric_limits<double>::quiet_NaN();
+    v[i] = value;
+    if (std::isfinite(value)) {
+      lo = std::min(lo, value);
+      hi = std::max(hi, value);
+    }
+  }
+  if (!(lo <= hi)) lo = 0, hi = 1;
+  if (hi == lo) hi = lo + 1;
+  auto tf = Ptr<vtkColorTransferFunction>::New();
+  tf->SetColorSpaceToDiverging();
+  tf->AddRGBPoint(lo, 0.23, 0.30, 0.75);
+  tf->AddRGBPoint(0.5 * (lo + hi), 0.87, 0.87, 0.87);
+  tf->AddRGBPoint(hi, 0.71, 0.02, 0.15);
+  tf->SetNanColor(0.5, 0.5, 0.5);
+
+  auto view = MakeView(spec.width, spec.height);
+  auto chart = Ptr<vtkChartHistogram2D>::New();
+  view->GetScene()->AddItem(chart);
+  chart->SetInputData(image);
+  chart->SetTransferFunction(tf);
+  chart->SetTitle(spec.title + (spec.log_values ? "  (colour: log10 " + spec.value_title + ")" : ""));
+  StyleAxis(chart->GetAxis(vtkAxis::BOTTOM), spec.x_title, false);
+  StyleAxis(chart->GetAxis(vtkAxis::LEFT), spec.y_title, false);
+  return Grab(view);
+}
+
+void WriteScalarFieldPng(const ScalarFieldSpec& spec, const std::string& png_path) {
+  WritePng(png_path, RenderScalarField(spec));
+}
+
+}  // namespace wobble::pipelines

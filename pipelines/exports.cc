@@ -1,0 +1,166 @@
+#include "pipelines/exports.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+#include <vtkErrorCode.h>
+#include <vtkImageData.h>
+#include <vtkPNGWriter.h>
+#include <vtkPolyData.h>
+#include <vtkXMLImageDataWriter.h>
+#include <vtkXMLPolyDataWriter.h>
+
+#include "wobble/dynamics/kinematics.h"
+#include "wobble/io/atomic_file.h"
+
+namespace wobble::pipelines {
+namespace {
+
+// Runs a configured VTK writer on the temporary file; VTK reports failures through an error
+// code rather than an exception.
+template <class Writer> void RunWriter(Writer* writer, const std::string& tmp) {
+  writer->SetFileName(tmp.c_str());
+  writer->Write();
+  const unsigned long code = writer->GetErrorCode();
+  if (code != 0) throw std::runtime_error(std::string("VTK writer: ") + vtkErrorCode::GetStringFromErrorCode(code));
+}
+
+std::string XmlEscape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '&') out += "&amp;";
+    else if (c == '"') out += "&quot;";
+    else if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+void WriteVtp(const std::string& path, vtkPolyData* data) {
+  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+    auto w = vtkSmartPointer<vtkXMLPolyDataWriter>::New();
+    w->SetInputData(data);
+    w->SetDataModeToAppended();
+    w->EncodeAppendedDataOff();  // raw binary: smaller and faster than base64
+    w->SetCompressorTypeToNone();
+    RunWriter(w.Get(), tmp);
+  });
+}
+
+void WriteVti(const std::string& path, vtkImageData* image) {
+  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+    auto w = vtkSmartPointer<vtkXMLImageDataWriter>::New();
+    w->SetInputData(image);
+    w->SetDataModeToAppended();
+    w->EncodeAppendedDataOff();
+    RunWriter(w.Get(), tmp);
+  });
+}
+
+void WritePng(const std::string& path, vtkImageData* image) {
+  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+    auto w = vtkSmartPointer<vtkPNGWriter>::New();
+    w->SetInputData(image);
+    RunWriter(w.Get(), tmp);
+  });
+}
+
+void PvdCollection::Add(double time, int part, const std::string& file, const std::string& name) {
+  entries_.push_back({time, part, file, name});
+}
+
+void PvdCollection::Write(const std::string& pvd_path) const {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(pvd_path).parent_path();
+  std::ostringstream xml;
+  xml.precision(17);
+  xml << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";
+  for (const Entry& e : entries_) {
+    std::string file = e.file;
+    const fs::path rel = fs::path(e.file).lexically_relative(folder.empty() ? fs::path(".") : folder);
+    if (!rel.empty() && rel.native().rfind("..", 0) != 0) file = rel.string();
+    xml << "    <DataSet timestep=\"" << e.time << "\" group=\"\" part=\"" << e.part << "\"";
+    if (!e.name.empty()) xml << " name=\"" << XmlEscape(e.name) << "\"";
+    xml << " file=\"" << XmlEscape(file) << "\"/>\n";
+  }
+  xml << "  </Collection>\n</VTKFile>\n";
+  const std::string text = xml.str();
+  io::WriteFileAtomically(pvd_path, [&](const std::string& tmp) {
+    std::FILE* f = std::fopen(tmp.c_str(), "w");
+    if (!f) throw std::runtime_error("cannot open " + tmp);
+    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if ((std::fclose(f) != 0) || !ok) throw std::runtime_error("short write to " + tmp);
+  });
+}
+
+std::vector<ExrChannel> DisplacementImage(const World& world, int body_index, int width, int height) {
+  if (width <= 0 || height <= 0) throw std::invalid_argument("displacement image size must be positive");
+  const BodyModel& body = world.body(body_index);
+  const Lattice& lat = body.lattice();
+  const VecQ<double>& q = world.state(body_index).q;
+  const Frame<double> frame(q);
+  std::vector<ExrChannel> channels = {{"disp.X", {}}, {"disp.Y", {}}};
+  channels[0].data.resize(size_t(width) * height);
+  channels[1].data.resize(size_t(width) * height);
+  for (int py = 0; py < height; ++py) {
+    const double t = 1.0 - (py + 0.5) / height;
+    for (int px = 0; px < width; ++px) {
+      const Eigen::Vector2d st((px + 0.5) / width, t);
+      const Eigen::Vector2d rest = lat.origin() + st.x() * lat.axis_s() + st.y() * lat.axis_t();
+      Eigen::Vector2d b0;
+      Mat2D<double> B;
+      body.LocalBasis(st, &b0, &B);
+      const Eigen::Vector2d d = WorldFromLocal(frame, LocalPosition<double>(b0, B, q)) - rest;
+      channels[0].data[size_t(py) * width + px] = float(d.x());
+      channels[1].data[size_t(py) * width + px] = float(d.y());
+    }
+  }
+  return channels;
+}
+
+void WriteDisplacementExr(const std::string& path, const World& world, int body, int width, int height) {
+  WriteExrChannels(path, width, height, DisplacementImage(world, body, width, height), ExrCompression::kZip);
+}
+
+VtpSeriesWriter::VtpSeriesWriter(const World* world, int body, std::string folder, std::string stem, int shape_samples)
+    : world_(world), folder_(std::move(folder)), stem_(std::move(stem)) {
+  if (!world_) throw std::invalid_argument("VtpSeriesWriter needs a world");
+  lattice_ = vtkSmartPointer<LatticeSource>::New();
+  points_ = vtkSmartPointer<MassPointSource>::New();
+  shape_ = vtkSmartPointer<ShapeSource>::New();
+  shape_->SetSamplesPerSegment(shape_samples);
+  for (WorldSourceBase* s : {static_cast<WorldSourceBase*>(lattice_), static_cast<WorldSourceBase*>(points_),
+                             static_cast<WorldSourceBase*>(shape_)}) {
+    s->SetWorld(world_);
+    s->SetBody(body);
+  }
+}
+
+void VtpSeriesWriter::WriteFrame(int frame) {
+  char number[32];
+  std::snprintf(number, sizeof(number), "%04d", frame);
+  const struct {
+    WorldSourceBase* source;
+    const char* part;
+  } parts[3] = {{lattice_, "lattice"}, {points_, "points"}, {shape_, "shape"}};
+  for (int p = 0; p < 3; ++p) {
+    parts[p].source->Modified();
+    parts[p].source->Update();
+    const std::string file = folder_ + "/" + stem_ + "_" + parts[p].part + "_" + number + ".vtp";
+    WriteVtp(file, parts[p].source->GetOutput());
+    pvd_.Add(world_->time(), p, file, parts[p].part);
+  }
+}
+
+std::string VtpSeriesWriter::WriteCollection() const {
+  pvd_.Write(CollectionPath());
+  return CollectionPath();
+}
+
+}  // namespace wobble::pipelines

@@ -1,0 +1,73 @@
+// Files people open elsewhere, every one written atomically (wobble/io/atomic_file.h):
+//   .vtp  one vtkPolyData (VTK XML, raw appended binary), with its TimeValue field array
+//   .pvd  a ParaView collection listing .vtp files per time step (and part): a time series
+//   .vti  one vtkImageData (VTK XML)
+//   .png  one RGB(A) vtkImageData
+//   .exr  the deformation as a data image over the body's rest lattice (disp.X, disp.Y)
+// Failures throw std::runtime_error naming the file and the reason; an earlier file of the
+// same name is left as it was.
+#pragma once
+
+#include <string>
+#include <vector>
+#include <vtkSmartPointer.h>
+
+#include "pipelines/exr_io.h"
+#include "pipelines/world_sources.h"
+
+class vtkImageData;
+class vtkPolyData;
+
+namespace wobble::pipelines {
+
+void WriteVtp(const std::string& path, vtkPolyData* data);
+void WriteVti(const std::string& path, vtkImageData* image);
+void WritePng(const std::string& path, vtkImageData* image);
+
+// A ParaView .pvd collection: <DataSet timestep=".." part=".." file=".."/> per entry; file
+// names are written relative to the .pvd's folder when they lie under it.
+class PvdCollection {
+ public:
+  void Add(double time, int part, const std::string& file, const std::string& name = "");
+  void Write(const std::string& pvd_path) const;
+  int size() const { return int(entries_.size()); }
+
+ private:
+  struct Entry {
+    double time;
+    int part;
+    std::string file, name;
+  };
+  std::vector<Entry> entries_;
+};
+
+// The deformation of body `body` over its rest lattice domain as a width × height image:
+// pixel (px, py) (py from the top) stands for lattice coordinates
+// s = (px + ½)/width, t = 1 − (py + ½)/height, i.e. the rest point p = origin + s·axis_s + t·axis_t,
+// and holds disp = x(s, t) − p: where that point of the rest drawing is now in the world
+// (Eq. 4.2, rigid motion included) minus where it was drawn. Channels disp.X, disp.Y.
+std::vector<ExrChannel> DisplacementImage(const World& world, int body, int width, int height);
+void WriteDisplacementExr(const std::string& path, const World& world, int body, int width, int height);
+
+// Writes the lattice, mass points and shape of one body per frame as three .vtp files
+// (<folder>/<stem>_lattice_NNNN.vtp, _points_, _shape_) and keeps <folder>/<stem>.pvd listing
+// them as parts 0, 1, 2 of each time step (rewritten by WriteCollection()).
+class VtpSeriesWriter {
+ public:
+  VtpSeriesWriter(const World* world, int body, std::string folder, std::string stem, int shape_samples = 16);
+  // Writes the current state as frame number `frame` (the file names' NNNN).
+  void WriteFrame(int frame);
+  // Writes the .pvd; returns its path.
+  std::string WriteCollection() const;
+  std::string CollectionPath() const { return folder_ + "/" + stem_ + ".pvd"; }
+
+ private:
+  const World* world_;
+  std::string folder_, stem_;
+  vtkSmartPointer<LatticeSource> lattice_;
+  vtkSmartPointer<MassPointSource> points_;
+  vtkSmartPointer<ShapeSource> shape_;
+  PvdCollection pvd_;
+};
+
+}  // namespace wobble::pipelines

@@ -1,0 +1,63 @@
+#include "pipelines/exr_io.h"
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <stdexcept>
+
+#include "wobble/io/atomic_file.h"
+
+namespace wobble::pipelines {
+
+void WriteExrChannels(const std::string& path, int width, int height, const std::vector<ExrChannel>& channels,
+                      ExrCompression compression) {
+  if (width <= 0 || height <= 0)
+    throw std::invalid_argument(path + ": image size " + std::to_string(width) + "x" + std::to_string(height));
+  if (channels.empty()) throw std::invalid_argument(path + ": no channels to write");
+  for (const ExrChannel& c : channels)
+    if (c.data.size() != size_t(width) * size_t(height))
+      throw std::invalid_argument(path + ": channel '" + c.name + "' has " + std::to_string(c.data.size()) +
+                                  " values, expected " + std::to_string(size_t(width) * height));
+  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+    Imf::Header header(width, height);
+    header.compression() = compression == ExrCompression::kNone  ? Imf::NO_COMPRESSION
+                           : compression == ExrCompression::kPiz ? Imf::PIZ_COMPRESSION
+                                                                 : Imf::ZIP_COMPRESSION;
+    Imf::FrameBuffer fb;
+    for (const ExrChannel& c : channels) {
+      header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+      fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.data.data(), sizeof(float), sizeof(float) * size_t(width)));
+    }
+    Imf::OutputFile file(tmp.c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(height);
+  });
+}
+
+ExrImage ReadExrChannels(const std::string& path) {
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i dw = file.header().dataWindow();
+    ExrImage image;
+    image.width = dw.max.x - dw.min.x + 1;
+    image.height = dw.max.y - dw.min.y + 1;
+    Imf::FrameBuffer fb;
+    const size_t n = size_t(image.width) * size_t(image.height);
+    for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) {
+      std::vector<float>& data = image.channels[it.name()];
+      data.assign(n, 0.0f);
+      // the slice base points at pixel (0, 0) of the data window's coordinates
+      char* base = (char*)(data.data() - dw.min.x - size_t(dw.min.y) * image.width);
+      fb.insert(it.name(), Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(image.width)));
+    }
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    return image;
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": cannot read as OpenEXR: " + e.what());
+  }
+}
+
+}  // namespace wobble::pipelines

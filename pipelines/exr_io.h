@@ -1,0 +1,37 @@
+// OpenEXR images of named float channels: render frames (R, G, B, A, depth.Z), data images
+// (disp.X, disp.Y) and any analysis field (cond, ...). No VTK here, only OpenEXR.
+//
+// Pixel layout everywhere: row-major, width × height floats per channel, row 0 at the TOP of
+// the image (the EXR convention; VTK images start at the bottom and are flipped by callers).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace wobble::pipelines {
+
+struct ExrChannel {
+  std::string name;         // e.g. "R", "depth.Z", "disp.X", "cond"
+  std::vector<float> data;  // width * height values, row 0 at the top
+};
+
+enum class ExrCompression { kNone, kZip, kPiz };
+
+// Writes a scan-line EXR of 32-bit float channels, atomically (temporary file + rename).
+// Throws std::invalid_argument for a bad size or channel length, std::runtime_error (naming
+// the path and reason) when the file cannot be written; an earlier file is then left intact.
+void WriteExrChannels(const std::string& path, int width, int height, const std::vector<ExrChannel>& channels,
+                      ExrCompression compression = ExrCompression::kZip);
+
+struct ExrImage {
+  int width = 0, height = 0;
+  std::map<std::string, std::vector<float>> channels;  // row 0 at the top
+  // Value of channel `name` at pixel (x, y), y from the top. Throws std::out_of_range.
+  float At(const std::string& name, int x, int y) const { return channels.at(name).at(size_t(y) * width + x); }
+};
+
+// Reads every channel of an EXR as floats. Throws std::runtime_error naming the file.
+ExrImage ReadExrChannels(const std::string& path);
+
+}  // namespace wobble::pipelines

@@ -1,0 +1,321 @@
+#include "pipelines/scene_view.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <vtkActor.h>
+#include <vtkCamera.h>
+#include <vtkDataArray.h>
+#include <vtkFloatArray.h>
+#include <vtkImageData.h>
+#include <vtkLookupTable.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkWindowToImageFilter.h>
+
+#include "pipelines/exports.h"
+
+namespace wobble::pipelines {
+
+template <class T> using Ptr = vtkSmartPointer<T>;
+
+bool HasDisplay() {
+  const char* d = std::getenv("DISPLAY");
+  return d && *d;
+}
+
+Eigen::AlignedBox2d BodyBounds(const World& world, int body_index) {
+  const BodyModel& body = world.body(body_index);
+  const VecQ<double>& q = world.state(body_index).q;
+  const Eigen::Matrix2d R = Rotation(q[2]);
+  Eigen::AlignedBox2d box;
+  for (int c = 0; c < body.lattice().size(); ++c) {
+    Eigen::Vector2d l = body.rest_control()[c];
+    for (int m = 0; m < body.num_modes(); ++m) l += body.modes()[m].displacement[c] * q[kRigidDofs + m];
+    box.extend(Eigen::Vector2d(q[0], q[1]) + R * l);
+  }
+  return box;
+}
+
+struct SceneView::Impl {
+  const World* world;
+  int body;
+  Ptr<vtkRenderWindow> window;
+  Ptr<vtkRenderer> renderer;
+  Ptr<GroundSource> ground;
+  Ptr<LatticeSource> lattice;
+  Ptr<MassPointSource> points;
+  Ptr<ShapeSource> shape;
+  Ptr<SpringSource> springs;
+  Ptr<TrailSource> trails;
+  Ptr<vtkPolyDataMapper> points_mapper, lattice_points_mapper;
+  Ptr<vtkLookupTable> lut;
+  Ptr<vtkScalarBarActor> bar;
+  Ptr<vtkTextActor> overlay;
+  vtkPolyDataMapper* colored = nullptr;  // the mapper that shows color_by, if any
+
+  Ptr<vtkActor> AddActor(vtkPolyDataAlgorithm* source, const double rgb[3], double line_width, double point_size,
+                         Ptr<vtkPolyDataMapper>* mapper_out = nullptr) {
+    auto mapper = Ptr<vtkPolyDataMapper>::New();
+    mapper->SetInputConnection(source->GetOutputPort());
+    mapper->ScalarVisibilityOff();
+    auto actor = Ptr<vtkActor>::New();
+    actor->SetMapper(mapper);
+    actor->GetProperty()->SetColor(rgb[0], rgb[1], rgb[2]);
+    actor->GetProperty()->SetLineWidth(float(line_width));
+    actor->GetProperty()->SetPointSize(float(point_size));
+    actor->GetProperty()->SetLighting(false);  // flat 2D colours
+    renderer->AddActor(actor);
+    if (mapper_out) *mapper_out = mapper;
+    return actor;
+  }
+};
+
+SceneView::SceneView(const World* world, int body, SceneOptions options) : impl_(new Impl), options_(std::move(options)) {
+  if (!HasDisplay())
+    throw std::runtime_error("rendering needs an X display (VTK 9.1): run under xvfb-run -a -s \"-screen 0 1280x1024x24\"");
+  if (!world || body < 0 || body >= world->num_bodies()) throw std::invalid_argument("SceneView: no such world/body");
+  if (options_.width < 16 || options_.height < 16 || options_.width > 8192 || options_.height > 8192)
+    throw std::invalid_argument("image size must be between 16 and 8192 pixels a side");
+  Impl& m = *impl_;
+  m.world = world;
+  m.body = body;
+  m.renderer = Ptr<vtkRenderer>::New();
+  m.renderer->SetBackground(1.0, 1.0, 1.0);
+  m.window = Ptr<vtkRenderWindow>::New();
+  m.window->SetOffScreenRendering(1);
+  m.window->SetMultiSamples(0);  // identical pixels run to run, cheaper readback
+  m.window->SetSize(options_.width, options_.height);
+  m.window->AddRenderer(m.renderer);
+
+  auto attach = [&](WorldSourceBase* s) {
+    s->SetWorld(world);
+    s->SetBody(body);
+  };
+  m.ground = Ptr<GroundSource>::New();
+  m.lattice = Ptr<LatticeSource>::New();
+  m.points = Ptr<MassPointSource>::New();
+  m.shape = Ptr<ShapeSource>::New();
+  m.shape->SetSamplesPerSegment(options_.shape_samples);
+  m.springs = Ptr<SpringSource>::New();
+  m.trails = Ptr<TrailSource>::New();
+  for (WorldSourceBase* s : {(WorldSourceBase*)m.ground, (WorldSourceBase*)m.lattice, (WorldSourceBase*)m.points,
+                             (WorldSourceBase*)m.shape, (WorldSourceBase*)m.springs, (WorldSourceBase*)m.trails})
+    attach(s);
+
+  // drawn back to front: painter's order does not matter in a flat 2D scene with a depth
+  // buffer, but the z offsets below keep points above lines above the ground
+  const double ground_rgb[3] = {0.55, 0.47, 0.38}, lattice_rgb[3] = {0.45, 0.6, 0.85}, shape_rgb[3] = {0.1, 0.1, 0.1},
+               points_rgb[3] = {0.85, 0.2, 0.15}, spring_rgb[3] = {0.2, 0.6, 0.2}, trail_rgb[3] = {0.6, 0.3, 0.7};
+  if (options_.show_ground) m.AddActor(m.ground, ground_rgb, 1.0, 1.0);
+  if (options_.show_trails) m.AddActor(m.trails, trail_rgb, 1.5, 1.0)->SetPosition(0, 0, 0.5);
+  if (options_.show_lattice)
+    m.AddActor(m.lattice, lattice_rgb, 1.0, options_.point_size * 0.75, &m.lattice_points_mapper)->SetPosition(0, 0, 1);
+  if (options_.show_springs) m.AddActor(m.springs, spring_rgb, 1.5, 1.0)->SetPosition(0, 0, 1.5);
+  if (options_.show_shape) m.AddActor(m.shape, shape_rgb, options_.line_width, 1.0)->SetPosition(0, 0, 2);
+  if (options_.show_points) m.AddActor(m.points, points_rgb, 1.0, options_.point_size, &m.points_mapper)->SetPosition(0, 0, 3);
+
+  // colour by an array: a mass-point array, or the lattice's displacement
+  if (!options_.color_by.empty()) {
+    const bool on_lattice = options_.color_by == "displacement";
+    static const char* kPointArrays[] = {"mass", "velocity", "applied_force", "in_contact"};
+    const bool known = on_lattice || std::any_of(std::begin(kPointArrays), std::end(kPointArrays),
+                                                 [&](const char* a) { return options_.color_by == a; });
+    if (!known)
+      throw std::invalid_argument("color by '" + options_.color_by +
+                                  "': not one of mass, velocity, applied_force, in_contact, displacement");
+    m.colored = on_lattice ? m.lattice_points_mapper.Get() : m.points_mapper.Get();
+    if (!m.colored) throw std::invalid_argument("color by '" + options_.color_by + "': that layer is hidden");
+    m.lut = Ptr<vtkLookupTable>::New();
+    m.lut->SetHueRange(0.667, 0.0);  // blue (low) to red (high)
+    m.lut->SetVectorModeToMagnitude();
+    m.lut->Build();
+    m.colored->ScalarVisibilityOn();
+    m.colored->SetScalarModeToUsePointFieldData();
+    m.colored->SelectColorArray(options_.color_by.c_str());
+    m.colored->SetColorModeToMapScalars();
+    m.colored->SetLookupTable(m.lut);
+    m.colored->UseLookupTableScalarRangeOn();
+    if (options_.show_color_bar) {
+      m.bar = Ptr<vtkScalarBarActor>::New();
+      m.bar->SetLookupTable(m.lut);
+      m.bar->SetTitle(options_.color_by.c_str());
+      m.bar->SetNumberOfLabels(3);
+      m.bar->SetOrientationToHorizontal();
+      m.bar->SetPosition(0.62, 0.86);
+      m.bar->SetWidth(0.36);
+      m.bar->SetHeight(0.12);
+      m.bar->GetTitleTextProperty()->SetColor(0, 0, 0);
+      m.bar->GetLabelTextProperty()->SetColor(0, 0, 0);
+      m.bar->GetTitleTextProperty()->ShadowOff();
+      m.bar->GetLabelTextProperty()->ShadowOff();
+      m.renderer->AddActor2D(m.bar);
+    }
+  }
+  if (options_.overlay || !options_.title.empty()) {
+    m.overlay = Ptr<vtkTextActor>::New();
+    m.overlay->GetTextProperty()->SetColor(0, 0, 0);
+    m.overlay->GetTextProperty()->SetFontSize(std::max(10, options_.height / 32));
+    m.overlay->GetTextProperty()->SetFontFamilyToCourier();
+    m.overlay->GetTextProperty()->SetVerticalJustificationToTop();
+    m.overlay->SetDisplayPosition(8, options_.height - 8);
+    m.renderer->AddActor2D(m.overlay);
+  }
+  FrameBox(BodyBounds(*world, body));
+}
+
+SceneView::~SceneView() = default;
+
+void SceneView::FrameBox(const Eigen::AlignedBox2d& box_in, double margin) {
+  Eigen::AlignedBox2d box = box_in;
+  if (box.isEmpty()) box = Eigen::AlignedBox2d(Eigen::Vector2d(-1, -1), Eigen::Vector2d(1, 1));
+  const Eigen::Vector2d c = box.center();
+  Eigen::Vector2d half = 0.5 * box.sizes() * (1.0 + 2.0 * margin);
+  half = half.cwiseMax(1e-6);
+  const double aspect = double(options_.width) / options_.height;
+  // parallel scale is half the visible height: fit both the box's height and its width
+  const double scale = std::max(half.y(), half.x() / aspect);
+  framed_ = Eigen::AlignedBox2d(c - Eigen::Vector2d(scale * aspect, scale), c + Eigen::Vector2d(scale * aspect, scale));
+  vtkCamera* cam = impl_->renderer->GetActiveCamera();
+  cam->ParallelProjectionOn();
+  const double distance = 10.0 * scale + 100.0;
+  cam->SetFocalPoint(c.x(), c.y(), 0.0);
+  cam->SetPosition(c.x(), c.y(), distance);
+  cam->SetViewUp(0, 1, 0);
+  cam->SetParallelScale(scale);
+  cam->SetClippingRange(distance - 10.0, distance + 10.0);
+  // the ground band: as long as the view is wide, reaching below its bottom edge
+  impl_->ground->SetCenter(c.x(), c.y());
+  impl_->ground->SetLength(4.0 * scale * aspect + 4.0 * scale);
+  impl_->ground->SetDepth(4.0 * scale);
+}
+
+void SceneView::Render() {
+  Impl& m = *impl_;
+  for (WorldSourceBase* s : {(WorldSourceBase*)m.ground, (WorldSourceBase*)m.lattice, (WorldSourceBase*)m.points,
+                             (WorldSourceBase*)m.shape, (WorldSourceBase*)m.springs})
+    s->Modified();
+  if (m.colored) {
+    double lo = options_.color_range[0], hi = options_.color_range[1];
+    if (!(lo < hi)) {
+      // this frame's range of the array (magnitude for vectors)
+      vtkPolyDataAlgorithm* src = options_.color_by == "displacement" ? (vtkPolyDataAlgorithm*)m.lattice
+                                                                       : (vtkPolyDataAlgorithm*)m.points;
+      src->Update();
+      vtkDataArray* a = src->GetOutput()->GetPointData()->GetArray(options_.color_by.c_str());
+      double r[2] = {0, 1};
+      if (a) a->GetRange(r, a->GetNumberOfComponents() > 1 ? -1 : 0);
+      lo = r[0];
+      hi = r[1] > r[0] ? r[1] : r[0] + 1.0;
+    }
+    m.lut->SetTableRange(lo, hi);
+  }
+  if (m.overlay) {
+    std::string text = options_.title.empty() ? "" : options_.title + "\n";
+    if (options_.overlay) {
+      const Energies e = m.world->ComputeEnergies(m.body);
+      char buf[256];
+      std::snprintf(buf, sizeof(buf), "t = %7.3f s\nE = %.4g (kin %.3g, grav %.3g, modes %.3g)", m.world->time(),
+                    e.total(), e.kinetic, e.gravity, e.modes);
+      text += buf;
+    }
+    m.overlay->SetInput(text.c_str());
+  }
+  m.window->Render();
+}
+
+vtkSmartPointer<vtkImageData> SceneView::Capture() {
+  auto grab = Ptr<vtkWindowToImageFilter>::New();
+  grab->SetInput(impl_->window);
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->ShouldRerenderOff();
+  grab->Update();
+  auto image = Ptr<vtkImageData>::New();
+  image->DeepCopy(grab->GetOutput());
+  return image;
+}
+
+void SceneView::WritePng(const std::string& path) { pipelines::WritePng(path, Capture()); }
+
+std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
+  const int w = options_.width, h = options_.height;
+  vtkRenderWindow* win = impl_->window;
+  auto rgba = Ptr<vtkFloatArray>::New();
+  win->GetRGBAPixelData(0, 0, w - 1, h - 1, 0, rgba, 0);
+  auto z = Ptr<vtkFloatArray>::New();
+  win->GetZbufferData(0, 0, w - 1, h - 1, z);
+  if (rgba->GetNumberOfValues() != vtkIdType(4) * w * h || z->GetNumberOfValues() != vtkIdType(w) * h)
+    throw std::runtime_error("reading the rendered pixels back failed");
+  // window depth d in [0, 1] is linear in the eye distance for a parallel projection:
+  // distance = near + d (far − near); the far plane (d = 1) means nothing was drawn
+  double range[2];
+  impl_->renderer->GetActiveCamera()->GetClippingRange(range);
+  std::vector<ExrChannel> ch = {{"R", {}}, {"G", {}}, {"B", {}}, {"A", {}}, {"depth.Z", {}}};
+  for (ExrChannel& c : ch) c.data.resize(size_t(w) * h);
+  const float* px = rgba->GetPointer(0);
+  const float* zp = z->GetPointer(0);
+  for (int y = 0; y < h; ++y) {
+    const size_t row_out = size_t(h - 1 - y) * w;  // VTK's rows start at the bottom
+    for (int x = 0; x < w; ++x) {
+      const size_t in = size_t(y) * w + x, out = row_out + x;
+      for (int c = 0; c < 4; ++c) ch[c].data[out] = px[4 * in + c];
+      const float d = zp[in];
+      ch[4].data[out] = d >= 1.0f ? std::numeric_limits<float>::infinity() : float(range[0] + d * (range[1] - range[0]));
+    }
+  }
+  return ch;
+}
+
+void SceneView::WriteExr(const std::string& path) {
+  WriteExrChannels(path, options_.width, options_.height, CaptureRgbaDepth(), ExrCompression::kZip);
+}
+
+TrailSource* SceneView::trails() { return impl_->trails; }
+vtkRenderWindow* SceneView::window() { return impl_->window; }
+
+vtkSmartPointer<vtkImageData> TileImages(const std::vector<vtkSmartPointer<vtkImageData>>& images, int columns, int gap) {
+  if (images.empty()) throw std::invalid_argument("TileImages: no images");
+  int dims[3];
+  images[0]->GetDimensions(dims);
+  const int comps = images[0]->GetNumberOfScalarComponents();
+  for (const auto& im : images) {
+    int d[3];
+    im->GetDimensions(d);
+    if (d[0] != dims[0] || d[1] != dims[1] || im->GetNumberOfScalarComponents() != comps ||
+        im->GetScalarType() != VTK_UNSIGNED_CHAR)
+      throw std::invalid_argument("TileImages: images differ in size, components or type");
+  }
+  const int n = int(images.size());
+  const int cols = columns <= 0 ? n : std::min(columns, n);
+  const int rows = (n + cols - 1) / cols;
+  const int W = cols * dims[0] + (cols - 1) * gap, H = rows * dims[1] + (rows - 1) * gap;
+  auto out = Ptr<vtkImageData>::New();
+  out->SetDimensions(W, H, 1);
+  out->AllocateScalars(VTK_UNSIGNED_CHAR, comps);
+  auto* dst = static_cast<unsigned char*>(out->GetScalarPointer());
+  std::memset(dst, 255, size_t(W) * H * comps);  // white gaps
+  for (int k = 0; k < n; ++k) {
+    // panel k goes left to right, top to bottom; image rows run bottom-up
+    const int col = k % cols, row_from_top = k / cols;
+    const int x0 = col * (dims[0] + gap), y0 = H - (row_from_top + 1) * dims[1] - row_from_top * gap;
+    const auto* src = static_cast<const unsigned char*>(images[k]->GetScalarPointer());
+    for (int y = 0; y < dims[1]; ++y)
+      std::memcpy(dst + (size_t(y0 + y) * W + x0) * comps, src + size_t(y) * dims[0] * comps, size_t(dims[0]) * comps);
+  }
+  return out;
+}
+
+}  // namespace wobble::pipelines

@@ -1,0 +1,86 @@
+// The offscreen renderer: one body of a World drawn with the sources of world_sources.h
+// (ground, deformed lattice, mass points, resampled shape, springs, trails) in a parallel
+// 2D view, with an overlay of the time and the energy, into PNG or EXR frames.
+//
+// VTK 9.1 as Debian ships it renders only through X: call HasDisplay() first and run under
+// `xvfb-run -a -s "-screen 0 1280x1024x24"` when there is no screen; without a display VTK
+// aborts the process.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <string>
+#include <vector>
+#include <vtkSmartPointer.h>
+
+#include "pipelines/exr_io.h"
+#include "pipelines/world_sources.h"
+
+class vtkImageData;
+class vtkRenderWindow;
+
+namespace wobble::pipelines {
+
+// True when an X display is set (VTK needs one to render, even offscreen).
+bool HasDisplay();
+
+struct SceneOptions {
+  int width = 640, height = 480;
+  bool show_ground = true, show_lattice = true, show_points = true, show_shape = true, show_springs = true,
+       show_trails = false;
+  // Colour the mass points by one of their arrays: "mass", "velocity", "applied_force" (vectors
+  // by magnitude), "in_contact"; or "displacement" colours the lattice points. Empty: plain.
+  std::string color_by;
+  // Fixed colour range; when lo >= hi the range of the current frame is used.
+  double color_range[2] = {0.0, 0.0};
+  bool show_color_bar = true;
+  bool overlay = true;     // time and energies, top left
+  std::string title;       // optional line above the overlay
+  int shape_samples = 16;  // ShapeSource::SamplesPerSegment
+  double point_size = 8.0, line_width = 3.0;
+};
+
+// A box holding every point of the body now: its deformed control points (by the convex-hull
+// property of the Bernstein/B-spline weights no point of the body lies outside them).
+Eigen::AlignedBox2d BodyBounds(const World& world, int body);
+
+class SceneView {
+ public:
+  // Needs a display (HasDisplay()); throws std::runtime_error without one.
+  SceneView(const World* world, int body, SceneOptions options = {});
+  ~SceneView();
+  SceneView(const SceneView&) = delete;
+  SceneView& operator=(const SceneView&) = delete;
+
+  // A parallel camera looking down −z that shows `box` (world units) with a margin
+  // (fraction of the box) around it, keeping the aspect ratio of the image.
+  void FrameBox(const Eigen::AlignedBox2d& box, double margin = 0.08);
+  const Eigen::AlignedBox2d& framed_box() const { return framed_; }
+
+  // Rebuilds every source from the world's current state and renders.
+  void Render();
+  // The last rendered image (RGB, bottom row first as VTK images are).
+  vtkSmartPointer<vtkImageData> Capture();
+  void WritePng(const std::string& path);
+  // R, G, B, A (0..1 floats) and depth.Z (distance from the camera plane along the view
+  // direction, world units; +inf where nothing was drawn), row 0 at the top.
+  std::vector<ExrChannel> CaptureRgbaDepth();
+  void WriteExr(const std::string& path);
+
+  TrailSource* trails();
+  vtkRenderWindow* window();
+  const SceneOptions& options() const { return options_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  SceneOptions options_;
+  Eigen::AlignedBox2d framed_;
+};
+
+// Puts images of one size side by side, `columns` per row (0: all in one row), with a thin
+// gap of background colour: the papers' strips of snapshots (thesis Fig. 4.10–4.12).
+vtkSmartPointer<vtkImageData> TileImages(const std::vector<vtkSmartPointer<vtkImageData>>& images, int columns,
+                                         int gap = 4);
+
+}  // namespace wobble::pipelines

@@ -1,0 +1,382 @@
+#include "pipelines/world_sources.h"
+
+#include <cmath>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkUnsignedCharArray.h>
+
+#include "wobble/dynamics/forces.h"
+#include "wobble/dynamics/kinematics.h"
+
+namespace wobble::pipelines {
+namespace {
+
+template <class T> using Ptr = vtkSmartPointer<T>;
+
+vtkPolyData* OutputOf(vtkInformationVector* out) {
+  return vtkPolyData::SafeDownCast(out->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT()));
+}
+
+Ptr<vtkDoubleArray> Vectors(const char* name, vtkIdType n) {
+  auto a = Ptr<vtkDoubleArray>::New();
+  a->SetName(name);
+  a->SetNumberOfComponents(3);
+  a->SetNumberOfTuples(n);
+  return a;
+}
+
+Ptr<vtkDoubleArray> Scalars(const char* name, vtkIdType n) {
+  auto a = Ptr<vtkDoubleArray>::New();
+  a->SetName(name);
+  a->SetNumberOfTuples(n);
+  return a;
+}
+
+// Every output carries the world's time as field data (ParaView reads TimeValue).
+void AddTimeValue(vtkPolyData* out, double time) {
+  auto t = Ptr<vtkDoubleArray>::New();
+  t->SetName("TimeValue");
+  t->InsertNextValue(time);
+  out->GetFieldData()->AddArray(t);
+}
+
+}  // namespace
+
+Eigen::Vector2d WorldPositionOf(const World& world, int body, const Eigen::Vector2d& st) {
+  Eigen::Vector2d b0;
+  Mat2D<double> B;
+  world.body(body).LocalBasis(st, &b0, &B);
+  const VecQ<double>& q = world.state(body).q;
+  return WorldFromLocal(Frame<double>(q), LocalPosition<double>(b0, B, q));
+}
+
+void WorldSourceBase::PrintSelf(ostream& os, vtkIndent indent) {
+  Superclass::PrintSelf(os, indent);
+  os << indent << "World: " << world_ << "\n" << indent << "Body: " << Body << "\n";
+}
+
+bool WorldSourceBase::CheckWorld() {
+  if (!world_) {
+    vtkErrorMacro("no world set");
+    return false;
+  }
+  if (Body < 0 || Body >= world_->num_bodies()) {
+    vtkErrorMacro("body " << Body << " not in the world (" << world_->num_bodies() << " bodies)");
+    return false;
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------
+vtkStandardNewMacro(LatticeSource);
+
+int LatticeSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
+  if (!CheckWorld()) return 0;
+  vtkPolyData* out = OutputOf(out_vec);
+  const BodyModel& body = world_->body(Body);
+  const VecQ<double>& q = world_->state(Body).q;
+  const Lattice& lat = body.lattice();
+  const Frame<double> frame(q);
+  const int n = lat.size();
+
+  // deformed control points: L_ij + Σ γ_d d^d_ij (Eq. 4.2), then into the world
+  auto points = Ptr<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  auto rest = Vectors("rest_position", n);
+  auto disp = Vectors("displacement", n);
+  for (int c = 0; c < n; ++c) {
+    Eigen::Vector2d d = Eigen::Vector2d::Zero();
+    for (int m = 0; m < body.num_modes(); ++m) d += body.modes()[m].displacement[c] * q[kRigidDofs + m];
+    const Eigen::Vector2d& r = body.rest_control()[c];
+    const Vec2<double> x = WorldFromLocal(frame, Vec2<double>(r + d));
+    points->SetPoint(c, x.x(), x.y(), 0.0);
+    rest->SetTuple3(c, r.x(), r.y(), 0.0);
+    disp->SetTuple3(c, d.x(), d.y(), 0.0);
+  }
+
+  // a vertex per control point, a line per lattice row and column
+  auto verts = Ptr<vtkCellArray>::New();
+  for (vtkIdType c = 0; c < n; ++c) verts->InsertNextCell(1, &c);
+  auto lines = Ptr<vtkCellArray>::New();
+  for (int i = 0; i < lat.num_s(); ++i) {
+    lines->InsertNextCell(lat.num_t());
+    for (int j = 0; j < lat.num_t(); ++j) lines->InsertCellPoint(lat.Index(i, j));
+  }
+  for (int j = 0; j < lat.num_t(); ++j) {
+    lines->InsertNextCell(lat.num_s());
+    for (int i = 0; i < lat.num_s(); ++i) lines->InsertCellPoint(lat.Index(i, j));
+  }
+  out->SetPoints(points);
+  out->SetVerts(verts);
+  out->SetLines(lines);
+  out->GetPointData()->AddArray(rest);
+  out->GetPointData()->AddArray(disp);
+  AddTimeValue(out, world_->time());
+  return 1;
+}
+
+// ---------------------------------------------------------------------------------------
+vtkStandardNewMacro(MassPointSource);
+
+int MassPointSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
+  if (!CheckWorld()) return 0;
+  vtkPolyData* out = OutputOf(out_vec);
+  const BodyModel& body = world_->body(Body);
+  const BodyState<double>& s = world_->state(Body);
+  const WorldParams& params = world_->options().params;
+  const Frame<double> frame(s.q);
+  const GroundFrame gf(params.ground);
+  const int n = body.num_points();
+
+  auto points = Ptr<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  auto mass = Scalars("mass", n);
+  auto velocity = Vectors("velocity", n);
+  auto force = Vectors("applied_force", n);
+  auto contact = Ptr<vtkUnsignedCharArray>::New();
+  contact->SetName("in_contact");
+  contact->SetNumberOfTuples(n);
+  contact->FillValue(0);
+  std::vector<Eigen::Vector2d> x(n), v(n), f(n);
+  for (int k = 0; k < n; ++k) {
+    const auto B = body.mode_matrix(k);
+    const Vec2<double> l = LocalPosition<double>(body.rest_local(k), B, s.q);
+    x[k] = WorldFromLocal(frame, l);
+    v[k] = PointVelocity(frame, s.qd, l, B);
+    f[k] = params.gravity_on ? Eigen::Vector2d(body.mass(k) * params.gravity) : Eigen::Vector2d::Zero();
+  }
+  // the ground's force on every point tied to it (Eq. 4.24, 4.25)
+  if (params.ground.enabled) {
+    for (const Contact<double>& c : s.contacts) {
+      bool slipping;
+      f[c.point] += GroundForce(params.ground, gf, Vec2<double>(x[c.point]), Vec2<double>(v[c.point]), c.anchor, &slipping);
+      contact->SetValue(c.point, 1);
+    }
+  }
+  auto verts = Ptr<vtkCellArray>::New();
+  for (vtkIdType k = 0; k < n; ++k) {
+    points->SetPoint(k, x[k].x(), x[k].y(), 0.0);
+    mass->SetValue(k, body.mass(k));
+    velocity->SetTuple3(k, v[k].x(), v[k].y(), 0.0);
+    force->SetTuple3(k, f[k].x(), f[k].y(), 0.0);
+    verts->InsertNextCell(1, &k);
+  }
+  out->SetPoints(points);
+  out->SetVerts(verts);
+  for (vtkDataArray* a : {static_cast<vtkDataArray*>(mass), static_cast<vtkDataArray*>(velocity),
+                          static_cast<vtkDataArray*>(force), static_cast<vtkDataArray*>(contact)})
+    out->GetPointData()->AddArray(a);
+  AddTimeValue(out, world_->time());
+  return 1;
+}
+
+// ---------------------------------------------------------------------------------------
+vtkStandardNewMacro(ShapeSource);
+
+void ShapeSource::PrintSelf(ostream& os, vtkIndent indent) {
+  Superclass::PrintSelf(os, indent);
+  os << indent << "SamplesPerSegment: " << SamplesPerSegment << "\n";
+}
+
+void ShapeSource::UpdateCache() {
+  const BodyModel& body = world_->body(Body);
+  if (cached_body_ == &body && cached_samples_ == SamplesPerSegment) return;
+  sample_st_.clear();
+  sample_b0_.clear();
+  sample_B_.clear();
+  polyline_sizes_.clear();
+  const Lattice& lat = body.lattice();
+  for (const Polyline& pl : body.def().shapes) {
+    const int np = int(pl.points.size());
+    if (np < 2) continue;  // nothing to draw
+    // a closed polyline's last segment returns to its first point, which is not repeated
+    const int segments = pl.closed ? np : np - 1;
+    for (int seg = 0; seg < segments; ++seg) {
+      const Eigen::Vector2d a = pl.points[seg], b = pl.points[(seg + 1) % np];
+      for (int k = 0; k < SamplesPerSegment; ++k)
+        sample_st_.push_back(lat.LocalCoords(a + (b - a) * (double(k) / SamplesPerSegment)));
+    }
+    if (!pl.closed) sample_st_.push_back(lat.LocalCoords(pl.points.back()));
+    polyline_sizes_.push_back({segments * SamplesPerSegment + (pl.closed ? 0 : 1), pl.closed});
+  }
+  for (const Eigen::Vector2d& st : sample_st_) {
+    Eigen::Vector2d b0;
+    Mat2D<double> B;
+    body.LocalBasis(st, &b0, &B);
+    sample_b0_.push_back(b0);
+    sample_B_.push_back(B);
+  }
+  cached_body_ = &body;
+  cached_samples_ = SamplesPerSegment;
+}
+
+std::vector<Eigen::Vector2d> ShapeSource::SampleLatticeCoords() const { return sample_st_; }
+
+int ShapeSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
+  if (!CheckWorld()) return 0;
+  UpdateCache();
+  vtkPolyData* out = OutputOf(out_vec);
+  const VecQ<double>& q = world_->state(Body).q;
+  const Frame<double> frame(q);
+  const vtkIdType n = vtkIdType(sample_st_.size());
+  auto points = Ptr<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  auto st_array = Ptr<vtkDoubleArray>::New();
+  st_array->SetName("lattice_coords");
+  st_array->SetNumberOfComponents(2);
+  st_array->SetNumberOfTuples(n);
+  for (vtkIdType k = 0; k < n; ++k) {
+    const Vec2<double> x = WorldFromLocal(frame, LocalPosition<double>(sample_b0_[k], sample_B_[k], q));
+    points->SetPoint(k, x.x(), x.y(), 0.0);
+    st_array->SetTuple2(k, sample_st_[k].x(), sample_st_[k].y());
+  }
+  auto lines = Ptr<vtkCellArray>::New();
+  vtkIdType first = 0;
+  for (const auto& [count, closed] : polyline_sizes_) {
+    lines->InsertNextCell(count + (closed ? 1 : 0));
+    for (int k = 0; k < count; ++k) lines->InsertCellPoint(first + k);
+    if (closed) lines->InsertCellPoint(first);
+    first += count;
+  }
+  out->SetPoints(points);
+  out->SetLines(lines);
+  out->GetPointData()->AddArray(st_array);
+  AddTimeValue(out, world_->time());
+  return 1;
+}
+
+// ---------------------------------------------------------------------------------------
+vtkStandardNewMacro(GroundSource);
+
+void GroundSource::PrintSelf(ostream& os, vtkIndent indent) {
+  Superclass::PrintSelf(os, indent);
+  os << indent << "Center: " << Center[0] << " " << Center[1] << "\n"
+     << indent << "Length: " << Length << "\n" << indent << "Depth: " << Depth << "\n";
+}
+
+int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
+  if (!world_) {
+    vtkErrorMacro("no world set");
+    return 0;
+  }
+  vtkPolyData* out = OutputOf(out_vec);
+  const Ground& g = world_->options().params.ground;
+  auto points = Ptr<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  AddTimeValue(out, world_->time());
+  if (!g.enabled) {
+    out->SetPoints(points);
+    return 1;
+  }
+  // the surface segment around the ground point nearest Center, and a band below it
+  const Eigen::Vector2d tau = g.tangent(), n = g.normal();
+  const Eigen::Vector2d c(Center[0], Center[1]);
+  const Eigen::Vector2d foot = g.point + tau * tau.dot(c - g.point);
+  const Eigen::Vector2d a = foot - 0.5 * Length * tau, b = foot + 0.5 * Length * tau;
+  const Eigen::Vector2d corners[4] = {a, b, b - Depth * n, a - Depth * n};
+  for (const Eigen::Vector2d& p : corners) points->InsertNextPoint(p.x(), p.y(), 0.0);
+  auto polys = Ptr<vtkCellArray>::New();
+  const vtkIdType quad[4] = {0, 1, 2, 3};
+  polys->InsertNextCell(4, quad);
+  auto lines = Ptr<vtkCellArray>::New();
+  const vtkIdType surface[2] = {0, 1};
+  lines->InsertNextCell(2, surface);
+  auto height = Scalars("height", 4);  // signed height above the ground surface
+  for (int k = 0; k < 4; ++k) height->SetValue(k, k < 2 ? 0.0 : -Depth);
+  out->SetPoints(points);
+  out->SetPolys(polys);
+  out->SetLines(lines);
+  out->GetPointData()->AddArray(height);
+  return 1;
+}
+
+// ---------------------------------------------------------------------------------------
+vtkStandardNewMacro(SpringSource);
+
+int SpringSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
+  if (!world_) {
+    vtkErrorMacro("no world set");
+    return 0;
+  }
+  vtkPolyData* out = OutputOf(out_vec);
+  auto points = Ptr<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  auto lines = Ptr<vtkCellArray>::New();
+  auto stretch = Ptr<vtkDoubleArray>::New();
+  stretch->SetName("stretch");  // length minus rest length, per line
+  for (const Spring& sp : world_->options().params.springs) {
+    if (sp.body < 0 || sp.body >= world_->num_bodies()) continue;
+    const VecQ<double>& q = world_->state(sp.body).q;
+    const Eigen::Vector2d x = WorldFromLocal(Frame<double>(q), LocalPosition<double>(sp.rest_local, sp.mode_matrix, q));
+    const vtkIdType ids[2] = {points->InsertNextPoint(sp.anchor.x(), sp.anchor.y(), 0.0),
+                              points->InsertNextPoint(x.x(), x.y(), 0.0)};
+    lines->InsertNextCell(2, ids);
+    stretch->InsertNextValue((x - sp.anchor).norm() - sp.rest_length);
+  }
+  out->SetPoints(points);
+  out->SetLines(lines);
+  out->GetCellData()->AddArray(stretch);
+  AddTimeValue(out, world_->time());
+  return 1;
+}
+
+// ---------------------------------------------------------------------------------------
+vtkStandardNewMacro(TrailSource);
+
+void TrailSource::SetTrackedPoints(const std::vector<Eigen::Vector2d>& lattice_coords) {
+  tracked_ = lattice_coords;
+  ClearHistory();
+}
+
+void TrailSource::ClearHistory() {
+  times_.clear();
+  history_.clear();
+  Modified();
+}
+
+void TrailSource::Record() {
+  if (!CheckWorld()) return;
+  std::vector<Eigen::Vector2d> now;
+  for (const Eigen::Vector2d& st : tracked_) now.push_back(WorldPositionOf(*world_, Body, st));
+  times_.push_back(world_->time());
+  history_.push_back(std::move(now));
+  Modified();
+}
+
+int TrailSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
+  vtkPolyData* out = OutputOf(out_vec);
+  auto points = Ptr<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  auto lines = Ptr<vtkCellArray>::New();
+  auto time = Ptr<vtkDoubleArray>::New();
+  time->SetName("time");
+  const int samples = int(times_.size());
+  for (size_t p = 0; p < tracked_.size(); ++p) {
+    if (samples == 0) break;
+    lines->InsertNextCell(samples);
+    for (int k = 0; k < samples; ++k) {
+      const Eigen::Vector2d& x = history_[k][p];
+      lines->InsertCellPoint(points->InsertNextPoint(x.x(), x.y(), 0.0));
+      time->InsertNextValue(times_[k]);
+    }
+  }
+  out->SetPoints(points);
+  out->SetLines(lines);
+  out->GetPointData()->AddArray(time);
+  AddTimeValue(out, world_ ? world_->time() : 0.0);
+  return 1;
+}
+
+}  // namespace wobble::pipelines
