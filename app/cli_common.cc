@@ -5,6 +5,9 @@
 #include <cstdlib>
 #include <sstream>
 
+#include <iostream>
+
+#include "wobble/analysis/conditioning.h"
 #include "wobble/io/deformation_file.h"
 #include "wobble/io/object_file.h"
 
@@ -20,7 +23,7 @@ void AddBodyFlags(CLI::App* cmd, BodyFiles* files) {
       ->type_name("FILE[,FILE...]");
 }
 
-std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files) {
+std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_modes) {
   BodyDef def = io::ReadObjectFile(files.object);
   std::vector<DeformationMode> modes;
   for (const std::string& path : files.modes) {
@@ -28,7 +31,17 @@ std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files) {
     std::vector<DeformationMode> more = io::ReadDeformationFile(path);
     modes.insert(modes.end(), more.begin(), more.end());
   }
-  return std::make_shared<const BodyModel>(std::move(def), std::move(modes));
+  auto body = std::make_shared<const BodyModel>(std::move(def), std::move(modes));
+  if (check_modes) {
+    const analysis::ModeSetReport report = analysis::CheckModeSet(*body);
+    if (report.level == analysis::ModeSetReport::Level::kError) {
+      std::string msg = "the modes of " + files.object + " cannot be simulated:";
+      for (const std::string& m : report.messages) msg += "\n  " + m;
+      throw std::invalid_argument(msg + "\n(wobble condition check explains the mode set)");
+    }
+    for (const std::string& m : report.messages) std::cerr << "wobble: warning: " << m << "\n";
+  }
+  return body;
 }
 
 void AddWorldFlags(CLI::App* cmd, WorldFlags* f) {

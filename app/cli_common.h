@@ -35,7 +35,10 @@ struct BodyFiles {
 void AddBodyFlags(CLI::App* cmd, BodyFiles* files);
 // Reads the files through wobble::io and builds the model. Throws io::ParseError for a bad
 // file and std::invalid_argument when the modes do not fit the object.
-std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files);
+// With check_modes, the mode set is checked as it loads (analysis::CheckModeSet): warnings
+// (nearly dependent modes, modes the mass cannot see) go to stderr, and a dependent set — M
+// singular — is refused with std::invalid_argument.
+std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_modes = true);
 
 // Gravity and ground flags, shared by simulate and inspect.
 struct WorldFlags {

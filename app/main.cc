@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "cli_common.h"
+#include "condition.h"
 #include "inspect.h"
 #ifdef WOBBLE_HAVE_PIPELINES
 #include "render.h"
@@ -25,6 +26,9 @@ int main(int argc, char** argv) {
   InspectArgs inspect_args;
   CLI::App* simulate = AddSimulateCommand(&app, &simulate_args);
   CLI::App* inspect = AddInspectCommand(&app, &inspect_args);
+  ConditionSweepArgs sweep_args;
+  ConditionCheckArgs check_args;
+  const ConditionCommands condition = AddConditionCommand(&app, &sweep_args, &check_args);
 #ifdef WOBBLE_HAVE_PIPELINES
   const std::string render_what = "frames,filmstrip,charts", export_what = "vtp,exr,disp";
   RenderArgs render_args, export_args;
@@ -45,6 +49,8 @@ int main(int argc, char** argv) {
   try {
     if (simulate->parsed()) return RunSimulate(simulate_args);
     if (inspect->parsed()) return RunInspect(inspect_args);
+    if (condition.sweep->parsed()) return RunConditionSweep(sweep_args);
+    if (condition.check->parsed()) return RunConditionCheck(check_args);
 #ifdef WOBBLE_HAVE_PIPELINES
     if (render->parsed()) return RunRender(render_args, render_what);
     if (exporter->parsed()) return RunRender(export_args, export_what);

@@ -1,0 +1,328 @@
+#include "condition.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "csv_writer.h"
+#include "wobble/analysis/conditioning.h"
+#include "wobble/io/atomic_file.h"
+#include "wobble/io/object_file.h"
+
+#ifdef WOBBLE_HAVE_PIPELINES
+#include <vtkDoubleArray.h>
+#include <vtkImageData.h>
+#include <vtkPointData.h>
+#include <vtkSmartPointer.h>
+
+#include "pipelines/charts.h"
+#include "pipelines/exports.h"
+#include "pipelines/exr_io.h"
+#include "pipelines/scene_view.h"
+#endif
+
+namespace wobble::app {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double Deg(double rad) { return rad * 180.0 / kPi; }
+double Rad(double deg) { return deg * kPi / 180.0; }
+
+// The sweep's φ samples: from, from + step, ..., and `to` itself (so that π/2 is always there).
+std::vector<double> Angles(const ConditionSweepArgs& a) {
+  RequireFinite(a.from_deg, "--from");
+  RequireFinite(a.to_deg, "--to");
+  RequirePositive(a.step_deg, "--step");
+  if (!(a.to_deg > a.from_deg)) throw UsageError("--to must be larger than --from");
+  std::vector<double> phis;
+  const int n = int(std::floor((a.to_deg - a.from_deg) / a.step_deg + 1e-9));
+  if (n > 100000) throw UsageError("--step gives more than 100000 samples");
+  for (int i = 0; i <= n; ++i) phis.push_back(Rad(a.from_deg + i * a.step_deg));
+  if (Deg(phis.back()) < a.to_deg - 1e-9) phis.push_back(Rad(a.to_deg));
+  if (std::abs(a.to_deg - 90.0) < 1e-12) phis.back() = kPi / 2;  // exactly the singular case
+  return phis;
+}
+
+void WriteTextAtomically(const std::string& path, const std::string& text) {
+  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+    std::ofstream f(tmp);
+    f << text;
+    f.close();
+    if (!f) throw std::runtime_error(tmp + ": write failed");
+  });
+}
+
+// A regular grid of samples (nx × ny, row-major from the bottom) for the picture writers.
+struct Grid {
+  int nx = 0, ny = 0;
+  double x0 = 0, dx = 1, y0 = 0, dy = 1;
+  std::vector<double> cond;  // +inf where M is singular
+};
+
+#ifdef WOBBLE_HAVE_PIPELINES
+// .vti for ParaView: point arrays cond and log10cond (NaN where singular) and singular (0/1).
+void WriteGridVti(const std::string& path, const Grid& g) {
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(g.nx, g.ny, 1);
+  image->SetOrigin(g.x0, g.y0, 0.0);
+  image->SetSpacing(g.dx, g.ny > 1 ? g.dy : 1.0, 1.0);
+  auto add = [&](const char* name, auto value) {
+    auto a = vtkSmartPointer<vtkDoubleArray>::New();
+    a->SetName(name);
+    a->SetNumberOfTuples(vtkIdType(g.cond.size()));
+    for (size_t i = 0; i < g.cond.size(); ++i) a->SetValue(vtkIdType(i), value(g.cond[i]));
+    image->GetPointData()->AddArray(a);
+  };
+  add("cond", [](double c) { return std::isfinite(c) ? c : std::nan(""); });
+  add("log10cond", [](double c) { return std::isfinite(c) ? std::log10(c) : std::nan(""); });
+  add("singular", [](double c) { return std::isfinite(c) ? 0.0 : 1.0; });
+  pipelines::WriteVti(path, image);
+}
+
+// The pictures of the sweep (Fig. 4.7 and 4.8) and of the map; needs an X display.
+void WriteSweepPictures(const std::filesystem::path& out, const std::vector<analysis::SweepSample>& samples,
+                        int drop_last) {
+  pipelines::ChartSpec all;
+  all.title = "cond(M) vs angle between vertical squash and rotated squash (Fig. 4.7)";
+  all.x_title = "phi (degrees)";
+  all.y_title = "cond(M)";
+  all.log_y = true;
+  pipelines::ChartSeries line;
+  line.name = "cond(M)";
+  for (const analysis::SweepSample& s : samples)
+    if (!s.cond.singular) line.x.push_back(Deg(s.phi)), line.y.push_back(s.cond.cond);
+  all.series.push_back(line);
+  // The raw M mixes units (mass, mass·length²), which bounds cond away from the modes'
+  // closeness until φ is within a fraction of a degree of π/2; the unit-free scaled cond shows
+  // the closeness itself.
+  pipelines::ChartSeries scaled;
+  scaled.name = "cond(S M S), S = diag(M)^-1/2";
+  for (const analysis::SweepSample& s : samples)
+    if (!s.cond.singular) scaled.x.push_back(Deg(s.phi)), scaled.y.push_back(s.cond.cond_scaled);
+  all.series.push_back(scaled);
+  pipelines::WriteChart(all, (out / "sweep.png").string(), "");
+  all.series.pop_back();
+
+  pipelines::ChartSpec small = all;
+  small.title = "the same without the last samples, points only (Fig. 4.8)";
+  small.log_y = false;
+  small.series[0].points = true;
+  const size_t keep = samples.size() > size_t(drop_last) ? samples.size() - size_t(drop_last) : 0;
+  small.series[0].x.clear();
+  small.series[0].y.clear();
+  for (size_t i = 0; i < keep; ++i)
+    if (!samples[i].cond.singular) small.series[0].x.push_back(Deg(samples[i].phi)), small.series[0].y.push_back(samples[i].cond.cond);
+  pipelines::WriteChart(small, (out / "sweep_small_angle.png").string(), "");
+}
+
+void WriteMapPictures(const std::filesystem::path& out, const Grid& g) {
+  std::vector<float> cond, log_cond;
+  // EXR rows run from the top: flip the grid's bottom-first rows
+  for (int j = g.ny - 1; j >= 0; --j)
+    for (int i = 0; i < g.nx; ++i) {
+      const double c = g.cond[size_t(j) * g.nx + i];
+      cond.push_back(float(c));
+      log_cond.push_back(std::isfinite(c) ? float(std::log10(c)) : INFINITY);
+    }
+  pipelines::WriteExrChannels((out / "map.exr").string(), g.nx, g.ny, {{"cond", cond}, {"log10cond", log_cond}});
+  WriteGridVti((out / "map.vti").string(), g);
+  if (!pipelines::HasDisplay()) return;
+  pipelines::ScalarFieldSpec spec;
+  spec.title = "cond(M) over phi and the vertical squash amplitude";
+  spec.x_title = "phi (degrees)";
+  spec.y_title = "gamma1 (vertical squash)";
+  spec.value_title = "cond(M)";
+  spec.nx = g.nx;
+  spec.ny = g.ny;
+  for (double c : g.cond) spec.values.push_back(std::isfinite(c) ? c : std::nan(""));
+  spec.x_min = g.x0;
+  spec.x_max = g.x0 + g.dx * (g.nx - 1);
+  spec.y_min = g.y0;
+  spec.y_max = g.y0 + g.dy * (g.ny - 1);
+  spec.log_values = true;
+  pipelines::WriteScalarFieldPng(spec, (out / "map.png").string());
+}
+#endif
+
+std::string CondText(const analysis::ConditionNumber& c) {
+  if (c.singular) return "singular";
+  std::ostringstream o;
+  o << std::setprecision(6) << c.cond;
+  return o.str();
+}
+
+}  // namespace
+
+ConditionCommands AddConditionCommand(CLI::App* app, ConditionSweepArgs* s, ConditionCheckArgs* c) {
+  CLI::App* cond = app->add_subcommand("condition", "Conditioning of the mass matrix (thesis §4.10.3)");
+  cond->require_subcommand(1);
+
+  CLI::App* sweep = cond->add_subcommand(
+      "sweep", "cond(M) against the angle between a vertical squash and a squash rotated by phi (Fig. 4.7, 4.8)");
+  sweep->add_option("--object", s->object, "Object file (its lattice and mass points)")->capture_default_str();
+  sweep->add_option("--from", s->from_deg, "First angle, degrees")->capture_default_str();
+  sweep->add_option("--to", s->to_deg, "Last angle, degrees (90: both modes are the vertical squash)")
+      ->capture_default_str();
+  sweep->add_option("--step", s->step_deg, "Angle step, degrees")->capture_default_str();
+  sweep->add_option("--compress", s->compress, "Squash: squeeze along its axis (displacement per unit length)")
+      ->capture_default_str();
+  sweep->add_option("--expand", s->expand, "Squash: bulge across its axis")->capture_default_str();
+  sweep->add_option("--q", s->q, "State \"tx ty theta g1 g2\" (default: rest)");
+  sweep->add_option("--drop-last", s->drop_last, "Samples left out of the small-angle chart (Fig. 4.8)")
+      ->capture_default_str();
+  sweep->add_option("--map", s->map_size, "Also map cond over phi and the squash amplitude g1, N x N samples")
+      ->capture_default_str();
+  sweep->add_option("--map-gamma", s->map_gamma, "The map's g1 range is [-G, G]")->capture_default_str();
+  sweep->add_option("--out", s->out, "Output folder")->capture_default_str();
+
+  CLI::App* check = cond->add_subcommand(
+      "check", "How close the modes are to each other and to the rigid motions; which modes the mass cannot see");
+  AddBodyFlags(check, &c->files);
+  check->add_option("--q", c->q, "State \"tx ty theta g1 ..\" (default: rest)");
+  check->add_option("--warn-angle", c->warn_angle_deg, "Warn below this angle, degrees")->capture_default_str();
+  check->add_option("--warn-visibility", c->warn_visibility, "Warn below this visibility (0..1)")
+      ->capture_default_str();
+  check->add_option("--json", c->json, "Also write the report as JSON")->type_name("FILE");
+  return {sweep, check};
+}
+
+int RunConditionSweep(const ConditionSweepArgs& a) {
+  const BodyDef def = io::ReadObjectFile(a.object);
+  const std::vector<double> phis = Angles(a);
+  RequirePositive(a.compress, "--compress");
+  RequireFinite(a.expand, "--expand");
+  if (a.drop_last < 0) throw UsageError("--drop-last must be >= 0");
+  analysis::Squash squash;
+  squash.compress = a.compress;
+  squash.expand = a.expand;
+  // a two-mode body only to parse --q against
+  const BodyModel probe(def, {analysis::SquashMode(def.lattice, 0.0, squash, "v"),
+                              analysis::SquashMode(def.lattice, 0.0, squash, "h")});
+  const Eigen::VectorXd q = ParseCoordinates(a.q, "--q", probe);
+  const std::vector<analysis::SweepSample> samples = analysis::AngleSweep(def, phis, squash, q);
+
+  const std::filesystem::path out(a.out);
+  std::vector<std::vector<double>> rows;
+  for (const analysis::SweepSample& s : samples) {
+    const Eigen::VectorXd& sv = s.cond.singular_values;
+    rows.push_back({Deg(s.phi), s.phi, s.cond.cond, s.cond.cond_scaled, double(s.cond.singular), sv.maxCoeff(),
+                    sv.minCoeff()});
+  }
+  const std::string csv = (out / "sweep.csv").string();
+  WriteCsvAtomically(csv, {"phi_deg", "phi_rad", "cond", "cond_scaled", "singular", "sigma_max", "sigma_min"}, rows);
+
+  std::cout << "phi (deg)   cond(M)        cond(scaled)\n";
+  for (const analysis::SweepSample& s : samples)
+    std::cout << std::setw(9) << std::setprecision(5) << Deg(s.phi) << "   " << std::setw(12) << CondText(s.cond)
+              << "   " << std::setw(12) << (s.cond.singular ? "singular" : std::to_string(s.cond.cond_scaled)) << "\n";
+  for (const analysis::SweepSample& s : samples)
+    if (s.cond.singular)
+      std::cout << "at phi = " << Deg(s.phi)
+                << " deg both modes are the vertical squash: M is singular (no finite condition number)\n";
+
+#ifdef WOBBLE_HAVE_PIPELINES
+  {
+    Grid line;
+    line.nx = int(samples.size());
+    line.ny = 1;
+    line.x0 = Deg(samples.front().phi);
+    line.dx = samples.size() > 1 ? Deg(samples[1].phi - samples[0].phi) : 1.0;
+    for (const analysis::SweepSample& s : samples) line.cond.push_back(s.cond.cond);
+    WriteGridVti((out / "sweep.vti").string(), line);
+  }
+  if (pipelines::HasDisplay()) {
+    WriteSweepPictures(out, samples, a.drop_last);
+  } else {
+    std::cout << "no X display: charts skipped (run under xvfb-run -a)\n";
+  }
+#endif
+  if (a.map_size > 0) {
+    if (a.map_size < 2 || a.map_size > 2000) throw UsageError("--map must be between 2 and 2000");
+    RequirePositive(a.map_gamma, "--map-gamma");
+    std::vector<std::vector<double>> map_rows;
+    Grid grid;
+    grid.nx = grid.ny = a.map_size;
+    grid.x0 = a.from_deg;
+    grid.dx = (a.to_deg - a.from_deg) / (a.map_size - 1);
+    grid.y0 = -a.map_gamma;
+    grid.dy = 2.0 * a.map_gamma / (a.map_size - 1);
+    for (int j = 0; j < a.map_size; ++j) {
+      Eigen::VectorXd qj = q;
+      qj[3] = -a.map_gamma + 2.0 * a.map_gamma * j / (a.map_size - 1);
+      std::vector<double> map_phis;
+      for (int i = 0; i < a.map_size; ++i)
+        map_phis.push_back(Rad(a.from_deg + (a.to_deg - a.from_deg) * i / (a.map_size - 1)));
+      for (const analysis::SweepSample& s : analysis::AngleSweep(def, map_phis, squash, qj)) {
+        map_rows.push_back({Deg(s.phi), qj[3], s.cond.cond, s.cond.singular ? INFINITY : std::log10(s.cond.cond)});
+        grid.cond.push_back(s.cond.cond);
+      }
+    }
+#ifdef WOBBLE_HAVE_PIPELINES
+    WriteMapPictures(out, grid);
+#endif
+    WriteCsvAtomically((out / "map.csv").string(), {"phi_deg", "gamma1", "cond", "log10cond"}, map_rows);
+    std::cout << "map: " << (out / "map.csv").string() << "\n";
+  }
+  std::cout << "wrote " << out.string() << "/: sweep.csv";
+#ifdef WOBBLE_HAVE_PIPELINES
+  std::cout << ", sweep.vti" << (pipelines::HasDisplay() ? ", sweep.png, sweep_small_angle.png" : "");
+  if (a.map_size > 0) std::cout << ", map.csv, map.exr, map.vti" << (pipelines::HasDisplay() ? ", map.png" : "");
+#endif
+  std::cout << "\n";
+  return kExitOk;
+}
+
+int RunConditionCheck(const ConditionCheckArgs& a) {
+  const std::shared_ptr<const BodyModel> body = LoadBody(a.files, /*check_modes=*/false);
+  RequirePositive(a.warn_angle_deg, "--warn-angle");
+  RequireNonNegative(a.warn_visibility, "--warn-visibility");
+  analysis::ModeCheckOptions options;
+  options.warn_angle_deg = a.warn_angle_deg;
+  options.warn_visibility = a.warn_visibility;
+  const analysis::ModeSetReport r = analysis::CheckModeSet(*body, ParseCoordinates(a.q, "--q", *body), options);
+
+  std::cout << "mode set of '" << body->name() << "': " << analysis::LevelName(r.level) << "\n";
+  for (const std::string& m : r.messages) std::cout << "  " << m << "\n";
+  std::cout << "cond(M) = " << CondText(r.condition) << ", scaled " << r.condition.cond_scaled << "\n";
+  std::cout << "mode          visibility  angle to the rest (deg)  closest combination\n";
+  for (const analysis::ModeFinding& f : r.modes) {
+    std::cout << "  " << std::left << std::setw(12) << f.mode << std::right << std::setw(10) << std::setprecision(3)
+              << f.visibility << std::setw(18) << f.angle_to_others_deg << "       ";
+    for (const analysis::Participant& p : f.closest_combination) std::cout << p.weight << " '" << p.dof << "' ";
+    std::cout << "\n";
+  }
+  if (!a.json.empty()) {
+    nlohmann::json j;
+    j["level"] = analysis::LevelName(r.level);
+    j["messages"] = r.messages;
+    j["dofs"] = r.dofs;
+    j["cond"] = r.condition.singular ? nlohmann::json(nullptr) : nlohmann::json(r.condition.cond);
+    j["singular"] = r.condition.singular;
+    j["cond_scaled"] = r.condition.cond_scaled;
+    j["singular_values"] = std::vector<double>(r.condition.singular_values.data(),
+                                               r.condition.singular_values.data() + r.condition.singular_values.size());
+    j["smallest_angle_deg"] = r.smallest_angle_deg;
+    j["smallest_mode"] = r.smallest_mode;
+    nlohmann::json pairs = nlohmann::json::array();
+    for (int i = 0; i < r.pair_angle_deg.rows(); ++i) {
+      std::vector<double> row(r.pair_angle_deg.cols());
+      for (int k = 0; k < r.pair_angle_deg.cols(); ++k) row[k] = r.pair_angle_deg(i, k);
+      pairs.push_back(row);
+    }
+    j["pair_angle_deg"] = pairs;
+    for (const analysis::ModeFinding& f : r.modes) {
+      nlohmann::json combo = nlohmann::json::array();
+      for (const analysis::Participant& p : f.closest_combination) combo.push_back({{"dof", p.dof}, {"weight", p.weight}});
+      j["modes"].push_back({{"mode", f.mode}, {"visibility", f.visibility},
+                            {"angle_to_others_deg", f.angle_to_others_deg}, {"closest_combination", combo}});
+    }
+    WriteTextAtomically(a.json, j.dump(2) + "\n");
+  }
+  return r.level == analysis::ModeSetReport::Level::kError ? kExitBadInput : kExitOk;
+}
+
+}  // namespace wobble::app
