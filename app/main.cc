@@ -28,7 +28,8 @@ int main(int argc, char** argv) {
   CLI::App* inspect = AddInspectCommand(&app, &inspect_args);
   ConditionSweepArgs sweep_args;
   ConditionCheckArgs check_args;
-  const ConditionCommands condition = AddConditionCommand(&app, &sweep_args, &check_args);
+  ConditionTimeArgs time_args;
+  const ConditionCommands condition = AddConditionCommand(&app, &sweep_args, &check_args, &time_args);
 #ifdef WOBBLE_HAVE_PIPELINES
   const std::string render_what = "frames,filmstrip,charts", export_what = "vtp,exr,disp";
   RenderArgs render_args, export_args;
@@ -51,6 +52,7 @@ int main(int argc, char** argv) {
     if (inspect->parsed()) return RunInspect(inspect_args);
     if (condition.sweep->parsed()) return RunConditionSweep(sweep_args);
     if (condition.check->parsed()) return RunConditionCheck(check_args);
+    if (condition.time->parsed()) return RunConditionTime(time_args);
 #ifdef WOBBLE_HAVE_PIPELINES
     if (render->parsed()) return RunRender(render_args, render_what);
     if (exporter->parsed()) return RunRender(export_args, export_what);
