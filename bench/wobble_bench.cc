@@ -150,6 +150,21 @@ void BM_TableRestingOnGround(benchmark::State& state) {
 }
 BENCHMARK(BM_TableRestingOnGround);
 
+// The same resting table resampled to 10,000 points: the ground scan visits only the point
+// groups whose bounding box reaches the ground (the feet), not all 10,000.
+void BM_Table10kRestingOnGround(benchmark::State& state) {
+  World world;
+  world.AddBody(Table10k());
+  world.SetState(0, TableQ(*Table10k(), 10.0), Eigen::VectorXd::Zero(Table10k()->num_q()));
+  for (int i = 0; i < 2000; ++i)
+    if (!world.Step()) {
+      state.SkipWithError(world.status().message.c_str());
+      return;
+    }
+  TimeSteps(state, world);
+}
+BENCHMARK(BM_Table10kRestingOnGround);
+
 // Falling freely far above the ground (convex-hull test only), or with no ground at all.
 void OutOfContact(benchmark::State& state, std::shared_ptr<const BodyModel> body) {
   WorldOptions options;

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <memory>
+#include <random>
+#include <algorithm>
 
 #include "test_bodies.h"
 #include "wobble/dynamics/world.h"
@@ -188,6 +190,41 @@ TEST(Ground, DroppedTableComesToRestWithBoundedPenetration) {
 
 // A rigid table standing on a slope α with friction cap μ = tan θ_f sticks when α < θ_f and
 // slides when α > θ_f with acceleration g (sin α − μ cos α) (Coulomb).
+// Large bodies scan only the point groups whose bounding box reaches below the ground: the
+// points visited must be exactly those a brute-force height test finds, for both bases, any
+// slope and deformed states.
+TEST(Ground, GroupedScanVisitsExactlyThePointsBelowTheGround) {
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int partial = 0;
+  for (BasisKind basis : {BasisKind::kBernstein, BasisKind::kCubicBSpline}) {
+    const BodyModel body = testing::RandomBody(rng, basis == BasisKind::kBernstein ? 4 : 6, 5, basis, 3, 3000);
+    ASSERT_GT(body.clusters().size(), 1u);
+    for (int trial = 0; trial < 20; ++trial) {
+      Ground g;
+      g.slope = 0.3 * u(rng);
+      g.point = Eigen::Vector2d(0.0, 40.0 * u(rng));
+      BodyState<double> s;
+      s.q = VecQ<double>::Zero(body.num_q());
+      s.qd = VecQ<double>::Zero(body.num_q());
+      s.q << 30 * u(rng), 30 * u(rng), 0.5 * u(rng), 0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng);
+      std::vector<int> visited, expected;
+      const Frame<double> frame(s.q);
+      ForEachPointInContact(body, g, s, frame, [&](int k, const Vec2<double>&, const Vec2<double>&,
+                                                   const Vec2<double>&, const Vec2<double>&) { visited.push_back(k); });
+      const GroundFrame gf(g);
+      for (int k = 0; k < body.num_points(); ++k) {
+        const Vec2<double> x = WorldFromLocal(frame, LocalPosition<double>(body.rest_local(k), body.mode_matrix(k), s.q));
+        if (gf.Height(x) < 0.0) expected.push_back(k);
+      }
+      std::sort(visited.begin(), visited.end());
+      EXPECT_EQ(visited, expected) << "trial " << trial;
+      if (!expected.empty() && int(expected.size()) < body.num_points()) ++partial;
+    }
+  }
+  EXPECT_GE(partial, 10);  // partial contacts, where skipping groups matters
+}
+
 TEST(Ground, SticksBelowFrictionCapAndSlidesAbove) {
   const double mu = std::tan(20.0 * kPi / 180);
   for (double alpha_deg : {10.0, 30.0}) {

@@ -2,7 +2,9 @@
 
 #include "wobble/numeric/cholesky.h"
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <stdexcept>
 
 namespace wobble {
@@ -62,6 +64,39 @@ BodyModel::BodyModel(BodyDef def, std::vector<DeformationMode> modes) : def_(std
   }
   mm.G_com_factor = mm.G - mm.C.transpose() * mm.C / mm.m;
   mm.G_com_positive = CholeskyInPlace(&mm.G_com_factor);
+  BuildClusters();
+}
+
+void BodyModel::BuildClusters() {
+  const int N = num_points(), D = num_modes();
+  // a square grid of cells over the lattice coordinates, about kPointsPerCluster per cell
+  const int cells = std::max(1, int(std::lround(std::sqrt(double(N) / kPointsPerCluster))));
+  std::vector<std::vector<int>> members(size_t(cells) * cells);
+  for (int k = 0; k < N; ++k) {
+    auto cell = [&](double u) { return std::clamp(int(std::floor(u * cells)), 0, cells - 1); };
+    members[size_t(cell(lattice_coords_[k].x())) * cells + cell(lattice_coords_[k].y())].push_back(k);
+  }
+  clusters_.clear();
+  for (std::vector<int>& pts : members) {
+    if (pts.empty()) continue;
+    // per coordinate, the interval of b0 and of each column of B over the group's points
+    auto interval = [&](auto value) {
+      Eigen::Vector2d lo = value(pts[0]), hi = lo;
+      for (int k : pts) lo = lo.cwiseMin(value(k)), hi = hi.cwiseMax(value(k));
+      return std::make_pair(Eigen::Vector2d(0.5 * (lo + hi)), Eigen::Vector2d(0.5 * (hi - lo)));
+    };
+    PointCluster c;
+    c.points = pts;
+    std::tie(c.centre0, c.half0) = interval([&](int k) { return rest_local_[k]; });
+    c.centre_modes.setZero(2, D);
+    c.half_modes.setZero(2, D);
+    for (int d = 0; d < D; ++d) {
+      const auto [centre, half] = interval([&](int k) { return Eigen::Vector2d(mode_matrix(k).col(d)); });
+      c.centre_modes.col(d) = centre;
+      c.half_modes.col(d) = half;
+    }
+    clusters_.push_back(std::move(c));
+  }
 }
 
 void BodyModel::LocalBasis(const Eigen::Vector2d& st, Eigen::Vector2d* b0, Mat2D<double>* B) const {

@@ -48,6 +48,17 @@ struct MassMoments {
   bool G_com_positive = false;  // false: some mode combination moves no mass relative to the centre
 };
 
+// Mass points grouped by where they sit in the lattice, with interval bounds of their local
+// positions: every l_k = b0_k + B_k γ of the group lies in the box centre(γ) ± half(γ) with
+// centre = centre0 + centre_modes γ and half = half0 + half_modes |γ|. The ground scan skips a
+// group whose box is above the ground, so a large body resting on its feet visits only the
+// points near them (any basis: the bound needs no convex-hull property).
+struct PointCluster {
+  std::vector<int> points;  // ascending
+  Eigen::Vector2d centre0 = Eigen::Vector2d::Zero(), half0 = Eigen::Vector2d::Zero();
+  Mat2D<double> centre_modes, half_modes;  // 2 x D
+};
+
 class BodyModel {
  public:
   // Throws std::invalid_argument when the modes do not fit the lattice, a mass is not
@@ -77,12 +88,19 @@ class BodyModel {
   // Rest control points L_ij (flat index), for the convex-hull ground test and drawing.
   const std::vector<Eigen::Vector2d>& rest_control() const { return rest_control_; }
 
+  // The points in groups of about kPointsPerCluster; a single group for small bodies.
+  static constexpr int kPointsPerCluster = 64;
+  const std::vector<PointCluster>& clusters() const { return clusters_; }
+
  private:
   BodyDef def_;
   std::vector<DeformationMode> modes_;
   std::vector<Eigen::Vector2d> lattice_coords_, rest_local_, rest_control_;
   std::vector<double> mode_rows_;  // per point, column-major 2 x D
   MassMoments moments_;
+  std::vector<PointCluster> clusters_;
+
+  void BuildClusters();
 };
 
 }  // namespace wobble

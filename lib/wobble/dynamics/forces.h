@@ -174,11 +174,37 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
     return;
   }
   if (ClearOfGround(body, g, s.q, frame)) return;
-  auto existing = s.contacts.begin();
-  for (int k = 0; k < body.num_points(); ++k) {
-    while (existing != s.contacts.end() && existing->point < k) ++existing;
-    const bool has_anchor = existing != s.contacts.end() && existing->point == k;
-    visit(k, has_anchor ? &existing->anchor : nullptr);
+  const std::vector<PointCluster>& clusters = body.clusters();
+  if (clusters.size() <= 1) {
+    auto existing = s.contacts.begin();
+    for (int k = 0; k < body.num_points(); ++k) {
+      while (existing != s.contacts.end() && existing->point < k) ++existing;
+      const bool has_anchor = existing != s.contacts.end() && existing->point == k;
+      visit(k, has_anchor ? &existing->anchor : nullptr);
+    }
+    return;
+  }
+  // Large bodies: only groups whose bounding box reaches below the ground. The box test is a
+  // decision, so it runs on plain values; height = n·(t − p) + (Rᵀn)·l.
+  const int D = body.num_modes();
+  const Eigen::Vector2d n_local = Mat2<double>(frame.R.unaryExpr([](const T& v) { return double(ScalarValue(v)); }))
+                                      .transpose() * gf.n;
+  const Eigen::Vector2d t(ScalarValue(s.q[0]), ScalarValue(s.q[1]));
+  const double offset = gf.n.dot(t - gf.point);
+  for (const PointCluster& c : clusters) {
+    Eigen::Vector2d centre = c.centre0, half = c.half0;
+    for (int d = 0; d < D; ++d) {
+      const double gamma = ScalarValue(s.q[kRigidDofs + d]);
+      centre += gamma * c.centre_modes.col(d);
+      half += std::abs(gamma) * c.half_modes.col(d);
+    }
+    if (offset + n_local.dot(centre) - n_local.cwiseAbs().dot(half) >= 0.0) continue;
+    for (int k : c.points) {
+      const auto existing = std::lower_bound(s.contacts.begin(), s.contacts.end(), k,
+                                             [](const Contact<T>& a, int point) { return a.point < point; });
+      const bool has_anchor = existing != s.contacts.end() && existing->point == k;
+      visit(k, has_anchor ? &existing->anchor : nullptr);
+    }
   }
 }
 
@@ -282,6 +308,8 @@ template <class T> void UpdateContacts(const BodyModel& body, const Ground& g, B
     next.push_back({k, anchor});
     s->penetration = std::max(s->penetration, -double(ScalarValue(gf.Height(x))));
   });
+  if (body.clusters().size() > 1)  // groups are visited in lattice order, not point order
+    std::sort(next.begin(), next.end(), [](const Contact<T>& a, const Contact<T>& b) { return a.point < b.point; });
   s->contacts.swap(next);
   cache.q = s->q;
   cache.qd = s->qd;
