@@ -236,6 +236,8 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
     s.width = strip_size.w;
     s.height = strip_size.h;
     s.show_color_bar = false;
+    s.overlay_energy = false;  // panels are small: the time only
+    s.title.clear();
     strip_view = std::make_unique<pl::SceneView>(&world, 0, s);
     strip_view->FrameBox(view_box);
   }

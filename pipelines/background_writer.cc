@@ -4,17 +4,19 @@
 
 namespace wobble::pipelines {
 
-BackgroundWriter::BackgroundWriter(int max_pending)
-    : max_pending_(size_t(std::max(1, max_pending))), worker_([this] { Run(); }) {}
+BackgroundWriter::BackgroundWriter(int threads, int max_pending) : max_pending_(size_t(std::max(1, max_pending))) {
+  const int n = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  for (int i = 0; i < n; ++i) workers_.emplace_back([this] { Run(); });
+}
 
 BackgroundWriter::~BackgroundWriter() {
   {
     std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait(lock, [&] { return jobs_.empty() && !busy_; });
+    changed_.wait(lock, [&] { return jobs_.empty() && busy_ == 0; });
     stop_ = true;
   }
   changed_.notify_all();
-  worker_.join();
+  for (std::thread& t : workers_) t.join();
 }
 
 void BackgroundWriter::RethrowLocked(std::unique_lock<std::mutex>&) {
@@ -35,7 +37,7 @@ void BackgroundWriter::Submit(std::function<void()> job) {
 
 void BackgroundWriter::Wait() {
   std::unique_lock<std::mutex> lock(mutex_);
-  changed_.wait(lock, [&] { return jobs_.empty() && !busy_; });
+  changed_.wait(lock, [&] { return jobs_.empty() && busy_ == 0; });
   RethrowLocked(lock);
 }
 
@@ -46,7 +48,7 @@ void BackgroundWriter::Run() {
     if (jobs_.empty()) return;  // stop_ and nothing left
     std::function<void()> job = std::move(jobs_.front());
     jobs_.pop_front();
-    busy_ = true;
+    ++busy_;
     lock.unlock();
     std::exception_ptr failure;
     try {
@@ -55,7 +57,7 @@ void BackgroundWriter::Run() {
       failure = std::current_exception();
     }
     lock.lock();
-    busy_ = false;
+    --busy_;
     if (failure && !error_) error_ = failure;
     changed_.notify_all();
   }

@@ -1,6 +1,7 @@
-// Writes files on one worker thread while the caller renders the next frame (the machine
-// has few cores; rendering and compression then overlap). Jobs run in submission order; the
-// queue holds at most `max_pending` jobs, so Submit blocks when writing falls behind.
+// Writes files on worker threads while the caller renders the next frame: compressing PNG
+// and EXR frames costs more than rendering them, so writing is spread over `threads` workers
+// (default: one per core). Jobs start in submission order and must write different files;
+// the queue holds at most `max_pending` jobs, so Submit blocks when writing falls behind.
 // A job that throws stops nothing else; the first error is rethrown by Wait() (and by
 // Submit() after it happened), naming the file as the job's exception did.
 #pragma once
@@ -11,12 +12,13 @@
 #include <functional>
 #include <mutex>
 #include <thread>
+#include <vector>
 
 namespace wobble::pipelines {
 
 class BackgroundWriter {
  public:
-  explicit BackgroundWriter(int max_pending = 8);
+  explicit BackgroundWriter(int threads = 0, int max_pending = 16);  // threads 0: one per core
   ~BackgroundWriter();  // waits for the queued jobs; errors not collected by Wait() are dropped
   BackgroundWriter(const BackgroundWriter&) = delete;
   BackgroundWriter& operator=(const BackgroundWriter&) = delete;
@@ -34,9 +36,10 @@ class BackgroundWriter {
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<std::function<void()>> jobs_;
-  bool busy_ = false, stop_ = false;
+  int busy_ = 0;  // jobs running now
+  bool stop_ = false;
   std::exception_ptr error_;
-  std::thread worker_;
+  std::vector<std::thread> workers_;
 };
 
 }  // namespace wobble::pipelines

@@ -5,10 +5,8 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
-#include <ImfThreading.h>
 #include <algorithm>
 #include <stdexcept>
-#include <thread>
 
 #include "wobble/io/atomic_file.h"
 
@@ -23,12 +21,6 @@ void WriteExrChannels(const std::string& path, int width, int height, const std:
     if (c.data.size() != size_t(width) * size_t(height))
       throw std::invalid_argument(path + ": channel '" + c.name + "' has " + std::to_string(c.data.size()) +
                                   " values, expected " + std::to_string(size_t(width) * height));
-  // compress blocks of scan lines on every core
-  static const bool threads_set = [] {
-    Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
-    return true;
-  }();
-  (void)threads_set;
   io::WriteFileAtomically(path, [&](const std::string& tmp) {
     Imf::Header header(width, height);
     switch (compression) {

@@ -226,11 +226,15 @@ void SceneView::Render() {
   if (m.overlay) {
     std::string text = options_.title.empty() ? "" : options_.title + "\n";
     if (options_.overlay) {
-      const Energies e = m.world->ComputeEnergies(m.body);
       char buf[256];
-      std::snprintf(buf, sizeof(buf), "t = %7.3f s\nE = %.4g (kin %.3g, grav %.3g, modes %.3g)", m.world->time(),
-                    e.total(), e.kinetic, e.gravity, e.modes);
+      std::snprintf(buf, sizeof(buf), "t = %.3f s", m.world->time());
       text += buf;
+      if (options_.overlay_energy) {
+        const Energies e = m.world->ComputeEnergies(m.body);
+        std::snprintf(buf, sizeof(buf), "\nE = %.4g (kin %.3g, grav %.3g, modes %.3g)", e.total(), e.kinetic,
+                      e.gravity, e.modes);
+        text += buf;
+      }
     }
     m.overlay->SetInput(text.c_str());
   }

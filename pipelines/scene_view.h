@@ -36,6 +36,7 @@ struct SceneOptions {
   double color_range[2] = {0.0, 0.0};
   bool show_color_bar = true;
   bool overlay = true;     // time and energies, top left
+  bool overlay_energy = true;  // the energy line of the overlay (filmstrip panels leave it out)
   std::string title;       // optional line above the overlay
   int shape_samples = 16;  // ShapeSource::SamplesPerSegment
   double point_size = 8.0, line_width = 3.0;
