@@ -236,6 +236,8 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
     s.width = strip_size.w;
     s.height = strip_size.h;
     s.show_color_bar = false;
+    s.overlay_energy = false;  // panels are small: the time only
+    s.title.clear();
     strip_view = std::make_unique<pl::SceneView>(&world, 0, s);
     strip_view->FrameBox(view_box);
   }
@@ -258,6 +260,7 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   size_t next_strip = 0;
   std::vector<vtkSmartPointer<vtkImageData>> strip_images;
   long written = 0;
+  pl::BackgroundWriter writer;  // files are compressed and written while the next frame renders
   Progress progress(isatty(STDERR_FILENO) == 1);
   const auto start = std::chrono::steady_clock::now();
   auto on_state = [&](const World& w) {
@@ -268,12 +271,12 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
         if (v && !tracked.empty()) v->trails()->Record();
       if (view) {
         view->Render();
-        if (what.count("frames")) view->WritePng(FrameName(a.out + "/frames", "frame", k, "png"));
-        if (what.count("exr")) view->WriteExr(FrameName(a.out + "/exr", "frame", k, "exr"));
+        if (what.count("frames")) view->WritePng(FrameName(a.out + "/frames", "frame", k, "png"), &writer);
+        if (what.count("exr")) view->WriteExr(FrameName(a.out + "/exr", "frame", k, "exr"), &writer);
       }
-      if (vtp) vtp->WriteFrame(k);
+      if (vtp) vtp->WriteFrame(k, &writer);
       if (what.count("disp"))
-        pl::WriteDisplacementExr(FrameName(a.out + "/exr", "disp", k, "exr"), w, 0, disp_size.w, disp_size.h);
+        pl::WriteDisplacementExr(FrameName(a.out + "/exr", "disp", k, "exr"), w, 0, disp_size.w, disp_size.h, &writer);
       ++written;
       progress.Update(double(next_frame) / double(num_frames), w.time());
     }
@@ -285,6 +288,7 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   };
   on_state(world);
   const bool ok = world.RunUntil(a.duration + 0.5 * a.dt, on_state);
+  writer.Wait();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.Finish();
 

@@ -1,5 +1,6 @@
 #include "pipelines/exports.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -62,10 +63,11 @@ void WriteVti(const std::string& path, vtkImageData* image) {
   });
 }
 
-void WritePng(const std::string& path, vtkImageData* image) {
+void WritePng(const std::string& path, vtkImageData* image, int compression) {
   io::WriteFileAtomically(path, [&](const std::string& tmp) {
     auto w = vtkSmartPointer<vtkPNGWriter>::New();
     w->SetInputData(image);
+    w->SetCompressionLevel(std::clamp(compression, 0, 9));
     RunWriter(w.Get(), tmp);
   });
 }
@@ -105,18 +107,35 @@ std::vector<ExrChannel> DisplacementImage(const World& world, int body_index, in
   const Lattice& lat = body.lattice();
   const VecQ<double>& q = world.state(body_index).q;
   const Frame<double> frame(q);
+  // deformed control points in the world, W_ij = t + R (L_ij + Σ γ_d d^d_ij); the weights are
+  // a partition of unity, so x(s, t) = Σ_ij W_ij B_i(s) B_j(t) is Eq. 4.2 with the rigid motion
+  const int ns = lat.num_s(), nt = lat.num_t();
+  std::vector<Eigen::Vector2d> W(lat.size());
+  for (int c = 0; c < lat.size(); ++c) {
+    Eigen::Vector2d l = body.rest_control()[c];
+    for (int m = 0; m < body.num_modes(); ++m) l += body.modes()[m].displacement[c] * q[kRigidDofs + m];
+    W[c] = WorldFromLocal(frame, Vec2<double>(l));
+  }
+  // the tensor-product weights separate: B_i(s) per column, B_j(t) per row
+  const Basis1D basis_s(lat.basis(), ns), basis_t(lat.basis(), nt);
+  std::vector<double> ws(size_t(width) * ns), wt(nt);
+  for (int px = 0; px < width; ++px) basis_s.Weights((px + 0.5) / width, &ws[size_t(px) * ns]);
   std::vector<ExrChannel> channels = {{"disp.X", {}}, {"disp.Y", {}}};
   channels[0].data.resize(size_t(width) * height);
   channels[1].data.resize(size_t(width) * height);
+  std::vector<Eigen::Vector2d> column(ns);
   for (int py = 0; py < height; ++py) {
     const double t = 1.0 - (py + 0.5) / height;
+    basis_t.Weights(t, wt.data());
+    for (int i = 0; i < ns; ++i) {
+      column[i].setZero();
+      for (int j = 0; j < nt; ++j) column[i] += wt[j] * W[lat.Index(i, j)];
+    }
     for (int px = 0; px < width; ++px) {
-      const Eigen::Vector2d st((px + 0.5) / width, t);
-      const Eigen::Vector2d rest = lat.origin() + st.x() * lat.axis_s() + st.y() * lat.axis_t();
-      Eigen::Vector2d b0;
-      Mat2D<double> B;
-      body.LocalBasis(st, &b0, &B);
-      const Eigen::Vector2d d = WorldFromLocal(frame, LocalPosition<double>(b0, B, q)) - rest;
+      const double s = (px + 0.5) / width;
+      Eigen::Vector2d x = Eigen::Vector2d::Zero();
+      for (int i = 0; i < ns; ++i) x += ws[size_t(px) * ns + i] * column[i];
+      const Eigen::Vector2d d = x - (lat.origin() + s * lat.axis_s() + t * lat.axis_t());
       channels[0].data[size_t(py) * width + px] = float(d.x());
       channels[1].data[size_t(py) * width + px] = float(d.y());
     }
@@ -124,8 +143,12 @@ std::vector<ExrChannel> DisplacementImage(const World& world, int body_index, in
   return channels;
 }
 
-void WriteDisplacementExr(const std::string& path, const World& world, int body, int width, int height) {
-  WriteExrChannels(path, width, height, DisplacementImage(world, body, width, height), ExrCompression::kZip);
+void WriteDisplacementExr(const std::string& path, const World& world, int body, int width, int height,
+                          BackgroundWriter* writer) {
+  if (!writer) return WriteExrChannels(path, width, height, DisplacementImage(world, body, width, height));
+  writer->Submit([path, width, height, ch = DisplacementImage(world, body, width, height)] {
+    WriteExrChannels(path, width, height, ch);
+  });
 }
 
 VtpSeriesWriter::VtpSeriesWriter(const World* world, int body, std::string folder, std::string stem, int shape_samples)
@@ -142,7 +165,7 @@ VtpSeriesWriter::VtpSeriesWriter(const World* world, int body, std::string folde
   }
 }
 
-void VtpSeriesWriter::WriteFrame(int frame) {
+void VtpSeriesWriter::WriteFrame(int frame, BackgroundWriter* writer) {
   char number[32];
   std::snprintf(number, sizeof(number), "%04d", frame);
   const struct {
@@ -153,7 +176,13 @@ void VtpSeriesWriter::WriteFrame(int frame) {
     parts[p].source->Modified();
     parts[p].source->Update();
     const std::string file = folder_ + "/" + stem_ + "_" + parts[p].part + "_" + number + ".vtp";
-    WriteVtp(file, parts[p].source->GetOutput());
+    if (writer) {
+      auto copy = vtkSmartPointer<vtkPolyData>::New();  // the source's output changes next frame
+      copy->DeepCopy(parts[p].source->GetOutput());
+      writer->Submit([file, copy] { WriteVtp(file, copy); });
+    } else {
+      WriteVtp(file, parts[p].source->GetOutput());
+    }
     pvd_.Add(world_->time(), p, file, parts[p].part);
   }
 }

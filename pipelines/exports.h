@@ -12,6 +12,7 @@
 #include <vector>
 #include <vtkSmartPointer.h>
 
+#include "pipelines/background_writer.h"
 #include "pipelines/exr_io.h"
 #include "pipelines/world_sources.h"
 
@@ -22,7 +23,8 @@ namespace wobble::pipelines {
 
 void WriteVtp(const std::string& path, vtkPolyData* data);
 void WriteVti(const std::string& path, vtkImageData* image);
-void WritePng(const std::string& path, vtkImageData* image);
+// compression: zlib level 0 (none, fastest) to 9 (smallest); PNG is lossless at every level.
+void WritePng(const std::string& path, vtkImageData* image, int compression = 5);
 
 // A ParaView .pvd collection: <DataSet timestep=".." part=".." file=".."/> per entry; file
 // names are written relative to the .pvd's folder when they lie under it.
@@ -47,7 +49,9 @@ class PvdCollection {
 // and holds disp = x(s, t) − p: where that point of the rest drawing is now in the world
 // (Eq. 4.2, rigid motion included) minus where it was drawn. Channels disp.X, disp.Y.
 std::vector<ExrChannel> DisplacementImage(const World& world, int body, int width, int height);
-void WriteDisplacementExr(const std::string& path, const World& world, int body, int width, int height);
+// With a BackgroundWriter the image is computed now and written by its thread.
+void WriteDisplacementExr(const std::string& path, const World& world, int body, int width, int height,
+                          BackgroundWriter* writer = nullptr);
 
 // Writes the lattice, mass points and shape of one body per frame as three .vtp files
 // (<folder>/<stem>_lattice_NNNN.vtp, _points_, _shape_) and keeps <folder>/<stem>.pvd listing
@@ -55,8 +59,9 @@ void WriteDisplacementExr(const std::string& path, const World& world, int body,
 class VtpSeriesWriter {
  public:
   VtpSeriesWriter(const World* world, int body, std::string folder, std::string stem, int shape_samples = 16);
-  // Writes the current state as frame number `frame` (the file names' NNNN).
-  void WriteFrame(int frame);
+  // Writes the current state as frame number `frame` (the file names' NNNN); with a
+  // BackgroundWriter the polydata are copied now and written by its thread.
+  void WriteFrame(int frame, BackgroundWriter* writer = nullptr);
   // Writes the .pvd; returns its path.
   std::string WriteCollection() const;
   std::string CollectionPath() const { return folder_ + "/" + stem_ + ".pvd"; }

@@ -16,7 +16,8 @@ struct ExrChannel {
   std::vector<float> data;  // width * height values, row 0 at the top
 };
 
-enum class ExrCompression { kNone, kZip, kPiz };
+// kRle is the fastest and suits rendered 2D frames (large flat areas); kZip is smaller for data.
+enum class ExrCompression { kNone, kRle, kZip, kPiz };
 
 // Writes a scan-line EXR of 32-bit float channels, atomically (temporary file + rename).
 // Throws std::invalid_argument for a bad size or channel length, std::runtime_error (naming

@@ -65,6 +65,7 @@ struct SceneView::Impl {
   Ptr<vtkScalarBarActor> bar;
   Ptr<vtkTextActor> overlay;
   vtkPolyDataMapper* colored = nullptr;  // the mapper that shows color_by, if any
+  Ptr<vtkImageData> last_rgb;            // read back from the window after the last Render()
 
   Ptr<vtkActor> AddActor(vtkPolyDataAlgorithm* source, const double rgb[3], double line_width, double point_size,
                          Ptr<vtkPolyDataMapper>* mapper_out = nullptr) {
@@ -225,18 +226,24 @@ void SceneView::Render() {
   if (m.overlay) {
     std::string text = options_.title.empty() ? "" : options_.title + "\n";
     if (options_.overlay) {
-      const Energies e = m.world->ComputeEnergies(m.body);
       char buf[256];
-      std::snprintf(buf, sizeof(buf), "t = %7.3f s\nE = %.4g (kin %.3g, grav %.3g, modes %.3g)", m.world->time(),
-                    e.total(), e.kinetic, e.gravity, e.modes);
+      std::snprintf(buf, sizeof(buf), "t = %.3f s", m.world->time());
       text += buf;
+      if (options_.overlay_energy) {
+        const Energies e = m.world->ComputeEnergies(m.body);
+        std::snprintf(buf, sizeof(buf), "\nE = %.4g (kin %.3g, grav %.3g, modes %.3g)", e.total(), e.kinetic,
+                      e.gravity, e.modes);
+        text += buf;
+      }
     }
     m.overlay->SetInput(text.c_str());
   }
   m.window->Render();
+  m.last_rgb = nullptr;
 }
 
 vtkSmartPointer<vtkImageData> SceneView::Capture() {
+  if (impl_->last_rgb) return impl_->last_rgb;
   auto grab = Ptr<vtkWindowToImageFilter>::New();
   grab->SetInput(impl_->window);
   grab->SetInputBufferTypeToRGB();
@@ -245,19 +252,25 @@ vtkSmartPointer<vtkImageData> SceneView::Capture() {
   grab->Update();
   auto image = Ptr<vtkImageData>::New();
   image->DeepCopy(grab->GetOutput());
+  impl_->last_rgb = image;
   return image;
 }
 
-void SceneView::WritePng(const std::string& path) { pipelines::WritePng(path, Capture()); }
+void SceneView::WritePng(const std::string& path, BackgroundWriter* writer) {
+  vtkSmartPointer<vtkImageData> image = Capture();  // a new image per Render(): safe to hand over
+  const int level = options_.png_compression;
+  if (!writer) return pipelines::WritePng(path, image, level);
+  writer->Submit([path, image, level] { pipelines::WritePng(path, image, level); });
+}
 
 std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
   const int w = options_.width, h = options_.height;
-  vtkRenderWindow* win = impl_->window;
-  auto rgba = Ptr<vtkFloatArray>::New();
-  win->GetRGBAPixelData(0, 0, w - 1, h - 1, 0, rgba, 0);
+  vtkImageData* rgb = Capture();
   auto z = Ptr<vtkFloatArray>::New();
-  win->GetZbufferData(0, 0, w - 1, h - 1, z);
-  if (rgba->GetNumberOfValues() != vtkIdType(4) * w * h || z->GetNumberOfValues() != vtkIdType(w) * h)
+  impl_->window->GetZbufferData(0, 0, w - 1, h - 1, z);
+  int dims[3];
+  rgb->GetDimensions(dims);
+  if (dims[0] != w || dims[1] != h || rgb->GetNumberOfScalarComponents() != 3 || z->GetNumberOfValues() != vtkIdType(w) * h)
     throw std::runtime_error("reading the rendered pixels back failed");
   // window depth d in [0, 1] is linear in the eye distance for a parallel projection:
   // distance = near + d (far − near); the far plane (d = 1) means nothing was drawn
@@ -265,22 +278,29 @@ std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
   impl_->renderer->GetActiveCamera()->GetClippingRange(range);
   std::vector<ExrChannel> ch = {{"R", {}}, {"G", {}}, {"B", {}}, {"A", {}}, {"depth.Z", {}}};
   for (ExrChannel& c : ch) c.data.resize(size_t(w) * h);
-  const float* px = rgba->GetPointer(0);
+  const auto* px = static_cast<const unsigned char*>(rgb->GetScalarPointer());
   const float* zp = z->GetPointer(0);
+  const float inf = std::numeric_limits<float>::infinity();
   for (int y = 0; y < h; ++y) {
     const size_t row_out = size_t(h - 1 - y) * w;  // VTK's rows start at the bottom
     for (int x = 0; x < w; ++x) {
       const size_t in = size_t(y) * w + x, out = row_out + x;
-      for (int c = 0; c < 4; ++c) ch[c].data[out] = px[4 * in + c];
       const float d = zp[in];
-      ch[4].data[out] = d >= 1.0f ? std::numeric_limits<float>::infinity() : float(range[0] + d * (range[1] - range[0]));
+      const bool drawn = d < 1.0f;
+      const float a = drawn ? 1.0f : 0.0f;
+      for (int c = 0; c < 3; ++c) ch[c].data[out] = a * (px[3 * in + c] / 255.0f);
+      ch[3].data[out] = a;
+      ch[4].data[out] = drawn ? float(range[0] + d * (range[1] - range[0])) : inf;
     }
   }
   return ch;
 }
 
-void SceneView::WriteExr(const std::string& path) {
-  WriteExrChannels(path, options_.width, options_.height, CaptureRgbaDepth(), ExrCompression::kZip);
+void SceneView::WriteExr(const std::string& path, BackgroundWriter* writer) {
+  const int w = options_.width, h = options_.height;
+  const ExrCompression compression = options_.exr_compression;
+  if (!writer) return WriteExrChannels(path, w, h, CaptureRgbaDepth(), compression);
+  writer->Submit([path, w, h, compression, ch = CaptureRgbaDepth()] { WriteExrChannels(path, w, h, ch, compression); });
 }
 
 TrailSource* SceneView::trails() { return impl_->trails; }

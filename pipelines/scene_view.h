@@ -13,6 +13,7 @@
 #include <vector>
 #include <vtkSmartPointer.h>
 
+#include "pipelines/background_writer.h"
 #include "pipelines/exr_io.h"
 #include "pipelines/world_sources.h"
 
@@ -35,9 +36,12 @@ struct SceneOptions {
   double color_range[2] = {0.0, 0.0};
   bool show_color_bar = true;
   bool overlay = true;     // time and energies, top left
+  bool overlay_energy = true;  // the energy line of the overlay (filmstrip panels leave it out)
   std::string title;       // optional line above the overlay
   int shape_samples = 16;  // ShapeSource::SamplesPerSegment
   double point_size = 8.0, line_width = 3.0;
+  ExrCompression exr_compression = ExrCompression::kZip;  // of WriteExr's frames
+  int png_compression = 1;                                // zlib level 0-9 of WritePng
 };
 
 // A box holding every point of the body now: its deformed control points (by the convex-hull
@@ -59,13 +63,18 @@ class SceneView {
 
   // Rebuilds every source from the world's current state and renders.
   void Render();
-  // The last rendered image (RGB, bottom row first as VTK images are).
+  // The last rendered image (RGB, bottom row first as VTK images are). Read back from the
+  // window once per Render() and shared by the PNG and EXR outputs.
   vtkSmartPointer<vtkImageData> Capture();
-  void WritePng(const std::string& path);
-  // R, G, B, A (0..1 floats) and depth.Z (distance from the camera plane along the view
-  // direction, world units; +inf where nothing was drawn), row 0 at the top.
+  // With a BackgroundWriter the pixels are read now and the file is written by its thread.
+  void WritePng(const std::string& path, BackgroundWriter* writer = nullptr);
+  // The last render for compositing, row 0 at the top: depth.Z is the distance from the
+  // camera along the view direction (world units) of what was drawn, +inf where nothing was;
+  // A is 1 where the scene drew geometry (depth < far) and 0 elsewhere, and R, G, B are the
+  // rendered 8-bit colours as 0..1 floats premultiplied by A (so the white background is
+  // transparent black; the 2D text overlay, which has no depth, is not in the EXR).
   std::vector<ExrChannel> CaptureRgbaDepth();
-  void WriteExr(const std::string& path);
+  void WriteExr(const std::string& path, BackgroundWriter* writer = nullptr);
 
   TrailSource* trails();
   vtkRenderWindow* window();

@@ -1,0 +1,310 @@
+// Export round trips: .vtp/.pvd read back with VTK's readers (points and arrays), EXR read
+// back with OpenEXR (named channels, displacement at known pixels against Eq. 4.2 evaluated
+// independently, rendered colour and depth), and failed writes that leave the earlier file
+// intact with a clear error.
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <vtkDataArray.h>
+#include <vtkCamera.h>
+#include <vtkFieldData.h>
+#include <vtkImageData.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkRendererCollection.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkXMLDataElement.h>
+#include <vtkXMLPolyDataReader.h>
+#include <vtkXMLUtilities.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "pipelines/charts.h"
+#include "pipelines/exports.h"
+#include "pipelines/exr_io.h"
+#include "pipelines/scene_view.h"
+#include "pipelines_test_util.h"
+#include "wobble/io/atomic_file.h"
+
+namespace wobble::pipelines {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::AirborneWorld;
+using testing::IndependentWorldPoint;
+using testing::TempDir;
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+vtkSmartPointer<vtkPolyData> ReadVtp(const std::string& path) {
+  auto r = vtkSmartPointer<vtkXMLPolyDataReader>::New();
+  r->SetFileName(path.c_str());
+  r->Update();
+  auto out = vtkSmartPointer<vtkPolyData>::New();
+  out->DeepCopy(r->GetOutput());
+  return out;
+}
+
+// Every point and every point array of a and b are bit-identical (raw binary doubles).
+void ExpectSamePolyData(vtkPolyData* a, vtkPolyData* b) {
+  ASSERT_EQ(a->GetNumberOfPoints(), b->GetNumberOfPoints());
+  ASSERT_GT(a->GetNumberOfPoints(), 0);
+  EXPECT_EQ(a->GetNumberOfCells(), b->GetNumberOfCells());
+  for (vtkIdType i = 0; i < a->GetNumberOfPoints(); ++i)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(a->GetPoint(i)[c], b->GetPoint(i)[c]);
+  ASSERT_EQ(a->GetPointData()->GetNumberOfArrays(), b->GetPointData()->GetNumberOfArrays());
+  for (int k = 0; k < a->GetPointData()->GetNumberOfArrays(); ++k) {
+    vtkDataArray* x = a->GetPointData()->GetArray(k);
+    vtkDataArray* y = b->GetPointData()->GetArray(x->GetName());
+    ASSERT_NE(y, nullptr) << x->GetName();
+    ASSERT_EQ(x->GetNumberOfValues(), y->GetNumberOfValues());
+    for (vtkIdType v = 0; v < x->GetNumberOfValues(); ++v)
+      EXPECT_EQ(x->GetComponent(v / x->GetNumberOfComponents(), int(v % x->GetNumberOfComponents())),
+                y->GetComponent(v / y->GetNumberOfComponents(), int(v % y->GetNumberOfComponents())))
+          << x->GetName();
+  }
+  vtkDataArray* ta = a->GetFieldData()->GetArray("TimeValue");
+  vtkDataArray* tb = b->GetFieldData()->GetArray("TimeValue");
+  ASSERT_TRUE(ta && tb);
+  EXPECT_EQ(ta->GetTuple1(0), tb->GetTuple1(0));
+}
+
+TEST(VtpExport, SeriesReadsBackThroughThePvdWithEveryPointAndArray) {
+  const std::string dir = TempDir("vtp");
+  auto world = AirborneWorld();
+  VtpSeriesWriter series(world.get(), 0, dir, "table");
+  std::vector<std::vector<vtkSmartPointer<vtkPolyData>>> expected;  // [frame][part]
+  std::vector<double> times;
+  for (int frame = 0; frame < 3; ++frame) {
+    for (int k = 0; k < 5; ++k) world->Step();
+    series.WriteFrame(frame);
+    // what the sources give now, built independently of the writer
+    std::vector<vtkSmartPointer<vtkPolyData>> parts;
+    auto lattice = vtkSmartPointer<LatticeSource>::New();
+    auto points = vtkSmartPointer<MassPointSource>::New();
+    auto shape = vtkSmartPointer<ShapeSource>::New();
+    for (WorldSourceBase* s : {(WorldSourceBase*)lattice, (WorldSourceBase*)points, (WorldSourceBase*)shape}) {
+      s->SetWorld(world.get());
+      s->Update();
+      auto copy = vtkSmartPointer<vtkPolyData>::New();
+      copy->DeepCopy(s->GetOutput());
+      parts.push_back(copy);
+    }
+    expected.push_back(parts);
+    times.push_back(world->time());
+  }
+  const std::string pvd = series.WriteCollection();
+
+  // the collection, parsed by VTK's XML parser: 3 time steps x 3 parts, relative file names
+  vtkXMLDataElement* root = vtkXMLUtilities::ReadElementFromFile(pvd.c_str());
+  ASSERT_NE(root, nullptr);
+  EXPECT_STREQ(root->GetAttribute("type"), "Collection");
+  vtkXMLDataElement* collection = root->FindNestedElementWithName("Collection");
+  ASSERT_NE(collection, nullptr);
+  ASSERT_EQ(collection->GetNumberOfNestedElements(), 9);
+  for (int e = 0; e < 9; ++e) {
+    vtkXMLDataElement* ds = collection->GetNestedElement(e);
+    double t = 0;
+    int part = -1;
+    ASSERT_TRUE(ds->GetScalarAttribute("timestep", t));
+    ASSERT_TRUE(ds->GetScalarAttribute("part", part));
+    const std::string file = ds->GetAttribute("file");
+    EXPECT_FALSE(fs::path(file).is_absolute()) << file;
+    const int frame = e / 3;
+    EXPECT_EQ(part, e % 3);
+    EXPECT_NEAR(t, times[frame], 1e-15);
+    // each file read back equals what the sources gave, bit for bit, TimeValue included
+    vtkSmartPointer<vtkPolyData> back = ReadVtp(dir + "/" + file);
+    ExpectSamePolyData(expected[frame][part], back);
+    EXPECT_EQ(back->GetFieldData()->GetArray("TimeValue")->GetTuple1(0), times[frame]);
+  }
+  root->Delete();
+  // the mass points part carries the named arrays
+  vtkSmartPointer<vtkPolyData> points = ReadVtp(dir + "/table_points_0002.vtp");
+  for (const char* name : {"mass", "velocity", "applied_force", "in_contact"})
+    EXPECT_NE(points->GetPointData()->GetArray(name), nullptr) << name;
+  fs::remove_all(dir);
+}
+
+TEST(ExrIo, NamedChannelsRoundTripExactly) {
+  const std::string dir = TempDir("exr");
+  const int w = 7, h = 5;
+  std::vector<ExrChannel> ch = {{"cond", {}}, {"angle.X", {}}, {"zeta", {}}};
+  for (size_t c = 0; c < ch.size(); ++c)
+    for (int i = 0; i < w * h; ++i) ch[c].data.push_back(float(1e-3 * i * i - 0.25 * c + (i % 3 ? 1e6 : -2.5)));
+  for (ExrCompression comp : {ExrCompression::kNone, ExrCompression::kRle, ExrCompression::kZip, ExrCompression::kPiz}) {
+    WriteExrChannels(dir + "/c.exr", w, h, ch, comp);
+    const ExrImage back = ReadExrChannels(dir + "/c.exr");
+    ASSERT_EQ(back.width, w);
+    ASSERT_EQ(back.height, h);
+    ASSERT_EQ(back.channels.size(), 3u);
+    for (const ExrChannel& c : ch) EXPECT_EQ(back.channels.at(c.name), c.data) << c.name;  // lossless floats
+    // row 0 is the top: pixel (x, y) is data[y * w + x]
+    EXPECT_EQ(back.At("zeta", 3, 2), ch[2].data[2 * w + 3]);
+  }
+  EXPECT_THROW(WriteExrChannels(dir + "/bad.exr", w, h, {{"a", std::vector<float>(3)}}), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(dir + "/bad.exr"));
+  fs::remove_all(dir);
+}
+
+TEST(DisplacementExr, ValuesAtKnownPixelsMatchTheFfdEvaluatedIndependently) {
+  const std::string dir = TempDir("disp");
+  auto world = AirborneWorld();
+  const BodyModel& body = world->body(0);
+  const Eigen::VectorXd q = world->state(0).q;
+  const int w = 64, h = 24;
+  WriteDisplacementExr(dir + "/disp.exr", *world, 0, w, h);
+  const ExrImage img = ReadExrChannels(dir + "/disp.exr");
+  ASSERT_EQ(img.width, w);
+  ASSERT_EQ(img.height, h);
+  ASSERT_TRUE(img.channels.count("disp.X") && img.channels.count("disp.Y"));
+  // corners, centre and a few inner pixels: pixel (px, py) stands for s = (px + ½)/w and
+  // t = 1 − (py + ½)/h, whose rest point on the 300 x 100 table lattice is (300 s, 100 t)
+  for (auto [px, py] : std::vector<std::pair<int, int>>{{0, 0}, {w - 1, 0}, {0, h - 1}, {w - 1, h - 1}, {32, 12}, {5, 17}, {50, 3}}) {
+    const Eigen::Vector2d st((px + 0.5) / w, 1.0 - (py + 0.5) / h);
+    const Eigen::Vector2d rest(300 * st.x(), 100 * st.y());
+    const Eigen::Vector2d disp = IndependentWorldPoint(body, q, st) - rest;
+    // float channels: relative 1e-6 of the world coordinates (a few hundred)
+    EXPECT_NEAR(img.At("disp.X", px, py), disp.x(), 1e-3) << px << "," << py;
+    EXPECT_NEAR(img.At("disp.Y", px, py), disp.y(), 1e-3) << px << "," << py;
+  }
+  // at rest nothing moves
+  World rest_world;
+  rest_world.AddBody(testing::Table());
+  WriteDisplacementExr(dir + "/rest.exr", rest_world, 0, 16, 8);
+  const ExrImage rest = ReadExrChannels(dir + "/rest.exr");
+  for (float v : rest.channels.at("disp.X")) EXPECT_NEAR(v, 0.0, 1e-4);
+  for (float v : rest.channels.at("disp.Y")) EXPECT_NEAR(v, 0.0, 1e-4);
+  fs::remove_all(dir);
+}
+
+TEST(RenderedExr, ColourAlphaAndDepthAtKnownPixels) {
+  if (!HasDisplay()) GTEST_SKIP() << "no DISPLAY: VTK 9.1 renders only through X (make test runs ctest under xvfb-run)";
+  const std::string dir = TempDir("frame_exr");
+  World world;  // flat ground through the origin, the table at rest standing on it
+  world.AddBody(testing::Table());
+  SceneOptions opt;
+  opt.width = 160;
+  opt.height = 120;
+  opt.overlay = false;
+  SceneView view(&world, 0, opt);
+  // 400 x 300 world units around (150, 50): 2.5 units per pixel
+  view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-50, -100), Eigen::Vector2d(350, 200)), 0.0);
+  view.Render();
+  view.WriteExr(dir + "/f.exr");
+  const ExrImage img = ReadExrChannels(dir + "/f.exr");
+  ASSERT_EQ(img.width, 160);
+  ASSERT_EQ(img.height, 120);
+  for (const char* c : {"R", "G", "B", "A", "depth.Z"}) ASSERT_TRUE(img.channels.count(c)) << c;
+  // pixel (10, 110) is at world (−50 + 10.5·2.5, 200 − 110.5·2.5) = (−23.75, −76.25): the
+  // ground band, drawn at z = 0, so its depth is the camera's height above z = 0
+  double cam[3];
+  vtkRenderer* renderer = view.window()->GetRenderers()->GetFirstRenderer();
+  renderer->GetActiveCamera()->GetPosition(cam);
+  EXPECT_NEAR(img.At("depth.Z", 10, 110), cam[2], 1e-3 * cam[2]);
+  EXPECT_EQ(img.At("A", 10, 110), 1.0f);
+  // the ground's colour (0.55, 0.47, 0.38), 8-bit in the frame buffer
+  EXPECT_NEAR(img.At("R", 10, 110), 0.55, 1.0 / 255);
+  EXPECT_NEAR(img.At("G", 10, 110), 0.47, 1.0 / 255);
+  EXPECT_NEAR(img.At("B", 10, 110), 0.38, 1.0 / 255);
+  // pixel (80, 10) is at world y = 200 − 10.5·2.5 = 173.75, above the table: nothing drawn
+  EXPECT_TRUE(std::isinf(img.At("depth.Z", 80, 10)));
+  EXPECT_EQ(img.At("A", 80, 10), 0.0f);
+  EXPECT_EQ(img.At("R", 80, 10), 0.0f);
+  fs::remove_all(dir);
+}
+
+// ---- failed writes: the earlier file stays, the error says which file and why ------------
+
+class FailedWrite : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = TempDir("fail"); }
+  void TearDown() override { fs::remove_all(dir_); }
+  // Writes `path` once successfully, then makes the next write to it fail by turning its
+  // temporary file into `kind`: a folder (cannot be opened) or a link to /dev/full (every
+  // write fails with "no space left", as on a full disk).
+  template <class Write> void ExpectFailureKeepsEarlierFile(const std::string& path, Write write, bool disk_full) {
+    ASSERT_NO_THROW(write());
+    const std::string before = ReadAll(path);
+    ASSERT_FALSE(before.empty());
+    const std::string tmp = io::TempPathFor(path);
+    if (disk_full) {
+      fs::create_symlink("/dev/full", tmp);
+    } else {
+      fs::create_directory(tmp);
+    }
+    try {
+      write();
+      ADD_FAILURE() << path << ": the write should have failed";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(ReadAll(path), before) << "the earlier file changed";
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(path))) << "the earlier file was replaced";
+    if (disk_full) EXPECT_FALSE(fs::exists(fs::symlink_status(tmp))) << "the temporary file was left";
+    fs::remove_all(tmp);
+  }
+  std::string dir_;
+};
+
+TEST_F(FailedWrite, VtpOnAFullDiskOrAnUnopenableTemporaryFile) {
+  auto world = AirborneWorld();
+  auto src = vtkSmartPointer<MassPointSource>::New();
+  src->SetWorld(world.get());
+  src->Update();
+  const std::string path = dir_ + "/p.vtp";
+  ExpectFailureKeepsEarlierFile(path, [&] { WriteVtp(path, src->GetOutput()); }, true);
+  ExpectFailureKeepsEarlierFile(path, [&] { WriteVtp(path, src->GetOutput()); }, false);
+}
+
+TEST_F(FailedWrite, ExrOnAFullDiskOrAnUnopenableTemporaryFile) {
+  auto world = AirborneWorld();
+  const std::string path = dir_ + "/d.exr";
+  ExpectFailureKeepsEarlierFile(path, [&] { WriteDisplacementExr(path, *world, 0, 32, 16); }, true);
+  ExpectFailureKeepsEarlierFile(path, [&] { WriteDisplacementExr(path, *world, 0, 32, 16); }, false);
+}
+
+TEST_F(FailedWrite, PvdAndChartCsvOnAFullDisk) {
+  PvdCollection pvd;
+  pvd.Add(0.5, 0, dir_ + "/a.vtp");
+  const std::string path = dir_ + "/s.pvd";
+  ExpectFailureKeepsEarlierFile(path, [&] { pvd.Write(path); }, true);
+  ChartSpec spec;
+  spec.series.push_back({"e", {0, 1}, {2, 3}});
+  const std::string csv = dir_ + "/c.csv";
+  ExpectFailureKeepsEarlierFile(csv, [&] { WriteChartCsv(spec, csv); }, true);
+}
+
+TEST_F(FailedWrite, PngWithAnUnopenableTemporaryFile) {
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(4, 3, 1);
+  image->AllocateScalars(VTK_UNSIGNED_CHAR, 3);
+  std::fill_n(static_cast<unsigned char*>(image->GetScalarPointer()), 36, 200);
+  const std::string path = dir_ + "/i.png";
+  ExpectFailureKeepsEarlierFile(path, [&] { WritePng(path, image); }, false);
+}
+
+TEST_F(FailedWrite, AFolderThatCannotBeCreatedIsNamed) {
+  // a path under a regular file: its folder can never exist, even for root
+  std::ofstream(dir_ + "/plain") << "x";
+  const std::string path = dir_ + "/plain/sub/d.exr";
+  auto world = AirborneWorld();
+  try {
+    WriteDisplacementExr(path, *world, 0, 8, 8);
+    ADD_FAILURE() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("folder"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace wobble::pipelines

@@ -1,0 +1,196 @@
+// Render regression: small offscreen images of each layer (lattice, mass points, shape,
+// ground), a full scene, a chart and a filmstrip, compared with baseline PNGs committed in
+// tests/baselines (made on the Xvfb + llvmpipe stack `make test` uses).
+//
+// Comparison (stated here, used by every case): a pixel matches when some pixel of the other
+// image within ±1 pixel in x and y has every channel within kChannelTolerance (of 255); both
+// directions are checked (new against baseline and baseline against new, so a missing line
+// counts as well as an extra one), and an image passes when at most kMaxBadFraction of its
+// pixels fail. On failure the new image and a diff image (|new − baseline| × 4) are written to
+// WOBBLE_RENDER_FAILURE_DIR (in the build folder).
+//
+// Without DISPLAY the tests skip with a message (VTK 9.1 aborts without X). To remake the
+// baselines after an intended change: WOBBLE_UPDATE_BASELINES=1 xvfb-run -a -s "-screen 0
+// 1280x1024x24" build/tests/pipelines_render_test, then look at every image before committing.
+#include <gtest/gtest.h>
+#include <vtkImageData.h>
+#include <vtkPNGReader.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+
+#include "pipelines/energy_charts.h"
+#include "pipelines/exports.h"
+#include "pipelines/scene_view.h"
+#include "pipelines_test_util.h"
+
+namespace wobble::pipelines {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::AirborneWorld;
+
+constexpr int kChannelTolerance = 24;     // of 255, per channel
+constexpr double kMaxBadFraction = 0.001;  // of the pixels
+
+bool PixelNear(vtkImageData* a, int x, int y, vtkImageData* b, int comps) {
+  int dims[3];
+  b->GetDimensions(dims);
+  const auto* pa = static_cast<const unsigned char*>(a->GetScalarPointer(x, y, 0));
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int bx = x + dx, by = y + dy;
+      if (bx < 0 || by < 0 || bx >= dims[0] || by >= dims[1]) continue;
+      const auto* pb = static_cast<const unsigned char*>(b->GetScalarPointer(bx, by, 0));
+      bool all = true;
+      for (int c = 0; c < comps && all; ++c) all = std::abs(int(pa[c]) - int(pb[c])) <= kChannelTolerance;
+      if (all) return true;
+    }
+  return false;
+}
+
+void CompareWithBaseline(const std::string& name, vtkImageData* image) {
+  const std::string baseline_path = std::string(WOBBLE_BASELINE_DIR) + "/" + name + ".png";
+  if (const char* update = std::getenv("WOBBLE_UPDATE_BASELINES"); update && std::string(update) == "1") {
+    WritePng(baseline_path, image, 9);
+    std::cout << "wrote baseline " << baseline_path << "\n";
+    return;
+  }
+  ASSERT_TRUE(fs::exists(baseline_path)) << baseline_path << " is missing: run with WOBBLE_UPDATE_BASELINES=1";
+  auto reader = vtkSmartPointer<vtkPNGReader>::New();
+  reader->SetFileName(baseline_path.c_str());
+  reader->Update();
+  vtkImageData* base = reader->GetOutput();
+  int dn[3], db[3];
+  image->GetDimensions(dn);
+  base->GetDimensions(db);
+  const int comps = image->GetNumberOfScalarComponents();
+  ASSERT_EQ(dn[0], db[0]);
+  ASSERT_EQ(dn[1], db[1]);
+  ASSERT_EQ(comps, base->GetNumberOfScalarComponents());
+  long bad = 0;
+  auto diff = vtkSmartPointer<vtkImageData>::New();
+  diff->SetDimensions(dn[0], dn[1], 1);
+  diff->AllocateScalars(VTK_UNSIGNED_CHAR, comps);
+  for (int y = 0; y < dn[1]; ++y)
+    for (int x = 0; x < dn[0]; ++x) {
+      const bool ok = PixelNear(image, x, y, base, comps) && PixelNear(base, x, y, image, comps);
+      bad += ok ? 0 : 1;
+      const auto* pn = static_cast<const unsigned char*>(image->GetScalarPointer(x, y, 0));
+      const auto* pb = static_cast<const unsigned char*>(base->GetScalarPointer(x, y, 0));
+      auto* pd = static_cast<unsigned char*>(diff->GetScalarPointer(x, y, 0));
+      for (int c = 0; c < comps; ++c) pd[c] = (unsigned char)std::min(255, 4 * std::abs(int(pn[c]) - int(pb[c])));
+    }
+  const double fraction = double(bad) / (double(dn[0]) * dn[1]);
+  if (fraction > kMaxBadFraction) {
+    const std::string out = WOBBLE_RENDER_FAILURE_DIR;
+    WritePng(out + "/" + name + "_new.png", image);
+    WritePng(out + "/" + name + "_diff.png", diff);
+    ADD_FAILURE() << name << ": " << bad << " pixels (" << 100 * fraction << "%) differ from " << baseline_path
+                  << " by more than " << kChannelTolerance << " within +-1 px; new image and diff in " << out;
+  }
+}
+
+#define REQUIRE_DISPLAY() \
+  if (!HasDisplay()) GTEST_SKIP() << "no DISPLAY: VTK 9.1 renders only through X (make test runs ctest under xvfb-run)"
+
+// One layer alone, 160 x 120, no overlay.
+SceneOptions OnlyLayer(const std::string& layer) {
+  SceneOptions o;
+  o.width = 160;
+  o.height = 120;
+  o.overlay = false;
+  o.show_ground = layer == "ground";
+  o.show_lattice = layer == "lattice";
+  o.show_points = layer == "points";
+  o.show_shape = layer == "shape";
+  o.show_springs = false;
+  return o;
+}
+
+vtkSmartPointer<vtkImageData> RenderLayer(const std::string& layer, const SceneOptions& options) {
+  auto world = AirborneWorld();
+  SceneView view(world.get(), 0, options);
+  view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-100, 0), Eigen::Vector2d(400, 350)));
+  view.Render();
+  return view.Capture();
+}
+
+TEST(RenderRegression, LatticeView) {
+  REQUIRE_DISPLAY();
+  CompareWithBaseline("lattice", RenderLayer("lattice", OnlyLayer("lattice")));
+}
+
+TEST(RenderRegression, MassPointsColouredByVelocity) {
+  REQUIRE_DISPLAY();
+  SceneOptions o = OnlyLayer("points");
+  o.color_by = "velocity";
+  o.color_range[0] = 0;
+  o.color_range[1] = 200;
+  o.show_color_bar = false;
+  CompareWithBaseline("mass_points", RenderLayer("points", o));
+}
+
+TEST(RenderRegression, ShapeResampled) {
+  REQUIRE_DISPLAY();
+  CompareWithBaseline("shape", RenderLayer("shape", OnlyLayer("shape")));
+}
+
+TEST(RenderRegression, SlopedGround) {
+  REQUIRE_DISPLAY();
+  CompareWithBaseline("ground", RenderLayer("ground", OnlyLayer("ground")));
+}
+
+TEST(RenderRegression, FullSceneWithOverlayAndColourBar) {
+  REQUIRE_DISPLAY();
+  SceneOptions o;
+  o.width = 240;
+  o.height = 180;
+  o.color_by = "applied_force";
+  o.color_range[0] = 0;
+  o.color_range[1] = 2000;
+  auto world = testing::TouchingWorld();
+  SceneView view(world.get(), 0, o);
+  view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-50, -150), Eigen::Vector2d(350, 150)));
+  view.Render();
+  CompareWithBaseline("full_scene", view.Capture());
+}
+
+TEST(RenderRegression, EnergyChart) {
+  REQUIRE_DISPLAY();
+  auto world = testing::AirborneWorld();
+  RunRecorder rec;
+  rec.Sample(*world);
+  world->RunUntil(1.0, [&](const World& w) { rec.Sample(w); });
+  ChartSpec spec = rec.EnergyChart("energy");
+  spec.width = 320;
+  spec.height = 200;
+  CompareWithBaseline("energy_chart", RenderChart(spec));
+}
+
+TEST(RenderRegression, Filmstrip) {
+  REQUIRE_DISPLAY();
+  auto world = testing::AirborneWorld();
+  SceneOptions o;
+  o.width = 96;
+  o.height = 72;
+  o.overlay = false;
+  SceneView view(world.get(), 0, o);
+  view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-100, -100), Eigen::Vector2d(500, 350)));
+  std::vector<vtkSmartPointer<vtkImageData>> panels;
+  for (double t : {0.0, 1.5, 3.0, 4.5}) {
+    world->RunUntil(t, [](const World&) {});
+    view.Render();
+    panels.push_back(view.Capture());
+  }
+  vtkSmartPointer<vtkImageData> strip = TileImages(panels, 2);
+  int dims[3];
+  strip->GetDimensions(dims);
+  EXPECT_EQ(dims[0], 2 * 96 + 4);  // two columns, a 4-pixel gap
+  EXPECT_EQ(dims[1], 2 * 72 + 4);
+  CompareWithBaseline("filmstrip", strip);
+}
+
+}  // namespace
+}  // namespace wobble::pipelines
