@@ -57,8 +57,6 @@ std::vector<std::string> CoordinateNames(const BodyModel& body) {
   return names;
 }
 
-namespace {
-
 // Weighted Procrustes: the rotation and translation that best carry the rest positions b0_i
 // onto the targets y_i (least squares), with γ = 0.
 Eigen::VectorXd RigidStart(const BodyModel& body, const std::vector<Eigen::Vector2d>& rest,
@@ -81,6 +79,8 @@ Eigen::VectorXd RigidStart(const BodyModel& body, const std::vector<Eigen::Vecto
   q << t.x(), t.y(), theta, Eigen::VectorXd::Zero(body.num_modes());
   return q;
 }
+
+namespace {
 
 void FillResiduals(const std::vector<SegmentResidual>& data, const Eigen::VectorXd& q, PoseFitResult* r) {
   r->point_residuals.clear();

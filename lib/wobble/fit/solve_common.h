@@ -13,6 +13,11 @@ namespace wobble::fit {
 inline double ModeLower(const PoseFitOptions& o, int d) { return o.mode_lower.empty() ? o.gamma_lower : o.mode_lower[d]; }
 inline double ModeUpper(const PoseFitOptions& o, int d) { return o.mode_upper.empty() ? o.gamma_upper : o.mode_upper[d]; }
 
+// Weighted Procrustes: q (γ = 0) whose rigid motion best carries the rest positions onto the
+// targets in the least-squares sense.
+Eigen::VectorXd RigidStart(const BodyModel& body, const std::vector<Eigen::Vector2d>& rest,
+                           const std::vector<Eigen::Vector2d>& target, const std::vector<double>& weights);
+
 // A new loss function for Problem (which takes ownership); nullptr for squared.
 ceres::LossFunction* MakeLoss(Loss loss, double scale);
 
