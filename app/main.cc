@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "cli_common.h"
+#include "fit.h"
 #include "inspect.h"
 #include "simulate.h"
 #include "wobble/io/object_file.h"
@@ -22,6 +23,9 @@ int main(int argc, char** argv) {
   InspectArgs inspect_args;
   CLI::App* simulate = AddSimulateCommand(&app, &simulate_args);
   CLI::App* inspect = AddInspectCommand(&app, &inspect_args);
+  FitPoseArgs fit_pose_args;
+  FitTrajectoryArgs fit_trajectory_args;
+  const FitCommands fit = AddFitCommand(&app, &fit_pose_args, &fit_trajectory_args);
 
   try {
     app.parse(argc, argv);
@@ -34,6 +38,8 @@ int main(int argc, char** argv) {
   try {
     if (simulate->parsed()) return RunSimulate(simulate_args);
     if (inspect->parsed()) return RunInspect(inspect_args);
+    if (fit.pose->parsed()) return RunFitPose(fit_pose_args);
+    if (fit.trajectory->parsed()) return RunFitTrajectory(fit_trajectory_args);
   } catch (const wobble::io::ParseError& e) {
     std::cerr << e.what() << std::endl;  // already "FILE:LINE: message"
     return kExitBadInput;

@@ -302,6 +302,8 @@ DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<i
   options.gradient_tolerance = 1e-16;
   options.parameter_tolerance = 1e-12;
   options.logging_type = ceres::SILENT;
+  IterationForwarder forward(o.on_iteration);
+  forward.Attach(&options);
   ceres::Solver::Summary summary;
   const auto t0 = std::chrono::steady_clock::now();
   ceres::Solve(options, &problem, &summary);

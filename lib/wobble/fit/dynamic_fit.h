@@ -29,6 +29,7 @@ struct DynamicFitOptions {
   bool fit_q0 = true, fit_qd0 = true, fit_stiffness = true, fit_damping = true;
   int max_iterations = 50;
   bool full_report = false;
+  std::function<void(int iteration, double cost)> on_iteration;  // progress display
 };
 
 struct DynamicFitResult {

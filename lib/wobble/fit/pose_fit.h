@@ -12,6 +12,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,8 @@ struct PoseFitOptions {
   // that both directions weigh the same in total): without it the body may cover only part
   // of the target.
   bool two_sided = true;
+  // Called after every Ceres iteration with its number and cost (progress display).
+  std::function<void(int iteration, double cost)> on_iteration;
 };
 // Empty when valid, otherwise what is wrong (for a body with `num_modes` modes).
 std::string ValidateOptions(const PoseFitOptions& options, int num_modes);

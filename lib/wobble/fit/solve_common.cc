@@ -64,6 +64,8 @@ void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
   options.gradient_tolerance = 1e-14;
   options.parameter_tolerance = 1e-12;
   options.logging_type = ceres::SILENT;
+  IterationForwarder forward(o.on_iteration);
+  forward.Attach(&options);
   ceres::Solver::Summary summary;
   const auto start = std::chrono::steady_clock::now();
   ceres::Solve(options, &problem, &summary);

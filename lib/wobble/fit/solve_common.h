@@ -28,6 +28,22 @@ std::vector<ceres::ResidualBlockId> AddPoseTerms(const BodyModel& body, const st
                                                  const std::vector<ReverseSegmentResidual>& reverse,
                                                  const PoseFitOptions& o, double* q, ceres::Problem* problem);
 
+// Forwards Ceres' iterations to an on_iteration function; attach with Attach().
+class IterationForwarder : public ceres::IterationCallback {
+ public:
+  explicit IterationForwarder(std::function<void(int, double)> f) : f_(std::move(f)) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    f_(s.iteration, s.cost);
+    return ceres::SOLVER_CONTINUE;
+  }
+  void Attach(ceres::Solver::Options* options) {
+    if (f_) options->callbacks.push_back(this);
+  }
+
+ private:
+  std::function<void(int, double)> f_;
+};
+
 // Copies what people need from a Ceres summary.
 void FillReport(const ceres::Solver::Summary& summary, bool full, double seconds, FitReport* report);
 

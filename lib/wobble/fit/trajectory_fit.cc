@@ -116,6 +116,8 @@ TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vec
   options.gradient_tolerance = 1e-14;
   options.parameter_tolerance = 1e-12;
   options.logging_type = ceres::SILENT;
+  IterationForwarder forward(po.on_iteration);
+  forward.Attach(&options);
   result.linear_solver = std::string("SPARSE_NORMAL_CHOLESKY/") +
                          ceres::SparseLinearAlgebraLibraryTypeToString(options.sparse_linear_algebra_library_type);
   ceres::Solver::Summary summary;
