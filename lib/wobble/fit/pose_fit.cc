@@ -133,7 +133,7 @@ PoseFitResult FitPose(const BodyModel& body, const std::vector<io::PointTarget>&
   SolvePose(body, data, {}, o, &result.q, &result.report);
   FillResiduals(data, result.q, &result);
   FillAtBound(body, o, &result);
-  result.conditioning = ComputeConditioning(body, data, {}, o, result.q);
+  if (o.analyze_conditioning) result.conditioning = ComputeConditioning(body, data, {}, o, result.q);
   return result;
 }
 
@@ -230,8 +230,13 @@ PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, c
     throw std::invalid_argument("curve fit: the body has no samples (no mass points used, no drawing)");
   const int ns = int(samples.points.size());
   const bool two_sided = o.two_sided && !samples.segments.empty();
+  std::vector<Eigen::Vector2d> reverse_points;
+  if (two_sided) {
+    const size_t nv = target.vertices.size(), keep = std::min(nv, size_t(std::max(1, o.max_reverse_points)));
+    for (size_t i = 0; i < keep; ++i) reverse_points.push_back(target.vertices[i * nv / keep]);
+  }
   // both directions weigh the same in total
-  const double reverse_weight = two_sided ? double(ns) / double(target.vertices.size()) : 0.0;
+  const double reverse_weight = two_sided ? double(ns) / double(reverse_points.size()) : 0.0;
 
   // the starts: centroid onto centroid, principal axis onto principal axis
   std::vector<Eigen::VectorXd> starts;
@@ -257,31 +262,34 @@ PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, c
     }
   }
 
-  PoseFitResult best;
-  std::vector<SegmentResidual> best_data;
-  std::vector<ReverseSegmentResidual> best_reverse;
-  bool have_best = false;
-  for (Eigen::VectorXd q : starts) {
-    for (int d = 0; d < body.num_modes(); ++d)
-      q[kRigidDofs + d] = std::clamp(q[kRigidDofs + d], ModeLower(o, d), ModeUpper(o, d));
+  // one start's state across rounds
+  struct Run {
+    Eigen::VectorXd q;
     PoseFitResult r;
-    std::vector<int> assigned(ns, -1), reverse_assigned(two_sided ? target.vertices.size() : 0, -1);
-    std::vector<SegmentResidual> data(ns);
-    std::vector<ReverseSegmentResidual> reverse(reverse_assigned.size());
-    double seconds = 0;
-    for (int round = 0; round < o.max_rounds; ++round) {
+    std::vector<int> assigned, reverse_assigned;
+    std::vector<SegmentResidual> data;
+    std::vector<ReverseSegmentResidual> reverse;
+    double seconds = 0, previous_cost = std::numeric_limits<double>::infinity();
+    int round = 0;
+    bool done = false;
+  };
+  // runs rounds until `last_round` (exclusive) or convergence
+  auto advance = [&](Run* run, int last_round) {
+    for (; run->round < last_round && !run->done; ++run->round) {
+      Eigen::VectorXd& q = run->q;
       // closest points at the current q: body samples to target segments ...
       bool changed = false;
       std::vector<Eigen::Vector2d> x(ns);
       for (int i = 0; i < ns; ++i) {
         x[i] = PointPosition(samples.points[i], q.data(), int(q.size()));
         const int seg = NearestSegment(target.a, target.b, x[i]);
-        changed = changed || seg != assigned[i];
-        assigned[i] = seg;
-        data[i].point = samples.points[i];
-        data[i].a = target.a[seg];
-        data[i].b = target.b[seg];
-        data[i].num_q = body.num_q();
+        changed = changed || seg != run->assigned[i];
+        run->assigned[i] = seg;
+        SegmentResidual& d = run->data[i];
+        d.point = samples.points[i];
+        d.a = target.a[seg];
+        d.b = target.b[seg];
+        d.num_q = body.num_q();
       }
       // ... and target vertices to the body's drawn segments
       if (two_sided) {
@@ -290,43 +298,68 @@ PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, c
           ba.push_back(x[i]);
           bb.push_back(x[j]);
         }
-        for (size_t v = 0; v < target.vertices.size(); ++v) {
-          const int seg = NearestSegment(ba, bb, target.vertices[v]);
-          changed = changed || seg != reverse_assigned[v];
-          reverse_assigned[v] = seg;
-          reverse[v].pa = samples.points[samples.segments[seg].first];
-          reverse[v].pb = samples.points[samples.segments[seg].second];
-          reverse[v].y = target.vertices[v];
-          reverse[v].sqrt_weight = std::sqrt(reverse_weight);
-          reverse[v].num_q = body.num_q();
+        for (size_t v = 0; v < reverse_points.size(); ++v) {
+          const int seg = NearestSegment(ba, bb, reverse_points[v]);
+          changed = changed || seg != run->reverse_assigned[v];
+          run->reverse_assigned[v] = seg;
+          ReverseSegmentResidual& d = run->reverse[v];
+          d.pa = samples.points[samples.segments[seg].first];
+          d.pb = samples.points[samples.segments[seg].second];
+          d.y = reverse_points[v];
+          d.sqrt_weight = std::sqrt(reverse_weight);
+          d.num_q = body.num_q();
         }
       }
-      if (!changed) break;
+      if (!changed) {
+        run->done = true;
+        break;
+      }
       FitReport round_report;
-      SolvePose(body, data, reverse, o, &q, &round_report);
+      SolvePose(body, run->data, run->reverse, o, &q, &round_report);
       // the cost history runs over all rounds; the summary is that of the last round
+      PoseFitResult& r = run->r;
       const std::vector<double> before = r.report.cost_per_iteration;
       const int iterations = r.report.iterations;
-      const double initial = round == 0 ? round_report.initial_cost : r.report.initial_cost;
+      const double initial = run->round == 0 ? round_report.initial_cost : r.report.initial_cost;
       r.report = round_report;
       r.report.initial_cost = initial;
       r.report.cost_per_iteration.insert(r.report.cost_per_iteration.begin(), before.begin(), before.end());
       r.report.iterations += iterations;
-      seconds += round_report.solve_seconds;
-      r.rounds = round + 1;
+      run->seconds += round_report.solve_seconds;
+      r.rounds = run->round + 1;
+      // assignments may keep flipping between neighbouring segments at equal distance: stop
+      // as well when a round no longer lowers the cost
+      if (run->round > 0 && run->previous_cost - round_report.final_cost <= 1e-6 * run->previous_cost) run->done = true;
+      run->previous_cost = round_report.final_cost;
     }
-    r.report.solve_seconds = seconds;
-    r.q = q;
-    if (!have_best || r.report.final_cost < best.report.final_cost) {
-      best = r;
-      best_data = data;
-      best_reverse = reverse;
-      have_best = true;
-    }
+  };
+
+  std::vector<Run> runs;
+  for (const Eigen::VectorXd& start : starts) {
+    Run run;
+    run.q = start;
+    for (int d = 0; d < body.num_modes(); ++d)
+      run.q[kRigidDofs + d] = std::clamp(run.q[kRigidDofs + d], ModeLower(o, d), ModeUpper(o, d));
+    run.assigned.assign(ns, -1);
+    run.reverse_assigned.assign(reverse_points.size(), -1);
+    run.data.resize(ns);
+    run.reverse.resize(reverse_points.size());
+    advance(&run, std::min(o.start_rounds, o.max_rounds));
+    runs.push_back(std::move(run));
   }
+  size_t best_index = 0;
+  for (size_t i = 1; i < runs.size(); ++i)
+    if (runs[i].r.report.final_cost < runs[best_index].r.report.final_cost) best_index = i;
+  Run& winner = runs[best_index];
+  advance(&winner, o.max_rounds);
+  PoseFitResult best = winner.r;
+  best.report.solve_seconds = winner.seconds;
+  best.q = winner.q;
+  const std::vector<SegmentResidual>& best_data = winner.data;
+  const std::vector<ReverseSegmentResidual>& best_reverse = winner.reverse;
   FillResiduals(best_data, best.q, &best);
   FillAtBound(body, o, &best);
-  best.conditioning = ComputeConditioning(body, best_data, best_reverse, o, best.q);
+  if (o.analyze_conditioning) best.conditioning = ComputeConditioning(body, best_data, best_reverse, o, best.q);
   return best;
 }
 

@@ -49,6 +49,13 @@ struct PoseFitOptions {
   // that both directions weigh the same in total): without it the body may cover only part
   // of the target.
   bool two_sided = true;
+  // Two-sided fits use at most this many target vertices (evenly spread) for the reverse
+  // direction: enough to see partial coverage, and the reverse terms are the costly ones.
+  int max_reverse_points = 200;
+  // Every start runs this many rounds; then only the best start continues.
+  int start_rounds = 3;
+  // Compute PoseFitResult::conditioning (an SVD of the data Jacobian at the solution).
+  bool analyze_conditioning = true;
   // Called after every Ceres iteration with its number and cost (progress display).
   std::function<void(int iteration, double cost)> on_iteration;
 };
@@ -129,8 +136,9 @@ struct CurveSamples {
 // Fits q to a curve target without correspondences, ICP-like: every round assigns each body
 // sample its nearest target segment at the current q (and, two-sided, each target vertex its
 // nearest body segment), then solves with point-to-segment residuals on those segments (the
-// distance is exact for the assigned segment), until the assignment stops changing or
-// options.max_rounds. point_residuals are those of the body samples (body → target). Start (without options.initial_q): the
+// distance is exact for the assigned segment), until the assignment stops changing, a round
+// no longer lowers the cost by a relative 1e-6, or options.max_rounds. Every start runs
+// options.start_rounds rounds, then the one with the lowest cost continues. point_residuals are those of the body samples (body → target). Start (without options.initial_q): the
 // rest shape's sample centroid moved onto the target's (length-weighted) centroid, its
 // principal axis turned onto the target's; both orientations of the axis are tried (four
 // quarter turns when either shape is nearly isotropic) and the lowest final cost wins; γ = 0.

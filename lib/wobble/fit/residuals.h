@@ -23,11 +23,19 @@ struct PointBasis {
 // Mass point k, or the body point at lattice coordinates (s, t) when k < 0.
 PointBasis BasisOf(const BodyModel& body, int mass_point, const Eigen::Vector2d& lattice_coords);
 
-// World position of a body point, templated for autodiff.
+// World position of a body point, templated for autodiff: x = t + R(θ)(b0 + Σ_d γ_d b^d)
+// (Eq. 4.2), as LocalPosition/WorldFromLocal of kinematics.h but reading q in place (copying
+// q into a VecQ of Jets dominated the cost of a residual).
 template <class T> Vec2<T> PointPosition(const PointBasis& p, const T* q, int num_q) {
-  VecQ<T> qv(num_q);
-  for (int i = 0; i < num_q; ++i) qv[i] = q[i];
-  return WorldFromLocal(Frame<T>(qv), LocalPosition<T>(p.b0, p.B, qv));
+  using std::cos;
+  using std::sin;
+  T lx(p.b0.x()), ly(p.b0.y());
+  for (int d = 0; d + kRigidDofs < num_q; ++d) {
+    lx += p.B(0, d) * q[kRigidDofs + d];
+    ly += p.B(1, d) * q[kRigidDofs + d];
+  }
+  const T c = cos(q[2]), s = sin(q[2]);
+  return Vec2<T>(q[0] + c * lx - s * ly, q[1] + s * lx + c * ly);
 }
 
 // The closest point of segment [a, b] to x (a == b: the point a). Where the projection is

@@ -58,7 +58,9 @@ void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
   ceres::Problem problem;
   AddPoseTerms(body, data, reverse, o, q->data(), &problem);
   ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
+  // normal equations: J has 2 rows per target but only num_q ≤ 15 columns; LM's damping keeps
+  // them positive definite even when a mode is undetermined
+  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   options.max_num_iterations = o.max_iterations;
   options.function_tolerance = 1e-12;
   options.gradient_tolerance = 1e-14;
