@@ -146,6 +146,27 @@ void BM_DynamicFit_100Steps(benchmark::State& state) {
 }
 BENCHMARK(BM_DynamicFit_100Steps)->Unit(benchmark::kMillisecond);
 
+// Baseline on the same problem: simulated annealing with a budget of simulations (the
+// argument; Ceres used 24, each a Jet simulation). Counter "cost": the best cost found;
+// compare with the Ceres fit's final cost, printed by tests/dynamic_fit_test (~1e-21).
+void BM_DynamicFit_Annealing(benchmark::State& state) {
+  const auto body = std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(3e6, 2e5));
+  const std::vector<io::TargetFrame> all = ThrownFrames(body, 101, 0.01);
+  std::vector<io::TargetFrame> frames;
+  for (size_t i = 0; i < all.size(); i += 2) frames.push_back(all[i]);
+  fit::DynamicParameters start;
+  start.stiffness = Eigen::VectorXd::Constant(4, 3e6 * 1.4);
+  start.damping = Eigen::VectorXd::Constant(4, 2e5 * 0.6);
+  fit::DynamicFitOptions o;
+  o.world.ground.enabled = false;
+  double cost = 0, ceres_cost = 0;
+  for (auto _ : state) cost = fit::AnnealDynamicTrajectory(*body, frames, start, o, state.range(0), 1).cost;
+  ceres_cost = fit::FitDynamicTrajectory(*body, frames, start, o).report.final_cost;
+  state.counters["cost"] = cost;
+  state.counters["ceres_cost"] = ceres_cost;
+}
+BENCHMARK(BM_DynamicFit_Annealing)->Arg(24)->Arg(240)->Arg(2400)->ArgName("simulations")->Unit(benchmark::kMillisecond);
+
 }  // namespace
 }  // namespace wobble
 
