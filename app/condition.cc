@@ -47,15 +47,6 @@ std::vector<double> Angles(const ConditionSweepArgs& a) {
   return phis;
 }
 
-void WriteTextAtomically(const std::string& path, const std::string& text) {
-  io::WriteFileAtomically(path, [&](const std::string& tmp) {
-    std::ofstream f(tmp);
-    f << text;
-    f.close();
-    if (!f) throw std::runtime_error(tmp + ": write failed");
-  });
-}
-
 // A regular grid of samples (nx × ny, row-major from the bottom) for the picture writers.
 struct Grid {
   int nx = 0, ny = 0;

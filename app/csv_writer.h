@@ -20,3 +20,9 @@ void CheckWritable(const std::string& path);
 std::string FormatDouble(double value);
 
 }  // namespace wobble::app
+
+namespace wobble::app {
+// Writes `text` to `path` atomically (FILE.tmp in the same folder, then renamed), creating the
+// folder. Throws std::runtime_error with the path and the reason. Used for JSON results.
+void WriteTextAtomically(const std::string& path, const std::string& text);
+}  // namespace wobble::app

@@ -7,6 +7,7 @@
 
 #include "cli_common.h"
 #include "condition.h"
+#include "fit.h"
 #include "inspect.h"
 #ifdef WOBBLE_HAVE_PIPELINES
 #include "render.h"
@@ -38,6 +39,9 @@ int main(int argc, char** argv) {
   CLI::App* exporter = AddRenderCommand(&app, "export", "Simulate and export: .vtp/.pvd for ParaView, EXR frames and "
                                         "displacement images", export_what, &export_args);
 #endif
+  FitPoseArgs fit_pose_args;
+  FitTrajectoryArgs fit_trajectory_args;
+  const FitCommands fit = AddFitCommand(&app, &fit_pose_args, &fit_trajectory_args);
 
   try {
     app.parse(argc, argv);
@@ -57,6 +61,8 @@ int main(int argc, char** argv) {
     if (render->parsed()) return RunRender(render_args, render_what);
     if (exporter->parsed()) return RunRender(export_args, export_what);
 #endif
+    if (fit.pose->parsed()) return RunFitPose(fit_pose_args);
+    if (fit.trajectory->parsed()) return RunFitTrajectory(fit_trajectory_args);
   } catch (const wobble::io::ParseError& e) {
     std::cerr << e.what() << std::endl;  // already "FILE:LINE: message"
     return kExitBadInput;

@@ -1,0 +1,386 @@
+#include "fit.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "csv_writer.h"
+#include "wobble/fit/dynamic_fit.h"
+#include "wobble/fit/pose_fit.h"
+#include "wobble/fit/trajectory_fit.h"
+#include "wobble/io/simulation_csv.h"
+#include "wobble/io/parse_error.h"
+#include "wobble/io/target_file.h"
+
+namespace wobble::app {
+namespace {
+
+using nlohmann::json;
+
+json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }  // JSON has no inf
+
+template <class Derived> json Vector(const Eigen::MatrixBase<Derived>& v) {
+  json a = json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(Number(double(v[i])));
+  return a;
+}
+json Point(const Eigen::Vector2d& p) { return json::array({p.x(), p.y()}); }
+
+void AddFitFlags(CLI::App* cmd, FitFlags* f) {
+  cmd->add_option("--q0", f->q0, "Starting q = \"tx ty theta g1 ..\" (default: see the README)")->type_name("\"NUMS\"");
+  cmd->add_option("--gamma-min", f->gamma_min, "Lower bound of every amplitude")->capture_default_str();
+  cmd->add_option("--gamma-max", f->gamma_max, "Upper bound of every amplitude")->capture_default_str();
+  cmd->add_option("--loss", f->loss, "squared | huber | cauchy (robust against outliers)")->capture_default_str();
+  cmd->add_option("--loss-scale", f->loss_scale, "Distance beyond which the robust loss gives way")->capture_default_str();
+  cmd->add_option("--prior", f->prior, "Weight of the prior pulling every amplitude toward rest")->capture_default_str();
+  cmd->add_option("--max-iterations", f->max_iterations, "Ceres iterations")->capture_default_str();
+  cmd->add_flag("--full-report", f->full_report, "Include Ceres' full report in the JSON and print it");
+  cmd->add_option("--out", f->out, "Result JSON (written atomically)")->type_name("FILE.json");
+  cmd->add_option("--costs", f->costs, "Cost per iteration as CSV (written atomically)")->type_name("FILE.csv");
+}
+
+fit::PoseFitOptions PoseOptions(const FitFlags& f, const BodyModel& body) {
+  fit::PoseFitOptions o;
+  if (!f.q0.empty()) o.initial_q = ParseCoordinates(f.q0, "--q0", body);
+  RequireFinite(f.gamma_min, "--gamma-min");
+  RequireFinite(f.gamma_max, "--gamma-max");
+  if (!(f.gamma_min < f.gamma_max)) throw UsageError("--gamma-min must be below --gamma-max");
+  o.gamma_lower = f.gamma_min;
+  o.gamma_upper = f.gamma_max;
+  if (!fit::ParseLoss(f.loss, &o.loss)) throw UsageError("--loss: '" + f.loss + "' is not one of squared, huber, cauchy");
+  RequirePositive(f.loss_scale, "--loss-scale");
+  o.loss_scale = f.loss_scale;
+  RequireNonNegative(f.prior, "--prior");
+  o.prior_weight = f.prior;
+  if (f.max_iterations < 1) throw UsageError("--max-iterations must be at least 1");
+  o.max_iterations = f.max_iterations;
+  o.full_report = f.full_report;
+  return o;
+}
+
+void CheckOutputs(const FitFlags& f) {
+  for (const std::string* path : {&f.out, &f.costs}) {
+    if (path->empty()) continue;
+    try {
+      CheckWritable(*path);
+    } catch (const std::runtime_error& e) {
+      throw UsageError(std::string(path == &f.out ? "--out: " : "--costs: ") + e.what());
+    }
+  }
+}
+
+// A one-line "iteration N, cost C" on stderr when it is a terminal (quiet otherwise).
+std::function<void(int, double)> IterationLine() {
+  if (isatty(STDERR_FILENO) != 1) return {};
+  return [](int iteration, double cost) {
+    std::fprintf(stderr, "\r  iteration %4d  cost %-14.6g", iteration, cost);
+    std::fflush(stderr);
+  };
+}
+void EndIterationLine() {
+  if (isatty(STDERR_FILENO) == 1) std::fprintf(stderr, "\n");
+}
+
+json ReportJson(const fit::FitReport& r) {
+  json j;
+  j["usable"] = r.usable;
+  j["termination"] = r.termination;
+  j["initial_cost"] = Number(r.initial_cost);
+  j["final_cost"] = Number(r.final_cost);
+  j["iterations"] = r.iterations;
+  j["solve_seconds"] = r.solve_seconds;
+  j["ceres_brief_report"] = r.brief_report;
+  if (!r.full_report.empty()) j["ceres_full_report"] = r.full_report;
+  return j;
+}
+
+void WriteOutputs(const FitFlags& f, const json& result, const fit::FitReport& r) {
+  if (!f.costs.empty()) {
+    std::vector<std::vector<double>> rows;
+    for (size_t i = 0; i < r.cost_per_iteration.size(); ++i) rows.push_back({double(i), r.cost_per_iteration[i]});
+    WriteCsvAtomically(f.costs, {"iteration", "cost"}, rows);
+  }
+  if (!f.out.empty()) WriteTextAtomically(f.out, result.dump(2) + "\n");
+}
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.6g", v);
+  return buf;
+}
+std::string List(const std::vector<std::string>& names) {
+  std::string s;
+  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s.empty() ? "none" : s;
+}
+
+}  // namespace
+
+FitCommands AddFitCommand(CLI::App* app, FitPoseArgs* pose, FitTrajectoryArgs* traj) {
+  FitCommands c;
+  c.fit = app->add_subcommand("fit", "Fit poses and trajectories with Ceres (see the README: Fitting)");
+  c.fit->require_subcommand(1);
+
+  c.pose = c.fit->add_subcommand("pose", "Fit q = [tx ty theta g..] to target points or a target curve");
+  AddBodyFlags(c.pose, &pose->files);
+  c.pose->add_option("--targets", pose->targets, "Target file (point/sample lines, or polyline/cloud lines)")
+      ->required()
+      ->type_name("FILE.tgt");
+  AddFitFlags(c.pose, &pose->fit);
+  c.pose->add_option("--samples-per-segment", pose->samples_per_segment, "Curve targets: samples per drawn segment")
+      ->capture_default_str();
+  c.pose->add_option("--max-rounds", pose->max_rounds, "Curve targets: closest-point rounds")->capture_default_str();
+  c.pose->add_flag("--one-sided", pose->one_sided, "Curve targets: only body-to-target distances");
+  c.pose->footer(
+      "Example:\n"
+      "  wobble fit pose --object data/table.obj --modes data/table_modes.def \\\n"
+      "      --targets data/table_pose.tgt --loss cauchy --loss-scale 5 --out out/pose.json");
+
+  c.trajectory = c.fit->add_subcommand("trajectory", "Fit q(t) per frame (kinematic) or the simulation's parameters (--dynamic)");
+  AddBodyFlags(c.trajectory, &traj->files);
+  c.trajectory->add_option("--reference", traj->reference, "Trajectory: a target file with frames, or a `wobble simulate` CSV")
+      ->required()
+      ->type_name("FILE");
+  AddFitFlags(c.trajectory, &traj->fit);
+  c.trajectory->add_option("--points", traj->points, "CSV reference: mass points observed, e.g. \"0,4,5\" (default all)");
+  c.trajectory->add_option("--every", traj->every, "CSV reference: use every Nth row")->capture_default_str();
+  c.trajectory->add_option("--smoothness", traj->smoothness, "Kinematic: weight of the second-difference term")
+      ->capture_default_str();
+  c.trajectory->add_flag("--dynamic", traj->dynamic, "Fit through the simulation: initial state, mode stiffness, damping");
+  c.trajectory->add_option("--dt", traj->dt, "Dynamic: time step (thesis integrator)")->capture_default_str();
+  c.trajectory->add_option("--fit", traj->fit_what, "Dynamic: what to fit, from q0,qdot0,stiffness,damping")
+      ->capture_default_str();
+  c.trajectory->add_option("--qdot0", traj->qdot0, "Dynamic: starting q-dot (default: from the first two frames)");
+  c.trajectory->add_flag("--anneal", traj->anneal, "Dynamic: also run simulated annealing with the same number of simulations");
+  AddWorldFlags(c.trajectory, &traj->world);
+  c.trajectory->footer(
+      "Examples:\n"
+      "  wobble fit trajectory --object data/table.obj --modes data/table_modes.def \\\n"
+      "      --reference data/table_keys.tgt --smoothness 1 --out out/keys.json\n"
+      "  wobble fit trajectory --object data/table.obj --modes data/table_modes.def \\\n"
+      "      --reference out/table_drop.csv --dynamic --no-ground --out out/dyn.json");
+  return c;
+}
+
+int RunFitPose(const FitPoseArgs& a) {
+  CheckOutputs(a.fit);
+  const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
+  fit::PoseFitOptions o = PoseOptions(a.fit, *body);
+  if (a.samples_per_segment < 0) throw UsageError("--samples-per-segment must be >= 0");
+  if (a.max_rounds < 1) throw UsageError("--max-rounds must be at least 1");
+  o.samples_per_segment = a.samples_per_segment;
+  o.max_rounds = a.max_rounds;
+  o.two_sided = !a.one_sided;
+  o.on_iteration = IterationLine();
+  const io::TargetFile targets = io::ReadTargetFile(a.targets);
+  io::CheckMassPointIndices(targets, body->num_points());
+  if (targets.is_trajectory())
+    throw io::ParseError(a.targets, targets.frames[0].line, "this file has frames: use `wobble fit trajectory`");
+
+  const bool curve = targets.has_curve();
+  const fit::PoseFitResult r = curve ? fit::FitPoseToCurve(*body, fit::CurveTarget::From(targets), o)
+                                     : fit::FitPose(*body, targets.points, o);
+  EndIterationLine();
+  const std::vector<std::string> names = fit::CoordinateNames(*body);
+
+  json j;
+  j["kind"] = curve ? "curve" : "correspondences";
+  j["body"] = body->name();
+  j["targets"] = a.targets;
+  j["coordinates"] = names;
+  j["q"] = Vector(r.q);
+  j["report"] = ReportJson(r.report);
+  j["rms_residual"] = r.rms_residual;
+  j["point_residuals"] = r.point_residuals;
+  j["at_bound"] = r.at_bound;
+  if (curve) j["rounds"] = r.rounds;
+  json c;
+  c["condition_number"] = Number(r.conditioning.condition_number);
+  c["scaled_condition_number"] = Number(r.conditioning.scaled_condition_number);
+  c["column_norms"] = r.conditioning.column_norms;
+  c["undetermined"] = r.conditioning.undetermined;
+  c["poorly_determined"] = r.conditioning.poorly_determined;
+  c["weak_directions"] = json::array();
+  for (const fit::WeakDirection& w : r.conditioning.weak)
+    c["weak_directions"].push_back({{"relative_singular_value", w.relative_singular_value},
+                                    {"coordinates", w.coordinates},
+                                    {"vector", Vector(w.vector)}});
+  j["conditioning"] = c;
+  // the overlay hook: fitted body points and their targets, world frame
+  json overlay;
+  overlay["fitted"] = json::array();
+  overlay["targets"] = json::array();
+  if (curve) {
+    for (const fit::PointBasis& p : fit::CurveSamples::Of(*body, o).points)
+      overlay["fitted"].push_back(Point(fit::PointPosition(p, r.q.data(), body->num_q())));
+    for (const io::TargetCurve& line : targets.polylines) {
+      json pl = json::array();
+      for (const Eigen::Vector2d& p : line.points) pl.push_back(Point(p));
+      overlay["targets"].push_back({{"polyline", pl}, {"closed", line.closed}});
+    }
+    for (const Eigen::Vector2d& p : targets.cloud) overlay["targets"].push_back({{"point", Point(p)}});
+  } else {
+    for (const io::PointTarget& t : targets.points) {
+      overlay["fitted"].push_back(
+          Point(fit::PointPosition(fit::BasisOf(*body, t.mass_point, t.lattice_coords), r.q.data(), body->num_q())));
+      overlay["targets"].push_back({{"point", Point(t.position)}});
+    }
+  }
+  j["overlay"] = overlay;
+  WriteOutputs(a.fit, j, r.report);
+
+  std::ostringstream out;
+  out << body->name() << ": " << (curve ? "curve" : "correspondence") << " fit to " << a.targets << ": "
+      << r.report.termination << " after " << r.report.iterations << " iterations"
+      << (curve ? " in " + std::to_string(r.rounds) + " closest-point rounds" : std::string()) << ".\n";
+  out << "q = [";
+  for (int i = 0; i < r.q.size(); ++i) out << (i ? " " : "") << names[i] << " " << Num(r.q[i]);
+  out << "]\n";
+  out << "cost " << Num(r.report.initial_cost) << " -> " << Num(r.report.final_cost) << ", rms residual "
+      << Num(r.rms_residual) << "; at a bound: " << List(r.at_bound) << ".\n";
+  out << "cond(JtJ) " << Num(r.conditioning.condition_number) << " (column-scaled "
+      << Num(r.conditioning.scaled_condition_number) << "); undetermined modes: " << List(r.conditioning.undetermined)
+      << "; poorly determined: " << List(r.conditioning.poorly_determined) << ".";
+  std::cout << out.str() << std::endl;
+  if (a.fit.full_report) std::cout << r.report.full_report << std::endl;
+  if (!r.report.usable) {
+    std::cerr << "wobble: the fit failed: " << r.report.brief_report << std::endl;
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+namespace {
+
+std::vector<int> ParsePointList(const std::string& text, int num_points) {
+  std::vector<int> points;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    if (item.empty()) continue;
+    char* end = nullptr;
+    const long k = std::strtol(item.c_str(), &end, 10);
+    if (*end != '\0' || k < 0 || k >= num_points)
+      throw UsageError("--points: '" + item + "' is not a mass point (0.." + std::to_string(num_points - 1) + ")");
+    points.push_back(int(k));
+  }
+  return points;
+}
+
+bool EndsWith(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+}  // namespace
+
+int RunFitTrajectory(const FitTrajectoryArgs& a) {
+  CheckOutputs(a.fit);
+  const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
+  fit::PoseFitOptions po = PoseOptions(a.fit, *body);
+  if (a.every < 1) throw UsageError("--every must be at least 1");
+  RequireNonNegative(a.smoothness, "--smoothness");
+
+  // the reference: a simulation CSV or a target file with frames
+  std::vector<io::TargetFrame> frames;
+  if (EndsWith(a.reference, ".csv")) {
+    const io::SimulationCsv sim = io::ReadSimulationCsv(a.reference, body->num_modes());
+    frames = fit::FramesFromStates(*body, sim.t, sim.q, ParsePointList(a.points, body->num_points()), a.every);
+  } else {
+    if (!a.points.empty() || a.every != 1) throw UsageError("--points and --every apply to a CSV reference only");
+    const io::TargetFile t = io::ReadTargetFile(a.reference);
+    if (!t.is_trajectory())
+      throw io::ParseError(a.reference, 0, "no 'frame' lines: a trajectory needs frames (for one pose use `wobble fit pose`)");
+    io::CheckMassPointIndices(t, body->num_points());
+    frames = t.frames;
+  }
+
+  json j;
+  j["body"] = body->name();
+  j["reference"] = a.reference;
+  j["coordinates"] = fit::CoordinateNames(*body);
+  std::ostringstream out;
+  fit::FitReport report;
+  if (!a.dynamic) {
+    fit::TrajectoryFitOptions o;
+    o.pose = po;
+    o.pose.on_iteration = IterationLine();
+    o.smoothness = a.smoothness;
+    const fit::TrajectoryFitResult r = fit::FitKinematicTrajectory(*body, frames, o);
+    EndIterationLine();
+    report = r.report;
+    j["kind"] = "kinematic";
+    j["smoothness"] = a.smoothness;
+    j["linear_solver"] = r.linear_solver;
+    j["report"] = ReportJson(r.report);
+    j["times"] = r.times;
+    j["q"] = json::array();
+    for (const Eigen::VectorXd& q : r.q) j["q"].push_back(Vector(q));
+    j["frame_rms"] = r.frame_rms;
+    j["rms_residual"] = r.rms_residual;
+    out << body->name() << ": kinematic fit of " << frames.size() << " frames (" << r.linear_solver << "): "
+        << r.report.termination << " after " << r.report.iterations << " iterations in " << Num(r.report.solve_seconds)
+        << " s.\ncost " << Num(r.report.initial_cost) << " -> " << Num(r.report.final_cost) << ", rms residual "
+        << Num(r.rms_residual) << ".";
+  } else {
+    fit::DynamicFitOptions o;
+    o.world = MakeWorldParams(a.world);
+    RequirePositive(a.dt, "--dt");
+    o.dt = a.dt;
+    o.max_iterations = po.max_iterations;
+    o.full_report = po.full_report;
+    o.fit_q0 = o.fit_qd0 = o.fit_stiffness = o.fit_damping = false;
+    std::stringstream what(a.fit_what);
+    for (std::string item; std::getline(what, item, ',');) {
+      if (item == "q0") o.fit_q0 = true;
+      else if (item == "qdot0") o.fit_qd0 = true;
+      else if (item == "stiffness") o.fit_stiffness = true;
+      else if (item == "damping") o.fit_damping = true;
+      else throw UsageError("--fit: '" + item + "' is not one of q0, qdot0, stiffness, damping");
+    }
+    fit::DynamicParameters start;
+    if (!a.fit.q0.empty()) start.q0 = po.initial_q;
+    if (!a.qdot0.empty()) start.qd0 = ParseCoordinates(a.qdot0, "--qdot0", *body);
+    try {
+      fit::FrameSteps(frames, o.dt);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string(e.what()) + " (--dt " + Num(o.dt) + ")");
+    }
+    o.on_iteration = IterationLine();
+    const fit::DynamicFitResult r = fit::FitDynamicTrajectory(*body, frames, start, o);
+    EndIterationLine();
+    report = r.report;
+    j["kind"] = "dynamic";
+    j["dt"] = o.dt;
+    j["report"] = ReportJson(r.report);
+    j["q0"] = Vector(r.params.q0);
+    j["qdot0"] = Vector(r.params.qd0);
+    j["stiffness"] = Vector(r.params.stiffness);
+    j["damping"] = Vector(r.params.damping);
+    j["rms_residual"] = r.rms_residual;
+    j["simulations"] = r.simulations;
+    out << body->name() << ": dynamic fit of " << frames.size() << " frames: " << r.report.termination << " after "
+        << r.report.iterations << " iterations, " << r.simulations << " simulations, " << Num(r.report.solve_seconds)
+        << " s.\ncost " << Num(r.report.initial_cost) << " -> " << Num(r.report.final_cost) << ", rms residual "
+        << Num(r.rms_residual) << ".\nq0 = " << r.params.q0.transpose() << "\nqdot0 = " << r.params.qd0.transpose()
+        << "\nstiffness = " << r.params.stiffness.transpose() << "\ndamping = " << r.params.damping.transpose();
+    if (a.anneal) {
+      const fit::AnnealingResult sa = fit::AnnealDynamicTrajectory(*body, frames, start, o, r.simulations);
+      j["annealing"] = {{"simulations", sa.simulations}, {"cost", Number(sa.cost)}};
+      out << "\nsimulated annealing with the same " << sa.simulations << " simulations: cost " << Num(sa.cost) << ".";
+    }
+  }
+  WriteOutputs(a.fit, j, report);
+  std::cout << out.str() << std::endl;
+  if (a.fit.full_report) std::cout << report.full_report << std::endl;
+  if (!report.usable) {
+    std::cerr << "wobble: the fit failed: " << report.brief_report << std::endl;
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+}  // namespace wobble::app

@@ -1,0 +1,62 @@
+// `wobble fit pose` and `wobble fit trajectory`: the Ceres fits of lib/wobble/fit on files.
+//
+// Results are one JSON object (written atomically with --out, otherwise nothing is written),
+// the cost per iteration as CSV (--costs), and a short summary on stdout. The JSON's
+// "overlay" member (fitted body points next to their targets) is the hook for the overlay
+// picture and the cost chart, which will be drawn with the pipelines' chart API (issue 3)
+// once it exists: nothing here renders.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "cli_common.h"
+
+namespace wobble::app {
+
+// Flags shared by both fits.
+struct FitFlags {
+  std::string q0;            // starting q; empty: each fit's own start
+  double gamma_min = -1.0, gamma_max = 1.0;
+  std::string loss = "squared";
+  double loss_scale = 1.0;
+  double prior = 0.0;
+  int max_iterations = 200;
+  bool full_report = false;
+  std::string out, costs;
+};
+
+struct FitPoseArgs {
+  BodyFiles files;
+  FitFlags fit;
+  std::string targets;
+  int samples_per_segment = 8;
+  bool one_sided = false;
+  int max_rounds = 30;
+};
+
+struct FitTrajectoryArgs {
+  BodyFiles files;
+  FitFlags fit;
+  WorldFlags world;  // --dynamic only
+  std::string reference;
+  std::string points;  // CSV reference: "0,4,5" (default all mass points)
+  int every = 1;       // CSV reference: every Nth row
+  double smoothness = 1.0;
+  bool dynamic = false;
+  double dt = 0.01;
+  std::string fit_what = "q0,qdot0,stiffness,damping";
+  std::string qdot0;
+  bool anneal = false;
+};
+
+struct FitCommands {
+  CLI::App* fit = nullptr;
+  CLI::App* pose = nullptr;
+  CLI::App* trajectory = nullptr;
+};
+FitCommands AddFitCommand(CLI::App* app, FitPoseArgs* pose, FitTrajectoryArgs* trajectory);
+int RunFitPose(const FitPoseArgs& args);
+int RunFitTrajectory(const FitTrajectoryArgs& args);
+
+}  // namespace wobble::app

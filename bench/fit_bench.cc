@@ -1,0 +1,173 @@
+// Fitting speed (issue 6): the 11-point table pose fit with correspondences (goal < 1 ms), a
+// 1,000-point polyline fit without correspondences, a 1,200-frame kinematic trajectory fit,
+// and a dynamic fit through 100 simulated steps. Baselines in the same run: the Procrustes-
+// only rigid fit of the same targets (a body without modes), and the pose fit without the
+// conditioning analysis.
+#include <benchmark/benchmark.h>
+
+#include "../tests/test_bodies.h"
+#include "wobble/dynamics/world.h"
+#include "wobble/fit/dynamic_fit.h"
+#include "wobble/fit/pose_fit.h"
+#include "wobble/fit/trajectory_fit.h"
+
+namespace wobble {
+namespace {
+
+Eigen::VectorXd KnownQ() {
+  Eigen::VectorXd q(7);
+  q << 40, -25, 0.3, 0.35, -0.2, 0.15, 0.25;
+  return q;
+}
+
+std::vector<io::PointTarget> MassTargets(const BodyModel& body, const Eigen::VectorXd& q) {
+  std::vector<io::PointTarget> t;
+  for (int k = 0; k < body.num_points(); ++k) {
+    io::PointTarget p;
+    p.mass_point = k;
+    p.position = fit::PointPosition(fit::BasisOf(body, k, {}), q.data(), int(q.size()));
+    t.push_back(p);
+  }
+  return t;
+}
+
+void BM_PoseFit_Table11(benchmark::State& state) {
+  const BodyModel body(testing::TableDef(), testing::TableModes());
+  const auto targets = MassTargets(body, KnownQ());
+  fit::PoseFitOptions o;
+  o.analyze_conditioning = state.range(0) != 0;
+  int iterations = 0;
+  for (auto _ : state) {
+    const fit::PoseFitResult r = fit::FitPose(body, targets, o);
+    iterations = r.report.iterations;
+    benchmark::DoNotOptimize(r.q.data());
+  }
+  state.counters["ceres_iterations"] = iterations;
+}
+BENCHMARK(BM_PoseFit_Table11)->Arg(1)->Arg(0)->ArgName("conditioning")->Unit(benchmark::kMicrosecond);
+
+// Baseline: the same 11 targets, rigid table (no modes).
+void BM_PoseFit_Table11_Rigid(benchmark::State& state) {
+  const BodyModel body(testing::TableDef(), {});
+  Eigen::VectorXd q(3);
+  q << 40, -25, 0.3;
+  const auto targets = MassTargets(body, q);
+  fit::PoseFitOptions o;
+  o.analyze_conditioning = false;
+  for (auto _ : state) benchmark::DoNotOptimize(fit::FitPose(body, targets, o).q.data());
+}
+BENCHMARK(BM_PoseFit_Table11_Rigid)->Unit(benchmark::kMicrosecond);
+
+// 1,000 target points on three polylines (the table's drawing at KnownQ).
+void BM_CurveFit_Polyline1000(benchmark::State& state) {
+  const BodyModel body(testing::TableDef(), testing::TableModes());
+  io::TargetFile f;
+  const int counts[3] = {400, 300, 300};
+  for (int l = 0; l < 3; ++l) {
+    const Polyline& line = body.def().shapes[l];
+    io::TargetCurve c;
+    for (int i = 0; i < counts[l]; ++i) {
+      const Eigen::Vector2d p = line.points[0] + (line.points[1] - line.points[0]) * (double(i) / (counts[l] - 1));
+      c.points.push_back(fit::PointPosition(fit::BasisOf(body, -1, body.lattice().LocalCoords(p)), KnownQ().data(), 7));
+    }
+    f.polylines.push_back(c);
+  }
+  const fit::CurveTarget target = fit::CurveTarget::From(f);
+  fit::PoseFitOptions o;
+  o.two_sided = state.range(0) != 0;
+  int rounds = 0, iterations = 0;
+  double rms = 0;
+  for (auto _ : state) {
+    const fit::PoseFitResult r = fit::FitPoseToCurve(body, target, o);
+    rounds = r.rounds;
+    iterations = r.report.iterations;
+    rms = r.rms_residual;
+  }
+  state.counters["rounds"] = rounds;
+  state.counters["ceres_iterations"] = iterations;
+  state.counters["rms"] = rms;
+}
+BENCHMARK(BM_CurveFit_Polyline1000)->Arg(1)->Arg(0)->ArgName("two_sided")->Unit(benchmark::kMillisecond);
+
+// The table thrown without ground, 1,200 frames at dt 0.005, all 11 mass points observed.
+std::vector<io::TargetFrame> ThrownFrames(const std::shared_ptr<const BodyModel>& body, int frames, double dt) {
+  WorldOptions wo;
+  wo.params.ground.enabled = false;
+  wo.dt = dt;
+  World world(wo);
+  world.AddBody(body);
+  Eigen::VectorXd q0(7), qd0(7);
+  q0 << 0, 100, 0.1, 0.2, -0.1, 0.1, 0.0;
+  qd0 << 50, 80, 1.5, 0.3, 0.4, -0.2, 0.3;
+  world.SetState(0, q0, qd0);
+  std::vector<double> t = {0};
+  std::vector<Eigen::VectorXd> q = {q0};
+  for (int i = 1; i < frames; ++i) {
+    world.Step();
+    t.push_back(world.time());
+    q.push_back(world.state(0).q);
+  }
+  return fit::FramesFromStates(*body, t, q, {});
+}
+
+void BM_KinematicTrajectory_1200Frames(benchmark::State& state) {
+  const auto body = std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(4e6, 1e5));
+  const std::vector<io::TargetFrame> frames = ThrownFrames(body, 1200, 0.005);
+  fit::TrajectoryFitOptions o;
+  o.smoothness = 1.0;
+  o.pose.gamma_lower = -3;
+  o.pose.gamma_upper = 3;
+  int iterations = 0;
+  double rms = 0;
+  for (auto _ : state) {
+    const fit::TrajectoryFitResult r = fit::FitKinematicTrajectory(*body, frames, o);
+    iterations = r.report.iterations;
+    rms = r.rms_residual;
+  }
+  state.counters["ceres_iterations"] = iterations;
+  state.counters["rms"] = rms;
+}
+BENCHMARK(BM_KinematicTrajectory_1200Frames)->Unit(benchmark::kMillisecond);
+
+// Dynamic fit of q0, q̇0, K, c to 100 steps (51 frames) from a start 40% off.
+void BM_DynamicFit_100Steps(benchmark::State& state) {
+  const auto body = std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(3e6, 2e5));
+  const std::vector<io::TargetFrame> all = ThrownFrames(body, 101, 0.01);
+  std::vector<io::TargetFrame> frames;
+  for (size_t i = 0; i < all.size(); i += 2) frames.push_back(all[i]);
+  fit::DynamicParameters start;
+  start.stiffness = Eigen::VectorXd::Constant(4, 3e6 * 1.4);
+  start.damping = Eigen::VectorXd::Constant(4, 2e5 * 0.6);
+  fit::DynamicFitOptions o;
+  o.world.ground.enabled = false;
+  long sims = 0;
+  for (auto _ : state) sims = fit::FitDynamicTrajectory(*body, frames, start, o).simulations;
+  state.counters["simulations"] = double(sims);
+}
+BENCHMARK(BM_DynamicFit_100Steps)->Unit(benchmark::kMillisecond);
+
+// Baseline on the same problem: simulated annealing with a budget of simulations (the
+// argument; Ceres used 24, each a Jet simulation). Counter "cost": the best cost found;
+// compare with the Ceres fit's final cost, printed by tests/dynamic_fit_test (~1e-21).
+void BM_DynamicFit_Annealing(benchmark::State& state) {
+  const auto body = std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(3e6, 2e5));
+  const std::vector<io::TargetFrame> all = ThrownFrames(body, 101, 0.01);
+  std::vector<io::TargetFrame> frames;
+  for (size_t i = 0; i < all.size(); i += 2) frames.push_back(all[i]);
+  fit::DynamicParameters start;
+  start.stiffness = Eigen::VectorXd::Constant(4, 3e6 * 1.4);
+  start.damping = Eigen::VectorXd::Constant(4, 2e5 * 0.6);
+  fit::DynamicFitOptions o;
+  o.world.ground.enabled = false;
+  double cost = 0, ceres_cost = 0;
+  for (auto _ : state) cost = fit::AnnealDynamicTrajectory(*body, frames, start, o, state.range(0), 1).cost;
+  ceres_cost = fit::FitDynamicTrajectory(*body, frames, start, o).report.final_cost;
+  state.counters["cost"] = cost;
+  state.counters["ceres_cost"] = ceres_cost;
+}
+BENCHMARK(BM_DynamicFit_Annealing)->Arg(24)->Arg(240)->Arg(2400)->ArgName("simulations")->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace wobble
+
+BENCHMARK_MAIN();

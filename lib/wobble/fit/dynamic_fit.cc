@@ -1,0 +1,386 @@
+#include "wobble/fit/dynamic_fit.h"
+
+#include <ceres/ceres.h>
+#include <ceres/dynamic_autodiff_cost_function.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+
+#include "wobble/fit/solve_common.h"
+#include "wobble/fit/trajectory_fit.h"
+
+namespace wobble::fit {
+
+namespace {
+
+// Jet width of the dynamic cost: 24 covers the table (7 + 7 + 4 + 4 parameters) in one pass;
+// bodies with more parameters take several passes (DynamicAutoDiffCostFunction strides).
+constexpr int kStride = 24;
+
+// The body with its mode potentials switched off: K and c come from the parameters instead
+// (lib/wobble/dynamics reads them from the model as doubles; see ThesisStep).
+BodyModel PassiveCopy(const BodyModel& body) {
+  std::vector<DeformationMode> modes = body.modes();
+  for (DeformationMode& m : modes) m.stiffness = m.damping = 0.0;
+  return BodyModel(body.def(), modes);
+}
+
+template <class T> struct ModeParams {
+  VecD<T> K, c;
+};
+
+// Generalized mode forces −2 K_d γ_d − c_d γ̇_d (§4.7) with K, c of scalar T.
+template <class T> void AddModeForces(const ModeParams<T>& p, const BodyState<T>& s, VecQ<T>* Q) {
+  for (int d = 0; d < p.K.size(); ++d)
+    (*Q)[kRigidDofs + d] += -T(2.0) * p.K[d] * s.q[kRigidDofs + d] - p.c[d] * s.qd[kRigidDofs + d];
+}
+
+// One step of the thesis scheme (Eq. 4.22/4.23), written exactly as StepBody's kThesis case,
+// but with the mode forces from `p`. StepBody takes its forces from the model only; once the
+// dynamics accept an extra generalized force (controllers, issue 5) this should call it.
+template <class T>
+bool ThesisStep(const BodyModel& passive, const WorldParams& w, double dt, const ModeParams<T>& p, BodyState<T>* s) {
+  const T h(dt);
+  MatQ<T> M;
+  VecQ<T> vel;
+  ForceBreakdown<T> f;
+  MassMatrix(passive.moments(), s->q, &M);
+  VelocityTerms(passive.moments(), s->q, s->qd, &vel);
+  EvaluateForces(passive, w, 0, *s, &f);
+  VecQ<T> a = f.total;
+  AddModeForces(p, *s, &a);
+  a -= vel;
+  if (!CholeskyInPlace(&M)) return false;
+  CholeskySolveInPlace(M, &a);
+  const VecQ<T> q_prev = s->q - h * s->qd;
+  const VecQ<T> q_next = T(2.0) * s->q - q_prev + h * h * a;
+  s->qd = (q_next - s->q) / h;
+  s->q = q_next;
+  UpdateContacts(passive, w.ground, s);
+  for (int i = 0; i < s->q.size(); ++i)
+    if (!std::isfinite(ScalarValue(s->q[i])) || !std::isfinite(ScalarValue(s->qd[i]))) return false;
+  return true;
+}
+
+template <class T, class F>
+bool Simulate(const BodyModel& passive, const WorldParams& w, double dt, const VecQ<T>& q0, const VecQ<T>& qd0,
+              const ModeParams<T>& p, const std::vector<int>& steps, F&& on_frame) {
+  BodyState<T> s;
+  s.q = q0;
+  s.qd = qd0;
+  UpdateContacts(passive, w.ground, &s);
+  int step = 0;
+  for (size_t f = 0; f < steps.size(); ++f) {
+    for (; step < steps[f]; ++step)
+      if (!ThesisStep(passive, w, dt, p, &s)) return false;
+    on_frame(int(f), s.q);
+  }
+  return true;
+}
+
+// G_dd, the generalized mass of each mode: the damping scale 2 sqrt(2 K G_dd) is the critical
+// damping of γ̈ G_dd = −2 K γ − c γ̇.
+VecD<double> ModeMasses(const BodyModel& body) {
+  VecD<double> g(body.num_modes());
+  for (int d = 0; d < body.num_modes(); ++d) g[d] = body.moments().G(d, d);
+  return g;
+}
+
+// The raw parameter blocks Ceres sees: q0, q̇0, log K, ζ.
+struct Blocks {
+  std::vector<double> q0, qd0, log_k, zeta;
+  static Blocks From(const DynamicParameters& p, const VecD<double>& G) {
+    Blocks b;
+    b.q0.assign(p.q0.data(), p.q0.data() + p.q0.size());
+    b.qd0.assign(p.qd0.data(), p.qd0.data() + p.qd0.size());
+    for (int d = 0; d < p.stiffness.size(); ++d) {
+      b.log_k.push_back(std::log(p.stiffness[d]));
+      b.zeta.push_back(p.damping[d] / (2.0 * std::sqrt(2.0 * p.stiffness[d] * G[d])));
+    }
+    return b;
+  }
+  DynamicParameters To(const VecD<double>& G) const {
+    DynamicParameters p;
+    p.q0 = Eigen::Map<const Eigen::VectorXd>(q0.data(), q0.size());
+    p.qd0 = Eigen::Map<const Eigen::VectorXd>(qd0.data(), qd0.size());
+    p.stiffness.resize(log_k.size());
+    p.damping.resize(log_k.size());
+    for (size_t d = 0; d < log_k.size(); ++d) {
+      p.stiffness[d] = std::exp(log_k[d]);
+      p.damping[d] = zeta[d] * 2.0 * std::sqrt(2.0 * p.stiffness[d] * G[d]);
+    }
+    return p;
+  }
+};
+
+// The reference: body points (bases) and their targets, per frame.
+struct Reference {
+  std::vector<int> steps;
+  std::vector<std::vector<SegmentResidual>> points;
+  int num_residuals = 0;
+};
+Reference MakeReference(const BodyModel& body, const std::vector<io::TargetFrame>& frames, double dt) {
+  Reference r;
+  r.steps = FrameSteps(frames, dt);
+  for (const io::TargetFrame& f : frames) {
+    std::vector<SegmentResidual> pts;
+    for (const io::PointTarget& t : f.points) {
+      if (t.mass_point >= body.num_points())
+        throw std::invalid_argument("dynamic fit: mass point " + std::to_string(t.mass_point) + " does not exist");
+      SegmentResidual s;
+      s.point = BasisOf(body, t.mass_point, t.lattice_coords);
+      s.a = s.b = t.position;
+      s.sqrt_weight = std::sqrt(t.weight);
+      s.num_q = body.num_q();
+      pts.push_back(s);
+      r.num_residuals += 2;
+    }
+    r.points.push_back(pts);
+  }
+  return r;
+}
+
+// Residuals sqrt(w)(x_i(q_f) − target) of every frame, from the raw blocks.
+struct DynamicResidual {
+  const BodyModel* passive;
+  const WorldParams* world;
+  double dt;
+  const Reference* ref;
+  VecD<double> G;
+  long* simulations;
+
+  template <class T> bool operator()(T const* const* p, T* r) const {
+    const int nq = passive->num_q(), D = passive->num_modes();
+    VecQ<T> q0(nq), qd0(nq);
+    for (int i = 0; i < nq; ++i) {
+      q0[i] = p[0][i];
+      qd0[i] = p[1][i];
+    }
+    ModeParams<T> mp;
+    mp.K.resize(D);
+    mp.c.resize(D);
+    for (int d = 0; d < D; ++d) {
+      using std::exp;
+      using std::sqrt;
+      mp.K[d] = exp(p[2][d]);
+      mp.c[d] = p[3][d] * T(2.0) * sqrt(T(2.0 * G[d]) * mp.K[d]);
+    }
+    ++*simulations;
+    int k = 0;
+    return Simulate(*passive, *world, dt, q0, qd0, mp, ref->steps, [&](int f, const VecQ<T>& q) {
+      for (const SegmentResidual& s : ref->points[f]) {
+        const Vec2<T> x = PointPosition(s.point, q.data(), nq);
+        r[k++] = T(s.sqrt_weight) * (x[0] - T(s.a[0]));
+        r[k++] = T(s.sqrt_weight) * (x[1] - T(s.a[1]));
+      }
+    });
+  }
+};
+
+void CheckParameters(const BodyModel& body, const DynamicParameters& p) {
+  const int nq = body.num_q(), D = body.num_modes();
+  if (p.q0.size() != nq || p.qd0.size() != nq) throw std::invalid_argument("dynamic fit: q0 and qdot0 need num_q values");
+  if (p.stiffness.size() != D || p.damping.size() != D)
+    throw std::invalid_argument("dynamic fit: stiffness and damping need one value per mode");
+  for (int d = 0; d < D; ++d) {
+    if (!(p.stiffness[d] > 0) || !std::isfinite(p.stiffness[d]))
+      throw std::invalid_argument("dynamic fit: mode '" + body.modes()[d].name +
+                                  "' needs a positive starting stiffness (it is fitted as log K)");
+    if (!(p.damping[d] >= 0) || !std::isfinite(p.damping[d]))
+      throw std::invalid_argument("dynamic fit: damping must be >= 0");
+  }
+}
+
+// Fills an empty q0 / q̇0 from pose fits of the first two frames.
+DynamicParameters Completed(const BodyModel& body, const std::vector<io::TargetFrame>& frames, DynamicParameters p) {
+  if (p.stiffness.size() == 0 && p.damping.size() == 0) {
+    p.stiffness.resize(body.num_modes());
+    p.damping.resize(body.num_modes());
+    for (int d = 0; d < body.num_modes(); ++d) {
+      p.stiffness[d] = body.modes()[d].stiffness;
+      p.damping[d] = body.modes()[d].damping;
+    }
+  }
+  if (p.q0.size() && p.qd0.size()) return p;
+  PoseFitOptions o;
+  o.gamma_lower = -10;
+  o.gamma_upper = 10;
+  const Eigen::VectorXd a = FitPose(body, frames[0].points, o).q;
+  if (!p.q0.size()) p.q0 = a;
+  if (!p.qd0.size()) {
+    if (frames.size() < 2) {
+      p.qd0 = Eigen::VectorXd::Zero(body.num_q());
+    } else {
+      o.initial_q = a;
+      const Eigen::VectorXd b = FitPose(body, frames[1].points, o).q;
+      p.qd0 = (b - a) / (frames[1].time - frames[0].time);
+    }
+  }
+  return p;
+}
+
+}  // namespace
+
+std::vector<int> FrameSteps(const std::vector<io::TargetFrame>& frames, double dt) {
+  if (!(dt > 0)) throw std::invalid_argument("dynamic fit: dt must be positive");
+  if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
+  std::vector<int> steps;
+  for (const io::TargetFrame& f : frames) {
+    const double n = (f.time - frames[0].time) / dt;
+    const double rounded = std::round(n);
+    if (std::abs(n - rounded) > 1e-6 * std::max(1.0, n))
+      throw std::invalid_argument("dynamic fit: frame time " + std::to_string(f.time) +
+                                  " is not a whole number of steps of dt after the first frame");
+    steps.push_back(int(rounded));
+  }
+  return steps;
+}
+
+bool SimulateWithParameters(const BodyModel& body, const DynamicFitOptions& o, const DynamicParameters& p,
+                            const std::vector<int>& frame_steps,
+                            const std::function<void(int, const Eigen::VectorXd&)>& on_frame) {
+  CheckParameters(body, p);
+  const BodyModel passive = PassiveCopy(body);
+  ModeParams<double> mp;
+  mp.K = p.stiffness;
+  mp.c = p.damping;
+  return Simulate(passive, o.world, o.dt, VecQ<double>(p.q0), VecQ<double>(p.qd0), mp, frame_steps,
+                  [&](int f, const VecQ<double>& q) { on_frame(f, Eigen::VectorXd(q)); });
+}
+
+double DynamicCost(const BodyModel& body, const std::vector<io::TargetFrame>& frames, const DynamicParameters& p,
+                   const DynamicFitOptions& o) {
+  const Reference ref = MakeReference(body, frames, o.dt);
+  double cost = 0;
+  const bool ok = SimulateWithParameters(body, o, p, ref.steps, [&](int f, const Eigen::VectorXd& q) {
+    for (const SegmentResidual& s : ref.points[f])
+      cost += 0.5 * s.sqrt_weight * s.sqrt_weight * (PointPosition(s.point, q.data(), int(q.size())) - s.a).squaredNorm();
+  });
+  return ok ? cost : std::numeric_limits<double>::infinity();
+}
+
+DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<io::TargetFrame>& frames,
+                                      const DynamicParameters& initial, const DynamicFitOptions& o) {
+  if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
+  const DynamicParameters start = Completed(body, frames, initial);
+  CheckParameters(body, start);
+  const BodyModel passive = PassiveCopy(body);
+  const Reference ref = MakeReference(body, frames, o.dt);
+  const VecD<double> G = ModeMasses(body);
+  Blocks blocks = Blocks::From(start, G);
+  const int nq = body.num_q(), D = body.num_modes();
+
+  DynamicFitResult result;
+  auto* cost = new ceres::DynamicAutoDiffCostFunction<DynamicResidual, kStride>(
+      new DynamicResidual{&passive, &o.world, o.dt, &ref, G, &result.simulations});
+  std::vector<double*> params = {blocks.q0.data(), blocks.qd0.data()};
+  cost->AddParameterBlock(nq);
+  cost->AddParameterBlock(nq);
+  if (D > 0) {
+    cost->AddParameterBlock(D);
+    cost->AddParameterBlock(D);
+    params.push_back(blocks.log_k.data());
+    params.push_back(blocks.zeta.data());
+  }
+  cost->SetNumResiduals(ref.num_residuals);
+  ceres::Problem problem;
+  problem.AddResidualBlock(cost, nullptr, params);
+  if (!o.fit_q0) problem.SetParameterBlockConstant(blocks.q0.data());
+  if (!o.fit_qd0) problem.SetParameterBlockConstant(blocks.qd0.data());
+  if (D > 0) {
+    if (!o.fit_stiffness) problem.SetParameterBlockConstant(blocks.log_k.data());
+    if (!o.fit_damping) problem.SetParameterBlockConstant(blocks.zeta.data());
+    for (int d = 0; d < D; ++d) problem.SetParameterLowerBound(blocks.zeta.data(), d, 0.0);
+  }
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.max_num_iterations = o.max_iterations;
+  options.function_tolerance = 1e-14;
+  options.gradient_tolerance = 1e-16;
+  options.parameter_tolerance = 1e-12;
+  options.logging_type = ceres::SILENT;
+  IterationForwarder forward(o.on_iteration);
+  forward.Attach(&options);
+  ceres::Solver::Summary summary;
+  const auto t0 = std::chrono::steady_clock::now();
+  ceres::Solve(options, &problem, &summary);
+  FillReport(summary, o.full_report, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+             &result.report);
+  result.params = blocks.To(G);
+  const double c = DynamicCost(body, frames, result.params, o);
+  result.rms_residual = std::sqrt(2.0 * c / (ref.num_residuals / 2));
+  return result;
+}
+
+AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<io::TargetFrame>& frames,
+                                        const DynamicParameters& initial, const DynamicFitOptions& o,
+                                        long budget, unsigned seed) {
+  const DynamicParameters start = Completed(body, frames, initial);
+  CheckParameters(body, start);
+  const VecD<double> G = ModeMasses(body);
+  const int nq = body.num_q(), D = body.num_modes();
+  const double duration = std::max(o.dt, frames.back().time - frames.front().time);
+  // step sizes that move the points by about one length unit (SmoothnessScales)
+  const VecQ<double> L = SmoothnessScales(body);
+  struct Coordinate {
+    double* value;
+    double step;
+  };
+  Blocks x = Blocks::From(start, G);
+  std::vector<Coordinate> coords;
+  for (int i = 0; i < nq; ++i) {
+    if (o.fit_q0) coords.push_back({&x.q0[i], 1.0 / L[i]});
+    if (o.fit_qd0) coords.push_back({&x.qd0[i], 1.0 / (L[i] * duration)});
+  }
+  for (int d = 0; d < D; ++d) {
+    if (o.fit_stiffness) coords.push_back({&x.log_k[d], 0.05});
+    if (o.fit_damping) coords.push_back({&x.zeta[d], 0.02});
+  }
+  AnnealingResult best;
+  double current = DynamicCost(body, frames, x.To(G), o);
+  best.params = x.To(G);
+  best.cost = current;
+  best.simulations = 1;
+  if (coords.empty()) return best;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_int_distribution<size_t> pick(0, coords.size() - 1);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  // geometric cooling from 10% of the starting cost down by 1e6 over the budget; step sizes
+  // adapt to keep about a third of the moves accepted
+  const double t_start = 0.1 * current, t_ratio = 1e-6;
+  double scale = 1.0;
+  int accepted_window = 0, window = 0;
+  for (long k = 1; k < budget; ++k) {
+    const double temperature = t_start * std::pow(t_ratio, double(k) / double(budget));
+    Coordinate& c = coords[pick(rng)];
+    const double old = *c.value;
+    if (c.value >= x.zeta.data() && c.value < x.zeta.data() + x.zeta.size()) {
+      *c.value = std::abs(old + scale * c.step * normal(rng));  // ζ >= 0
+    } else {
+      *c.value = old + scale * c.step * normal(rng);
+    }
+    const double trial = DynamicCost(body, frames, x.To(G), o);
+    ++best.simulations;
+    if (trial < current || uniform(rng) < std::exp(-(trial - current) / temperature)) {
+      current = trial;
+      ++accepted_window;
+      if (trial < best.cost) {
+        best.cost = trial;
+        best.params = x.To(G);
+      }
+    } else {
+      *c.value = old;
+    }
+    if (++window == 50) {
+      scale *= accepted_window > 17 ? 1.3 : 0.7;
+      accepted_window = window = 0;
+    }
+  }
+  return best;
+}
+
+}  // namespace wobble::fit

@@ -1,0 +1,366 @@
+#include "wobble/fit/pose_fit.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include "wobble/fit/solve_common.h"
+
+namespace wobble::fit {
+
+std::string LossName(Loss loss) {
+  switch (loss) {
+    case Loss::kSquared: return "squared";
+    case Loss::kHuber: return "huber";
+    case Loss::kCauchy: return "cauchy";
+  }
+  return "?";
+}
+
+bool ParseLoss(const std::string& text, Loss* loss) {
+  for (Loss l : {Loss::kSquared, Loss::kHuber, Loss::kCauchy})
+    if (text == LossName(l)) {
+      *loss = l;
+      return true;
+    }
+  return false;
+}
+
+std::string ValidateOptions(const PoseFitOptions& o, int num_modes) {
+  auto finite = [](double v) { return std::isfinite(v); };
+  if (o.initial_q.size() != 0 && o.initial_q.size() != kRigidDofs + num_modes)
+    return "initial q has " + std::to_string(o.initial_q.size()) + " numbers, the body has " +
+           std::to_string(kRigidDofs + num_modes) + " coordinates";
+  for (int i = 0; i < o.initial_q.size(); ++i)
+    if (!finite(o.initial_q[i])) return "initial q is not finite";
+  if (!o.mode_lower.empty() && int(o.mode_lower.size()) != num_modes) return "mode_lower needs one bound per mode";
+  if (!o.mode_upper.empty() && int(o.mode_upper.size()) != num_modes) return "mode_upper needs one bound per mode";
+  for (int d = 0; d < num_modes; ++d)
+    if (!(ModeLower(o, d) < ModeUpper(o, d))) return "mode bounds: lower must be below upper (mode " + std::to_string(d) + ")";
+  if (!(o.loss_scale > 0) || !finite(o.loss_scale)) return "loss scale must be positive";
+  if (!(o.prior_weight >= 0) || !finite(o.prior_weight)) return "prior weight must be >= 0";
+  if (o.max_iterations < 1) return "max iterations must be >= 1";
+  if (o.samples_per_segment < 0) return "samples per segment must be >= 0";
+  if (o.max_rounds < 1) return "max rounds must be >= 1";
+  return "";
+}
+
+std::vector<std::string> CoordinateNames(const BodyModel& body) {
+  std::vector<std::string> names = {"tx", "ty", "theta"};
+  for (const DeformationMode& m : body.modes()) names.push_back(m.name);
+  return names;
+}
+
+// Weighted Procrustes: the rotation and translation that best carry the rest positions b0_i
+// onto the targets y_i (least squares), with γ = 0.
+Eigen::VectorXd RigidStart(const BodyModel& body, const std::vector<Eigen::Vector2d>& rest,
+                           const std::vector<Eigen::Vector2d>& target, const std::vector<double>& w) {
+  Eigen::Vector2d ps = Eigen::Vector2d::Zero(), ys = Eigen::Vector2d::Zero();
+  double wsum = 0;
+  for (size_t i = 0; i < rest.size(); ++i) {
+    ps += w[i] * rest[i];
+    ys += w[i] * target[i];
+    wsum += w[i];
+  }
+  ps /= wsum;
+  ys /= wsum;
+  Eigen::Matrix2d H = Eigen::Matrix2d::Zero();
+  for (size_t i = 0; i < rest.size(); ++i) H += w[i] * (rest[i] - ps) * (target[i] - ys).transpose();
+  // maximise Σ w yᵀ R p: θ = atan2(H01 − H10, H00 + H11) (0 when the points are all one point)
+  const double theta = std::atan2(H(0, 1) - H(1, 0), H(0, 0) + H(1, 1));
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(body.num_q());
+  const Eigen::Vector2d t = ys - Rotation(theta) * ps;
+  q << t.x(), t.y(), theta, Eigen::VectorXd::Zero(body.num_modes());
+  return q;
+}
+
+namespace {
+
+void FillResiduals(const std::vector<SegmentResidual>& data, const Eigen::VectorXd& q, PoseFitResult* r) {
+  r->point_residuals.clear();
+  double sum = 0;
+  for (const SegmentResidual& d : data) {
+    const Vec2<double> x = PointPosition(d.point, q.data(), int(q.size()));
+    const double dist = (x - ClosestOnSegment(x, d.a, d.b)).norm();
+    r->point_residuals.push_back(dist);
+    sum += dist * dist;
+  }
+  r->rms_residual = data.empty() ? 0.0 : std::sqrt(sum / double(data.size()));
+}
+
+void FillAtBound(const BodyModel& body, const PoseFitOptions& o, PoseFitResult* r) {
+  r->at_bound.clear();
+  for (int d = 0; d < body.num_modes(); ++d) {
+    const double g = r->q[kRigidDofs + d];
+    const double tol = 1e-9 * (ModeUpper(o, d) - ModeLower(o, d));
+    if (g <= ModeLower(o, d) + tol || g >= ModeUpper(o, d) - tol) r->at_bound.push_back(body.modes()[d].name);
+  }
+}
+
+}  // namespace
+
+PoseFitResult FitPose(const BodyModel& body, const std::vector<io::PointTarget>& targets, const PoseFitOptions& o) {
+  const std::string error = ValidateOptions(o, body.num_modes());
+  if (!error.empty()) throw std::invalid_argument("pose fit: " + error);
+  if (targets.empty()) throw std::invalid_argument("pose fit: no target points");
+  std::vector<SegmentResidual> data;
+  std::vector<Eigen::Vector2d> rest, goal;
+  std::vector<double> weights;
+  for (const io::PointTarget& t : targets) {
+    if (t.mass_point >= body.num_points())
+      throw std::invalid_argument("pose fit: mass point " + std::to_string(t.mass_point) + " does not exist");
+    SegmentResidual r;
+    r.point = BasisOf(body, t.mass_point, t.lattice_coords);
+    r.a = r.b = t.position;
+    r.sqrt_weight = std::sqrt(t.weight);
+    r.num_q = body.num_q();
+    data.push_back(r);
+    rest.push_back(r.point.b0);
+    goal.push_back(t.position);
+    weights.push_back(t.weight);
+  }
+  PoseFitResult result;
+  result.q = o.initial_q.size() ? o.initial_q : RigidStart(body, rest, goal, weights);
+  // the start must lie inside the bounds
+  for (int d = 0; d < body.num_modes(); ++d)
+    result.q[kRigidDofs + d] = std::clamp(result.q[kRigidDofs + d], ModeLower(o, d), ModeUpper(o, d));
+  SolvePose(body, data, {}, o, &result.q, &result.report);
+  FillResiduals(data, result.q, &result);
+  FillAtBound(body, o, &result);
+  if (o.analyze_conditioning) result.conditioning = ComputeConditioning(body, data, {}, o, result.q);
+  return result;
+}
+
+CurveTarget CurveTarget::From(const io::TargetFile& file) {
+  CurveTarget c;
+  for (const io::TargetCurve& line : file.polylines) {
+    const size_t n = line.points.size();
+    for (size_t i = 0; i + 1 < n + (line.closed ? 1 : 0); ++i) {
+      c.a.push_back(line.points[i]);
+      c.b.push_back(line.points[(i + 1) % n]);
+    }
+    c.vertices.insert(c.vertices.end(), line.points.begin(), line.points.end());
+  }
+  for (const Eigen::Vector2d& p : file.cloud) {
+    c.a.push_back(p);
+    c.b.push_back(p);
+    c.vertices.push_back(p);
+  }
+  return c;
+}
+
+CurveSamples CurveSamples::Of(const BodyModel& body, const PoseFitOptions& o) {
+  CurveSamples s;
+  if (o.use_mass_points)
+    for (int k = 0; k < body.num_points(); ++k) s.points.push_back(BasisOf(body, k, {}));
+  for (const Polyline& line : body.def().shapes) {
+    const size_t n = line.points.size();
+    const int m = std::max(1, o.samples_per_segment);
+    const int first = int(s.points.size());
+    for (size_t i = 0; i + 1 < n + (line.closed ? 1 : 0); ++i) {
+      const Eigen::Vector2d a = line.points[i], b = line.points[(i + 1) % n];
+      for (int j = (i == 0 ? 0 : 1); j <= m; ++j) {
+        if (j == m && line.closed && i + 1 == n) break;  // back at the first point
+        const Eigen::Vector2d p = a + (b - a) * (double(j) / m);
+        if (int(s.points.size()) > first) s.segments.push_back({int(s.points.size()) - 1, int(s.points.size())});
+        s.points.push_back(BasisOf(body, -1, body.lattice().LocalCoords(p)));
+      }
+    }
+    if (line.closed && int(s.points.size()) - first > 2) s.segments.push_back({int(s.points.size()) - 1, first});
+  }
+  return s;
+}
+
+namespace {
+
+// Centroid and principal-axis angle of weighted points; `isotropy` = λ_min / λ_max.
+struct Shape2 {
+  Eigen::Vector2d centroid;
+  double axis_angle = 0, isotropy = 1;
+};
+Shape2 Principal(const std::vector<Eigen::Vector2d>& p, const std::vector<double>& w) {
+  Shape2 s;
+  double wsum = 0;
+  s.centroid.setZero();
+  for (size_t i = 0; i < p.size(); ++i) {
+    s.centroid += w[i] * p[i];
+    wsum += w[i];
+  }
+  s.centroid /= wsum;
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (size_t i = 0; i < p.size(); ++i) cov += w[i] * (p[i] - s.centroid) * (p[i] - s.centroid).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+  const Eigen::Vector2d major = eig.eigenvectors().col(1);
+  s.axis_angle = std::atan2(major.y(), major.x());
+  const double hi = eig.eigenvalues()[1];
+  s.isotropy = hi > 0 ? eig.eigenvalues()[0] / hi : 1.0;
+  return s;
+}
+
+// Index of the segment [a_i, b_i] nearest to x (brute force: targets of a few thousand
+// segments and bodies of a few hundred samples cost well under a millisecond per round).
+int NearestSegment(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b,
+                   const Eigen::Vector2d& x) {
+  int best = 0;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < a.size(); ++i) {
+    const double d2 = (x - ClosestOnSegment<double>(x, a[i], b[i])).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = int(i);
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, const PoseFitOptions& o) {
+  const std::string error = ValidateOptions(o, body.num_modes());
+  if (!error.empty()) throw std::invalid_argument("curve fit: " + error);
+  if (target.a.empty()) throw std::invalid_argument("curve fit: the target has no points");
+  const CurveSamples samples = CurveSamples::Of(body, o);
+  if (samples.points.empty())
+    throw std::invalid_argument("curve fit: the body has no samples (no mass points used, no drawing)");
+  const int ns = int(samples.points.size());
+  const bool two_sided = o.two_sided && !samples.segments.empty();
+  std::vector<Eigen::Vector2d> reverse_points;
+  if (two_sided) {
+    const size_t nv = target.vertices.size(), keep = std::min(nv, size_t(std::max(1, o.max_reverse_points)));
+    for (size_t i = 0; i < keep; ++i) reverse_points.push_back(target.vertices[i * nv / keep]);
+  }
+  // both directions weigh the same in total
+  const double reverse_weight = two_sided ? double(ns) / double(reverse_points.size()) : 0.0;
+
+  // the starts: centroid onto centroid, principal axis onto principal axis
+  std::vector<Eigen::VectorXd> starts;
+  if (o.initial_q.size()) {
+    starts.push_back(o.initial_q);
+  } else {
+    std::vector<Eigen::Vector2d> rest, tp;
+    std::vector<double> ones(ns, 1.0), tw;
+    for (const PointBasis& s : samples.points) rest.push_back(s.b0);
+    for (size_t i = 0; i < target.a.size(); ++i) {
+      tp.push_back(0.5 * (target.a[i] + target.b[i]));
+      const double len = (target.b[i] - target.a[i]).norm();
+      tw.push_back(len > 0 ? len : 1.0);  // cloud points weigh like a unit of length
+    }
+    const Shape2 bs = Principal(rest, ones), ts = Principal(tp, tw);
+    const int turns = (bs.isotropy > 0.8 || ts.isotropy > 0.8) ? 4 : 2;
+    for (int k = 0; k < turns; ++k) {
+      const double theta = std::remainder(ts.axis_angle - bs.axis_angle + k * 2.0 * M_PI / turns, 2.0 * M_PI);
+      Eigen::VectorXd q = Eigen::VectorXd::Zero(body.num_q());
+      const Eigen::Vector2d t = ts.centroid - Rotation(theta) * bs.centroid;
+      q << t.x(), t.y(), theta, Eigen::VectorXd::Zero(body.num_modes());
+      starts.push_back(q);
+    }
+  }
+
+  // one start's state across rounds
+  struct Run {
+    Eigen::VectorXd q;
+    PoseFitResult r;
+    std::vector<int> assigned, reverse_assigned;
+    std::vector<SegmentResidual> data;
+    std::vector<ReverseSegmentResidual> reverse;
+    double seconds = 0, previous_cost = std::numeric_limits<double>::infinity();
+    int round = 0;
+    bool done = false;
+  };
+  // runs rounds until `last_round` (exclusive) or convergence
+  auto advance = [&](Run* run, int last_round) {
+    for (; run->round < last_round && !run->done; ++run->round) {
+      Eigen::VectorXd& q = run->q;
+      // closest points at the current q: body samples to target segments ...
+      bool changed = false;
+      std::vector<Eigen::Vector2d> x(ns);
+      for (int i = 0; i < ns; ++i) {
+        x[i] = PointPosition(samples.points[i], q.data(), int(q.size()));
+        const int seg = NearestSegment(target.a, target.b, x[i]);
+        changed = changed || seg != run->assigned[i];
+        run->assigned[i] = seg;
+        SegmentResidual& d = run->data[i];
+        d.point = samples.points[i];
+        d.a = target.a[seg];
+        d.b = target.b[seg];
+        d.num_q = body.num_q();
+      }
+      // ... and target vertices to the body's drawn segments
+      if (two_sided) {
+        std::vector<Eigen::Vector2d> ba, bb;
+        for (const auto& [i, j] : samples.segments) {
+          ba.push_back(x[i]);
+          bb.push_back(x[j]);
+        }
+        for (size_t v = 0; v < reverse_points.size(); ++v) {
+          const int seg = NearestSegment(ba, bb, reverse_points[v]);
+          changed = changed || seg != run->reverse_assigned[v];
+          run->reverse_assigned[v] = seg;
+          ReverseSegmentResidual& d = run->reverse[v];
+          d.pa = samples.points[samples.segments[seg].first];
+          d.pb = samples.points[samples.segments[seg].second];
+          d.y = reverse_points[v];
+          d.sqrt_weight = std::sqrt(reverse_weight);
+          d.num_q = body.num_q();
+        }
+      }
+      if (!changed) {
+        run->done = true;
+        break;
+      }
+      FitReport round_report;
+      SolvePose(body, run->data, run->reverse, o, &q, &round_report);
+      // the cost history runs over all rounds; the summary is that of the last round
+      PoseFitResult& r = run->r;
+      const std::vector<double> before = r.report.cost_per_iteration;
+      const int iterations = r.report.iterations;
+      const double initial = run->round == 0 ? round_report.initial_cost : r.report.initial_cost;
+      r.report = round_report;
+      r.report.initial_cost = initial;
+      r.report.cost_per_iteration.insert(r.report.cost_per_iteration.begin(), before.begin(), before.end());
+      r.report.iterations += iterations;
+      run->seconds += round_report.solve_seconds;
+      r.rounds = run->round + 1;
+      // assignments may keep flipping between neighbouring segments at equal distance: stop
+      // as well when a round no longer lowers the cost
+      if (run->round > 0 && run->previous_cost - round_report.final_cost <= 1e-6 * run->previous_cost) run->done = true;
+      run->previous_cost = round_report.final_cost;
+    }
+  };
+
+  std::vector<Run> runs;
+  for (const Eigen::VectorXd& start : starts) {
+    Run run;
+    run.q = start;
+    for (int d = 0; d < body.num_modes(); ++d)
+      run.q[kRigidDofs + d] = std::clamp(run.q[kRigidDofs + d], ModeLower(o, d), ModeUpper(o, d));
+    run.assigned.assign(ns, -1);
+    run.reverse_assigned.assign(reverse_points.size(), -1);
+    run.data.resize(ns);
+    run.reverse.resize(reverse_points.size());
+    advance(&run, std::min(o.start_rounds, o.max_rounds));
+    runs.push_back(std::move(run));
+  }
+  size_t best_index = 0;
+  for (size_t i = 1; i < runs.size(); ++i)
+    if (runs[i].r.report.final_cost < runs[best_index].r.report.final_cost) best_index = i;
+  Run& winner = runs[best_index];
+  advance(&winner, o.max_rounds);
+  PoseFitResult best = winner.r;
+  best.report.solve_seconds = winner.seconds;
+  best.q = winner.q;
+  const std::vector<SegmentResidual>& best_data = winner.data;
+  const std::vector<ReverseSegmentResidual>& best_reverse = winner.reverse;
+  FillResiduals(best_data, best.q, &best);
+  FillAtBound(body, o, &best);
+  if (o.analyze_conditioning) best.conditioning = ComputeConditioning(body, best_data, best_reverse, o, best.q);
+  return best;
+}
+
+}  // namespace wobble::fit

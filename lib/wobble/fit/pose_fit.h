@@ -1,0 +1,147 @@
+// Pose fits: q = [tx, ty, θ, γ1..γD] (Eq. 4.4) so that the body matches a target shape.
+//
+//   FitPose         with correspondences: body points (mass points or lattice points, e.g. of
+//                   the drawing) and where each should be.
+//   FitPoseToCurve  without correspondences: the target is a set of polylines and/or an
+//                   unordered point cloud; the residual of each body sample is its distance
+//                   to the nearest target segment (ICP-like, see the function).
+//
+// Both minimise Σ ρ(w_i |x_i(q) − target_i|²) + w_prior |γ|² with Ceres (automatic
+// derivatives through the templated kinematics), γ_d bounded to [lower_d, upper_d]. The
+// result says how well the targets determine q: see Conditioning.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "wobble/body/body_model.h"
+#include "wobble/fit/residuals.h"
+#include "wobble/io/target_file.h"
+
+namespace wobble::fit {
+
+enum class Loss { kSquared, kHuber, kCauchy };
+std::string LossName(Loss loss);
+bool ParseLoss(const std::string& text, Loss* loss);
+
+struct PoseFitOptions {
+  // Starting q (size num_q). Empty: a rigid start (see each fit), γ = 0.
+  Eigen::VectorXd initial_q;
+  // Bounds of every γ_d; per-mode vectors (size D) override the scalars when not empty.
+  double gamma_lower = -1.0, gamma_upper = 1.0;
+  std::vector<double> mode_lower, mode_upper;
+  // Robust loss for outliers: ρ(s) of Ceres with this scale (a distance, in length units:
+  // residuals beyond about `loss_scale` count linearly (Huber) or logarithmically (Cauchy)).
+  Loss loss = Loss::kSquared;
+  double loss_scale = 1.0;
+  // Weight of the prior pulling every γ toward rest (0): adds prior_weight * Σ γ_d².
+  double prior_weight = 0.0;
+  int max_iterations = 200;
+  bool full_report = false;  // also fill FitReport::full_report (long)
+  // Curve fits: samples per segment of the drawing (besides the mass points), and the number
+  // of closest-point/solve rounds.
+  int samples_per_segment = 8;
+  bool use_mass_points = true;
+  int max_rounds = 30;
+  // Also pull every target vertex to the nearest segment of the body's drawing (weighted so
+  // that both directions weigh the same in total): without it the body may cover only part
+  // of the target.
+  bool two_sided = true;
+  // Two-sided fits use at most this many target vertices (evenly spread) for the reverse
+  // direction: enough to see partial coverage, and the reverse terms are the costly ones.
+  int max_reverse_points = 200;
+  // Every start runs this many rounds; then only the best start continues.
+  int start_rounds = 3;
+  // Compute PoseFitResult::conditioning (an SVD of the data Jacobian at the solution).
+  bool analyze_conditioning = true;
+  // Called after every Ceres iteration with its number and cost (progress display).
+  std::function<void(int iteration, double cost)> on_iteration;
+};
+// Empty when valid, otherwise what is wrong (for a body with `num_modes` modes).
+std::string ValidateOptions(const PoseFitOptions& options, int num_modes);
+
+// How well the data terms (not the prior, not the bounds) determine q at the solution, from
+// the SVD of their Jacobian J. Coordinates have different units (length, radians,
+// amplitudes), so besides cond(JᵀJ) of the raw J the weak directions are found after scaling
+// every column to unit norm (Jacobi equilibration); a column that is (numerically) zero is a
+// coordinate the targets cannot see at all.
+struct WeakDirection {
+  double relative_singular_value = 0;  // σ_i / σ_max of the column-scaled J
+  std::vector<std::string> coordinates; // names of the coordinates with |v| > 0.3 in it
+  Eigen::VectorXd vector;               // the right singular vector (scaled coordinates)
+};
+struct Conditioning {
+  double condition_number = 0;         // cond(JᵀJ) = (σ_max/σ_min)², raw J; inf if singular
+  double scaled_condition_number = 0;  // the same for the column-scaled J, over seen columns
+  std::vector<double> column_norms;    // |∂residuals/∂q_i|: how strongly the data sees q_i
+  std::vector<WeakDirection> weak;     // σ_i/σ_max < kPoorlyDetermined, weakest first
+  std::vector<std::string> undetermined;        // modes the data cannot see (σ_rel < kUndetermined or zero column)
+  std::vector<std::string> poorly_determined;   // modes in a weak direction, not undetermined
+  static constexpr double kUndetermined = 1e-7;
+  static constexpr double kPoorlyDetermined = 1e-3;
+};
+
+// Common result of every fit.
+struct FitReport {
+  bool usable = false;             // Ceres' Summary::IsSolutionUsable()
+  std::string termination;         // e.g. "CONVERGENCE"
+  std::string brief_report, full_report;
+  double initial_cost = 0, final_cost = 0;  // Ceres' cost ½ Σ ρ(|r|²), prior included
+  std::vector<double> cost_per_iteration;    // iteration 0 = start; all rounds of a curve fit
+  int iterations = 0;
+  double solve_seconds = 0;
+};
+
+struct PoseFitResult {
+  Eigen::VectorXd q;
+  FitReport report;
+  // Unweighted distance of every body point to its target (or nearest target segment), in
+  // the order of the targets (curve fits: the body samples, mass points first).
+  std::vector<double> point_residuals;
+  double rms_residual = 0;
+  std::vector<std::string> at_bound;  // modes that ended on a bound
+  Conditioning conditioning;
+  int rounds = 0;  // curve fits: closest-point rounds of the best start
+};
+
+// The names of q's coordinates: tx, ty, theta, then the mode names.
+std::vector<std::string> CoordinateNames(const BodyModel& body);
+
+// Fits q to point correspondences. Without options.initial_q the start is the best rigid
+// placement of the rest shape onto the targets (weighted Procrustes), γ = 0.
+// Throws std::invalid_argument for invalid options, no targets or a mass point index the body
+// does not have.
+PoseFitResult FitPose(const BodyModel& body, const std::vector<io::PointTarget>& targets,
+                      const PoseFitOptions& options);
+
+// A curve target: segments (a == b for a cloud point) and its vertices (polyline points
+// and cloud points, each once).
+struct CurveTarget {
+  std::vector<Eigen::Vector2d> a, b;
+  std::vector<Eigen::Vector2d> vertices;
+  static CurveTarget From(const io::TargetFile& file);
+};
+
+// Body samples of a curve fit: the mass points (if options.use_mass_points) and
+// options.samples_per_segment + 1 points along every segment of the drawing; `segments`
+// joins consecutive drawing samples (indices into `points`) into the body's curve.
+struct CurveSamples {
+  std::vector<PointBasis> points;
+  std::vector<std::pair<int, int>> segments;
+  static CurveSamples Of(const BodyModel& body, const PoseFitOptions& options);
+};
+
+// Fits q to a curve target without correspondences, ICP-like: every round assigns each body
+// sample its nearest target segment at the current q (and, two-sided, each target vertex its
+// nearest body segment), then solves with point-to-segment residuals on those segments (the
+// distance is exact for the assigned segment), until the assignment stops changing, a round
+// no longer lowers the cost by a relative 1e-6, or options.max_rounds. Every start runs
+// options.start_rounds rounds, then the one with the lowest cost continues. point_residuals are those of the body samples (body → target). Start (without options.initial_q): the
+// rest shape's sample centroid moved onto the target's (length-weighted) centroid, its
+// principal axis turned onto the target's; both orientations of the axis are tried (four
+// quarter turns when either shape is nearly isotropic) and the lowest final cost wins; γ = 0.
+PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, const PoseFitOptions& options);
+
+}  // namespace wobble::fit

@@ -1,0 +1,138 @@
+// Ceres cost functors shared by the pose and trajectory fits, and the helper that turns a
+// run-time number of coordinates into Ceres' compile-time block sizes.
+//
+// Every functor follows Ceres' pattern (examples/snavely_reprojection_error.h): it stores its
+// observation and has a templated operator(); positions come from the same scalar-templated
+// kinematics (Eq. 4.2, wobble/dynamics/kinematics.h) that the simulation uses.
+#pragma once
+
+#include <ceres/autodiff_cost_function.h>
+
+#include <type_traits>
+
+#include "wobble/body/body_model.h"
+#include "wobble/dynamics/kinematics.h"
+
+namespace wobble::fit {
+
+// What a body point needs to be placed: x(q) = t + R(θ)(b0 + B γ) (Eq. 4.2).
+struct PointBasis {
+  Eigen::Vector2d b0 = Eigen::Vector2d::Zero();
+  Mat2D<double> B;
+};
+// Mass point k, or the body point at lattice coordinates (s, t) when k < 0.
+PointBasis BasisOf(const BodyModel& body, int mass_point, const Eigen::Vector2d& lattice_coords);
+
+// World position of a body point, templated for autodiff: x = t + R(θ)(b0 + Σ_d γ_d b^d)
+// (Eq. 4.2), as LocalPosition/WorldFromLocal of kinematics.h but reading q in place (copying
+// q into a VecQ of Jets dominated the cost of a residual).
+template <class T> Vec2<T> PointPosition(const PointBasis& p, const T* q, int num_q) {
+  using std::cos;
+  using std::sin;
+  T lx(p.b0.x()), ly(p.b0.y());
+  for (int d = 0; d + kRigidDofs < num_q; ++d) {
+    lx += p.B(0, d) * q[kRigidDofs + d];
+    ly += p.B(1, d) * q[kRigidDofs + d];
+  }
+  const T c = cos(q[2]), s = sin(q[2]);
+  return Vec2<T>(q[0] + c * lx - s * ly, q[1] + s * lx + c * ly);
+}
+
+// The closest point of segment [a, b] to x (a == b: the point a). Where the projection is
+// clamped to an end the end is a constant, otherwise derivatives flow through the projection.
+template <class T> Vec2<T> ClosestOnSegment(const Vec2<T>& x, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  if (len2 == 0.0) return a.cast<T>();
+  const T u = (x - a.cast<T>()).dot(ab.cast<T>()) / T(len2);
+  if (!(ScalarValue(u) > 0.0)) return a.cast<T>();
+  if (!(ScalarValue(u) < 1.0)) return b.cast<T>();
+  return a.cast<T>() + u * ab.cast<T>();
+}
+
+// Residual sqrt(w) (x(q) − closest point of [a, b]): a target point when a == b, a
+// point-to-segment distance for curve targets. Its norm is sqrt(w) times the distance.
+struct SegmentResidual {
+  PointBasis point;
+  Eigen::Vector2d a, b;
+  double sqrt_weight = 1.0;
+  int num_q = kRigidDofs;
+  template <class T> bool operator()(const T* q, T* r) const {
+    const Vec2<T> x = PointPosition(point, q, num_q);
+    const Vec2<T> e = (x - ClosestOnSegment(x, a, b)) * T(sqrt_weight);
+    r[0] = e[0];
+    r[1] = e[1];
+    return true;
+  }
+};
+
+// The reverse direction of a curve fit: sqrt(w) (y − closest point of the deformed body
+// segment [x_a(q), x_b(q)]) for a fixed target point y. Keeps the body from covering only
+// part of the target (a one-sided fit lets legs shrink and slide along longer target legs).
+struct ReverseSegmentResidual {
+  PointBasis pa, pb;
+  Eigen::Vector2d y;
+  double sqrt_weight = 1.0;
+  int num_q = kRigidDofs;
+  template <class T> bool operator()(const T* q, T* r) const {
+    const Vec2<T> xa = PointPosition(pa, q, num_q), xb = PointPosition(pb, q, num_q);
+    const Vec2<T> ab = xb - xa;
+    const T len2 = ab.squaredNorm();
+    Vec2<T> closest = xa;
+    if (ScalarValue(len2) > 0.0) {
+      const T u = (y.cast<T>() - xa).dot(ab) / len2;
+      if (!(ScalarValue(u) > 0.0)) {
+        closest = xa;
+      } else if (!(ScalarValue(u) < 1.0)) {
+        closest = xb;
+      } else {
+        closest = xa + u * ab;
+      }
+    }
+    const Vec2<T> e = (y.cast<T>() - closest) * T(sqrt_weight);
+    r[0] = e[0];
+    r[1] = e[1];
+    return true;
+  }
+};
+
+// Prior toward rest: sqrt(w) γ_d for every mode d (one residual per mode).
+struct RestPrior {
+  double sqrt_weight = 0.0;
+  int num_q = kRigidDofs;
+  template <class T> bool operator()(const T* q, T* r) const {
+    for (int i = kRigidDofs; i < num_q; ++i) r[i - kRigidDofs] = T(sqrt_weight) * q[i];
+    return true;
+  }
+};
+
+// Temporal smoothness between three consecutive frames: the divided second difference
+// c0 q_{f−1} + c1 q_f + c2 q_{f+1} (c0 = h̄/h0, c2 = h̄/h1, c1 = −c0 − c2, h̄ = (h0 + h1)/2;
+// q_{f−1} − 2q_f + q_{f+1} for even frames), each coordinate times a length scale so that
+// translation, angle and amplitudes are weighed in the same unit.
+struct SecondDifference {
+  double c0 = 1, c1 = -2, c2 = 1;
+  VecQ<double> scale;  // per coordinate, times sqrt(w)
+  template <class T> bool operator()(const T* a, const T* b, const T* c, T* r) const {
+    for (int i = 0; i < scale.size(); ++i) r[i] = T(scale[i]) * (T(c0) * a[i] + T(c1) * b[i] + T(c2) * c[i]);
+    return true;
+  }
+};
+
+// Calls make(std::integral_constant<int, N>) with N = num_q, for num_q in [kRigidDofs, kMaxQ]:
+// Ceres' AutoDiffCostFunction wants block sizes at compile time.
+template <int N = kRigidDofs, class Make> ceres::CostFunction* WithNumQ(int num_q, Make&& make) {
+  if constexpr (N > kMaxQ) {
+    return nullptr;
+  } else {
+    if (num_q == N) return make(std::integral_constant<int, N>{});
+    return WithNumQ<N + 1>(num_q, make);
+  }
+}
+
+ceres::CostFunction* MakeSegmentCost(const SegmentResidual& r);
+ceres::CostFunction* MakeReverseSegmentCost(const ReverseSegmentResidual& r);
+ceres::CostFunction* MakeRestPriorCost(const RestPrior& r);
+ceres::CostFunction* MakeSecondDifferenceCost(const SecondDifference& r);
+
+}  // namespace wobble::fit

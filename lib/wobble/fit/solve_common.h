@@ -1,0 +1,60 @@
+// Internals shared by the fits (not part of the public API): bounds, losses, the Ceres solve
+// of a pose, the summary → FitReport copy and the conditioning analysis.
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <vector>
+
+#include "wobble/fit/pose_fit.h"
+
+namespace wobble::fit {
+
+inline double ModeLower(const PoseFitOptions& o, int d) { return o.mode_lower.empty() ? o.gamma_lower : o.mode_lower[d]; }
+inline double ModeUpper(const PoseFitOptions& o, int d) { return o.mode_upper.empty() ? o.gamma_upper : o.mode_upper[d]; }
+
+// Weighted Procrustes: q (γ = 0) whose rigid motion best carries the rest positions onto the
+// targets in the least-squares sense.
+Eigen::VectorXd RigidStart(const BodyModel& body, const std::vector<Eigen::Vector2d>& rest,
+                           const std::vector<Eigen::Vector2d>& target, const std::vector<double>& weights);
+
+// A new loss function for Problem (which takes ownership); nullptr for squared.
+ceres::LossFunction* MakeLoss(Loss loss, double scale);
+
+// Adds the data terms (and the rest prior) of one pose to `problem` over q, with the mode
+// bounds. Returns the data residual blocks.
+// `reverse` holds the target-to-body terms of a two-sided curve fit.
+std::vector<ceres::ResidualBlockId> AddPoseTerms(const BodyModel& body, const std::vector<SegmentResidual>& data,
+                                                 const std::vector<ReverseSegmentResidual>& reverse,
+                                                 const PoseFitOptions& o, double* q, ceres::Problem* problem);
+
+// Forwards Ceres' iterations to an on_iteration function; attach with Attach().
+class IterationForwarder : public ceres::IterationCallback {
+ public:
+  explicit IterationForwarder(std::function<void(int, double)> f) : f_(std::move(f)) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    f_(s.iteration, s.cost);
+    return ceres::SOLVER_CONTINUE;
+  }
+  void Attach(ceres::Solver::Options* options) {
+    if (f_) options->callbacks.push_back(this);
+  }
+
+ private:
+  std::function<void(int, double)> f_;
+};
+
+// Copies what people need from a Ceres summary.
+void FillReport(const ceres::Solver::Summary& summary, bool full, double seconds, FitReport* report);
+
+// Solves one pose (dense: a handful of unknowns), q in and out.
+void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
+               const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o, Eigen::VectorXd* q,
+               FitReport* report);
+
+// Conditioning of the data terms at q (see Conditioning in pose_fit.h).
+Conditioning ComputeConditioning(const BodyModel& body, const std::vector<SegmentResidual>& data,
+                                 const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o,
+                                 const Eigen::VectorXd& q);
+
+}  // namespace wobble::fit

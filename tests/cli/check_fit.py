@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""`wobble fit`: checks the JSON and CSV it writes against the q that generated the targets
+(data/*.tgt headers) and a simulated reference, and its handling of bad input.
+Usage: check_fit.py WOBBLE DATA_DIR CLI_DIR WORK_DIR"""
+import csv, json, os, subprocess, sys
+
+wobble, data, cli, work = sys.argv[1:5]
+os.makedirs(work, exist_ok=True)
+body = ["--object", f"{data}/table.obj", "--modes", f"{data}/table_modes.def"]
+failures = []
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        failures.append(what)
+
+
+def run(*args):
+    return subprocess.run([wobble, *args], capture_output=True, text=True)
+
+
+# pose with correspondences and an outlier: the generating q (data/table_pose.tgt header)
+r = run("fit", "pose", *body, "--targets", f"{data}/table_pose.tgt", "--loss", "cauchy", "--loss-scale", "5",
+        "--out", f"{work}/pose.json", "--costs", f"{work}/pose_costs.csv")
+check(r.returncode == 0, "fit pose exits 0: " + r.stderr.strip())
+j = json.load(open(f"{work}/pose.json"))
+truth = [120, 40, 0.2, 0.3, -0.15, 0.2, 0.1]
+tol = [1, 1, 5e-3, 0.02, 0.02, 0.02, 0.02]
+check(all(abs(a - b) <= t for a, b, t in zip(j["q"], truth, tol)), f"pose q {j['q']} near {truth}")
+check(j["point_residuals"][7] > 50, "the outlier (mass point 7) keeps its residual")
+check(j["conditioning"]["undetermined"] == [], "no undetermined mode")
+rows = list(csv.reader(open(f"{work}/pose_costs.csv")))
+check(rows[0] == ["iteration", "cost"], "costs CSV header")
+check(abs(float(rows[-1][1]) - j["report"]["final_cost"]) <= 1e-9 * j["report"]["final_cost"], "last cost = final cost")
+check(len(j["overlay"]["fitted"]) == len(j["overlay"]["targets"]), "overlay pairs fitted points with targets")
+
+# curve without correspondences (data/table_curve.tgt header)
+r = run("fit", "pose", *body, "--targets", f"{data}/table_curve.tgt", "--out", f"{work}/curve.json")
+check(r.returncode == 0, "fit pose (curve) exits 0")
+j = json.load(open(f"{work}/curve.json"))
+truth = [-40, 10, -0.1, 0.4, 0.1, -0.2, 0.15]
+tol = [1.5, 1.5, 5e-3, 0.03, 0.03, 0.03, 0.03]
+check(all(abs(a - b) <= t for a, b, t in zip(j["q"], truth, tol)), f"curve q {j['q']} near {truth}")
+
+# a recorded simulation as the reference: kinematic and dynamic fits
+sim = f"{work}/throw.csv"
+r = run("simulate", *body, "--q", "0 100 0.1 0.1 0 0 0", "--qdot", "20 40 0.5 0.3 0 0 0", "--no-ground",
+        "--dt", "0.01", "--duration", "0.5", "--out", sim)
+check(r.returncode == 0, "simulate the reference")
+r = run("fit", "trajectory", *body, "--reference", sim, "--smoothness", "0", "--out", f"{work}/kin.json")
+check(r.returncode == 0, "fit trajectory (kinematic) exits 0: " + r.stderr.strip())
+j = json.load(open(f"{work}/kin.json"))
+ref = [[float(x) for x in row[1:8]] for row in list(csv.reader(open(sim)))[1:]]
+err = max(abs(a - b) for qa, qb in zip(j["q"], ref) for a, b in zip(qa, qb))
+check(len(j["q"]) == len(ref) and err < 1e-6, f"kinematic q matches the simulation (max error {err:.2g})")
+# the fit starts from other modes: K = 2e6, c = 5e5 in place of data/table_modes.def's 4e6, 1e6
+start_modes = f"{work}/start_modes.def"
+with open(start_modes, "w") as f:
+    f.write(open(f"{data}/table_modes.def").read().replace("stiffness 4000000 damping 1000000",
+                                                         "stiffness 2000000 damping 500000"))
+start_body = ["--object", f"{data}/table.obj", "--modes", start_modes]
+r = run("fit", "trajectory", *start_body, "--reference", sim, "--dynamic", "--no-ground", "--dt", "0.01", "--every", "5",
+        "--fit", "stiffness,damping", "--q0", "0 100 0.1 0.1 0 0 0", "--qdot0", "20 40 0.5 0.3 0 0 0",
+        "--out", f"{work}/dyn.json")
+check(r.returncode == 0, "fit trajectory --dynamic exits 0: " + r.stderr.strip())
+j = json.load(open(f"{work}/dyn.json"))
+check(abs(j["stiffness"][0] / 4e6 - 1) < 1e-4 and abs(j["damping"][0] / 1e6 - 1) < 1e-3,
+      f"dynamic fit from K = 2e6, c = 5e5 finds the bend's K = 4e6, c = 1e6 of the reference: "
+      f"{j['stiffness'][0]}, {j['damping'][0]}")
+
+# bad input: file and line, exit 2, nothing written
+out = f"{work}/never.json"
+r = run("fit", "pose", *body, "--targets", f"{cli}/bad_target.tgt", "--out", out)
+check(r.returncode == 2 and "bad_target.tgt:2: expected a number for y, got 'forty'" in r.stderr,
+      "malformed target: exit 2 with file:line: " + r.stderr.strip())
+check(not os.path.exists(out), "nothing written for bad input")
+r = run("fit", "trajectory", *body, "--reference", f"{data}/table_pose.tgt")
+check(r.returncode == 2 and "table_pose.tgt:0: no 'frame' lines" in r.stderr, "a pose file is not a trajectory")
+r = run("fit", "pose", *body, "--targets", f"{data}/table_pose.tgt", "--loss", "quadratic")
+check(r.returncode == 2 and "--loss" in r.stderr, "unknown loss: exit 2")
+sys.exit(1 if failures else 0)

@@ -1,0 +1,341 @@
+// Pose fits (lib/wobble/fit): synthetic targets made from a known q are recovered; bounds
+// hold; unreachable targets end with an honest residual; a mode the data cannot see is
+// reported as undetermined; target files are parsed strictly.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <sstream>
+
+#include "test_bodies.h"
+#include "wobble/fit/pose_fit.h"
+#include "wobble/io/parse_error.h"
+#include "wobble/io/target_file.h"
+
+namespace wobble {
+namespace {
+
+using fit::PoseFitOptions;
+using fit::PoseFitResult;
+using io::PointTarget;
+
+BodyModel Table() { return BodyModel(testing::TableDef(), testing::TableModes()); }
+
+Eigen::VectorXd KnownQ() {
+  Eigen::VectorXd q(7);
+  q << 40, -25, 0.3, 0.35, -0.2, 0.15, 0.25;
+  return q;
+}
+
+Eigen::Vector2d Place(const BodyModel& body, int k, const Eigen::Vector2d& st, const Eigen::VectorXd& q) {
+  return fit::PointPosition(fit::BasisOf(body, k, st), q.data(), int(q.size()));
+}
+
+// Targets for every mass point and 5 samples along each drawn segment of the table.
+std::vector<PointTarget> TargetsFrom(const BodyModel& body, const Eigen::VectorXd& q) {
+  std::vector<PointTarget> t;
+  for (int k = 0; k < body.num_points(); ++k) {
+    PointTarget p;
+    p.mass_point = k;
+    p.position = Place(body, k, {}, q);
+    t.push_back(p);
+  }
+  for (double u : {0.1, 0.3, 0.5, 0.7, 0.9})
+    for (Eigen::Vector2d st : {Eigen::Vector2d(u, 1.0), Eigen::Vector2d(0.0, u), Eigen::Vector2d(1.0, u)}) {
+      PointTarget p;
+      p.lattice_coords = st;
+      p.position = Place(body, -1, st, q);
+      t.push_back(p);
+    }
+  return t;
+}
+
+TEST(PoseFit, ExactTargetsRecoverQ) {
+  const BodyModel body = Table();
+  const PoseFitResult r = fit::FitPose(body, TargetsFrom(body, KnownQ()), PoseFitOptions());
+  ASSERT_TRUE(r.report.usable) << r.report.brief_report;
+  for (int i = 0; i < 7; ++i) EXPECT_NEAR(r.q[i], KnownQ()[i], 1e-7) << i;
+  EXPECT_LT(r.rms_residual, 1e-6);
+  EXPECT_TRUE(r.conditioning.undetermined.empty());
+  EXPECT_TRUE(std::isfinite(r.conditioning.condition_number));
+  // the cost history starts at the initial cost and ends at the final one
+  EXPECT_DOUBLE_EQ(r.report.cost_per_iteration.front(), r.report.initial_cost);
+  EXPECT_LE(r.report.cost_per_iteration.back(), r.report.initial_cost);
+}
+
+// Gaussian noise of 0.5 (lattice 300 x 100) and three outliers moved by 60-90 units.
+std::vector<PointTarget> NoisyTargets(const BodyModel& body, unsigned seed) {
+  std::vector<PointTarget> t = TargetsFrom(body, KnownQ());
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.5);
+  for (PointTarget& p : t) p.position += Eigen::Vector2d(noise(rng), noise(rng));
+  t[2].position += Eigen::Vector2d(80, -30);
+  t[7].position += Eigen::Vector2d(-60, 40);
+  t[15].position += Eigen::Vector2d(0, 90);
+  return t;
+}
+
+TEST(PoseFit, RobustLossRecoversQDespiteNoiseAndOutliers) {
+  const BodyModel body = Table();
+  for (unsigned seed : {1u, 2u, 3u}) {
+    PoseFitOptions o;
+    o.loss = fit::Loss::kCauchy;
+    o.loss_scale = 2.0;  // four times the noise
+    const PoseFitResult r = fit::FitPose(body, NoisyTargets(body, seed), o);
+    ASSERT_TRUE(r.report.usable);
+    // stated tolerances: translation 0.5, angle 2e-3 rad, amplitudes 0.01 (a unit amplitude
+    // moves the points by 50-150)
+    EXPECT_NEAR(r.q[0], KnownQ()[0], 0.5);
+    EXPECT_NEAR(r.q[1], KnownQ()[1], 0.5);
+    EXPECT_NEAR(r.q[2], KnownQ()[2], 2e-3);
+    for (int d = 3; d < 7; ++d) EXPECT_NEAR(r.q[d], KnownQ()[d], 0.01) << "mode " << d - 3 << " seed " << seed;
+    // the outliers keep their large residuals instead of dragging the fit
+    EXPECT_GT(r.point_residuals[2], 50);
+    EXPECT_GT(r.point_residuals[15], 50);
+  }
+  // the squared loss is dragged by the same outliers: the check above is not vacuous
+  const PoseFitResult plain = fit::FitPose(body, NoisyTargets(body, 1), PoseFitOptions());
+  double worst = 0;
+  for (int d = 3; d < 7; ++d) worst = std::max(worst, std::abs(plain.q[d] - KnownQ()[d]));
+  EXPECT_GT(worst, 0.02);
+}
+
+TEST(PoseFit, BoundsHoldAndUnreachableTargetsEndWithHonestResidual) {
+  const BodyModel body = Table();
+  Eigen::VectorXd far = KnownQ();
+  far[3] = 1.8;  // bend beyond the bound 1
+  far[5] = -1.5;
+  const std::vector<PointTarget> t = TargetsFrom(body, far);
+  const PoseFitResult r = fit::FitPose(body, t, PoseFitOptions());
+  ASSERT_TRUE(r.report.usable) << r.report.brief_report;
+  for (int d = 3; d < 7; ++d) {
+    EXPECT_GE(r.q[d], -1.0);
+    EXPECT_LE(r.q[d], 1.0);
+  }
+  EXPECT_DOUBLE_EQ(r.q[3], 1.0);
+  EXPECT_DOUBLE_EQ(r.q[5], -1.0);
+  EXPECT_EQ(r.at_bound, (std::vector<std::string>{"bend", "vsquash"}));
+  EXPECT_GT(r.rms_residual, 5.0);
+  // the reported cost is the residuals': ½ Σ |r|² with unit weights
+  double half_sum = 0;
+  for (double d : r.point_residuals) half_sum += 0.5 * d * d;
+  EXPECT_NEAR(r.report.final_cost, half_sum, 1e-9 * half_sum);
+  // per-mode bounds override the scalars
+  PoseFitOptions wide;
+  wide.mode_lower = {-2, -2, -2, -2};
+  wide.mode_upper = {2, 2, 2, 2};
+  const PoseFitResult w = fit::FitPose(body, t, wide);
+  for (int i = 0; i < 7; ++i) EXPECT_NEAR(w.q[i], far[i], 1e-7);
+
+  // a shape the table cannot take (a circle): no failure, the residual says how far it is
+  std::vector<PointTarget> circle;
+  for (int k = 0; k < body.num_points(); ++k) {
+    PointTarget p;
+    p.mass_point = k;
+    p.position = 100.0 * Eigen::Vector2d(std::cos(k * 2 * M_PI / 11), std::sin(k * 2 * M_PI / 11));
+    circle.push_back(p);
+  }
+  const PoseFitResult c = fit::FitPose(body, circle, PoseFitOptions());
+  EXPECT_TRUE(c.report.usable);
+  EXPECT_GT(c.rms_residual, 20.0);
+  EXPECT_EQ(c.point_residuals.size(), 11u);
+}
+
+TEST(PoseFit, PriorPullsTowardRest) {
+  const BodyModel body = Table();
+  const std::vector<PointTarget> t = TargetsFrom(body, KnownQ());
+  PoseFitOptions o;
+  o.prior_weight = 1e5;
+  const PoseFitResult r = fit::FitPose(body, t, o);
+  for (int d = 3; d < 7; ++d) EXPECT_LT(std::abs(r.q[d]), std::abs(KnownQ()[d]) - 1e-3) << d;
+}
+
+// A mode that moves only the interior control points (i = 1, 2; j = 0, 1, 2) of the 4 x 4
+// Bernstein lattice: every table mass point lies on an edge (s = 0, s = 1 or t = 1), where
+// those control points have zero weight, so the mass points cannot see the mode.
+DeformationMode HiddenMode() {
+  DeformationMode m;
+  m.name = "hidden";
+  m.displacement.assign(16, Eigen::Vector2d::Zero());
+  for (int i = 1; i <= 2; ++i)
+    for (int j = 0; j <= 2; ++j) m.displacement[i * 4 + j] = {0, -40};
+  return m;
+}
+
+TEST(PoseFit, ModeTheMassPointsCannotSeeIsReportedUndetermined) {
+  std::vector<DeformationMode> modes = testing::TableModes();
+  modes.push_back(HiddenMode());
+  const BodyModel body(testing::TableDef(), modes);
+  Eigen::VectorXd q(8);
+  q << 40, -25, 0.3, 0.35, -0.2, 0.15, 0.25, 0.0;
+  std::vector<PointTarget> t;
+  for (int k = 0; k < body.num_points(); ++k) {
+    PointTarget p;
+    p.mass_point = k;
+    p.position = Place(body, k, {}, q);
+    t.push_back(p);
+  }
+  const PoseFitResult r = fit::FitPose(body, t, PoseFitOptions());
+  ASSERT_TRUE(r.report.usable);
+  EXPECT_EQ(r.conditioning.undetermined, std::vector<std::string>{"hidden"});
+  EXPECT_TRUE(std::isinf(r.conditioning.condition_number));
+  EXPECT_EQ(r.conditioning.column_norms[7], 0.0);
+  for (int i = 0; i < 7; ++i) EXPECT_NEAR(r.q[i], q[i], 1e-7) << i;
+
+  // a target inside the lattice (under the table top) makes it visible
+  PointTarget inside;
+  inside.lattice_coords = {0.5, 0.3};
+  q[7] = 0.4;
+  inside.position = Place(body, -1, inside.lattice_coords, q);
+  t.push_back(inside);
+  for (PointTarget& p : t)
+    if (p.mass_point >= 0) p.position = Place(body, p.mass_point, {}, q);
+  const PoseFitResult seen = fit::FitPose(body, t, PoseFitOptions());
+  EXPECT_TRUE(seen.conditioning.undetermined.empty());
+  EXPECT_TRUE(std::isfinite(seen.conditioning.condition_number));
+  EXPECT_NEAR(seen.q[7], 0.4, 1e-6);
+}
+
+TEST(PoseFit, NearlyDependentModesArePoorlyDetermined) {
+  // a second copy of the bend, changed a little at one corner: the targets can hardly tell
+  // the two apart
+  std::vector<DeformationMode> modes = testing::TableModes();
+  DeformationMode twin = modes[0];
+  twin.name = "bend_twin";
+  twin.displacement[0] += Eigen::Vector2d(0.01, 0);
+  modes.push_back(twin);
+  const BodyModel body(testing::TableDef(), modes);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(8);
+  q.head(7) = KnownQ();
+  std::vector<PointTarget> t = TargetsFrom(body, q);
+  const PoseFitResult r = fit::FitPose(body, t, PoseFitOptions());
+  EXPECT_EQ(r.conditioning.poorly_determined, (std::vector<std::string>{"bend", "bend_twin"}));
+  ASSERT_FALSE(r.conditioning.weak.empty());
+  EXPECT_LT(r.conditioning.weak[0].relative_singular_value, 1e-3);
+}
+
+// ---- without correspondences ----
+
+// The table's drawing deformed by q, as polylines of `n` points each.
+io::TargetFile DrawnTarget(const BodyModel& body, const Eigen::VectorXd& q, int n, double noise, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, noise);
+  io::TargetFile f;
+  for (const Polyline& line : body.def().shapes) {
+    io::TargetCurve c;
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector2d p = line.points[0] + (line.points[1] - line.points[0]) * (double(i) / (n - 1));
+      c.points.push_back(Place(body, -1, body.lattice().LocalCoords(p), q) +
+                         (noise > 0 ? Eigen::Vector2d(g(rng), g(rng)) : Eigen::Vector2d::Zero()));
+    }
+    f.polylines.push_back(c);
+  }
+  return f;
+}
+
+TEST(CurveFit, RecoversQFromTheDrawnShape) {
+  const BodyModel body = Table();
+  for (double noise : {0.0, 0.3}) {
+    const io::TargetFile target = DrawnTarget(body, KnownQ(), 60, noise, 5);
+    const PoseFitResult r = fit::FitPoseToCurve(body, fit::CurveTarget::From(target), PoseFitOptions());
+    ASSERT_TRUE(r.report.usable);
+    // stated tolerances: translation 1, angle 5e-3 rad, amplitudes 0.02 (the polyline is a
+    // chord approximation of the deformed curve, and points may slide along it)
+    EXPECT_NEAR(r.q[0], KnownQ()[0], 1.0) << noise;
+    EXPECT_NEAR(r.q[1], KnownQ()[1], 1.0) << noise;
+    EXPECT_NEAR(r.q[2], KnownQ()[2], 5e-3) << noise;
+    for (int d = 3; d < 7; ++d) EXPECT_NEAR(r.q[d], KnownQ()[d], 0.02) << "mode " << d - 3 << " noise " << noise;
+    EXPECT_LT(r.rms_residual, 0.5 + noise);
+    EXPECT_GE(r.rounds, 2);
+  }
+}
+
+TEST(CurveFit, StartsFromThePrincipalAxisEvenUpsideDown) {
+  const BodyModel body = Table();
+  Eigen::VectorXd q = KnownQ();
+  q[2] = 3.0;  // nearly upside down: the other orientation of the axis must win
+  const PoseFitResult r =
+      fit::FitPoseToCurve(body, fit::CurveTarget::From(DrawnTarget(body, q, 60, 0.0, 1)), PoseFitOptions());
+  EXPECT_NEAR(r.q[2], 3.0, 5e-3);
+  EXPECT_LT(r.rms_residual, 0.5);
+}
+
+TEST(CurveFit, CloudTargetAndUnreachableShape) {
+  const BodyModel body = Table();
+  // a point cloud: points of the drawing at the known pose, shuffled (no order, no segments)
+  io::TargetFile cloud;
+  for (const io::TargetCurve& c : DrawnTarget(body, KnownQ(), 20, 0.0, 1).polylines)
+    cloud.cloud.insert(cloud.cloud.end(), c.points.begin(), c.points.end());
+  std::shuffle(cloud.cloud.begin(), cloud.cloud.end(), std::mt19937(3));
+  const PoseFitResult r = fit::FitPoseToCurve(body, fit::CurveTarget::From(cloud), PoseFitOptions());
+  for (int d = 3; d < 7; ++d) EXPECT_NEAR(r.q[d], KnownQ()[d], 0.05) << d;
+  // a body sample is as far as the nearest cloud point: at most half the spacing (300 / 19)
+  EXPECT_LT(r.rms_residual, 0.5 * 300.0 / 19.0);
+  // a short dash the 300-wide table cannot shrink to (|γ| <= 1): an honest residual, not a failure
+  io::TargetFile dash;
+  dash.polylines.push_back({{{0, 0}, {10, 0}}, false});
+  const PoseFitResult rc = fit::FitPoseToCurve(body, fit::CurveTarget::From(dash), PoseFitOptions());
+  EXPECT_TRUE(rc.report.usable);
+  EXPECT_GT(rc.rms_residual, 20.0);
+  for (int d = 3; d < 7; ++d) EXPECT_LE(std::abs(rc.q[d]), 1.0);
+}
+
+// ---- target files ----
+
+std::string ParseMessage(const std::string& text) {
+  std::istringstream in(text);
+  try {
+    io::ParseTargets(in, "t.tgt");
+  } catch (const io::ParseError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(TargetFile, ParsesEveryStatement) {
+  std::istringstream in(
+      "# a comment\n"
+      "point 3 10 20\n"
+      "sample 0.5 1 1.5 -2 weight 4   # the top's middle\n");
+  const io::TargetFile f = io::ParseTargets(in, "t.tgt");
+  ASSERT_EQ(f.points.size(), 2u);
+  EXPECT_EQ(f.points[0].mass_point, 3);
+  EXPECT_EQ(f.points[0].position, Eigen::Vector2d(10, 20));
+  EXPECT_EQ(f.points[1].mass_point, -1);
+  EXPECT_EQ(f.points[1].lattice_coords, Eigen::Vector2d(0.5, 1));
+  EXPECT_EQ(f.points[1].weight, 4.0);
+  EXPECT_EQ(f.points[1].line, 3);
+  std::istringstream curve("polyline 0 0 1 0 1 1 closed\ncloud 5 5\n");
+  const io::TargetFile c = io::ParseTargets(curve, "c.tgt");
+  EXPECT_EQ(fit::CurveTarget::From(c).a.size(), 4u);  // 3 closed segments + 1 cloud point
+  std::istringstream traj("frame 0\npoint 0 1 2\nframe 0.5\npoint 0 1 3\nsample 0 0 1 1\n");
+  const io::TargetFile t = io::ParseTargets(traj, "k.tgt");
+  ASSERT_EQ(t.frames.size(), 2u);
+  EXPECT_EQ(t.frames[1].points.size(), 2u);
+}
+
+TEST(TargetFile, RejectsMalformedInputWithFileAndLine) {
+  EXPECT_EQ(ParseMessage(""), "t.tgt:0: file is empty: expected point, sample, polyline, cloud or frame lines");
+  EXPECT_EQ(ParseMessage("point 1 2 x\n"), "t.tgt:1: expected a number for y, got 'x' (point <k> <x> <y> [weight <w>])");
+  EXPECT_EQ(ParseMessage("\npoint -1 2 3\n"), "t.tgt:2: expected a mass point index >= 0, got '-1' (point <k> <x> <y> [weight <w>])");
+  EXPECT_EQ(ParseMessage("sample 1.5 0 1 1\n"), "t.tgt:1: lattice coordinate s must be in [0, 1], got 1.5");
+  EXPECT_EQ(ParseMessage("point 0 1 2 weight 0\n"), "t.tgt:1: the weight must be > 0, got 0");
+  EXPECT_EQ(ParseMessage("point 0 1 2 3\n"), "t.tgt:1: unexpected '3' (point <k> <x> <y> [weight <w>])");
+  EXPECT_EQ(ParseMessage("polyline 0 0 1\n"), "t.tgt:1: expected pairs of numbers (polyline <x1> <y1> <x2> <y2> ... [closed])");
+  EXPECT_EQ(ParseMessage("point 0 1 2\npolyline 0 0 1 1\n"),
+            "t.tgt:2: a file holds correspondences (point/sample) or a curve (polyline/cloud), not both");
+  EXPECT_EQ(ParseMessage("frame 1\npoint 0 1 2\nframe 1\n"), "t.tgt:3: frame times must strictly increase (previous frame: 1)");
+  EXPECT_EQ(ParseMessage("frame 1\nframe 2\npoint 0 0 0\n"), "t.tgt:1: frame has no point or sample lines");
+  EXPECT_EQ(ParseMessage("wobble 1\n"), "t.tgt:1: unknown keyword 'wobble' (expected point, sample, polyline, cloud or frame)");
+  std::istringstream in("point 0 1 2\n\npoint 11 1 2\n");
+  const io::TargetFile f = io::ParseTargets(in, "t.tgt");
+  try {
+    io::CheckMassPointIndices(f, 11);
+    FAIL() << "index 11 accepted";
+  } catch (const io::ParseError& e) {
+    EXPECT_STREQ(e.what(), "t.tgt:3: mass point 11 does not exist: the body has 11 (numbered from 0)");
+  }
+}
+
+}  // namespace
+}  // namespace wobble
