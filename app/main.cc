@@ -7,6 +7,7 @@
 
 #include "cli_common.h"
 #include "inspect.h"
+#include "run.h"
 #include "simulate.h"
 #include "wobble/io/object_file.h"
 
@@ -22,6 +23,8 @@ int main(int argc, char** argv) {
   InspectArgs inspect_args;
   CLI::App* simulate = AddSimulateCommand(&app, &simulate_args);
   CLI::App* inspect = AddInspectCommand(&app, &inspect_args);
+  RunArgs run_args;
+  CLI::App* run = AddRunCommand(&app, &run_args);
 
   try {
     app.parse(argc, argv);
@@ -34,6 +37,7 @@ int main(int argc, char** argv) {
   try {
     if (simulate->parsed()) return RunSimulate(simulate_args);
     if (inspect->parsed()) return RunInspect(inspect_args);
+    if (run->parsed()) return RunScript(run_args);
   } catch (const wobble::io::ParseError& e) {
     std::cerr << e.what() << std::endl;  // already "FILE:LINE: message"
     return kExitBadInput;

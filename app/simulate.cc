@@ -54,29 +54,6 @@ std::vector<double> CsvRow(const World& world, double t) {
   return row;
 }
 
-// A one-line progress bar on stderr, redrawn when the percentage changes.
-class Progress {
- public:
-  explicit Progress(bool enabled) : enabled_(enabled) {}
-  void Update(double fraction, double t) {
-    if (!enabled_) return;
-    const int percent = int(std::floor(100.0 * std::min(1.0, std::max(0.0, fraction))));
-    if (percent == last_) return;
-    last_ = percent;
-    const int width = 40, filled = percent * width / 100;
-    std::fprintf(stderr, "\r[%s%s] %3d%%  t = %-10.4g", std::string(filled, '#').c_str(),
-                 std::string(width - filled, '.').c_str(), percent, t);
-    std::fflush(stderr);
-  }
-  void Finish() {
-    if (enabled_ && last_ >= 0) std::fprintf(stderr, "\n");
-  }
-
- private:
-  bool enabled_;
-  int last_ = -1;
-};
-
 }  // namespace
 
 CLI::App* AddSimulateCommand(CLI::App* app, SimulateArgs* a) {
