@@ -48,6 +48,7 @@ const std::vector<CommandInfo>& Interpreter::Commands() {
       {"output", "output FILE.csv [EVERY] | output off", "record the state of every EVERY-th step as CSV"},
       {"print", "print", "print the state, energies and the control energy"},
       {"anneal", "anneal ITERATIONS", "simulated annealing of the pose graph (Fig. 5.2)"},
+      {"gait", "gait SKIP CYCLES", "distance travelled per cycle of the pose graph, after SKIP cycles"},
       {"save", "save FILE", "write a script that rebuilds the current setup and replays its controller"},
       {"echo", "echo TEXT", "print TEXT"},
       {"quit", "quit", "stop (interactive use)"},
@@ -496,6 +497,25 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
          << ", control energy " << Num(r.best_outcome.energy) << ")\n";
     graph_ = r.best;
     anneal_ = std::move(r);
+  } else if (cmd == "gait") {
+    ExpectWords(w, 3, 3, usage(), ctx);
+    RequireBody(ctx, "gait");
+    int skip, cycles;
+    if (!detail::ParseInt(w[1], &skip) || skip < 0 || !detail::ParseInt(w[2], &cycles) || cycles < 1)
+      ctx.Fail("expected 'gait SKIP CYCLES' with SKIP >= 0 and CYCLES >= 1 whole numbers");
+    if (graph_.empty() || !graph_.cyclic) ctx.Fail("gait needs a cyclic pose graph: 'pose ...' lines first");
+    const std::string invalid = graph_.Validate(int(control::ActiveModes(*BuildBody()).size()));
+    if (!invalid.empty()) ctx.Fail("pose graph: " + invalid);
+    // from the anneal's start state when there was one: the gait the trials measured
+    synth::Problem p = MakeProblem(1);
+    if (anneal_start_q_.size()) {
+      p.q0 = anneal_start_q_;
+      p.qd0 = anneal_start_qd_;
+    }
+    const std::vector<double> d = synth::DistancePerCycle(p, graph_, skip, cycles);
+    out_ << "gait: period " << Num(graph_.Period()) << ", distance per cycle:";
+    for (double x : d) out_ << " " << Num(x);
+    out_ << "\n";
   } else if (cmd == "save") {
     ExpectWords(w, 2, 2, usage(), ctx);
     RequireBody(ctx, "save");

@@ -63,6 +63,17 @@ double EvaluateCost(const CostFunction& c, const TrialOutcome& o) {
   return c.high;
 }
 
+void CenterOfMassX(const BodyModel& body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double* x, double* v) {
+  const MassMoments& mm = body.moments();
+  const int D = body.num_modes();
+  const Eigen::Vector2d l = mm.c0 + mm.C * q.tail(D);
+  const Eigen::Matrix2d R = Rotation(q[2]);
+  const Eigen::Vector2d pos = q.head<2>() + R * l / mm.m;
+  const Eigen::Vector2d vel = qd.head<2>() + (R * Perp<double>(l) * qd[2] + R * (mm.C * qd.tail(D))) / mm.m;
+  *x = pos.x();
+  *v = vel.x();
+}
+
 TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
                       const std::function<void(const World&)>& on_step) {
   TrialOutcome out;
@@ -90,8 +101,11 @@ TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
     if (on_step) on_step(world);
   }
   out.ok = true;
-  out.distance = world.state(0).q[0] - p.q0[0];
-  out.speed = world.state(0).qd[0];
+  double x0, v0, x1, v1;
+  CenterOfMassX(*p.body, p.q0, p.qd0, &x0, &v0);
+  CenterOfMassX(*p.body, world.state(0).q, world.state(0).qd, &x1, &v1);
+  out.distance = x1 - x0;
+  out.speed = v1;
   out.energy = energy.consumed;
   out.cost = EvaluateCost(p.cost, out);
   return out;
@@ -212,7 +226,9 @@ std::vector<double> DistancePerCycle(const Problem& problem, const control::Pose
   int next_cycle = skip;
   RunTrial(p, graph, [&](const World& w) {
     if (next_cycle <= skip + cycles && w.time() + 0.5 * dt >= next_cycle * period) {
-      marks.push_back(w.state(0).q[0]);
+      double x, v;
+      CenterOfMassX(*p.body, w.state(0).q, w.state(0).qd, &x, &v);
+      marks.push_back(x);
       ++next_cycle;
     }
   });

@@ -21,8 +21,9 @@
 namespace wobble::synth {
 
 // Cost functions of Table 5.1; E is the control energy consumed over the trial
-// (control::ControlEnergy::consumed), q_x the distance travelled along x (tx at the end minus tx
-// at the start), q̇_x the x velocity at the end. A trial that went backwards (q_x ≤ 0) or whose
+// (control::ControlEnergy::consumed), q_x the distance travelled along x by the centre of mass
+// (end minus start; the body-frame origin tx would count a mere tilt as travel), q̇_x the
+// centre of mass' x velocity at the end. A trial that went backwards (q_x ≤ 0) or whose
 // q_x q̇_x < 0 (the thesis' rule), or whose simulation stopped, gets the cost `high`.
 enum class CostKind {
   kInverseDistance,               // 1 / q_x                          (hopping, unrealistic jumps)
@@ -57,6 +58,10 @@ struct Problem {
   long steps = 1200;  // forward simulation per trial (thesis: 1200 steps of 0.01)
   CostFunction cost;
 };
+
+// x position and velocity of the body's centre of mass: m x_c = m t + R (c0 + C γ), from the
+// mass moments, so its velocity is ṫ + R S (c0 + Cγ) θ̇ / m + R C γ̇ / m.
+void CenterOfMassX(const BodyModel& body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double* x, double* v);
 
 // Simulates one controller from the problem's start state. Calls on_step(world) after every
 // step when given (replays, gait measurements).
@@ -112,7 +117,7 @@ AnnealResult Anneal(const Problem& problem, const control::PoseGraph& initial, c
 std::vector<std::string> HistoryHeader();
 std::vector<std::vector<double>> HistoryRows(const std::vector<IterationRecord>& history);
 
-// Distance travelled in each of `cycles` consecutive periods of a cyclic controller, after
+// Distance travelled by the centre of mass in each of `cycles` consecutive periods of a cyclic controller, after
 // `skip` periods to let the gait settle (a stable periodic gait has equal, positive entries).
 std::vector<double> DistancePerCycle(const Problem& problem, const control::PoseGraph& graph, int skip, int cycles);
 
