@@ -802,7 +802,9 @@ std::string Interpreter::ReplayScript() const {
     for (int k = 0; k < graph_.poses[i].size(); ++k) s << " " << Num(graph_.poses[i][k]);
     s << " " << Num(graph_.durations[i]) << "\n";
   }
-  s << "set time 0\nset end " << Num(trial_steps_ * world_.dt) << "\n";
+  // after an anneal: one trial's length, the motion the cost judged; otherwise the current span
+  if (anneal_start_q_.size()) s << "set time 0\nset end " << Num(trial_steps_ * world_.dt) << "\n";
+  else s << "set time " << Num(time_) << "\nset end " << Num(end_) << "\n";
   s << "# output replay.csv   # uncomment to record the motion\n";
   s << "simul\nprint\n";
   return s.str();
