@@ -507,11 +507,7 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
     const std::string invalid = graph_.Validate(int(control::ActiveModes(*BuildBody()).size()));
     if (!invalid.empty()) ctx.Fail("pose graph: " + invalid);
     // from the anneal's start state when there was one: the gait the trials measured
-    synth::Problem p = MakeProblem(1);
-    if (anneal_start_q_.size()) {
-      p.q0 = anneal_start_q_;
-      p.qd0 = anneal_start_qd_;
-    }
+    const synth::Problem p = SynthesisProblem();
     const std::vector<double> d = synth::DistancePerCycle(p, graph_, skip, cycles);
     out_ << "gait: period " << Num(graph_.Period()) << ", distance per cycle:";
     for (double x : d) out_ << " " << Num(x);
@@ -675,6 +671,15 @@ synth::Problem Interpreter::MakeProblem(long steps) {
   p.qd0 = qd_;
   p.steps = steps;
   p.cost = cost_;
+  return p;
+}
+
+synth::Problem Interpreter::SynthesisProblem() {
+  synth::Problem p = MakeProblem(trial_steps_);
+  if (anneal_start_q_.size()) {
+    p.q0 = anneal_start_q_;
+    p.qd0 = anneal_start_qd_;
+  }
   return p;
 }
 

@@ -71,6 +71,9 @@ class Interpreter {
   const WorldOptions& world_options() const { return world_; }
   // Summary of the last anneal (empty before one ran).
   const std::optional<synth::AnnealResult>& last_anneal() const { return anneal_; }
+  // The synthesis problem `anneal` would solve now (after an anneal: from the state its trials
+  // started from), for tests and gait measurements.
+  synth::Problem SynthesisProblem();
   // The script that rebuilds the current setup (object, modes, parameters, state, pose graph)
   // and replays it with `simul`.
   std::string ReplayScript() const;
