@@ -235,3 +235,49 @@ TEST(Interpreter, OutputWritesOneRowPerRecordedStep) {
 
 }  // namespace
 }  // namespace wobble
+
+namespace wobble {
+namespace {
+
+// Fig. 4.12: the keyframed jump hands over to the simulation, and the table clears the cliff
+// (the cliff top y = 200 for x <= 300 is not simulated: no mass point may be below it while
+// over it after the hand-over) and lands on the valley floor y = 0.
+TEST(CliffJump, ClearsTheCliffEdgeAndLandsBelow) {
+  const auto dir = std::filesystem::temp_directory_path() / "wobble_cliff_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const auto cwd = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  interp.RunFile(kData + "/table_cliff.wob");
+  std::filesystem::current_path(cwd);
+  const BodyModel& table = *interp.body();
+  std::ifstream f(dir / "out/table_cliff.csv");
+  std::string line;
+  std::getline(f, line);
+  const double hand_over = 1.5;  // the last key
+  double lowest_over_cliff = 1e9, landed_at = -1;
+  int rows = 0;
+  while (std::getline(f, line)) {
+    std::stringstream ss(line);
+    std::vector<double> v;
+    for (std::string x; std::getline(ss, x, ',');) v.push_back(std::stod(x));
+    ASSERT_GE(v.size(), size_t(1 + table.num_q()));
+    const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(v.data() + 1, table.num_q());
+    ASSERT_TRUE(q.allFinite());
+    ++rows;
+    for (int k = 0; k < table.num_points(); ++k) {
+      const Eigen::Vector2d p = control::PointAt(table, table.lattice_coords(k), q);
+      if (v[0] > hand_over + 1e-9 && p.x() <= 300) lowest_over_cliff = std::min(lowest_over_cliff, p.y() - 200);
+      if (p.y() < 0 && landed_at < 0) landed_at = v[0];
+    }
+  }
+  EXPECT_EQ(rows, 151 + 1850);  // keyframes at t = 0 .. 1.5, then 18.5 s of simulation
+  EXPECT_GT(lowest_over_cliff, 0.0);
+  EXPECT_GT(landed_at, hand_over);
+  EXPECT_DOUBLE_EQ(interp.time(), 20.0);
+}
+
+}  // namespace
+}  // namespace wobble

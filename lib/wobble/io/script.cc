@@ -698,7 +698,8 @@ void Interpreter::Simulate(double duration, const Context& ctx) {
   }
   const double t0 = time_;
   int pose = -1;
-  RecordRow(world, t0, pose);
+  // the start state, unless the run before (a keyframed one, say) already recorded it
+  if (rows_.empty() || rows_.back()[0] != t0) RecordRow(world, t0, pose);
   for (long n = 0; n < steps; ++n) {
     // the pose graph cycles from its first pose at the start of every simul (chapter 5)
     if (controlled) {
