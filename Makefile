@@ -32,6 +32,7 @@ DEMO_OBJECT   ?= data/table.obj
 DEMO_MODES    ?= data/table_modes.def
 DEMO_ARGS     ?= --q "0 50 0 0 0 0 0" --integrator thesis --dt 0.01 --duration 10
 WOBBLE        := $(BUILD)/app/wobble
+DEMO_SCRIPT   ?= data/table_cliff.wob
 
 .PHONY: all deps configure build demo-build demo test test-release asan bench clean
 
@@ -72,9 +73,13 @@ demo: demo-build
 	echo '$$ $(WOBBLE) simulate --object $(DEMO_OBJECT) --modes $(DEMO_MODES) $(DEMO_ARGS) --out $(OUT)/table_drop.csv'
 	status=0
 	$(WOBBLE) simulate --object $(DEMO_OBJECT) --modes $(DEMO_MODES) $(DEMO_ARGS) --out $(OUT)/table_drop.csv || status=$$?
+	# the table jumping off a cliff (Fig. 4.12): keyframed jump, then simulation (issue 5)
+	echo '$$ $(WOBBLE) run $(DEMO_SCRIPT)'
+	$(WOBBLE) run $(DEMO_SCRIPT) || status=$$?
 	echo
 	echo "files:"
 	echo "  trajectory  $(OUT)/table_drop.csv  (t, q, q-dot, energies, contacts, penetration per step)"
+	echo "  cliff jump  out/table_cliff.csv  (keyframed, then simulated; see README: Scripts)"
 	echo "  command     $(WOBBLE)  (see $(WOBBLE) --help, and README.md)"
 	exit $$status
 
