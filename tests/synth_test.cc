@@ -9,6 +9,9 @@
 
 #include "wobble/io/script.h"
 #include "wobble/synth/anneal.h"
+#ifdef WOBBLE_HAVE_PAGMO
+#include "wobble/synth/cmaes.h"
+#endif
 
 namespace wobble {
 namespace {
@@ -121,6 +124,29 @@ TEST(BoundingTable, AnnealingImprovesAndFindsAStableForwardGaitThatTheSavedScrip
   EXPECT_DOUBLE_EQ(x1 - x0, r.best_outcome.distance);
   EXPECT_DOUBLE_EQ(replay.control_energy(), r.best_outcome.energy);
 }
+
+#ifdef WOBBLE_HAVE_PAGMO
+// CMA-ES on the same problem: reproducible from its seed, better than where it started, and it
+// counts its simulations (the budget the comparison with annealing is made on).
+TEST(Cmaes, ReproducibleFromItsSeedAndImprovesOnTheInitialController) {
+  std::vector<synth::AnnealResult> results;
+  for (int run = 0; run < 2; ++run) {
+    std::ostringstream out;
+    io::Interpreter interp(out);
+    std::istringstream in("load_obj table.obj\nload_def table_modes.def\nassign bend 4e7 4e6\nassign shear 4e7 4e6\n"
+                          "set integrator thesis\nset dt 0.01\nset grconst 45000\nset grdam 3000\nset frconst 3000\n"
+                          "set frsin 0.5\npose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\npose 0 0.1 0.4\n"
+                          "set seed 5\nset batch 6\ncmaes 8\n");
+    interp.RunStream(in, "cmaes.wob", kData);
+    results.push_back(*interp.last_anneal());
+  }
+  EXPECT_EQ(results[0].best_outcome.cost, results[1].best_outcome.cost);
+  for (size_t p = 0; p < results[0].best.poses.size(); ++p) EXPECT_EQ(results[0].best.poses[p], results[1].best.poses[p]);
+  EXPECT_EQ(results[0].trials, 6 + 8 * 6);
+  EXPECT_LT(results[0].best_outcome.cost, results[0].initial_outcome.cost);
+  for (size_t i = 1; i < results[0].history.size(); ++i) EXPECT_LE(results[0].history[i].best, results[0].history[i - 1].best);
+}
+#endif
 
 }  // namespace
 }  // namespace wobble

@@ -14,6 +14,9 @@
 #include "wobble/io/deformation_file.h"
 #include "wobble/io/line_reader.h"
 #include "wobble/io/object_file.h"
+#ifdef WOBBLE_HAVE_PAGMO
+#include "wobble/synth/cmaes.h"
+#endif
 
 namespace wobble::io {
 
@@ -48,6 +51,7 @@ const std::vector<CommandInfo>& Interpreter::Commands() {
       {"output", "output FILE.csv [EVERY] | output off", "record the state of every EVERY-th step as CSV"},
       {"print", "print", "print the state, energies and the control energy"},
       {"anneal", "anneal ITERATIONS", "simulated annealing of the pose graph (Fig. 5.2)"},
+      {"cmaes", "cmaes GENERATIONS", "CMA-ES (pagmo2) on the same problem as anneal; population = batch (>= 5)"},
       {"gait", "gait SKIP CYCLES", "distance travelled per cycle of the pose graph, after SKIP cycles"},
       {"save", "save FILE", "write a script that rebuilds the current setup and replays its controller"},
       {"echo", "echo TEXT", "print TEXT"},
@@ -63,7 +67,7 @@ const std::vector<std::string>& Interpreter::Parameters() {
       "time", "end", "dt", "ground_height", "ground_slope", "max_penetration",             //
       "integrator", "interp",                                                               // words
       "seed", "batch", "cooling", "temperature", "optimize", "cost", "cost_scale", "trial_steps",
-      "pose_step", "time_step", "threads", "anneal_csv", "min_amplitude", "max_amplitude", "min_time", "max_time"};
+      "pose_step", "time_step", "threads", "anneal_csv", "cmaes_csv", "sigma0", "min_amplitude", "max_amplitude", "min_time", "max_time"};
   return names;
 }
 
@@ -497,6 +501,48 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
          << ", control energy " << Num(r.best_outcome.energy) << ")\n";
     graph_ = r.best;
     anneal_ = std::move(r);
+  } else if (cmd == "cmaes") {
+    ExpectWords(w, 2, 2, usage(), ctx);
+    RequireBody(ctx, "cmaes");
+    int generations;
+    if (!detail::ParseInt(w[1], &generations) || generations < 0)
+      ctx.Fail("expected GENERATIONS as a whole number >= 0, got '" + w[1] + "'");
+    if (graph_.empty()) ctx.Fail("cmaes needs an initial pose graph: 'pose ...' lines first");
+#ifdef WOBBLE_HAVE_PAGMO
+    synth::CmaesOptions o;
+    o.seed = anneal_options_.seed;
+    o.generations = generations;
+    o.population = anneal_options_.batch;
+    o.sigma0 = sigma0_;
+    o.optimize = anneal_options_.optimize;
+    o.min_amplitude = anneal_options_.min_amplitude;
+    o.max_amplitude = anneal_options_.max_amplitude;
+    o.min_time = anneal_options_.min_time;
+    o.max_time = anneal_options_.max_time;
+    const std::string invalid = o.Validate();
+    if (!invalid.empty()) ctx.Fail("cmaes: " + invalid + " (the population is `batch`)");
+    const synth::Problem problem = MakeProblem(trial_steps_);
+    graph_.cyclic = true;
+    anneal_start_q_ = q_;
+    anneal_start_qd_ = qd_;
+    synth::AnnealResult r = synth::Cmaes(problem, graph_, o, [&](const synth::IterationRecord& rec) {
+      if (progress_) progress_(generations ? double(rec.iteration) / generations : 1.0, rec.best);
+    });
+    if (!cmaes_csv_.empty()) {
+      try {
+        WriteFileAtomically(cmaes_csv_, CsvText(synth::HistoryHeader(), synth::HistoryRows(r.history)));
+      } catch (const std::runtime_error& e) {
+        ctx.Fail(e.what());
+      }
+    }
+    out_ << "cmaes: " << r.trials << " trials; cost " << Num(r.initial_outcome.cost) << " -> " << Num(r.best_outcome.cost)
+         << " (distance " << Num(r.best_outcome.distance) << ", end speed " << Num(r.best_outcome.speed)
+         << ", control energy " << Num(r.best_outcome.energy) << ")\n";
+    graph_ = r.best;
+    anneal_ = std::move(r);
+#else
+    ctx.Fail("cmaes: this wobble was built without pagmo2 (Debian: libpagmo-dev); use anneal");
+#endif
   } else if (cmd == "gait") {
     ExpectWords(w, 3, 3, usage(), ctx);
     RequireBody(ctx, "gait");
@@ -614,6 +660,11 @@ void Interpreter::Set(const std::vector<std::string>& w, const Context& ctx) {
       ctx.Fail("expected a cost (inverse_distance, energy_per_distance, energy_per_sqrt_distance_speed, "
                "energy_per_sqrt_distance), got '" + value + "'");
   } else if (name == "anneal_csv") anneal_csv_ = value;
+  else if (name == "cmaes_csv") cmaes_csv_ = value;
+  else if (name == "sigma0") {
+    sigma0_ = positive();
+    if (sigma0_ > 1) ctx.Fail("expected sigma0 in (0, 1], got " + value);
+  }
   else {
     const std::string near = Nearest(name, Parameters());
     ctx.Fail("unknown parameter '" + name + "'" + (near.empty() ? "" : "; did you mean '" + near + "'?"));

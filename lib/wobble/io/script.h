@@ -69,7 +69,7 @@ class Interpreter {
   double control_energy() const { return energy_.consumed; }
   const control::PoseGraph& pose_graph() const { return graph_; }
   const WorldOptions& world_options() const { return world_; }
-  // Summary of the last anneal (empty before one ran).
+  // Summary of the last anneal or cmaes (empty before one ran).
   const std::optional<synth::AnnealResult>& last_anneal() const { return anneal_; }
   // The synthesis problem `anneal` would solve now (after an anneal: from the state its trials
   // started from), for tests and gait measurements.
@@ -127,7 +127,8 @@ class Interpreter {
   synth::AnnealOptions anneal_options_;
   synth::CostFunction cost_;
   long trial_steps_ = 1200;
-  std::string anneal_csv_;
+  std::string anneal_csv_, cmaes_csv_;
+  double sigma0_ = 0.1;  // CMA-ES initial step, a fraction of each variable's range
   std::optional<synth::AnnealResult> anneal_;
   Eigen::VectorXd anneal_start_q_, anneal_start_qd_;  // the trials' start state
 
