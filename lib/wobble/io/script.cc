@@ -232,6 +232,7 @@ void Interpreter::LoadObject(const std::string& path) {
   def_paths_.clear();
   q_.setZero(kRigidDofs);
   qd_.setZero(kRigidDofs);
+  Place(placement_, &q_, &qd_);  // at rest where `trans` put it
   Invalidate();
 }
 
