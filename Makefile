@@ -23,7 +23,7 @@ OUT        ?= out/demo
 
 PACKAGES := libvtk9-dev libeigen3-dev libceres-dev libopenexr-dev libimath-dev \
             libgtest-dev libgmock-dev libbenchmark-dev xvfb xauth libcli11-dev \
-            nlohmann-json3-dev cmake g++ make
+            nlohmann-json3-dev cmake g++ make libpagmo-dev
 
 
 # The default scene: the table (lattice 300 x 100) dropped from 50 onto the ground sloped by
@@ -34,6 +34,7 @@ DEMO_MODES    ?= data/table_modes.def
 DEMO_ARGS     ?= --q "0 50 0 0 0 0 0" --integrator thesis --dt 0.01 --duration 10 --ground-slope -5
 DEMO_WHAT     ?= frames,filmstrip,charts,vtp,exr,disp
 WOBBLE        := $(BUILD)/app/wobble
+DEMO_SCRIPT   ?= data/table_cliff.wob
 
 .PHONY: all deps configure build demo-build demo test test-release asan bench clean
 
@@ -80,6 +81,9 @@ demo: demo-build
 	echo
 	echo "\$$ $$xvfb" '$(WOBBLE) render --object $(DEMO_OBJECT) --modes $(DEMO_MODES) $(DEMO_ARGS) --what $(DEMO_WHAT) --out $(OUT)'
 	eval "$$xvfb" '$(WOBBLE) render --object $(DEMO_OBJECT) --modes $(DEMO_MODES) $(DEMO_ARGS) --what $(DEMO_WHAT) --out $(OUT)' || status=$$?
+	# the table jumping off a cliff (Fig. 4.12): keyframed jump, then simulation (issue 5)
+	echo '$$ $(WOBBLE) run $(DEMO_SCRIPT)'
+	$(WOBBLE) run $(DEMO_SCRIPT) || status=$$?
 	echo
 	echo "files:"
 	echo "  trajectory  $(OUT)/table_drop.csv  (t, q, q-dot, energies, contacts, penetration per step)"
@@ -88,6 +92,7 @@ demo: demo-build
 	echo "  ParaView    $(OUT)/vtp/table.pvd  (lattice, mass points, shape per frame)"
 	echo "  EXR         $(OUT)/exr/frame_NNNN.exr  (R,G,B,A, depth.Z), $(OUT)/exr/disp_NNNN.exr  (disp.X, disp.Y)"
 	echo "  plots       $(OUT)/energy.png, $(OUT)/condition.png  (numbers in the .csv beside them)"
+	echo "  cliff jump  out/table_cliff.csv  (keyframed, then simulated; see README: Scripts)"
 	echo "  command     $(WOBBLE)  (see $(WOBBLE) --help, and README.md)"
 	echo "all under $(OUT)/"
 	exit $$status

@@ -12,6 +12,7 @@
 #ifdef WOBBLE_HAVE_PIPELINES
 #include "render.h"
 #endif
+#include "run.h"
 #include "simulate.h"
 #include "wobble/io/object_file.h"
 
@@ -42,6 +43,8 @@ int main(int argc, char** argv) {
   FitPoseArgs fit_pose_args;
   FitTrajectoryArgs fit_trajectory_args;
   const FitCommands fit = AddFitCommand(&app, &fit_pose_args, &fit_trajectory_args);
+  RunArgs run_args;
+  CLI::App* run = AddRunCommand(&app, &run_args);
 
   try {
     app.parse(argc, argv);
@@ -63,6 +66,7 @@ int main(int argc, char** argv) {
 #endif
     if (fit.pose->parsed()) return RunFitPose(fit_pose_args);
     if (fit.trajectory->parsed()) return RunFitTrajectory(fit_trajectory_args);
+    if (run->parsed()) return RunScript(run_args);
   } catch (const wobble::io::ParseError& e) {
     std::cerr << e.what() << std::endl;  // already "FILE:LINE: message"
     return kExitBadInput;

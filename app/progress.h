@@ -9,18 +9,19 @@
 
 namespace wobble::app {
 
-// Redrawn only when the percentage changes; t is shown beside it.
+// Redrawn only when the percentage changes; the simulated time (or what `label` names) is
+// shown beside it.
 class Progress {
  public:
-  explicit Progress(bool enabled) : enabled_(enabled) {}
+  explicit Progress(bool enabled, const char* label = "t") : enabled_(enabled), label_(label) {}
   void Update(double fraction, double t) {
     if (!enabled_) return;
     const int percent = int(std::floor(100.0 * std::min(1.0, std::max(0.0, fraction))));
     if (percent == last_) return;
     last_ = percent;
     const int width = 40, filled = percent * width / 100;
-    std::fprintf(stderr, "\r[%s%s] %3d%%  t = %-10.4g", std::string(filled, '#').c_str(),
-                 std::string(width - filled, '.').c_str(), percent, t);
+    std::fprintf(stderr, "\r[%s%s] %3d%%  %s = %-10.4g", std::string(filled, '#').c_str(),
+                 std::string(width - filled, '.').c_str(), percent, label_, t);
     std::fflush(stderr);
   }
   void Finish() {
@@ -29,6 +30,7 @@ class Progress {
 
  private:
   bool enabled_;
+  const char* label_;
   int last_ = -1;
 };
 

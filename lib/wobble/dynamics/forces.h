@@ -87,6 +87,9 @@ template <class T> struct BodyState {
     VecQ<T> q, qd, force;
     Ground ground;
   } ground_cache;
+  // PD targets γ0 of the modes (chapter 5: Q_r = −(C(q − q0) + D q̇)); empty means all zero,
+  // i.e. every mode is passive and pulled back to its rest shape. Set by wobble/control.
+  VecD<T> mode_target;
 };
 
 // The cached ground force of s, when it was computed at s's current state on ground g.
@@ -220,11 +223,14 @@ void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index,
   } else {
     out->gravity.setZero(nq);
   }
-  // mode potentials V = K γ² → Q = −2Kγ, and damping −c γ̇ (§4.7)
+  // mode potentials V = K γ² → Q = −2Kγ, and damping −c γ̇ (§4.7); with a PD target γ0 this
+  // is the controller of chapter 5, Q_r = −(C(γ − γ0) + D γ̇) with C = 2K, D = c
   out->modes.setZero(nq);
+  const bool targeted = s.mode_target.size() == D;
   for (int d = 0; d < D; ++d) {
     const DeformationMode& m = body.modes()[d];
-    out->modes[kRigidDofs + d] = -T(2.0 * m.stiffness) * s.q[kRigidDofs + d] - T(m.damping) * s.qd[kRigidDofs + d];
+    const T offset = targeted ? T(s.q[kRigidDofs + d] - s.mode_target[d]) : T(s.q[kRigidDofs + d]);
+    out->modes[kRigidDofs + d] = -T(2.0 * m.stiffness) * offset - T(m.damping) * s.qd[kRigidDofs + d];
   }
   // penalty ground, only over points below it
   const GroundFrame gf(w.ground);

@@ -59,6 +59,14 @@ void World::SetState(int i, const Eigen::VectorXd& q, const Eigen::VectorXd& qd)
   UpdateContacts(*bodies_[i], options_.params.ground, &states_[i]);
 }
 
+void World::SetModeTargets(int i, const Eigen::VectorXd& targets) {
+  const int D = bodies_.at(i)->num_modes();
+  if (targets.size() != 0 && targets.size() != D)
+    throw std::invalid_argument("body '" + bodies_[i]->name() + "' has " + std::to_string(D) + " modes, got " +
+                                std::to_string(targets.size()) + " targets");
+  states_[i].mode_target = targets;
+}
+
 void World::AddSpring(Spring spring) {
   const BodyModel& b = *bodies_.at(spring.body);
   b.LocalBasis(spring.lattice_coords, &spring.rest_local, &spring.mode_matrix);

@@ -40,6 +40,8 @@ class World {
   // Returns the body's index. q and q̇ start at rest in the body frame unless set.
   int AddBody(std::shared_ptr<const BodyModel> body);
   void SetState(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  // PD targets γ0 of the body's modes (one per mode; empty: all zero). See wobble/control.
+  void SetModeTargets(int body, const Eigen::VectorXd& targets);
   // Springs hold a point given by lattice coordinates (Fig. 4.4).
   void AddSpring(Spring spring);
 

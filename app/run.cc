@@ -1,0 +1,91 @@
+#include "run.h"
+
+#include <unistd.h>
+
+#include <iostream>
+#include <string>
+
+#include "progress.h"
+#include "cli_common.h"
+#include "wobble/io/script.h"
+
+namespace wobble::app {
+
+CLI::App* AddRunCommand(CLI::App* app, RunArgs* a) {
+  CLI::App* cmd = app->add_subcommand("run", "Run a command script (appendix C); no script on a terminal: a prompt");
+  cmd->add_option("script", a->script, "Script file (see README: Scripts)")->type_name("SCRIPT");
+  cmd->add_option("--object", a->object, "Object file loaded before the script (appendix C's script loads none)")
+      ->type_name("FILE");
+  cmd->footer(
+      "Examples:\n"
+      "  wobble run data/appendix_c.wob --object data/pot.obj\n"
+      "  wobble run data/bounding_table.wob\n"
+      "  wobble run --object data/table.obj      (interactive: 'help' lists the commands)");
+  return cmd;
+}
+
+namespace {
+
+void PrintHelp(std::ostream& out) {
+  out << "commands:\n";
+  for (const io::CommandInfo& c : io::Interpreter::Commands()) out << "  " << c.usage << "\n      " << c.summary << "\n";
+  out << "parameters of set:";
+  for (const std::string& p : io::Interpreter::Parameters()) out << " " << p;
+  out << "\n";
+}
+
+}  // namespace
+
+int RunScript(const RunArgs& a) {
+  io::Interpreter interp(std::cout);
+  Progress progress(isatty(STDERR_FILENO) == 1);
+  interp.SetProgress([&](double fraction, double t) {
+    progress.Update(fraction, t);
+    if (fraction >= 1.0) {
+      progress.Finish();
+      progress = Progress(isatty(STDERR_FILENO) == 1);
+    }
+  });
+  if (!a.object.empty()) interp.LoadObject(a.object);
+  if (!a.script.empty()) {
+    try {
+      interp.RunFile(a.script);
+    } catch (const io::SimulationStopped& e) {
+      progress.Finish();
+      std::cerr << e.what() << std::endl;
+      return kExitSimStopped;
+    }
+    return kExitOk;
+  }
+  // commands from stdin: a prompt on a terminal, a plain script otherwise
+  const bool interactive = isatty(STDIN_FILENO) == 1;
+  if (!interactive) {
+    try {
+      interp.RunStream(std::cin, "<stdin>", "");
+    } catch (const io::SimulationStopped& e) {
+      std::cerr << e.what() << std::endl;
+      return kExitSimStopped;
+    }
+    return kExitOk;
+  }
+  std::cout << "wobble interactive: 'help' lists the commands, 'quit' leaves.\n";
+  std::string line;
+  for (int number = 1;; ++number) {
+    std::cout << "wobble> " << std::flush;
+    if (!std::getline(std::cin, line)) break;
+    if (line == "help") {
+      PrintHelp(std::cout);
+      continue;
+    }
+    try {
+      if (!interp.RunLine(line, "<prompt>", number, "")) break;
+    } catch (const std::exception& e) {
+      // at a prompt a mistake is reported and the session goes on
+      progress.Finish();
+      std::cerr << e.what() << std::endl;
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace wobble::app

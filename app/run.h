@@ -1,0 +1,17 @@
+// `wobble run SCRIPT`: runs a command script (appendix C's interpreter, extended; README
+// "Scripts"). Without a script, on a terminal, it is an interactive prompt.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace wobble::app {
+
+struct RunArgs {
+  std::string script;  // empty: read commands from stdin (a prompt on a terminal)
+  std::string object;  // loaded before the script, as `load_obj` would
+};
+CLI::App* AddRunCommand(CLI::App* app, RunArgs* args);
+int RunScript(const RunArgs& args);
+
+}  // namespace wobble::app

@@ -1,0 +1,74 @@
+// Motion-synthesis throughput (issue 5): bounding-table trials (11 points, 4 modes, 1200 steps
+// of 0.01, PD-controlled by a 4-pose graph, as in §5.2) per second on one thread, and a batch
+// of 1000 trials on 1 thread and on every core (wall time; the ratio is the parallel speed-up).
+// Goal: 1000 trials in under 2 s wall on the 2-core machine. The thesis: 0.12 s CPU per trial.
+#include <benchmark/benchmark.h>
+
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "wobble/io/script.h"
+#include "wobble/synth/anneal.h"
+
+namespace wobble {
+namespace {
+
+// The bounding-table scene's setup: data/bounding_table.wob up to (not including) its anneal.
+struct BoundingTable {
+  BoundingTable() : interp(sink) {
+    const std::string path = std::string(WOBBLE_DATA_DIR) + "/bounding_table.wob";
+    std::ifstream f(path);
+    std::string line;
+    for (int n = 1; std::getline(f, line); ++n) {
+      if (line.rfind("anneal", 0) == 0) break;
+      interp.RunLine(line, path, n, WOBBLE_DATA_DIR);
+    }
+    problem = interp.SynthesisProblem();
+    graph = interp.pose_graph();
+  }
+  std::ostringstream sink;
+  io::Interpreter interp;
+  synth::Problem problem;
+  control::PoseGraph graph;
+};
+
+const BoundingTable& Scene() {
+  static const BoundingTable scene;
+  return scene;
+}
+
+// 1000 random neighbours of the initial controller (fixed seed: the same work every run).
+std::vector<control::PoseGraph> Candidates(int n) {
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> normal(0.0, 0.1);
+  std::vector<control::PoseGraph> out(n, Scene().graph);
+  for (control::PoseGraph& g : out)
+    for (Eigen::VectorXd& p : g.poses)
+      for (int i = 0; i < p.size(); ++i) p[i] += normal(rng);
+  return out;
+}
+
+void BM_BoundingTableTrial(benchmark::State& state) {
+  const BoundingTable& s = Scene();
+  for (auto _ : state) benchmark::DoNotOptimize(synth::RunTrial(s.problem, s.graph).cost);
+  state.SetItemsProcessed(state.iterations());  // trials
+  state.counters["steps/s"] = benchmark::Counter(double(state.iterations()) * s.problem.steps, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_BoundingTableTrial)->Unit(benchmark::kMillisecond);
+
+// 1000 trials on `threads` threads (0 = every core), wall time.
+void BM_Trials1000(benchmark::State& state) {
+  const std::vector<control::PoseGraph> graphs = Candidates(1000);
+  const int threads = int(state.range(0));
+  for (auto _ : state) benchmark::DoNotOptimize(synth::RunTrials(Scene().problem, graphs, threads).size());
+  state.SetItemsProcessed(state.iterations() * 1000);
+  state.counters["threads"] = threads ? threads : double(std::thread::hardware_concurrency());
+}
+BENCHMARK(BM_Trials1000)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+
+}  // namespace
+}  // namespace wobble
+
+BENCHMARK_MAIN();

@@ -1,0 +1,96 @@
+// Control of active characters (Faloutsos 1995, chapter 5 and §4.10.1).
+//
+// Low level: one PD controller per deformation mode (chapter 5),
+//     Q_r = −(C (γ − γ0) + D γ̇),   C = 2K, D = c,
+// i.e. the mode's own potential V = K γ² and damping c (§4.7) pulled towards a moving target
+// γ0 instead of the rest shape. Passive modes keep γ0 = 0; active modes get their targets from
+// a high-level controller: a pose graph (chapter 5) or keyframes (§4.10.1). The dynamics apply
+// the targets through BodyState::mode_target (World::SetModeTargets).
+//
+// The control energy of a run — the thesis' "total energy consumed by the deformation forces
+// throughout the forward simulation (including the forces associated with passive deformation
+// modes)" — is defined here as
+//     E = Σ_d ∫ |Q_r,d γ̇_d| dt
+// (the absolute mechanical power of every mode force, passive and active: a mode that brakes
+// consumes energy as much as one that pushes, like an actuator that cannot store it). The signed
+// work Σ_d ∫ Q_r,d γ̇_d dt is kept beside it. Both are integrated by the rectangle rule on the
+// state after each step.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "wobble/body/body_model.h"
+#include "wobble/dynamics/forces.h"
+
+namespace wobble::control {
+
+// Indices (0-based) of the body's active modes, in order: a pose lists one target per entry.
+std::vector<int> ActiveModes(const BodyModel& body);
+
+// Full target vector γ0 (one per mode): the pose's values on the active modes, 0 elsewhere.
+Eigen::VectorXd TargetsFromPose(const BodyModel& body, const Eigen::VectorXd& pose);
+
+// Q_r,d = −(2K_d (γ_d − γ0_d) + c_d γ̇_d) of every mode (the modes' block of the generalized
+// forces). `targets` empty means all zero.
+Eigen::VectorXd ModeControlForces(const BodyModel& body, const BodyState<double>& s);
+
+struct ControlEnergy {
+  double consumed = 0.0;  // Σ_d ∫ |Q_r,d γ̇_d| dt
+  double work = 0.0;      // Σ_d ∫ Q_r,d γ̇_d dt (signed)
+  // Adds one step of length dt at the state after the step.
+  void Accumulate(const BodyModel& body, const BodyState<double>& s, double dt);
+};
+
+// A pose graph (chapter 5): poses (targets for the active modes) each held for its transition
+// time. Cyclic graphs cycle from the first pose for ever; acyclic ones (a sequence) hold the
+// last pose after the end.
+struct PoseGraph {
+  std::vector<Eigen::VectorXd> poses;  // one target per active mode
+  std::vector<double> durations;       // transition times, > 0
+  bool cyclic = true;
+
+  bool empty() const { return poses.empty(); }
+  double Period() const;  // the sum of the transition times
+  // Index of the pose active at time t since the graph started (t >= 0).
+  int PoseAt(double t) const;
+  // Checks sizes and durations; returns an empty string or what is wrong.
+  std::string Validate(int num_active) const;
+};
+
+// Keyframed mode amplitudes (§4.10.1): keys (time, amplitudes of every mode) interpolated
+// linearly, as in the thesis, or by a C1 cubic (Catmull–Rom tangents) as an option.
+enum class Interpolation { kLinear, kSmooth };
+
+struct Keyframes {
+  std::vector<double> times;              // strictly increasing, the first is 0
+  std::vector<Eigen::VectorXd> amplitudes;  // one per key, one value per mode
+  Interpolation interpolation = Interpolation::kLinear;
+
+  double Duration() const { return times.empty() ? 0.0 : times.back(); }
+  // γ(t) and γ̇(t), t clamped to [0, Duration()]. At a key, γ̇ is the slope of the segment
+  // that ends there (the velocity the keyframed motion "had"), so the hand-over at the end
+  // keeps the velocity of the last segment.
+  void Evaluate(double t, Eigen::VectorXd* gamma, Eigen::VectorXd* gamma_dot) const;
+  std::string Validate(int num_modes) const;
+};
+
+// A point of the body held in place while keyframed deformation runs (§4.10.1: "so that when
+// the object deforms this point remains in place", e.g. a foot on the ground).
+struct HeldPoint {
+  bool enabled = false;
+  Eigen::Vector2d lattice_coords = Eigen::Vector2d(0.0, 0.0);  // (s, t)
+};
+
+// The full state of a keyframed body at amplitudes γ, γ̇ with θ kept at `theta`: when a point is
+// held, t is solved so that the point stays at `anchor`: t = anchor − R(θ)(b0 + B γ) and
+// ṫ = −R(θ) B γ̇ (θ̇ = 0); otherwise t is `translation` and ṫ = 0.
+void KeyframedState(const BodyModel& body, const HeldPoint& hold, const Eigen::Vector2d& anchor,
+                    const Eigen::Vector2d& translation, double theta, const Eigen::VectorXd& gamma,
+                    const Eigen::VectorXd& gamma_dot, Eigen::VectorXd* q, Eigen::VectorXd* qd);
+
+// World position of a point given by lattice coordinates at state q.
+Eigen::Vector2d PointAt(const BodyModel& body, const Eigen::Vector2d& lattice_coords, const Eigen::VectorXd& q);
+
+}  // namespace wobble::control

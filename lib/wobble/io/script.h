@@ -1,0 +1,148 @@
+// The command interpreter of Faloutsos 1995 (§4.10.2, appendix C), extended to everything
+// wobble does: objects, modes, PD control, pose graphs, keyframes, springs, outputs and motion
+// synthesis. README.md ("Scripts") documents every command and parameter; Commands() below is
+// the list the interpreter checks against (and suggests from).
+//
+// A script is line-based: `#` starts a comment, words are separated by white space. Every
+// error is an io::ParseError naming the script, the line and what was expected; a simulation
+// that stops on numerical trouble raises SimulationStopped (same prefix, plus the world's
+// status). Input files named in a script are found relative to the script's folder; output
+// files relative to the working directory.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <iosfwd>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "wobble/body/body_model.h"
+#include "wobble/control/control.h"
+#include "wobble/dynamics/world.h"
+#include "wobble/io/parse_error.h"
+#include "wobble/synth/anneal.h"
+
+namespace wobble::io {
+
+// A simulation run by the script stopped (non-finite state, runaway penetration, ...).
+class SimulationStopped : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct CommandInfo {
+  std::string name, usage, summary;
+};
+
+class Interpreter {
+ public:
+  // Messages (results of print, summaries of runs) go to `out`.
+  explicit Interpreter(std::ostream& out);
+  ~Interpreter();
+
+  // Runs a whole script file; input paths in it are relative to its folder.
+  void RunFile(const std::string& path);
+  // Runs lines from a stream; `name` is used in errors, `dir` for input paths.
+  void RunStream(std::istream& in, const std::string& name, const std::string& dir);
+  // Runs one line (interactive use). Returns false for `quit`.
+  bool RunLine(const std::string& line, const std::string& name, int line_number, const std::string& dir);
+
+  // Loads an object before the script (the CLI's --object), as `load_obj` would.
+  void LoadObject(const std::string& path);
+
+  // Called during simulations with the fraction done and the time (a progress bar).
+  void SetProgress(std::function<void(double, double)> progress) { progress_ = std::move(progress); }
+
+  static const std::vector<CommandInfo>& Commands();
+  static const std::vector<std::string>& Parameters();  // names `set` accepts
+  // The known word nearest to `word` by edit distance, or "" when none is close.
+  static std::string Nearest(const std::string& word, const std::vector<std::string>& known);
+
+  // State, for tests and the CLI.
+  const BodyModel* body();  // nullptr until an object and modes are loaded
+  const Eigen::VectorXd& q() const { return q_; }
+  const Eigen::VectorXd& qd() const { return qd_; }
+  double time() const { return time_; }
+  double control_energy() const { return energy_.consumed; }
+  const control::PoseGraph& pose_graph() const { return graph_; }
+  const WorldOptions& world_options() const { return world_; }
+  // Summary of the last anneal or cmaes (empty before one ran).
+  const std::optional<synth::AnnealResult>& last_anneal() const { return anneal_; }
+  // The synthesis problem `anneal` would solve now (after an anneal: from the state its trials
+  // started from), for tests and gait measurements.
+  synth::Problem SynthesisProblem();
+  // The script that rebuilds the current setup (object, modes, parameters, state, pose graph)
+  // and replays it with `simul`.
+  std::string ReplayScript() const;
+
+ private:
+  struct Context;
+  void Execute(const std::vector<std::string>& words, const Context& ctx);
+  void Set(const std::vector<std::string>& words, const Context& ctx);
+  void RequireBody(const Context& ctx, const std::string& command);
+  int ModeIndex(const std::string& word, const Context& ctx);
+  void Simulate(double duration, const Context& ctx);
+  void RunKeyframes(const Context& ctx);
+  void RecordRow(const World& world, double t, int pose);
+  void FlushOutput(const Context& ctx);
+  void Invalidate() { body_.reset(); }
+  std::shared_ptr<const BodyModel> BuildBody();
+  synth::Problem MakeProblem(long steps);
+  WorldOptions MakeWorldOptions() const;
+
+  std::ostream& out_;
+  std::function<void(double, double)> progress_;
+
+  // what was loaded
+  std::optional<BodyDef> object_;
+  std::string object_path_;
+  std::vector<std::string> def_paths_;
+  std::vector<DeformationMode> modes_;
+  std::shared_ptr<const BodyModel> body_;  // built lazily from object_, modes_ and codamA
+
+  // parameters
+  WorldOptions world_;
+  bool springs_on_ = true;
+  std::vector<Spring> springs_;
+  double spring_stiffness_ = 1000.0, spring_damping_ = 0.0;
+  double codam_active_ = 0.0;
+  bool debug_ = false;
+  double time_ = 0.0, end_ = 10.0;
+  Eigen::Vector3d placement_ = Eigen::Vector3d::Zero();  // trans x y θ
+
+  // state
+  Eigen::VectorXd q_, qd_;
+  control::ControlEnergy energy_;
+
+  // control
+  control::PoseGraph graph_;
+  bool control_on_ = true;
+  control::Keyframes keys_;
+  control::HeldPoint hold_;
+
+  // synthesis
+  synth::AnnealOptions anneal_options_;
+  synth::CostFunction cost_;
+  long trial_steps_ = 1200;
+  std::string anneal_csv_, cmaes_csv_;
+  double sigma0_ = 0.1;  // CMA-ES initial step, a fraction of each variable's range
+  std::optional<synth::AnnealResult> anneal_;
+  Eigen::VectorXd anneal_start_q_, anneal_start_qd_;  // the trials' start state
+
+  // output
+  std::string output_path_;
+  int output_every_ = 1;
+  long output_counter_ = 0;
+  std::vector<std::vector<double>> rows_;
+};
+
+// Writes `text` to `path` atomically: to PATH.tmp in the same folder, then renamed. Creates the
+// folder. Throws std::runtime_error with the path and the reason.
+void WriteFileAtomically(const std::string& path, const std::string& text);
+// The CSV text of a table (numbers in shortest round-trip form).
+std::string CsvText(const std::vector<std::string>& header, const std::vector<std::vector<double>>& rows);
+
+}  // namespace wobble::io

@@ -1,0 +1,240 @@
+#include "wobble/synth/anneal.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <random>
+#include <sstream>
+#include <thread>
+
+namespace wobble::synth {
+
+std::string CostKindName(CostKind kind) {
+  switch (kind) {
+    case CostKind::kInverseDistance: return "inverse_distance";
+    case CostKind::kEnergyPerDistance: return "energy_per_distance";
+    case CostKind::kEnergyPerSqrtDistanceSpeed: return "energy_per_sqrt_distance_speed";
+    case CostKind::kEnergyPerSqrtDistance: return "energy_per_sqrt_distance";
+  }
+  return "?";
+}
+
+bool ParseCostKind(const std::string& text, CostKind* kind) {
+  for (CostKind k : {CostKind::kInverseDistance, CostKind::kEnergyPerDistance, CostKind::kEnergyPerSqrtDistanceSpeed,
+                     CostKind::kEnergyPerSqrtDistance})
+    if (CostKindName(k) == text) {
+      *kind = k;
+      return true;
+    }
+  return false;
+}
+
+std::string OptimizeName(Optimize what) {
+  switch (what) {
+    case Optimize::kPoses: return "poses";
+    case Optimize::kTimes: return "times";
+    case Optimize::kBoth: return "both";
+  }
+  return "?";
+}
+
+bool ParseOptimize(const std::string& text, Optimize* what) {
+  for (Optimize o : {Optimize::kPoses, Optimize::kTimes, Optimize::kBoth})
+    if (OptimizeName(o) == text) {
+      *what = o;
+      return true;
+    }
+  return false;
+}
+
+double EvaluateCost(const CostFunction& c, const TrialOutcome& o) {
+  // Table 5.1, with the thesis' rule: q_x q̇_x < 0 costs `high` (and so does going backwards,
+  // where the square roots and quotients have no meaning)
+  if (!o.ok || !(o.distance > 0.0)) return c.high;
+  switch (c.kind) {
+    case CostKind::kInverseDistance: return 1.0 / o.distance;
+    case CostKind::kEnergyPerDistance: return o.energy / o.distance;
+    case CostKind::kEnergyPerSqrtDistanceSpeed:
+      if (o.distance * o.speed < 0.0) return c.high;
+      if (o.speed == 0.0) return c.high;
+      return o.energy / (c.scale * std::sqrt(o.distance * o.speed));
+    case CostKind::kEnergyPerSqrtDistance: return o.energy / (c.scale * std::sqrt(o.distance));
+  }
+  return c.high;
+}
+
+void CenterOfMassX(const BodyModel& body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double* x, double* v) {
+  const MassMoments& mm = body.moments();
+  const int D = body.num_modes();
+  const Eigen::Vector2d l = mm.c0 + mm.C * q.tail(D);
+  const Eigen::Matrix2d R = Rotation(q[2]);
+  const Eigen::Vector2d pos = q.head<2>() + R * l / mm.m;
+  const Eigen::Vector2d vel = qd.head<2>() + (R * Perp<double>(l) * qd[2] + R * (mm.C * qd.tail(D))) / mm.m;
+  *x = pos.x();
+  *v = vel.x();
+}
+
+TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
+                      const std::function<void(const World&)>& on_step) {
+  TrialOutcome out;
+  World world(p.world);
+  world.AddBody(p.body);
+  world.SetState(0, p.q0, p.qd0);
+  const double dt = p.world.dt;
+  control::ControlEnergy energy;
+  int pose = -1;
+  for (long n = 0; n < p.steps; ++n) {
+    // the pose graph picks the targets for this step (chapter 5)
+    if (!graph.empty()) {
+      const int now = graph.PoseAt(n * dt);
+      if (now != pose) {
+        pose = now;
+        world.SetModeTargets(0, control::TargetsFromPose(*p.body, graph.poses[pose]));
+      }
+    }
+    if (!world.Step()) {
+      out.failure = world.status().message;
+      out.cost = p.cost.high;
+      return out;
+    }
+    energy.Accumulate(*p.body, world.state(0), dt);
+    if (on_step) on_step(world);
+  }
+  out.ok = true;
+  double x0, v0, x1, v1;
+  CenterOfMassX(*p.body, p.q0, p.qd0, &x0, &v0);
+  CenterOfMassX(*p.body, world.state(0).q, world.state(0).qd, &x1, &v1);
+  out.distance = x1 - x0;
+  out.speed = v1;
+  out.energy = energy.consumed;
+  out.cost = EvaluateCost(p.cost, out);
+  return out;
+}
+
+std::vector<TrialOutcome> RunTrials(const Problem& p, const std::vector<control::PoseGraph>& graphs, int threads) {
+  std::vector<TrialOutcome> out(graphs.size());
+  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  threads = std::min<int>(threads, int(graphs.size()));
+  if (threads <= 1) {
+    for (size_t i = 0; i < graphs.size(); ++i) out[i] = RunTrial(p, graphs[i]);
+    return out;
+  }
+  // each trial is independent and writes its own slot: the order of work never matters
+  std::atomic<size_t> next{0};
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t)
+    pool.emplace_back([&] {
+      for (size_t i; (i = next.fetch_add(1)) < graphs.size();) out[i] = RunTrial(p, graphs[i]);
+    });
+  for (std::thread& th : pool) th.join();
+  return out;
+}
+
+std::string AnnealOptions::Validate() const {
+  std::ostringstream err;
+  if (iterations < 0) return "iterations must be at least 0";
+  if (batch < 1) return "batch must be at least 1";
+  if (!(cooling > 0.0 && cooling <= 1.0)) return "cooling must be in (0, 1]";
+  if (!(initial_temperature >= 0.0) || !std::isfinite(initial_temperature)) return "temperature must be >= 0";
+  if (!(pose_step >= 0.0) || !(time_step >= 0.0)) return "step sizes must be >= 0";
+  if (!(min_amplitude < max_amplitude)) return "amplitude bounds must satisfy min < max";
+  if (!(min_time > 0.0 && min_time < max_time)) return "time bounds must satisfy 0 < min < max";
+  return "";
+}
+
+namespace {
+
+// A random neighbour of P (Fig. 5.2 step 4a): every target moves by N(0, pose_step) and every
+// transition time is scaled by exp(N(0, time_step)), within the bounds.
+control::PoseGraph Neighbour(const control::PoseGraph& p, const AnnealOptions& o, std::mt19937_64* rng) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  control::PoseGraph n = p;
+  if (o.optimize != Optimize::kTimes)
+    for (Eigen::VectorXd& pose : n.poses)
+      for (int i = 0; i < pose.size(); ++i)
+        pose[i] = std::clamp(pose[i] + o.pose_step * normal(*rng), o.min_amplitude, o.max_amplitude);
+  if (o.optimize != Optimize::kPoses)
+    for (double& d : n.durations) d = std::clamp(d * std::exp(o.time_step * normal(*rng)), o.min_time, o.max_time);
+  return n;
+}
+
+}  // namespace
+
+AnnealResult Anneal(const Problem& p, const control::PoseGraph& initial, const AnnealOptions& o,
+                    const std::function<void(const IterationRecord&)>& on_iteration) {
+  std::mt19937_64 rng(o.seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  AnnealResult r;
+  // steps 1-3: the initial controller, its cost and the starting temperature
+  control::PoseGraph current = initial;
+  TrialOutcome current_outcome = RunTrial(p, current);
+  r.initial_outcome = r.best_outcome = current_outcome;
+  r.best = current;
+  r.trials = 1;
+  double T = o.initial_temperature > 0.0 ? o.initial_temperature
+                                         : (current_outcome.cost < p.cost.high ? 0.1 * current_outcome.cost : 1.0);
+  auto record = [&](const IterationRecord& rec) {
+    r.history.push_back(rec);
+    if (on_iteration) on_iteration(rec);
+  };
+  record({0, r.trials, current_outcome.cost, current_outcome.cost, current_outcome.cost, T, true});
+  // step 4: neighbours, acceptance, cooling
+  for (int it = 1; it <= o.iterations; ++it) {
+    std::vector<control::PoseGraph> candidates;
+    for (int b = 0; b < o.batch; ++b) candidates.push_back(Neighbour(current, o, &rng));
+    const std::vector<TrialOutcome> outcomes = RunTrials(p, candidates, o.threads);
+    r.trials += long(candidates.size());
+    int pick = 0;
+    for (int b = 1; b < o.batch; ++b)
+      if (outcomes[b].cost < outcomes[pick].cost) pick = b;
+    const double delta = outcomes[pick].cost - current_outcome.cost;
+    // the uniform draw is made every iteration so that the stream never depends on Δ's sign
+    const double u = uniform(rng);
+    const bool accept = delta <= 0.0 || u < std::exp(-delta / T);
+    if (accept) {
+      current = candidates[pick];
+      current_outcome = outcomes[pick];
+    }
+    if (outcomes[pick].cost < r.best_outcome.cost) {
+      r.best = candidates[pick];
+      r.best_outcome = outcomes[pick];
+    }
+    record({it, r.trials, outcomes[pick].cost, current_outcome.cost, r.best_outcome.cost, T, accept});
+    T *= o.cooling;
+  }
+  return r;
+}
+
+std::vector<std::string> HistoryHeader() {
+  return {"iteration", "trials", "candidate_cost", "current_cost", "best_cost", "temperature", "accepted"};
+}
+
+std::vector<std::vector<double>> HistoryRows(const std::vector<IterationRecord>& history) {
+  std::vector<std::vector<double>> rows;
+  for (const IterationRecord& h : history)
+    rows.push_back({double(h.iteration), double(h.trials), h.candidate, h.current, h.best, h.temperature,
+                    h.accepted ? 1.0 : 0.0});
+  return rows;
+}
+
+std::vector<double> DistancePerCycle(const Problem& problem, const control::PoseGraph& graph, int skip, int cycles) {
+  Problem p = problem;
+  const double period = graph.Period();
+  const double dt = p.world.dt;
+  p.steps = long(std::ceil((skip + cycles) * period / dt)) + 1;
+  std::vector<double> marks;  // tx at every cycle boundary from `skip` on
+  int next_cycle = skip;
+  RunTrial(p, graph, [&](const World& w) {
+    if (next_cycle <= skip + cycles && w.time() + 0.5 * dt >= next_cycle * period) {
+      double x, v;
+      CenterOfMassX(*p.body, w.state(0).q, w.state(0).qd, &x, &v);
+      marks.push_back(x);
+      ++next_cycle;
+    }
+  });
+  std::vector<double> out;
+  for (size_t i = 1; i < marks.size(); ++i) out.push_back(marks[i] - marks[i - 1]);
+  return out;
+}
+
+}  // namespace wobble::synth
