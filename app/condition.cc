@@ -19,6 +19,8 @@
 #include <vtkSmartPointer.h>
 
 #include "pipelines/charts.h"
+#include "pipelines/condition_charts.h"
+#include "pipelines/energy_charts.h"
 #include "pipelines/exports.h"
 #include "pipelines/exr_io.h"
 #include "pipelines/scene_view.h"
@@ -47,16 +49,11 @@ std::vector<double> Angles(const ConditionSweepArgs& a) {
   return phis;
 }
 
-// A regular grid of samples (nx × ny, row-major from the bottom) for the picture writers.
-struct Grid {
-  int nx = 0, ny = 0;
-  double x0 = 0, dx = 1, y0 = 0, dy = 1;
-  std::vector<double> cond;  // +inf where M is singular
-};
-
 #ifdef WOBBLE_HAVE_PIPELINES
+using pipelines::ConditionGrid;
+
 // .vti for ParaView: point arrays cond and log10cond (NaN where singular) and singular (0/1).
-void WriteGridVti(const std::string& path, const Grid& g) {
+void WriteGridVti(const std::string& path, const ConditionGrid& g) {
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->SetDimensions(g.nx, g.ny, 1);
   image->SetOrigin(g.x0, g.y0, 0.0);
@@ -74,45 +71,10 @@ void WriteGridVti(const std::string& path, const Grid& g) {
   pipelines::WriteVti(path, image);
 }
 
-// The pictures of the sweep (Fig. 4.7 and 4.8) and of the map; needs an X display.
-void WriteSweepPictures(const std::filesystem::path& out, const std::vector<analysis::SweepSample>& samples,
-                        int drop_last) {
-  pipelines::ChartSpec all;
-  all.title = "cond(M) vs angle between vertical squash and rotated squash (Fig. 4.7)";
-  all.x_title = "phi (degrees)";
-  all.y_title = "cond(M)";
-  all.log_y = true;
-  pipelines::ChartSeries line;
-  line.name = "cond(M)";
-  for (const analysis::SweepSample& s : samples)
-    if (!s.cond.singular) line.x.push_back(Deg(s.phi)), line.y.push_back(s.cond.cond);
-  all.series.push_back(line);
-  // The raw M mixes units (mass, mass·length²), which bounds cond away from the modes'
-  // closeness until φ is within a fraction of a degree of π/2; the unit-free scaled cond shows
-  // the closeness itself.
-  pipelines::ChartSeries scaled;
-  scaled.name = "cond(S M S), S = diag(M)^-1/2";
-  for (const analysis::SweepSample& s : samples)
-    if (!s.cond.singular) scaled.x.push_back(Deg(s.phi)), scaled.y.push_back(s.cond.cond_scaled);
-  all.series.push_back(scaled);
-  pipelines::WriteChart(all, (out / "sweep.png").string(), "");
-  all.series.pop_back();
-
-  pipelines::ChartSpec small = all;
-  small.title = "the same without the last samples, points only (Fig. 4.8)";
-  small.log_y = false;
-  small.series[0].points = true;
-  const size_t keep = samples.size() > size_t(drop_last) ? samples.size() - size_t(drop_last) : 0;
-  small.series[0].x.clear();
-  small.series[0].y.clear();
-  for (size_t i = 0; i < keep; ++i)
-    if (!samples[i].cond.singular) small.series[0].x.push_back(Deg(samples[i].phi)), small.series[0].y.push_back(samples[i].cond.cond);
-  pipelines::WriteChart(small, (out / "sweep_small_angle.png").string(), "");
-}
-
-void WriteMapPictures(const std::filesystem::path& out, const Grid& g) {
+// The map as EXR (float channels cond and log10cond, +inf where singular; rows from the top as
+// EXR has them), .vti, and a colour-mapped PNG when there is a display.
+void WriteMapFiles(const std::filesystem::path& out, const ConditionGrid& g) {
   std::vector<float> cond, log_cond;
-  // EXR rows run from the top: flip the grid's bottom-first rows
   for (int j = g.ny - 1; j >= 0; --j)
     for (int i = 0; i < g.nx; ++i) {
       const double c = g.cond[size_t(j) * g.nx + i];
@@ -121,21 +83,9 @@ void WriteMapPictures(const std::filesystem::path& out, const Grid& g) {
     }
   pipelines::WriteExrChannels((out / "map.exr").string(), g.nx, g.ny, {{"cond", cond}, {"log10cond", log_cond}});
   WriteGridVti((out / "map.vti").string(), g);
-  if (!pipelines::HasDisplay()) return;
-  pipelines::ScalarFieldSpec spec;
-  spec.title = "cond(M) over phi and the vertical squash amplitude";
-  spec.x_title = "phi (degrees)";
-  spec.y_title = "gamma1 (vertical squash)";
-  spec.value_title = "cond(M)";
-  spec.nx = g.nx;
-  spec.ny = g.ny;
-  for (double c : g.cond) spec.values.push_back(std::isfinite(c) ? c : std::nan(""));
-  spec.x_min = g.x0;
-  spec.x_max = g.x0 + g.dx * (g.nx - 1);
-  spec.y_min = g.y0;
-  spec.y_max = g.y0 + g.dy * (g.ny - 1);
-  spec.log_values = true;
-  pipelines::WriteScalarFieldPng(spec, (out / "map.png").string());
+  if (pipelines::HasDisplay())
+    pipelines::WriteScalarFieldPng(pipelines::ConditionMapField(g, "phi (degrees)", "gamma1 (vertical squash)"),
+                                   (out / "map.png").string());
 }
 #endif
 
@@ -228,7 +178,7 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
 
 #ifdef WOBBLE_HAVE_PIPELINES
   {
-    Grid line;
+    ConditionGrid line;
     line.nx = int(samples.size());
     line.ny = 1;
     line.x0 = Deg(samples.front().phi);
@@ -237,7 +187,8 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
     WriteGridVti((out / "sweep.vti").string(), line);
   }
   if (pipelines::HasDisplay()) {
-    WriteSweepPictures(out, samples, a.drop_last);
+    pipelines::WriteChart(pipelines::SweepChart(samples), (out / "sweep.png").string(), "");
+    pipelines::WriteChart(pipelines::SmallAngleChart(samples, a.drop_last), (out / "sweep_small_angle.png").string(), "");
   } else {
     std::cout << "no X display: charts skipped (run under xvfb-run -a)\n";
   }
@@ -246,12 +197,6 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
     if (a.map_size < 2 || a.map_size > 2000) throw UsageError("--map must be between 2 and 2000");
     RequirePositive(a.map_gamma, "--map-gamma");
     std::vector<std::vector<double>> map_rows;
-    Grid grid;
-    grid.nx = grid.ny = a.map_size;
-    grid.x0 = a.from_deg;
-    grid.dx = (a.to_deg - a.from_deg) / (a.map_size - 1);
-    grid.y0 = -a.map_gamma;
-    grid.dy = 2.0 * a.map_gamma / (a.map_size - 1);
     for (int j = 0; j < a.map_size; ++j) {
       Eigen::VectorXd qj = q;
       qj[3] = -a.map_gamma + 2.0 * a.map_gamma * j / (a.map_size - 1);
@@ -260,11 +205,17 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
         map_phis.push_back(Rad(a.from_deg + (a.to_deg - a.from_deg) * i / (a.map_size - 1)));
       for (const analysis::SweepSample& s : analysis::AngleSweep(def, map_phis, squash, qj)) {
         map_rows.push_back({Deg(s.phi), qj[3], s.cond.cond, s.cond.singular ? INFINITY : std::log10(s.cond.cond)});
-        grid.cond.push_back(s.cond.cond);
       }
     }
 #ifdef WOBBLE_HAVE_PIPELINES
-    WriteMapPictures(out, grid);
+    ConditionGrid grid;  // the same numbers as the CSV, on their regular grid
+    grid.nx = grid.ny = a.map_size;
+    grid.x0 = a.from_deg;
+    grid.dx = (a.to_deg - a.from_deg) / (a.map_size - 1);
+    grid.y0 = -a.map_gamma;
+    grid.dy = 2.0 * a.map_gamma / (a.map_size - 1);
+    for (const std::vector<double>& r : map_rows) grid.cond.push_back(r[2]);
+    WriteMapFiles(out, grid);
 #endif
     WriteCsvAtomically((out / "map.csv").string(), {"phi_deg", "gamma1", "cond", "log10cond"}, map_rows);
     std::cout << "map: " << (out / "map.csv").string() << "\n";
@@ -279,6 +230,10 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
 }
 
 int RunConditionTime(const ConditionTimeArgs& a) {
+#ifndef WOBBLE_HAVE_PIPELINES
+  (void)a;
+  throw UsageError("condition time needs the pipelines (VTK), which this build does not have");
+#else
   const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
   RequirePositive(a.dt, "--dt");
   RequirePositive(a.duration, "--duration");
@@ -290,48 +245,26 @@ int RunConditionTime(const ConditionTimeArgs& a) {
   world.AddBody(body);
   world.SetState(0, ParseCoordinates(a.q, "--q", *body), Eigen::VectorXd::Zero(body->num_q()));
 
-  std::vector<std::vector<double>> rows;
-  std::vector<double> contact_starts;
-  bool touching = !world.state(0).contacts.empty();
-  auto sample = [&](const World& w) {
-    const analysis::ConditionNumber c = analysis::MassMatrixCondition(w.body(0), w.state(0).q);
-    const bool now = !w.state(0).contacts.empty();
-    if (now && !touching) contact_starts.push_back(w.time());
-    touching = now;
-    rows.push_back({w.time(), c.cond, c.cond_scaled, double(now)});
-  };
-  sample(world);
-  const bool ok = world.RunUntil(a.duration, sample);
+  pipelines::RunRecorder recorder;  // cond₂(M) and the contact events, as for wobble render
+  recorder.Sample(world);
+  const bool ok = world.RunUntil(a.duration, [&](const World& w) { recorder.Sample(w); });
   const std::filesystem::path out(a.out);
-  WriteCsvAtomically((out / "cond_time.csv").string(), {"t", "cond", "cond_scaled", "in_contact"}, rows);
-  std::vector<std::vector<double>> events;
-  for (double t : contact_starts) events.push_back({t});
-  WriteCsvAtomically((out / "cond_time_contacts.csv").string(), {"t_contact_start"}, events);
-  std::cout << "wrote " << (out / "cond_time.csv").string() << " (" << rows.size() << " samples, "
-            << contact_starts.size() << " contact events)\n";
-#ifdef WOBBLE_HAVE_PIPELINES
-  if (pipelines::HasDisplay()) {
-    pipelines::ChartSpec spec;
-    spec.title = "cond(M) vs time: " + body->name() + " falling onto the ground (Fig. 4.9)";
-    spec.x_title = "time";
-    spec.y_title = "cond(M)";
-    pipelines::ChartSeries series;
-    series.name = "cond(M)";
-    for (const std::vector<double>& r : rows) series.x.push_back(r[0]), series.y.push_back(r[1]);
-    spec.series.push_back(series);
-    spec.markers = contact_starts;
-    spec.markers_name = "contact starts";
-    pipelines::WriteChart(spec, (out / "cond_time.png").string(), "");
-    std::cout << "wrote " << (out / "cond_time.png").string() << "\n";
-  } else {
+  const pipelines::ChartSpec spec =
+      recorder.ConditionChart("cond(M) vs time: " + body->name() + " falling onto the ground (Fig. 4.9)");
+  const std::string png = pipelines::HasDisplay() ? (out / "cond_time.png").string() : "";
+  pipelines::WriteChart(spec, png, (out / "cond_time.csv").string());
+  std::cout << "wrote " << (out / "cond_time.csv").string() << " (" << recorder.time().size() << " samples, "
+            << recorder.contact_events().size() << " contact events, in cond_time_markers.csv)\n";
+  if (png.empty())
     std::cout << "no X display: chart skipped (run under xvfb-run -a)\n";
-  }
-#endif
+  else
+    std::cout << "wrote " << png << "\n";
   if (!ok) {
     std::cerr << "wobble: " << world.status().message << "\n";
     return kExitSimStopped;
   }
   return kExitOk;
+#endif
 }
 
 int RunConditionCheck(const ConditionCheckArgs& a) {

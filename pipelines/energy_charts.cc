@@ -1,19 +1,11 @@
 #include "pipelines/energy_charts.h"
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <limits>
 
-#include "wobble/dynamics/kinematics.h"
+#include "wobble/analysis/conditioning.h"
 
 namespace wobble::pipelines {
-
-double MassMatrixCondition(const World& world, int body) {
-  MatQ<double> M;
-  MassMatrix(world.body(body).moments(), world.state(body).q, &M);
-  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(Eigen::MatrixXd(M)).singularValues();
-  return sv.minCoeff() > 0.0 ? sv.maxCoeff() / sv.minCoeff() : std::numeric_limits<double>::infinity();
-}
 
 void RunRecorder::Sample(const World& world) {
   const BodyModel& body = world.body(body_);
@@ -33,7 +25,8 @@ void RunRecorder::Sample(const World& world) {
     const double g = q[kRigidDofs + d];
     modes_[d].push_back(body.modes()[d].stiffness * g * g);  // V = K γ² (§4.7)
   }
-  cond_.push_back(MassMatrixCondition(world, body_));
+  // +∞ when M is singular (analysis::Condition's numerical-rank test)
+  cond_.push_back(analysis::MassMatrixCondition(body, world.state(body_).q).cond);
   const bool touching = !world.state(body_).contacts.empty();
   if (touching && !touching_ && t_.size() > 1) events_.push_back(world.time());
   touching_ = touching;

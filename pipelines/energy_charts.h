@@ -37,7 +37,5 @@ class RunRecorder {
   bool touching_ = false;
 };
 
-// 2-norm condition number of the body's mass matrix at its current state (∞ if singular).
-double MassMatrixCondition(const World& world, int body);
 
 }  // namespace wobble::pipelines

@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "pipelines/condition_charts.h"
 #include "pipelines/energy_charts.h"
 #include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
@@ -190,6 +191,41 @@ TEST(RenderRegression, Filmstrip) {
   EXPECT_EQ(dims[0], 2 * 96 + 4);  // two columns, a 4-pixel gap
   EXPECT_EQ(dims[1], 2 * 72 + 4);
   CompareWithBaseline("filmstrip", strip);
+}
+
+// Issue 4's pictures: the Fig. 4.7 sweep chart and the cond map over the angle and the
+// vertical squash amplitude, for the table of data/table.obj.
+TEST(RenderRegression, ConditionSweepChart) {
+  REQUIRE_DISPLAY();
+  std::vector<double> phis;
+  for (int i = 0; i <= 18; ++i) phis.push_back(3.14159265358979323846 / 2 * i / 18);
+  const auto samples = analysis::AngleSweep(testing::Table()->def(), phis, analysis::Squash(), Eigen::VectorXd::Zero(5));
+  ChartSpec spec = SweepChart(samples);
+  spec.width = 320;
+  spec.height = 200;
+  CompareWithBaseline("condition_sweep", RenderChart(spec));
+}
+
+TEST(RenderRegression, ConditionMap) {
+  REQUIRE_DISPLAY();
+  ConditionGrid grid;
+  grid.nx = grid.ny = 12;
+  grid.x0 = 0.0;
+  grid.dx = 90.0 / 11;
+  grid.y0 = -0.5;
+  grid.dy = 1.0 / 11;
+  for (int j = 0; j < grid.ny; ++j) {
+    std::vector<double> phis;
+    for (int i = 0; i < grid.nx; ++i) phis.push_back((grid.x0 + grid.dx * i) * 3.14159265358979323846 / 180);
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(5);
+    q[3] = grid.y0 + grid.dy * j;
+    for (const auto& s : analysis::AngleSweep(testing::Table()->def(), phis, analysis::Squash(), q))
+      grid.cond.push_back(s.cond.cond);
+  }
+  ScalarFieldSpec spec = ConditionMapField(grid, "phi (degrees)", "gamma1");
+  spec.width = 320;
+  spec.height = 240;
+  CompareWithBaseline("condition_map", RenderScalarField(spec));
 }
 
 }  // namespace
