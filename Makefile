@@ -94,7 +94,7 @@ demo: demo-build
 	echo "  plots       $(OUT)/energy.png, $(OUT)/condition.png  (numbers in the .csv beside them)"
 	echo "  cliff jump  out/table_cliff.csv  (keyframed, then simulated; see README: Scripts)"
 	echo "  command     $(WOBBLE)  (see $(WOBBLE) --help, and README.md)"
-	echo "all under $(OUT)/"
+	echo "all under out/ (the drop in $(OUT)/, the cliff jump in out/table_cliff.csv)"
 	exit $$status
 
 test: test-release

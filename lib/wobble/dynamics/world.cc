@@ -131,7 +131,12 @@ Energies World::ComputeEnergies(int i) const {
   MassMatrix(b.moments(), s.q, &M);
   e.kinetic = 0.5 * s.qd.dot(M * s.qd);  // Eq. 4.9
   if (p.gravity_on) e.gravity = GravityEnergy(b.moments(), s.q, p.gravity);
-  for (int d = 0; d < b.num_modes(); ++d) e.modes += b.modes()[d].stiffness * s.q[kRigidDofs + d] * s.q[kRigidDofs + d];
+  // K (γ − γ0)²: the potential whose gradient is the mode force, PD target γ0 included
+  const bool targeted = s.mode_target.size() == b.num_modes();
+  for (int d = 0; d < b.num_modes(); ++d) {
+    const double offset = s.q[kRigidDofs + d] - (targeted ? s.mode_target[d] : 0.0);
+    e.modes += b.modes()[d].stiffness * offset * offset;
+  }
   ForEachPointInContact(b, p.ground, s, Frame<double>(s.q), [&](int, const Vec2<double>&, const Vec2<double>& x, const Vec2<double>&,
                                             const Vec2<double>& anchor) {
     e.ground += 0.5 * p.ground.stiffness * (x - anchor).squaredNorm();
