@@ -9,6 +9,13 @@
 #include "cli_common.h"
 #include "wobble/io/script.h"
 
+#ifdef WOBBLE_HAVE_PIPELINES
+#include <filesystem>
+
+#include "pipelines/charts.h"
+#include "pipelines/scene_view.h"
+#endif
+
 namespace wobble::app {
 
 CLI::App* AddRunCommand(CLI::App* app, RunArgs* a) {
@@ -34,10 +41,42 @@ void PrintHelp(std::ostream& out) {
   out << "\n";
 }
 
+// Fig. 5.4/5.5: cost against iteration, as FILE.png beside the optimiser's FILE.csv.
+void PlotCostHistory(const std::string& csv_path, const std::string& optimiser,
+                     const std::vector<synth::IterationRecord>& history) {
+#ifdef WOBBLE_HAVE_PIPELINES
+  if (!pipelines::HasDisplay()) {
+    std::cout << "no X display: cost chart skipped (run under xvfb-run -a)\n";
+    return;
+  }
+  pipelines::ChartSpec spec;
+  spec.title = "cost against iteration: " + optimiser + " (Fig. 5.4/5.5)";
+  spec.x_title = "iteration";
+  spec.y_title = "cost";
+  spec.log_y = true;
+  pipelines::ChartSeries current, best;
+  current.name = "current controller";
+  best.name = "best so far";
+  for (const synth::IterationRecord& r : history) {
+    current.x.push_back(r.iteration);
+    current.y.push_back(r.current);
+    best.x.push_back(r.iteration);
+    best.y.push_back(r.best);
+  }
+  spec.series = {current, best};
+  const std::string png = std::filesystem::path(csv_path).replace_extension(".png").string();
+  pipelines::WriteChart(spec, png, "");
+  std::cout << "wrote " << png << "\n";
+#else
+  (void)csv_path, (void)optimiser, (void)history;
+#endif
+}
+
 }  // namespace
 
 int RunScript(const RunArgs& a) {
   io::Interpreter interp(std::cout);
+  interp.SetHistoryHook(PlotCostHistory);
   Progress progress(isatty(STDERR_FILENO) == 1);
   interp.SetProgress([&](double fraction, double t) {
     progress.Update(fraction, t);

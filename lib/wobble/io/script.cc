@@ -490,9 +490,10 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
       if (progress_) progress_(iterations ? double(rec.iteration) / iterations : 1.0, rec.best);
     });
     if (!anneal_csv_.empty()) {
-      // cost against iteration (Fig. 5.4/5.5); a chart of this CSV is the pipelines' job
+      // cost against iteration (Fig. 5.4/5.5); the hook draws it
       try {
         WriteFileAtomically(anneal_csv_, CsvText(synth::HistoryHeader(), synth::HistoryRows(r.history)));
+        if (history_hook_) history_hook_(anneal_csv_, "simulated annealing", r.history);
       } catch (const std::runtime_error& e) {
         ctx.Fail(e.what());
       }
@@ -532,6 +533,7 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
     if (!cmaes_csv_.empty()) {
       try {
         WriteFileAtomically(cmaes_csv_, CsvText(synth::HistoryHeader(), synth::HistoryRows(r.history)));
+        if (history_hook_) history_hook_(cmaes_csv_, "CMA-ES", r.history);
       } catch (const std::runtime_error& e) {
         ctx.Fail(e.what());
       }

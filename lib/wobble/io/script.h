@@ -55,6 +55,11 @@ class Interpreter {
 
   // Called during simulations with the fraction done and the time (a progress bar).
   void SetProgress(std::function<void(double, double)> progress) { progress_ = std::move(progress); }
+  // Called after `anneal` or `cmaes` wrote its cost history to csv_path (anneal_csv/cmaes_csv):
+  // the CLI draws the cost against iteration (Fig. 5.4/5.5) beside it. lib draws nothing.
+  using HistoryHook = std::function<void(const std::string& csv_path, const std::string& optimiser,
+                                         const std::vector<synth::IterationRecord>& history)>;
+  void SetHistoryHook(HistoryHook hook) { history_hook_ = std::move(hook); }
 
   static const std::vector<CommandInfo>& Commands();
   static const std::vector<std::string>& Parameters();  // names `set` accepts
@@ -126,6 +131,7 @@ class Interpreter {
   // synthesis
   synth::AnnealOptions anneal_options_;
   synth::CostFunction cost_;
+  HistoryHook history_hook_;
   long trial_steps_ = 1200;
   std::string anneal_csv_, cmaes_csv_;
   double sigma0_ = 0.1;  // CMA-ES initial step, a fraction of each variable's range
