@@ -1,5 +1,5 @@
 // Render regression: small offscreen images of each layer (lattice, mass points, shape,
-// ground), a full scene, a chart and a filmstrip, compared with baseline PNGs committed in
+// ground), a full scene, a chart, a colour-mapped field and a filmstrip, compared with baseline PNGs committed in
 // tests/baselines (made on the Xvfb + llvmpipe stack `make test` uses).
 //
 // Comparison (stated here, used by every case): a pixel matches when some pixel of the other
@@ -20,6 +20,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "pipelines/charts.h"
 #include "pipelines/energy_charts.h"
 #include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
@@ -190,6 +191,26 @@ TEST(RenderRegression, Filmstrip) {
   EXPECT_EQ(dims[0], 2 * 96 + 4);  // two columns, a 4-pixel gap
   EXPECT_EQ(dims[1], 2 * 72 + 4);
   CompareWithBaseline("filmstrip", strip);
+}
+
+TEST(RenderRegression, ScalarFieldWithColourLegend) {
+  REQUIRE_DISPLAY();
+  ScalarFieldSpec s;
+  s.title = "field";
+  s.x_title = "x";
+  s.y_title = "y";
+  s.value_title = "v";
+  s.nx = 12;
+  s.ny = 8;
+  s.x_min = 0;
+  s.x_max = 1.1;
+  s.y_min = -1;
+  s.y_max = 0.4;
+  for (int j = 0; j < s.ny; ++j)
+    for (int i = 0; i < s.nx; ++i) s.values.push_back(1.0 + i * i + 3.0 * j);
+  s.width = 240;
+  s.height = 180;
+  CompareWithBaseline("scalar_field", RenderScalarField(s));
 }
 
 }  // namespace
