@@ -191,7 +191,7 @@ TEST(DisplacementExr, ValuesAtKnownPixelsMatchTheFfdEvaluatedIndependently) {
 }
 
 TEST(RenderedExr, ColourAlphaAndDepthAtKnownPixels) {
-  if (!HasDisplay()) GTEST_SKIP() << "no DISPLAY: VTK 9.1 renders only through X (make test runs ctest under xvfb-run)";
+  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
   const std::string dir = TempDir("frame_exr");
   World world;  // flat ground through the origin, the table at rest standing on it
   world.AddBody(testing::Table());

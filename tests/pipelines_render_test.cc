@@ -94,7 +94,7 @@ void CompareWithBaseline(const std::string& name, vtkImageData* image) {
 }
 
 #define REQUIRE_DISPLAY() \
-  if (!HasDisplay()) GTEST_SKIP() << "no DISPLAY: VTK 9.1 renders only through X (make test runs ctest under xvfb-run)"
+  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run"
 
 // One layer alone, 160 x 120, no overlay.
 SceneOptions OnlyLayer(const std::string& layer) {
