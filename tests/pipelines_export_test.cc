@@ -341,7 +341,9 @@ class FailedWrite : public ::testing::Test {
     }
     EXPECT_EQ(ReadAll(path), before) << "the earlier file changed";
     EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(path))) << "the earlier file was replaced";
-    if (disk_full) EXPECT_FALSE(fs::exists(fs::symlink_status(tmp))) << "the temporary file was left";
+    if (disk_full) {
+      EXPECT_FALSE(fs::exists(fs::symlink_status(tmp))) << "the temporary file was left";
+    }
     fs::remove_all(tmp);
   }
   std::string dir_;

@@ -110,7 +110,7 @@ SceneOptions OnlyLayer(const std::string& layer) {
   return o;
 }
 
-vtkSmartPointer<vtkImageData> RenderLayer(const std::string& layer, const SceneOptions& options) {
+vtkSmartPointer<vtkImageData> RenderLayer(const SceneOptions& options) {
   auto world = AirborneWorld();
   SceneView view(world.get(), 0, options);
   view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-100, 0), Eigen::Vector2d(400, 350)));
@@ -120,7 +120,7 @@ vtkSmartPointer<vtkImageData> RenderLayer(const std::string& layer, const SceneO
 
 TEST(RenderRegression, LatticeView) {
   REQUIRE_DISPLAY();
-  CompareWithBaseline("lattice", RenderLayer("lattice", OnlyLayer("lattice")));
+  CompareWithBaseline("lattice", RenderLayer(OnlyLayer("lattice")));
 }
 
 TEST(RenderRegression, MassPointsColouredByVelocity) {
@@ -130,17 +130,17 @@ TEST(RenderRegression, MassPointsColouredByVelocity) {
   o.color_range[0] = 0;
   o.color_range[1] = 200;
   o.show_color_bar = false;
-  CompareWithBaseline("mass_points", RenderLayer("points", o));
+  CompareWithBaseline("mass_points", RenderLayer(o));
 }
 
 TEST(RenderRegression, ShapeResampled) {
   REQUIRE_DISPLAY();
-  CompareWithBaseline("shape", RenderLayer("shape", OnlyLayer("shape")));
+  CompareWithBaseline("shape", RenderLayer(OnlyLayer("shape")));
 }
 
 TEST(RenderRegression, SlopedGround) {
   REQUIRE_DISPLAY();
-  CompareWithBaseline("ground", RenderLayer("ground", OnlyLayer("ground")));
+  CompareWithBaseline("ground", RenderLayer(OnlyLayer("ground")));
 }
 
 TEST(RenderRegression, FullSceneWithOverlayAndColourBar) {
