@@ -35,14 +35,14 @@ template <class T> using Ptr = vtkSmartPointer<T>;
 
 bool HasDisplay() {
   // DISPLAY alone is not enough: a stale one (an X server that is gone) makes VTK abort, so
-  // open a connection once and keep the answer
+  // open a connection once and keep the answer. The probe connection stays open for the
+  // life of the process: closing it made VTK's own XOpenDisplay fail now and then (seen
+  // with Xvfb + Mesa here, about one process in three).
   static const bool has = [] {
     const char* d = std::getenv("DISPLAY");
     if (!d || !*d) return false;
-    Display* x = XOpenDisplay(nullptr);
-    if (!x) return false;
-    XCloseDisplay(x);
-    return true;
+    static Display* probe = XOpenDisplay(nullptr);
+    return probe != nullptr;
   }();
   return has;
 }
