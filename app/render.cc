@@ -150,7 +150,7 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   if (trail_coords.size() % 2) throw UsageError("--trail: lattice coordinates come in pairs s t");
   const bool renders = what.count("frames") || what.count("filmstrip") || what.count("charts") || what.count("exr");
   if (renders && !pl::HasDisplay())
-    throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is not set: run under\n"
+    throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"
                      "  xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble ...\n"
                      "or ask only for --what vtp,disp");
   try {

@@ -242,9 +242,11 @@ vtkSmartPointer<vtkImageData> RenderScalarField(const ScalarFieldSpec& spec) {
   // the field as an image in data coordinates, coloured through a transfer function
   auto image = Ptr<vtkImageData>::New();
   image->SetDimensions(spec.nx, spec.ny, 1);
-  image->SetOrigin(spec.x_min, spec.y_min, 0.0);
-  image->SetSpacing(spec.nx > 1 ? (spec.x_max - spec.x_min) / (spec.nx - 1) : 1.0,
-                    spec.ny > 1 ? (spec.y_max - spec.y_min) / (spec.ny - 1) : 1.0, 1.0);
+  // the chart draws sample i as the cell [origin + i h, origin + (i + 1) h]: centre it on its x
+  const double hx = spec.nx > 1 ? (spec.x_max - spec.x_min) / (spec.nx - 1) : 1.0;
+  const double hy = spec.ny > 1 ? (spec.y_max - spec.y_min) / (spec.ny - 1) : 1.0;
+  image->SetOrigin(spec.x_min - 0.5 * hx, spec.y_min - 0.5 * hy, 0.0);
+  image->SetSpacing(hx, hy, 1.0);
   image->AllocateScalars(VTK_DOUBLE, 1);
   auto* v = static_cast<double*>(image->GetScalarPointer());
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -271,7 +273,8 @@ vtkSmartPointer<vtkImageData> RenderScalarField(const ScalarFieldSpec& spec) {
   view->GetScene()->AddItem(chart);
   chart->SetInputData(image);
   chart->SetTransferFunction(tf);
-  chart->SetTitle(spec.title + (spec.log_values ? "  (colour: log10 " + spec.value_title + ")" : ""));
+  std::string colour = spec.log_values ? "log10 " + spec.value_title : spec.value_title;
+  chart->SetTitle(spec.title + (colour.empty() || colour == "log10 " ? "" : "  (colour: " + colour + ")"));
   StyleAxis(chart->GetAxis(vtkAxis::BOTTOM), spec.x_title, false);
   StyleAxis(chart->GetAxis(vtkAxis::LEFT), spec.y_title, false);
   return Grab(view);

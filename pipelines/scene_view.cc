@@ -25,6 +25,8 @@
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
 
+#include <X11/Xlib.h>  // after VTK: Xlib defines macros such as Status and Bool
+
 #include "pipelines/exports.h"
 
 namespace wobble::pipelines {
@@ -32,8 +34,17 @@ namespace wobble::pipelines {
 template <class T> using Ptr = vtkSmartPointer<T>;
 
 bool HasDisplay() {
-  const char* d = std::getenv("DISPLAY");
-  return d && *d;
+  // DISPLAY alone is not enough: a stale one (an X server that is gone) makes VTK abort, so
+  // open a connection once and keep the answer. The probe connection stays open for the
+  // life of the process: closing it made VTK's own XOpenDisplay fail now and then (seen
+  // with Xvfb + Mesa here, about one process in three).
+  static const bool has = [] {
+    const char* d = std::getenv("DISPLAY");
+    if (!d || !*d) return false;
+    static Display* probe = XOpenDisplay(nullptr);
+    return probe != nullptr;
+  }();
+  return has;
 }
 
 Eigen::AlignedBox2d BodyBounds(const World& world, int body_index) {

@@ -22,7 +22,8 @@ class vtkRenderWindow;
 
 namespace wobble::pipelines {
 
-// True when an X display is set (VTK needs one to render, even offscreen).
+// True when DISPLAY names an X server that accepts a connection (VTK 9.1 needs one to
+// render, even offscreen, and aborts the process without it). Checked once per process.
 bool HasDisplay();
 
 struct SceneOptions {

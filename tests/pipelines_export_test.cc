@@ -15,6 +15,7 @@
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkXMLDataElement.h>
+#include <vtkXMLImageDataReader.h>
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLUtilities.h>
 
@@ -23,7 +24,10 @@
 #include <sstream>
 
 #include "pipelines/charts.h"
+#include "pipelines/energy_charts.h"
 #include "pipelines/exports.h"
+#include "wobble/dynamics/reference.h"
+#include <Eigen/Eigenvalues>
 #include "pipelines/exr_io.h"
 #include "pipelines/scene_view.h"
 #include "pipelines_test_util.h"
@@ -187,7 +191,7 @@ TEST(DisplacementExr, ValuesAtKnownPixelsMatchTheFfdEvaluatedIndependently) {
 }
 
 TEST(RenderedExr, ColourAlphaAndDepthAtKnownPixels) {
-  if (!HasDisplay()) GTEST_SKIP() << "no DISPLAY: VTK 9.1 renders only through X (make test runs ctest under xvfb-run)";
+  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
   const std::string dir = TempDir("frame_exr");
   World world;  // flat ground through the origin, the table at rest standing on it
   world.AddBody(testing::Table());
@@ -222,6 +226,94 @@ TEST(RenderedExr, ColourAlphaAndDepthAtKnownPixels) {
   fs::remove_all(dir);
 }
 
+TEST(VtiExport, ImageReadsBackWithItsGeometryAndValues) {
+  const std::string dir = TempDir("vti");
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(5, 4, 1);
+  image->SetOrigin(0.5, -2, 0);
+  image->SetSpacing(0.25, 0.5, 1);
+  image->AllocateScalars(VTK_DOUBLE, 1);
+  auto* v = static_cast<double*>(image->GetScalarPointer());
+  for (int i = 0; i < 20; ++i) v[i] = 1e5 / (1 + i) + 0.125;
+  image->GetPointData()->GetScalars()->SetName("cond");
+  WriteVti(dir + "/c.vti", image);
+  auto r = vtkSmartPointer<vtkXMLImageDataReader>::New();
+  r->SetFileName((dir + "/c.vti").c_str());
+  r->Update();
+  vtkImageData* back = r->GetOutput();
+  int dims[3];
+  back->GetDimensions(dims);
+  EXPECT_EQ(dims[0], 5);
+  EXPECT_EQ(dims[1], 4);
+  EXPECT_EQ(back->GetOrigin()[0], 0.5);
+  EXPECT_EQ(back->GetSpacing()[1], 0.5);
+  vtkDataArray* a = back->GetPointData()->GetArray("cond");
+  ASSERT_NE(a, nullptr);
+  for (int i = 0; i < 20; ++i) EXPECT_EQ(a->GetTuple1(i), v[i]);
+  fs::remove_all(dir);
+}
+
+TEST(RunRecorder, EnergiesConditionAndContactEventsAgreeWithIndependentSums) {
+  WorldOptions o;
+  o.params.ground.slope = -5.0 * M_PI / 180.0;
+  World world(o);
+  world.AddBody(testing::Table());
+  world.SetState(0, testing::Vec({0, 50, 0, 0, 0, 0, 0}), Eigen::VectorXd::Zero(7));
+  RunRecorder rec;
+  rec.Sample(world);
+  double first_contact = -1;
+  world.RunUntil(4.0, [&](const World& w) {
+    rec.Sample(w);
+    if (first_contact < 0 && !w.state(0).contacts.empty()) first_contact = w.time();
+    // cond₂ of the per-point reference M (Eq. 4.10), by eigenvalues: M is symmetric positive definite
+    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
+        reference::MassMatrix(w.body(0), w.state(0).q)).eigenvalues();
+    EXPECT_NEAR(rec.condition().back(), ev.maxCoeff() / ev.minCoeff(), 1e-8 * rec.condition().back());
+  });
+  // a fall from 50 lands after about sqrt(2 * 50 / g) = 3.19 s; the first event is that step
+  ASSERT_FALSE(rec.contact_events().empty());
+  EXPECT_EQ(rec.contact_events().front(), first_contact);
+  EXPECT_NEAR(first_contact, std::sqrt(2 * 50 / 9.81), 0.05);
+
+  const ChartSpec spec = rec.EnergyChart("e");
+  auto series = [&](const std::string& name) -> const std::vector<double>& {
+    for (const ChartSeries& s : spec.series)
+      if (s.name == name) return s.y;
+    throw std::runtime_error("no series " + name);
+  };
+  const std::vector<double>& total = series("total");
+  for (size_t i = 0; i < total.size(); ++i) {
+    double modes = 0;
+    for (const char* m : {"mode bend", "mode shear", "mode vsquash", "mode hsquash"}) modes += series(m)[i];
+    const double sum = series("kinetic")[i] + series("gravity")[i] + modes + series("ground")[i];
+    EXPECT_NEAR(total[i], sum, 1e-9 * std::abs(total[i]));
+  }
+  // at the start: at rest, 50 up: gravity m g h = 550 · 9.81 · (50 + 50) (centre of mass 50 above the lattice's foot)
+  EXPECT_NEAR(series("gravity")[0], world.body(0).moments().m * 9.81 * (50 + world.body(0).moments().c0.y() / world.body(0).moments().m), 1e-6);
+
+  // the CSV beside the chart holds the same numbers
+  const std::string dir = TempDir("chart_csv");
+  WriteChartCsv(spec, dir + "/e.csv");
+  std::ifstream in(dir + "/e.csv");
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_EQ(header.rfind("time (s),kinetic,gravity", 0), 0u) << header;
+  size_t rows = 0;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string cell;
+    std::vector<double> cells;
+    while (std::getline(ss, cell, ',')) cells.push_back(std::stod(cell));
+    ASSERT_EQ(cells.size(), spec.series.size() + 1);
+    EXPECT_EQ(cells[0], spec.series[0].x[rows]);
+    EXPECT_EQ(cells.back(), total[rows]);
+    ++rows;
+  }
+  EXPECT_EQ(rows, total.size());
+  EXPECT_TRUE(fs::exists(dir + "/e_markers.csv"));
+  fs::remove_all(dir);
+}
+
 // ---- failed writes: the earlier file stays, the error says which file and why ------------
 
 class FailedWrite : public ::testing::Test {
@@ -249,7 +341,9 @@ class FailedWrite : public ::testing::Test {
     }
     EXPECT_EQ(ReadAll(path), before) << "the earlier file changed";
     EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(path))) << "the earlier file was replaced";
-    if (disk_full) EXPECT_FALSE(fs::exists(fs::symlink_status(tmp))) << "the temporary file was left";
+    if (disk_full) {
+      EXPECT_FALSE(fs::exists(fs::symlink_status(tmp))) << "the temporary file was left";
+    }
     fs::remove_all(tmp);
   }
   std::string dir_;

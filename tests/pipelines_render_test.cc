@@ -1,5 +1,5 @@
 // Render regression: small offscreen images of each layer (lattice, mass points, shape,
-// ground), a full scene, a chart and a filmstrip, compared with baseline PNGs committed in
+// ground), a full scene, a chart, a colour-mapped field and a filmstrip, compared with baseline PNGs committed in
 // tests/baselines (made on the Xvfb + llvmpipe stack `make test` uses).
 //
 // Comparison (stated here, used by every case): a pixel matches when some pixel of the other
@@ -21,6 +21,7 @@
 #include <filesystem>
 
 #include "pipelines/condition_charts.h"
+#include "pipelines/charts.h"
 #include "pipelines/energy_charts.h"
 #include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
@@ -94,7 +95,7 @@ void CompareWithBaseline(const std::string& name, vtkImageData* image) {
 }
 
 #define REQUIRE_DISPLAY() \
-  if (!HasDisplay()) GTEST_SKIP() << "no DISPLAY: VTK 9.1 renders only through X (make test runs ctest under xvfb-run)"
+  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run"
 
 // One layer alone, 160 x 120, no overlay.
 SceneOptions OnlyLayer(const std::string& layer) {
@@ -110,7 +111,7 @@ SceneOptions OnlyLayer(const std::string& layer) {
   return o;
 }
 
-vtkSmartPointer<vtkImageData> RenderLayer(const std::string& layer, const SceneOptions& options) {
+vtkSmartPointer<vtkImageData> RenderLayer(const SceneOptions& options) {
   auto world = AirborneWorld();
   SceneView view(world.get(), 0, options);
   view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-100, 0), Eigen::Vector2d(400, 350)));
@@ -120,7 +121,7 @@ vtkSmartPointer<vtkImageData> RenderLayer(const std::string& layer, const SceneO
 
 TEST(RenderRegression, LatticeView) {
   REQUIRE_DISPLAY();
-  CompareWithBaseline("lattice", RenderLayer("lattice", OnlyLayer("lattice")));
+  CompareWithBaseline("lattice", RenderLayer(OnlyLayer("lattice")));
 }
 
 TEST(RenderRegression, MassPointsColouredByVelocity) {
@@ -130,17 +131,17 @@ TEST(RenderRegression, MassPointsColouredByVelocity) {
   o.color_range[0] = 0;
   o.color_range[1] = 200;
   o.show_color_bar = false;
-  CompareWithBaseline("mass_points", RenderLayer("points", o));
+  CompareWithBaseline("mass_points", RenderLayer(o));
 }
 
 TEST(RenderRegression, ShapeResampled) {
   REQUIRE_DISPLAY();
-  CompareWithBaseline("shape", RenderLayer("shape", OnlyLayer("shape")));
+  CompareWithBaseline("shape", RenderLayer(OnlyLayer("shape")));
 }
 
 TEST(RenderRegression, SlopedGround) {
   REQUIRE_DISPLAY();
-  CompareWithBaseline("ground", RenderLayer("ground", OnlyLayer("ground")));
+  CompareWithBaseline("ground", RenderLayer(OnlyLayer("ground")));
 }
 
 TEST(RenderRegression, FullSceneWithOverlayAndColourBar) {
@@ -226,6 +227,26 @@ TEST(RenderRegression, ConditionMap) {
   spec.width = 320;
   spec.height = 240;
   CompareWithBaseline("condition_map", RenderScalarField(spec));
+}
+
+TEST(RenderRegression, ScalarFieldWithColourLegend) {
+  REQUIRE_DISPLAY();
+  ScalarFieldSpec s;
+  s.title = "field";
+  s.x_title = "x";
+  s.y_title = "y";
+  s.value_title = "v";
+  s.nx = 12;
+  s.ny = 8;
+  s.x_min = 0;
+  s.x_max = 1.1;
+  s.y_min = -1;
+  s.y_max = 0.4;
+  for (int j = 0; j < s.ny; ++j)
+    for (int i = 0; i < s.nx; ++i) s.values.push_back(1.0 + i * i + 3.0 * j);
+  s.width = 240;
+  s.height = 180;
+  CompareWithBaseline("scalar_field", RenderScalarField(s));
 }
 
 }  // namespace
