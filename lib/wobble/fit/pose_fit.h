@@ -54,6 +54,9 @@ struct PoseFitOptions {
   int max_reverse_points = 200;
   // Every start runs this many rounds; then only the best start continues.
   int start_rounds = 3;
+  // Curve fits: find the nearest segments inside every residual evaluation (one solve per
+  // start) instead of alternating closest-point rounds and solves.
+  bool joint_closest_points = true;
   // Compute PoseFitResult::conditioning (an SVD of the data Jacobian at the solution).
   bool analyze_conditioning = true;
   // Called after every Ceres iteration with its number and cost (progress display).
@@ -133,7 +136,10 @@ struct CurveSamples {
   static CurveSamples Of(const BodyModel& body, const PoseFitOptions& options);
 };
 
-// Fits q to a curve target without correspondences, ICP-like: every round assigns each body
+// Fits q to a curve target without correspondences. Jointly (options.joint_closest_points,
+// the default): one solve per start whose residuals are the distances of every body sample to
+// its nearest target segment and (two-sided) of every target vertex to the nearest drawn body
+// segment, the nearest segment chosen anew at every evaluation. Alternated (ICP-like): every round assigns each body
 // sample its nearest target segment at the current q (and, two-sided, each target vertex its
 // nearest body segment), then solves with point-to-segment residuals on those segments (the
 // distance is exact for the assigned segment), until the assignment stops changing, a round

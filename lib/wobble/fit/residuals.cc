@@ -25,6 +25,33 @@ ceres::CostFunction* MakeReverseSegmentCost(const ReverseSegmentResidual& r) {
   });
 }
 
+int NearestSegment(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b,
+                   const Eigen::Vector2d& x) {
+  int best = 0;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < a.size(); ++i) {
+    const double d2 = (x - ClosestOnSegment<double>(x, a[i], b[i])).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = int(i);
+    }
+  }
+  return best;
+}
+
+ceres::CostFunction* MakeNearestSegmentCost(const NearestSegmentResidual& r) {
+  return WithNumQ(r.num_q, [&](auto n) -> ceres::CostFunction* {
+    return new ceres::AutoDiffCostFunction<NearestSegmentResidual, 2, decltype(n)::value>(new NearestSegmentResidual(r));
+  });
+}
+
+ceres::CostFunction* MakeNearestBodySegmentCost(const NearestBodySegmentResidual& r) {
+  return WithNumQ(r.num_q, [&](auto n) -> ceres::CostFunction* {
+    return new ceres::AutoDiffCostFunction<NearestBodySegmentResidual, 2, decltype(n)::value>(
+        new NearestBodySegmentResidual(r));
+  });
+}
+
 ceres::CostFunction* MakeRestPriorCost(const RestPrior& r) {
   return WithNumQ(r.num_q, [&](auto n) -> ceres::CostFunction* {
     constexpr int N = decltype(n)::value;
