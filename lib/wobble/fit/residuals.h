@@ -145,7 +145,7 @@ struct NearestBodySegmentResidual {
     int best = 0;
     double best_d2 = std::numeric_limits<double>::infinity();
     int cached = -1;
-    Eigen::Vector2d xb_cached;
+    Eigen::Vector2d xb_cached = Eigen::Vector2d::Zero();
     for (size_t k = 0; k < segments->size(); ++k) {
       const auto [i, j] = (*segments)[k];
       // consecutive segments share their joint point
@@ -169,27 +169,20 @@ struct NearestBodySegmentResidual {
   }
 };
 
-// Prior toward rest: sqrt(w) γ_d for every mode d (one residual per mode).
+// Prior toward rest: sqrt(w) γ_d for every mode d (one residual per mode). Linear, so its
+// Jacobian is written out (an autodiff instance per size would only cost compile time).
 struct RestPrior {
   double sqrt_weight = 0.0;
   int num_q = kRigidDofs;
-  template <class T> bool operator()(const T* q, T* r) const {
-    for (int i = kRigidDofs; i < num_q; ++i) r[i - kRigidDofs] = T(sqrt_weight) * q[i];
-    return true;
-  }
 };
 
 // Temporal smoothness between three consecutive frames: the divided second difference
 // c0 q_{f−1} + c1 q_f + c2 q_{f+1} (c0 = h̄/h0, c2 = h̄/h1, c1 = −c0 − c2, h̄ = (h0 + h1)/2;
 // q_{f−1} − 2q_f + q_{f+1} for even frames), each coordinate times a length scale so that
-// translation, angle and amplitudes are weighed in the same unit.
+// translation, angle and amplitudes are weighed in the same unit. Linear, Jacobian written out.
 struct SecondDifference {
   double c0 = 1, c1 = -2, c2 = 1;
   VecQ<double> scale;  // per coordinate, times sqrt(w)
-  template <class T> bool operator()(const T* a, const T* b, const T* c, T* r) const {
-    for (int i = 0; i < scale.size(); ++i) r[i] = T(scale[i]) * (T(c0) * a[i] + T(c1) * b[i] + T(c2) * c[i]);
-    return true;
-  }
 };
 
 // Calls make(std::integral_constant<int, N>) with N = num_q, for num_q in [kRigidDofs, kMaxQ]:
