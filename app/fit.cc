@@ -134,8 +134,10 @@ FitCommands AddFitCommand(CLI::App* app, FitPoseArgs* pose, FitTrajectoryArgs* t
   AddFitFlags(c.pose, &pose->fit);
   c.pose->add_option("--samples-per-segment", pose->samples_per_segment, "Curve targets: samples per drawn segment")
       ->capture_default_str();
-  c.pose->add_option("--max-rounds", pose->max_rounds, "Curve targets: closest-point rounds")->capture_default_str();
+  c.pose->add_option("--max-rounds", pose->max_rounds, "Curve targets with --alternate: closest-point rounds")->capture_default_str();
   c.pose->add_flag("--one-sided", pose->one_sided, "Curve targets: only body-to-target distances");
+  c.pose->add_flag("--alternate", pose->alternate,
+                   "Curve targets: alternate closest-point rounds and solves (ICP) instead of one joint solve");
   c.pose->footer(
       "Example:\n"
       "  wobble fit pose --object data/table.obj --modes data/table_modes.def \\\n"
@@ -176,6 +178,7 @@ int RunFitPose(const FitPoseArgs& a) {
   o.samples_per_segment = a.samples_per_segment;
   o.max_rounds = a.max_rounds;
   o.two_sided = !a.one_sided;
+  o.joint_closest_points = !a.alternate;
   o.on_iteration = IterationLine();
   const io::TargetFile targets = io::ReadTargetFile(a.targets);
   io::CheckMassPointIndices(targets, body->num_points());
@@ -237,7 +240,7 @@ int RunFitPose(const FitPoseArgs& a) {
   std::ostringstream out;
   out << body->name() << ": " << (curve ? "curve" : "correspondence") << " fit to " << a.targets << ": "
       << r.report.termination << " after " << r.report.iterations << " iterations"
-      << (curve ? " in " + std::to_string(r.rounds) + " closest-point rounds" : std::string()) << ".\n";
+      << (curve && a.alternate ? " in " + std::to_string(r.rounds) + " closest-point rounds" : std::string()) << ".\n";
   out << "q = [";
   for (int i = 0; i < r.q.size(); ++i) out << (i ? " " : "") << names[i] << " " << Num(r.q[i]);
   out << "]\n";

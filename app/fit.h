@@ -32,6 +32,7 @@ struct FitPoseArgs {
   std::string targets;
   int samples_per_segment = 8;
   bool one_sided = false;
+  bool alternate = false;
   int max_rounds = 30;
 };
 

@@ -75,6 +75,7 @@ void BM_CurveFit_Polyline1000(benchmark::State& state) {
   const fit::CurveTarget target = fit::CurveTarget::From(f);
   fit::PoseFitOptions o;
   o.two_sided = state.range(0) != 0;
+  o.joint_closest_points = state.range(1) != 0;
   int rounds = 0, iterations = 0;
   double rms = 0;
   for (auto _ : state) {
@@ -87,7 +88,13 @@ void BM_CurveFit_Polyline1000(benchmark::State& state) {
   state.counters["ceres_iterations"] = iterations;
   state.counters["rms"] = rms;
 }
-BENCHMARK(BM_CurveFit_Polyline1000)->Arg(1)->Arg(0)->ArgName("two_sided")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_CurveFit_Polyline1000)
+    ->Args({1, 1})
+    ->Args({1, 0})
+    ->Args({0, 1})
+    ->Args({0, 0})
+    ->ArgNames({"two_sided", "joint"})
+    ->Unit(benchmark::kMillisecond);
 
 // The table thrown without ground, 1,200 frames at dt 0.005, all 11 mass points observed.
 std::vector<io::TargetFrame> ThrownFrames(const std::shared_ptr<const BodyModel>& body, int frames, double dt) {

@@ -235,9 +235,12 @@ io::TargetFile DrawnTarget(const BodyModel& body, const Eigen::VectorXd& q, int 
 
 TEST(CurveFit, RecoversQFromTheDrawnShape) {
   const BodyModel body = Table();
-  for (double noise : {0.0, 0.3}) {
+  for (double noise : {0.0, 0.3})
+  for (bool joint : {true, false}) {
     const io::TargetFile target = DrawnTarget(body, KnownQ(), 60, noise, 5);
-    const PoseFitResult r = fit::FitPoseToCurve(body, fit::CurveTarget::From(target), PoseFitOptions());
+    PoseFitOptions o;
+    o.joint_closest_points = joint;
+    const PoseFitResult r = fit::FitPoseToCurve(body, fit::CurveTarget::From(target), o);
     ASSERT_TRUE(r.report.usable);
     // stated tolerances: translation 1, angle 5e-3 rad, amplitudes 0.02 (the polyline is a
     // chord approximation of the deformed curve, and points may slide along it)
@@ -246,7 +249,7 @@ TEST(CurveFit, RecoversQFromTheDrawnShape) {
     EXPECT_NEAR(r.q[2], KnownQ()[2], 5e-3) << noise;
     for (int d = 3; d < 7; ++d) EXPECT_NEAR(r.q[d], KnownQ()[d], 0.02) << "mode " << d - 3 << " noise " << noise;
     EXPECT_LT(r.rms_residual, 0.5 + noise);
-    EXPECT_GE(r.rounds, 2);
+    EXPECT_EQ(r.rounds >= 2, !joint);  // alternated fits take several closest-point rounds
   }
 }
 

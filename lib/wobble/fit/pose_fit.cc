@@ -203,22 +203,6 @@ Shape2 Principal(const std::vector<Eigen::Vector2d>& p, const std::vector<double
   return s;
 }
 
-// Index of the segment [a_i, b_i] nearest to x (brute force: targets of a few thousand
-// segments and bodies of a few hundred samples cost well under a millisecond per round).
-int NearestSegment(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b,
-                   const Eigen::Vector2d& x) {
-  int best = 0;
-  double best_d2 = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < a.size(); ++i) {
-    const double d2 = (x - ClosestOnSegment<double>(x, a[i], b[i])).squaredNorm();
-    if (d2 < best_d2) {
-      best_d2 = d2;
-      best = int(i);
-    }
-  }
-  return best;
-}
-
 }  // namespace
 
 PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, const PoseFitOptions& o) {
@@ -273,44 +257,49 @@ PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, c
     int round = 0;
     bool done = false;
   };
+  // closest points at run->q; returns whether any assignment changed
+  auto assign = [&](Run* run) {
+    const Eigen::VectorXd& q = run->q;
+    // closest points at the current q: body samples to target segments ...
+    bool changed = false;
+    std::vector<Eigen::Vector2d> x(ns);
+    for (int i = 0; i < ns; ++i) {
+      x[i] = PointPosition(samples.points[i], q.data(), int(q.size()));
+      const int seg = NearestSegment(target.a, target.b, x[i]);
+      changed = changed || seg != run->assigned[i];
+      run->assigned[i] = seg;
+      SegmentResidual& d = run->data[i];
+      d.point = samples.points[i];
+      d.a = target.a[seg];
+      d.b = target.b[seg];
+      d.num_q = body.num_q();
+    }
+    // ... and target vertices to the body's drawn segments
+    if (two_sided) {
+      std::vector<Eigen::Vector2d> ba, bb;
+      for (const auto& [i, j] : samples.segments) {
+        ba.push_back(x[i]);
+        bb.push_back(x[j]);
+      }
+      for (size_t v = 0; v < reverse_points.size(); ++v) {
+        const int seg = NearestSegment(ba, bb, reverse_points[v]);
+        changed = changed || seg != run->reverse_assigned[v];
+        run->reverse_assigned[v] = seg;
+        ReverseSegmentResidual& d = run->reverse[v];
+        d.pa = samples.points[samples.segments[seg].first];
+        d.pb = samples.points[samples.segments[seg].second];
+        d.y = reverse_points[v];
+        d.sqrt_weight = std::sqrt(reverse_weight);
+        d.num_q = body.num_q();
+      }
+    }
+    return changed;
+  };
   // runs rounds until `last_round` (exclusive) or convergence
   auto advance = [&](Run* run, int last_round) {
     for (; run->round < last_round && !run->done; ++run->round) {
       Eigen::VectorXd& q = run->q;
-      // closest points at the current q: body samples to target segments ...
-      bool changed = false;
-      std::vector<Eigen::Vector2d> x(ns);
-      for (int i = 0; i < ns; ++i) {
-        x[i] = PointPosition(samples.points[i], q.data(), int(q.size()));
-        const int seg = NearestSegment(target.a, target.b, x[i]);
-        changed = changed || seg != run->assigned[i];
-        run->assigned[i] = seg;
-        SegmentResidual& d = run->data[i];
-        d.point = samples.points[i];
-        d.a = target.a[seg];
-        d.b = target.b[seg];
-        d.num_q = body.num_q();
-      }
-      // ... and target vertices to the body's drawn segments
-      if (two_sided) {
-        std::vector<Eigen::Vector2d> ba, bb;
-        for (const auto& [i, j] : samples.segments) {
-          ba.push_back(x[i]);
-          bb.push_back(x[j]);
-        }
-        for (size_t v = 0; v < reverse_points.size(); ++v) {
-          const int seg = NearestSegment(ba, bb, reverse_points[v]);
-          changed = changed || seg != run->reverse_assigned[v];
-          run->reverse_assigned[v] = seg;
-          ReverseSegmentResidual& d = run->reverse[v];
-          d.pa = samples.points[samples.segments[seg].first];
-          d.pb = samples.points[samples.segments[seg].second];
-          d.y = reverse_points[v];
-          d.sqrt_weight = std::sqrt(reverse_weight);
-          d.num_q = body.num_q();
-        }
-      }
-      if (!changed) {
+      if (!assign(run)) {
         run->done = true;
         break;
       }
@@ -344,14 +333,42 @@ PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, c
     run.reverse_assigned.assign(reverse_points.size(), -1);
     run.data.resize(ns);
     run.reverse.resize(reverse_points.size());
-    advance(&run, std::min(o.start_rounds, o.max_rounds));
+    if (o.joint_closest_points) {
+      // one solve, nearest segments found inside the residuals
+      ceres::Problem problem;
+      ceres::LossFunction* loss = MakeLoss(o.loss, o.loss_scale);
+      for (const PointBasis& p : samples.points) {
+        NearestSegmentResidual r;
+        r.point = p;
+        r.a = &target.a;
+        r.b = &target.b;
+        r.num_q = body.num_q();
+        problem.AddResidualBlock(MakeNearestSegmentCost(r), loss, run.q.data());
+      }
+      for (const Eigen::Vector2d& y : reverse_points) {
+        NearestBodySegmentResidual r;
+        r.points = &samples.points;
+        r.segments = &samples.segments;
+        r.y = y;
+        r.sqrt_weight = std::sqrt(reverse_weight);
+        r.num_q = body.num_q();
+        problem.AddResidualBlock(MakeNearestBodySegmentCost(r), loss, run.q.data());
+      }
+      AddPoseTerms(body, {}, {}, o, run.q.data(), &problem);  // prior and bounds
+      SolvePoseProblem(o, &problem, &run.r.report);
+      run.seconds = run.r.report.solve_seconds;
+      run.r.rounds = 1;
+      assign(&run);  // the final nearest segments, for the residuals and the conditioning
+    } else {
+      advance(&run, std::min(o.start_rounds, o.max_rounds));
+    }
     runs.push_back(std::move(run));
   }
   size_t best_index = 0;
   for (size_t i = 1; i < runs.size(); ++i)
     if (runs[i].r.report.final_cost < runs[best_index].r.report.final_cost) best_index = i;
   Run& winner = runs[best_index];
-  advance(&winner, o.max_rounds);
+  if (!o.joint_closest_points) advance(&winner, o.max_rounds);
   PoseFitResult best = winner.r;
   best.report.solve_seconds = winner.seconds;
   best.q = winner.q;

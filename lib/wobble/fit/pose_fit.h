@@ -54,6 +54,9 @@ struct PoseFitOptions {
   int max_reverse_points = 200;
   // Every start runs this many rounds; then only the best start continues.
   int start_rounds = 3;
+  // Curve fits: find the nearest segments inside every residual evaluation (one solve per
+  // start) instead of alternating closest-point rounds and solves.
+  bool joint_closest_points = true;
   // Compute PoseFitResult::conditioning (an SVD of the data Jacobian at the solution).
   bool analyze_conditioning = true;
   // Called after every Ceres iteration with its number and cost (progress display).
@@ -133,15 +136,19 @@ struct CurveSamples {
   static CurveSamples Of(const BodyModel& body, const PoseFitOptions& options);
 };
 
-// Fits q to a curve target without correspondences, ICP-like: every round assigns each body
-// sample its nearest target segment at the current q (and, two-sided, each target vertex its
-// nearest body segment), then solves with point-to-segment residuals on those segments (the
-// distance is exact for the assigned segment), until the assignment stops changing, a round
-// no longer lowers the cost by a relative 1e-6, or options.max_rounds. Every start runs
-// options.start_rounds rounds, then the one with the lowest cost continues. point_residuals are those of the body samples (body → target). Start (without options.initial_q): the
-// rest shape's sample centroid moved onto the target's (length-weighted) centroid, its
-// principal axis turned onto the target's; both orientations of the axis are tried (four
-// quarter turns when either shape is nearly isotropic) and the lowest final cost wins; γ = 0.
+// Fits q to a curve target without correspondences. The residuals are the distances of every
+// body sample to its nearest target segment and (two-sided) of up to max_reverse_points
+// target vertices to the nearest drawn body segment.
+//   Jointly (options.joint_closest_points, the default): one solve per start, the nearest
+//   segments chosen anew at every residual evaluation.
+//   Alternated (ICP-like): every round fixes the nearest segments at the current q and solves
+//   with point-to-segment residuals on them, until the assignment stops changing, a round no
+//   longer lowers the cost by a relative 1e-6, or options.max_rounds; every start runs
+//   options.start_rounds rounds, then only the lowest-cost one continues.
+// Start (without options.initial_q): the rest shape's sample centroid moved onto the target's
+// (length-weighted) centroid, its principal axis turned onto the target's; both orientations
+// of the axis are tried (four quarter turns when either shape is nearly isotropic) and the
+// lowest final cost wins; γ = 0. point_residuals are those of the body samples.
 PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, const PoseFitOptions& options);
 
 }  // namespace wobble::fit

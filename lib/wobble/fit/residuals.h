@@ -8,7 +8,11 @@
 
 #include <ceres/autodiff_cost_function.h>
 
+#include <cmath>
+#include <limits>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "wobble/body/body_model.h"
 #include "wobble/dynamics/kinematics.h"
@@ -96,27 +100,89 @@ struct ReverseSegmentResidual {
   }
 };
 
-// Prior toward rest: sqrt(w) γ_d for every mode d (one residual per mode).
+// Index of the segment [a_i, b_i] nearest to x (brute force).
+int NearestSegment(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b,
+                   const Eigen::Vector2d& x);
+
+// Joint closest points: like SegmentResidual, but the target segment is the one nearest to
+// the body point at every evaluation (chosen on plain values), so the solver moves across
+// segments freely. The distance to a polyline is continuous in q; its gradient jumps only
+// where two segments are equally near.
+struct NearestSegmentResidual {
+  PointBasis point;
+  const std::vector<Eigen::Vector2d>* a = nullptr;
+  const std::vector<Eigen::Vector2d>* b = nullptr;
+  double sqrt_weight = 1.0;
+  int num_q = kRigidDofs;
+  template <class T> bool operator()(const T* q, T* r) const {
+    const Vec2<T> x = PointPosition(point, q, num_q);
+    const Eigen::Vector2d xv(ScalarValue(x[0]), ScalarValue(x[1]));
+    const int seg = NearestSegment(*a, *b, xv);
+    const Vec2<T> e = (x - ClosestOnSegment(x, (*a)[seg], (*b)[seg])) * T(sqrt_weight);
+    r[0] = e[0];
+    r[1] = e[1];
+    return true;
+  }
+};
+
+// Joint closest points in the reverse direction: the body segment nearest to target point y
+// at every evaluation.
+struct NearestBodySegmentResidual {
+  const std::vector<PointBasis>* points = nullptr;
+  const std::vector<std::pair<int, int>>* segments = nullptr;
+  Eigen::Vector2d y;
+  double sqrt_weight = 1.0;
+  int num_q = kRigidDofs;
+  template <class T> bool operator()(const T* q, T* r) const {
+    // every drawn sample's position at the plain values of q (one sin/cos for all)
+    const double c = std::cos(ScalarValue(q[2])), s = std::sin(ScalarValue(q[2]));
+    const Eigen::Vector2d t(ScalarValue(q[0]), ScalarValue(q[1]));
+    auto place = [&](const PointBasis& p) {
+      Eigen::Vector2d l = p.b0;
+      for (int d = 0; d + kRigidDofs < num_q; ++d) l += p.B.col(d) * ScalarValue(q[kRigidDofs + d]);
+      return Eigen::Vector2d(t.x() + c * l.x() - s * l.y(), t.y() + s * l.x() + c * l.y());
+    };
+    int best = 0;
+    double best_d2 = std::numeric_limits<double>::infinity();
+    int cached = -1;
+    Eigen::Vector2d xb_cached = Eigen::Vector2d::Zero();
+    for (size_t k = 0; k < segments->size(); ++k) {
+      const auto [i, j] = (*segments)[k];
+      // consecutive segments share their joint point
+      const Eigen::Vector2d xa = i == cached ? xb_cached : place((*points)[i]);
+      const Eigen::Vector2d xb = place((*points)[j]);
+      cached = j;
+      xb_cached = xb;
+      const double d2 = (y - ClosestOnSegment<double>(y, xa, xb)).squaredNorm();
+      if (d2 < best_d2) {
+        best_d2 = d2;
+        best = int(k);
+      }
+    }
+    ReverseSegmentResidual fixed;
+    fixed.pa = (*points)[(*segments)[best].first];
+    fixed.pb = (*points)[(*segments)[best].second];
+    fixed.y = y;
+    fixed.sqrt_weight = sqrt_weight;
+    fixed.num_q = num_q;
+    return fixed(q, r);
+  }
+};
+
+// Prior toward rest: sqrt(w) γ_d for every mode d (one residual per mode). Linear, so its
+// Jacobian is written out (an autodiff instance per size would only cost compile time).
 struct RestPrior {
   double sqrt_weight = 0.0;
   int num_q = kRigidDofs;
-  template <class T> bool operator()(const T* q, T* r) const {
-    for (int i = kRigidDofs; i < num_q; ++i) r[i - kRigidDofs] = T(sqrt_weight) * q[i];
-    return true;
-  }
 };
 
 // Temporal smoothness between three consecutive frames: the divided second difference
 // c0 q_{f−1} + c1 q_f + c2 q_{f+1} (c0 = h̄/h0, c2 = h̄/h1, c1 = −c0 − c2, h̄ = (h0 + h1)/2;
 // q_{f−1} − 2q_f + q_{f+1} for even frames), each coordinate times a length scale so that
-// translation, angle and amplitudes are weighed in the same unit.
+// translation, angle and amplitudes are weighed in the same unit. Linear, Jacobian written out.
 struct SecondDifference {
   double c0 = 1, c1 = -2, c2 = 1;
   VecQ<double> scale;  // per coordinate, times sqrt(w)
-  template <class T> bool operator()(const T* a, const T* b, const T* c, T* r) const {
-    for (int i = 0; i < scale.size(); ++i) r[i] = T(scale[i]) * (T(c0) * a[i] + T(c1) * b[i] + T(c2) * c[i]);
-    return true;
-  }
 };
 
 // Calls make(std::integral_constant<int, N>) with N = num_q, for num_q in [kRigidDofs, kMaxQ]:
@@ -132,6 +198,8 @@ template <int N = kRigidDofs, class Make> ceres::CostFunction* WithNumQ(int num_
 
 ceres::CostFunction* MakeSegmentCost(const SegmentResidual& r);
 ceres::CostFunction* MakeReverseSegmentCost(const ReverseSegmentResidual& r);
+ceres::CostFunction* MakeNearestSegmentCost(const NearestSegmentResidual& r);
+ceres::CostFunction* MakeNearestBodySegmentCost(const NearestBodySegmentResidual& r);
 ceres::CostFunction* MakeRestPriorCost(const RestPrior& r);
 ceres::CostFunction* MakeSecondDifferenceCost(const SecondDifference& r);
 

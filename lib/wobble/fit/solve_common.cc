@@ -20,8 +20,8 @@ std::vector<ceres::ResidualBlockId> AddPoseTerms(const BodyModel& body, const st
                                                  const std::vector<ReverseSegmentResidual>& reverse,
                                                  const PoseFitOptions& o, double* q, ceres::Problem* problem) {
   std::vector<ceres::ResidualBlockId> ids;
-  // one loss object shared by every data term (Ceres deletes it once)
-  ceres::LossFunction* loss = MakeLoss(o.loss, o.loss_scale);
+  // one loss object shared by every data term (Ceres deletes it once); none without terms
+  ceres::LossFunction* loss = data.empty() && reverse.empty() ? nullptr : MakeLoss(o.loss, o.loss_scale);
   for (const SegmentResidual& d : data) ids.push_back(problem->AddResidualBlock(MakeSegmentCost(d), loss, q));
   for (const ReverseSegmentResidual& d : reverse)
     ids.push_back(problem->AddResidualBlock(MakeReverseSegmentCost(d), loss, q));
@@ -52,13 +52,9 @@ void FillReport(const ceres::Solver::Summary& summary, bool full, double seconds
   report->solve_seconds = seconds;
 }
 
-void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
-               const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o, Eigen::VectorXd* q,
-               FitReport* report) {
-  ceres::Problem problem;
-  AddPoseTerms(body, data, reverse, o, q->data(), &problem);
+void SolvePoseProblem(const PoseFitOptions& o, ceres::Problem* problem, FitReport* report) {
   ceres::Solver::Options options;
-  // normal equations: J has 2 rows per target but only num_q ≤ 15 columns; LM's damping keeps
+  // normal equations: J has 2 rows per target but only num_q <= 15 columns; LM's damping keeps
   // them positive definite even when a mode is undetermined
   options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   options.max_num_iterations = o.max_iterations;
@@ -70,9 +66,17 @@ void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
   forward.Attach(&options);
   ceres::Solver::Summary summary;
   const auto start = std::chrono::steady_clock::now();
-  ceres::Solve(options, &problem, &summary);
+  ceres::Solve(options, problem, &summary);
   FillReport(summary, o.full_report, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
              report);
+}
+
+void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
+               const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o, Eigen::VectorXd* q,
+               FitReport* report) {
+  ceres::Problem problem;
+  AddPoseTerms(body, data, reverse, o, q->data(), &problem);
+  SolvePoseProblem(o, &problem, report);
 }
 
 Conditioning ComputeConditioning(const BodyModel& body, const std::vector<SegmentResidual>& data,

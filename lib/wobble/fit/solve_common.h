@@ -47,6 +47,9 @@ class IterationForwarder : public ceres::IterationCallback {
 // Copies what people need from a Ceres summary.
 void FillReport(const ceres::Solver::Summary& summary, bool full, double seconds, FitReport* report);
 
+// Solves a pose problem built by the caller (dense normal equations, the fit's tolerances).
+void SolvePoseProblem(const PoseFitOptions& o, ceres::Problem* problem, FitReport* report);
+
 // Solves one pose (dense: a handful of unknowns), q in and out.
 void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
                const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o, Eigen::VectorXd* q,

@@ -57,6 +57,9 @@ TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vec
     throw std::invalid_argument("trajectory fit: smoothness must be >= 0");
   if (frames.empty()) throw std::invalid_argument("trajectory fit: no frames");
   const int F = int(frames.size()), n = body.num_q();
+  for (int f = 1; f < F; ++f)
+    if (!(frames[f].time > frames[f - 1].time))
+      throw std::invalid_argument("trajectory fit: frame times must strictly increase");
 
   // per-frame data terms and starts
   TrajectoryFitResult result;
