@@ -17,6 +17,13 @@
 #include "wobble/io/parse_error.h"
 #include "wobble/io/target_file.h"
 
+#ifdef WOBBLE_HAVE_PIPELINES
+#include <filesystem>
+
+#include "pipelines/charts.h"
+#include "pipelines/scene_view.h"
+#endif
+
 namespace wobble::app {
 namespace {
 
@@ -99,6 +106,62 @@ json ReportJson(const fit::FitReport& r) {
   return j;
 }
 
+#ifdef WOBBLE_HAVE_PIPELINES
+// Pictures beside the files, when there is a display: the cost per iteration beside --costs
+// (FILE.png), and beside --out the fitted points over their targets (FILE_overlay.png, from
+// the JSON's "overlay": target polylines as lines, target points and fitted points as dots).
+void WritePictures(const FitFlags& f, const json& result, const fit::FitReport& r) {
+  if (!pipelines::HasDisplay()) {
+    if (!f.costs.empty() || !f.out.empty()) std::cout << "no X display: fit pictures skipped (run under xvfb-run -a)\n";
+    return;
+  }
+  if (!f.costs.empty()) {
+    pipelines::ChartSpec spec;
+    spec.title = "fit cost per iteration";
+    spec.x_title = "iteration";
+    spec.y_title = "cost";
+    spec.log_y = true;
+    pipelines::ChartSeries s;
+    s.name = "cost";
+    for (size_t i = 0; i < r.cost_per_iteration.size(); ++i) s.x.push_back(double(i)), s.y.push_back(r.cost_per_iteration[i]);
+    spec.series = {s};
+    pipelines::WriteChart(spec, std::filesystem::path(f.costs).replace_extension(".png").string(), "");
+  }
+  if (!f.out.empty() && result.contains("overlay")) {
+    const json& overlay = result["overlay"];
+    pipelines::ChartSpec spec;
+    spec.title = "fit (dots) against target";
+    spec.x_title = "x";
+    spec.y_title = "y";
+    spec.width = spec.height = 700;
+    pipelines::ChartSeries target_points, fitted;
+    target_points.name = "target points";
+    target_points.points = true;
+    fitted.name = "fitted";
+    fitted.points = true;
+    for (const json& p : overlay["fitted"]) fitted.x.push_back(p[0]), fitted.y.push_back(p[1]);
+    int line = 0;
+    for (const json& t : overlay["targets"]) {
+      if (t.contains("point")) {
+        target_points.x.push_back(t["point"][0]);
+        target_points.y.push_back(t["point"][1]);
+        continue;
+      }
+      pipelines::ChartSeries curve;
+      curve.name = "target curve " + std::to_string(++line);
+      for (const json& p : t["polyline"]) curve.x.push_back(p[0]), curve.y.push_back(p[1]);
+      if (t.value("closed", false) && !curve.x.empty()) curve.x.push_back(curve.x[0]), curve.y.push_back(curve.y[0]);
+      spec.series.push_back(curve);
+    }
+    if (!target_points.x.empty()) spec.series.push_back(target_points);
+    if (!fitted.x.empty()) spec.series.push_back(fitted);
+    const std::filesystem::path out(f.out);
+    if (!spec.series.empty())
+      pipelines::WriteChart(spec, (out.parent_path() / (out.stem().string() + "_overlay.png")).string(), "");
+  }
+}
+#endif
+
 void WriteOutputs(const FitFlags& f, const json& result, const fit::FitReport& r) {
   if (!f.costs.empty()) {
     std::vector<std::vector<double>> rows;
@@ -106,6 +169,9 @@ void WriteOutputs(const FitFlags& f, const json& result, const fit::FitReport& r
     WriteCsvAtomically(f.costs, {"iteration", "cost"}, rows);
   }
   if (!f.out.empty()) WriteTextAtomically(f.out, result.dump(2) + "\n");
+#ifdef WOBBLE_HAVE_PIPELINES
+  WritePictures(f, result, r);
+#endif
 }
 
 std::string Num(double v) {
