@@ -9,7 +9,6 @@ namespace wobble::pipelines {
 
 void RunRecorder::Sample(const World& world) {
   const BodyModel& body = world.body(body_);
-  const VecQ<double>& q = world.state(body_).q;
   if (mode_names_.empty() && body.num_modes() > 0) {
     for (const DeformationMode& m : body.modes()) mode_names_.push_back(m.name);
     modes_.resize(body.num_modes());
@@ -21,10 +20,7 @@ void RunRecorder::Sample(const World& world) {
   ground_.push_back(e.ground);
   springs_.push_back(e.springs);
   total_.push_back(e.total());
-  for (int d = 0; d < body.num_modes(); ++d) {
-    const double g = q[kRigidDofs + d];
-    modes_[d].push_back(body.modes()[d].stiffness * g * g);  // V = K γ² (§4.7)
-  }
+  for (int d = 0; d < body.num_modes(); ++d) modes_[d].push_back(e.per_mode[d]);  // K (γ − γ0)² (§4.7)
   // +∞ when M is singular (analysis::Condition's numerical-rank test)
   cond_.push_back(analysis::MassMatrixCondition(body, world.state(body_).q).cond);
   const bool touching = !world.state(body_).contacts.empty();

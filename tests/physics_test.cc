@@ -151,6 +151,26 @@ TEST(Conservation, ThesisSchemeEnergyErrorWithinMeasuredBound) {
   EXPECT_LT(MaxEnergyDeviation(Integrator::kThesis, &first_half), 2e-3);
 }
 
+// A constant PD target γ0 makes the mode force −2K(γ − γ0): the energy World reports must be
+// the potential of that force, K(γ − γ0)², or the total would swing by K((γ−γ0)² − γ²) as the
+// modes oscillate about their targets instead of staying put.
+TEST(Conservation, EnergyWithPdTargetsIsConserved) {
+  World w(NoGround(Integrator::kVariational, 1e-3, /*gravity=*/false));
+  w.AddBody(std::make_shared<BodyModel>(TableDef(), TableModes(2e5)));
+  w.SetState(0, State({0, 0, 0, 0, 0, 0, 0}), State({0.5, 0, 0.1, 0, 0, 0, 0}));
+  w.SetModeTargets(0, State({0.3, -0.2, 0.1, 0.25}));
+  const double e0 = w.ComputeEnergies(0).total();
+  double max_dev = 0, max_modes = 0;
+  for (int i = 0; i < 20000; ++i) {
+    ASSERT_TRUE(w.Step()) << w.status().message;
+    const Energies e = w.ComputeEnergies(0);
+    max_dev = std::max(max_dev, std::abs(e.total() - e0));
+    max_modes = std::max(max_modes, e.modes);
+  }
+  EXPECT_GT(max_modes, 0.0);
+  EXPECT_LT(max_dev, 1e-5 * max_modes);
+}
+
 TEST(Conservation, MomentaWithoutGravity) {
   World w(NoGround(Integrator::kRK4, 1e-3, /*gravity=*/false));
   w.AddBody(std::make_shared<BodyModel>(TableDef(), TableModes(2e5)));

@@ -135,7 +135,8 @@ Energies World::ComputeEnergies(int i) const {
   const bool targeted = s.mode_target.size() == b.num_modes();
   for (int d = 0; d < b.num_modes(); ++d) {
     const double offset = s.q[kRigidDofs + d] - (targeted ? s.mode_target[d] : 0.0);
-    e.modes += b.modes()[d].stiffness * offset * offset;
+    e.per_mode.push_back(b.modes()[d].stiffness * offset * offset);
+    e.modes += e.per_mode.back();
   }
   ForEachPointInContact(b, p.ground, s, Frame<double>(s.q), [&](int, const Vec2<double>&, const Vec2<double>& x, const Vec2<double>&,
                                             const Vec2<double>& anchor) {

@@ -15,6 +15,7 @@ namespace wobble {
 
 struct Energies {
   double kinetic = 0, gravity = 0, modes = 0, ground = 0, springs = 0;
+  std::vector<double> per_mode;  // each mode's K (γ − γ0)²; `modes` is their sum
   double total() const { return kinetic + gravity + modes + ground + springs; }
 };
 
