@@ -21,13 +21,8 @@ std::string FormatDouble(double value) {
 }
 
 void CheckWritable(const std::string& path) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  std::error_code ec;
-  if (fs::is_directory(target, ec)) throw std::runtime_error(path + ": is a directory");
-  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-  if (ec) throw std::runtime_error(path + ": cannot create its folder: " + ec.message());
-  const std::string tmp = path + ".tmp";
+  io::CreateParentFolder(path);
+  const std::string tmp = io::TempPathFor(path);
   std::FILE* f = std::fopen(tmp.c_str(), "w");
   if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
   std::fclose(f);
@@ -69,29 +64,3 @@ void WriteCsvAtomically(const std::string& path, const std::vector<std::string>&
 
 }  // namespace wobble::app
 
-namespace wobble::app {
-
-void WriteTextAtomically(const std::string& path, const std::string& text) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  std::error_code ec;
-  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-  if (ec) throw std::runtime_error(path + ": cannot create its folder: " + ec.message());
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
-  bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  const int saved_errno = errno;
-  ok = (std::fclose(f) == 0) && ok;
-  if (!ok) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(tmp + ": write failed: " + std::strerror(saved_errno));
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot rename " + tmp + " to it: " + ec.message());
-  }
-}
-
-}  // namespace wobble::app

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "wobble/io/atomic_file.h"
+
 namespace wobble::app {
 
 // Throws std::runtime_error (with the path and the reason) when the file cannot be written.
@@ -22,7 +24,5 @@ std::string FormatDouble(double value);
 }  // namespace wobble::app
 
 namespace wobble::app {
-// Writes `text` to `path` atomically (FILE.tmp in the same folder, then renamed), creating the
-// folder. Throws std::runtime_error with the path and the reason. Used for JSON results.
-void WriteTextAtomically(const std::string& path, const std::string& text);
+using io::WriteTextAtomically;  // JSON results and reports: lib/wobble/io/atomic_file.h
 }  // namespace wobble::app

@@ -154,8 +154,7 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
                      "  xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble ...\n"
                      "or ask only for --what vtp,disp");
   try {
-    io::CreateParentFolder(a.out + "/x");
-    CheckWritable(a.out + "/.wobble-probe");
+    CheckWritable(a.out + "/.wobble-probe");  // creates the folder, leaves nothing else
   } catch (const std::runtime_error& e) {
     throw UsageError(std::string("--out: ") + e.what());
   }

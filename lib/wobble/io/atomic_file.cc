@@ -42,4 +42,15 @@ void WriteFileAtomically(const std::string& path, const std::function<void(const
   }
 }
 
+void WriteTextAtomically(const std::string& path, const std::string& text) {
+  WriteFileAtomically(path, [&](const std::string& tmp) {
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw std::runtime_error(std::string("cannot open ") + tmp + ": " + std::strerror(errno));
+    bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    const int saved_errno = errno;
+    ok = (std::fclose(f) == 0) && ok;
+    if (!ok) throw std::runtime_error(std::strerror(saved_errno));
+  });
+}
+
 }  // namespace wobble::io

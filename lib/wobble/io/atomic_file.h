@@ -21,4 +21,7 @@ void CreateParentFolder(const std::string& path);
 // std::runtime_error naming `path` and the reason is thrown.
 void WriteFileAtomically(const std::string& path, const std::function<void(const std::string& temp_path)>& write);
 
+// The common case: `text` becomes the whole file (JSON, CSV, scripts), by the function above.
+void WriteTextAtomically(const std::string& path, const std::string& text);
+
 }  // namespace wobble::io

@@ -1,5 +1,7 @@
 #include "wobble/io/script.h"
 
+#include "wobble/io/atomic_file.h"
+
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -151,28 +153,6 @@ void Place(const Eigen::Vector3d& placement, Eigen::VectorXd* q, Eigen::VectorXd
 
 }  // namespace
 
-void WriteFileAtomically(const std::string& path, const std::string& text) {
-  const fs::path target(path);
-  std::error_code ec;
-  if (fs::is_directory(target, ec)) throw std::runtime_error(path + ": is a directory");
-  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-  if (ec) throw std::runtime_error(path + ": cannot create its folder: " + ec.message());
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
-  bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  const int saved = errno;
-  ok = (std::fclose(f) == 0) && ok;
-  if (!ok) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(tmp + ": write failed: " + std::strerror(saved));
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot rename " + tmp + " to it: " + ec.message());
-  }
-}
 
 std::string CsvText(const std::vector<std::string>& header, const std::vector<std::vector<double>>& rows) {
   std::string text;
@@ -492,7 +472,7 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
     if (!anneal_csv_.empty()) {
       // cost against iteration (Fig. 5.4/5.5); the hook draws it
       try {
-        WriteFileAtomically(anneal_csv_, CsvText(synth::HistoryHeader(), synth::HistoryRows(r.history)));
+        WriteTextAtomically(anneal_csv_, CsvText(synth::HistoryHeader(), synth::HistoryRows(r.history)));
         if (history_hook_) history_hook_(anneal_csv_, "simulated annealing", r.history);
       } catch (const std::runtime_error& e) {
         ctx.Fail(e.what());
@@ -532,7 +512,7 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
     });
     if (!cmaes_csv_.empty()) {
       try {
-        WriteFileAtomically(cmaes_csv_, CsvText(synth::HistoryHeader(), synth::HistoryRows(r.history)));
+        WriteTextAtomically(cmaes_csv_, CsvText(synth::HistoryHeader(), synth::HistoryRows(r.history)));
         if (history_hook_) history_hook_(cmaes_csv_, "CMA-ES", r.history);
       } catch (const std::runtime_error& e) {
         ctx.Fail(e.what());
@@ -565,7 +545,7 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
     ExpectWords(w, 2, 2, usage(), ctx);
     RequireBody(ctx, "save");
     try {
-      WriteFileAtomically(w[1], ReplayScript());
+      WriteTextAtomically(w[1], ReplayScript());
     } catch (const std::runtime_error& e) {
       ctx.Fail(e.what());
     }
@@ -706,7 +686,7 @@ void Interpreter::RecordRow(const World& world, double t, int pose) {
 void Interpreter::FlushOutput(const Context& ctx) {
   if (output_path_.empty()) return;
   try {
-    WriteFileAtomically(output_path_, CsvText(OutputHeader(int(modes_.size())), rows_));
+    WriteTextAtomically(output_path_, CsvText(OutputHeader(int(modes_.size())), rows_));
   } catch (const std::runtime_error& e) {
     ctx.Fail(std::string("output: ") + e.what());
   }

@@ -145,9 +145,6 @@ class Interpreter {
   std::vector<std::vector<double>> rows_;
 };
 
-// Writes `text` to `path` atomically: to PATH.tmp in the same folder, then renamed. Creates the
-// folder. Throws std::runtime_error with the path and the reason.
-void WriteFileAtomically(const std::string& path, const std::string& text);
 // The CSV text of a table (numbers in shortest round-trip form).
 std::string CsvText(const std::vector<std::string>& header, const std::vector<std::vector<double>>& rows);
 
