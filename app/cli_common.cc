@@ -139,4 +139,14 @@ void RequireNonNegative(double value, const std::string& what) {
   if (!std::isfinite(value) || value < 0.0) throw UsageError(what + " must be a non-negative number");
 }
 
+Integrator ParseIntegratorFlag(const std::string& name) {
+  Integrator integrator;
+  if (ParseIntegrator(name, &integrator)) return integrator;
+  std::string names;
+  for (Integrator i : {Integrator::kThesis, Integrator::kSymplecticEuler, Integrator::kRK4, Integrator::kImplicitEuler,
+                       Integrator::kVariational})
+    names += (names.empty() ? "" : ", ") + IntegratorName(i);
+  throw UsageError("--integrator: '" + name + "' is not one of " + names);
+}
+
 }  // namespace wobble::app

@@ -63,6 +63,9 @@ WorldParams MakeWorldParams(const WorldFlags& flags);
 // gives zeros. Throws UsageError on a non-number, a non-finite number or a wrong count.
 Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& what, const BodyModel& body);
 
+// --integrator NAME; a UsageError listing the known names otherwise.
+Integrator ParseIntegratorFlag(const std::string& name);
+
 // "tx ty theta g1 .. gD" for a body.
 std::string CoordinateNames(const BodyModel& body);
 

@@ -133,9 +133,7 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
 
 int RunRender(const RenderArgs& a, const std::string& default_what) {
   // check every value before reading files or simulating
-  Integrator integrator;
-  if (!ParseIntegrator(a.integrator, &integrator))
-    throw UsageError("--integrator: '" + a.integrator + "' is not one of thesis, symplectic, rk4, implicit, variational");
+  const Integrator integrator = ParseIntegratorFlag(a.integrator);
   RequirePositive(a.dt, "--dt");
   RequireNonNegative(a.duration, "--duration");
   RequirePositive(a.fps, "--fps");

@@ -82,15 +82,7 @@ CLI::App* AddSimulateCommand(CLI::App* app, SimulateArgs* a) {
 
 int RunSimulate(const SimulateArgs& a) {
   // check the numbers before reading any file
-  Integrator integrator;
-  if (!ParseIntegrator(a.integrator, &integrator)) {
-    std::string names;
-    for (const char* name : {"thesis", "symplectic", "rk4", "implicit", "variational"}) {
-      Integrator known;
-      if (ParseIntegrator(name, &known)) names += std::string(names.empty() ? "" : ", ") + name;
-    }
-    throw UsageError("--integrator: '" + a.integrator + "' is not one of " + names);
-  }
+  const Integrator integrator = ParseIntegratorFlag(a.integrator);
   RequirePositive(a.dt, "--dt");
   RequireNonNegative(a.duration, "--duration");
   if (a.every < 1) throw UsageError("--every must be at least 1");

@@ -233,11 +233,11 @@ void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index,
     out->modes[kRigidDofs + d] = -T(2.0 * m.stiffness) * offset - T(m.damping) * s.qd[kRigidDofs + d];
   }
   // penalty ground, only over points below it
-  const GroundFrame gf(w.ground);
   const VecQ<T>* cached = contact_set == ContactSet::kDetect ? CachedGroundForce(s, w.ground) : nullptr;
   if (cached) {
     out->ground = *cached;
   } else {
+    const GroundFrame gf(w.ground);  // sin/cos of the slope: only when the points are visited
     out->ground.setZero(nq);
     ForEachPointInContact(body, w.ground, s, frame, [&](int k, const Vec2<T>& l, const Vec2<T>& x, const Vec2<T>& v,
                                                  const Vec2<T>& anchor) {
