@@ -92,9 +92,13 @@ std::string Fmt(const char* format, double v) {
   return buf;
 }
 
-// A horizontal slider in normalized display coordinates of the window.
+// A horizontal slider in normalized display coordinates of the window. Sizes are given here in
+// pixels: vtkSliderRepresentation2D (9.1, as measured on screen at 800x500) takes lengths along
+// the slider as fractions of the window's width, and widths across it as fractions of about
+// 0.21 of the window's width whatever the slider's length; the text heights are its own
+// fractions, kept fixed.
 Ptr<vtkSliderRepresentation2D> MakeSliderRep(double x0, double x1, double y, double lo, double hi, double value,
-                                             const std::string& title) {
+                                             const std::string& title, int window_width) {
   auto rep = Ptr<vtkSliderRepresentation2D>::New();
   rep->GetPoint1Coordinate()->SetCoordinateSystemToNormalizedDisplay();
   rep->GetPoint1Coordinate()->SetValue(x0, y);
@@ -104,14 +108,18 @@ Ptr<vtkSliderRepresentation2D> MakeSliderRep(double x0, double x1, double y, dou
   rep->SetMaximumValue(hi);
   rep->SetValue(value);
   rep->SetTitleText(title.c_str());
-  rep->SetSliderLength(0.015);
-  rep->SetSliderWidth(0.025);
-  rep->SetTubeWidth(0.006);
-  rep->SetEndCapLength(0.006);
-  rep->SetEndCapWidth(0.025);
-  rep->SetTitleHeight(0.022);
-  rep->SetLabelHeight(0.02);
-  rep->GetTubeProperty()->SetColor(0.55, 0.55, 0.6);
+  rep->SetLabelFormat("%.3g");
+  const double across_unit = std::max(1.0, 0.21 * window_width);  // pixels
+  auto along = [&](double pixels) { return std::clamp(pixels / std::max(1, window_width), 0.001, 0.99); };
+  auto across = [&](double pixels) { return std::clamp(pixels / across_unit, 0.001, 0.99); };
+  rep->SetSliderLength(along(12));
+  rep->SetSliderWidth(across(20));
+  rep->SetTubeWidth(across(6));
+  rep->SetEndCapLength(along(4));
+  rep->SetEndCapWidth(across(20));
+  rep->SetTitleHeight(0.09);
+  rep->SetLabelHeight(0.08);
+  rep->GetTubeProperty()->SetColor(0.35, 0.35, 0.4);
   rep->GetSliderProperty()->SetColor(0.85, 0.2, 0.15);
   rep->GetCapProperty()->SetColor(0.3, 0.3, 0.3);
   rep->GetSelectedProperty()->SetColor(0.2, 0.6, 0.2);
@@ -305,8 +313,8 @@ InteractiveView::InteractiveView(ViewerScene scene, ViewerOptions options) : imp
     // what the body will sweep is unknown: show it with room around and below
     Eigen::AlignedBox2d box = BodyBounds(*m.world, 0);
     const double size = box.sizes().maxCoeff();
-    box.extend(box.min() - Eigen::Vector2d(size, size));
-    box.extend(box.max() + Eigen::Vector2d(size, 0.5 * size));
+    box.extend(box.min() - Eigen::Vector2d(size, 0.4 * size));
+    box.extend(box.max() + Eigen::Vector2d(size, 0.8 * size));
     m.view->FrameBox(box);
   }
   m.status = Ptr<vtkTextActor>::New();
@@ -371,7 +379,8 @@ InteractiveView::InteractiveView(ViewerScene scene, ViewerOptions options) : imp
   for (int d = 0; d < D; ++d) {
     const std::string& name = m.scene.body->modes()[d].name;
     auto rep = MakeSliderRep(0.02 + d * width + 0.01, 0.02 + (d + 1) * width - 0.02, 0.15, -options.slider_range,
-                             options.slider_range, 0.0, "target " + (name.empty() ? std::to_string(d + 1) : name));
+                             options.slider_range, 0.0, "target " + (name.empty() ? std::to_string(d + 1) : name),
+                             options.width);
     // the mode index rides in the callback's client data as an integer beside `this`
     auto* data = new std::pair<InteractiveView*, int>(this, d);
     auto w = add_slider(
@@ -388,7 +397,7 @@ InteractiveView::InteractiveView(ViewerScene scene, ViewerOptions options) : imp
     m.callbacks.back()->SetClientDataDeleteCallback([](void* p) { delete static_cast<std::pair<InteractiveView*, int>*>(p); });
   }
   // the time slider: the recorded frames
-  m.time_slider = add_slider(MakeSliderRep(0.02, 0.98, 0.05, 0.0, 1.0, 0.0, "recorded frame"),
+  m.time_slider = add_slider(MakeSliderRep(0.02, 0.98, 0.05, 0.0, 1.0, 0.0, "recorded frame", options.width),
                              [](vtkObject* caller, unsigned long, void* client, void*) {
                                auto* view = static_cast<InteractiveView*>(client);
                                auto* widget = static_cast<vtkSliderWidget*>(caller);
