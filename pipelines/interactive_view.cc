@@ -255,10 +255,30 @@ struct InteractiveView::Impl {
     rep->SetValue(scrubbing ? double(scrub_frame) : last);
   }
 
+  // The charts show the last kChartWindow seconds: redrawing the whole of a long session
+  // every few frames would slow the window down as it goes.
+  static constexpr double kChartWindow = 30.0;
+  static void Trim(ChartSpec* spec) {
+    for (ChartSeries& s : spec->series) {
+      if (s.x.empty()) continue;
+      const double from = s.x.back() - kChartWindow;
+      const size_t first = size_t(std::lower_bound(s.x.begin(), s.x.end(), from) - s.x.begin());
+      s.x.erase(s.x.begin(), s.x.begin() + long(first));
+      s.y.erase(s.y.begin(), s.y.begin() + long(first));
+    }
+    if (!spec->series.empty() && !spec->series[0].x.empty()) {
+      const double from = spec->series[0].x.front();
+      spec->markers.erase(std::remove_if(spec->markers.begin(), spec->markers.end(), [&](double m) { return m < from; }),
+                          spec->markers.end());
+    }
+  }
   void UpdateCharts() {
     if (!options.charts || recorder->time().size() < 2) return;  // a line needs two points
-    FillChart(energy_chart, recorder->EnergyChart("energy"));
+    ChartSpec energy = recorder->EnergyChart("energy");
     ChartSpec cond = recorder->ConditionChart("cond2(M)");
+    Trim(&energy);
+    Trim(&cond);
+    FillChart(energy_chart, energy);
     FillChart(cond_chart, cond);
   }
 
