@@ -175,8 +175,12 @@ int RunView(const ViewArgs& a) {
     std::printf("frames drawn: %ld in %.3f s wall: %.1f frames/s\n", s.frames, s.wall, fps);
     std::printf("simulation steps: %ld, %.2f per drawn frame (dt %g s)\n", s.steps,
                 s.playing_frames ? double(s.steps) / double(s.playing_frames) : 0.0, view.world().options().dt);
-    std::printf("simulated %.3f s in %.3f s of wall time playing at speed %g: %.3f x real time (%s)\n", s.simulated,
-                s.playing_wall, a.speed, ratio, ratio >= 0.98 * a.speed ? "keeps up" : "falls behind");
+    if (a.fixed_frame_time)
+      std::printf("simulated %.3f s in %.3f s of wall time (--fixed-frame-time: each frame advances speed/fps, so "
+                  "this is no real-time measurement)\n", s.simulated, s.playing_wall);
+    else
+      std::printf("simulated %.3f s in %.3f s of wall time playing at speed %g: %.3f x real time (%s)\n", s.simulated,
+                  s.playing_wall, a.speed, ratio, ratio >= 0.98 * a.speed ? "keeps up" : "falls behind");
   }
   std::printf("t = %.6g, q =", view.time());
   for (int i = 0; i < view.world().state(0).q.size(); ++i) std::printf(" %.17g", view.world().state(0).q[i]);

@@ -282,6 +282,23 @@ struct InteractiveView::Impl {
     FillChart(cond_chart, cond);
   }
 
+  // What the body will sweep is unknown: show it with room around it, and the ground under it
+  // when the ground is within a few body sizes below.
+  void FrameBody() {
+    const World& w = scrubbing ? *scrub_world : *world;
+    Eigen::AlignedBox2d box = BodyBounds(w, 0);
+    const double size = box.sizes().maxCoeff();
+    const Ground& g = scene.world.params.ground;
+    if (g.enabled && std::abs(std::cos(g.slope)) > 1e-6) {
+      const double x = box.center().x();
+      const double ground_y = g.point.y() + std::tan(g.slope) * (x - g.point.x());
+      if (ground_y < box.min().y() && ground_y > box.min().y() - 4.0 * size) box.extend(Eigen::Vector2d(x, ground_y));
+    }
+    box.extend(box.min() - Eigen::Vector2d(size, 0.4 * size));
+    box.extend(box.max() + Eigen::Vector2d(size, 0.8 * size));
+    view->FrameBox(box);
+  }
+
   void UpdateStatus() {
     status->SetInput(self->StatusLine().c_str());
   }
@@ -329,14 +346,7 @@ InteractiveView::InteractiveView(ViewerScene scene, ViewerOptions options) : imp
   m.view = std::make_unique<SceneView>(m.world.get(), 0, so);
   vtkRenderWindow* window = m.view->window();
   window->SetWindowName("wobble view");
-  {
-    // what the body will sweep is unknown: show it with room around and below
-    Eigen::AlignedBox2d box = BodyBounds(*m.world, 0);
-    const double size = box.sizes().maxCoeff();
-    box.extend(box.min() - Eigen::Vector2d(size, 0.4 * size));
-    box.extend(box.max() + Eigen::Vector2d(size, 0.8 * size));
-    m.view->FrameBox(box);
-  }
+  m.FrameBody();
   m.status = Ptr<vtkTextActor>::New();
   m.status->GetTextProperty()->SetColor(0, 0, 0);
   m.status->GetTextProperty()->SetFontSize(14);
@@ -514,11 +524,7 @@ bool InteractiveView::HandleKey(const std::string& k) {
   else if (k == "g") ToggleLayer(SceneLayer::kGround);
   else if (k == "p") ToggleLayer(SceneLayer::kSprings);
   else if (k == "c") {
-    Eigen::AlignedBox2d box = BodyBounds(*m.world, 0);
-    const double size = box.sizes().maxCoeff();
-    box.extend(box.min() - Eigen::Vector2d(0.5 * size, 0.5 * size));
-    box.extend(box.max() + Eigen::Vector2d(0.5 * size, 0.5 * size));
-    m.view->FrameBox(box);
+    m.FrameBody();
   } else if (k == "k") RecordPose();
   else if (k == "w") {
     try {
