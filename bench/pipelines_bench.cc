@@ -45,7 +45,7 @@ std::unique_ptr<World> DemoWorld() {
 void Advance(std::unique_ptr<World>* world, long* frame) {
   ++*frame;
   if (*frame > 300) {
-    *world = DemoWorld();
+    **world = std::move(*DemoWorld());  // in place: the views and writers keep pointing at it
     *frame = 0;
   }
   (*world)->RunUntil(*frame / 30.0, [](const World&) {});
