@@ -85,7 +85,7 @@ CLI::App* AddViewCommand(CLI::App* app, ViewArgs* a) {
       ->type_name("FILE");
   cmd->add_flag("--report-fps", a->report_fps, "Print frames drawn per second and steps per frame at the end");
   cmd->add_option("--slider-range", a->slider_range, "Mode target sliders span -R..R")->capture_default_str();
-  cmd->add_option("--drag-stiffness", a->drag_stiffness, "Stiffness of the mouse spring (0: automatic, ~2 Hz)")
+  cmd->add_option("--drag-stiffness", a->drag_stiffness, "Stiffness of the mouse spring (0: automatic, ~1 Hz)")
       ->capture_default_str();
   cmd->footer(
       "Examples:\n"

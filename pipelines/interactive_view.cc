@@ -684,9 +684,11 @@ bool InteractiveView::BeginDrag(int x, int y) {
     }
   }
   if (pick < 0) return false;
-  // a spring of about 2 Hz for the whole body, half critically damped
+  // a spring of about 1 Hz for the whole body, half critically damped: stiff enough to lift it
+  // (its weight needs a stretch of g / (2 pi)^2 = 0.25 length units), soft enough that a quick
+  // move of the cursor does not fling it
   const double mass = m.scene.body->moments().m;
-  const double k = m.options.drag_stiffness > 0 ? m.options.drag_stiffness : mass * std::pow(2.0 * M_PI * 2.0, 2);
+  const double k = m.options.drag_stiffness > 0 ? m.options.drag_stiffness : mass * std::pow(2.0 * M_PI * 1.0, 2);
   const double c = m.options.drag_damping > 0 ? m.options.drag_damping : std::sqrt(k * mass);
   Spring sp;
   sp.body = 0;

@@ -64,7 +64,7 @@ struct ViewerOptions {
   // time since the last frame (at most kMaxFrameTime) times speed.
   bool fixed_frame_time = false;
   double slider_range = 0.5;    // mode sliders go from -range to +range
-  double drag_stiffness = 0.0;  // 0: total mass x (2 pi x 2 Hz)^2
+  double drag_stiffness = 0.0;  // 0: total mass x (2 pi x 1 Hz)^2
   double drag_damping = 0.0;    // 0: half of critical for the total mass on that spring
   bool charts = true;
   int chart_every = 10;  // frames between chart redraws
