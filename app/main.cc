@@ -11,6 +11,7 @@
 #include "inspect.h"
 #ifdef WOBBLE_HAVE_PIPELINES
 #include "render.h"
+#include "view.h"
 #endif
 #include "run.h"
 #include "simulate.h"
@@ -39,6 +40,8 @@ int main(int argc, char** argv) {
                                       render_what, &render_args);
   CLI::App* exporter = AddRenderCommand(&app, "export", "Simulate and export: .vtp/.pvd for ParaView, EXR frames and "
                                         "displacement images", export_what, &export_args);
+  ViewArgs view_args;
+  CLI::App* view = AddViewCommand(&app, &view_args);
 #endif
   FitPoseArgs fit_pose_args;
   FitTrajectoryArgs fit_trajectory_args;
@@ -63,6 +66,7 @@ int main(int argc, char** argv) {
 #ifdef WOBBLE_HAVE_PIPELINES
     if (render->parsed()) return RunRender(render_args, render_what);
     if (exporter->parsed()) return RunRender(export_args, export_what);
+    if (view->parsed()) return RunView(view_args);
 #endif
     if (fit.pose->parsed()) return RunFitPose(fit_pose_args);
     if (fit.trajectory->parsed()) return RunFitTrajectory(fit_trajectory_args);

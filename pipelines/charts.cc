@@ -115,6 +115,14 @@ vtkSmartPointer<vtkImageData> RenderChart(const ChartSpec& spec) {
   auto view = MakeView(spec.width, spec.height);
   auto chart = Ptr<vtkChartXY>::New();
   view->GetScene()->AddItem(chart);
+  FillChart(chart, spec);
+  return Grab(view);
+}
+
+void FillChart(vtkChartXY* chart, const ChartSpec& spec) {
+  Validate(spec);
+  chart->ClearPlots();
+  chart->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::AUTO);
   chart->SetTitle(spec.title);
   chart->GetTitleProperties()->SetFontSize(16);
   chart->SetShowLegend(true);
@@ -198,7 +206,6 @@ vtkSmartPointer<vtkImageData> RenderChart(const ChartSpec& spec) {
       first = false;
     }
   }
-  return Grab(view);
 }
 
 void WriteChartCsv(const ChartSpec& spec, const std::string& csv_path) {

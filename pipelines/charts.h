@@ -7,6 +7,7 @@
 #include <vector>
 #include <vtkSmartPointer.h>
 
+class vtkChartXY;
 class vtkImageData;
 
 namespace wobble::pipelines {
@@ -34,6 +35,10 @@ struct ChartSpec {
 // Renders the chart offscreen (RGB image, bottom row first). Throws std::invalid_argument for
 // a malformed spec, std::runtime_error without a display.
 vtkSmartPointer<vtkImageData> RenderChart(const ChartSpec& spec);
+// Replaces the plots of an existing chart by the spec's (title, axes, series, markers; the
+// size fields are not used): what RenderChart draws, for a chart that lives in a window of
+// its own, e.g. the interactive viewer's live panel, redrawn as the run goes on.
+void FillChart(vtkChartXY* chart, const ChartSpec& spec);
 
 // Writes the chart as PNG and its data as CSV, both atomically. The CSV has a header row;
 // when every series shares one x it is wide (x, then one column per series), otherwise long

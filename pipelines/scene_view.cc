@@ -77,6 +77,7 @@ struct SceneView::Impl {
   Ptr<vtkTextActor> overlay;
   vtkPolyDataMapper* colored = nullptr;  // the mapper that shows color_by, if any
   Ptr<vtkImageData> last_rgb;            // read back from the window after the last Render()
+  Ptr<vtkActor> layers[6];               // by SceneLayer
 
   Ptr<vtkActor> AddActor(vtkPolyDataAlgorithm* source, const double rgb[3], double line_width, double point_size,
                          Ptr<vtkPolyDataMapper>* mapper_out = nullptr) {
@@ -107,10 +108,14 @@ SceneView::SceneView(const World* world, int body, SceneOptions options) : impl_
   m.renderer = Ptr<vtkRenderer>::New();
   m.renderer->SetBackground(1.0, 1.0, 1.0);
   m.window = Ptr<vtkRenderWindow>::New();
-  m.window->SetOffScreenRendering(1);
+  m.window->SetOffScreenRendering(options_.offscreen ? 1 : 0);
   m.window->SetMultiSamples(0);  // identical pixels run to run, cheaper readback
   m.window->SetSize(options_.width, options_.height);
   m.window->AddRenderer(m.renderer);
+  const double* vp = options_.viewport;
+  if (!(vp[0] >= 0 && vp[1] >= 0 && vp[2] <= 1 && vp[3] <= 1 && vp[0] < vp[2] && vp[1] < vp[3]))
+    throw std::invalid_argument("SceneView: the viewport must lie inside [0, 1] x [0, 1]");
+  m.renderer->SetViewport(vp[0], vp[1], vp[2], vp[3]);
 
   auto attach = [&](WorldSourceBase* s) {
     s->SetWorld(world);
@@ -131,13 +136,25 @@ SceneView::SceneView(const World* world, int body, SceneOptions options) : impl_
   // buffer, but the z offsets below keep points above lines above the ground
   const double ground_rgb[3] = {0.55, 0.47, 0.38}, lattice_rgb[3] = {0.45, 0.6, 0.85}, shape_rgb[3] = {0.1, 0.1, 0.1},
                points_rgb[3] = {0.85, 0.2, 0.15}, spring_rgb[3] = {0.2, 0.6, 0.2}, trail_rgb[3] = {0.6, 0.3, 0.7};
-  if (options_.show_ground) m.AddActor(m.ground, ground_rgb, 1.0, 1.0);
-  if (options_.show_trails) m.AddActor(m.trails, trail_rgb, 1.5, 1.0)->SetPosition(0, 0, 0.5);
-  if (options_.show_lattice)
-    m.AddActor(m.lattice, lattice_rgb, 1.0, options_.point_size * 0.75, &m.lattice_points_mapper)->SetPosition(0, 0, 1);
-  if (options_.show_springs) m.AddActor(m.springs, spring_rgb, 1.5, 1.0)->SetPosition(0, 0, 1.5);
-  if (options_.show_shape) m.AddActor(m.shape, shape_rgb, options_.line_width, 1.0)->SetPosition(0, 0, 2);
-  if (options_.show_points) m.AddActor(m.points, points_rgb, 1.0, options_.point_size, &m.points_mapper)->SetPosition(0, 0, 3);
+  // every layer gets its actor; the show_* options only set whether it starts visible
+  m.layers[int(SceneLayer::kGround)] = m.AddActor(m.ground, ground_rgb, 1.0, 1.0);
+  m.layers[int(SceneLayer::kTrails)] = m.AddActor(m.trails, trail_rgb, 1.5, 1.0);
+  m.layers[int(SceneLayer::kTrails)]->SetPosition(0, 0, 0.5);
+  m.layers[int(SceneLayer::kLattice)] =
+      m.AddActor(m.lattice, lattice_rgb, 1.0, options_.point_size * 0.75, &m.lattice_points_mapper);
+  m.layers[int(SceneLayer::kLattice)]->SetPosition(0, 0, 1);
+  m.layers[int(SceneLayer::kSprings)] = m.AddActor(m.springs, spring_rgb, 1.5, 1.0);
+  m.layers[int(SceneLayer::kSprings)]->SetPosition(0, 0, 1.5);
+  m.layers[int(SceneLayer::kShape)] = m.AddActor(m.shape, shape_rgb, options_.line_width, 1.0);
+  m.layers[int(SceneLayer::kShape)]->SetPosition(0, 0, 2);
+  m.layers[int(SceneLayer::kPoints)] = m.AddActor(m.points, points_rgb, 1.0, options_.point_size, &m.points_mapper);
+  m.layers[int(SceneLayer::kPoints)]->SetPosition(0, 0, 3);
+  SetLayerVisible(SceneLayer::kGround, options_.show_ground);
+  SetLayerVisible(SceneLayer::kTrails, options_.show_trails);
+  SetLayerVisible(SceneLayer::kLattice, options_.show_lattice);
+  SetLayerVisible(SceneLayer::kSprings, options_.show_springs);
+  SetLayerVisible(SceneLayer::kShape, options_.show_shape);
+  SetLayerVisible(SceneLayer::kPoints, options_.show_points);
 
   // colour by an array: a mass-point array, or the lattice's displacement
   if (!options_.color_by.empty()) {
@@ -148,6 +165,8 @@ SceneView::SceneView(const World* world, int body, SceneOptions options) : impl_
     if (!known)
       throw std::invalid_argument("color by '" + options_.color_by +
                                   "': not one of mass, velocity, applied_force, in_contact, displacement");
+    if (!(on_lattice ? options_.show_lattice : options_.show_points))
+      throw std::invalid_argument("color by '" + options_.color_by + "': that layer is hidden");
     m.colored = on_lattice ? m.lattice_points_mapper.Get() : m.points_mapper.Get();
     if (!m.colored) throw std::invalid_argument("color by '" + options_.color_by + "': that layer is hidden");
     m.lut = Ptr<vtkLookupTable>::New();
@@ -182,7 +201,8 @@ SceneView::SceneView(const World* world, int body, SceneOptions options) : impl_
     m.overlay->GetTextProperty()->SetFontSize(std::max(10, options_.height / 32));
     m.overlay->GetTextProperty()->SetFontFamilyToCourier();
     m.overlay->GetTextProperty()->SetVerticalJustificationToTop();
-    m.overlay->SetDisplayPosition(8, options_.height - 8);
+    m.overlay->SetDisplayPosition(int(options_.viewport[0] * options_.width) + 8,
+                                  int(options_.viewport[3] * options_.height) - 8);
     m.renderer->AddActor2D(m.overlay);
   }
   FrameBox(BodyBounds(*world, body));
@@ -196,7 +216,9 @@ void SceneView::FrameBox(const Eigen::AlignedBox2d& box_in, double margin) {
   const Eigen::Vector2d c = box.center();
   Eigen::Vector2d half = 0.5 * box.sizes() * (1.0 + 2.0 * margin);
   half = half.cwiseMax(1e-6);
-  const double aspect = double(options_.width) / options_.height;
+  // the renderer's part of the window
+  const double* vp = options_.viewport;
+  const double aspect = double(options_.width) * (vp[2] - vp[0]) / (options_.height * (vp[3] - vp[1]));
   // parallel scale is half the visible height: fit both the box's height and its width
   const double scale = std::max(half.y(), half.x() / aspect);
   framed_ = Eigen::AlignedBox2d(c - Eigen::Vector2d(scale * aspect, scale), c + Eigen::Vector2d(scale * aspect, scale));
@@ -314,8 +336,21 @@ void SceneView::WriteExr(const std::string& path, BackgroundWriter* writer) {
   writer->Submit([path, w, h, compression, ch = CaptureRgbaDepth()] { WriteExrChannels(path, w, h, ch, compression); });
 }
 
+void SceneView::SetLayerVisible(SceneLayer layer, bool visible) { impl_->layers[int(layer)]->SetVisibility(visible); }
+bool SceneView::LayerVisible(SceneLayer layer) const { return impl_->layers[int(layer)]->GetVisibility() != 0; }
+
+void SceneView::SetWorld(const World* world) {
+  if (!world || impl_->body >= world->num_bodies()) throw std::invalid_argument("SceneView::SetWorld: no such world/body");
+  Impl& m = *impl_;
+  m.world = world;
+  for (WorldSourceBase* s : {(WorldSourceBase*)m.ground, (WorldSourceBase*)m.lattice, (WorldSourceBase*)m.points,
+                             (WorldSourceBase*)m.shape, (WorldSourceBase*)m.springs, (WorldSourceBase*)m.trails})
+    s->SetWorld(world);
+}
+
 TrailSource* SceneView::trails() { return impl_->trails; }
 vtkRenderWindow* SceneView::window() { return impl_->window; }
+vtkRenderer* SceneView::renderer() { return impl_->renderer; }
 
 vtkSmartPointer<vtkImageData> TileImages(const std::vector<vtkSmartPointer<vtkImageData>>& images, int columns, int gap) {
   if (images.empty()) throw std::invalid_argument("TileImages: no images");

@@ -19,6 +19,7 @@
 
 class vtkImageData;
 class vtkRenderWindow;
+class vtkRenderer;
 
 namespace wobble::pipelines {
 
@@ -43,7 +44,15 @@ struct SceneOptions {
   double point_size = 8.0, line_width = 3.0;
   ExrCompression exr_compression = ExrCompression::kZip;  // of WriteExr's frames
   int png_compression = 1;                                // zlib level 0-9 of WritePng
+  // The interactive viewer (interactive_view.h) draws on screen, in a part of its window:
+  // offscreen false opens a visible window; viewport = {xmin, ymin, xmax, ymax} of the window
+  // (fractions) that the scene's renderer covers. width and height stay the window's size.
+  bool offscreen = true;
+  double viewport[4] = {0.0, 0.0, 1.0, 1.0};
 };
+
+// The layers a SceneView draws; each can be shown or hidden after construction.
+enum class SceneLayer { kGround, kLattice, kPoints, kShape, kSprings, kTrails };
 
 // A box holding every point of the body now: its deformed control points (by the convex-hull
 // property of the Bernstein/B-spline weights no point of the body lies outside them).
@@ -77,8 +86,15 @@ class SceneView {
   std::vector<ExrChannel> CaptureRgbaDepth();
   void WriteExr(const std::string& path, BackgroundWriter* writer = nullptr);
 
+  // Shows or hides one layer (the interactive viewer's keys). The show_* options set the start.
+  void SetLayerVisible(SceneLayer layer, bool visible);
+  bool LayerVisible(SceneLayer layer) const;
+  // Draws another world from now on (same body index; e.g. a recorded state while scrubbing).
+  void SetWorld(const World* world);
+
   TrailSource* trails();
   vtkRenderWindow* window();
+  vtkRenderer* renderer();
   const SceneOptions& options() const { return options_; }
 
  private:

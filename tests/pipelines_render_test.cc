@@ -26,76 +26,14 @@
 #include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
 #include "pipelines_test_util.h"
+#include "render_baseline.h"
 
 namespace wobble::pipelines {
 namespace {
 
 namespace fs = std::filesystem;
 using testing::AirborneWorld;
-
-constexpr int kChannelTolerance = 24;     // of 255, per channel
-constexpr double kMaxBadFraction = 0.001;  // of the pixels
-
-bool PixelNear(vtkImageData* a, int x, int y, vtkImageData* b, int comps) {
-  int dims[3];
-  b->GetDimensions(dims);
-  const auto* pa = static_cast<const unsigned char*>(a->GetScalarPointer(x, y, 0));
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
-      const int bx = x + dx, by = y + dy;
-      if (bx < 0 || by < 0 || bx >= dims[0] || by >= dims[1]) continue;
-      const auto* pb = static_cast<const unsigned char*>(b->GetScalarPointer(bx, by, 0));
-      bool all = true;
-      for (int c = 0; c < comps && all; ++c) all = std::abs(int(pa[c]) - int(pb[c])) <= kChannelTolerance;
-      if (all) return true;
-    }
-  return false;
-}
-
-void CompareWithBaseline(const std::string& name, vtkImageData* image) {
-  const std::string baseline_path = std::string(WOBBLE_BASELINE_DIR) + "/" + name + ".png";
-  if (const char* update = std::getenv("WOBBLE_UPDATE_BASELINES"); update && std::string(update) == "1") {
-    WritePng(baseline_path, image, 9);
-    std::cout << "wrote baseline " << baseline_path << "\n";
-    return;
-  }
-  ASSERT_TRUE(fs::exists(baseline_path)) << baseline_path << " is missing: run with WOBBLE_UPDATE_BASELINES=1";
-  auto reader = vtkSmartPointer<vtkPNGReader>::New();
-  reader->SetFileName(baseline_path.c_str());
-  reader->Update();
-  vtkImageData* base = reader->GetOutput();
-  int dn[3], db[3];
-  image->GetDimensions(dn);
-  base->GetDimensions(db);
-  const int comps = image->GetNumberOfScalarComponents();
-  ASSERT_EQ(dn[0], db[0]);
-  ASSERT_EQ(dn[1], db[1]);
-  ASSERT_EQ(comps, base->GetNumberOfScalarComponents());
-  long bad = 0;
-  auto diff = vtkSmartPointer<vtkImageData>::New();
-  diff->SetDimensions(dn[0], dn[1], 1);
-  diff->AllocateScalars(VTK_UNSIGNED_CHAR, comps);
-  for (int y = 0; y < dn[1]; ++y)
-    for (int x = 0; x < dn[0]; ++x) {
-      const bool ok = PixelNear(image, x, y, base, comps) && PixelNear(base, x, y, image, comps);
-      bad += ok ? 0 : 1;
-      const auto* pn = static_cast<const unsigned char*>(image->GetScalarPointer(x, y, 0));
-      const auto* pb = static_cast<const unsigned char*>(base->GetScalarPointer(x, y, 0));
-      auto* pd = static_cast<unsigned char*>(diff->GetScalarPointer(x, y, 0));
-      for (int c = 0; c < comps; ++c) pd[c] = (unsigned char)std::min(255, 4 * std::abs(int(pn[c]) - int(pb[c])));
-    }
-  const double fraction = double(bad) / (double(dn[0]) * dn[1]);
-  if (fraction > kMaxBadFraction) {
-    const std::string out = WOBBLE_RENDER_FAILURE_DIR;
-    WritePng(out + "/" + name + "_new.png", image);
-    WritePng(out + "/" + name + "_diff.png", diff);
-    ADD_FAILURE() << name << ": " << bad << " pixels (" << 100 * fraction << "%) differ from " << baseline_path
-                  << " by more than " << kChannelTolerance << " within +-1 px; new image and diff in " << out;
-  }
-}
-
-#define REQUIRE_DISPLAY() \
-  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run"
+using testing_render::CompareWithBaseline;
 
 // One layer alone, 160 x 120, no overlay.
 SceneOptions OnlyLayer(const std::string& layer) {

@@ -801,6 +801,22 @@ void Interpreter::RunKeyframes(const Context& ctx) {
   out_ << "]\n";
 }
 
+Interpreter::SimulationSetup Interpreter::CurrentSetup() {
+  SimulationSetup setup;
+  setup.body = BuildBody();
+  if (!setup.body) return setup;
+  const synth::Problem p = MakeProblem(0);  // the world options with the springs, as simul builds them
+  setup.world = p.world;
+  setup.q = q_;
+  setup.qd = qd_;
+  setup.time = time_;
+  setup.end = end_;
+  if (control_on_) setup.graph = graph_;
+  setup.object_path = object_path_;
+  setup.mode_paths = def_paths_;
+  return setup;
+}
+
 std::string Interpreter::ReplayScript() const {
   std::ostringstream s;
   const Ground& g = world_.params.ground;

@@ -83,6 +83,21 @@ class Interpreter {
   // and replays it with `simul`.
   std::string ReplayScript() const;
 
+  // What `simul` would run now, for clients that step a World themselves (`wobble view`):
+  // the body (codamA included in the active modes' damping), the world options with the
+  // script's springs (when `set spring` is on), the state, the time and the pose graph (empty
+  // when `set control F`), and the files it was loaded from. body is null before load_obj.
+  struct SimulationSetup {
+    std::shared_ptr<const BodyModel> body;
+    WorldOptions world;
+    Eigen::VectorXd q, qd;
+    double time = 0.0, end = 0.0;
+    control::PoseGraph graph;
+    std::string object_path;              // absolute
+    std::vector<std::string> mode_paths;  // absolute, in load order
+  };
+  SimulationSetup CurrentSetup();
+
  private:
   struct Context;
   void Execute(const std::vector<std::string>& words, const Context& ctx);

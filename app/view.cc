@@ -1,0 +1,195 @@
+#include "view.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include <vtkImageData.h>
+
+#include "pipelines/exports.h"
+#include "pipelines/interactive_view.h"
+#include "pipelines/scene_view.h"
+#include "wobble/io/script.h"
+
+namespace wobble::app {
+namespace {
+
+namespace pl = wobble::pipelines;
+namespace fs = std::filesystem;
+
+bool IsScript(const std::string& path) { return fs::path(path).extension() == ".wob"; }
+
+// Runs the script in the interpreter up to (not including) its first `simul` or `keyframe`:
+// the viewer plays that simulation live. Returns the line it stopped at (0: the whole script).
+int RunScriptSetup(io::Interpreter* interp, const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw UsageError(path + ": cannot open the script");
+  const std::string dir = fs::path(path).parent_path().string();
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    std::istringstream words(line.substr(0, line.find('#')));
+    std::string first;
+    words >> first;
+    if (first == "simul" || first == "keyframe") return number;
+    if (!interp->RunLine(line, path, number, dir)) return number;  // quit
+  }
+  return 0;
+}
+
+int ParseSide(const std::string& text, int* w, int* h) {
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", w, &x, h, &extra) != 3 || (x != 'x' && x != 'X') || *w < 320 ||
+      *h < 240 || *w > 8192 || *h > 8192)
+    throw UsageError("--size: expected WIDTHxHEIGHT of at least 320x240, such as 1280x720, got '" + text + "'");
+  return 0;
+}
+
+}  // namespace
+
+CLI::App* AddViewCommand(CLI::App* app, ViewArgs* a) {
+  CLI::App* cmd = app->add_subcommand("view", "Interactive viewer: simulate live, pull points, set mode targets, "
+                                              "record poses, save the session as a script");
+  cmd->add_option("scene", a->scene, "An object file (with --modes) or a script (.wob)")->type_name("SCENE_OR_SCRIPT");
+  cmd->add_option("--object", a->object, "Object file (instead of the positional SCENE)")->type_name("FILE");
+  cmd->add_option("--modes", a->modes, "Deformation files of the object; the modes of all files, in order")
+      ->delimiter(',')
+      ->type_name("FILE[,FILE...]");
+  cmd->add_option("--q", a->q, "Initial q = \"tx ty theta g1 ..\" (object files; a script uses set_vec)")
+      ->type_name("\"NUMS\"");
+  cmd->add_option("--qdot", a->qdot, "Initial q-dot, same layout")->type_name("\"NUMS\"");
+  cmd->add_option("--integrator", a->integrator, "thesis | symplectic | rk4 | implicit | variational (object files)")
+      ->capture_default_str()
+      ->type_name("NAME");
+  cmd->add_option("--dt", a->dt, "Time step (object files)")->capture_default_str();
+  AddWorldFlags(cmd, &a->world);
+  cmd->add_option("--size", a->size, "Window size")->capture_default_str()->type_name("WxH");
+  cmd->add_option("--fps", a->fps, "Frames per second the timer asks for")->capture_default_str();
+  cmd->add_option("--speed", a->speed, "Simulated seconds per second of wall time (keys + and -)")
+      ->capture_default_str();
+  cmd->add_flag("--paused", a->paused, "Start paused (space plays)");
+  cmd->add_flag("--fixed-frame-time", a->fixed_frame_time,
+                "Every frame advances speed/fps of simulated time, whatever the wall clock (reproducible runs)");
+  cmd->add_flag("--no-charts", a->no_charts, "No live charts (the scene takes the whole width)");
+  cmd->add_option("--frames", a->frames, "Quit after drawing this many frames (0: run until closed)")
+      ->capture_default_str();
+  cmd->add_option("--play-events", a->play_events,
+                  "Play recorded interactor events (vtkInteractorEventRecorder format; TimerEvent lines draw "
+                  "frames), then quit unless --frames asks for more")
+      ->type_name("FILE");
+  cmd->add_option("--screenshot", a->screenshot, "Write the window as PNG when the viewer ends")->type_name("PNG");
+  cmd->add_option("--session", a->session, "Where the key w writes the session script")->capture_default_str()
+      ->type_name("FILE");
+  cmd->add_option("--save-session", a->save_session, "Write the session script here when the viewer ends")
+      ->type_name("FILE");
+  cmd->add_flag("--report-fps", a->report_fps, "Print frames drawn per second and steps per frame at the end");
+  cmd->add_option("--slider-range", a->slider_range, "Mode target sliders span -R..R")->capture_default_str();
+  cmd->add_option("--drag-stiffness", a->drag_stiffness, "Stiffness of the mouse spring (0: automatic, ~1 Hz)")
+      ->capture_default_str();
+  cmd->footer(
+      "Examples:\n"
+      "  wobble view data/table.obj --modes data/table_modes.def --q \"0 50 0 0 0 0 0\"\n"
+      "  wobble view data/bounding_table.wob\n"
+      "Keys: space play/pause, n step, r restart, +/- speed, s l m g p toggle shape/lattice/points/ground/springs,\n"
+      "k record pose, w write session, Left/Right scrub, h help, q quit. Left mouse pulls a point.");
+  return cmd;
+}
+
+int RunView(const ViewArgs& a) {
+  // every value first, then the display, then the files
+  RequirePositive(a.fps, "--fps");
+  RequirePositive(a.speed, "--speed");
+  RequirePositive(a.slider_range, "--slider-range");
+  RequireNonNegative(a.drag_stiffness, "--drag-stiffness");
+  if (a.frames < 0) throw UsageError("--frames must be >= 0");
+  int width = 0, height = 0;
+  ParseSide(a.size, &width, &height);
+  if (a.scene.empty() && a.object.empty()) throw UsageError("view: give an object file (with --modes) or a script");
+  if (!a.scene.empty() && !a.object.empty() && !IsScript(a.scene))
+    throw UsageError("view: give the object either as SCENE or with --object, not both");
+  if (!a.play_events.empty() && !fs::exists(a.play_events)) throw UsageError("--play-events: no file " + a.play_events);
+  if (!pl::HasDisplay())
+    throw UsageError("view needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run it on a desktop,\n"
+                     "or headless: xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble view ... --frames N");
+
+  pl::ViewerScene scene;
+  const bool script = !a.scene.empty() && IsScript(a.scene);
+  if (script) {
+    if (!a.q.empty() || !a.qdot.empty() || !a.modes.empty())
+      throw UsageError("view: --q, --qdot and --modes apply to object files; a script sets them itself");
+    io::Interpreter interp(std::cout);
+    if (!a.object.empty()) interp.LoadObject(a.object);
+    const int stop = RunScriptSetup(&interp, a.scene);
+    io::Interpreter::SimulationSetup setup = interp.CurrentSetup();
+    if (!setup.body) throw UsageError(a.scene + ": the script loads no object (load_obj FILE, or --object FILE)");
+    if (stop > 0)
+      std::cout << "wobble view: " << a.scene << " ran up to line " << stop
+                << "; the viewer plays its simulation from there\n";
+    scene.body = setup.body;
+    scene.world = setup.world;
+    scene.q0 = setup.q;
+    scene.qd0 = setup.qd;
+    scene.t0 = setup.time;
+    scene.graph = setup.graph;
+    scene.object_path = setup.object_path;
+    scene.mode_paths = setup.mode_paths;
+  } else {
+    BodyFiles files;
+    files.object = a.object.empty() ? a.scene : a.object;
+    files.modes = a.modes;
+    WorldOptions options;
+    options.params = MakeWorldParams(a.world);
+    options.integrator = ParseIntegratorFlag(a.integrator);
+    RequirePositive(a.dt, "--dt");
+    options.dt = a.dt;
+    scene.body = LoadBody(files);
+    scene.world = options;
+    scene.q0 = ParseCoordinates(a.q, "--q", *scene.body);
+    scene.qd0 = ParseCoordinates(a.qdot, "--qdot", *scene.body);
+    scene.object_path = fs::absolute(files.object).string();
+    for (const std::string& m : files.modes) scene.mode_paths.push_back(fs::absolute(m).string());
+  }
+
+  pl::ViewerOptions vo;
+  vo.width = width;
+  vo.height = height;
+  vo.fps = a.fps;
+  vo.speed = a.speed;
+  vo.fixed_frame_time = a.fixed_frame_time;
+  vo.charts = !a.no_charts;
+  vo.start_playing = !a.paused;
+  vo.slider_range = a.slider_range;
+  vo.drag_stiffness = a.drag_stiffness;
+  vo.session_path = a.session;
+  pl::InteractiveView view(std::move(scene), vo);
+  view.Run(a.frames, a.play_events, a.frames > 0);
+
+  if (!a.screenshot.empty()) pl::WritePng(a.screenshot, view.Capture());
+  if (!a.save_session.empty())
+    for (const std::string& f : view.SaveSession(a.save_session)) std::cout << "wrote " << f << "\n";
+  if (a.report_fps) {
+    const pl::ViewerStats& s = view.stats();
+    const double fps = s.wall > 0 ? double(s.frames - 1) / s.wall : 0.0;
+    const double ratio = s.playing_wall > 0 ? s.simulated / s.playing_wall : 0.0;
+    std::printf("frames drawn: %ld in %.3f s wall: %.1f frames/s\n", s.frames, s.wall, fps);
+    std::printf("simulation steps: %ld, %.2f per drawn frame (dt %g s)\n", s.steps,
+                s.playing_frames ? double(s.steps) / double(s.playing_frames) : 0.0, view.world().options().dt);
+    if (a.fixed_frame_time)
+      std::printf("simulated %.3f s in %.3f s of wall time (--fixed-frame-time: each frame advances speed/fps, so "
+                  "this is no real-time measurement)\n", s.simulated, s.playing_wall);
+    else
+      std::printf("simulated %.3f s in %.3f s of wall time playing at speed %g: %.3f x real time (%s)\n", s.simulated,
+                  s.playing_wall, a.speed, ratio, ratio >= 0.98 * a.speed ? "keeps up" : "falls behind");
+  }
+  std::printf("t = %.6g, q =", view.time());
+  for (int i = 0; i < view.world().state(0).q.size(); ++i) std::printf(" %.17g", view.world().state(0).q[i]);
+  std::printf("\n");
+  if (!view.world().status().ok()) {
+    std::cerr << "wobble: simulation stopped: " << view.world().status().message << std::endl;
+    return kExitSimStopped;
+  }
+  return kExitOk;
+}
+
+}  // namespace wobble::app

@@ -1,0 +1,372 @@
+// The interactive viewer (pipelines/interactive_view.h) driven without a person: events are
+// played into its interactor with vtkInteractorEventRecorder (the format `wobble view
+// --play-events` reads) or invoked one by one, and every frame advances a fixed 1/fps of
+// simulated time, so runs are reproducible.
+//
+//   - a recorded drag picks a point, and the world then moves exactly like a World stepped
+//     on its own with a spring from that point to the cursor (same steps, 1e-12), and the
+//     point comes closer to the cursor;
+//   - a click on a mode's slider sets that mode's PD target to the value under the cursor and
+//     the amplitude follows it;
+//   - the key `l` hides the lattice (and the pixels of its colour go away);
+//   - the session script, run by the interpreter, ends in the viewer's state (1e-9), also
+//     with a pose graph from a script driving the targets and a slider taking over;
+//   - screenshots of the window against baselines (render_baseline.h).
+// Without DISPLAY every test skips (VTK 9.1 needs X).
+#include <gtest/gtest.h>
+#include <vtkCommand.h>
+#include <vtkImageData.h>
+#include <vtkInteractorEventRecorder.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkSliderRepresentation2D.h>
+#include <vtkSliderWidget.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "pipelines/interactive_view.h"
+#include "pipelines_test_util.h"
+#include "render_baseline.h"
+#include "wobble/io/script.h"
+
+namespace wobble::pipelines {
+namespace {
+
+using testing::Table;
+using testing::Vec;
+using testing_render::CompareWithBaseline;
+
+const std::string kData = WOBBLE_DATA_DIR;
+
+ViewerScene TableScene(const Eigen::VectorXd& q0) {
+  ViewerScene s;
+  s.body = Table();
+  s.world.integrator = Integrator::kThesis;
+  s.world.dt = 0.01;
+  s.q0 = q0;
+  s.qd0 = Eigen::VectorXd::Zero(q0.size());
+  s.object_path = kData + "/table.obj";
+  s.mode_paths = {kData + "/table_modes.def"};
+  return s;
+}
+
+ViewerOptions TestOptions() {
+  ViewerOptions o;
+  o.width = 800;
+  o.height = 500;
+  o.fixed_frame_time = true;  // every frame advances 1/30 s: reproducible
+  o.chart_every = 5;
+  return o;
+}
+
+// Plays events written in vtkInteractorEventRecorder's format into the view's interactor.
+void Play(InteractiveView* view, const std::string& events) {
+  auto recorder = vtkSmartPointer<vtkInteractorEventRecorder>::New();
+  recorder->SetInteractor(view->interactor());
+  recorder->ReadFromInputStringOn();
+  recorder->SetInputString(events.c_str());
+  recorder->Play();
+  recorder->Off();
+}
+
+std::string Event(const char* name, double x, double y, char key = 0, const char* sym = "0") {
+  std::ostringstream s;
+  s << name << " " << std::lround(x) << " " << std::lround(y) << " 0 0 " << int(key) << " 0 " << sym << "\n";
+  return s.str();
+}
+
+void PressKey(InteractiveView* view, char key) {
+  vtkRenderWindowInteractor* i = view->interactor();
+  i->SetKeyEventInformation(0, 0, key, 1, std::string(1, key).c_str());
+  i->InvokeEvent(vtkCommand::KeyPressEvent);
+  i->InvokeEvent(vtkCommand::CharEvent);
+  i->InvokeEvent(vtkCommand::KeyReleaseEvent);
+}
+
+// Pixels of the scene's part of the window (left of the charts, above the sliders) within 20
+// (of 255) of a colour.
+long CountColour(vtkImageData* image, double r, double g, double b) {
+  int dims[3];
+  image->GetDimensions(dims);
+  long n = 0;
+  for (int y = int(0.22 * dims[1]) + 1; y < dims[1]; ++y)
+    for (int x = 0; x < int(0.62 * dims[0]); ++x) {
+      const auto* p = static_cast<const unsigned char*>(image->GetScalarPointer(x, y, 0));
+      if (std::abs(p[0] - r * 255) < 20 && std::abs(p[1] - g * 255) < 20 && std::abs(p[2] - b * 255) < 20) ++n;
+    }
+  return n;
+}
+
+// Display position of a slider's value (its tube runs between Point1 and Point2).
+Eigen::Vector2d SliderPixel(InteractiveView* view, vtkSliderWidget* w, double value) {
+  auto* rep = vtkSliderRepresentation2D::SafeDownCast(w->GetRepresentation());
+  int* size = view->window()->GetSize();
+  const double* p1 = rep->GetPoint1Coordinate()->GetValue();
+  const double* p2 = rep->GetPoint2Coordinate()->GetValue();
+  const double f = (value - rep->GetMinimumValue()) / (rep->GetMaximumValue() - rep->GetMinimumValue());
+  return {(p1[0] + f * (p2[0] - p1[0])) * size[0], (p1[1] + f * (p2[1] - p1[1])) * size[1]};
+}
+
+TEST(InteractiveView, RecordedDragPullsThePointLikeASpringToTheCursor) {
+  REQUIRE_DISPLAY();
+  // the table standing on its feet
+  InteractiveView view(TableScene(Vec({0, 0, 0, 0, 0, 0, 0})), TestOptions());
+  view.Initialize();  // opens the window and draws once; no event loop
+  for (int k = 0; k < 10; ++k) view.Frame();  // let it settle a little
+  // press on the top right corner of the table top, pull up and to the right
+  const Eigen::Vector2d corner = WorldPositionOf(view.world(), 0, Eigen::Vector2d(1.0, 1.0));
+  const Eigen::Vector2d press = view.WorldToDisplay(corner);
+  const Eigen::Vector2d cursor_px = press + Eigen::Vector2d(40, 60);
+  std::string events = Event("MouseMoveEvent", press.x(), press.y()) + Event("LeftButtonPressEvent", press.x(), press.y()) +
+                       Event("MouseMoveEvent", cursor_px.x(), cursor_px.y());
+  Play(&view, events);
+  ASSERT_TRUE(view.dragged_point().has_value()) << "the press did not pick a point";
+  const Eigen::Vector2d st = *view.dragged_point();
+  const Eigen::Vector2d cursor = view.DisplayToWorld(std::lround(cursor_px.x()), std::lround(cursor_px.y()));
+  const double before = (WorldPositionOf(view.world(), 0, st) - cursor).norm();
+
+  // (on the ground the contacts' anchors are state too; the exact comparison with an
+  // independent World is the next test, in the air)
+  std::string frames;
+  for (int k = 0; k < 30; ++k) frames += Event("TimerEvent", cursor_px.x(), cursor_px.y());
+  Play(&view, frames);
+  const double after = (WorldPositionOf(view.world(), 0, st) - cursor).norm();
+  EXPECT_LT(after, 0.6 * before) << "the pulled point did not come toward the cursor: " << before << " -> " << after;
+  // the spring is drawn while pulling (the springs layer) and goes away on release
+  EXPECT_EQ(view.world().options().params.springs.size(), 1u);
+  Play(&view, Event("LeftButtonReleaseEvent", cursor_px.x(), cursor_px.y()));
+  EXPECT_FALSE(view.dragged_point().has_value());
+  EXPECT_TRUE(view.world().options().params.springs.empty());
+}
+
+TEST(InteractiveView, DragInTheAirMatchesAWorldWithASpring) {
+  REQUIRE_DISPLAY();
+  // no ground: the state is q and q̇ alone, so an independent World can follow exactly
+  ViewerScene scene = TableScene(Vec({0, 200, 0.1, 0, 0, 0, 0}));
+  scene.world.params.ground.enabled = false;
+  InteractiveView view(scene, TestOptions());
+  view.Initialize();
+  const Eigen::Vector2d point = WorldPositionOf(view.world(), 0, Eigen::Vector2d(0.0, 1.0));
+  const Eigen::Vector2d press = view.WorldToDisplay(point);
+  const Eigen::Vector2d cursor_px = press + Eigen::Vector2d(-50, 30);
+  Play(&view, Event("LeftButtonPressEvent", press.x(), press.y()) + Event("MouseMoveEvent", cursor_px.x(), cursor_px.y()));
+  ASSERT_TRUE(view.dragged_point().has_value());
+  const Eigen::Vector2d st = *view.dragged_point();
+  const Eigen::Vector2d cursor = view.DisplayToWorld(std::lround(cursor_px.x()), std::lround(cursor_px.y()));
+
+  World ref(scene.world);
+  ref.AddBody(scene.body);
+  ref.SetState(0, scene.q0, scene.qd0);
+  Spring sp = view.world().options().params.springs.at(0);
+  EXPECT_EQ(sp.lattice_coords, st);
+  EXPECT_NEAR((sp.anchor - cursor).norm(), 0.0, 1e-9);
+  ref.AddSpring(sp);
+  const double before = (WorldPositionOf(view.world(), 0, st) - cursor).norm();
+  std::string frames;
+  for (int k = 0; k < 45; ++k) frames += Event("TimerEvent", cursor_px.x(), cursor_px.y());
+  Play(&view, frames);
+  for (long n = 0; n < view.session_steps(); ++n) ASSERT_TRUE(ref.Step());
+  EXPECT_EQ(ref.steps(), view.world().steps());
+  const Eigen::VectorXd dq = view.world().state(0).q - ref.state(0).q;
+  EXPECT_LT(dq.cwiseAbs().maxCoeff(), 1e-9) << "viewer " << view.world().state(0).q.transpose() << "\nreference "
+                                           << ref.state(0).q.transpose();
+  const double after = (WorldPositionOf(view.world(), 0, st) - cursor).norm();
+  EXPECT_LT(after, before);
+  // the match with the independent World (gravity, modes, the spring) is the check that the
+  // rest of the body moves by the same passive dynamics
+}
+
+TEST(InteractiveView, SliderClickSetsTheModeTargetAndTheAmplitudeFollows) {
+  REQUIRE_DISPLAY();
+  InteractiveView view(TableScene(Vec({0, 0, 0, 0, 0, 0, 0})), TestOptions());
+  view.Initialize();
+  const int bend = 0;  // data/table_modes.def: bend is the first mode
+  const Eigen::Vector2d at = SliderPixel(&view, view.mode_slider(bend), 0.25);
+  Play(&view, Event("MouseMoveEvent", at.x(), at.y()) + Event("LeftButtonPressEvent", at.x(), at.y()) +
+                  Event("LeftButtonReleaseEvent", at.x(), at.y()));
+  const double target = view.mode_targets()[bend];
+  // the target is the slider's value; the slider maps its travel inside the end caps, a few
+  // pixels short of Point1..Point2, so the value under the cursor is 0.25 within 0.05
+  EXPECT_EQ(target, static_cast<vtkSliderRepresentation*>(view.mode_slider(bend)->GetRepresentation())->GetValue());
+  EXPECT_NEAR(target, 0.25, 0.05) << "the click on the slider's tube at 0.25";
+  for (int d = 1; d < 4; ++d) EXPECT_EQ(view.mode_targets()[d], 0.0);
+  std::string frames;
+  for (int k = 0; k < 60; ++k) frames += Event("TimerEvent", 10, 10);
+  Play(&view, frames);
+  const double gamma = view.world().state(0).q[3 + bend];
+  EXPECT_GT(gamma, 0.6 * target) << "the bend amplitude did not follow its target";
+  EXPECT_LT(gamma, 1.4 * target);
+}
+
+TEST(InteractiveView, KeyTogglesTheLatticeAndScreenshotsMatchBaselines) {
+  REQUIRE_DISPLAY();
+  ViewerScene scene = TableScene(Vec({0, 60, 0.1, 0.1, 0, 0, 0}));
+  InteractiveView view(scene, TestOptions());
+  view.Initialize();
+  for (int k = 0; k < 15; ++k) view.Frame();
+  auto with = view.Capture();
+  const double lattice_rgb[3] = {0.45, 0.6, 0.85};
+  const long lattice_pixels = CountColour(with, lattice_rgb[0], lattice_rgb[1], lattice_rgb[2]);
+  EXPECT_TRUE(view.LayerVisible(SceneLayer::kLattice));
+  PressKey(&view, 'l');
+  EXPECT_FALSE(view.LayerVisible(SceneLayer::kLattice));
+  auto without = view.Capture();
+  const long left = CountColour(without, lattice_rgb[0], lattice_rgb[1], lattice_rgb[2]);
+  EXPECT_GT(lattice_pixels, 200);
+  EXPECT_LT(left, lattice_pixels / 4) << "lattice-coloured pixels remain after 'l'";
+  CompareWithBaseline("view_window", with);
+  CompareWithBaseline("view_no_lattice", without);
+  PressKey(&view, 'l');
+  EXPECT_TRUE(view.LayerVisible(SceneLayer::kLattice));
+  // space pauses: frames then leave the world alone
+  PressKey(&view, ' ');
+  EXPECT_FALSE(view.playing());
+  const long steps = view.world().steps();
+  view.Frame();
+  EXPECT_EQ(view.world().steps(), steps);
+  // n steps once
+  PressKey(&view, 'n');
+  EXPECT_EQ(view.world().steps(), steps + 1);
+}
+
+TEST(InteractiveView, TimeSliderScrubsRecordedFrames) {
+  REQUIRE_DISPLAY();
+  InteractiveView view(TableScene(Vec({0, 60, 0, 0, 0, 0, 0})), TestOptions());
+  view.Initialize();
+  for (int k = 0; k < 20; ++k) view.Frame();
+  ASSERT_EQ(view.num_recorded_frames(), 21);  // the start and 20 frames
+  const Eigen::Vector2d at = SliderPixel(&view, view.time_slider(), 5.0);
+  Play(&view, Event("MouseMoveEvent", at.x(), at.y()) + Event("LeftButtonPressEvent", at.x(), at.y()) +
+                  Event("LeftButtonReleaseEvent", at.x(), at.y()));
+  EXPECT_FALSE(view.playing());
+  EXPECT_NE(view.StatusLine().find("recorded frame 5:"), std::string::npos) << view.StatusLine();
+  // the live world is untouched; space goes back to it and plays on
+  const long steps = view.world().steps();
+  PressKey(&view, ' ');
+  EXPECT_TRUE(view.playing());
+  view.Frame();
+  EXPECT_GT(view.world().steps(), steps);
+}
+
+void ExpectReplayMatches(InteractiveView& view, const std::string& name) {
+  const std::string dir = testing::TempDir(name);
+  const std::string path = dir + "/session.wob";
+  view.SaveSession(path);
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  interp.RunFile(path);
+  const Eigen::VectorXd& q = interp.q();
+  ASSERT_EQ(q.size(), view.world().state(0).q.size());
+  const Eigen::VectorXd d = q - view.world().state(0).q;
+  EXPECT_LT(d.cwiseAbs().maxCoeff(), 1e-9) << "replay " << q.transpose() << "\nviewer " << view.world().state(0).q.transpose()
+                                          << "\nscript:\n" << view.SessionScriptText();
+  EXPECT_NEAR(interp.time(), view.time(), 1e-9);
+}
+
+TEST(InteractiveView, SavedSessionReplaysToTheSameState) {
+  REQUIRE_DISPLAY();
+  // dropped onto the ground; targets changed three times while it plays, once in the same
+  // frame as a step boundary would be ambiguous without the half-step rule
+  InteractiveView view(TableScene(Vec({0, 30, 0, 0, 0, 0, 0})), TestOptions());
+  view.Initialize();
+  for (int k = 0; k < 20; ++k) view.Frame();
+  view.SetModeTarget(0, 0.2);
+  for (int k = 0; k < 20; ++k) view.Frame();
+  view.SetModeTarget(1, -0.15);
+  view.SetModeTarget(2, 0.05);  // a passive mode: the script makes every mode active, codamA 0
+  for (int k = 0; k < 25; ++k) view.Frame();
+  view.StepOnce();
+  view.SetModeTarget(0, -0.1);
+  view.SetPlaying(true);
+  for (int k = 0; k < 15; ++k) view.Frame();
+  ExpectReplayMatches(view, "view_replay");
+  EXPECT_EQ(view.SessionScriptText().find("pull"), std::string::npos);
+}
+
+TEST(InteractiveView, ScriptPoseGraphDrivesTheTargetsAndReplays) {
+  REQUIRE_DISPLAY();
+  // a script like data/bounding_table.wob without the anneal: its pose graph drives the
+  // active modes until a slider takes over
+  const std::string dir = testing::TempDir("view_script");
+  const std::string script = dir + "/gait.wob";
+  std::ofstream(script) << "load_obj " << kData << "/table.obj\nload_def " << kData << "/table_modes.def\n"
+                        << "set codamA 250000\nset integrator thesis\nset dt 0.01\nset grconst 45000\nset grdam 3000\n"
+                        << "set frconst 3000\nset frsin 0.5\nset_vec q 0 0 0 0 0 0 0\n"
+                        << "pose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\npose 0 0.1 0.4\n"
+                        << "spring 0.5 1 150 200 200 10\n";
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  interp.RunFile(script);
+  const io::Interpreter::SimulationSetup setup = interp.CurrentSetup();
+  ASSERT_TRUE(setup.body);
+  ASSERT_EQ(setup.world.params.springs.size(), 1u);
+  ViewerScene scene;
+  scene.body = setup.body;
+  scene.world = setup.world;
+  scene.q0 = setup.q;
+  scene.qd0 = setup.qd;
+  scene.t0 = setup.time;
+  scene.graph = setup.graph;
+  scene.object_path = setup.object_path;
+  scene.mode_paths = setup.mode_paths;
+  InteractiveView view(scene, TestOptions());
+  view.Initialize();
+  for (int k = 0; k < 40; ++k) view.Frame();  // 1.33 s: poses 0..3 and 0 again
+  EXPECT_NE(view.mode_targets().norm(), 0.0);
+  view.SetModeTarget(3, 0.05);  // the slider takes over from the graph
+  const Eigen::VectorXd held = view.mode_targets();
+  for (int k = 0; k < 30; ++k) view.Frame();
+  EXPECT_EQ(view.mode_targets(), held) << "the pose graph still drives after a slider moved";
+  ExpectReplayMatches(view, "view_script_replay");
+}
+
+TEST(InteractiveView, SessionWithADragSaysTheReplayStopsFollowing) {
+  REQUIRE_DISPLAY();
+  InteractiveView view(TableScene(Vec({0, 0, 0, 0, 0, 0, 0})), TestOptions());
+  view.Initialize();
+  for (int k = 0; k < 5; ++k) view.Frame();
+  const Eigen::Vector2d p = view.WorldToDisplay(WorldPositionOf(view.world(), 0, Eigen::Vector2d(0.5, 1.0)));
+  ASSERT_TRUE(view.BeginDrag(int(p.x()), int(p.y())));
+  view.DragTo(int(p.x()), int(p.y()) + 40);
+  for (int k = 0; k < 5; ++k) view.Frame();
+  view.EndDrag();
+  EXPECT_NE(view.SessionScriptText().find("1 pull(s) by the mouse"), std::string::npos) << view.SessionScriptText();
+  // a press far from the body picks nothing
+  EXPECT_FALSE(view.BeginDrag(2, 499));
+}
+
+TEST(InteractiveView, RecordedPosesBecomeACyclicPoseGraphScript) {
+  REQUIRE_DISPLAY();
+  ViewerScene scene = TableScene(Vec({0, 300, 0, 0, 0, 0, 0}));
+  scene.world.params.gravity_on = false;
+  InteractiveView view(scene, TestOptions());
+  view.Initialize();
+  // the table in the air, free of the ground: the bend follows its target within ~2 s (K 4e6 on G ~ 1e7)
+  std::vector<Eigen::VectorXd> amplitudes;
+  view.SetModeTarget(0, 0.1);
+  for (int k = 0; k < 60; ++k) view.Frame();
+  amplitudes.push_back(view.world().state(0).q.tail(4));
+  PressKey(&view, 'k');
+  view.SetModeTarget(0, -0.1);
+  for (int k = 0; k < 60; ++k) view.Frame();
+  amplitudes.push_back(view.world().state(0).q.tail(4));
+  PressKey(&view, 'k');
+  const std::string dir = testing::TempDir("view_poses");
+  const std::vector<std::string> files = view.SaveSession(dir + "/s.wob");
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(files[1], dir + "/s_poses.wob");
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  interp.RunFile(files[1]);  // parses and runs: 2 poses, 3 periods
+  EXPECT_EQ(interp.pose_graph().poses.size(), 2u);
+  EXPECT_TRUE(interp.pose_graph().cyclic);
+  // the poses are the amplitudes at the key presses, exactly (shortest round-trip numbers)
+  for (int i = 0; i < 2; ++i) EXPECT_EQ(interp.pose_graph().poses[i], amplitudes[i]);
+  EXPECT_GT(amplitudes[0][0], 0.0);  // bent toward +0.1 when recorded
+  EXPECT_LT(amplitudes[1][0], amplitudes[0][0]);
+  EXPECT_NEAR(interp.pose_graph().durations[0], 2.0, 0.011);  // 60 frames of 1/30 s
+}
+
+}  // namespace
+}  // namespace wobble::pipelines
