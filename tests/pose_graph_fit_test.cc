@@ -68,7 +68,7 @@ struct Case {
     std::vector<double> t = {0};
     q.push_back(truth.q0);
     for (int n = 0; n < steps; ++n) {
-      world.SetModeTargets(0, fit::SmoothPoseTargets(*body, truth.graph, n * options.dt, kWidth));
+      world.SetModeTargets(0, control::SmoothPoseTargets(*body, truth.graph, n * options.dt, kWidth));
       EXPECT_TRUE(world.Step()) << world.status().message;
       t.push_back(world.time());
       q.push_back(world.state(0).q);
@@ -104,13 +104,13 @@ TEST(PoseGraphFit, SmoothTargetsFollowThePoseGraph) {
   const auto body = Table();
   const control::PoseGraph g = TrueGraph();
   for (double t : {0.0, 0.2, 0.55, 0.95, 1.4, 1.8, 2.6, 3.0}) {
-    const Eigen::VectorXd target = fit::SmoothPoseTargets(*body, g, t, 1e-3);
+    const Eigen::VectorXd target = control::SmoothPoseTargets(*body, g, t, 1e-3);
     const Eigen::VectorXd hard = control::TargetsFromPose(*body, g.poses[g.PoseAt(t)]);
     EXPECT_LT((target - hard).cwiseAbs().maxCoeff(), 1e-12) << t;
   }
   // half way through the switch at S = 0.4: the mean of the two poses, plus the start of the
   // next switch (S = 0.7, σ(−6)); the one after (S = 1.2, σ(−16) ≈ 1e-7) is below the tolerance
-  const Eigen::VectorXd mid = fit::SmoothPoseTargets(*body, g, 0.4, kWidth);
+  const Eigen::VectorXd mid = control::SmoothPoseTargets(*body, g, 0.4, kWidth);
   const double sigma6 = 1.0 / (1.0 + std::exp(6.0));
   const Eigen::VectorXd expected = 0.5 * (g.poses[0] + g.poses[1]) + (g.poses[2] - g.poses[1]) * sigma6;
   EXPECT_NEAR(mid[0], expected[0], 1e-6);

@@ -33,40 +33,6 @@ template <class T> struct ModeParams {
   VecD<T> K, c;
 };
 
-// The pose-graph controller with scalar T: poses of the active modes, transition times.
-template <class T> struct Controller {
-  std::vector<VecD<T>> poses;
-  std::vector<T> durations;
-  bool cyclic = true;
-  std::vector<int> active;  // mode index of each pose entry
-  bool empty() const { return poses.empty(); }
-};
-
-// γ0(t) of the smoothed pose switch (dynamic_fit.h), one per mode (0 on passive modes).
-template <class T> VecD<T> SmoothTargets(const Controller<T>& c, int num_modes, double t, double width) {
-  VecD<T> target = VecD<T>::Zero(num_modes);
-  if (c.empty()) return target;
-  const int n = int(c.poses.size());
-  VecD<T> active = c.poses[0];
-  T switch_time(0.0);
-  // switches far after t add nothing (σ < e^-30); the count bound only guards silly times
-  for (int k = 1; k < 1000000; ++k) {
-    if (!c.cyclic && k >= n) break;
-    switch_time += c.durations[(k - 1) % n];
-    if (ScalarValue(switch_time) > t + 30.0 * width) break;
-    const VecD<T> jump = c.poses[k % n] - c.poses[(k - 1) % n];
-    if (width > 0) {
-      using std::exp;
-      const T sigma = T(1.0) / (T(1.0) + exp(-(T(t) - switch_time) / T(width)));
-      active += jump * sigma;
-    } else if (ScalarValue(switch_time) <= t) {
-      active += jump;  // a hard switch: the pose graph of lib/wobble/control
-    }
-  }
-  for (size_t i = 0; i < c.active.size(); ++i) target[c.active[i]] = active[int(i)];
-  return target;
-}
-
 // StepBody's extra generalized force: the mode forces −2K_d (γ_d − γ0_d) − c_d γ̇_d (§4.7, and
 // the PD controller of chapter 5) with K, c and γ0 of scalar T; the body's own are switched off.
 template <class T> struct ModeForce {
@@ -83,7 +49,7 @@ template <class T> struct ModeForce {
 // sets them). Calls on_frame(f, q) at every frame step.
 template <class T, class F>
 bool Simulate(const BodyModel& passive, const WorldParams& w, double dt, double width, const VecQ<T>& q0,
-              const VecQ<T>& qd0, const ModeParams<T>& p, const Controller<T>& control, const std::vector<int>& steps,
+              const VecQ<T>& qd0, const ModeParams<T>& p, const control::PoseGraphOf<T>& control, const std::vector<int>& steps,
               F&& on_frame) {
   BodyState<T> s;
   s.q = q0;
@@ -93,7 +59,7 @@ bool Simulate(const BodyModel& passive, const WorldParams& w, double dt, double 
   int step = 0;
   for (size_t f = 0; f < steps.size(); ++f) {
     for (; step < steps[f]; ++step) {
-      if (!control.empty()) target = SmoothTargets(control, passive.num_modes(), step * dt, width);
+      if (!control.empty()) target = control::SmoothPoseTargets(control, passive.num_modes(), step * dt, width);
       if (!StepBody(passive, w, 0, Integrator::kThesis, dt, &s, ModeForce<T>{&p, &target}).ok()) return false;
       for (int i = 0; i < s.q.size(); ++i)
         if (!std::isfinite(ScalarValue(s.q[i])) || !std::isfinite(ScalarValue(s.qd[i]))) return false;
@@ -103,13 +69,8 @@ bool Simulate(const BodyModel& passive, const WorldParams& w, double dt, double 
   return true;
 }
 
-Controller<double> ControllerOf(const BodyModel& body, const control::PoseGraph& g) {
-  Controller<double> c;
-  c.cyclic = g.cyclic;
-  c.active = control::ActiveModes(body);
-  for (const Eigen::VectorXd& pose : g.poses) c.poses.push_back(pose);
-  c.durations = g.durations;
-  return c;
+control::PoseGraphOf<double> ControllerOf(const BodyModel& body, const control::PoseGraph& g) {
+  return control::PoseGraphOf<double>::From(body, g);
 }
 
 // G_dd, the generalized mass of each mode: the damping scale 2 sqrt(2 K G_dd) is the critical
@@ -216,7 +177,7 @@ struct DynamicResidual {
       mp.K[d] = exp(p[2][d]);
       mp.c[d] = p[3][d] * T(2.0) * sqrt(T(2.0 * G[d]) * mp.K[d]);
     }
-    Controller<T> control;
+    control::PoseGraphOf<T> control;
     if (num_poses > 0) {
       const int b = D > 0 ? 4 : 2;  // index of the poses block
       control.cyclic = cyclic;
@@ -400,10 +361,6 @@ DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<i
   const double c = DynamicCost(body, frames, result.params, o);
   result.rms_residual = std::sqrt(2.0 * c / (ref.num_residuals / 2));
   return result;
-}
-
-Eigen::VectorXd SmoothPoseTargets(const BodyModel& body, const control::PoseGraph& graph, double t, double width) {
-  return SmoothTargets(ControllerOf(body, graph), body.num_modes(), t, width);
 }
 
 AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<io::TargetFrame>& frames,

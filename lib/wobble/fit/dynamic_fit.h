@@ -16,8 +16,8 @@
 // (the pose graph of lib/wobble/control) has a cost that is piecewise constant in the times
 // between steps, with zero gradient almost everywhere; the smoothed one is a controller in its
 // own right (a PD servo whose set point moves in about 4w) and tends to the hard one as w → 0.
-// The fit models a controller with smoothed switches; SmoothPoseTargets gives the same targets
-// to anyone (the World, with SetModeTargets before each step) who wants to run it.
+// The fit models a controller with smoothed switches: control::SmoothPoseTargets, which scripts
+// run with `set switch_width W` (and anyone with World::SetModeTargets before each step).
 #pragma once
 
 #include <cstdint>
@@ -67,9 +67,6 @@ std::vector<int> FrameSteps(const std::vector<io::TargetFrame>& frames, double d
 bool SimulateWithParameters(const BodyModel& body, const DynamicFitOptions& options, const DynamicParameters& p,
                             const std::vector<int>& frame_steps,
                             const std::function<void(int, const Eigen::VectorXd&)>& on_frame);
-
-// The PD targets γ0(t) (one per mode, 0 on passive modes) of the smoothed pose graph above.
-Eigen::VectorXd SmoothPoseTargets(const BodyModel& body, const control::PoseGraph& graph, double t, double width);
 
 // Fits the parameters, starting from `initial`. An empty initial q0 / q̇0 is estimated from
 // pose fits of the first two frames. Stiffness starts must be > 0 (it is fitted as log K);

@@ -71,7 +71,7 @@ const std::vector<std::string>& Interpreter::Parameters() {
       "time", "end", "dt", "ground_height", "ground_slope", "max_penetration",             //
       "integrator", "interp",                                                               // words
       "seed", "batch", "cooling", "temperature", "optimize", "cost", "cost_scale", "trial_steps",
-      "pose_step", "time_step", "threads", "anneal_csv", "cmaes_csv", "sigma0", "min_amplitude", "max_amplitude", "min_time", "max_time"};
+      "pose_step", "time_step", "threads", "anneal_csv", "cmaes_csv", "sigma0", "min_amplitude", "max_amplitude", "min_time", "max_time", "switch_width"};
   return names;
 }
 
@@ -661,6 +661,7 @@ void Interpreter::Set(const std::vector<std::string>& w, const Context& ctx) {
                "energy_per_sqrt_distance), got '" + value + "'");
   } else if (name == "anneal_csv") anneal_csv_ = value;
   else if (name == "cmaes_csv") cmaes_csv_ = value;
+  else if (name == "switch_width") switch_width_ = non_negative();
   else if (name == "sigma0") {
     sigma0_ = positive();
     if (sigma0_ > 1) ctx.Fail("expected sigma0 in (0, 1], got " + value);
@@ -855,7 +856,11 @@ void Interpreter::Simulate(double duration, const Context& ctx) {
   RecordTrack(world, t0);
   for (long n = 0; n < steps; ++n) {
     // the pose graph cycles from its first pose at the start of every simul (chapter 5)
-    if (controlled) {
+    if (controlled && switch_width_ > 0) {
+      // smoothed switches (control::SmoothPoseTargets), as the dynamic fit models the controller
+      pose = graph_.PoseAt(n * world_.dt);
+      world.SetModeTargets(0, control::SmoothPoseTargets(*body, graph_, n * world_.dt, switch_width_));
+    } else if (controlled) {
       const int now = graph_.PoseAt(n * world_.dt);
       if (now != pose) {
         pose = now;
@@ -958,6 +963,7 @@ std::string Interpreter::ReplayScript() const {
   vec("q", anneal_start_q_.size() ? anneal_start_q_ : q_);
   vec("dq", anneal_start_q_.size() ? anneal_start_qd_ : qd_);
   s << "set cyclic " << (graph_.cyclic ? "T" : "F") << "\n";
+  s << "set switch_width " << Num(switch_width_) << "\n";
   for (size_t i = 0; i < graph_.poses.size(); ++i) {
     s << "pose";
     for (int k = 0; k < graph_.poses[i].size(); ++k) s << " " << Num(graph_.poses[i][k]);

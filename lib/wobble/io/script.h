@@ -151,6 +151,7 @@ class Interpreter {
   // control
   control::PoseGraph graph_;
   bool control_on_ = true;
+  double switch_width_ = 0.0;  // > 0: simul switches poses smoothly (control::SmoothPoseTargets)
   control::Keyframes keys_;
   control::HeldPoint hold_;
 
