@@ -1,6 +1,6 @@
 # wobble — the two commands people need: `make demo` and `make test`.
 #
-#   make demo    install what is missing, build (Release), drop the table onto the ground
+#   make demo    install what is missing, build (Release), render the table jumping off a cliff
 #   make test    install, build, run every test (under Xvfb when available), then the unit
 #                tests again in an AddressSanitizer + UBSan debug build (make asan alone)
 #   make bench   build and run the benchmarks
@@ -34,7 +34,7 @@ DEMO_MODES    ?= data/table_modes.def
 DEMO_ARGS     ?= --q "0 50 0 0 0 0 0" --integrator thesis --dt 0.01 --duration 10 --ground-slope -5
 DEMO_WHAT     ?= frames,filmstrip,charts,vtp,exr,disp
 WOBBLE        := $(BUILD)/app/wobble
-DEMO_SCRIPT   ?= data/table_cliff.wob
+DEMO_SCRIPT   ?= data/table_cliff.wob  # writes and renders into out/demo (its `output` and `render` lines)
 
 .PHONY: all deps configure build demo-build demo test test-release asan bench clean
 
@@ -78,23 +78,21 @@ demo: demo-build
 	# pictures and exports (pipelines/): VTK renders through X, so a virtual one without DISPLAY
 	xvfb=""
 	if [ -z "$${DISPLAY:-}" ]; then xvfb='xvfb-run -a -s "-screen 0 1280x1024x24"'; fi
+	# the main scene: the table jumping off a cliff (Fig. 1.3/4.12: keyframed jump, then simulation);
+	# its script ends with `render out/demo ...`: frames, filmstrip, .pvd/.vtp, EXR and charts
 	echo
-	echo "\$$ $$xvfb" '$(WOBBLE) render --object $(DEMO_OBJECT) --modes $(DEMO_MODES) $(DEMO_ARGS) --what $(DEMO_WHAT) --out $(OUT)'
-	eval "$$xvfb" '$(WOBBLE) render --object $(DEMO_OBJECT) --modes $(DEMO_MODES) $(DEMO_ARGS) --what $(DEMO_WHAT) --out $(OUT)' || status=$$?
-	# the table jumping off a cliff (Fig. 4.12): keyframed jump, then simulation (issue 5)
-	echo '$$ $(WOBBLE) run $(DEMO_SCRIPT)'
-	$(WOBBLE) run $(DEMO_SCRIPT) || status=$$?
+	echo "\$$ $$xvfb" '$(WOBBLE) run $(DEMO_SCRIPT)'
+	eval "$$xvfb" '$(WOBBLE) run $(DEMO_SCRIPT)' || status=$$?
 	echo
-	echo "files:"
-	echo "  trajectory  $(OUT)/table_drop.csv  (t, q, q-dot, energies, contacts, penetration per step)"
+	echo "files (the cliff jump, in $(OUT)/):"
+	echo "  trajectory  $(OUT)/table_cliff.csv  (t, q, q-dot, energies, control energy, contacts per step)"
 	echo "  frames      $(OUT)/frames/frame_NNNN.png  (640x480, 30 fps)"
 	echo "  filmstrip   $(OUT)/filmstrip.png"
 	echo "  ParaView    $(OUT)/vtp/table.pvd  (lattice, mass points, shape per frame)"
 	echo "  EXR         $(OUT)/exr/frame_NNNN.exr  (R,G,B,A, depth.Z), $(OUT)/exr/disp_NNNN.exr  (disp.X, disp.Y)"
 	echo "  plots       $(OUT)/energy.png, $(OUT)/condition.png  (numbers in the .csv beside them)"
-	echo "  cliff jump  out/table_cliff.csv  (keyframed, then simulated; see README: Scripts)"
+	echo "  table drop  $(OUT)/table_drop.csv  (the sloped-ground drop, simulated only: README, Pictures and exports)"
 	echo "  command     $(WOBBLE)  (see $(WOBBLE) --help, and README.md)"
-	echo "all under out/ (the drop in $(OUT)/, the cliff jump in out/table_cliff.csv)"
 	exit $$status
 
 test: test-release

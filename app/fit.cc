@@ -225,13 +225,25 @@ FitCommands AddFitCommand(CLI::App* app, FitPoseArgs* pose, FitTrajectoryArgs* t
       ->capture_default_str();
   c.trajectory->add_option("--qdot0", traj->qdot0, "Dynamic: starting q-dot (default: from the first two frames)");
   c.trajectory->add_flag("--anneal", traj->anneal, "Dynamic: also run simulated annealing with the same number of simulations");
+  c.trajectory->add_option("--poses", traj->poses,
+                           "Dynamic: a pose-graph controller to start from, \"T1 .. Tk DURATION; ...\" (k active modes)")
+      ->type_name("\"POSES\"");
+  c.trajectory->add_option("--active", traj->active, "Dynamic: modes the pose graph drives, \"bend,shear\" (default: "
+                                                     "those declared active in the .def files)");
+  c.trajectory->add_flag("--sequence", traj->sequence, "Dynamic: the poses play once (default: they cycle)");
+  c.trajectory->add_option("--switch-width", traj->switch_width,
+                           "Dynamic: width w of the smoothed pose switch, seconds (README: Fitting)")
+      ->capture_default_str();
   AddWorldFlags(c.trajectory, &traj->world);
   c.trajectory->footer(
       "Examples:\n"
       "  wobble fit trajectory --object data/table.obj --modes data/table_modes.def \\\n"
       "      --reference data/table_keys.tgt --smoothness 1 --out out/keys.json\n"
       "  wobble fit trajectory --object data/table.obj --modes data/table_modes.def \\\n"
-      "      --reference out/table_drop.csv --dynamic --no-ground --out out/dyn.json");
+      "      --reference out/table_drop.csv --dynamic --no-ground --out out/dyn.json\n"
+      "  wobble fit trajectory --object data/table.obj --modes data/bend.def,data/shear.def,data/vsquash.def \\\n"
+      "      --active bend,shear --reference out/pose_graph.csv --dynamic --fit poses,times \\\n"
+      "      --poses \"0.25 -0.05 0.45; -0.05 0.2 0.25; 0.1 0.1 0.55\" --anneal --out out/graph.json");
   return c;
 }
 
@@ -344,11 +356,51 @@ bool EndsWith(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
+// --active: a copy of the body with those modes active (the pose graph drives them).
+std::shared_ptr<const BodyModel> WithActiveModes(const std::shared_ptr<const BodyModel>& body, const std::string& names) {
+  if (names.empty()) return body;
+  std::vector<DeformationMode> modes = body->modes();
+  for (DeformationMode& m : modes) m.active = false;
+  std::stringstream in(names);
+  for (std::string name; std::getline(in, name, ',');) {
+    auto it = std::find_if(modes.begin(), modes.end(), [&](const DeformationMode& m) { return m.name == name; });
+    if (it == modes.end()) throw UsageError("--active: the body has no mode '" + name + "'");
+    it->active = true;
+  }
+  return std::make_shared<const BodyModel>(body->def(), modes);
+}
+
+// --poses "T1 .. Tk D; ...": k targets of the active modes and a transition time per pose.
+control::PoseGraph ParsePoseGraph(const std::string& text, int num_active, bool sequence) {
+  control::PoseGraph g;
+  g.cyclic = !sequence;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ';');) {
+    std::istringstream words(item);
+    std::vector<double> v;
+    for (std::string w; words >> w;) {
+      char* end = nullptr;
+      const double x = std::strtod(w.c_str(), &end);
+      if (end == w.c_str() || *end != '\0' || !std::isfinite(x)) throw UsageError("--poses: '" + w + "' is not a number");
+      v.push_back(x);
+    }
+    if (v.empty()) continue;
+    if (int(v.size()) != num_active + 1)
+      throw UsageError("--poses: a pose needs " + std::to_string(num_active) + " targets (one per active mode) and a "
+                       "transition time, got " + std::to_string(v.size()) + " numbers in '" + item + "'");
+    g.poses.push_back(Eigen::Map<const Eigen::VectorXd>(v.data(), num_active));
+    g.durations.push_back(v.back());
+  }
+  const std::string invalid = g.Validate(num_active);
+  if (!invalid.empty()) throw UsageError("--poses: " + invalid);
+  return g;
+}
+
 }  // namespace
 
 int RunFitTrajectory(const FitTrajectoryArgs& a) {
   CheckOutputs(a.fit);
-  const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
+  const std::shared_ptr<const BodyModel> body = WithActiveModes(LoadBody(a.files), a.active);
   fit::PoseFitOptions po = PoseOptions(a.fit, *body);
   if (a.every < 1) throw UsageError("--every must be at least 1");
   RequireNonNegative(a.smoothness, "--smoothness");
@@ -408,9 +460,21 @@ int RunFitTrajectory(const FitTrajectoryArgs& a) {
       else if (item == "qdot0") o.fit_qd0 = true;
       else if (item == "stiffness") o.fit_stiffness = true;
       else if (item == "damping") o.fit_damping = true;
-      else throw UsageError("--fit: '" + item + "' is not one of q0, qdot0, stiffness, damping");
+      else if (item == "poses") o.fit_poses = true;
+      else if (item == "times") o.fit_times = true;
+      else throw UsageError("--fit: '" + item + "' is not one of q0, qdot0, stiffness, damping, poses, times");
     }
+    RequireNonNegative(a.switch_width, "--switch-width");
+    o.switch_width = a.switch_width;
     fit::DynamicParameters start;
+    const int num_active = int(control::ActiveModes(*body).size());
+    if (!a.poses.empty()) {
+      if (num_active == 0) throw UsageError("--poses: no mode is active (--active, or 'active' in the .def header)");
+      start.graph = ParsePoseGraph(a.poses, num_active, a.sequence);
+    }
+    if ((o.fit_poses || o.fit_times) && start.graph.empty()) throw UsageError("--fit poses,times needs --poses to start from");
+    if (o.fit_times && !(o.switch_width > 0))
+      throw UsageError("--fit times needs --switch-width > 0: a hard switch gives the times no gradient");
     if (!a.fit.q0.empty()) start.q0 = po.initial_q;
     if (!a.qdot0.empty()) start.qd0 = ParseCoordinates(a.qdot0, "--qdot0", *body);
     try {
@@ -436,8 +500,27 @@ int RunFitTrajectory(const FitTrajectoryArgs& a) {
         << " s.\ncost " << Num(r.report.initial_cost) << " -> " << Num(r.report.final_cost) << ", rms residual "
         << Num(r.rms_residual) << ".\nq0 = " << r.params.q0.transpose() << "\nqdot0 = " << r.params.qd0.transpose()
         << "\nstiffness = " << r.params.stiffness.transpose() << "\ndamping = " << r.params.damping.transpose();
+    if (!r.params.graph.empty()) {
+      json g;
+      g["poses"] = json::array();
+      for (const Eigen::VectorXd& p : r.params.graph.poses) g["poses"].push_back(Vector(p));
+      g["durations"] = r.params.graph.durations;
+      g["cyclic"] = r.params.graph.cyclic;
+      g["switch_width"] = o.switch_width;
+      g["active"] = json::array();
+      for (int m : control::ActiveModes(*body)) g["active"].push_back(body->modes()[m].name);
+      j["pose_graph"] = g;
+      out << "\npose graph (active:";
+      for (int m : control::ActiveModes(*body)) out << " " << body->modes()[m].name;
+      out << "):";
+      for (size_t i = 0; i < r.params.graph.poses.size(); ++i)
+        out << "\n  pose " << i << ": " << r.params.graph.poses[i].transpose() << "  held " << Num(r.params.graph.durations[i]);
+    }
     if (a.anneal) {
-      const fit::AnnealingResult sa = fit::AnnealDynamicTrajectory(*body, frames, start, o, r.simulations);
+      // the controller alone by lib/wobble/synth's annealer when poses or times are fitted
+      const fit::AnnealingResult sa = o.fit_poses || o.fit_times
+                                          ? fit::AnnealPoseGraph(*body, frames, start, o, r.simulations)
+                                          : fit::AnnealDynamicTrajectory(*body, frames, start, o, r.simulations);
       j["annealing"] = {{"simulations", sa.simulations}, {"cost", Number(sa.cost)}};
       out << "\nsimulated annealing with the same " << sa.simulations << " simulations: cost " << Num(sa.cost) << ".";
     }

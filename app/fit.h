@@ -49,6 +49,11 @@ struct FitTrajectoryArgs {
   std::string fit_what = "q0,qdot0,stiffness,damping";
   std::string qdot0;
   bool anneal = false;
+  // --dynamic with a pose-graph controller (poses, times in --fit)
+  std::string poses;     // "T1 .. Tk DURATION; T1 .. Tk DURATION; ..." (k = active modes)
+  std::string active;    // mode names made active, "bend,shear" (default: the .def headers')
+  bool sequence = false;  // acyclic: hold the last pose
+  double switch_width = 0.05;
 };
 
 struct FitCommands {

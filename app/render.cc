@@ -138,14 +138,34 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   RequireNonNegative(a.duration, "--duration");
   RequirePositive(a.fps, "--fps");
   if (a.duration * a.fps > 1e6) throw UsageError("--duration * --fps asks for more than a million frames");
+  CheckRenderOptions(a, default_what);
+
+  // the body and its world
+  const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
+  const Eigen::VectorXd q0 = ParseCoordinates(a.q, "--q", *body);
+  const Eigen::VectorXd qd0 = ParseCoordinates(a.qdot, "--qdot", *body);
+  WorldOptions options;
+  options.params = MakeWorldParams(a.world);
+  options.integrator = integrator;
+  options.dt = a.dt;
+  // the motion: a simulation from (q0, q̇0), run the same way in both passes
+  const Motion simulate = [&](World& world, const std::function<void(const World&)>& on_state) {
+    world.SetState(0, q0, qd0);
+    on_state(world);
+    return world.RunUntil(a.duration + 0.5 * a.dt, on_state);
+  };
+  return RenderMotion(a, default_what, body, options, 0.0, a.duration, simulate);
+}
+
+void CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
+  RequirePositive(a.fps, "--fps");
   if (a.shape_samples < 1 || a.shape_samples > 10000) throw UsageError("--shape-samples must be between 1 and 10000");
   const std::set<std::string> what = ParseWhat(a.what.empty() ? default_what : a.what);
-  const Size frame_size = ParseSize(a.size, "--size");
-  const Size strip_size = ParseSize(a.filmstrip_size, "--filmstrip-size");
-  const Size chart_size = ParseSize(a.chart_size, "--chart-size");
-  std::vector<double> strip_times = ParseNumbers(a.filmstrip_times, "--filmstrip");
-  const std::vector<double> trail_coords = ParseNumbers(a.trail, "--trail");
-  if (trail_coords.size() % 2) throw UsageError("--trail: lattice coordinates come in pairs s t");
+  ParseSize(a.size, "--size");
+  ParseSize(a.filmstrip_size, "--filmstrip-size");
+  ParseSize(a.chart_size, "--chart-size");
+  ParseNumbers(a.filmstrip_times, "--filmstrip");
+  if (ParseNumbers(a.trail, "--trail").size() % 2) throw UsageError("--trail: lattice coordinates come in pairs s t");
   const bool renders = what.count("frames") || what.count("filmstrip") || what.count("charts") || what.count("exr");
   if (renders && !pl::HasDisplay())
     throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"
@@ -156,29 +176,32 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   } catch (const std::runtime_error& e) {
     throw UsageError(std::string("--out: ") + e.what());
   }
+}
 
-  // the body and its world
-  const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
-  const Eigen::VectorXd q0 = ParseCoordinates(a.q, "--q", *body);
-  const Eigen::VectorXd qd0 = ParseCoordinates(a.qdot, "--qdot", *body);
-  WorldOptions options;
-  options.params = MakeWorldParams(a.world);
-  options.integrator = integrator;
-  options.dt = a.dt;
-  const long num_frames = long(std::floor(a.duration * a.fps + 1e-9)) + 1;
-  auto frame_time = [&](long k) { return double(k) / a.fps; };
+int RenderMotion(const RenderArgs& a, const std::string& default_what, const std::shared_ptr<const BodyModel>& body,
+                 const WorldOptions& options, double t_begin, double t_end, const Motion& motion) {
+  CheckRenderOptions(a, default_what);
+  const std::set<std::string> what = ParseWhat(a.what.empty() ? default_what : a.what);
+  const Size frame_size = ParseSize(a.size, "--size");
+  const Size strip_size = ParseSize(a.filmstrip_size, "--filmstrip-size");
+  const Size chart_size = ParseSize(a.chart_size, "--chart-size");
+  std::vector<double> strip_times = ParseNumbers(a.filmstrip_times, "--filmstrip");
+  const std::vector<double> trail_coords = ParseNumbers(a.trail, "--trail");
+  const double duration = t_end - t_begin;
+  const double dt = options.dt;
+  const long num_frames = long(std::floor(duration * a.fps + 1e-9)) + 1;
+  auto frame_time = [&](long k) { return t_begin + double(k) / a.fps; };
   // a frame shows the first state at or after its time (within half a step)
-  auto due = [&](long k, double t) { return k < num_frames && frame_time(k) <= t + 0.5 * a.dt; };
+  auto due = [&](long k, double t) { return k < num_frames && frame_time(k) <= t + 0.5 * dt; };
   if (strip_times.empty())
-    for (int k = 0; k < 6; ++k) strip_times.push_back(a.duration * k / 5.0);
+    for (int k = 0; k < 6; ++k) strip_times.push_back(t_begin + duration * k / 5.0);
 
   // pass 1: where the body goes (the camera keeps all of it in view) and the colour range
-  Eigen::AlignedBox2d motion;
+  Eigen::AlignedBox2d swept;
   double color_lo = 1e300, color_hi = -1e300;
   {
     World world(options);
     world.AddBody(body);
-    world.SetState(0, q0, qd0);
     auto probe = vtkSmartPointer<pl::MassPointSource>::New();
     auto lattice_probe = vtkSmartPointer<pl::LatticeSource>::New();
     probe->SetWorld(&world);
@@ -186,7 +209,7 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
     long k = 0;
     auto look = [&](const World& w) {
       while (due(k, w.time())) {
-        motion.extend(pl::BodyBounds(w, 0));
+        swept.extend(pl::BodyBounds(w, 0));
         if (!a.color_by.empty()) {
           vtkPolyDataAlgorithm* src = a.color_by == "displacement" ? (vtkPolyDataAlgorithm*)lattice_probe : probe.Get();
           src->Modified();
@@ -201,14 +224,12 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
         ++k;
       }
     };
-    look(world);
-    world.RunUntil(a.duration + 0.5 * a.dt, look);
+    motion(world, look);
   }
 
   // pass 2: the same run, writing as it goes
   World world(options);
   world.AddBody(body);
-  world.SetState(0, q0, qd0);
   pl::SceneOptions scene;
   scene.width = frame_size.w;
   scene.height = frame_size.h;
@@ -221,8 +242,8 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   scene.show_trails = !trail_coords.empty();
   scene.title = body->name();
   // the ground seen below the body: frame the motion plus a band under its lowest point
-  Eigen::AlignedBox2d view_box = motion;
-  view_box.extend(motion.min() - Eigen::Vector2d(0, 0.1 * motion.sizes().maxCoeff()));
+  Eigen::AlignedBox2d view_box = swept;
+  view_box.extend(swept.min() - Eigen::Vector2d(0, 0.1 * swept.sizes().maxCoeff()));
   std::unique_ptr<pl::SceneView> view, strip_view;
   if (what.count("frames") || what.count("exr")) {
     view = std::make_unique<pl::SceneView>(&world, 0, scene);
@@ -277,14 +298,13 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
       ++written;
       progress.Update(double(next_frame) / double(num_frames), w.time());
     }
-    while (strip_view && next_strip < strip_times.size() && strip_times[next_strip] <= w.time() + 0.5 * a.dt) {
+    while (strip_view && next_strip < strip_times.size() && strip_times[next_strip] <= w.time() + 0.5 * dt) {
       strip_view->Render();
       strip_images.push_back(strip_view->Capture());
       ++next_strip;
     }
   };
-  on_state(world);
-  const bool ok = world.RunUntil(a.duration + 0.5 * a.dt, on_state);
+  const bool ok = motion(world, on_state);
   writer.Wait();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.Finish();
@@ -314,7 +334,7 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   }
 
   std::cout << body->name() << ": " << written << " frames at " << Num(a.fps) << " fps over " << Num(world.time())
-            << " s simulated, " << Num(wall) << " s wall (" << (wall > 0 ? Num(written / wall) : std::string("-"))
+            << " s, " << Num(wall) << " s wall (" << (wall > 0 ? Num(written / wall) : std::string("-"))
             << " frames/s).\n";
   for (const std::string& f : files) std::cout << "  " << f << "\n";
   std::cout << std::flush;

@@ -10,10 +10,13 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "cli_common.h"
+#include "wobble/dynamics/world.h"
 
 namespace wobble::app {
 
@@ -42,5 +45,15 @@ struct RenderArgs {
 CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::string& description,
                            const std::string& default_what, RenderArgs* args);
 int RunRender(const RenderArgs& args, const std::string& default_what);
+
+// The render driver both commands share, and `wobble run`'s `render` (a script's recorded runs):
+// a motion puts a world holding `body` (index 0) through its states, calling on_state after each,
+// the first included; it runs twice (the camera's pass, then the writing pass) and must give the
+// same states both times. Returns false when it stopped early (world.status() says why).
+using Motion = std::function<bool(World& world, const std::function<void(const World&)>& on_state)>;
+int RenderMotion(const RenderArgs& args, const std::string& default_what, const std::shared_ptr<const BodyModel>& body,
+                 const WorldOptions& options, double t_begin, double t_end, const Motion& motion);
+// Checks the picture options (--what, sizes, display, --out) before anything is simulated.
+void CheckRenderOptions(const RenderArgs& args, const std::string& default_what);
 
 }  // namespace wobble::app

@@ -14,6 +14,7 @@
 
 #include "pipelines/charts.h"
 #include "pipelines/scene_view.h"
+#include "render.h"
 #endif
 
 namespace wobble::app {
@@ -72,11 +73,48 @@ void PlotCostHistory(const std::string& csv_path, const std::string& optimiser,
 #endif
 }
 
+// `render DIR [WHAT]`: a script's recorded runs through the same driver as `wobble render`, the
+// states replayed instead of simulated. Without a display only vtp and disp can be written.
+void RenderRecordedRuns(const io::RenderRequest& r) {
+#ifdef WOBBLE_HAVE_PIPELINES
+  RenderArgs a;
+  a.out = r.dir;
+  a.what = r.what.empty() ? "frames,filmstrip,charts" : r.what;
+  if (!pipelines::HasDisplay()) {
+    std::string kept;
+    for (const char* w : {"vtp", "disp"})
+      if (("," + a.what + ",").find(std::string(",") + w + ",") != std::string::npos) kept += (kept.empty() ? "" : ",") + std::string(w);
+    std::cout << "no X display: render draws no pictures (run under xvfb-run -a -s \"-screen 0 1280x1024x24\")"
+              << (kept.empty() ? "" : "; writing " + kept + " only") << "\n";
+    if (kept.empty()) return;
+    a.what = kept;
+  }
+  const Motion replay = [&](World& world, const std::function<void(const World&)>& on_state) {
+    for (const io::TrackState& s : r.states) {
+      world.SetModeTargets(0, s.targets);
+      world.SetState(0, s.q, s.qd);
+      world.SetTime(s.t);
+      on_state(world);
+    }
+    return true;
+  };
+  try {
+    RenderMotion(a, "frames,filmstrip,charts", r.body, r.world, r.states.front().t, r.states.back().t, replay);
+  } catch (const UsageError& e) {
+    throw std::runtime_error(e.what());
+  }
+#else
+  (void)r;
+  throw std::runtime_error("this wobble was built without pipelines/ (VTK): it cannot render");
+#endif
+}
+
 }  // namespace
 
 int RunScript(const RunArgs& a) {
   io::Interpreter interp(std::cout);
   interp.SetHistoryHook(PlotCostHistory);
+  interp.SetRenderHook(RenderRecordedRuns);
   Progress progress(isatty(STDERR_FILENO) == 1);
   interp.SetProgress([&](double fraction, double t) {
     progress.Update(fraction, t);

@@ -174,6 +174,73 @@ void BM_DynamicFit_Annealing(benchmark::State& state) {
 }
 BENCHMARK(BM_DynamicFit_Annealing)->Arg(24)->Arg(240)->Arg(2400)->ArgName("simulations")->Unit(benchmark::kMillisecond);
 
+// Pose-graph controller (bounding table's modes: bend and shear active, K 4e7, c 4e6) standing
+// on the synthesis scenes' ground, 3 s (300 steps), every 2nd step observed: poses and times
+// fitted from a start 0.03-0.05 off in every target and 8-12% off in every time (as
+// tests/pose_graph_fit_test.cc). Counter "cost": the final cost; "simulations".
+struct PoseGraphProblem {
+  std::shared_ptr<const BodyModel> body;
+  fit::DynamicFitOptions o;
+  fit::DynamicParameters truth, start;
+  std::vector<io::TargetFrame> frames;
+  PoseGraphProblem() {
+    std::vector<DeformationMode> modes = testing::TableModes(4e7, 4e6);
+    modes[0].active = modes[1].active = true;
+    body = std::make_shared<const BodyModel>(testing::TableDef(), modes);
+    o.world.ground.stiffness = 45000;
+    o.world.ground.normal_damping = 3000;
+    o.world.ground.friction_damping = 3000;
+    o.world.ground.friction_cap = 0.5;
+    o.fit_q0 = o.fit_qd0 = o.fit_stiffness = o.fit_damping = false;
+    o.fit_poses = o.fit_times = true;
+    truth.q0 = truth.qd0 = Eigen::VectorXd::Zero(7);
+    truth.stiffness = Eigen::VectorXd::Constant(4, 4e7);
+    truth.damping = Eigen::VectorXd::Constant(4, 4e6);
+    truth.graph.poses = {(Eigen::VectorXd(2) << 0.2, -0.1).finished(), (Eigen::VectorXd(2) << -0.1, 0.15).finished(),
+                         (Eigen::VectorXd(2) << 0.05, 0.1).finished()};
+    truth.graph.durations = {0.4, 0.3, 0.5};
+    WorldOptions wo;
+    wo.params = o.world;
+    World world(wo);
+    world.AddBody(body);
+    world.SetState(0, truth.q0, truth.qd0);
+    std::vector<double> t = {0};
+    std::vector<Eigen::VectorXd> q = {truth.q0};
+    for (int n = 0; n < 300; ++n) {
+      world.SetModeTargets(0, control::SmoothPoseTargets(*body, truth.graph, n * o.dt, o.switch_width));
+      world.Step();
+      t.push_back(world.time());
+      q.push_back(world.state(0).q);
+    }
+    frames = fit::FramesFromStates(*body, t, q, {}, 2);
+    start = truth;
+    const double dp[3][2] = {{0.05, -0.04}, {-0.03, 0.05}, {0.04, 0.03}};
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 2; ++k) start.graph.poses[i][k] += dp[i][k];
+    start.graph.durations = {0.44, 0.27, 0.56};
+  }
+};
+
+void BM_PoseGraphFit_Ground(benchmark::State& state) {
+  const PoseGraphProblem p;
+  fit::DynamicFitResult r;
+  for (auto _ : state) r = fit::FitDynamicTrajectory(*p.body, p.frames, p.start, p.o);
+  state.counters["simulations"] = double(r.simulations);
+  state.counters["cost"] = r.report.final_cost;
+  state.counters["start_cost"] = fit::DynamicCost(*p.body, p.frames, p.start, p.o);
+}
+BENCHMARK(BM_PoseGraphFit_Ground)->Unit(benchmark::kMillisecond);
+
+// The same problem by lib/wobble/synth's simulated annealing (Fig. 5.2, batch 1) with a budget
+// of simulations (the argument; Ceres used about 24).
+void BM_PoseGraphFit_Annealing(benchmark::State& state) {
+  const PoseGraphProblem p;
+  fit::AnnealingResult r;
+  for (auto _ : state) r = fit::AnnealPoseGraph(*p.body, p.frames, p.start, p.o, state.range(0), 1);
+  state.counters["cost"] = r.cost;
+}
+BENCHMARK(BM_PoseGraphFit_Annealing)->Arg(24)->Arg(240)->Arg(2400)->ArgName("simulations")->Unit(benchmark::kMillisecond)->Iterations(1);
+
 }  // namespace
 }  // namespace wobble
 

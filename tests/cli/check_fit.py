@@ -69,6 +69,35 @@ check(abs(j["stiffness"][0] / 4e6 - 1) < 1e-4 and abs(j["damping"][0] / 1e6 - 1)
       f"dynamic fit from K = 2e6, c = 5e5 finds the bend's K = 4e6, c = 1e6 of the reference: "
       f"{j['stiffness'][0]}, {j['damping'][0]}")
 
+# a pose-graph controller (issue 6): data/pose_graph_reference.wob records 3 s of the table
+# driven by three poses (smoothed switches); the poses and times come back from a start 0.05 off
+# in every target and 10-25% off in every time, with annealing on the same budget beside it
+r = subprocess.run([wobble, "run", f"{data}/pose_graph_reference.wob"], capture_output=True, text=True, cwd=work)
+check(r.returncode == 0, "wobble run data/pose_graph_reference.wob exits 0: " + r.stderr.strip())
+ground = ["--ground-stiffness", "45000", "--ground-damping", "3000", "--friction-damping", "3000", "--friction-cap", "0.5"]
+r = run("fit", "trajectory", "--object", f"{data}/table.obj", "--modes", f"{data}/bounding_modes.def",
+        "--reference", f"{work}/out/pose_graph.csv", "--dynamic", "--dt", "0.01", "--every", "2", "--fit", "poses,times",
+        "--q0", "0 0 0 0 0 0 0", "--qdot0", "0 0 0 0 0 0 0", *ground,
+        "--poses", "0.25 -0.05 0.45; -0.05 0.2 0.25; 0.1 0.1 0.55", "--anneal", "--out", f"{work}/graph.json")
+check(r.returncode == 0, "fit trajectory --fit poses,times exits 0: " + r.stderr.strip())
+j = json.load(open(f"{work}/graph.json"))
+g = j["pose_graph"]
+truth_poses, truth_times = [[0.2, -0.1], [-0.1, 0.15], [0.05, 0.1]], [0.4, 0.3, 0.5]
+err = max(max(abs(a - b) for pa, pb in zip(g["poses"], truth_poses) for a, b in zip(pa, pb)),
+          max(abs(a - b) for a, b in zip(g["durations"], truth_times)))
+check(err < 1e-6 and g["active"] == ["bend", "shear"] and g["cyclic"],
+      f"the pose graph of the reference is recovered (max error {err:.2g})")
+check(j["annealing"]["simulations"] == j["simulations"] and j["annealing"]["cost"] > 1e3 * j["report"]["final_cost"],
+      f"annealing with the same {j['simulations']} simulations ends higher: {j['annealing']['cost']} vs "
+      f"{j['report']['final_cost']}")
+r = run("fit", "trajectory", "--object", f"{data}/table.obj", "--modes", f"{data}/bounding_modes.def",
+        "--reference", f"{work}/out/pose_graph.csv", "--dynamic", "--fit", "poses", "--poses", "0.2 0.4; 0.1 0.1 0.3")
+check(r.returncode == 2 and "--poses: a pose needs 2 targets" in r.stderr, "a pose of the wrong size: exit 2 " + r.stderr.strip())
+r = run("fit", "trajectory", "--object", f"{data}/table.obj", "--modes", f"{data}/bounding_modes.def",
+        "--reference", f"{work}/out/pose_graph.csv", "--dynamic", "--fit", "times", "--switch-width", "0",
+        "--poses", "0.2 0.1 0.4")
+check(r.returncode == 2 and "--switch-width > 0" in r.stderr, "times with a hard switch: exit 2 " + r.stderr.strip())
+
 # bad input: file and line, exit 2, nothing written
 out = f"{work}/never.json"
 r = run("fit", "pose", *body, "--targets", f"{cli}/bad_target.tgt", "--out", out)

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,55 @@ struct PoseGraph {
   // Checks sizes and durations; returns an empty string or what is wrong.
   std::string Validate(int num_active) const;
 };
+
+// A pose graph whose targets switch smoothly, for fits through the simulation (lib/wobble/fit),
+// where transition times need a gradient:
+//     γ0(t) = P_0 + Σ_k (P_{k mod n} − P_{(k−1) mod n}) σ((t − S_k)/w),  S_k = τ_0 + … + τ_{k−1},
+// σ the logistic function, w the switch width (the set point moves in about 4w). As w → 0 it is
+// the pose graph above (w = 0: exactly, a hard switch at S_k). Scalar T: double or a Ceres Jet.
+template <class T> struct PoseGraphOf {
+  std::vector<VecD<T>> poses;  // one target per active mode
+  std::vector<T> durations;
+  bool cyclic = true;
+  std::vector<int> active;     // mode index of each pose entry (ActiveModes)
+  bool empty() const { return poses.empty(); }
+  static PoseGraphOf From(const BodyModel& body, const PoseGraph& g) {
+    PoseGraphOf c;
+    c.cyclic = g.cyclic;
+    c.active = ActiveModes(body);
+    for (const Eigen::VectorXd& pose : g.poses) c.poses.push_back(pose.cast<T>());
+    for (double d : g.durations) c.durations.push_back(T(d));
+    return c;
+  }
+};
+
+// γ0(t) of the smoothed graph, one per mode (0 on passive modes).
+template <class T> VecD<T> SmoothPoseTargets(const PoseGraphOf<T>& c, int num_modes, double t, double width) {
+  VecD<T> target = VecD<T>::Zero(num_modes);
+  if (c.empty()) return target;
+  const int n = int(c.poses.size());
+  VecD<T> active = c.poses[0];
+  T switch_time(0.0);
+  // switches far after t add nothing (σ < e^-30); the count bound only guards silly times
+  for (int k = 1; k < 1000000; ++k) {
+    if (!c.cyclic && k >= n) break;
+    switch_time += c.durations[(k - 1) % n];
+    if (ScalarValue(switch_time) > t + 30.0 * width) break;
+    const VecD<T> jump = c.poses[k % n] - c.poses[(k - 1) % n];
+    if (width > 0) {
+      using std::exp;
+      const T sigma = T(1.0) / (T(1.0) + exp(-(T(t) - switch_time) / T(width)));
+      active += jump * sigma;
+    } else if (ScalarValue(switch_time) <= t) {
+      active += jump;  // a hard switch
+    }
+  }
+  for (size_t i = 0; i < c.active.size(); ++i) target[c.active[i]] = active[int(i)];
+  return target;
+}
+inline Eigen::VectorXd SmoothPoseTargets(const BodyModel& body, const PoseGraph& g, double t, double width) {
+  return SmoothPoseTargets(PoseGraphOf<double>::From(body, g), body.num_modes(), t, width);
+}
 
 // Keyframed mode amplitudes (§4.10.1): keys (time, amplitudes of every mode) interpolated
 // linearly, as in the thesis, or by a C1 cubic (Catmull–Rom tangents) as an option.

@@ -32,19 +32,28 @@ struct StepStatus {
 };
 std::string StatusCodeName(StepStatus::Code code);
 
+// An extra generalized force added to Q at every force evaluation, as extra(s, &Q) with s the
+// state being evaluated (every stage of a multi-stage integrator). The World adds none; the
+// dynamic fit (lib/wobble/fit) adds mode and PD-control forces whose gains and targets are
+// Ceres Jets, so that it steps with exactly this code. The default costs nothing (inlined away).
+struct NoExtraForce {
+  template <class T> void operator()(const BodyState<T>&, VecQ<T>*) const {}
+};
+
 // q̈ of Eq. 4.21, M q̈ = Q − w, solved about the centre of mass (SolveMassSystem). Fails with
 // kIllConditioned when the elimination's pivot ratio, a lower bound of cond₂(M), exceeds
-// w.max_condition.
-template <class T>
+// w.max_condition. `extra` is added to Q (and to forces->total).
+template <class T, class Extra = NoExtraForce>
 StepStatus Accelerations(const BodyModel& body, const WorldParams& w, int body_index, const BodyState<T>& s,
                          VecQ<T>* qdd, ForceBreakdown<T>* forces = nullptr,
-                         ContactSet contact_set = ContactSet::kDetect) {
+                         ContactSet contact_set = ContactSet::kDetect, const Extra& extra = Extra()) {
   VecQ<T> vel;
   ForceBreakdown<T> local;
   ForceBreakdown<T>& f = forces ? *forces : local;
   const Frame<T> frame(s.q);
   VelocityTerms(body.moments(), s.q, s.qd, frame.R, &vel);
   EvaluateForces(body, w, body_index, s, frame, &f, contact_set);
+  extra(s, &f.total);
   double cond_estimate = 0.0;
   if (!SolveMassSystem(body.moments(), s.q, frame.R, VecQ<T>(f.total - vel), qdd, &cond_estimate))
     return {StepStatus::Code::kSingularMass, 0.0};
@@ -92,10 +101,11 @@ template <class T, class Residual> StepStatus SolveNewton(Residual&& residual, V
   return norm(r) <= 1e-8 * scale ? StepStatus{} : StepStatus{StepStatus::Code::kSolverFailed, norm(r)};
 }
 
-// Advances one body by dt with contacts held fixed, then updates its contacts.
-template <class T>
+// Advances one body by dt with contacts held fixed, then updates its contacts. `extra`: an
+// extra generalized force (see NoExtraForce).
+template <class T, class Extra = NoExtraForce>
 StepStatus StepBody(const BodyModel& body, const WorldParams& w, int body_index, Integrator integrator, double dt,
-                    BodyState<T>* s) {
+                    BodyState<T>* s, const Extra& extra = Extra()) {
   const T h(dt);
   VecQ<T> a;
   StepStatus st;
@@ -103,12 +113,14 @@ StepStatus StepBody(const BodyModel& body, const WorldParams& w, int body_index,
   auto accel = [&](const VecQ<T>& q, const VecQ<T>& qd, VecQ<T>* out, ContactSet set = ContactSet::kDetect) {
     s->q = q;
     s->qd = qd;
-    return Accelerations(body, w, body_index, *s, out, static_cast<ForceBreakdown<T>*>(nullptr), set);
+    return Accelerations(body, w, body_index, *s, out, static_cast<ForceBreakdown<T>*>(nullptr), set, extra);
   };
   switch (integrator) {
     case Integrator::kThesis: {
       // Störmer form of Eq. 4.22/4.23 with q̇_n = (q_n − q_{n−1})/Δt kept as the state
-      if (!(st = Accelerations(body, w, body_index, *s, &a)).ok()) return st;
+      if (!(st = Accelerations(body, w, body_index, *s, &a, static_cast<ForceBreakdown<T>*>(nullptr),
+                               ContactSet::kDetect, extra)).ok())
+        return st;
       const VecQ<T> q_prev = s->q - h * s->qd;
       const VecQ<T> q_next = T(2.0) * s->q - q_prev + h * h * a;
       s->qd = (q_next - s->q) / h;
@@ -117,7 +129,9 @@ StepStatus StepBody(const BodyModel& body, const WorldParams& w, int body_index,
     }
     case Integrator::kSymplecticEuler: {
       s->q += h * s->qd;
-      if (!(st = Accelerations(body, w, body_index, *s, &a)).ok()) return st;
+      if (!(st = Accelerations(body, w, body_index, *s, &a, static_cast<ForceBreakdown<T>*>(nullptr),
+                               ContactSet::kDetect, extra)).ok())
+        return st;
       s->qd += h * a;
       break;
     }
@@ -178,6 +192,7 @@ StepStatus StepBody(const BodyModel& body, const WorldParams& w, int body_index,
         s->q = m;
         s->qd = v;
         EvaluateForces(body, w, body_index, *s, &f, ContactSet::kFrozen);
+        extra(*s, &f.total);
         *Mv = Mm * v;
         *half_force = T(0.5) * h * (dT + f.total);
       };

@@ -116,7 +116,7 @@ bool World::Step() {
     }
   }
   ++steps_;
-  time_ = steps_ * options_.dt;
+  time_ = time_origin_ + steps_ * options_.dt;
   status_.step = steps_;
   status_.time = time_;
   return true;

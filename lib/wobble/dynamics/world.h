@@ -43,6 +43,12 @@ class World {
   void SetState(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
   // PD targets γ0 of the body's modes (one per mode; empty: all zero). See wobble/control.
   void SetModeTargets(int body, const Eigen::VectorXd& targets);
+  // Sets the clock, for replaying recorded states (a script's runs drawn by `render`); later
+  // steps continue from t.
+  void SetTime(double t) {
+    time_origin_ = t - steps_ * options_.dt;
+    time_ = t;
+  }
   // Springs hold a point given by lattice coordinates (Fig. 4.4).
   void AddSpring(Spring spring);
 
@@ -80,6 +86,7 @@ class World {
   std::vector<std::shared_ptr<const BodyModel>> bodies_;
   std::vector<BodyState<double>> states_;
   double time_ = 0.0;
+  double time_origin_ = 0.0;  // SetTime
   long steps_ = 0;
   SimStatus status_;
 };

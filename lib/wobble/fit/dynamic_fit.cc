@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "wobble/fit/solve_common.h"
+#include "wobble/synth/anneal.h"
 #include "wobble/fit/trajectory_fit.h"
 
 namespace wobble::fit {
@@ -18,7 +19,7 @@ namespace {
 
 // Jet width of the dynamic cost: 24 covers the table (7 + 7 + 4 + 4 parameters) in one pass;
 // bodies with more parameters take several passes (DynamicAutoDiffCostFunction strides).
-constexpr int kStride = 24;
+constexpr int kStride = 32;
 
 // The body with its mode potentials switched off: K and c come from the parameters instead
 // (lib/wobble/dynamics reads them from the model as doubles; see ThesisStep).
@@ -32,53 +33,44 @@ template <class T> struct ModeParams {
   VecD<T> K, c;
 };
 
-// Generalized mode forces −2 K_d γ_d − c_d γ̇_d (§4.7) with K, c of scalar T.
-template <class T> void AddModeForces(const ModeParams<T>& p, const BodyState<T>& s, VecQ<T>* Q) {
-  for (int d = 0; d < p.K.size(); ++d)
-    (*Q)[kRigidDofs + d] += -T(2.0) * p.K[d] * s.q[kRigidDofs + d] - p.c[d] * s.qd[kRigidDofs + d];
-}
+// StepBody's extra generalized force: the mode forces −2K_d (γ_d − γ0_d) − c_d γ̇_d (§4.7, and
+// the PD controller of chapter 5) with K, c and γ0 of scalar T; the body's own are switched off.
+template <class T> struct ModeForce {
+  const ModeParams<T>* p;
+  const VecD<T>* target;
+  void operator()(const BodyState<T>& s, VecQ<T>* Q) const {
+    for (int d = 0; d < p->K.size(); ++d)
+      (*Q)[kRigidDofs + d] += -T(2.0) * p->K[d] * (s.q[kRigidDofs + d] - (*target)[d]) - p->c[d] * s.qd[kRigidDofs + d];
+  }
+};
 
-// One step of the thesis scheme (Eq. 4.22/4.23), written exactly as StepBody's kThesis case,
-// but with the mode forces from `p`. StepBody takes its forces from the model only; once the
-// dynamics accept an extra generalized force (controllers, issue 5) this should call it.
-template <class T>
-bool ThesisStep(const BodyModel& passive, const WorldParams& w, double dt, const ModeParams<T>& p, BodyState<T>* s) {
-  const T h(dt);
-  MatQ<T> M;
-  VecQ<T> vel;
-  ForceBreakdown<T> f;
-  MassMatrix(passive.moments(), s->q, &M);
-  VelocityTerms(passive.moments(), s->q, s->qd, &vel);
-  EvaluateForces(passive, w, 0, *s, &f);
-  VecQ<T> a = f.total;
-  AddModeForces(p, *s, &a);
-  a -= vel;
-  if (!CholeskyInPlace(&M)) return false;
-  CholeskySolveInPlace(M, &a);
-  const VecQ<T> q_prev = s->q - h * s->qd;
-  const VecQ<T> q_next = T(2.0) * s->q - q_prev + h * h * a;
-  s->qd = (q_next - s->q) / h;
-  s->q = q_next;
-  UpdateContacts(passive, w.ground, s);
-  for (int i = 0; i < s->q.size(); ++i)
-    if (!std::isfinite(ScalarValue(s->q[i])) || !std::isfinite(ScalarValue(s->qd[i]))) return false;
-  return true;
-}
-
+// The thesis integrator (Eq. 4.22/4.23), exactly as World runs it: StepBody with the mode forces
+// from `p` and the controller's targets at the start of every step (as the World's pose graph
+// sets them). Calls on_frame(f, q) at every frame step.
 template <class T, class F>
-bool Simulate(const BodyModel& passive, const WorldParams& w, double dt, const VecQ<T>& q0, const VecQ<T>& qd0,
-              const ModeParams<T>& p, const std::vector<int>& steps, F&& on_frame) {
+bool Simulate(const BodyModel& passive, const WorldParams& w, double dt, double width, const VecQ<T>& q0,
+              const VecQ<T>& qd0, const ModeParams<T>& p, const control::PoseGraphOf<T>& control, const std::vector<int>& steps,
+              F&& on_frame) {
   BodyState<T> s;
   s.q = q0;
   s.qd = qd0;
   UpdateContacts(passive, w.ground, &s);
+  VecD<T> target = VecD<T>::Zero(passive.num_modes());
   int step = 0;
   for (size_t f = 0; f < steps.size(); ++f) {
-    for (; step < steps[f]; ++step)
-      if (!ThesisStep(passive, w, dt, p, &s)) return false;
+    for (; step < steps[f]; ++step) {
+      if (!control.empty()) target = control::SmoothPoseTargets(control, passive.num_modes(), step * dt, width);
+      if (!StepBody(passive, w, 0, Integrator::kThesis, dt, &s, ModeForce<T>{&p, &target}).ok()) return false;
+      for (int i = 0; i < s.q.size(); ++i)
+        if (!std::isfinite(ScalarValue(s.q[i])) || !std::isfinite(ScalarValue(s.qd[i]))) return false;
+    }
     on_frame(int(f), s.q);
   }
   return true;
+}
+
+control::PoseGraphOf<double> ControllerOf(const BodyModel& body, const control::PoseGraph& g) {
+  return control::PoseGraphOf<double>::From(body, g);
 }
 
 // G_dd, the generalized mass of each mode: the damping scale 2 sqrt(2 K G_dd) is the critical
@@ -92,6 +84,9 @@ VecD<double> ModeMasses(const BodyModel& body) {
 // The raw parameter blocks Ceres sees: q0, q̇0, log K, ζ.
 struct Blocks {
   std::vector<double> q0, qd0, log_k, zeta;
+  std::vector<double> poses, log_times;  // the controller: poses flattened, log transition times
+  int pose_size = 0;
+  bool cyclic = true;
   static Blocks From(const DynamicParameters& p, const VecD<double>& G) {
     Blocks b;
     b.q0.assign(p.q0.data(), p.q0.data() + p.q0.size());
@@ -99,6 +94,12 @@ struct Blocks {
     for (int d = 0; d < p.stiffness.size(); ++d) {
       b.log_k.push_back(std::log(p.stiffness[d]));
       b.zeta.push_back(p.damping[d] / (2.0 * std::sqrt(2.0 * p.stiffness[d] * G[d])));
+    }
+    b.cyclic = p.graph.cyclic;
+    for (size_t i = 0; i < p.graph.poses.size(); ++i) {
+      b.pose_size = int(p.graph.poses[i].size());
+      for (int k = 0; k < b.pose_size; ++k) b.poses.push_back(p.graph.poses[i][k]);
+      b.log_times.push_back(std::log(p.graph.durations[i]));
     }
     return b;
   }
@@ -111,6 +112,11 @@ struct Blocks {
     for (size_t d = 0; d < log_k.size(); ++d) {
       p.stiffness[d] = std::exp(log_k[d]);
       p.damping[d] = zeta[d] * 2.0 * std::sqrt(2.0 * p.stiffness[d] * G[d]);
+    }
+    p.graph.cyclic = cyclic;
+    for (size_t i = 0; i < log_times.size(); ++i) {
+      p.graph.poses.push_back(Eigen::Map<const Eigen::VectorXd>(poses.data() + i * pose_size, pose_size));
+      p.graph.durations.push_back(std::exp(log_times[i]));
     }
     return p;
   }
@@ -147,7 +153,10 @@ Reference MakeReference(const BodyModel& body, const std::vector<io::TargetFrame
 struct DynamicResidual {
   const BodyModel* passive;
   const WorldParams* world;
-  double dt;
+  double dt, width;
+  int num_poses, pose_size;  // the controller's blocks follow q0, q̇0, log K, ζ when num_poses > 0
+  bool cyclic;
+  std::vector<int> active;
   const Reference* ref;
   VecD<double> G;
   long* simulations;
@@ -168,9 +177,22 @@ struct DynamicResidual {
       mp.K[d] = exp(p[2][d]);
       mp.c[d] = p[3][d] * T(2.0) * sqrt(T(2.0 * G[d]) * mp.K[d]);
     }
+    control::PoseGraphOf<T> control;
+    if (num_poses > 0) {
+      const int b = D > 0 ? 4 : 2;  // index of the poses block
+      control.cyclic = cyclic;
+      control.active = active;
+      for (int i = 0; i < num_poses; ++i) {
+        VecD<T> pose(pose_size);
+        for (int k = 0; k < pose_size; ++k) pose[k] = p[b][i * pose_size + k];
+        control.poses.push_back(pose);
+        using std::exp;
+        control.durations.push_back(exp(p[b + 1][i]));
+      }
+    }
     ++*simulations;
     int k = 0;
-    return Simulate(*passive, *world, dt, q0, qd0, mp, ref->steps, [&](int f, const VecQ<T>& q) {
+    return Simulate(*passive, *world, dt, width, q0, qd0, mp, control, ref->steps, [&](int f, const VecQ<T>& q) {
       for (const SegmentResidual& s : ref->points[f]) {
         const Vec2<T> x = PointPosition(s.point, q.data(), nq);
         r[k++] = T(s.sqrt_weight) * (x[0] - T(s.a[0]));
@@ -191,6 +213,10 @@ void CheckParameters(const BodyModel& body, const DynamicParameters& p) {
                                   "' needs a positive starting stiffness (it is fitted as log K)");
     if (!(p.damping[d] >= 0) || !std::isfinite(p.damping[d]))
       throw std::invalid_argument("dynamic fit: damping must be >= 0");
+  }
+  if (!p.graph.empty()) {
+    const std::string invalid = p.graph.Validate(int(control::ActiveModes(body).size()));
+    if (!invalid.empty()) throw std::invalid_argument("dynamic fit: pose graph: " + invalid);
   }
 }
 
@@ -247,7 +273,8 @@ bool SimulateWithParameters(const BodyModel& body, const DynamicFitOptions& o, c
   ModeParams<double> mp;
   mp.K = p.stiffness;
   mp.c = p.damping;
-  return Simulate(passive, o.world, o.dt, VecQ<double>(p.q0), VecQ<double>(p.qd0), mp, frame_steps,
+  return Simulate(passive, o.world, o.dt, o.switch_width, VecQ<double>(p.q0), VecQ<double>(p.qd0), mp,
+                  ControllerOf(body, p.graph), frame_steps,
                   [&](int f, const VecQ<double>& q) { on_frame(f, Eigen::VectorXd(q)); });
 }
 
@@ -274,8 +301,14 @@ DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<i
   const int nq = body.num_q(), D = body.num_modes();
 
   DynamicFitResult result;
+  if ((o.fit_poses || o.fit_times) && start.graph.empty())
+    throw std::invalid_argument("dynamic fit: fitting poses or times needs a pose graph to start from");
+  if (o.fit_times && !(o.switch_width > 0))
+    throw std::invalid_argument("dynamic fit: fitting transition times needs a switch width > 0 (a hard switch has no gradient)");
+  const int num_poses = int(start.graph.poses.size());
   auto* cost = new ceres::DynamicAutoDiffCostFunction<DynamicResidual, kStride>(
-      new DynamicResidual{&passive, &o.world, o.dt, &ref, G, &result.simulations});
+      new DynamicResidual{&passive, &o.world, o.dt, o.switch_width, num_poses, blocks.pose_size, start.graph.cyclic,
+                          control::ActiveModes(body), &ref, G, &result.simulations});
   std::vector<double*> params = {blocks.q0.data(), blocks.qd0.data()};
   cost->AddParameterBlock(nq);
   cost->AddParameterBlock(nq);
@@ -284,6 +317,13 @@ DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<i
     cost->AddParameterBlock(D);
     params.push_back(blocks.log_k.data());
     params.push_back(blocks.zeta.data());
+  }
+  if (num_poses > 0) {
+    if (D == 0) throw std::invalid_argument("dynamic fit: a pose graph needs modes");
+    cost->AddParameterBlock(int(blocks.poses.size()));
+    cost->AddParameterBlock(num_poses);
+    params.push_back(blocks.poses.data());
+    params.push_back(blocks.log_times.data());
   }
   cost->SetNumResiduals(ref.num_residuals);
   ceres::Problem problem;
@@ -294,6 +334,14 @@ DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<i
     if (!o.fit_stiffness) problem.SetParameterBlockConstant(blocks.log_k.data());
     if (!o.fit_damping) problem.SetParameterBlockConstant(blocks.zeta.data());
     for (int d = 0; d < D; ++d) problem.SetParameterLowerBound(blocks.zeta.data(), d, 0.0);
+  }
+  if (num_poses > 0) {
+    if (!o.fit_poses) problem.SetParameterBlockConstant(blocks.poses.data());
+    if (!o.fit_times) problem.SetParameterBlockConstant(blocks.log_times.data());
+    for (int i = 0; i < num_poses; ++i) {
+      problem.SetParameterLowerBound(blocks.log_times.data(), i, std::log(o.min_time));
+      problem.SetParameterUpperBound(blocks.log_times.data(), i, std::log(o.max_time));
+    }
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
@@ -313,6 +361,41 @@ DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<i
   const double c = DynamicCost(body, frames, result.params, o);
   result.rms_residual = std::sqrt(2.0 * c / (ref.num_residuals / 2));
   return result;
+}
+
+AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<io::TargetFrame>& frames,
+                                const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
+                                std::uint64_t seed) {
+  const DynamicParameters start = Completed(body, frames, initial);
+  CheckParameters(body, start);
+  if (start.graph.empty()) throw std::invalid_argument("anneal: needs a pose graph to start from");
+  // the synthesis problem of lib/wobble/synth with this fit's cost in place of Table 5.1's
+  synth::Problem problem;
+  problem.body = std::make_shared<BodyModel>(body);
+  problem.custom_cost = [&](const control::PoseGraph& g) {
+    DynamicParameters p = start;
+    p.graph = g;
+    return DynamicCost(body, frames, p, o);
+  };
+  synth::AnnealOptions a;
+  a.seed = seed;
+  a.iterations = int(std::max<long>(0, budget - 1));
+  a.batch = 1;
+  a.threads = 1;
+  a.optimize = o.fit_poses && o.fit_times ? synth::Optimize::kBoth
+               : o.fit_times              ? synth::Optimize::kTimes
+                                          : synth::Optimize::kPoses;
+  a.min_time = o.min_time;
+  a.max_time = o.max_time;
+  a.pose_step = 0.02;  // the scale of the perturbations the fit starts from
+  a.time_step = 0.05;
+  const synth::AnnealResult r = synth::Anneal(problem, start.graph, a);
+  AnnealingResult out;
+  out.params = start;
+  out.params.graph = r.best;
+  out.cost = r.best_outcome.cost;
+  out.simulations = r.trials;
+  return out;
 }
 
 AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<io::TargetFrame>& frames,

@@ -3,16 +3,28 @@
 // from automatic differentiation through the templated dynamics (Ceres Jets through
 // MassMatrix, VelocityTerms, EvaluateForces and the thesis integrator, Eq. 4.21–4.23).
 //
-// Fitted now: the initial state (q0, q̇0) and the passive mode stiffness K_d (V = K γ²) and
-// damping c_d of every mode. Each is its own Ceres parameter block, so that the controller
-// parameters of issue 5 (PD gains, pose-graph poses and timings) can join later as further
-// blocks: add them to DynamicParameters, to the block list in dynamic_fit.cc (Blocks) and
-// their generalized force to ModeForces.
+// Fitted: the initial state (q0, q̇0), the stiffness K_d (V = K γ²) and damping c_d of every
+// mode — also the PD gains of chapter 5 (C = 2K, D = c) —, and a pose-graph controller's poses
+// (targets of the active modes) and transition times. Each is its own Ceres parameter block.
+// The simulation is the world's own step (StepBody, thesis integrator) on the body with its mode
+// forces switched off; the mode and PD forces −2K(γ − γ0(t)) − c γ̇, whose K, c and γ0 are Jets,
+// enter as StepBody's extra generalized force.
+//
+// Transition times are made differentiable by a smoothed pose switch: the targets are
+//     γ0(t) = P_0 + Σ_k (P_{k mod n} − P_{(k−1) mod n}) σ((t − S_k)/w),  S_k = τ_0 + … + τ_{k−1},
+// σ the logistic function and w the switch width (DynamicFitOptions::switch_width). A hard switch
+// (the pose graph of lib/wobble/control) has a cost that is piecewise constant in the times
+// between steps, with zero gradient almost everywhere; the smoothed one is a controller in its
+// own right (a PD servo whose set point moves in about 4w) and tends to the hard one as w → 0.
+// The fit models a controller with smoothed switches: control::SmoothPoseTargets, which scripts
+// run with `set switch_width W` (and anyone with World::SetModeTargets before each step).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <vector>
 
+#include "wobble/control/control.h"
 #include "wobble/dynamics/step.h"
 #include "wobble/fit/pose_fit.h"
 
@@ -21,12 +33,18 @@ namespace wobble::fit {
 struct DynamicParameters {
   Eigen::VectorXd q0, qd0;             // initial state (num_q each)
   Eigen::VectorXd stiffness, damping;  // per mode: K_d > 0, c_d >= 0
+  // Pose-graph controller of the active modes (DeformationMode::active); empty: no controller,
+  // every mode is pulled to 0. Transition times > 0.
+  control::PoseGraph graph;
 };
 
 struct DynamicFitOptions {
   WorldParams world;  // gravity, ground, springs
   double dt = 0.01;   // thesis integrator (Eq. 4.22/4.23), as `wobble simulate --integrator thesis`
   bool fit_q0 = true, fit_qd0 = true, fit_stiffness = true, fit_damping = true;
+  bool fit_poses = false, fit_times = false;  // the controller's (needs a non-empty graph)
+  double switch_width = 0.05;  // w of the smoothed pose switch, seconds (> 0 to fit times)
+  double min_time = 0.05, max_time = 10.0;  // bounds of the transition times
   int max_iterations = 50;
   bool full_report = false;
   std::function<void(int iteration, double cost)> on_iteration;  // progress display
@@ -64,6 +82,12 @@ struct AnnealingResult {
   double cost = 0;
   long simulations = 0;
 };
+// Simulated annealing of the controller (lib/wobble/synth, Fig. 5.2) on the same cost: the
+// poses and/or times (options.fit_poses/fit_times) of initial.graph, the rest of `initial`
+// fixed, with `simulation_budget` simulations (batch 1). The best graph is in result.params.
+AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<io::TargetFrame>& frames,
+                                const DynamicParameters& initial, const DynamicFitOptions& options,
+                                long simulation_budget, std::uint64_t seed = 1);
 AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<io::TargetFrame>& frames,
                                         const DynamicParameters& initial, const DynamicFitOptions& options,
                                         long simulation_budget, unsigned seed = 1);

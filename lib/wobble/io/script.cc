@@ -49,13 +49,15 @@ const std::vector<CommandInfo>& Interpreter::Commands() {
       {"hold", "hold S T | hold off", "hold the point at lattice coordinates (S, T) in place while keyframing"},
       {"keyframe", "keyframe", "play the keys from the current state, then hand over to simulation"},
       {"spring", "spring S T X Y [K [C [REST]]]", "a spring from lattice point (S, T) to the world point (X, Y)"},
-      {"clear", "clear poses|keys|springs|output|energy", "forget poses, keys, springs, recorded rows or energy"},
+      {"clear", "clear poses|keys|springs|output|energy|track", "forget poses, keys, springs, recorded rows, energy or the runs render draws"},
       {"output", "output FILE.csv [EVERY] | output off", "record the state of every EVERY-th step as CSV"},
       {"print", "print", "print the state, energies and the control energy"},
       {"anneal", "anneal ITERATIONS", "simulated annealing of the pose graph (Fig. 5.2)"},
       {"cmaes", "cmaes GENERATIONS", "CMA-ES (pagmo2) on the same problem as anneal; population = batch (>= 5)"},
       {"gait", "gait SKIP CYCLES", "distance travelled per cycle of the pose graph, after SKIP cycles"},
       {"save", "save FILE", "write a script that rebuilds the current setup and replays its controller"},
+      {"render", "render DIR [WHAT]", "draw every run since load_obj (or clear track) into DIR: frames, filmstrip, "
+                                      "charts, vtp, exr, disp (comma list; default frames,filmstrip,charts)"},
       {"echo", "echo TEXT", "print TEXT"},
       {"quit", "quit", "stop (interactive use)"},
   };
@@ -69,7 +71,7 @@ const std::vector<std::string>& Interpreter::Parameters() {
       "time", "end", "dt", "ground_height", "ground_slope", "max_penetration",             //
       "integrator", "interp",                                                               // words
       "seed", "batch", "cooling", "temperature", "optimize", "cost", "cost_scale", "trial_steps",
-      "pose_step", "time_step", "threads", "anneal_csv", "cmaes_csv", "sigma0", "min_amplitude", "max_amplitude", "min_time", "max_time"};
+      "pose_step", "time_step", "threads", "anneal_csv", "cmaes_csv", "sigma0", "min_amplitude", "max_amplitude", "min_time", "max_time", "switch_width"};
   return names;
 }
 
@@ -207,6 +209,7 @@ bool Interpreter::RunLine(const std::string& line, const std::string& name, int 
 
 void Interpreter::LoadObject(const std::string& path) {
   object_ = ReadObjectFile(path);
+  track_.clear();
   object_path_ = fs::absolute(path).string();
   modes_.clear();
   def_paths_.clear();
@@ -427,9 +430,10 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
     if (w[1] == "poses") graph_ = {};
     else if (w[1] == "keys") keys_ = {};
     else if (w[1] == "springs") springs_.clear();
-    else if (w[1] == "output") rows_.clear();
+    else if (w[1] == "output") ClearOutputRows();
     else if (w[1] == "energy") energy_ = {};
-    else ctx.Fail("expected poses, keys, springs, output or energy after 'clear', got '" + w[1] + "'");
+    else if (w[1] == "track") track_.clear();
+    else ctx.Fail("expected poses, keys, springs, output, energy or track after 'clear', got '" + w[1] + "'");
   } else if (cmd == "output") {
     ExpectWords(w, 2, 3, usage(), ctx);
     if (w[1] == "off") {
@@ -442,7 +446,7 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
     output_path_ = w[1];
     output_every_ = every;
     output_counter_ = 0;
-    rows_.clear();
+    ClearOutputRows();
   } else if (cmd == "print") {
     ExpectWords(w, 1, 1, usage(), ctx);
     RequireBody(ctx, "print");
@@ -549,6 +553,19 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
     } catch (const std::runtime_error& e) {
       ctx.Fail(e.what());
     }
+  } else if (cmd == "render") {
+    ExpectWords(w, 2, 3, usage(), ctx);
+    RequireBody(ctx, "render");
+    if (track_.empty()) ctx.Fail("render: nothing to draw yet (run 'simul' or 'keyframe' first)");
+    if (!render_hook_) ctx.Fail("render: this program has no renderer ('wobble run' has one)");
+    RenderRequest request = MakeRenderRequest();
+    request.dir = w[1];
+    request.what = w.size() > 2 ? w[2] : "";
+    try {
+      render_hook_(request);
+    } catch (const std::exception& e) {
+      ctx.Fail(std::string("render: ") + e.what());
+    }
   } else if (cmd == "echo") {
     for (size_t i = 1; i < w.size(); ++i) out_ << (i > 1 ? " " : "") << w[i];
     out_ << "\n";
@@ -644,6 +661,7 @@ void Interpreter::Set(const std::vector<std::string>& w, const Context& ctx) {
                "energy_per_sqrt_distance), got '" + value + "'");
   } else if (name == "anneal_csv") anneal_csv_ = value;
   else if (name == "cmaes_csv") cmaes_csv_ = value;
+  else if (name == "switch_width") switch_width_ = non_negative();
   else if (name == "sigma0") {
     sigma0_ = positive();
     if (sigma0_ > 1) ctx.Fail("expected sigma0 in (0, 1], got " + value);
@@ -680,13 +698,114 @@ void Interpreter::RecordRow(const World& world, double t, int pose) {
   for (double v : {e.kinetic, e.gravity, e.modes, e.ground, e.springs, e.total(), energy_.consumed, double(pose),
                    double(s.contacts.size())})
     row.push_back(v);
+  // the column of each mode, by name: a load_def between runs (the cliff jump's switch of mode
+  // sets) keeps a mode's column, and a new mode gets a new one
+  std::vector<int> slots;
+  for (const DeformationMode& m : world.body(0).modes()) {
+    const auto it = std::find(output_modes_.begin(), output_modes_.end(), m.name);
+    slots.push_back(int(it - output_modes_.begin()));
+    if (it == output_modes_.end()) output_modes_.push_back(m.name);
+  }
+  if (slot_sets_.empty() || slot_sets_.back() != slots) slot_sets_.push_back(slots);
   rows_.push_back(std::move(row));
+  row_slot_set_.push_back(int(slot_sets_.size()) - 1);
+}
+
+void Interpreter::RecordTrack(const World& world, double t) {
+  // a state at the same time as the last one (the hand-over) replaces it: the later run goes on
+  if (!track_.empty() && track_.back().state.t == t) track_.pop_back();
+  const BodyState<double>& s = world.state(0);
+  track_.push_back({body_, {t, s.q, s.qd, s.mode_target}});
+}
+
+RenderRequest Interpreter::MakeRenderRequest() const {
+  // one body with every mode the recorded runs used (the last definition of each name)
+  std::vector<DeformationMode> modes;
+  std::vector<std::vector<int>> slots;  // per distinct run body: column of each of its modes
+  std::vector<const BodyModel*> bodies;
+  for (const TrackEntry& e : track_) {
+    if (!bodies.empty() && bodies.back() == e.body.get()) continue;
+    bodies.push_back(e.body.get());
+    std::vector<int> s;
+    for (const DeformationMode& m : e.body->modes()) {
+      auto it = std::find_if(modes.begin(), modes.end(), [&](const DeformationMode& x) { return x.name == m.name; });
+      if (it == modes.end()) {
+        modes.push_back(m);
+        it = modes.end() - 1;
+      } else {
+        *it = m;
+      }
+      s.push_back(int(it - modes.begin()));
+    }
+    slots.push_back(s);
+  }
+  RenderRequest r;
+  r.body = std::make_shared<const BodyModel>(*object_, modes);
+  r.world = MakeWorldOptions();
+  if (springs_on_)
+    for (Spring sp : springs_) {
+      r.body->LocalBasis(sp.lattice_coords, &sp.rest_local, &sp.mode_matrix);
+      r.world.params.springs.push_back(sp);
+    }
+  const int N = int(modes.size());
+  size_t b = 0;
+  for (size_t i = 0; i < track_.size(); ++i) {
+    if (i > 0 && track_[i].body != track_[i - 1].body) ++b;
+    const TrackState& in = track_[i].state;
+    TrackState out;
+    out.t = in.t;
+    out.q.setZero(kRigidDofs + N);
+    out.qd.setZero(kRigidDofs + N);
+    out.q.head<kRigidDofs>() = in.q.head<kRigidDofs>();
+    out.qd.head<kRigidDofs>() = in.qd.head<kRigidDofs>();
+    if (in.targets.size()) out.targets.setZero(N);
+    for (size_t d = 0; d < slots[b].size(); ++d) {
+      out.q[kRigidDofs + slots[b][d]] = in.q[kRigidDofs + d];
+      out.qd[kRigidDofs + slots[b][d]] = in.qd[kRigidDofs + d];
+      if (in.targets.size()) out.targets[slots[b][d]] = in.targets[d];
+    }
+    r.states.push_back(std::move(out));
+  }
+  return r;
+}
+
+void Interpreter::ClearOutputRows() {
+  rows_.clear();
+  row_slot_set_.clear();
+  slot_sets_.clear();
+  output_modes_.clear();
+}
+
+std::vector<std::vector<double>> Interpreter::OutputRows() const {
+  // every row gets a column per mode recorded since `output`; a mode that was not loaded during
+  // a row's run has amplitude and rate 0 there
+  const int N = int(output_modes_.size());
+  std::vector<std::vector<double>> rows;
+  rows.reserve(rows_.size());
+  for (size_t r = 0; r < rows_.size(); ++r) {
+    const std::vector<double>& raw = rows_[r];
+    const std::vector<int>& slots = slot_sets_[row_slot_set_[r]];
+    const int D = int(slots.size());
+    std::vector<double> row(1 + 2 * (kRigidDofs + N) + (raw.size() - 1 - 2 * (kRigidDofs + D)), 0.0);
+    row[0] = raw[0];
+    for (int i = 0; i < kRigidDofs; ++i) {
+      row[1 + i] = raw[1 + i];
+      row[1 + kRigidDofs + N + i] = raw[1 + kRigidDofs + D + i];
+    }
+    for (int d = 0; d < D; ++d) {
+      row[1 + kRigidDofs + slots[d]] = raw[1 + kRigidDofs + d];
+      row[1 + 2 * kRigidDofs + N + slots[d]] = raw[1 + 2 * kRigidDofs + D + d];
+    }
+    std::copy(raw.begin() + 1 + 2 * (kRigidDofs + D), raw.end(), row.begin() + 1 + 2 * (kRigidDofs + N));
+    rows.push_back(std::move(row));
+  }
+  return rows;
 }
 
 void Interpreter::FlushOutput(const Context& ctx) {
   if (output_path_.empty()) return;
   try {
-    WriteTextAtomically(output_path_, CsvText(OutputHeader(int(modes_.size())), rows_));
+    WriteTextAtomically(output_path_, CsvText(OutputHeader(int(output_modes_.size())), OutputRows()));
   } catch (const std::runtime_error& e) {
     ctx.Fail(std::string("output: ") + e.what());
   }
@@ -734,9 +853,14 @@ void Interpreter::Simulate(double duration, const Context& ctx) {
   int pose = -1;
   // the start state, unless the run before (a keyframed one, say) already recorded it
   if (rows_.empty() || rows_.back()[0] != t0) RecordRow(world, t0, pose);
+  RecordTrack(world, t0);
   for (long n = 0; n < steps; ++n) {
     // the pose graph cycles from its first pose at the start of every simul (chapter 5)
-    if (controlled) {
+    if (controlled && switch_width_ > 0) {
+      // smoothed switches (control::SmoothPoseTargets), as the dynamic fit models the controller
+      pose = graph_.PoseAt(n * world_.dt);
+      world.SetModeTargets(0, control::SmoothPoseTargets(*body, graph_, n * world_.dt, switch_width_));
+    } else if (controlled) {
       const int now = graph_.PoseAt(n * world_.dt);
       if (now != pose) {
         pose = now;
@@ -754,6 +878,7 @@ void Interpreter::Simulate(double duration, const Context& ctx) {
     energy_.Accumulate(*body, world.state(0), world_.dt);
     const double t = t0 + world.time();
     RecordRow(world, t, pose);
+    RecordTrack(world, t);
     if (debug_) {
       out_ << "t " << Num(t) << " q";
       for (int i = 0; i < world.state(0).q.size(); ++i) out_ << " " << Num(world.state(0).q[i]);
@@ -789,6 +914,7 @@ void Interpreter::RunKeyframes(const Context& ctx) {
     control::KeyframedState(*body, hold_, anchor, translation, theta, gamma, gamma_dot, &q, &qd);
     view.SetState(0, q, qd);
     RecordRow(view, t0 + t, -1);
+    RecordTrack(view, t0 + t);
     if (progress_ && (n % 64 == 0 || n == steps)) progress_(double(n) / double(std::max(1L, steps)), t0 + t);
   }
   // hand-over: the simulation continues from the keyframed q and the velocity it had
@@ -853,6 +979,7 @@ std::string Interpreter::ReplayScript() const {
   vec("q", anneal_start_q_.size() ? anneal_start_q_ : q_);
   vec("dq", anneal_start_q_.size() ? anneal_start_qd_ : qd_);
   s << "set cyclic " << (graph_.cyclic ? "T" : "F") << "\n";
+  s << "set switch_width " << Num(switch_width_) << "\n";
   for (size_t i = 0; i < graph_.poses.size(); ++i) {
     s << "pose";
     for (int k = 0; k < graph_.poses[i].size(); ++k) s << " " << Num(graph_.poses[i][k]);

@@ -33,6 +33,23 @@ class SimulationStopped : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// One recorded state of a script's runs (keyframed or simulated), for `render`.
+struct TrackState {
+  double t = 0;
+  Eigen::VectorXd q, qd, targets;  // targets: PD targets γ0 (empty: all 0)
+};
+
+// What `render DIR [WHAT]` asks the CLI to draw: every state of the runs since the object was
+// loaded (or `clear track`), in the coordinates of `body`, whose modes are every mode those runs
+// used (a mode absent from a run's set has amplitude and rate 0 there).
+struct RenderRequest {
+  std::string dir;   // output folder
+  std::string what;  // comma list (frames, filmstrip, charts, vtp, exr, disp); empty: the default
+  std::shared_ptr<const BodyModel> body;
+  WorldOptions world;  // ground, gravity, springs, dt
+  std::vector<TrackState> states;
+};
+
 struct CommandInfo {
   std::string name, usage, summary;
 };
@@ -60,6 +77,11 @@ class Interpreter {
   using HistoryHook = std::function<void(const std::string& csv_path, const std::string& optimiser,
                                          const std::vector<synth::IterationRecord>& history)>;
   void SetHistoryHook(HistoryHook hook) { history_hook_ = std::move(hook); }
+
+  // Draws a script's runs (`render`); the CLI installs it (pipelines/, VTK). lib draws nothing:
+  // without a hook `render` is an error. The hook reports trouble by throwing.
+  using RenderHook = std::function<void(const RenderRequest& request)>;
+  void SetRenderHook(RenderHook hook) { render_hook_ = std::move(hook); }
 
   static const std::vector<CommandInfo>& Commands();
   static const std::vector<std::string>& Parameters();  // names `set` accepts
@@ -108,6 +130,10 @@ class Interpreter {
   void RunKeyframes(const Context& ctx);
   void RecordRow(const World& world, double t, int pose);
   void FlushOutput(const Context& ctx);
+  void ClearOutputRows();
+  std::vector<std::vector<double>> OutputRows() const;
+  void RecordTrack(const World& world, double t);
+  RenderRequest MakeRenderRequest() const;  // rows_ with one column per output_modes_
   void Invalidate() { body_.reset(); }
   std::shared_ptr<const BodyModel> BuildBody();
   synth::Problem MakeProblem(long steps);
@@ -140,6 +166,7 @@ class Interpreter {
   // control
   control::PoseGraph graph_;
   bool control_on_ = true;
+  double switch_width_ = 0.0;  // > 0: simul switches poses smoothly (control::SmoothPoseTargets)
   control::Keyframes keys_;
   control::HeldPoint hold_;
 
@@ -157,7 +184,18 @@ class Interpreter {
   std::string output_path_;
   int output_every_ = 1;
   long output_counter_ = 0;
-  std::vector<std::vector<double>> rows_;
+  std::vector<std::vector<double>> rows_;  // t, q, q̇, energies... of the mode set of that run
+  std::vector<std::string> output_modes_;  // every mode recorded since `output`, first seen first
+  std::vector<std::vector<int>> slot_sets_;  // column (index into output_modes_) of each mode
+  std::vector<int> row_slot_set_;          // per row: its entry in slot_sets_
+
+  // render
+  RenderHook render_hook_;
+  struct TrackEntry {
+    std::shared_ptr<const BodyModel> body;  // the mode set of that run
+    TrackState state;
+  };
+  std::vector<TrackEntry> track_;
 };
 
 // The CSV text of a table (numbers in shortest round-trip form).

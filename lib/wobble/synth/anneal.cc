@@ -77,6 +77,12 @@ void CenterOfMassX(const BodyModel& body, const Eigen::VectorXd& q, const Eigen:
 TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
                       const std::function<void(const World&)>& on_step) {
   TrialOutcome out;
+  if (p.custom_cost) {
+    out.cost = p.custom_cost(graph);
+    out.ok = std::isfinite(out.cost);
+    if (!out.ok) out.cost = p.cost.high;
+    return out;
+  }
   World world(p.world);
   world.AddBody(p.body);
   world.SetState(0, p.q0, p.qd0);

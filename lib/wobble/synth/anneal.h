@@ -57,6 +57,10 @@ struct Problem {
   Eigen::VectorXd q0, qd0;
   long steps = 1200;  // forward simulation per trial (thesis: 1200 steps of 0.01)
   CostFunction cost;
+  // When set, a trial's cost is this function of the controller instead of a World run judged by
+  // `cost` (e.g. the dynamic fit's distance to a reference trajectory, lib/wobble/fit), so the
+  // same annealer can be compared with other optimisers on their problem. Must be thread-safe.
+  std::function<double(const control::PoseGraph&)> custom_cost;
 };
 
 // x position and velocity of the body's centre of mass: m x_c = m t + R (c0 + C γ), from the

@@ -1,0 +1,51 @@
+#!/usr/bin/env python3
+# `wobble run` draws a script's runs with `render` through the same driver as `wobble render`:
+# a keyframed half second and a simulated half second become 31 frames (30 fps over 1 s) of
+# the ParaView series, with the keyframed and simulated states in order. Without a display only
+# vtp/disp are written (with a message); with one (make test runs under Xvfb) also PNG frames.
+import os, re, subprocess, sys
+
+wobble, data, work = sys.argv[1:4]
+os.makedirs(work, exist_ok=True)
+failures = []
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        failures.append(what)
+
+
+script = f"""load_obj {data}/table.obj
+load_def {data}/bend.def {data}/shear.def
+assign bend 4000000 1000000
+assign shear 4000000 1000000
+set_vec q 0 50 0 0 0
+key 0
+key 0.5 bend=0.1 shear=0.1
+keyframe
+simul 0.5
+render pics vtp,frames
+"""
+path = os.path.join(work, "render.wob")
+open(path, "w").write(script)
+env = dict(os.environ)
+has_display = bool(env.get("DISPLAY"))
+r = subprocess.run([wobble, "run", path], capture_output=True, text=True, cwd=work, env=env)
+check(r.returncode == 0, "wobble run with render exits 0: " + r.stderr.strip())
+pvd = os.path.join(work, "pics", "vtp", "table.pvd")
+check(os.path.exists(pvd), "the ParaView series is written")
+if os.path.exists(pvd):
+    times = sorted({float(t) for t in re.findall(r'timestep="([^"]+)"', open(pvd).read())})
+    check(len(times) == 31 and abs(times[0]) < 1e-12 and abs(times[-1] - 1.0) < 1e-9,
+          f"31 frames from t = 0 to 1 (keyframes, then simulation): {len(times)} from {times[:1]} to {times[-1:]}")
+png = os.path.join(work, "pics", "frames", "frame_0030.png")
+if has_display:
+    check(os.path.exists(png), "with a display the PNG frames are written too")
+else:
+    check("no X display" in r.stdout and not os.path.exists(png), "without a display: a message, vtp only")
+r = subprocess.run([wobble, "run", path], capture_output=True, text=True, cwd=work,
+                   env={k: v for k, v in env.items() if k != "DISPLAY"})
+check(r.returncode == 0 and "no X display: render draws no pictures" in r.stdout and "writing vtp only" in r.stdout,
+      "without DISPLAY: the pictures are skipped with a message: " + r.stdout.strip()[-200:])
+sys.exit(1 if failures else 0)
