@@ -1,6 +1,8 @@
 #include "wobble/body/affine_energy.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <limits>
 
 namespace wobble {
 namespace {
@@ -51,6 +53,33 @@ Eigen::MatrixXd AffineForce(const AffineMaterial& mat, const Eigen::MatrixXd& R,
   const Eigen::MatrixXd grad = AffineEnergyGradient(mat, R);
   const double v_dot = (grad.array() * R_dot.array()).sum();  // V̇ = ⟨∂V/∂R, Ṙ⟩
   return -(1.0 + mat.damping * v_dot) * grad;                 // −∂V/∂R − k_d V̇ ∂V/∂R (§2.4)
+}
+
+Eigen::VectorXd VibrationFrequencies(const LinearBodyModel& model, const AffineMaterial& mat) {
+  const int d = model.dim(), n = model.basis_size(), N = d * n;
+  const Eigen::MatrixXd R0 = model.RestState();
+  // H by central differences of the gradient, in the flattening index i·n + s
+  Eigen::MatrixXd H(N, N);
+  const double eps = 1e-6;
+  for (int a = 0; a < N; ++a) {
+    Eigen::MatrixXd Rp = R0, Rm = R0;
+    Rp(a / n, a % n) += eps;
+    Rm(a / n, a % n) -= eps;
+    const Eigen::MatrixXd dg = (AffineEnergyGradient(mat, Rp) - AffineEnergyGradient(mat, Rm)) / (2 * eps);
+    for (int b = 0; b < N; ++b) H(b, a) = dg(b / n, b % n);
+  }
+  H = 0.5 * (H + H.transpose());
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(N, N);
+  for (int i = 0; i < d; ++i) M.block(i * n, i * n, n, n) = model.mass_matrix();
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(H, M);
+  Eigen::VectorXd w = es.eigenvalues();
+  for (int i = 0; i < N; ++i) w[i] = std::sqrt(std::max(0.0, w[i]));
+  return w;
+}
+
+double StableTimeStep(const LinearBodyModel& model, const AffineMaterial& mat) {
+  const double w_max = VibrationFrequencies(model, mat).maxCoeff();
+  return w_max > 0 ? 1.0 / w_max : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace wobble

@@ -587,7 +587,10 @@ bool ConstrainedWorld::Step() {
         if (!c.enabled) continue;
         Targets(c, time_, &n, &nd, &ndd);
         const int d = int(n.size());
-        Eigen::VectorXd accel_c = -ndd, pos_c = EndPosition(c.a) - n, vel_c = EndVelocity(c.a) - nd;
+        // Velocity-first symplectic Euler staggers velocities: q̇ₙ = (qₙ − qₙ₋₁)/Δt is the velocity
+        // of t − Δt/2, so ċ compares it with ṅ(t − Δt/2) ≈ ṅ − ½Δt n̈. Against ṅ(t) the β term
+        // would see a false ċ = −½Δt n̈ and hold the point β Δt n̈ / (2α) behind its path.
+        Eigen::VectorXd accel_c = -ndd, pos_c = EndPosition(c.a) - n, vel_c = EndVelocity(c.a) - nd + 0.5 * h * ndd;
         auto add_end = [&](const End& e, double sign) {
           const Body& b = bodies_[e.body];
           if (b.kind == BodyKind::kLinear) {
