@@ -401,7 +401,9 @@ TEST(ConstrainedWorld, TrajectoryControlFollowsPathAndSwitchingRefactorsOnlyThen
   double worst = 0;
   ASSERT_TRUE(world.RunUntil(2.0, [&](ConstrainedWorld& wd) { worst = std::max(worst, wd.ConstraintError(control).norm()); }));
   std::printf("circle path: max |c| = %.3g over 2 s\n", worst);
-  EXPECT_LT(worst, 1e-6);  // only the path's variation within a step is missed
+  // The largest error is the onset transient: the staggered start velocity 0 differs from
+  // ṅ(−Δt/2) = −½Δt n̈(0), so it is O(Δt²) (9e-7 here, 2.3e-7 at half the step, 3.6e-6 at twice).
+  EXPECT_LT(worst, 2e-6);
   EXPECT_EQ(world.factorizations(), 1);
   // replacing the path (a behaviour rebuilding its curve) keeps the factorization
   world.SetPath(control, circle);
