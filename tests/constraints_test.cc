@@ -572,7 +572,7 @@ std::shared_ptr<const BodyModel> Table(double stiffness, double damping) {
 // the same order). Halving Δt must divide the violation by about 4 and the energy error by
 // about 2: both vanish as Δt → 0, so the nail does no work.
 struct FfdRun {
-  double violation = 0, energy = 0;  // max |c| (cm), max |E − E0| / (m g L)
+  double violation = 0, energy = 0;  // max |c| (m), max |E − E0| / (m g L)
   long steps = 0, per_step_factorizations = 0;
   Eigen::VectorXd far_corner;
 };
@@ -581,15 +581,14 @@ FfdRun RunNailedTable(double dt) {
   ConstrainedWorldOptions opt;
   opt.dt = dt;
   opt.params.ground.enabled = false;
-  opt.params.gravity = Eigen::Vector2d(0, -981.0);  // lattice units are cm
-  ConstrainedWorld world(opt);
-  const int table = world.AddFfdBody(Table(20.0, 0.0));
+  ConstrainedWorld world(opt);  // the project's units: g = 9.81, lattice units are metres
+  const int table = world.AddFfdBody(Table(4e6, 0.0));  // K of data/table_modes.def
   const int nail = world.AddNail(At(table, Eigen::Vector2d(0.0, 1.0)));  // top-left corner
   EXPECT_LT(world.ConstraintError(nail).norm(), 1e-12);
   const double E0 = world.TotalEnergy();
-  const double scale = 550.0 * 981.0 * 150.0;  // m g × half the table: the swing's energy scale
+  const double scale = 550.0 * 9.81 * 150.0;  // m g × half the table: the swing's energy scale
   FfdRun r;
-  EXPECT_TRUE(world.RunUntil(5.0, [&](ConstrainedWorld& w) {
+  EXPECT_TRUE(world.RunUntil(20.0, [&](ConstrainedWorld& w) {
     r.energy = std::max(r.energy, std::abs(w.TotalEnergy() - E0) / scale);
     r.violation = std::max(r.violation, w.MaxViolation());
   })) << world.status().message;
@@ -600,13 +599,13 @@ FfdRun RunNailedTable(double dt) {
 }
 
 TEST(FfdConstraints, TableNailedAtCornerHoldsAndConservesEnergy) {
-  const FfdRun coarse = RunNailedTable(1e-3), fine = RunNailedTable(5e-4);
-  std::printf("FFD table nailed, dt 1e-3: max |c| = %.3g cm, max |dE|/(m g L) = %.3g\n", coarse.violation, coarse.energy);
-  std::printf("FFD table nailed, dt 5e-4: max |c| = %.3g cm, max |dE|/(m g L) = %.3g\n", fine.violation, fine.energy);
+  const FfdRun coarse = RunNailedTable(0.01), fine = RunNailedTable(0.005);
+  std::printf("FFD table nailed, dt 0.01: max |c| = %.3g m, max |dE|/(m g L) = %.3g\n", coarse.violation, coarse.energy);
+  std::printf("FFD table nailed, dt 0.005: max |c| = %.3g m, max |dE|/(m g L) = %.3g\n", fine.violation, fine.energy);
   EXPECT_GT(coarse.violation / fine.violation, 3.0);  // second order
   EXPECT_GT(coarse.energy / fine.energy, 1.7);        // first order
-  EXPECT_LT(fine.violation, 0.01);                    // cm, on a 300 cm table
-  EXPECT_LT(fine.energy, 0.01);
+  EXPECT_LT(fine.violation, 5e-3);                    // m, on a 300 m table (measured 1.7e-3)
+  EXPECT_LT(fine.energy, 2e-3);                       // measured 3.8e-4
   EXPECT_EQ(fine.per_step_factorizations, fine.steps);  // q-dependent A: one factorization per step
   EXPECT_LT(fine.far_corner[1], 0.0);                   // it really swung down
 }
@@ -616,11 +615,12 @@ double RunTableOnBar(double dt, Eigen::VectorXd* gap) {
   ConstrainedWorldOptions opt;
   opt.dt = dt;
   opt.params.ground.enabled = false;
-  opt.params.gravity = Eigen::Vector2d(0, -981.0);
   ConstrainedWorld world(opt);
-  const int table = world.AddFfdBody(Table(20.0, 5.0));
+  const int table = world.AddFfdBody(Table(4e6, 1e6));  // data/table_modes.def's K and c
   const auto bar_model = Bar2D(100.0, 30.0, 200.0);
-  const int bar = world.AddLinearBody(bar_model, AffineMaterial{1e5, 1e5, 0.0, 0.0});
+  const AffineMaterial stiff{1e7, 1e7, 0.0, 0.0};
+  EXPECT_LE(dt, StableTimeStep(*bar_model, stiff));
+  const int bar = world.AddLinearBody(bar_model, stiff);
   // the bar lies from (300, 100) to (500, 100): its left end on the table's top-right corner
   world.SetLinearState(bar, bar_model->PlacedState(Eigen::Matrix2d::Identity(), Eigen::Vector2d(400, 100)),
                        Eigen::MatrixXd::Zero(2, 3));
@@ -628,7 +628,7 @@ double RunTableOnBar(double dt, Eigen::VectorXd* gap) {
   const int joint = world.AddAttachment(At(table, Eigen::Vector2d(1.0, 1.0)), At(bar, Eigen::Vector2d(-100, 0)));
   EXPECT_LT(world.ConstraintError(joint).norm(), 1e-9);
   double worst = 0, lowest = 1e9;
-  EXPECT_TRUE(world.RunUntil(5.0, [&](ConstrainedWorld& w) {
+  EXPECT_TRUE(world.RunUntil(20.0, [&](ConstrainedWorld& w) {
     worst = std::max(worst, w.MaxViolation());
     lowest = std::min(lowest, w.PointPosition(At(bar, Eigen::Vector2d(-100, 0)))[1]);
   })) << world.status().message;
@@ -639,10 +639,10 @@ double RunTableOnBar(double dt, Eigen::VectorXd* gap) {
 
 TEST(FfdConstraints, TableAttachedToLinearBody) {
   Eigen::VectorXd gap;
-  const double coarse = RunTableOnBar(1e-3, &gap), fine = RunTableOnBar(5e-4, &gap);
-  std::printf("FFD table on an affine bar: max |c| = %.3g cm (dt 1e-3), %.3g cm (dt 5e-4)\n", coarse, fine);
+  const double coarse = RunTableOnBar(0.01, &gap), fine = RunTableOnBar(0.005, &gap);
+  std::printf("FFD table on an affine bar: max |c| = %.3g m (dt 0.01), %.3g m (dt 0.005)\n", coarse, fine);
   EXPECT_GT(coarse / fine, 3.0);  // second order in dt
-  EXPECT_LT(fine, 0.02);          // cm
+  EXPECT_LT(fine, 0.02);          // m, on a 300 m table (measured 8e-3)
   EXPECT_LT(gap.norm(), 0.02);
 }
 
