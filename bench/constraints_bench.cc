@@ -90,8 +90,8 @@ void BM_ChainStep(benchmark::State& state) {
   state.SetLabel(MultiplierMethodName(method));
 }
 BENCHMARK(BM_ChainStep)
-    ->ArgsProduct({{10, 100, 1000}, {int(MultiplierMethod::kSparse)}})
-    ->ArgsProduct({{10, 100, 1000}, {int(MultiplierMethod::kDense)}})
+    ->ArgsProduct({{10, 30, 100, 300, 1000}, {int(MultiplierMethod::kSparse)}})
+    ->ArgsProduct({{10, 30, 100, 300, 1000}, {int(MultiplierMethod::kDense)}})
     ->Unit(benchmark::kMicrosecond);
 
 // Switching the top nail off and on forces a refactor at the next step: the timed step pays
@@ -112,8 +112,8 @@ void BM_ChainRefactor(benchmark::State& state) {
   state.SetLabel(MultiplierMethodName(method));
 }
 BENCHMARK(BM_ChainRefactor)
-    ->ArgsProduct({{10, 100, 1000}, {int(MultiplierMethod::kSparse)}})
-    ->ArgsProduct({{10, 100, 1000}, {int(MultiplierMethod::kDense)}})
+    ->ArgsProduct({{10, 30, 100, 300, 1000}, {int(MultiplierMethod::kSparse)}})
+    ->ArgsProduct({{10, 30, 100, 300, 1000}, {int(MultiplierMethod::kDense)}})
     ->Unit(benchmark::kMicrosecond);
 
 void BM_FfdTableNailed(benchmark::State& state) {

@@ -31,6 +31,8 @@ double AffineEnergy(const AffineMaterial& mat, const Eigen::MatrixXd& R);
 Eigen::MatrixXd AffineEnergyGradient(const AffineMaterial& mat, const Eigen::MatrixXd& R);
 // The generalized force of the energies with their damping: −∂V/∂R − k_d V̇ ∂V/∂R.
 Eigen::MatrixXd AffineForce(const AffineMaterial& mat, const Eigen::MatrixXd& R, const Eigen::MatrixXd& R_dot);
+// Q += AffineForce(mat, R, Ṙ) without heap allocations (the per-step form).
+void AddAffineForce(const AffineMaterial& mat, const Eigen::MatrixXd& R, const Eigen::MatrixXd& R_dot, Eigen::MatrixXd* Q);
 
 // Angular frequencies ω (ascending) of a linear body's small vibrations about its rest shape:
 // H v = ω² (I_d ⊗ M) v, with H the Hessian of the energies at R = [I | 0 | 0] (central
