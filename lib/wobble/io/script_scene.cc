@@ -449,6 +449,15 @@ bool Interpreter::ExecuteScene(const std::vector<std::string>& w, const Context&
       record();
       if (progress_ && (n % 64 == 0 || n + 1 == steps)) progress_(double(n + 1) / double(steps), world.time());
     }
+    // behaviours due at the end time act now (a Connect at a chase's contact time at the end)
+    if (steps > 0) {
+      try {
+        s.sequencer.BeforeStep(bctx, log);
+      } catch (const control::BehaviourError& e) {
+        ctx.Fail(std::string("at t = ") + Num(world.time()) + ": " + e.what());
+      }
+      for (const auto& kv : s.constraints) s.promised.erase(kv.first);
+    }
     time_ = world.time();
     out_ << "simul: t = " << Num(world.time()) << ", " << steps << " steps; energy " << Num(world.TotalEnergy())
          << ", largest constraint violation " << Num(world.MaxViolation())
