@@ -1,5 +1,6 @@
 #include "pipelines/scene_run.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -103,6 +104,7 @@ std::vector<std::string> WriteSceneRun(ConstrainedWorld& world, const Constraine
     SceneOptions o = out.view;
     o.width = out.filmstrip_width;
     o.height = out.filmstrip_height;
+    o.point_size = std::max(2.0, 0.6 * o.point_size);  // small panels: smaller dots
     o.overlay_energy = false;
     o.title.clear();
     strip_view = std::make_unique<SceneView>(&world, spec, o);

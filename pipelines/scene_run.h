@@ -19,7 +19,12 @@ struct SceneRunOutputs {
   // Filmstrip panels: the recorded frames nearest these times (empty: 6 evenly spaced).
   std::vector<double> filmstrip_times;
   int filmstrip_width = 320, filmstrip_height = 240, filmstrip_columns = 3;
-  SceneOptions view;  // colours, sizes, 3D camera angles (width/height come from above)
+  SceneOptions view = DefaultView();  // sizes, 3D camera angles (width/height come from above)
+  static SceneOptions DefaultView() {
+    SceneOptions o;
+    o.point_size = 5.0;  // a scene has many mass points: smaller dots than the FFD view's
+    return o;
+  }
 };
 
 // Writes <folder>/frames/frame_NNNN.png (one per recorded frame), <folder>/filmstrip.png and

@@ -305,15 +305,40 @@ SceneView::SceneView(const ConstrainedWorld* world, ConstrainedSceneSpec spec, S
 void SceneView::FrameBox3d(const Eigen::AlignedBox3d& box_in, double margin) {
   Eigen::AlignedBox3d box = box_in;
   if (box.isEmpty()) box = Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1));
-  const Eigen::Vector3d c = box.center();
-  const double radius = std::max(0.5 * box.sizes().norm() * (1.0 + 2.0 * margin), 1e-6);
-  // the sphere fits the narrower of the two opening angles
-  const double aspect = double(options_.width) / options_.height;
-  const double half_v = 0.5 * options_.view_angle * M_PI / 180.0;
-  const double half_narrow = aspect >= 1.0 ? half_v : std::atan(std::tan(half_v) * aspect);
-  const double distance = radius / std::sin(half_narrow);
   const double az = options_.azimuth * M_PI / 180.0, el = options_.elevation * M_PI / 180.0;
+  // the camera looks at the box's centre from direction `dir`; right and up span the image
   const Eigen::Vector3d dir(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+  const Eigen::Vector3d right = Eigen::Vector3d::UnitY().cross(dir).normalized();
+  const Eigen::Vector3d up = dir.cross(right);
+  const double aspect = double(options_.width) / options_.height;
+  const double tan_v = std::tan(0.5 * options_.view_angle * M_PI / 180.0) / (1.0 + 2.0 * margin);
+  const double tan_h = tan_v * aspect;
+  // the nearest distance that keeps every corner of the box inside the view: a corner at
+  // offset r from the centre is at depth d − r·dir and must have |r·right| <= depth tan_h and
+  // |r·up| <= depth tan_v
+  // |r·up| <= depth tan_v. Then the focal point moves so the box's image is centred (a box
+  // seen from above projects lower than its centre), and the distance is fitted again.
+  Eigen::Vector3d c = box.center();
+  double distance = 1e-6;
+  for (int pass = 0; pass < 3; ++pass) {
+    distance = 1e-6;
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector3d r = box.corner(Eigen::AlignedBox3d::CornerType(k)) - c;
+      distance = std::max({distance, r.dot(dir) + std::abs(r.dot(right)) / tan_h, r.dot(dir) + std::abs(r.dot(up)) / tan_v});
+    }
+    if (pass == 2) break;
+    Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector3d r = box.corner(Eigen::AlignedBox3d::CornerType(k)) - c;
+      const double depth = distance - r.dot(dir);
+      const Eigen::Vector2d screen(r.dot(right) / depth, r.dot(up) / depth);  // tangents of the angles
+      lo = lo.cwiseMin(screen);
+      hi = hi.cwiseMax(screen);
+    }
+    const Eigen::Vector2d mid = 0.5 * (lo + hi);
+    c += distance * (mid.x() * right + mid.y() * up);
+  }
+  const double radius = 0.5 * box.sizes().norm();
   const Eigen::Vector3d eye = c + distance * dir;
   vtkCamera* cam = impl_->renderer->GetActiveCamera();
   cam->ParallelProjectionOff();
@@ -322,8 +347,8 @@ void SceneView::FrameBox3d(const Eigen::AlignedBox3d& box_in, double margin) {
   cam->SetPosition(eye.x(), eye.y(), eye.z());
   cam->SetViewUp(0, 1, 0);
   cam->SetClippingRange(std::max(1e-3 * distance, distance - 1.5 * radius), distance + 1.5 * radius);
-  // what the frame shows, in the x-y plane through the centre (for callers that want a box)
-  const double half_h = distance * std::tan(half_v);
+  // what the frame shows in the plane through the centre facing the camera, for callers
+  const double half_h = distance * std::tan(0.5 * options_.view_angle * M_PI / 180.0);
   framed_ = Eigen::AlignedBox2d(c.head<2>() - Eigen::Vector2d(half_h * aspect, half_h),
                                 c.head<2>() + Eigen::Vector2d(half_h * aspect, half_h));
 }

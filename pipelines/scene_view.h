@@ -82,8 +82,8 @@ class SceneView {
   // A parallel camera looking down −z that shows `box` (world units) with a margin
   // (fraction of the box) around it, keeping the aspect ratio of the image.
   void FrameBox(const Eigen::AlignedBox2d& box, double margin = 0.08);
-  // A perspective camera from options().azimuth/elevation that keeps the sphere around `box`
-  // (plus the margin) in view, whatever the camera turns to: the 3D view.
+  // A perspective camera from options().azimuth/elevation, looking at the centre of `box`
+  // from the nearest distance that keeps all its corners in view (plus the margin): the 3D view.
   void FrameBox3d(const Eigen::AlignedBox3d& box, double margin = 0.08);
   const Eigen::AlignedBox2d& framed_box() const { return framed_; }
 

@@ -56,7 +56,8 @@ const std::vector<CommandInfo>& Interpreter::Commands() {
       // Witkin & Welch scenes (linear bodies, constraints, motion control, goal behaviours)
       {"linear", "linear NAME 2d|3d affine|quadratic box HX HY [HZ] | pyramid W H [grid N] [levels N] [mass M] [at X Y [Z]] [ke K] [kc K] [kd K] [kq K]",
        "a linear-deformation body x = R p(u) (a box or a pyramid of mass points), at rest at X Y Z"},
-      {"point", "point NAME BODY U1 U2 [U3]", "name a material point of a body (undeformed coordinates)"},
+      {"ffd", "ffd NAME", "the loaded FFD object (its modes and state q, dq) joins the scene as body NAME"},
+      {"point", "point NAME BODY U1 U2 [U3]", "name a material point of a body (undeformed coordinates; lattice S T of an FFD body)"},
       {"place", "place NAME X Y [Z]", "name a fixed place in the world (a sky point)"},
       {"nail", "nail NAME POINT [X Y [Z]]", "nail a point where it is (or at X Y Z), now"},
       {"attach", "attach NAME POINT_A POINT_B", "attach two points of bodies to each other, now"},

@@ -55,7 +55,7 @@ template <class M> std::vector<std::string> Keys(const M& map) {
   return k;
 }
 
-const std::vector<std::string> kSceneCommands = {"linear", "point", "place", "nail", "attach", "path", "trajectory",
+const std::vector<std::string> kSceneCommands = {"linear", "ffd", "point", "place", "nail", "attach", "path", "trajectory",
                                                  "impulse", "chase", "connect", "grab", "release", "on", "off",
                                                  "wait", "wait_for", "record", "render"};
 
@@ -226,6 +226,17 @@ bool Interpreter::ExecuteScene(const std::vector<std::string>& w, const Context&
     s.bodies[name] = b;
     s.drawings.resize(world.num_bodies());
     s.drawings[b] = shape == "box" ? MakeBoxDrawing(sizes, 8) : MakePyramidDrawing(dim, sizes[0], sizes[1], 8);
+  } else if (cmd == "ffd") {
+    // ffd NAME: the loaded FFD object (load_obj, load_def, assign, set_vec q/dq) joins the scene
+    ExpectWords(w, 2, 2, usage(), ctx);
+    const std::string& name = w[1];
+    if (s.bodies.count(name)) ctx.Fail("a body named '" + name + "' exists already");
+    RequireBody(ctx, "ffd");
+    const std::shared_ptr<const BodyModel> body = BuildBody();
+    const int b = world.AddFfdBody(body);
+    world.SetFfdState(b, q_, qd_);
+    s.bodies[name] = b;
+    s.drawings.resize(world.num_bodies());  // FFD bodies draw their own shape
   } else if (cmd == "point") {
     // point NAME BODY U1 U2 [U3]
     if (w.size() < 4) ctx.Fail("expected '" + usage() + "'");
@@ -240,7 +251,13 @@ bool Interpreter::ExecuteScene(const std::vector<std::string>& w, const Context&
     if (int(w.size()) != 3 + dim)
       ctx.Fail("expected " + std::to_string(dim) + " undeformed coordinates for a point of the " + std::to_string(dim) +
                "D body '" + w[2] + "'");
-    s.anchors[w[1]] = control::PointAnchor(w[1], At(it->second, Vector(w, 3, dim, "a coordinate", ctx)));
+    const MaterialPoint point = At(it->second, Vector(w, 3, dim, "a coordinate", ctx));
+    try {
+      world.PointPosition(point);  // lattice coordinates of an FFD body must lie in [0, 1]²
+    } catch (const std::invalid_argument& e) {
+      ctx.Fail(std::string("point ") + w[1] + ": " + e.what());
+    }
+    s.anchors[w[1]] = control::PointAnchor(w[1], point);
   } else if (cmd == "place") {
     ExpectWords(w, 4, 5, usage(), ctx);
     if (s.anchors.count(w[1])) ctx.Fail("a point or place named '" + w[1] + "' exists already");
