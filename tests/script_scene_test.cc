@@ -92,7 +92,7 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"impulse pa 1 2", "expected 3 velocity components after 'impulse pa'"},
         ErrorCase{"chase sky pa 1", "chase 'sky' is a fixed place; expected a point of a body"},
         ErrorCase{"chase pa pb 0", "expected a positive DURATION, got 0"},
-        ErrorCase{"chase pa pb 1 1 2", "with 3 velocity components or none"},
+        ErrorCase{"chase pa pb 1 1 2", "expected 'chase POINT TARGET DURATION [VX VY [VZ]]' with 3 velocity components or none"},
         ErrorCase{"grab pa pf 1", "'pa' and 'pf' differ in dimension"},
         ErrorCase{"connect pa pb j1 extra", "expected 'connect POINT TARGET [NAME]'"},
         // release, on, off, wait, wait_for
