@@ -13,6 +13,8 @@
 
 #include <Eigen/Core>
 
+#include "wobble/body/linear_body.h"
+
 namespace wobble {
 
 // Stiffness and drag constants: from near-rigid (large k_e, k_c) to jello (small, with k_d).
@@ -29,5 +31,17 @@ double AffineEnergy(const AffineMaterial& mat, const Eigen::MatrixXd& R);
 Eigen::MatrixXd AffineEnergyGradient(const AffineMaterial& mat, const Eigen::MatrixXd& R);
 // The generalized force of the energies with their damping: −∂V/∂R − k_d V̇ ∂V/∂R.
 Eigen::MatrixXd AffineForce(const AffineMaterial& mat, const Eigen::MatrixXd& R, const Eigen::MatrixXd& R_dot);
+// Q += AffineForce(mat, R, Ṙ) without heap allocations (the per-step form).
+void AddAffineForce(const AffineMaterial& mat, const Eigen::MatrixXd& R, const Eigen::MatrixXd& R_dot, Eigen::MatrixXd* Q);
+
+// Angular frequencies ω (ascending) of a linear body's small vibrations about its rest shape:
+// H v = ω² (I_d ⊗ M) v, with H the Hessian of the energies at R = [I | 0 | 0] (central
+// differences of the analytic gradient) in the row-major flattening of R. Rigid motions give 0.
+Eigen::VectorXd VibrationFrequencies(const LinearBodyModel& model, const AffineMaterial& mat);
+// A step the explicit integrator stays stable with: 1/ω_max (half the linear limit 2/ω_max,
+// because V is quartic in R and stiffens under large deformation, and the damping term is
+// explicit too). Infinity for a body without energies. Thin bodies are the stiff ones: their
+// short axis carries little inertia.
+double StableTimeStep(const LinearBodyModel& model, const AffineMaterial& mat);
 
 }  // namespace wobble

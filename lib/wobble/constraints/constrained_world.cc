@@ -168,16 +168,24 @@ ConstrainedWorld::End ConstrainedWorld::Resolve(const MaterialPoint& point) cons
   return e;
 }
 
-Eigen::VectorXd ConstrainedWorld::EndPosition(const End& e) const {
+ConstrainedWorld::PointVec ConstrainedWorld::EndPosition(const End& e) const {
   const Body& b = bodies_[e.body];
-  if (b.kind == BodyKind::kLinear) return linear_[b.index].R * e.p;
+  if (b.kind == BodyKind::kLinear) {
+    PointVec x;
+    x.noalias() = linear_[b.index].R * e.p;
+    return x;
+  }
   const BodyState<double>& s = ffd_.state(b.index);
   return WorldFromLocal(Frame<double>(s.q), LocalPosition<double>(e.b0, e.B, s.q));
 }
 
-Eigen::VectorXd ConstrainedWorld::EndVelocity(const End& e) const {
+ConstrainedWorld::PointVec ConstrainedWorld::EndVelocity(const End& e) const {
   const Body& b = bodies_[e.body];
-  if (b.kind == BodyKind::kLinear) return linear_[b.index].R_dot * e.p;
+  if (b.kind == BodyKind::kLinear) {
+    PointVec v;
+    v.noalias() = linear_[b.index].R_dot * e.p;
+    return v;
+  }
   const BodyState<double>& s = ffd_.state(b.index);
   const Frame<double> frame(s.q);
   return wobble::PointVelocity(frame, s.qd, LocalPosition<double>(e.b0, e.B, s.q), e.B);
@@ -217,9 +225,9 @@ void ConstrainedWorld::ApplyPointForce(const MaterialPoint& point, const Eigen::
   }
 }
 
-Eigen::VectorXd ConstrainedWorld::EndJdotQdot(const End& e) const {
+ConstrainedWorld::PointVec ConstrainedWorld::EndJdotQdot(const End& e) const {
   const Body& b = bodies_[e.body];
-  if (b.kind == BodyKind::kLinear) return Eigen::VectorXd::Zero(linear_[b.index].model->dim());  // J constant
+  if (b.kind == BodyKind::kLinear) return PointVec::Zero(linear_[b.index].model->dim());  // J constant
   // J̇ q̇ = R(−θ̇² l + 2 θ̇ S B γ̇) (ARCHITECTURE.md, from Eq. 4.21's velocity terms)
   const BodyState<double>& s = ffd_.state(b.index);
   const Frame<double> frame(s.q);
@@ -297,7 +305,7 @@ int ConstrainedWorld::AddNail(const MaterialPoint& point, Eigen::VectorXd where,
   Constraint c;
   c.kind = ConstraintKind::kNail;
   c.a = Resolve(point);
-  c.where = where.size() == 0 ? EndPosition(c.a) : where;
+  c.where = where.size() == 0 ? Eigen::VectorXd(EndPosition(c.a)) : where;
   if (c.where.size() != dim(point.body) || !c.where.allFinite())
     throw std::invalid_argument("nail on body '" + body_name(point.body) + "': the place needs " +
                                 std::to_string(dim(point.body)) + " finite coordinates");
@@ -398,7 +406,7 @@ Eigen::VectorXd ConstrainedWorld::ConstraintError(int id) const {
   const Constraint& c = Get(id);
   Eigen::VectorXd n, nd, ndd;
   Targets(c, time_, &n, &nd, &ndd);
-  Eigen::VectorXd e = EndPosition(c.a) - n;
+  PointVec e = EndPosition(c.a) - n;
   if (c.b.body >= 0) e -= EndPosition(c.b);
   return e;
 }
@@ -407,7 +415,7 @@ Eigen::VectorXd ConstrainedWorld::ConstraintVelocityError(int id) const {
   const Constraint& c = Get(id);
   Eigen::VectorXd n, nd, ndd;
   Targets(c, time_, &n, &nd, &ndd);
-  Eigen::VectorXd e = EndVelocity(c.a) - nd;
+  PointVec e = EndVelocity(c.a) - nd;
   if (c.b.body >= 0) e -= EndVelocity(c.b);
   return e;
 }
@@ -538,22 +546,22 @@ bool ConstrainedWorld::Fail(ConstrainedStatus::Code code, int body, const std::s
   return false;
 }
 
-bool ConstrainedWorld::FreeAccelerations(std::vector<Eigen::VectorXd>* acc, int* failed_body, StepStatus* st) const {
+bool ConstrainedWorld::FreeAccelerations(std::vector<Eigen::VectorXd>* acc, int* failed_body, StepStatus* st) {
   acc->resize(num_bodies());
   const WorldParams& params = ffd_.options().params;
+  const Eigen::VectorXd g2 = params.gravity, g3 = options_.gravity_3d;
   for (int body = 0; body < num_bodies(); ++body) {
     const Body& b = bodies_[body];
     Eigen::VectorXd& a = (*acc)[body];
     if (b.kind == BodyKind::kLinear) {
-      const LinearEntry& e = linear_[b.index];
+      LinearEntry& e = linear_[b.index];
       const LinearBodyModel& m = *e.model;
-      Eigen::MatrixXd Q = e.applied + AffineForce(e.material, e.R, e.R_dot);
-      if (params.gravity_on) {
-        const Eigen::VectorXd g = m.dim() == 2 ? Eigen::VectorXd(params.gravity) : Eigen::VectorXd(options_.gravity_3d);
-        Q += g * m.first_moment().transpose();  // Σ m_k g p_kᵀ
-      }
+      Eigen::MatrixXd& Q = e.Q;
+      Q = e.applied;
+      AddAffineForce(e.material, e.R, e.R_dot, &Q);
+      if (params.gravity_on) Q.noalias() += (m.dim() == 2 ? g2 : g3) * m.first_moment().transpose();  // Σ m_k g p_kᵀ
       a.resize(m.num_q());
-      AsMatrix(a, m.dim(), m.basis_size()) = Q * m.inverse_mass_matrix();  // R̈ = Q W (Eq. 5)
+      AsMatrix(a, m.dim(), m.basis_size()).noalias() = Q * m.inverse_mass_matrix();  // R̈ = Q W (Eq. 5)
     } else {
       VecQ<double> qdd;
       *st = Accelerations(ffd_.body(b.index), params, b.index, ffd_.state(b.index), &qdd);
@@ -572,7 +580,7 @@ bool ConstrainedWorld::Step() {
   if (!status_.ok()) return false;
   const double h = options_.dt;
   // unconstrained accelerations W Q of every body
-  std::vector<Eigen::VectorXd> acc;
+  std::vector<Eigen::VectorXd>& acc = acc_;
   int failed = -1;
   StepStatus st;
   if (!FreeAccelerations(&acc, &failed, &st)) return Fail(ConstrainedStatus::Code::kBodyFailed, failed, StatusCodeName(st.code));
@@ -587,12 +595,16 @@ bool ConstrainedWorld::Step() {
         if (!c.enabled) continue;
         Targets(c, time_, &n, &nd, &ndd);
         const int d = int(n.size());
-        Eigen::VectorXd accel_c = -ndd, pos_c = EndPosition(c.a) - n, vel_c = EndVelocity(c.a) - nd;
+        // Velocity-first symplectic Euler staggers velocities: q̇ₙ = (qₙ − qₙ₋₁)/Δt is the velocity
+        // of t − Δt/2, so ċ compares it with ṅ(t − Δt/2) ≈ ṅ − ½Δt n̈. Against ṅ(t) the β term
+        // would see a false ċ = −½Δt n̈ and hold the point β Δt n̈ / (2α) behind its path.
+        PointVec accel_c = -ndd, pos_c = EndPosition(c.a) - n, vel_c = EndVelocity(c.a) - nd + 0.5 * h * ndd, Ja;
         auto add_end = [&](const End& e, double sign) {
           const Body& b = bodies_[e.body];
           if (b.kind == BodyKind::kLinear) {
             const LinearBodyModel& m = *linear_[b.index].model;
-            accel_c += sign * (AsMatrix(acc[e.body], d, m.basis_size()) * e.p);  // J a = R̈ p; J̇ = 0
+            Ja.noalias() = AsMatrix(acc[e.body], d, m.basis_size()) * e.p;  // J a = R̈ p; J̇ = 0
+            accel_c += sign * Ja;
           } else {
             accel_c += sign * (EndJacobian(e) * acc[e.body] + EndJdotQdot(e));
           }
@@ -608,7 +620,9 @@ bool ConstrainedWorld::Step() {
       Eigen::VectorXd lambda;
       solver.Solve(-rhs, &lambda);
       // constrained accelerations q̈ = W(Q + Jᵀ λ)
-      std::vector<Eigen::VectorXd> force(num_bodies());
+      std::vector<Eigen::VectorXd>& force = force_;
+      force.resize(num_bodies());
+      for (Eigen::VectorXd& f : force) f.resize(0);
       for (const Constraint& c : constraints_) {
         if (!c.enabled) continue;
         const int d = dim(c.a.body);
@@ -619,7 +633,7 @@ bool ConstrainedWorld::Step() {
           const Body& b = bodies_[e.body];
           if (b.kind == BodyKind::kLinear) {
             const int n_basis = int(e.p.size());
-            AsMatrix(acc[e.body], d, n_basis) += sign * c.lambda * e.Wp.transpose();  // (λ pᵀ) W
+            AsMatrix(acc[e.body], d, n_basis).noalias() += (sign * c.lambda) * e.Wp.transpose();  // (λ pᵀ) W
           } else {
             if (force[e.body].size() == 0) force[e.body] = Eigen::VectorXd::Zero(acc[e.body].size());
             AddEndForce(e, sign * c.lambda, &force);

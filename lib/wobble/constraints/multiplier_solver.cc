@@ -36,14 +36,14 @@ bool PivotsOk(const Eigen::VectorXd& D, std::string* why) {
 }  // namespace
 
 bool MultiplierSolver::Factor(const Eigen::SparseMatrix<double>& A, MultiplierMethod method, std::string* why) {
-  ++factorizations_;
   factored_ = false;
   method_ = method;
   rows_ = int(A.rows());
-  if (rows_ == 0) {
+  if (rows_ == 0) {  // no constraints: nothing to factor, nothing counted
     factored_ = true;
     return true;
   }
+  ++factorizations_;
   if (method == MultiplierMethod::kDense) {
     const Eigen::MatrixXd dense(A);
     Eigen::LDLT<Eigen::MatrixXd> ldlt(dense);

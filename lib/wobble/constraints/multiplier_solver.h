@@ -20,9 +20,23 @@ const char* MultiplierMethodName(MultiplierMethod m);
 
 class MultiplierSolver {
  public:
+  MultiplierSolver() = default;
+  // Copies keep a dense inverse; Eigen's sparse factorization cannot be copied, so a copy of a
+  // sparse solver is unfactored (its owner refactors at the next use, and counts it).
+  MultiplierSolver(const MultiplierSolver& o) { *this = o; }
+  MultiplierSolver& operator=(const MultiplierSolver& o) {
+    if (this == &o) return *this;
+    method_ = o.method_;
+    rows_ = o.rows_;
+    factorizations_ = o.factorizations_;
+    inverse_ = o.inverse_;
+    factored_ = o.factored_ && (method_ == MultiplierMethod::kDense || rows_ == 0);
+    return *this;
+  }
+
   // Factors A (symmetric positive semi-definite by construction). Returns false with *why set
   // when A is singular to within a relative pivot of 1e-10 (redundant constraints) or not
-  // positive. `method` must be kDense or kSparse. Counts every call in factorizations().
+  // positive. `method` must be kDense or kSparse. Counts every non-empty A in factorizations().
   bool Factor(const Eigen::SparseMatrix<double>& A, MultiplierMethod method, std::string* why);
   // x = A⁻¹ b with the last successful factorization.
   void Solve(const Eigen::VectorXd& b, Eigen::VectorXd* x) const;
