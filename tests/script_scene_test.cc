@@ -14,7 +14,7 @@ namespace {
 const std::string kData = WOBBLE_DATA_DIR;
 
 // Runs `text` as a script named "s.wob"; returns the error message ("" when it ran).
-std::string Run(io::Interpreter& interp, const std::string& text) {
+std::string RunScript(io::Interpreter& interp, const std::string& text) {
   std::istringstream in(text);
   try {
     interp.RunStream(in, "s.wob", "");
@@ -27,7 +27,7 @@ std::string Run(io::Interpreter& interp, const std::string& text) {
 std::string RunFresh(const std::string& text) {
   std::ostringstream out;
   io::Interpreter interp(out);
-  return Run(interp, text);
+  return RunScript(interp, text);
 }
 
 const char* kTwoBlocks =
@@ -160,6 +160,51 @@ TEST(SceneScript, Fig2PendulumKeepsItsNailJointsAndEnergyAndRendersEveryFrame) {
   EXPECT_LT(std::abs(w.TotalEnergy()), 0.01 * 3 * 9.81 * 1.5);
   // it swung: the tip is well below where it started
   EXPECT_LT(interp.ScenePoint("tip")[1], -0.5);
+}
+
+TEST(SceneScript, AThinStiffBodyWarnsAboutTheTimeStep) {
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  EXPECT_EQ(RunScript(interp, "set gravity F\nset dt 0.01\nlinear thin 2d affine box 1 0.01 ke 1000 kc 1000\nsimul 0.01\n"), "");
+  EXPECT_NE(out.str().find("warning: dt 0.01 is above the stable step"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("of body 'thin'"), std::string::npos);
+}
+
+TEST(SceneScript, AnFfdTableJoinsTheSceneNailedAtACornerAndAttachedToALinearBlock) {
+  // the same world holds both kinds: the table of data/ (lattice 300 x 100) hangs from its
+  // top-left corner and carries an affine block attached at its top-right corner
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  const std::string script = "load_obj " + kData + "/table.obj\nload_def " + kData + "/table_modes.def\n" +
+                             "set dt 0.0005\nset ground F\n"
+                             "ffd table\n"
+                             "linear block 2d affine box 20 10 at 320 100 mass 100 ke 1 kc 1\n"
+                             "point corner table 0 1\n"
+                             "point right table 1 1\n"
+                             "point block_end block -20 0\n"
+                             "nail hold corner\n"
+                             "attach joint right block_end\n"
+                             "simul 1\n";
+  ASSERT_EQ(RunScript(interp, script), "");
+  const ConstrainedWorld& w = *interp.scene();
+  ASSERT_EQ(w.num_bodies(), 2);
+  EXPECT_EQ(w.kind(0), BodyKind::kFfd);
+  EXPECT_LT((interp.ScenePoint("corner") - (Eigen::VectorXd(2) << 0, 100).finished()).norm(), 1e-3);
+  EXPECT_LT((interp.ScenePoint("right") - interp.ScenePoint("block_end")).norm(), 1e-3);
+  // it swings down about the nail: the far corner fell
+  EXPECT_LT(interp.ScenePoint("right")[1], 100 - 1.0);
+  EXPECT_NE(RunFresh("load_obj " + kData + "/table.obj\nffd t\npoint p t 1.5 0\n").find("s.wob:3: point p:"),
+            std::string::npos);
+}
+
+TEST(SceneScript, GravitySetAfterTheBodiesAppliesToTheNextSimul) {
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  ASSERT_EQ(RunScript(interp, "linear b 3d affine box 0.5 0.5 0.5\npoint c b 0 0 0\nset gravity F\nsimul 1\n"), "");
+  EXPECT_LT(interp.ScenePoint("c").norm(), 1e-12) << "no gravity: at rest where it was";
+  ASSERT_EQ(RunScript(interp, "set gravity T\nsimul 1\n"), "");
+  // free fall for 1 s from rest: y = −g/2 (the semi-implicit step falls g Δt t further at most)
+  EXPECT_NEAR(interp.ScenePoint("c")[1], -0.5 * 9.81, 9.81 * 0.01 * 1.0 + 1e-9);
 }
 
 }  // namespace

@@ -439,11 +439,23 @@ bool Interpreter::ExecuteScene(const std::vector<std::string>& w, const Context&
     double duration = end_ - world.time();
     if (w.size() == 2) duration = NonNegative(w[1], "DURATION", ctx);
     else if (duration < 0) ctx.Fail("end (" + Num(end_) + ") is before the scene's time (" + Num(world.time()) + ")");
-    // the interpreter's parameters apply to the scene's world
+    // the interpreter's parameters apply to the scene's world (gravity and the ground are read
+    // from the parameters of the world that holds its FFD bodies, for linear bodies too)
     world.options().dt = world_.dt;
     world.options().params.gravity_on = world_.params.gravity_on;
+    world.ffd_world().params().gravity_on = world_.params.gravity_on;
+    world.ffd_world().params().ground = world_.params.ground;
     const double dt = world_.dt;
     const long steps = std::lround(duration / dt);
+    // explicit stepping of stiff energies on a thin body blows up: say so before it does
+    for (const auto& [name, b] : s.bodies) {
+      if (world.kind(b) != BodyKind::kLinear) continue;
+      const double stable = StableTimeStep(world.linear_model(b), world.material(b));
+      if (dt > stable)
+        out_ << "warning: dt " << Num(dt) << " is above the stable step " << Num(stable) << " of body '" << name
+             << "' (its energies k_e, k_c, k_q on its thinnest axis); the run may stop with a non-finite state: "
+                "set dt below that, or soften or thicken the body\n";
+    }
     control::BehaviourContext bctx{&world, &s.constraints};
     auto log = [&](const std::string& line) { out_ << "  " << line << "\n"; };
     auto record = [&]() {
