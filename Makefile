@@ -84,6 +84,9 @@ demo: demo-build
 	# the table jumping off a cliff (Fig. 4.12): keyframed jump, then simulation (issue 5)
 	echo '$$ $(WOBBLE) run $(DEMO_SCRIPT)'
 	$(WOBBLE) run $(DEMO_SCRIPT) || status=$$?
+	# Witkin & Welch, Fig. 3: the sky hook grabs the pyramid and hangs itself up (issue 7)
+	echo "\$$ $$xvfb" '$(WOBBLE) run data/fig3_sky_hook.wob'
+	eval "$$xvfb" '$(WOBBLE) run data/fig3_sky_hook.wob' || status=$$?
 	echo
 	echo "files:"
 	echo "  trajectory  $(OUT)/table_drop.csv  (t, q, q-dot, energies, contacts, penetration per step)"
@@ -93,6 +96,7 @@ demo: demo-build
 	echo "  EXR         $(OUT)/exr/frame_NNNN.exr  (R,G,B,A, depth.Z), $(OUT)/exr/disp_NNNN.exr  (disp.X, disp.Y)"
 	echo "  plots       $(OUT)/energy.png, $(OUT)/condition.png  (numbers in the .csv beside them)"
 	echo "  cliff jump  out/table_cliff.csv  (keyframed, then simulated; see README: Scripts)"
+	echo "  sky hook    out/fig3/filmstrip.png, out/fig3/frames/, out/fig3/vtp/fig3_sky_hook.pvd  (Witkin & Welch Fig. 3)"
 	echo "  command     $(WOBBLE)  (see $(WOBBLE) --help, and README.md)"
 	echo "all under out/ (the drop in $(OUT)/, the cliff jump in out/table_cliff.csv)"
 	exit $$status
