@@ -37,7 +37,6 @@ struct Interpreter::Scene {
   double record_fps = 0.0;                      // 0: not recording
   double next_frame = 0.0;
   std::vector<control::SceneFrame> frames;
-  double feedback_rate = -1.0;                  // < 0: the world's default
   double azimuth = 30.0, elevation = 20.0;      // render's 3D camera
   explicit Scene(ConstrainedWorldOptions o) : world(std::move(o)) {}
 };
