@@ -339,7 +339,8 @@ TEST(Chase, ReachesALinearlyMovingTargetAtTheContactTime) {
   s.Run(1.5);
   EXPECT_TRUE(s.seq.idle());
   const double miss = (s.w.PointPosition(s.hand) - s.w.PointPosition(s.handle)).norm();
-  EXPECT_LT(miss, 1e-4) << "chaser " << s.w.PointPosition(s.hand).transpose() << " target "
+  std::cout << "chase of a target at constant velocity: missed by " << miss << "\n";
+  EXPECT_LT(miss, 1e-6) << "chaser " << s.w.PointPosition(s.hand).transpose() << " target "
                         << s.w.PointPosition(s.handle).transpose();
   // the target really moved there (the linear prediction was right), a long way from the start
   EXPECT_LT((s.w.PointPosition(s.handle) - predicted).norm(), 1e-9);
@@ -356,7 +357,8 @@ TEST(Chase, ReplanningCatchesAnAcceleratingTarget) {
   s.seq.Add(std::make_unique<Chase>(PointAnchor("hand", s.hand), PointAnchor("handle", s.handle), T));
   s.Run(T);
   const double miss = (s.w.PointPosition(s.hand) - s.w.PointPosition(s.handle)).norm();
-  EXPECT_LT(miss, 0.02) << "against 2.76 without re-planning";
+  std::cout << "chase of a falling target: missed by " << miss << "\n";
+  EXPECT_LT(miss, 2e-3) << "against 2.76 without re-planning";
 }
 
 TEST(Connect, MatchesVelocitiesThenHolds) {
