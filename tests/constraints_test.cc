@@ -319,6 +319,32 @@ TEST(ConstrainedWorld, NailedPendulumConservesEnergy) {
   }
 }
 
+// The same in 3D: an affine slab nailed at a corner swings in space (a spherical pendulum that
+// also turns about its own axis), frictionless; the energy stays within the same kind of bound.
+TEST(ConstrainedWorld, NailedPendulumConservesEnergy3D) {
+  ConstrainedWorldOptions opt;
+  opt.dt = 5e-4;
+  ConstrainedWorld world(opt);
+  const auto model = std::make_shared<LinearBodyModel>(
+      MakeBoxBody("slab", 3, LinearOrder::kAffine, Eigen::Vector3d(0.5, 0.15, 0.25), 3, 2.0));
+  const AffineMaterial mat{500.0, 500.0, 0.0, 0.0};
+  ASSERT_LE(opt.dt, StableTimeStep(*model, mat));
+  const int slab = world.AddLinearBody(model, mat);
+  const Eigen::Matrix3d tilt = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, 0.2, 1.0).normalized()).toRotationMatrix();
+  world.SetLinearState(slab, model->PlacedState(tilt, Eigen::Vector3d::Zero()), Eigen::MatrixXd::Zero(3, 4));
+  world.AddNail(At(slab, Eigen::Vector3d(-0.5, 0.15, 0.25)));
+  const double E0 = world.TotalEnergy();
+  const double scale = model->total_mass() * 9.81 * 0.6;  // m g × pivot-to-centre distance
+  double worst = 0, worst_c = 0;
+  ASSERT_TRUE(world.RunUntil(20.0, [&](ConstrainedWorld& w) {
+    worst = std::max(worst, std::abs(w.TotalEnergy() - E0));
+    worst_c = std::max(worst_c, w.MaxViolation());
+  })) << world.status().message;
+  std::printf("3D slab: max |E - E0| = %.3g (m g L = %.3g), max |c| = %.3g\n", worst, scale, worst_c);
+  EXPECT_LT(worst, 2e-3 * scale);
+  EXPECT_LT(worst_c, 1e-9);
+}
+
 // Fig. 2: a triple pendulum of affine parts attached end to end, nailed at the top; long run.
 ConstrainedWorld TriplePendulum(MultiplierMethod method, double dt, std::vector<int>* links) {
   ConstrainedWorldOptions opt;
@@ -545,6 +571,19 @@ TEST(ConstrainedWorld, BadInputIsReportedNotNaN) {
   world.ClearStatus();
   EXPECT_TRUE(world.Step()) << world.status().message;
   EXPECT_TRUE(world.linear_R(bar).allFinite());
+  // a path that returns NaN stops the run with the cause, before anything moves
+  {
+    ConstrainedWorld w3;
+    const int b = w3.AddLinearBody(model);
+    w3.AddTrajectory(At(b, Eigen::Vector2d(0.5, 0)), std::make_shared<FunctionPath>(2, [](double t) {
+      const double v = t > 0.01 ? std::nan("") : 0.0;
+      return PathSample{Eigen::Vector2d(0.5, v), Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+    }));
+    EXPECT_FALSE(w3.RunUntil(1.0));
+    EXPECT_EQ(w3.status().code, ConstrainedStatus::Code::kBadPath);
+    EXPECT_NE(w3.status().message.find("non-finite sample"), std::string::npos) << w3.status().message;
+    EXPECT_TRUE(w3.linear_R(b).allFinite());
+  }
   // the same point nailed twice is also redundant (dense and sparse)
   for (MultiplierMethod method : {MultiplierMethod::kDense, MultiplierMethod::kSparse}) {
     ConstrainedWorldOptions opt;
@@ -608,6 +647,24 @@ TEST(FfdConstraints, TableNailedAtCornerHoldsAndConservesEnergy) {
   EXPECT_LT(fine.energy, 2e-3);                       // measured 3.8e-4
   EXPECT_EQ(fine.per_step_factorizations, fine.steps);  // q-dependent A: one factorization per step
   EXPECT_LT(fine.far_corner[1], 0.0);                   // it really swung down
+}
+
+// Impulses on an FFD body (J at the current q, W through its mass solve): the swinging table's
+// far corner stops dead while the nailed corner keeps ċ = 0.
+TEST(FfdConstraints, ImpulseStopsAnFfdPointDead) {
+  ConstrainedWorldOptions opt;
+  opt.dt = 0.005;
+  opt.params.ground.enabled = false;
+  ConstrainedWorld world(opt);
+  const int table = world.AddFfdBody(Table(4e6, 0.0));
+  const int nail = world.AddNail(At(table, Eigen::Vector2d(0.0, 1.0)));
+  ASSERT_TRUE(world.RunUntil(3.0)) << world.status().message;
+  const MaterialPoint far = At(table, Eigen::Vector2d(1.0, 0.0));
+  ASSERT_GT(world.PointVelocity(far).norm(), 1.0);
+  ASSERT_TRUE(world.ApplyImpulse({{far, MaterialPoint(), Eigen::Vector2d::Zero()}}));
+  EXPECT_LT(world.PointVelocity(far).norm(), 1e-9);
+  EXPECT_LT(world.ConstraintVelocityError(nail).norm(), 1e-9);
+  ASSERT_TRUE(world.RunUntil(4.0)) << world.status().message;
 }
 
 // An FFD table hanging by its top-right corner from the end of a nailed affine bar.

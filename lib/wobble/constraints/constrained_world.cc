@@ -391,7 +391,11 @@ void ConstrainedWorld::Targets(const Constraint& c, double t, Eigen::VectorXd* n
   if (c.kind == ConstraintKind::kTrajectory) {
     PathSample s = c.path->Evaluate(t);
     if (s.n.size() != d || s.n_dot.size() != d || s.n_ddot.size() != d)
-      throw std::invalid_argument("a path returned a sample of the wrong size");
+      throw std::invalid_argument("the path of a trajectory on body '" + body_name(c.a.body) +
+                                  "' returned a sample of the wrong size at t = " + std::to_string(t));
+    if (!s.n.allFinite() || !s.n_dot.allFinite() || !s.n_ddot.allFinite())
+      throw std::invalid_argument("the path of a trajectory on body '" + body_name(c.a.body) +
+                                  "' returned a non-finite sample at t = " + std::to_string(t));
     *n = std::move(s.n);
     *n_dot = std::move(s.n_dot);
     *n_ddot = std::move(s.n_ddot);
@@ -643,8 +647,8 @@ bool ConstrainedWorld::Step() {
       for (int body = 0; body < num_bodies(); ++body)
         if (force[body].size() > 0) ApplyGeneralized(body, force[body], &acc[body]);
     }
-  } catch (const std::invalid_argument& e) {
-    return Fail(ConstrainedStatus::Code::kSingularConstraints, -1, e.what());
+  } catch (const std::invalid_argument& e) {  // only paths throw here
+    return Fail(ConstrainedStatus::Code::kBadPath, -1, e.what());
   }
   // semi-implicit Euler, velocity first; the whole step is refused when anything is non-finite
   for (int body = 0; body < num_bodies(); ++body)

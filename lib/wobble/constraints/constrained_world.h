@@ -88,7 +88,7 @@ struct ConstrainedWorldOptions {
 };
 
 struct ConstrainedStatus {
-  enum class Code { kOk, kSingularConstraints, kBodyFailed, kNonFinite };
+  enum class Code { kOk, kSingularConstraints, kBodyFailed, kNonFinite, kBadPath };
   Code code = Code::kOk;
   long step = 0;
   double time = 0.0;
