@@ -83,6 +83,9 @@ demo: demo-build
 	echo
 	echo "\$$ $$xvfb" '$(WOBBLE) run $(DEMO_SCRIPT)'
 	eval "$$xvfb" '$(WOBBLE) run $(DEMO_SCRIPT)' || status=$$?
+	# Witkin & Welch, Fig. 3: the sky hook grabs the pyramid and hangs itself up (issue 7)
+	echo "\$$ $$xvfb" '$(WOBBLE) run data/fig3_sky_hook.wob'
+	eval "$$xvfb" '$(WOBBLE) run data/fig3_sky_hook.wob' || status=$$?
 	echo
 	echo "files (the cliff jump, in $(OUT)/):"
 	echo "  trajectory  $(OUT)/table_cliff.csv  (t, q, q-dot, energies, control energy, contacts per step)"
@@ -92,6 +95,7 @@ demo: demo-build
 	echo "  EXR         $(OUT)/exr/frame_NNNN.exr  (R,G,B,A, depth.Z), $(OUT)/exr/disp_NNNN.exr  (disp.X, disp.Y)"
 	echo "  plots       $(OUT)/energy.png, $(OUT)/condition.png  (numbers in the .csv beside them)"
 	echo "  table drop  $(OUT)/table_drop.csv  (the sloped-ground drop, simulated only: README, Pictures and exports)"
+	echo "  sky hook    out/fig3/filmstrip.png, out/fig3/frames/, out/fig3/vtp/fig3_sky_hook.pvd  (Witkin & Welch Fig. 3)"
 	echo "  command     $(WOBBLE)  (see $(WOBBLE) --help, and README.md)"
 	exit $$status
 

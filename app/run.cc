@@ -13,6 +13,7 @@
 #include <filesystem>
 
 #include "pipelines/charts.h"
+#include "pipelines/scene_run.h"
 #include "pipelines/scene_view.h"
 #include "render.h"
 #endif
@@ -109,12 +110,47 @@ void RenderRecordedRuns(const io::RenderRequest& r) {
 #endif
 }
 
+// `render DIR` in a script: the recorded Witkin & Welch scene as frames, filmstrip and .pvd.
+std::vector<std::string> RenderScene(const io::SceneRenderRequest& r) {
+#ifdef WOBBLE_HAVE_PIPELINES
+  pipelines::SceneRunOutputs out;
+  out.folder = r.folder;
+  out.name = r.name;
+  out.frames = r.frames;
+  out.filmstrip = r.filmstrip;
+  out.vtp = r.vtp;
+  if ((out.frames || out.filmstrip) && !pipelines::HasDisplay()) {
+    // as for the cost charts: the exports that need no display are still written
+    std::cout << "no X display: frames and filmstrip skipped (run under xvfb-run -a -s \"-screen 0 1280x1024x24\")\n";
+    out.frames = out.filmstrip = false;
+  }
+  out.view.azimuth = r.azimuth;
+  out.view.elevation = r.elevation;
+  out.view.title = r.name;
+  pipelines::ConstrainedSceneSpec spec;
+  spec.drawings = *r.drawings;
+  for (const control::Anchor& a : r.anchors) {
+    pipelines::AnchorSource::Anchor d;
+    d.name = a.name;
+    if (a.point) d.point = *a.point;
+    d.place = a.place;
+    spec.anchors.push_back(d);
+  }
+  if (!out.frames && !out.filmstrip && !out.vtp) return {};
+  return pipelines::WriteSceneRun(*r.world, spec, *r.recorded, out);
+#else
+  (void)r;
+  throw std::runtime_error("this wobble was built without pipelines/ (VTK): nothing can be drawn");
+#endif
+}
+
 }  // namespace
 
 int RunScript(const RunArgs& a) {
   io::Interpreter interp(std::cout);
   interp.SetHistoryHook(PlotCostHistory);
   interp.SetRenderHook(RenderRecordedRuns);
+  interp.SetSceneRenderHook(RenderScene);
   Progress progress(isatty(STDERR_FILENO) == 1);
   interp.SetProgress([&](double fraction, double t) {
     progress.Update(fraction, t);

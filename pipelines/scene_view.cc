@@ -60,9 +60,32 @@ Eigen::AlignedBox2d BodyBounds(const World& world, int body_index) {
   return box;
 }
 
+Eigen::AlignedBox3d SceneBounds(const ConstrainedWorld& world, const ConstrainedSceneSpec& spec) {
+  Eigen::AlignedBox3d box;
+  for (int b = 0; b < world.num_bodies(); ++b) {
+    if (world.kind(b) == BodyKind::kLinear) {
+      const LinearDrawing* d = b < int(spec.drawings.size()) ? &spec.drawings[b] : nullptr;
+      box.extend(LinearBodyBounds(world, b, d));
+    } else {
+      const Eigen::AlignedBox2d flat = BodyBounds(world.ffd_world(), world.ffd_index(b));
+      box.extend(Eigen::Vector3d(flat.min().x(), flat.min().y(), 0.0));
+      box.extend(Eigen::Vector3d(flat.max().x(), flat.max().y(), 0.0));
+    }
+  }
+  return box;
+}
+
+bool IsFlat(const ConstrainedWorld& world) {
+  for (int b = 0; b < world.num_bodies(); ++b)
+    if (world.dim(b) != 2) return false;
+  return true;
+}
+
 struct SceneView::Impl {
-  const World* world;
-  int body;
+  const World* world = nullptr;
+  int body = 0;
+  const ConstrainedWorld* cworld = nullptr;            // the other kind of view
+  std::vector<Ptr<vtkPolyDataAlgorithm>> csources;     // its sources, re-run every Render()
   Ptr<vtkRenderWindow> window;
   Ptr<vtkRenderer> renderer;
   Ptr<GroundSource> ground;
@@ -105,17 +128,7 @@ SceneView::SceneView(const World* world, int body, SceneOptions options) : impl_
   Impl& m = *impl_;
   m.world = world;
   m.body = body;
-  m.renderer = Ptr<vtkRenderer>::New();
-  m.renderer->SetBackground(1.0, 1.0, 1.0);
-  m.window = Ptr<vtkRenderWindow>::New();
-  m.window->SetOffScreenRendering(options_.offscreen ? 1 : 0);
-  m.window->SetMultiSamples(0);  // identical pixels run to run, cheaper readback
-  m.window->SetSize(options_.width, options_.height);
-  m.window->AddRenderer(m.renderer);
-  const double* vp = options_.viewport;
-  if (!(vp[0] >= 0 && vp[1] >= 0 && vp[2] <= 1 && vp[3] <= 1 && vp[0] < vp[2] && vp[1] < vp[3]))
-    throw std::invalid_argument("SceneView: the viewport must lie inside [0, 1] x [0, 1]");
-  m.renderer->SetViewport(vp[0], vp[1], vp[2], vp[3]);
+  SetUpWindow();
 
   auto attach = [&](WorldSourceBase* s) {
     s->SetWorld(world);
@@ -195,6 +208,27 @@ SceneView::SceneView(const World* world, int body, SceneOptions options) : impl_
       m.renderer->AddActor2D(m.bar);
     }
   }
+  SetUpOverlay();
+  FrameBox(BodyBounds(*world, body));
+}
+
+void SceneView::SetUpWindow() {
+  Impl& m = *impl_;
+  m.renderer = Ptr<vtkRenderer>::New();
+  m.renderer->SetBackground(1.0, 1.0, 1.0);
+  m.window = Ptr<vtkRenderWindow>::New();
+  m.window->SetOffScreenRendering(options_.offscreen ? 1 : 0);
+  m.window->SetMultiSamples(0);  // identical pixels run to run, cheaper readback
+  m.window->SetSize(options_.width, options_.height);
+  m.window->AddRenderer(m.renderer);
+  const double* vp = options_.viewport;
+  if (!(vp[0] >= 0 && vp[1] >= 0 && vp[2] <= 1 && vp[3] <= 1 && vp[0] < vp[2] && vp[1] < vp[3]))
+    throw std::invalid_argument("SceneView: the viewport must lie inside [0, 1] x [0, 1]");
+  m.renderer->SetViewport(vp[0], vp[1], vp[2], vp[3]);
+}
+
+void SceneView::SetUpOverlay() {
+  Impl& m = *impl_;
   if (options_.overlay || !options_.title.empty()) {
     m.overlay = Ptr<vtkTextActor>::New();
     m.overlay->GetTextProperty()->SetColor(0, 0, 0);
@@ -205,7 +239,138 @@ SceneView::SceneView(const World* world, int body, SceneOptions options) : impl_
                                   int(options_.viewport[3] * options_.height) - 8);
     m.renderer->AddActor2D(m.overlay);
   }
-  FrameBox(BodyBounds(*world, body));
+}
+
+SceneView::SceneView(const ConstrainedWorld* world, ConstrainedSceneSpec spec, SceneOptions options)
+    : impl_(new Impl), options_(std::move(options)) {
+  if (!HasDisplay())
+    throw std::runtime_error("rendering needs an X display (VTK 9.1): run under xvfb-run -a -s \"-screen 0 1280x1024x24\"");
+  if (!world) throw std::invalid_argument("SceneView: no world");
+  if (options_.width < 16 || options_.height < 16 || options_.width > 8192 || options_.height > 8192)
+    throw std::invalid_argument("image size must be between 16 and 8192 pixels a side");
+  Impl& m = *impl_;
+  m.cworld = world;
+  SetUpWindow();
+  const bool flat = IsFlat(*world);
+  // the same colours and layering as the FFD view: control box, shape, mass points, anchors
+  const double box_rgb[3] = {0.45, 0.6, 0.85}, shape_rgb[3] = {0.1, 0.1, 0.1}, surface_rgb[3] = {0.95, 0.75, 0.35},
+               points_rgb[3] = {0.85, 0.2, 0.15}, anchor_rgb[3] = {0.1, 0.55, 0.2};
+  // in 2D the z offsets keep points above lines (as in the FFD view); in 3D depth decides
+  const double z = flat ? 1.0 : 0.0;
+  auto add = [&](vtkPolyDataAlgorithm* src, const double rgb[3], double line_width, double point_size, double z_offset,
+                 bool lit = false) {
+    Ptr<vtkActor> a = m.AddActor(src, rgb, line_width, point_size);
+    a->SetPosition(0, 0, z_offset * z);
+    if (lit) a->GetProperty()->SetLighting(true);
+    m.csources.push_back(src);
+    return a;
+  };
+  for (int b = 0; b < world->num_bodies(); ++b) {
+    if (world->kind(b) == BodyKind::kFfd) {
+      // FFD bodies through the sources of world_sources.h on the world that steps them
+      auto lattice = Ptr<LatticeSource>::New();
+      auto points = Ptr<MassPointSource>::New();
+      auto shape = Ptr<ShapeSource>::New();
+      shape->SetSamplesPerSegment(options_.shape_samples);
+      for (WorldSourceBase* s : {(WorldSourceBase*)lattice, (WorldSourceBase*)points, (WorldSourceBase*)shape}) {
+        s->SetWorld(&world->ffd_world());
+        s->SetBody(world->ffd_index(b));
+      }
+      if (options_.show_lattice) add(lattice, box_rgb, 1.0, options_.point_size * 0.75, 1);
+      if (options_.show_shape) add(shape, shape_rgb, options_.line_width, 1.0, 2);
+      if (options_.show_points) add(points, points_rgb, 1.0, options_.point_size, 3);
+      continue;
+    }
+    auto box = Ptr<LinearBoxSource>::New();
+    auto points = Ptr<LinearMassPointSource>::New();
+    for (ConstrainedSourceBase* s : {(ConstrainedSourceBase*)box, (ConstrainedSourceBase*)points}) {
+      s->SetWorld(world);
+      s->SetBody(b);
+    }
+    if (options_.show_lattice) add(box, box_rgb, 1.0, options_.point_size * 0.75, 1);
+    if (options_.show_shape && b < int(spec.drawings.size()) && spec.drawings[b].dim() != 0) {
+      const LinearDrawing& d = spec.drawings[b];
+      if (!d.triangles.empty()) {
+        // a lit, slightly transparent surface under the outline so the mass points show through
+        auto surface = Ptr<LinearShapeSource>::New();
+        surface->SetWorld(world);
+        surface->SetBody(b);
+        surface->SetDrawing(d);
+        surface->SetLines(false);
+        add(surface, surface_rgb, 1.0, 1.0, 0.5, true)->GetProperty()->SetOpacity(0.55);
+      }
+      auto lines = Ptr<LinearShapeSource>::New();
+      lines->SetWorld(world);
+      lines->SetBody(b);
+      lines->SetDrawing(d);
+      lines->SetSurface(false);
+      add(lines, shape_rgb, options_.line_width, 1.0, 2);
+    }
+    if (options_.show_points) add(points, points_rgb, 1.0, options_.point_size, 3);
+  }
+  if (!spec.anchors.empty()) {
+    auto anchors = Ptr<AnchorSource>::New();
+    anchors->SetWorld(world);
+    anchors->SetAnchors(spec.anchors);
+    add(anchors, anchor_rgb, 1.0, options_.point_size * 1.6, 4);
+  }
+  SetUpOverlay();
+  const Eigen::AlignedBox3d bounds = SceneBounds(*world, spec);
+  if (flat)
+    FrameBox(Eigen::AlignedBox2d(bounds.min().head<2>(), bounds.max().head<2>()));
+  else
+    FrameBox3d(bounds);
+}
+
+void SceneView::FrameBox3d(const Eigen::AlignedBox3d& box_in, double margin) {
+  Eigen::AlignedBox3d box = box_in;
+  if (box.isEmpty()) box = Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1));
+  const double az = options_.azimuth * M_PI / 180.0, el = options_.elevation * M_PI / 180.0;
+  // the camera looks at the box's centre from direction `dir`; right and up span the image
+  const Eigen::Vector3d dir(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+  const Eigen::Vector3d right = Eigen::Vector3d::UnitY().cross(dir).normalized();
+  const Eigen::Vector3d up = dir.cross(right);
+  const double aspect = double(options_.width) / options_.height;
+  const double tan_v = std::tan(0.5 * options_.view_angle * M_PI / 180.0) / (1.0 + 2.0 * margin);
+  const double tan_h = tan_v * aspect;
+  // the nearest distance that keeps every corner of the box inside the view: a corner at
+  // offset r from the centre is at depth d − r·dir and must have |r·right| <= depth tan_h and
+  // |r·up| <= depth tan_v
+  // |r·up| <= depth tan_v. Then the focal point moves so the box's image is centred (a box
+  // seen from above projects lower than its centre), and the distance is fitted again.
+  Eigen::Vector3d c = box.center();
+  double distance = 1e-6;
+  for (int pass = 0; pass < 3; ++pass) {
+    distance = 1e-6;
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector3d r = box.corner(Eigen::AlignedBox3d::CornerType(k)) - c;
+      distance = std::max({distance, r.dot(dir) + std::abs(r.dot(right)) / tan_h, r.dot(dir) + std::abs(r.dot(up)) / tan_v});
+    }
+    if (pass == 2) break;
+    Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector3d r = box.corner(Eigen::AlignedBox3d::CornerType(k)) - c;
+      const double depth = distance - r.dot(dir);
+      const Eigen::Vector2d screen(r.dot(right) / depth, r.dot(up) / depth);  // tangents of the angles
+      lo = lo.cwiseMin(screen);
+      hi = hi.cwiseMax(screen);
+    }
+    const Eigen::Vector2d mid = 0.5 * (lo + hi);
+    c += distance * (mid.x() * right + mid.y() * up);
+  }
+  const double radius = 0.5 * box.sizes().norm();
+  const Eigen::Vector3d eye = c + distance * dir;
+  vtkCamera* cam = impl_->renderer->GetActiveCamera();
+  cam->ParallelProjectionOff();
+  cam->SetViewAngle(options_.view_angle);
+  cam->SetFocalPoint(c.x(), c.y(), c.z());
+  cam->SetPosition(eye.x(), eye.y(), eye.z());
+  cam->SetViewUp(0, 1, 0);
+  cam->SetClippingRange(std::max(1e-3 * distance, distance - 1.5 * radius), distance + 1.5 * radius);
+  // what the frame shows in the plane through the centre facing the camera, for callers
+  const double half_h = distance * std::tan(0.5 * options_.view_angle * M_PI / 180.0);
+  framed_ = Eigen::AlignedBox2d(c.head<2>() - Eigen::Vector2d(half_h * aspect, half_h),
+                                c.head<2>() + Eigen::Vector2d(half_h * aspect, half_h));
 }
 
 SceneView::~SceneView() = default;
@@ -231,16 +396,20 @@ void SceneView::FrameBox(const Eigen::AlignedBox2d& box_in, double margin) {
   cam->SetParallelScale(scale);
   cam->SetClippingRange(distance - 10.0, distance + 10.0);
   // the ground band: as long as the view is wide, reaching below its bottom edge
-  impl_->ground->SetCenter(c.x(), c.y());
-  impl_->ground->SetLength(4.0 * scale * aspect + 4.0 * scale);
-  impl_->ground->SetDepth(4.0 * scale);
+  if (impl_->ground) {
+    impl_->ground->SetCenter(c.x(), c.y());
+    impl_->ground->SetLength(4.0 * scale * aspect + 4.0 * scale);
+    impl_->ground->SetDepth(4.0 * scale);
+  }
 }
 
 void SceneView::Render() {
   Impl& m = *impl_;
-  for (WorldSourceBase* s : {(WorldSourceBase*)m.ground, (WorldSourceBase*)m.lattice, (WorldSourceBase*)m.points,
-                             (WorldSourceBase*)m.shape, (WorldSourceBase*)m.springs})
-    s->Modified();
+  if (m.world)
+    for (WorldSourceBase* s : {(WorldSourceBase*)m.ground, (WorldSourceBase*)m.lattice, (WorldSourceBase*)m.points,
+                               (WorldSourceBase*)m.shape, (WorldSourceBase*)m.springs})
+      s->Modified();
+  for (vtkPolyDataAlgorithm* s : m.csources) s->Modified();
   if (m.colored) {
     double lo = options_.color_range[0], hi = options_.color_range[1];
     if (!(lo < hi)) {
@@ -260,9 +429,14 @@ void SceneView::Render() {
     std::string text = options_.title.empty() ? "" : options_.title + "\n";
     if (options_.overlay) {
       char buf[256];
-      std::snprintf(buf, sizeof(buf), "t = %.3f s", m.world->time());
+      std::snprintf(buf, sizeof(buf), "t = %.3f s", m.world ? m.world->time() : m.cworld->time());
       text += buf;
-      if (options_.overlay_energy) {
+      if (options_.overlay_energy && m.cworld) {
+        double kinetic = 0.0;
+        for (int b = 0; b < m.cworld->num_bodies(); ++b) kinetic += m.cworld->KineticEnergy(b);
+        std::snprintf(buf, sizeof(buf), "\nE = %.4g (kin %.3g)", m.cworld->TotalEnergy(), kinetic);
+        text += buf;
+      } else if (options_.overlay_energy) {
         const Energies e = m.world->ComputeEnergies(m.body);
         std::snprintf(buf, sizeof(buf), "\nE = %.4g (kin %.3g, grav %.3g, modes %.3g)", e.total(), e.kinetic,
                       e.gravity, e.modes);
@@ -306,9 +480,14 @@ std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
   if (dims[0] != w || dims[1] != h || rgb->GetNumberOfScalarComponents() != 3 || z->GetNumberOfValues() != vtkIdType(w) * h)
     throw std::runtime_error("reading the rendered pixels back failed");
   // window depth d in [0, 1] is linear in the eye distance for a parallel projection:
-  // distance = near + d (far − near); the far plane (d = 1) means nothing was drawn
+  // distance = near + d (far − near); in perspective (3D views) it is hyperbolic:
+  // distance = n f / (f − d (f − n)). The far plane (d = 1) means nothing was drawn.
   double range[2];
   impl_->renderer->GetActiveCamera()->GetClippingRange(range);
+  const bool parallel = impl_->renderer->GetActiveCamera()->GetParallelProjection() != 0;
+  auto eye_distance = [&](double d) {
+    return parallel ? range[0] + d * (range[1] - range[0]) : range[0] * range[1] / (range[1] - d * (range[1] - range[0]));
+  };
   std::vector<ExrChannel> ch = {{"R", {}}, {"G", {}}, {"B", {}}, {"A", {}}, {"depth.Z", {}}};
   for (ExrChannel& c : ch) c.data.resize(size_t(w) * h);
   const auto* px = static_cast<const unsigned char*>(rgb->GetScalarPointer());
@@ -323,7 +502,7 @@ std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
       const float a = drawn ? 1.0f : 0.0f;
       for (int c = 0; c < 3; ++c) ch[c].data[out] = a * (px[3 * in + c] / 255.0f);
       ch[3].data[out] = a;
-      ch[4].data[out] = drawn ? float(range[0] + d * (range[1] - range[0])) : inf;
+      ch[4].data[out] = drawn ? float(eye_distance(d)) : inf;
     }
   }
   return ch;

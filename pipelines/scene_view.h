@@ -14,6 +14,7 @@
 #include <vtkSmartPointer.h>
 
 #include "pipelines/background_writer.h"
+#include "pipelines/constrained_sources.h"
 #include "pipelines/exr_io.h"
 #include "pipelines/world_sources.h"
 
@@ -49,6 +50,16 @@ struct SceneOptions {
   // (fractions) that the scene's renderer covers. width and height stay the window's size.
   bool offscreen = true;
   double viewport[4] = {0.0, 0.0, 1.0, 1.0};
+  // 3D views (FrameBox3d): the camera looks at the box from this azimuth (degrees about +y,
+  // from +z towards +x) and elevation (degrees above the x-z plane), in perspective.
+  double azimuth = 30.0, elevation = 20.0;
+  double view_angle = 30.0;  // perspective opening, degrees
+};
+
+// What a view of a ConstrainedWorld draws besides its bodies' mass points and control boxes.
+struct ConstrainedSceneSpec {
+  std::vector<LinearDrawing> drawings;        // per body index; empty or missing: no shape
+  std::vector<AnchorSource::Anchor> anchors;  // named points, drawn as larger dots
 };
 
 // The layers a SceneView draws; each can be shown or hidden after construction.
@@ -57,6 +68,11 @@ enum class SceneLayer { kGround, kLattice, kPoints, kShape, kSprings, kTrails };
 // A box holding every point of the body now: its deformed control points (by the convex-hull
 // property of the Bernstein/B-spline weights no point of the body lies outside them).
 Eigen::AlignedBox2d BodyBounds(const World& world, int body);
+// A box holding every body of a ConstrainedWorld now (linear bodies with their drawings,
+// FFD bodies by their control points; z = 0 for 2D bodies).
+Eigen::AlignedBox3d SceneBounds(const ConstrainedWorld& world, const ConstrainedSceneSpec& spec);
+// True when every body of the world is 2D (the parallel 2D view suits it).
+bool IsFlat(const ConstrainedWorld& world);
 
 class SceneView {
  public:
@@ -66,9 +82,18 @@ class SceneView {
   SceneView(const SceneView&) = delete;
   SceneView& operator=(const SceneView&) = delete;
 
+  // Every body of a ConstrainedWorld (Witkin & Welch bodies, 2D or 3D, and FFD bodies): linear
+  // bodies as control box, mass points and shape (LinearDrawing; a lit surface in 3D), FFD
+  // bodies with the sources above, anchors as dots. The camera starts on the world's bodies:
+  // FrameBox for a world of 2D bodies, FrameBox3d when any body is 3D. No ground is drawn.
+  SceneView(const ConstrainedWorld* world, ConstrainedSceneSpec spec, SceneOptions options = {});
+
   // A parallel camera looking down −z that shows `box` (world units) with a margin
   // (fraction of the box) around it, keeping the aspect ratio of the image.
   void FrameBox(const Eigen::AlignedBox2d& box, double margin = 0.08);
+  // A perspective camera from options().azimuth/elevation, looking at the centre of `box`
+  // from the nearest distance that keeps all its corners in view (plus the margin): the 3D view.
+  void FrameBox3d(const Eigen::AlignedBox3d& box, double margin = 0.08);
   const Eigen::AlignedBox2d& framed_box() const { return framed_; }
 
   // Rebuilds every source from the world's current state and renders.
@@ -99,6 +124,8 @@ class SceneView {
 
  private:
   struct Impl;
+  void SetUpWindow();
+  void SetUpOverlay();
   std::unique_ptr<Impl> impl_;
   SceneOptions options_;
   Eigen::AlignedBox2d framed_;

@@ -25,6 +25,7 @@
 #include "pipelines/energy_charts.h"
 #include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
+#include "wobble/body/linear_shapes.h"
 #include "pipelines_test_util.h"
 #include "render_baseline.h"
 
@@ -185,6 +186,42 @@ TEST(RenderRegression, ScalarFieldWithColourLegend) {
   s.width = 240;
   s.height = 180;
   CompareWithBaseline("scalar_field", RenderScalarField(s));
+}
+
+// Issue 7: a 3D frame of Witkin & Welch bodies in perspective: a quadratic block bent by its
+// second-order terms (control box, mass points, lit surface and outline), a pyramid sheared
+// and lifted, and two named points.
+TEST(RenderRegression, ConstrainedScene3d) {
+  REQUIRE_DISPLAY();
+  ConstrainedWorld world;
+  Eigen::VectorXd half(3);
+  half << 1.0, 0.5, 0.5;
+  auto block = std::make_shared<const LinearBodyModel>(MakeBoxBody("block", 3, LinearOrder::kQuadratic, half, 3, 1.0));
+  auto pyramid = std::make_shared<const LinearBodyModel>(MakePyramidBody("pyramid", 3, LinearOrder::kAffine, 0.5, 1.0, 3, 3, 1.0));
+  const int b = world.AddLinearBody(block), p = world.AddLinearBody(pyramid);
+  Eigen::MatrixXd R = block->RestState();
+  R(1, 7) = -0.3;  // y −= 0.3 x²: the block bends down at both ends (basis [x y z 1 xy xz yz x² y² z²])
+  R(0, 4) = 0.2;   // x += 0.2 xy: and shears with height
+  world.SetLinearState(b, R, Eigen::MatrixXd::Zero(3, 10));
+  Eigen::MatrixXd Rp = pyramid->RestState();
+  Rp(0, 1) = 0.3;  // x += 0.3 y: leaning
+  Rp.col(3) << 2.2, -0.5, 0.3;
+  world.SetLinearState(p, Rp, Eigen::MatrixXd::Zero(3, 4));
+  ConstrainedSceneSpec spec;
+  spec.drawings = {MakeBoxDrawing(half, 6), MakePyramidDrawing(3, 0.5, 1.0, 6)};
+  AnchorSource::Anchor corner, sky;
+  corner.point = At(b, (Eigen::VectorXd(3) << 1, 0.5, 0.5).finished());
+  sky.place = Eigen::Vector3d(0.0, 1.5, 0.0);
+  spec.anchors = {corner, sky};
+  SceneOptions o;
+  o.width = 200;
+  o.height = 150;
+  o.overlay = false;
+  o.azimuth = 30;
+  o.elevation = 20;
+  SceneView view(&world, spec, o);
+  view.Render();
+  CompareWithBaseline("constrained_scene_3d", view.Capture());
 }
 
 }  // namespace

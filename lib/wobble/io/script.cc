@@ -1,4 +1,5 @@
 #include "wobble/io/script.h"
+#include "wobble/io/script_internal.h"
 
 #include "wobble/io/atomic_file.h"
 
@@ -23,13 +24,8 @@
 namespace wobble::io {
 
 namespace fs = std::filesystem;
+using namespace script_detail;
 
-struct Interpreter::Context {
-  std::string file;
-  int line = 0;
-  std::string dir;
-  [[noreturn]] void Fail(const std::string& message) const { throw ParseError(file, line, message); }
-};
 
 // ---------------------------------------------------------------------------------------------
 // the language
@@ -56,9 +52,31 @@ const std::vector<CommandInfo>& Interpreter::Commands() {
       {"cmaes", "cmaes GENERATIONS", "CMA-ES (pagmo2) on the same problem as anneal; population = batch (>= 5)"},
       {"gait", "gait SKIP CYCLES", "distance travelled per cycle of the pose graph, after SKIP cycles"},
       {"save", "save FILE", "write a script that rebuilds the current setup and replays its controller"},
-      {"render", "render DIR [WHAT]", "draw every run since load_obj (or clear track) into DIR: frames, filmstrip, "
-                                      "charts, vtp, exr, disp (comma list; default frames,filmstrip,charts)"},
+      {"render", "render DIR [WHAT]",
+       "draw into DIR: with a scene (linear bodies) its recorded frames, WHAT a comma list of frames, filmstrip, vtp "
+       "(default all); otherwise every FFD run since load_obj (or clear track), WHAT of frames, filmstrip, charts, vtp, "
+       "exr, disp (default frames,filmstrip,charts)"},
       {"echo", "echo TEXT", "print TEXT"},
+      // Witkin & Welch scenes (linear bodies, constraints, motion control, goal behaviours)
+      {"linear", "linear NAME 2d|3d affine|quadratic box HX HY [HZ] | pyramid W H [grid N] [levels N] [mass M] [at X Y [Z]] [ke K] [kc K] [kd K] [kq K]",
+       "a linear-deformation body x = R p(u) (a box or a pyramid of mass points), at rest at X Y Z"},
+      {"ffd", "ffd NAME", "the loaded FFD object (its modes and state q, dq) joins the scene as body NAME"},
+      {"point", "point NAME BODY U1 U2 [U3]", "name a material point of a body (undeformed coordinates; lattice S T of an FFD body)"},
+      {"place", "place NAME X Y [Z]", "name a fixed place in the world (a sky point)"},
+      {"nail", "nail NAME POINT [X Y [Z]]", "nail a point where it is (or at X Y Z), now"},
+      {"attach", "attach NAME POINT_A POINT_B", "attach two points of bodies to each other, now"},
+      {"path", "path NAME 2d|3d T X Y [Z] T X Y [Z] ...", "keyframes of a control point: a C2 cubic spline through them"},
+      {"trajectory", "trajectory NAME POINT PATH [preroll DT]", "queue: the point follows PATH from its first key (preroll: a cubic from where it is)"},
+      {"impulse", "impulse POINT VX VY [VZ]", "queue: an impulse that gives the point this velocity (0: stop dead)"},
+      {"chase", "chase POINT TARGET DURATION [VX VY [VZ]]", "queue: the point chases a point or place, meeting it after DURATION"},
+      {"connect", "connect POINT TARGET [NAME]", "queue: velocity-matching impulse, then attach (nail for a place)"},
+      {"grab", "grab POINT TARGET DURATION [VX VY [VZ]]", "queue: chase, then connect (constraint connect:POINT)"},
+      {"release", "release NAME", "queue: remove a constraint"},
+      {"on", "on NAME", "queue: switch a constraint on (with an impulse that makes velocities legal)"},
+      {"off", "off NAME", "queue: switch a constraint off (the point goes ballistic)"},
+      {"wait", "wait DURATION", "queue: let DURATION pass before the next behaviour"},
+      {"wait_for", "wait_for time T | near A B R | below A Y | above A Y", "queue: wait until the condition holds"},
+      {"record", "record FPS | record off", "record the scene's state FPS times per simulated second for render"},
       {"quit", "quit", "stop (interactive use)"},
   };
   return commands;
@@ -71,7 +89,8 @@ const std::vector<std::string>& Interpreter::Parameters() {
       "time", "end", "dt", "ground_height", "ground_slope", "max_penetration",             //
       "integrator", "interp",                                                               // words
       "seed", "batch", "cooling", "temperature", "optimize", "cost", "cost_scale", "trial_steps",
-      "pose_step", "time_step", "threads", "anneal_csv", "cmaes_csv", "sigma0", "min_amplitude", "max_amplitude", "min_time", "max_time", "switch_width"};
+      "pose_step", "time_step", "threads", "anneal_csv", "cmaes_csv", "sigma0", "min_amplitude", "max_amplitude", "min_time", "max_time", "switch_width",
+      "feedback_rate", "view_azimuth", "view_elevation"};  // scenes
   return names;
 }
 
@@ -107,41 +126,9 @@ std::string Interpreter::Nearest(const std::string& word, const std::vector<std:
 }
 
 // ---------------------------------------------------------------------------------------------
-// small helpers
+// small helpers (the shared ones are in script_internal.h)
 
 namespace {
-
-std::string Num(double v) {
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof(buf), v);
-  return std::string(buf, res.ptr);
-}
-
-template <class C> double Number(const std::string& word, const std::string& what, const C& ctx) {
-  double v;
-  if (!detail::ParseNumber(word, &v) || !std::isfinite(v))
-    ctx.Fail("expected " + what + " (a finite number), got '" + word + "'");
-  return v;
-}
-
-template <class C> bool Boolean(const std::string& word, const std::string& what, const C& ctx) {
-  for (const char* t : {"T", "t", "true", "on", "1", "yes"})
-    if (word == t) return true;
-  for (const char* f : {"F", "f", "false", "off", "0", "no"})
-    if (word == f) return false;
-  ctx.Fail("expected T or F for " + what + ", got '" + word + "'");
-}
-
-template <class C>
-void ExpectWords(const std::vector<std::string>& w, size_t min, size_t max, const std::string& usage, const C& ctx) {
-  if (w.size() < min || w.size() > max) ctx.Fail("expected '" + usage + "'");
-}
-
-std::string Resolve(const std::string& path, const std::string& dir) {
-  const fs::path p(path);
-  if (p.is_absolute() || dir.empty()) return path;
-  return (fs::path(dir) / p).string();
-}
 
 // Rigid placement (x, y, θ) composed with a body-relative q: world = placement ∘ q.
 void Place(const Eigen::Vector3d& placement, Eigen::VectorXd* q, Eigen::VectorXd* qd) {
@@ -260,6 +247,7 @@ WorldOptions Interpreter::MakeWorldOptions() const {
 }
 
 void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx) {
+  if (ExecuteScene(w, ctx)) return;  // script_scene.cc
   const std::string& cmd = w[0];
   auto usage = [&]() -> std::string {
     for (const CommandInfo& c : Commands())
@@ -666,7 +654,8 @@ void Interpreter::Set(const std::vector<std::string>& w, const Context& ctx) {
     sigma0_ = positive();
     if (sigma0_ > 1) ctx.Fail("expected sigma0 in (0, 1], got " + value);
   }
-  else {
+  else if (SetSceneParameter(name, value, ctx)) {
+  } else {
     const std::string near = Nearest(name, Parameters());
     ctx.Fail("unknown parameter '" + name + "'" + (near.empty() ? "" : "; did you mean '" + near + "'?"));
   }

@@ -20,7 +20,11 @@
 #include <vector>
 
 #include "wobble/body/body_model.h"
+#include "wobble/body/linear_shapes.h"
+#include "wobble/constraints/constrained_world.h"
+#include "wobble/control/behaviours.h"
 #include "wobble/control/control.h"
+#include "wobble/control/scene_recording.h"
 #include "wobble/dynamics/world.h"
 #include "wobble/io/parse_error.h"
 #include "wobble/synth/anneal.h"
@@ -54,6 +58,21 @@ struct CommandInfo {
   std::string name, usage, summary;
 };
 
+// What `render` hands to the CLI (lib draws nothing): the scene of Witkin & Welch bodies, the
+// frames recorded by `record`, and what to write where. The hook may change the world's state
+// (the interpreter restores it afterwards) and returns the paths it wrote; it throws
+// std::runtime_error on failure.
+struct SceneRenderRequest {
+  std::string folder, name;
+  bool frames = true, filmstrip = true, vtp = true;
+  double azimuth = 30.0, elevation = 20.0;  // 3D camera, degrees
+  ConstrainedWorld* world = nullptr;
+  const std::vector<LinearDrawing>* drawings = nullptr;  // per body
+  std::vector<control::Anchor> anchors;                   // named points, drawn as dots
+  const std::vector<control::SceneFrame>* recorded = nullptr;
+};
+using SceneRenderHook = std::function<std::vector<std::string>(const SceneRenderRequest&)>;
+
 class Interpreter {
  public:
   // Messages (results of print, summaries of runs) go to `out`.
@@ -77,11 +96,13 @@ class Interpreter {
   using HistoryHook = std::function<void(const std::string& csv_path, const std::string& optimiser,
                                          const std::vector<synth::IterationRecord>& history)>;
   void SetHistoryHook(HistoryHook hook) { history_hook_ = std::move(hook); }
-
-  // Draws a script's runs (`render`); the CLI installs it (pipelines/, VTK). lib draws nothing:
-  // without a hook `render` is an error. The hook reports trouble by throwing.
+  // `render` draws a script's runs through hooks the CLI installs (pipelines/, VTK); lib draws
+  // nothing, and without the hook `render` is an error. One command, two kinds of run: with a
+  // Witkin & Welch scene (`linear`, ...) it draws the scene's recorded frames (SceneRenderHook),
+  // otherwise the FFD object's runs (RenderHook). Hooks report trouble by throwing.
   using RenderHook = std::function<void(const RenderRequest& request)>;
   void SetRenderHook(RenderHook hook) { render_hook_ = std::move(hook); }
+  void SetSceneRenderHook(SceneRenderHook hook) { scene_render_hook_ = std::move(hook); }
 
   static const std::vector<CommandInfo>& Commands();
   static const std::vector<std::string>& Parameters();  // names `set` accepts
@@ -120,9 +141,25 @@ class Interpreter {
   };
   SimulationSetup CurrentSetup();
 
+  // The Witkin & Welch scene (`linear`, `nail`, `grab`, ...): nullptr until a linear body is
+  // made. Its bodies, named points and constraints, for tests and the CLI.
+  const ConstrainedWorld* scene() const;
+  // Position of a named point or place (`point`, `place`); throws std::out_of_range.
+  Eigen::VectorXd ScenePoint(const std::string& name) const;
+  // The constraint id of a name (`nail`, `attach`, `connect`, ...), or -1.
+  int SceneConstraint(const std::string& name) const;
+  const std::vector<control::SceneFrame>& recorded_frames() const;
+
  private:
   struct Context;
+  struct Scene;  // script_scene.cc
   void Execute(const std::vector<std::string>& words, const Context& ctx);
+  // The scene commands; false when `words` is not one of them (or a simul/print that belongs
+  // to the FFD object because no scene exists).
+  bool ExecuteScene(const std::vector<std::string>& words, const Context& ctx);
+  // `set` of a scene parameter; false when the name is not one.
+  bool SetSceneParameter(const std::string& name, const std::string& value, const Context& ctx);
+  Scene& EnsureScene();
   void Set(const std::vector<std::string>& words, const Context& ctx);
   void RequireBody(const Context& ctx, const std::string& command);
   int ModeIndex(const std::string& word, const Context& ctx);
@@ -174,6 +211,8 @@ class Interpreter {
   synth::AnnealOptions anneal_options_;
   synth::CostFunction cost_;
   HistoryHook history_hook_;
+  RenderHook render_hook_;
+  std::unique_ptr<Scene> scene_;
   long trial_steps_ = 1200;
   std::string anneal_csv_, cmaes_csv_;
   double sigma0_ = 0.1;  // CMA-ES initial step, a fraction of each variable's range
@@ -190,7 +229,7 @@ class Interpreter {
   std::vector<int> row_slot_set_;          // per row: its entry in slot_sets_
 
   // render
-  RenderHook render_hook_;
+  SceneRenderHook scene_render_hook_;
   struct TrackEntry {
     std::shared_ptr<const BodyModel> body;  // the mode set of that run
     TrackState state;

@@ -1,0 +1,211 @@
+// The interpreter's Witkin & Welch commands: every command's errors name the line and what
+// was expected (and suggest near names); a scene runs, its constraints hold, its behaviours
+// chain, and `render` hands the recorded frames to the hook.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "wobble/io/script.h"
+
+namespace wobble {
+namespace {
+
+const std::string kData = WOBBLE_DATA_DIR;
+
+// Runs `text` as a script named "s.wob"; returns the error message ("" when it ran).
+std::string RunScript(io::Interpreter& interp, const std::string& text) {
+  std::istringstream in(text);
+  try {
+    interp.RunStream(in, "s.wob", "");
+  } catch (const io::ParseError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string RunFresh(const std::string& text) {
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  return RunScript(interp, text);
+}
+
+const char* kTwoBlocks =
+    "linear a 3d affine box 0.5 0.2 0.2 at 0 0 0\n"
+    "linear b 3d affine box 0.5 0.2 0.2 at 2 0 0\n"
+    "linear flat 2d affine box 0.5 0.2\n"
+    "point pa a 0.5 0 0\n"
+    "point pb b -0.5 0 0\n"
+    "point pf flat 0.5 0\n"
+    "place sky 0 3 0\n"
+    "path swoop 3d 0 0 0 0  1 1 1 0\n";  // lines 1-8
+
+struct ErrorCase {
+  const char* line;      // appended as line 9 (after kTwoBlocks)
+  const char* expected;  // in the message, after "s.wob:9: "
+};
+
+class SceneErrors : public testing::TestWithParam<ErrorCase> {};
+
+TEST_P(SceneErrors, NameTheLineAndWhatWasExpected) {
+  const ErrorCase& c = GetParam();
+  const std::string message = RunFresh(std::string(kTwoBlocks) + c.line + "\n");
+  EXPECT_NE(message.find(std::string("s.wob:9: ") + c.expected), std::string::npos) << "got: " << message;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EveryCommand, SceneErrors,
+    testing::Values(
+        // linear
+        ErrorCase{"linear c 3d affine box 1 1", "expected 3 numbers for a half extent"},
+        ErrorCase{"linear c 4d affine box 1 1 1", "expected 2d or 3d, got '4d'"},
+        ErrorCase{"linear c 3d cubic box 1 1 1", "expected affine or quadratic, got 'cubic'"},
+        ErrorCase{"linear c 3d affine sphere 1 1 1", "expected box or pyramid, got 'sphere'"},
+        ErrorCase{"linear c 3d affine box 1 0 1", "expected positive sizes"},
+        ErrorCase{"linear c 3d affine box 1 1 1 mas 2", "unknown option 'mas' of linear; did you mean 'mass'?"},
+        ErrorCase{"linear c 3d affine box 1 1 1 grid 1", "expected grid as a whole number >= 2, got '1'"},
+        ErrorCase{"linear c 3d affine box 1 1 1 ke -1", "expected a non-negative ke, got -1"},
+        ErrorCase{"linear c 3d affine box 1 1 1 at 1 2", "expected 3 numbers for the position after 'at'"},
+        ErrorCase{"linear a 3d affine box 1 1 1", "a body named 'a' exists already"},
+        ErrorCase{"linear c 3d quadratic box 1 1 1 grid 2", "linear body 'c': the 8 mass points do not span"},
+        ErrorCase{"linear c 2d", "expected 'linear NAME 2d|3d"},
+        // point, place
+        ErrorCase{"point q aa 0 0 0", "no body named 'aa'; did you mean 'a'?"},
+        ErrorCase{"point q a 0 0", "expected 3 undeformed coordinates for a point of the 3D body 'a'"},
+        ErrorCase{"point pa a 0 0 0", "a point or place named 'pa' exists already"},
+        ErrorCase{"place here 1", "expected 'place NAME X Y [Z]'"},
+        ErrorCase{"place here 1 x", "expected a coordinate (a finite number), got 'x'"},
+        // nail, attach
+        ErrorCase{"nail n pz", "no point or place named 'pz'; did you mean 'pa'?"},
+        ErrorCase{"nail n sky", "nail 'sky' is a fixed place; expected a point of a body ('point')"},
+        ErrorCase{"nail n pa 1 2", "expected 3 coordinates for where to nail, or none"},
+        ErrorCase{"attach j pa pf", "cannot attach a 2D point to a 3D one"},
+        ErrorCase{"attach j pa", "expected 'attach NAME POINT_A POINT_B'"},
+        // path, trajectory
+        ErrorCase{"path p 2d 0 1 1", "expected at least two keys of 3 numbers"},
+        ErrorCase{"path p 2d 0 1 1  0 2 2", "path p: key times must strictly increase"},
+        ErrorCase{"trajectory t pa swop", "no path named 'swop'; did you mean 'swoop'?"},
+        ErrorCase{"trajectory t pf swoop", "path 'swoop' and point 'pf' differ in dimension"},
+        ErrorCase{"trajectory t pa swoop prerol 1", "expected 'preroll DT' after the path, got 'prerol'"},
+        ErrorCase{"trajectory t pa swoop preroll -1", "expected a non-negative preroll time, got -1"},
+        // impulse, chase, grab, connect
+        ErrorCase{"impulse pa 1 2", "expected 3 velocity components after 'impulse pa'"},
+        ErrorCase{"chase sky pa 1", "chase 'sky' is a fixed place; expected a point of a body"},
+        ErrorCase{"chase pa pb 0", "expected a positive DURATION, got 0"},
+        ErrorCase{"chase pa pb 1 1 2", "expected 'chase POINT TARGET DURATION [VX VY [VZ]]' with 3 velocity components or none"},
+        ErrorCase{"grab pa pf 1", "'pa' and 'pf' differ in dimension"},
+        ErrorCase{"connect pa pb j1 extra", "expected 'connect POINT TARGET [NAME]'"},
+        // release, on, off, wait, wait_for
+        ErrorCase{"release pivot", "no constraint named 'pivot' (known: none)"},
+        ErrorCase{"off swoop", "no constraint named 'swoop'"},
+        ErrorCase{"on", "expected 'on NAME'"},
+        ErrorCase{"wait -1", "expected a non-negative DURATION, got -1"},
+        ErrorCase{"wait_for soon 1", "expected 'time', 'near', 'below' or 'above' after wait_for, got 'soon'"},
+        ErrorCase{"wait_for near pa pb 0", "expected a positive distance R, got 0"},
+        ErrorCase{"wait_for below pq 1", "no point or place named 'pq'"},
+        // record, render, set
+        ErrorCase{"record 0", "expected a positive FPS, got 0"},
+        ErrorCase{"render out", "nothing was recorded: 'record FPS' before 'simul'"},
+        ErrorCase{"render out frames,pictures", "expected a comma list of frames, filmstrip, vtp after 'render DIR' for a scene, got 'pictures'"},
+        ErrorCase{"set feedback_rate -1", "expected a positive feedback_rate, got -1"},
+        ErrorCase{"set view_elevation 95", "expected an elevation between -90 and 90 degrees, got 95"},
+        ErrorCase{"grap pa pb 1", "unknown command 'grap'; did you mean 'grab'?"},
+        ErrorCase{"simul -1", "expected a non-negative DURATION, got -1"}));
+
+TEST(SceneScript, ConstraintNamesAreCheckedWhenQueuedAndKnownOnceMade) {
+  // a name a queued behaviour will make can be released later; a second one of the same name
+  // is refused at once
+  EXPECT_EQ(RunFresh(std::string(kTwoBlocks) + "connect pa pb held\nrelease held\n"), "");
+  EXPECT_NE(RunFresh(std::string(kTwoBlocks) + "nail held pa\nconnect pb pa held\n")
+                .find("s.wob:10: a constraint named 'held' exists already"),
+            std::string::npos);
+  EXPECT_NE(RunFresh(std::string(kTwoBlocks) + "grab pa pb 1\ngrab pa pb 1\n")
+                .find("s.wob:10: a queued behaviour will make a constraint named 'connect:pa' already"),
+            std::string::npos);
+}
+
+TEST(SceneScript, RenderWithoutAHookSaysItCannotDraw) {
+  const std::string m = RunFresh(std::string(kTwoBlocks) + "record 10\nsimul 0.1\nrender out\n");
+  EXPECT_NE(m.find("s.wob:11: render: this program cannot draw"), std::string::npos) << m;
+}
+
+TEST(SceneScript, Fig2PendulumKeepsItsNailJointsAndEnergyAndRendersEveryFrame) {
+  // Fig. 2's triple pendulum: the nail and the attachments hold, and since nothing damps the
+  // motion and constraint forces do no work, the total energy stays what it was: 0 (at rest,
+  // at y = 0, undeformed). The scene's `render` reaches the hook with every recorded frame.
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  int hook_calls = 0;
+  size_t frames = 0;
+  std::string folder;
+  interp.SetSceneRenderHook([&](const io::SceneRenderRequest& r) {
+    ++hook_calls;
+    frames = r.recorded->size();
+    folder = r.folder;
+    EXPECT_TRUE(r.frames && r.filmstrip && r.vtp);
+    EXPECT_EQ(r.drawings->size(), 3u);
+    EXPECT_EQ(r.anchors.size(), 6u);
+    return std::vector<std::string>{};
+  });
+  interp.RunFile(kData + "/fig2_triple_pendulum.wob");
+  EXPECT_EQ(hook_calls, 1);
+  EXPECT_EQ(frames, 121u);  // 4 s at 30 per second, both ends
+  EXPECT_EQ(folder, "out/fig2");
+  const ConstrainedWorld& w = *interp.scene();
+  EXPECT_NEAR(w.time(), 4.0, 1e-9);
+  EXPECT_LT(interp.ScenePoint("top").norm(), 1e-6);
+  EXPECT_LT((interp.ScenePoint("elbow1") - interp.ScenePoint("elbow1b")).norm(), 1e-6);
+  EXPECT_LT((interp.ScenePoint("elbow2") - interp.ScenePoint("elbow2b")).norm(), 1e-6);
+  std::cout << "energy after 4 s: " << w.TotalEnergy() << " (m g L = " << 3 * 9.81 * 1.5 << ")\n";
+  EXPECT_LT(std::abs(w.TotalEnergy()), 0.01 * 3 * 9.81 * 1.5);
+  // it swung: the tip is well below where it started
+  EXPECT_LT(interp.ScenePoint("tip")[1], -0.5);
+}
+
+TEST(SceneScript, AThinStiffBodyWarnsAboutTheTimeStep) {
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  EXPECT_EQ(RunScript(interp, "set gravity F\nset dt 0.01\nlinear thin 2d affine box 1 0.01 ke 1000 kc 1000\nsimul 0.01\n"), "");
+  EXPECT_NE(out.str().find("warning: dt 0.01 is above the stable step"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("of body 'thin'"), std::string::npos);
+}
+
+TEST(SceneScript, AnFfdTableJoinsTheSceneNailedAtACornerAndAttachedToALinearBlock) {
+  // the same world holds both kinds: the table of data/ (lattice 300 x 100) hangs from its
+  // top-left corner and carries an affine block attached at its top-right corner
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  const std::string script = "load_obj " + kData + "/table.obj\nload_def " + kData + "/table_modes.def\n" +
+                             "set dt 0.0005\nset ground F\n"
+                             "ffd table\n"
+                             "linear block 2d affine box 20 10 at 320 100 mass 100 ke 1 kc 1\n"
+                             "point corner table 0 1\n"
+                             "point right table 1 1\n"
+                             "point block_end block -20 0\n"
+                             "nail hold corner\n"
+                             "attach joint right block_end\n"
+                             "simul 1\n";
+  ASSERT_EQ(RunScript(interp, script), "");
+  const ConstrainedWorld& w = *interp.scene();
+  ASSERT_EQ(w.num_bodies(), 2);
+  EXPECT_EQ(w.kind(0), BodyKind::kFfd);
+  EXPECT_LT((interp.ScenePoint("corner") - (Eigen::VectorXd(2) << 0, 100).finished()).norm(), 1e-3);
+  EXPECT_LT((interp.ScenePoint("right") - interp.ScenePoint("block_end")).norm(), 1e-3);
+  // it swings down about the nail: the far corner fell
+  EXPECT_LT(interp.ScenePoint("right")[1], 100 - 1.0);
+  EXPECT_NE(RunFresh("load_obj " + kData + "/table.obj\nffd t\npoint p t 1.5 0\n").find("s.wob:3: point p:"),
+            std::string::npos);
+}
+
+TEST(SceneScript, GravitySetAfterTheBodiesAppliesToTheNextSimul) {
+  std::ostringstream out;
+  io::Interpreter interp(out);
+  ASSERT_EQ(RunScript(interp, "linear b 3d affine box 0.5 0.5 0.5\npoint c b 0 0 0\nset gravity F\nsimul 1\n"), "");
+  EXPECT_LT(interp.ScenePoint("c").norm(), 1e-12) << "no gravity: at rest where it was";
+  ASSERT_EQ(RunScript(interp, "set gravity T\nsimul 1\n"), "");
+  // free fall for 1 s from rest: y = −g/2 (the semi-implicit step falls g Δt t further at most)
+  EXPECT_NEAR(interp.ScenePoint("c")[1], -0.5 * 9.81, 9.81 * 0.01 * 1.0 + 1e-9);
+}
+
+}  // namespace
+}  // namespace wobble
