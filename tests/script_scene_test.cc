@@ -44,6 +44,7 @@ struct ErrorCase {
   const char* line;      // appended as line 9 (after kTwoBlocks)
   const char* expected;  // in the message, after "s.wob:9: "
 };
+void PrintTo(const ErrorCase& c, std::ostream* os) { *os << '"' << c.line << '"'; }
 
 class SceneErrors : public testing::TestWithParam<ErrorCase> {};
 
@@ -110,7 +111,13 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"set feedback_rate -1", "expected a positive feedback_rate, got -1"},
         ErrorCase{"set view_elevation 95", "expected an elevation between -90 and 90 degrees, got 95"},
         ErrorCase{"grap pa pb 1", "unknown command 'grap'; did you mean 'grab'?"},
-        ErrorCase{"simul -1", "expected a non-negative DURATION, got -1"}));
+        ErrorCase{"simul -1", "expected a non-negative DURATION, got -1"}),
+    // test names from the command word and the case's index: "render_37"
+    [](const testing::TestParamInfo<ErrorCase>& info) {
+      std::string word = info.param.line;
+      word = word.substr(0, word.find(' '));
+      return word + "_" + std::to_string(info.index);
+    });
 
 TEST(SceneScript, ConstraintNamesAreCheckedWhenQueuedAndKnownOnceMade) {
   // a name a queued behaviour will make can be released later; a second one of the same name
