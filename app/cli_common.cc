@@ -93,6 +93,25 @@ std::string CoordinateNames(const BodyModel& body) {
   return names;
 }
 
+StartingWorld LoadStartingWorld(const BodyFiles& files, const std::string& q, const std::string& qdot,
+                                const WorldFlags& flags, Integrator integrator, double dt) {
+  StartingWorld s;
+  s.options.params = MakeWorldParams(flags);
+  s.options.integrator = integrator;
+  s.options.dt = dt;
+  s.body = LoadBody(files);
+  s.q0 = ParseCoordinates(q, "--q", *s.body);
+  s.qd0 = ParseCoordinates(qdot, "--qdot", *s.body);
+  return s;
+}
+
+World StartingWorld::MakeWorld() const {
+  World world(options);
+  world.AddBody(body);
+  world.SetState(0, q0, qd0);
+  return world;
+}
+
 Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& what, const BodyModel& body) {
   const int expected_size = body.num_q();
   std::vector<double> values;

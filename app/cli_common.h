@@ -63,6 +63,17 @@ WorldParams MakeWorldParams(const WorldFlags& flags);
 // gives zeros. Throws UsageError on a non-number, a non-finite number or a wrong count.
 Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& what, const BodyModel& body);
 
+// What simulate, render, inspect and condition time start from: the body of the files, its
+// start state (--q, --qdot; empty texts give rest) and the world options of the flags.
+struct StartingWorld {
+  std::shared_ptr<const BodyModel> body;
+  Eigen::VectorXd q0, qd0;
+  WorldOptions options;
+  World MakeWorld() const;  // the body alone in a world, at (q0, q̇0)
+};
+StartingWorld LoadStartingWorld(const BodyFiles& files, const std::string& q, const std::string& qdot,
+                                const WorldFlags& flags, Integrator integrator, double dt);
+
 // --integrator NAME; a UsageError listing the known names otherwise.
 Integrator ParseIntegratorFlag(const std::string& name);
 

@@ -234,16 +234,12 @@ int RunConditionTime(const ConditionTimeArgs& a) {
   (void)a;
   throw UsageError("condition time needs the pipelines (VTK), which this build does not have");
 #else
-  const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
   RequirePositive(a.dt, "--dt");
   RequirePositive(a.duration, "--duration");
   if (a.duration / a.dt > 1e7) throw UsageError("--duration / --dt asks for more than 10^7 steps");
-  WorldOptions options;
-  options.params = MakeWorldParams(a.world);
-  options.dt = a.dt;
-  World world(options);
-  world.AddBody(body);
-  world.SetState(0, ParseCoordinates(a.q, "--q", *body), Eigen::VectorXd::Zero(body->num_q()));
+  const StartingWorld setup = LoadStartingWorld(a.files, a.q, "", a.world, Integrator::kThesis, a.dt);
+  const std::shared_ptr<const BodyModel>& body = setup.body;
+  World world = setup.MakeWorld();
 
   pipelines::RunRecorder recorder;  // cond₂(M) and the contact events, as for wobble render
   recorder.Sample(world);

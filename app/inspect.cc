@@ -56,14 +56,9 @@ CLI::App* AddInspectCommand(CLI::App* app, InspectArgs* a) {
 
 int RunInspect(const InspectArgs& a) {
   if (a.indent < -1 || a.indent > 16) throw UsageError("--indent must be between 0 and 16");
-  const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
-  const Eigen::VectorXd q = ParseCoordinates(a.q, "--q", *body);
-  const Eigen::VectorXd qd = ParseCoordinates(a.qdot, "--qdot", *body);
-  WorldOptions options;
-  options.params = MakeWorldParams(a.world);
-  World world(options);
-  world.AddBody(body);
-  world.SetState(0, q, qd);
+  const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, Integrator::kThesis, 0.01);
+  const std::shared_ptr<const BodyModel>& body = setup.body;
+  const World world = setup.MakeWorld();
   const BodyState<double>& s = world.state(0);
   const Lattice& lat = body->lattice();
 

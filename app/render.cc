@@ -141,20 +141,14 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   CheckRenderOptions(a, default_what);
 
   // the body and its world
-  const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
-  const Eigen::VectorXd q0 = ParseCoordinates(a.q, "--q", *body);
-  const Eigen::VectorXd qd0 = ParseCoordinates(a.qdot, "--qdot", *body);
-  WorldOptions options;
-  options.params = MakeWorldParams(a.world);
-  options.integrator = integrator;
-  options.dt = a.dt;
+  const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, integrator, a.dt);
   // the motion: a simulation from (q0, q̇0), run the same way in both passes
   const Motion simulate = [&](World& world, const std::function<void(const World&)>& on_state) {
-    world.SetState(0, q0, qd0);
+    world.SetState(0, setup.q0, setup.qd0);
     on_state(world);
     return world.RunUntil(a.duration + 0.5 * a.dt, on_state);
   };
-  return RenderMotion(a, default_what, body, options, 0.0, a.duration, simulate);
+  return RenderMotion(a, default_what, setup.body, setup.options, 0.0, a.duration, simulate);
 }
 
 void CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {

@@ -99,16 +99,9 @@ int RunSimulate(const SimulateArgs& a) {
   }
 
   // the body and its world
-  const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
-  const Eigen::VectorXd q0 = ParseCoordinates(a.q, "--q", *body);
-  const Eigen::VectorXd qd0 = ParseCoordinates(a.qdot, "--qdot", *body);
-  WorldOptions options;
-  options.params = MakeWorldParams(a.world);
-  options.integrator = integrator;
-  options.dt = a.dt;
-  World world(options);
-  world.AddBody(body);
-  world.SetState(0, q0, qd0);
+  const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, integrator, a.dt);
+  const std::shared_ptr<const BodyModel>& body = setup.body;
+  World world = setup.MakeWorld();
   const Energies e0 = world.ComputeEnergies(0);
 
   // step, recording every Nth state and the deepest penetration
@@ -139,7 +132,7 @@ int RunSimulate(const SimulateArgs& a) {
   // (a fresh world at that state; its contact anchors restart at the entry points)
   std::unique_ptr<World> restored;
   if (!ok && (world.state(0).q != last_good.q || world.state(0).qd != last_good.qd)) {
-    restored = std::make_unique<World>(options);
+    restored = std::make_unique<World>(setup.options);
     restored->AddBody(body);
     restored->SetState(0, last_good.q, last_good.qd);
   }
@@ -152,11 +145,11 @@ int RunSimulate(const SimulateArgs& a) {
   // the summary: one paragraph, a sentence per line
   const BodyState<double>& s = final_world.state(0);
   const Energies e = final_world.ComputeEnergies(0);
-  const Ground& g = options.params.ground;
+  const Ground& g = setup.options.params.ground;
   std::ostringstream out;
   out << body->name() << ": " << body->num_points() << " mass points, " << body->num_modes() << " modes; "
       << IntegratorName(integrator) << " integrator, dt " << Num(a.dt) << "; gravity "
-      << (options.params.gravity_on ? "on" : "off") << "; ";
+      << (setup.options.params.gravity_on ? "on" : "off") << "; ";
   if (g.enabled) {
     out << "ground through y = " << Num(g.point.y()) << " at " << Num(a.world.ground_slope_deg) << " deg.\n";
   } else {
