@@ -23,6 +23,7 @@
 #include <vtkRenderer.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkWindowToImageFilter.h>
 
 namespace wobble::pipelines {
 
@@ -160,20 +161,21 @@ struct InteractiveSceneView::Impl {
       }
   }
 
-  // The bodies now with room around them to move (a pendulum swings below its start).
+  // The bodies now with room around them to move by their own size every way (a pendulum
+  // let go from the horizontal swings through a circle of its length about its pivot).
   void FrameScene() {
     const Eigen::AlignedBox3d b = SceneBounds(world(), input.spec);
     const double size = std::max(1e-6, b.sizes().maxCoeff());
     if (IsFlat(world())) {
       Eigen::AlignedBox2d box(b.min().head<2>(), b.max().head<2>());
-      box.extend(box.min() - Eigen::Vector2d(0.25 * size, size));
-      box.extend(box.max() + Eigen::Vector2d(0.25 * size, 0.25 * size));
-      view->FrameBox(box);
+      box.extend(box.min() - Eigen::Vector2d::Constant(size));
+      box.extend(box.max() + Eigen::Vector2d::Constant(size));
+      view->FrameBox(box, 0.02);
     } else {
       Eigen::AlignedBox3d box = b;
-      box.extend(box.min() - Eigen::Vector3d(0.25, 1.0, 0.25) * size);
-      box.extend(box.max() + Eigen::Vector3d::Constant(0.25 * size));
-      view->FrameBox3d(box);
+      box.extend(box.min() - Eigen::Vector3d::Constant(0.5 * size));
+      box.extend(box.max() + Eigen::Vector3d::Constant(0.5 * size));
+      view->FrameBox3d(box, 0.02);
     }
   }
 
@@ -447,6 +449,18 @@ std::string InteractiveSceneView::StatusLine() const {
 vtkRenderWindow* InteractiveSceneView::window() { return impl_->view->window(); }
 vtkRenderWindowInteractor* InteractiveSceneView::interactor() { return impl_->interactor; }
 SceneView& InteractiveSceneView::scene() { return *impl_->view; }
-vtkSmartPointer<vtkImageData> InteractiveSceneView::Capture() { return impl_->view->Capture(); }
+// An on-screen window's back buffer is undefined after the swap: draw again and read it (as
+// InteractiveView does), not SceneView::Capture's read-back of an offscreen render.
+vtkSmartPointer<vtkImageData> InteractiveSceneView::Capture() {
+  auto grab = Ptr<vtkWindowToImageFilter>::New();
+  grab->SetInput(window());
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->ShouldRerenderOn();
+  grab->Update();
+  auto image = Ptr<vtkImageData>::New();
+  image->DeepCopy(grab->GetOutput());
+  return image;
+}
 
 }  // namespace wobble::pipelines
