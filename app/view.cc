@@ -146,6 +146,7 @@ CLI::App* AddViewCommand(CLI::App* app, ViewArgs* a) {
       "Examples:\n"
       "  wobble view data/table.obj --modes data/table_modes.def --q \"0 50 0 0 0 0 0\"\n"
       "  wobble view data/bounding_table.wob\n"
+      "  wobble view data/fig2_triple_pendulum.wob   (a Witkin & Welch scene: drag = trajectory constraint, a anchors)\n"
       "Keys: space play/pause, n step, r restart, +/- speed, s l m g p toggle shape/lattice/points/ground/springs,\n"
       "k record pose, w write session, Left/Right scrub, h help, q quit. Left mouse pulls a point.");
   return cmd;
