@@ -127,15 +127,7 @@ std::vector<std::string> RenderScene(const io::SceneRenderRequest& r) {
   out.view.azimuth = r.azimuth;
   out.view.elevation = r.elevation;
   out.view.title = r.name;
-  pipelines::ConstrainedSceneSpec spec;
-  spec.drawings = *r.drawings;
-  for (const control::Anchor& a : r.anchors) {
-    pipelines::AnchorSource::Anchor d;
-    d.name = a.name;
-    if (a.point) d.point = *a.point;
-    d.place = a.place;
-    spec.anchors.push_back(d);
-  }
+  const pipelines::ConstrainedSceneSpec spec = pipelines::SceneSpecOf(*r.drawings, r.anchors);
   if (!out.frames && !out.filmstrip && !out.vtp) return {};
   return pipelines::WriteSceneRun(*r.world, spec, *r.recorded, out);
 #else

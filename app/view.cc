@@ -9,7 +9,9 @@
 #include <vtkImageData.h>
 
 #include "pipelines/exports.h"
+#include "pipelines/interactive_scene_view.h"
 #include "pipelines/interactive_view.h"
+#include "pipelines/scene_run.h"
 #include "pipelines/scene_view.h"
 #include "wobble/io/script.h"
 
@@ -44,6 +46,59 @@ int ParseSide(const std::string& text, int* w, int* h) {
       *h < 240 || *w > 8192 || *h > 8192)
     throw UsageError("--size: expected WIDTHxHEIGHT of at least 320x240, such as 1280x720, got '" + text + "'");
   return 0;
+}
+
+// --report-fps: frames drawn per second, steps per frame, and whether the simulation kept up.
+void ReportFps(const pl::ViewerStats& s, const ViewArgs& a, double dt) {
+  const double fps = s.wall > 0 ? double(s.frames - 1) / s.wall : 0.0;
+  const double ratio = s.playing_wall > 0 ? s.simulated / s.playing_wall : 0.0;
+  std::printf("frames drawn: %ld in %.3f s wall: %.1f frames/s\n", s.frames, s.wall, fps);
+  std::printf("simulation steps: %ld, %.2f per drawn frame (dt %g s)\n", s.steps,
+              s.playing_frames ? double(s.steps) / double(s.playing_frames) : 0.0, dt);
+  if (a.fixed_frame_time)
+    std::printf("simulated %.3f s in %.3f s of wall time (--fixed-frame-time: each frame advances speed/fps, so "
+                "this is no real-time measurement)\n", s.simulated, s.playing_wall);
+  else
+    std::printf("simulated %.3f s in %.3f s of wall time playing at speed %g: %.3f x real time (%s)\n", s.simulated,
+                s.playing_wall, a.speed, ratio, ratio >= 0.98 * a.speed ? "keeps up" : "falls behind");
+}
+
+pl::ViewerOptions MakeViewerOptions(const ViewArgs& a, int width, int height) {
+  pl::ViewerOptions vo;
+  vo.width = width;
+  vo.height = height;
+  vo.fps = a.fps;
+  vo.speed = a.speed;
+  vo.fixed_frame_time = a.fixed_frame_time;
+  vo.charts = !a.no_charts;
+  vo.start_playing = !a.paused;
+  vo.slider_range = a.slider_range;
+  vo.drag_stiffness = a.drag_stiffness;
+  vo.session_path = a.session;
+  return vo;
+}
+
+// A script with a Witkin & Welch scene: its ConstrainedWorld live, stepped by the interpreter
+// (the queued behaviours act between steps as in `simul`).
+int ViewScene(io::Interpreter* interp, const ViewArgs& a, int width, int height) {
+  if (!a.save_session.empty()) throw UsageError("--save-session: sessions are saved for FFD objects, not for scenes");
+  const io::SceneRenderRequest drawing = interp->SceneDrawing();
+  pl::InteractiveSceneInput input;
+  input.world = interp->mutable_scene();
+  input.spec = pl::SceneSpecOf(*drawing.drawings, drawing.anchors);
+  input.azimuth = drawing.azimuth;
+  input.elevation = drawing.elevation;
+  input.step = [interp] { interp->StepScene(); };
+  pl::InteractiveSceneView view(std::move(input), MakeViewerOptions(a, width, height));
+  view.Run(a.frames, a.play_events, a.frames > 0);
+  if (!a.screenshot.empty()) pl::WritePng(a.screenshot, view.Capture());
+  if (a.report_fps) ReportFps(view.stats(), a, view.world().options().dt);
+  std::printf("t = %.6g, largest constraint violation %.3g\n", view.time(), view.world().MaxViolation());
+  if (!view.message().empty()) {
+    std::cerr << "wobble: simulation " << view.message() << std::endl;
+    return kExitSimStopped;
+  }
+  return kExitOk;
 }
 
 }  // namespace
@@ -91,6 +146,7 @@ CLI::App* AddViewCommand(CLI::App* app, ViewArgs* a) {
       "Examples:\n"
       "  wobble view data/table.obj --modes data/table_modes.def --q \"0 50 0 0 0 0 0\"\n"
       "  wobble view data/bounding_table.wob\n"
+      "  wobble view data/fig2_triple_pendulum.wob   (a Witkin & Welch scene: drag = trajectory constraint, a anchors)\n"
       "Keys: space play/pause, n step, r restart, +/- speed, s l m g p toggle shape/lattice/points/ground/springs,\n"
       "k record pose, w write session, Left/Right scrub, h help, q quit. Left mouse pulls a point.");
   return cmd;
@@ -121,6 +177,12 @@ int RunView(const ViewArgs& a) {
     io::Interpreter interp(std::cout);
     if (!a.object.empty()) interp.LoadObject(a.object);
     const int stop = RunScriptSetup(&interp, a.scene);
+    if (interp.scene() && interp.scene()->num_bodies() > 0) {
+      if (stop > 0)
+        std::cout << "wobble view: " << a.scene << " ran up to line " << stop
+                  << "; the viewer steps its scene from there\n";
+      return ViewScene(&interp, a, width, height);
+    }
     io::Interpreter::SimulationSetup setup = interp.CurrentSetup();
     if (!setup.body) throw UsageError(a.scene + ": the script loads no object (load_obj FILE, or --object FILE)");
     if (stop > 0)
@@ -151,37 +213,13 @@ int RunView(const ViewArgs& a) {
     for (const std::string& m : files.modes) scene.mode_paths.push_back(fs::absolute(m).string());
   }
 
-  pl::ViewerOptions vo;
-  vo.width = width;
-  vo.height = height;
-  vo.fps = a.fps;
-  vo.speed = a.speed;
-  vo.fixed_frame_time = a.fixed_frame_time;
-  vo.charts = !a.no_charts;
-  vo.start_playing = !a.paused;
-  vo.slider_range = a.slider_range;
-  vo.drag_stiffness = a.drag_stiffness;
-  vo.session_path = a.session;
-  pl::InteractiveView view(std::move(scene), vo);
+  pl::InteractiveView view(std::move(scene), MakeViewerOptions(a, width, height));
   view.Run(a.frames, a.play_events, a.frames > 0);
 
   if (!a.screenshot.empty()) pl::WritePng(a.screenshot, view.Capture());
   if (!a.save_session.empty())
     for (const std::string& f : view.SaveSession(a.save_session)) std::cout << "wrote " << f << "\n";
-  if (a.report_fps) {
-    const pl::ViewerStats& s = view.stats();
-    const double fps = s.wall > 0 ? double(s.frames - 1) / s.wall : 0.0;
-    const double ratio = s.playing_wall > 0 ? s.simulated / s.playing_wall : 0.0;
-    std::printf("frames drawn: %ld in %.3f s wall: %.1f frames/s\n", s.frames, s.wall, fps);
-    std::printf("simulation steps: %ld, %.2f per drawn frame (dt %g s)\n", s.steps,
-                s.playing_frames ? double(s.steps) / double(s.playing_frames) : 0.0, view.world().options().dt);
-    if (a.fixed_frame_time)
-      std::printf("simulated %.3f s in %.3f s of wall time (--fixed-frame-time: each frame advances speed/fps, so "
-                  "this is no real-time measurement)\n", s.simulated, s.playing_wall);
-    else
-      std::printf("simulated %.3f s in %.3f s of wall time playing at speed %g: %.3f x real time (%s)\n", s.simulated,
-                  s.playing_wall, a.speed, ratio, ratio >= 0.98 * a.speed ? "keeps up" : "falls behind");
-  }
+  if (a.report_fps) ReportFps(view.stats(), a, view.world().options().dt);
   std::printf("t = %.6g, q =", view.time());
   for (int i = 0; i < view.world().state(0).q.size(); ++i) std::printf(" %.17g", view.world().state(0).q[i]);
   std::printf("\n");

@@ -62,6 +62,19 @@ std::vector<BodyParts> MakeParts(const ConstrainedWorld& world, const Constraine
 
 }  // namespace
 
+ConstrainedSceneSpec SceneSpecOf(const std::vector<LinearDrawing>& drawings, const std::vector<control::Anchor>& anchors) {
+  ConstrainedSceneSpec spec;
+  spec.drawings = drawings;
+  for (const control::Anchor& a : anchors) {
+    AnchorSource::Anchor d;
+    d.name = a.name;
+    if (a.point) d.point = *a.point;
+    d.place = a.place;
+    spec.anchors.push_back(d);
+  }
+  return spec;
+}
+
 std::vector<std::string> WriteSceneRun(ConstrainedWorld& world, const ConstrainedSceneSpec& spec,
                                        const std::vector<control::SceneFrame>& frames, const SceneRunOutputs& out) {
   if (frames.empty()) throw std::invalid_argument("nothing was recorded: no frames to render");

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "pipelines/scene_view.h"
+#include "wobble/control/behaviours.h"
 #include "wobble/control/scene_recording.h"
 
 namespace wobble::pipelines {
@@ -33,6 +34,10 @@ struct SceneRunOutputs {
 // HasDisplay() (frames, filmstrip); vtp does not. The world is left in the state of the last
 // frame. Returns the paths written (the frame pattern once). Throws std::runtime_error on a
 // failed write and std::invalid_argument on an empty recording.
+// What a script's scene draws besides its bodies (`render` and `wobble view`): its drawings
+// and its named points (`point`, `place`) as anchors.
+ConstrainedSceneSpec SceneSpecOf(const std::vector<LinearDrawing>& drawings, const std::vector<control::Anchor>& anchors);
+
 std::vector<std::string> WriteSceneRun(ConstrainedWorld& world, const ConstrainedSceneSpec& spec,
                                        const std::vector<control::SceneFrame>& frames, const SceneRunOutputs& out);
 

@@ -100,7 +100,8 @@ struct SceneView::Impl {
   Ptr<vtkTextActor> overlay;
   vtkPolyDataMapper* colored = nullptr;  // the mapper that shows color_by, if any
   Ptr<vtkImageData> last_rgb;            // read back from the window after the last Render()
-  Ptr<vtkActor> layers[6];               // by SceneLayer
+  Ptr<vtkActor> layers[7];               // by SceneLayer (the FFD view: one actor a layer)
+  std::vector<Ptr<vtkActor>> clayers[7];  // by SceneLayer (a ConstrainedWorld's: one per body)
 
   Ptr<vtkActor> AddActor(vtkPolyDataAlgorithm* source, const double rgb[3], double line_width, double point_size,
                          Ptr<vtkPolyDataMapper>* mapper_out = nullptr) {
@@ -257,9 +258,10 @@ SceneView::SceneView(const ConstrainedWorld* world, ConstrainedSceneSpec spec, S
                points_rgb[3] = {0.85, 0.2, 0.15}, anchor_rgb[3] = {0.1, 0.55, 0.2};
   // in 2D the z offsets keep points above lines (as in the FFD view); in 3D depth decides
   const double z = flat ? 1.0 : 0.0;
-  auto add = [&](vtkPolyDataAlgorithm* src, const double rgb[3], double line_width, double point_size, double z_offset,
-                 bool lit = false) {
+  auto add = [&](SceneLayer layer, vtkPolyDataAlgorithm* src, const double rgb[3], double line_width,
+                 double point_size, double z_offset, bool lit = false) {
     Ptr<vtkActor> a = m.AddActor(src, rgb, line_width, point_size);
+    m.clayers[int(layer)].push_back(a);
     a->SetPosition(0, 0, z_offset * z);
     if (lit) a->GetProperty()->SetLighting(true);
     m.csources.push_back(src);
@@ -276,9 +278,9 @@ SceneView::SceneView(const ConstrainedWorld* world, ConstrainedSceneSpec spec, S
         s->SetWorld(&world->ffd_world());
         s->SetBody(world->ffd_index(b));
       }
-      if (options_.show_lattice) add(lattice, box_rgb, 1.0, options_.point_size * 0.75, 1);
-      if (options_.show_shape) add(shape, shape_rgb, options_.line_width, 1.0, 2);
-      if (options_.show_points) add(points, points_rgb, 1.0, options_.point_size, 3);
+      if (options_.show_lattice) add(SceneLayer::kLattice, lattice, box_rgb, 1.0, options_.point_size * 0.75, 1);
+      if (options_.show_shape) add(SceneLayer::kShape, shape, shape_rgb, options_.line_width, 1.0, 2);
+      if (options_.show_points) add(SceneLayer::kPoints, points, points_rgb, 1.0, options_.point_size, 3);
       continue;
     }
     auto box = Ptr<LinearBoxSource>::New();
@@ -287,7 +289,7 @@ SceneView::SceneView(const ConstrainedWorld* world, ConstrainedSceneSpec spec, S
       s->SetWorld(world);
       s->SetBody(b);
     }
-    if (options_.show_lattice) add(box, box_rgb, 1.0, options_.point_size * 0.75, 1);
+    if (options_.show_lattice) add(SceneLayer::kLattice, box, box_rgb, 1.0, options_.point_size * 0.75, 1);
     if (options_.show_shape && b < int(spec.drawings.size()) && spec.drawings[b].dim() != 0) {
       const LinearDrawing& d = spec.drawings[b];
       if (!d.triangles.empty()) {
@@ -297,22 +299,22 @@ SceneView::SceneView(const ConstrainedWorld* world, ConstrainedSceneSpec spec, S
         surface->SetBody(b);
         surface->SetDrawing(d);
         surface->SetLines(false);
-        add(surface, surface_rgb, 1.0, 1.0, 0.5, true)->GetProperty()->SetOpacity(0.55);
+        add(SceneLayer::kShape, surface, surface_rgb, 1.0, 1.0, 0.5, true)->GetProperty()->SetOpacity(0.55);
       }
       auto lines = Ptr<LinearShapeSource>::New();
       lines->SetWorld(world);
       lines->SetBody(b);
       lines->SetDrawing(d);
       lines->SetSurface(false);
-      add(lines, shape_rgb, options_.line_width, 1.0, 2);
+      add(SceneLayer::kShape, lines, shape_rgb, options_.line_width, 1.0, 2);
     }
-    if (options_.show_points) add(points, points_rgb, 1.0, options_.point_size, 3);
+    if (options_.show_points) add(SceneLayer::kPoints, points, points_rgb, 1.0, options_.point_size, 3);
   }
   if (!spec.anchors.empty()) {
     auto anchors = Ptr<AnchorSource>::New();
     anchors->SetWorld(world);
     anchors->SetAnchors(spec.anchors);
-    add(anchors, anchor_rgb, 1.0, options_.point_size * 1.6, 4);
+    add(SceneLayer::kAnchors, anchors, anchor_rgb, 1.0, options_.point_size * 1.6, 4);
   }
   SetUpOverlay();
   const Eigen::AlignedBox3d bounds = SceneBounds(*world, spec);
@@ -515,8 +517,15 @@ void SceneView::WriteExr(const std::string& path, BackgroundWriter* writer) {
   writer->Submit([path, w, h, compression, ch = CaptureRgbaDepth()] { WriteExrChannels(path, w, h, ch, compression); });
 }
 
-void SceneView::SetLayerVisible(SceneLayer layer, bool visible) { impl_->layers[int(layer)]->SetVisibility(visible); }
-bool SceneView::LayerVisible(SceneLayer layer) const { return impl_->layers[int(layer)]->GetVisibility() != 0; }
+void SceneView::SetLayerVisible(SceneLayer layer, bool visible) {
+  if (impl_->layers[int(layer)]) impl_->layers[int(layer)]->SetVisibility(visible);
+  for (vtkActor* a : impl_->clayers[int(layer)]) a->SetVisibility(visible);
+}
+bool SceneView::LayerVisible(SceneLayer layer) const {
+  if (impl_->layers[int(layer)]) return impl_->layers[int(layer)]->GetVisibility() != 0;
+  const auto& c = impl_->clayers[int(layer)];
+  return !c.empty() && c.front()->GetVisibility() != 0;  // a layer the view does not draw: hidden
+}
 
 void SceneView::SetWorld(const World* world) {
   if (!world || impl_->body >= world->num_bodies()) throw std::invalid_argument("SceneView::SetWorld: no such world/body");

@@ -62,8 +62,10 @@ struct ConstrainedSceneSpec {
   std::vector<AnchorSource::Anchor> anchors;  // named points, drawn as larger dots
 };
 
-// The layers a SceneView draws; each can be shown or hidden after construction.
-enum class SceneLayer { kGround, kLattice, kPoints, kShape, kSprings, kTrails };
+// The layers a SceneView draws; each can be shown or hidden after construction. A view of a
+// ConstrainedWorld has kLattice (control boxes, FFD lattices), kShape, kPoints and kAnchors
+// (named points); the FFD view has all but kAnchors.
+enum class SceneLayer { kGround, kLattice, kPoints, kShape, kSprings, kTrails, kAnchors };
 
 // A box holding every point of the body now: its deformed control points (by the convex-hull
 // property of the Bernstein/B-spline weights no point of the body lies outside them).

@@ -11,7 +11,11 @@
 //   - the key `l` hides the lattice (and the pixels of its colour go away);
 //   - the session script, run by the interpreter, ends in the viewer's state (1e-9), also
 //     with a pose graph from a script driving the targets and a slider taking over;
-//   - screenshots of the window against baselines (render_baseline.h).
+//   - screenshots of the window against baselines (render_baseline.h);
+//   - a Witkin & Welch scene (data/fig2_triple_pendulum.wob): the viewer steps the script's
+//     scene exactly as `simul` does (same state, 1e-12) with the nail holding; a drag picks the
+//     named point under the cursor and its trajectory constraint takes it to the cursor, and
+//     releasing removes the constraint; the key `a` hides the anchors (their pixels go away).
 // Without DISPLAY every test skips (VTK 9.1 needs X).
 #include <gtest/gtest.h>
 #include <vtkCommand.h>
@@ -25,7 +29,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "pipelines/interactive_scene_view.h"
 #include "pipelines/interactive_view.h"
+#include "pipelines/scene_run.h"
 #include "pipelines_test_util.h"
 #include "render_baseline.h"
 #include "wobble/io/script.h"
@@ -61,7 +67,7 @@ ViewerOptions TestOptions() {
 }
 
 // Plays events written in vtkInteractorEventRecorder's format into the view's interactor.
-void Play(InteractiveView* view, const std::string& events) {
+template <class View> void Play(View* view, const std::string& events) {
   auto recorder = vtkSmartPointer<vtkInteractorEventRecorder>::New();
   recorder->SetInteractor(view->interactor());
   recorder->ReadFromInputStringOn();
@@ -76,7 +82,7 @@ std::string Event(const char* name, double x, double y, char key = 0, const char
   return s.str();
 }
 
-void PressKey(InteractiveView* view, char key) {
+template <class View> void PressKey(View* view, char key) {
   vtkRenderWindowInteractor* i = view->interactor();
   i->SetKeyEventInformation(0, 0, key, 1, std::string(1, key).c_str());
   i->InvokeEvent(vtkCommand::KeyPressEvent);
@@ -366,6 +372,133 @@ TEST(InteractiveView, RecordedPosesBecomeACyclicPoseGraphScript) {
   EXPECT_GT(amplitudes[0][0], 0.0);  // bent toward +0.1 when recorded
   EXPECT_LT(amplitudes[1][0], amplitudes[0][0]);
   EXPECT_NEAR(interp.pose_graph().durations[0], 2.0, 0.011);  // 60 frames of 1/30 s
+}
+
+// Runs a scene script up to its first `simul`, as `wobble view` does.
+void RunUpToSimul(io::Interpreter* interp, const std::string& path) {
+  std::ifstream in(path);
+  ASSERT_TRUE(in) << path;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    std::istringstream words(line.substr(0, line.find('#')));
+    std::string first;
+    words >> first;
+    if (first == "simul") return;
+    interp->RunLine(line, path, number, kData);
+  }
+}
+
+InteractiveSceneInput SceneInput(io::Interpreter* interp) {
+  const io::SceneRenderRequest d = interp->SceneDrawing();
+  InteractiveSceneInput input;
+  input.world = interp->mutable_scene();
+  input.spec = SceneSpecOf(*d.drawings, d.anchors);
+  input.azimuth = d.azimuth;
+  input.elevation = d.elevation;
+  input.step = [interp] { interp->StepScene(); };
+  return input;
+}
+
+const std::string kFig2 = kData + "/fig2_triple_pendulum.wob";
+
+TEST(InteractiveSceneView, Fig2StepsTheScriptsSceneAsSimulDoes) {
+  REQUIRE_DISPLAY();
+  std::ostringstream log;
+  io::Interpreter interp(log);
+  RunUpToSimul(&interp, kFig2);
+  ASSERT_NE(interp.scene(), nullptr);
+  InteractiveSceneView view(SceneInput(&interp), TestOptions());
+  view.Initialize();
+  for (int k = 0; k < 30; ++k) view.Frame();  // 30 frames of 1/30 s: 1 s, 1000 steps of dt 0.001
+  EXPECT_NEAR(view.time(), 1.0, 1e-9);
+  EXPECT_EQ(view.stats().steps, 1000);
+  const int pivot = interp.SceneConstraint("pivot");
+  ASSERT_GE(pivot, 0);
+  EXPECT_LT(view.world().ConstraintError(pivot).norm(), 1e-4);
+  EXPECT_LT(view.world().MaxViolation(), 1e-4);
+  // the pendulum has swung down from the horizontal
+  EXPECT_LT(interp.ScenePoint("tip")[1], -0.5);
+  // an interpreter that runs `simul 1` itself ends in the same state
+  std::ostringstream log2;
+  io::Interpreter ref(log2);
+  RunUpToSimul(&ref, kFig2);
+  ref.RunLine("simul 1", "<test>", 1, kData);
+  for (const char* name : {"elbow1", "elbow2", "tip"})
+    EXPECT_LT((interp.ScenePoint(name) - ref.ScenePoint(name)).norm(), 1e-12) << name;
+}
+
+TEST(InteractiveSceneView, DragTakesThePickedPointToTheCursorAndReleaseRemovesIt) {
+  REQUIRE_DISPLAY();
+  std::ostringstream log;
+  io::Interpreter interp(log);
+  RunUpToSimul(&interp, kFig2);
+  InteractiveSceneView view(SceneInput(&interp), TestOptions());
+  view.Initialize();
+  // press on the tip (3, 0) and pull it to (2.5, -1), within reach of the nailed chain
+  const Eigen::Vector3d press = view.WorldToDisplay(interp.ScenePoint("tip"));
+  const Eigen::Vector3d cursor_px = view.WorldToDisplay(Vec({2.5, -1.0}));
+  Play(&view, Event("MouseMoveEvent", press.x(), press.y()) + Event("LeftButtonPressEvent", press.x(), press.y()) +
+                  Event("MouseMoveEvent", cursor_px.x(), cursor_px.y()));
+  ASSERT_TRUE(view.dragged_point().has_value()) << "the press did not pick a point";
+  const int id = view.drag_constraint();
+  ASSERT_GE(id, 0);
+  EXPECT_EQ(view.world().constraint_kind(id), ConstraintKind::kTrajectory);
+  const MaterialPoint picked = *view.dragged_point();
+  EXPECT_LT((view.world().PointPosition(picked) - interp.ScenePoint("tip")).norm(), 1e-12) << "not the tip";
+  const Eigen::VectorXd target = view.drag_target();
+  EXPECT_LT((target - Vec({2.5, -1.0})).norm(), 0.02) << "the cursor in the world: " << target.transpose();
+  const double before = (view.world().PointPosition(picked) - target).norm();
+  std::string frames;
+  for (int k = 0; k < 15; ++k) frames += Event("TimerEvent", cursor_px.x(), cursor_px.y());
+  Play(&view, frames);
+  const double after = (view.world().PointPosition(picked) - target).norm();
+  // the chain starts at rest, so the path is n(s) = c + A (1 + s/tau) e^(-s/tau) with
+  // |A| = before (interactive_scene_view.cc); after 15 frames (s = 0.5 s) the point is on it
+  const double s = 0.5, tau = InteractiveSceneView::kDragTime;
+  EXPECT_GT(before, 0.9);
+  EXPECT_NEAR(after, before * (1.0 + s / tau) * std::exp(-s / tau), 1e-4) << before << " -> " << after;
+  EXPECT_LT(view.world().MaxViolation(), 1e-3);  // the nail and the joints hold meanwhile
+  Play(&view, Event("LeftButtonReleaseEvent", cursor_px.x(), cursor_px.y()));
+  EXPECT_FALSE(view.dragged_point().has_value());
+  EXPECT_EQ(view.drag_constraint(), -1);
+  EXPECT_FALSE(view.world().exists(id));
+  // the chain falls again once let go
+  const double y = view.world().PointPosition(picked)[1];
+  Play(&view, frames);
+  EXPECT_LT(view.world().PointPosition(picked)[1], y - 0.05);
+}
+
+// Pixels of the whole window within 20 (of 255) of a colour.
+long CountColourEverywhere(vtkImageData* image, double r, double g, double b) {
+  int dims[3];
+  image->GetDimensions(dims);
+  long n = 0;
+  for (int y = 0; y < dims[1]; ++y)
+    for (int x = 0; x < dims[0]; ++x) {
+      const auto* p = static_cast<const unsigned char*>(image->GetScalarPointer(x, y, 0));
+      if (std::abs(p[0] - r * 255) < 20 && std::abs(p[1] - g * 255) < 20 && std::abs(p[2] - b * 255) < 20) ++n;
+    }
+  return n;
+}
+
+TEST(InteractiveSceneView, KeyTogglesTheAnchors) {
+  REQUIRE_DISPLAY();
+  std::ostringstream log;
+  io::Interpreter interp(log);
+  RunUpToSimul(&interp, kFig2);
+  InteractiveSceneView view(SceneInput(&interp), TestOptions());
+  view.Initialize();
+  view.Frame();
+  const double green[3] = {0.1, 0.55, 0.2};  // the anchors' colour (scene_view.cc)
+  EXPECT_TRUE(view.LayerVisible(SceneLayer::kAnchors));
+  const long shown = CountColourEverywhere(view.Capture(), green[0], green[1], green[2]);
+  EXPECT_GT(shown, 20);
+  PressKey(&view, 'a');
+  EXPECT_FALSE(view.LayerVisible(SceneLayer::kAnchors));
+  EXPECT_LT(CountColourEverywhere(view.Capture(), green[0], green[1], green[2]), shown / 10);
+  PressKey(&view, 'a');
+  EXPECT_TRUE(view.LayerVisible(SceneLayer::kAnchors));
+  EXPECT_EQ(CountColourEverywhere(view.Capture(), green[0], green[1], green[2]), shown);
 }
 
 }  // namespace

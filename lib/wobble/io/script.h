@@ -149,6 +149,17 @@ class Interpreter {
   // The constraint id of a name (`nail`, `attach`, `connect`, ...), or -1.
   int SceneConstraint(const std::string& name) const;
   const std::vector<control::SceneFrame>& recorded_frames() const;
+  // For clients that step the scene themselves (`wobble view`): one step as `simul` takes it
+  // (the script's dt, gravity and ground; the queued behaviours act, then the world steps;
+  // behaviour messages go to `out`). Throws SimulationStopped when the world stops,
+  // control::BehaviourError when a behaviour cannot act, std::logic_error without a scene.
+  void StepScene();
+  // The scene's world, for such clients to add their own constraints (a mouse drag); nullptr
+  // without a scene.
+  ConstrainedWorld* mutable_scene();
+  // What `render` draws of the scene: world, drawings, named points and camera angles (no
+  // folder, no recorded frames). std::logic_error without a scene.
+  SceneRenderRequest SceneDrawing();
 
  private:
   struct Context;
@@ -159,6 +170,11 @@ class Interpreter {
   bool ExecuteScene(const std::vector<std::string>& words, const Context& ctx);
   // `set` of a scene parameter; false when the name is not one.
   bool SetSceneParameter(const std::string& name, const std::string& value, const Context& ctx);
+  // The script's dt, gravity and ground onto the scene's world (before stepping it).
+  void SyncSceneOptions();
+  // One step of the scene: behaviours (may throw control::BehaviourError), then the world.
+  // False when the world stopped.
+  bool SceneStep(const std::function<void(const std::string&)>& log);
   Scene& EnsureScene();
   void Set(const std::vector<std::string>& words, const Context& ctx);
   void RequireBody(const Context& ctx, const std::string& command);

@@ -84,6 +84,46 @@ int Interpreter::SceneConstraint(const std::string& name) const {
   return it == scene_->constraints.end() || !scene_->world.exists(it->second) ? -1 : it->second;
 }
 
+ConstrainedWorld* Interpreter::mutable_scene() { return scene_ ? &scene_->world : nullptr; }
+
+SceneRenderRequest Interpreter::SceneDrawing() {
+  if (!scene_) throw std::logic_error("SceneDrawing: the script made no scene");
+  SceneRenderRequest req;
+  req.azimuth = scene_->azimuth;
+  req.elevation = scene_->elevation;
+  req.world = &scene_->world;
+  req.drawings = &scene_->drawings;
+  for (const auto& [name, a] : scene_->anchors) req.anchors.push_back(a);
+  return req;
+}
+
+void Interpreter::SyncSceneOptions() {
+  // the interpreter's parameters apply to the scene's world (gravity and the ground are read
+  // from the parameters of the world that holds its FFD bodies, for linear bodies too)
+  ConstrainedWorld& world = scene_->world;
+  world.options().dt = world_.dt;
+  world.options().params.gravity_on = world_.params.gravity_on;
+  world.ffd_world().params().gravity_on = world_.params.gravity_on;
+  world.ffd_world().params().ground = world_.params.ground;
+}
+
+bool Interpreter::SceneStep(const std::function<void(const std::string&)>& log) {
+  Scene& s = *scene_;
+  control::BehaviourContext bctx{&s.world, &s.constraints};
+  s.sequencer.BeforeStep(bctx, log);
+  // names made by behaviours are no longer promised
+  for (const auto& kv : s.constraints) s.promised.erase(kv.first);
+  return s.world.Step();
+}
+
+void Interpreter::StepScene() {
+  if (!scene_ || scene_->world.num_bodies() == 0) throw std::logic_error("StepScene: the script made no scene");
+  SyncSceneOptions();
+  if (!SceneStep([&](const std::string& line) { out_ << "  " << line << "\n"; }))
+    throw SimulationStopped("simulation stopped: " + scene_->world.status().message);
+  time_ = scene_->world.time();
+}
+
 const std::vector<control::SceneFrame>& Interpreter::recorded_frames() const {
   static const std::vector<control::SceneFrame> none;
   return scene_ ? scene_->frames : none;
@@ -417,11 +457,12 @@ bool Interpreter::ExecuteScene(const std::vector<std::string>& w, const Context&
     }
     if (s.frames.empty()) ctx.Fail("nothing was recorded: 'record FPS' before 'simul'");
     if (!scene_render_hook_) ctx.Fail("render: this program cannot draw (wobble run draws through pipelines/, built with VTK)");
-    req.azimuth = s.azimuth;
-    req.elevation = s.elevation;
-    req.world = &world;
-    req.drawings = &s.drawings;
-    for (const auto& [name, a] : s.anchors) req.anchors.push_back(a);
+    const SceneRenderRequest drawing = SceneDrawing();
+    req.azimuth = drawing.azimuth;
+    req.elevation = drawing.elevation;
+    req.world = drawing.world;
+    req.drawings = drawing.drawings;
+    req.anchors = drawing.anchors;
     req.recorded = &s.frames;
     const control::SceneFrame now = control::CaptureFrame(world);
     std::vector<std::string> files;
@@ -439,12 +480,7 @@ bool Interpreter::ExecuteScene(const std::vector<std::string>& w, const Context&
     double duration = end_ - world.time();
     if (w.size() == 2) duration = NonNegative(w[1], "DURATION", ctx);
     else if (duration < 0) ctx.Fail("end (" + Num(end_) + ") is before the scene's time (" + Num(world.time()) + ")");
-    // the interpreter's parameters apply to the scene's world (gravity and the ground are read
-    // from the parameters of the world that holds its FFD bodies, for linear bodies too)
-    world.options().dt = world_.dt;
-    world.options().params.gravity_on = world_.params.gravity_on;
-    world.ffd_world().params().gravity_on = world_.params.gravity_on;
-    world.ffd_world().params().ground = world_.params.ground;
+    SyncSceneOptions();
     const double dt = world_.dt;
     const long steps = std::lround(duration / dt);
     // explicit stepping of stiff energies on a thin body blows up: say so before it does
@@ -466,14 +502,13 @@ bool Interpreter::ExecuteScene(const std::vector<std::string>& w, const Context&
     };
     record();
     for (long n = 0; n < steps; ++n) {
+      bool stepped = false;
       try {
-        s.sequencer.BeforeStep(bctx, log);
+        stepped = SceneStep(log);
       } catch (const control::BehaviourError& e) {
         ctx.Fail(std::string("at t = ") + Num(world.time()) + ": " + e.what());
       }
-      // names made by behaviours are no longer promised
-      for (const auto& kv : s.constraints) s.promised.erase(kv.first);
-      if (!world.Step())
+      if (!stepped)
         throw SimulationStopped(ctx.file + ":" + std::to_string(ctx.line) + ": simulation stopped: " + world.status().message);
       record();
       if (progress_ && (n % 64 == 0 || n + 1 == steps)) progress_(double(n + 1) / double(steps), world.time());
