@@ -115,7 +115,7 @@ TEST(LinearBody, FreeFallIsUniform3D) {
   // symplectic Euler: y_n = −g h² n(n+1)/2
   const double n = 1000, h = 1e-3;
   const double expected = -9.81 * h * h * n * (n + 1) / 2;
-  for (const Eigen::Vector3d u : {Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(-1, 0.3, 0.2)}) {
+  for (const Eigen::Vector3d& u : {Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(-1, 0.3, 0.2)}) {
     const Eigen::VectorXd x = world.PointPosition(At(b, u));
     EXPECT_NEAR(x[1] - u[1], expected, 1e-9);
     EXPECT_NEAR(x[0], u[0], 1e-12);
