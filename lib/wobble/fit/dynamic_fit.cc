@@ -3,7 +3,6 @@
 #include <ceres/ceres.h>
 #include <ceres/dynamic_autodiff_cost_function.h>
 
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -349,14 +348,7 @@ DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<i
   options.function_tolerance = 1e-14;
   options.gradient_tolerance = 1e-16;
   options.parameter_tolerance = 1e-12;
-  options.logging_type = ceres::SILENT;
-  IterationForwarder forward(o.on_iteration);
-  forward.Attach(&options);
-  ceres::Solver::Summary summary;
-  const auto t0 = std::chrono::steady_clock::now();
-  ceres::Solve(options, &problem, &summary);
-  FillReport(summary, o.full_report, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-             &result.report);
+  SolveAndReport(options, &problem, o.on_iteration, o.full_report, &result.report);
   result.params = blocks.To(G);
   const double c = DynamicCost(body, frames, result.params, o);
   result.rms_residual = std::sqrt(2.0 * c / (ref.num_residuals / 2));

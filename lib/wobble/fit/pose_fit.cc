@@ -4,7 +4,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>

@@ -61,13 +61,18 @@ void SolvePoseProblem(const PoseFitOptions& o, ceres::Problem* problem, FitRepor
   options.function_tolerance = 1e-12;
   options.gradient_tolerance = 1e-14;
   options.parameter_tolerance = 1e-12;
+  SolveAndReport(options, problem, o.on_iteration, o.full_report, report);
+}
+
+void SolveAndReport(ceres::Solver::Options options, ceres::Problem* problem,
+                    const std::function<void(int, double)>& on_iteration, bool full_report, FitReport* report) {
   options.logging_type = ceres::SILENT;
-  IterationForwarder forward(o.on_iteration);
+  IterationForwarder forward(on_iteration);
   forward.Attach(&options);
   ceres::Solver::Summary summary;
   const auto start = std::chrono::steady_clock::now();
   ceres::Solve(options, problem, &summary);
-  FillReport(summary, o.full_report, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+  FillReport(summary, full_report, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
              report);
 }
 

@@ -47,6 +47,10 @@ class IterationForwarder : public ceres::IterationCallback {
 // Copies what people need from a Ceres summary.
 void FillReport(const ceres::Solver::Summary& summary, bool full, double seconds, FitReport* report);
 
+// Every fit's last move: silent logging, on_iteration attached, ceres::Solve timed, the report filled.
+void SolveAndReport(ceres::Solver::Options options, ceres::Problem* problem,
+                    const std::function<void(int, double)>& on_iteration, bool full_report, FitReport* report);
+
 // Solves a pose problem built by the caller (dense normal equations, the fit's tolerances).
 void SolvePoseProblem(const PoseFitOptions& o, ceres::Problem* problem, FitReport* report);
 

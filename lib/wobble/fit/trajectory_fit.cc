@@ -1,6 +1,5 @@
 #include "wobble/fit/trajectory_fit.h"
 
-#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -118,16 +117,9 @@ TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vec
   options.function_tolerance = 1e-12;
   options.gradient_tolerance = 1e-14;
   options.parameter_tolerance = 1e-12;
-  options.logging_type = ceres::SILENT;
-  IterationForwarder forward(po.on_iteration);
-  forward.Attach(&options);
   result.linear_solver = std::string("SPARSE_NORMAL_CHOLESKY/") +
                          ceres::SparseLinearAlgebraLibraryTypeToString(options.sparse_linear_algebra_library_type);
-  ceres::Solver::Summary summary;
-  const auto start = std::chrono::steady_clock::now();
-  ceres::Solve(options, &problem, &summary);
-  FillReport(summary, po.full_report, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-             &result.report);
+  SolveAndReport(options, &problem, po.on_iteration, po.full_report, &result.report);
 
   // residuals per frame
   double sum = 0;
