@@ -4,14 +4,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <stdexcept>
 
 #include <vtkActor.h>
 #include <vtkCellArray.h>
 #include <vtkImageData.h>
-#include <vtkInteractorEventRecorder.h>
 #include <vtkInteractorStyleImage.h>
 #include <vtkObjectFactory.h>
 #include <vtkPoints.h>
@@ -28,7 +26,6 @@
 namespace wobble::pipelines {
 
 template <class T> using Ptr = vtkSmartPointer<T>;
-using Clock = std::chrono::steady_clock;
 
 namespace {
 
@@ -128,12 +125,8 @@ struct InteractiveSceneView::Impl {
   std::shared_ptr<const ApproachPath> drag_path;
   bool playing = true;
   double speed = 1.0;
-  double sim_goal = 0.0;
   std::string message;
-  ViewerStats stats;
-  Clock::time_point first_frame, last_frame;
-  bool have_frame = false;
-  long max_frames = 0;
+  FramePacer pacer;  // frame clock, the simulated time asked for, measurements
   bool initialized = false;
 
   ConstrainedWorld& world() { return *input.world; }
@@ -147,18 +140,12 @@ struct InteractiveSceneView::Impl {
       std::cerr << "wobble view: " << message << std::endl;
       return false;
     }
-    ++stats.steps;
+    ++pacer.stats.steps;
     return true;
   }
 
   void Advance(double duration) {
-    sim_goal += duration;
-    const double dt = world().options().dt;
-    while (world().time() + 0.5 * dt < sim_goal)
-      if (!StepWorld()) {
-        sim_goal = world().time();
-        return;
-      }
+    pacer.Advance(duration, world().options().dt, [&] { return world().time(); }, [&] { return StepWorld(); });
   }
 
   // The bodies now with room around them to move by their own size every way (a pendulum
@@ -223,7 +210,7 @@ InteractiveSceneView::InteractiveSceneView(InteractiveSceneInput input, ViewerOp
   m.options = options;
   m.speed = options.speed;
   m.playing = options.start_playing;
-  m.sim_goal = m.world().time();
+  m.pacer.SetGoal(m.world().time());
 
   // render's drawing path (scene_run.h's view options), on screen
   SceneOptions so;
@@ -271,20 +258,9 @@ InteractiveSceneView::~InteractiveSceneView() {
 
 void InteractiveSceneView::Run(long max_frames, const std::string& events_file, bool keep_open) {
   Impl& m = *impl_;
-  m.max_frames = max_frames;
+  m.pacer.max_frames = max_frames;
   Initialize();
-  if (!events_file.empty()) {
-    if (!std::filesystem::exists(events_file)) throw std::invalid_argument(events_file + ": no such events file");
-    auto recorder = Ptr<vtkInteractorEventRecorder>::New();
-    recorder->SetInteractor(m.interactor);
-    recorder->SetFileName(events_file.c_str());
-    recorder->Play();
-    recorder->Off();
-    if (!keep_open) return;
-  }
-  if (max_frames > 0 && m.stats.frames >= max_frames) return;
-  m.interactor->CreateRepeatingTimer(std::max(1UL, (unsigned long)std::lround(1000.0 / m.options.fps)));
-  m.interactor->Start();
+  RunViewerLoop(m.interactor, m.options.fps, m.pacer, events_file, keep_open);
 }
 
 void InteractiveSceneView::Initialize() {
@@ -297,25 +273,16 @@ void InteractiveSceneView::Initialize() {
 
 void InteractiveSceneView::Frame() {
   Impl& m = *impl_;
-  const Clock::time_point now = Clock::now();
-  const double since = m.have_frame ? std::chrono::duration<double>(now - m.last_frame).count() : 1.0 / m.options.fps;
-  if (!m.have_frame) m.first_frame = now;
-  m.have_frame = true;
-  m.last_frame = now;
+  const double frame_time = m.pacer.BeginFrame(m.options.fps, m.options.fixed_frame_time);
   if (m.playing) {
-    const double frame_time = m.options.fixed_frame_time ? 1.0 / m.options.fps : std::min(since, kMaxFrameTime);
     const double before = m.world().time();
     m.Advance(m.speed * frame_time);
-    m.stats.simulated += m.world().time() - before;
-    if (m.stats.frames > 0) m.stats.playing_wall += since;
-    ++m.stats.playing_frames;
+    m.pacer.Played(m.world().time() - before);
   }
   m.UpdateDragLine();
   m.UpdateStatus();
   m.view->Render();
-  ++m.stats.frames;
-  m.stats.wall = std::chrono::duration<double>(m.last_frame - m.first_frame).count();
-  if (m.max_frames > 0 && m.stats.frames >= m.max_frames) m.interactor->TerminateApp();
+  if (m.pacer.EndFrame()) m.interactor->TerminateApp();
 }
 
 bool InteractiveSceneView::HandleKey(const std::string& k) {
@@ -346,7 +313,7 @@ bool InteractiveSceneView::playing() const { return impl_->playing; }
 void InteractiveSceneView::StepOnce() {
   Impl& m = *impl_;
   m.playing = false;
-  if (m.StepWorld()) m.sim_goal = m.world().time();
+  if (m.StepWorld()) m.pacer.SetGoal(m.world().time());
   m.UpdateDragLine();
 }
 
@@ -435,7 +402,7 @@ Eigen::VectorXd InteractiveSceneView::drag_target() const {
 
 const ConstrainedWorld& InteractiveSceneView::world() const { return *impl_->input.world; }
 double InteractiveSceneView::time() const { return impl_->input.world->time(); }
-const ViewerStats& InteractiveSceneView::stats() const { return impl_->stats; }
+const ViewerStats& InteractiveSceneView::stats() const { return impl_->pacer.stats; }
 const std::string& InteractiveSceneView::message() const { return impl_->message; }
 
 std::string InteractiveSceneView::StatusLine() const {

@@ -44,7 +44,7 @@ struct InteractiveSceneInput {
 
 class InteractiveSceneView {
  public:
-  static constexpr double kMaxFrameTime = InteractiveView::kMaxFrameTime;
+  static constexpr double kMaxFrameTime = FramePacer::kMaxFrameTime;
   // Time constant (s) of the path that takes a dragged point to the cursor.
   static constexpr double kDragTime = 0.08;
 

@@ -35,7 +35,6 @@
 namespace wobble::pipelines {
 
 template <class T> using Ptr = vtkSmartPointer<T>;
-using Clock = std::chrono::steady_clock;
 
 namespace {
 
@@ -156,7 +155,6 @@ struct InteractiveView::Impl {
   // state of the session
   bool playing = true, scrubbing = false, graph_drives = false;
   double speed = 1.0;
-  double sim_goal = 0.0;  // the live world's time the frames have asked for
   Eigen::VectorXd targets;
   long session_steps = 0;
   std::vector<io::SessionRecord::Segment> segments;
@@ -174,11 +172,7 @@ struct InteractiveView::Impl {
   std::vector<Recorded> history;
   long scrub_frame = -1;
   std::string message;  // one line shown under the status (saved files, trouble)
-  // measurements
-  ViewerStats stats;
-  Clock::time_point first_frame, last_frame;
-  bool have_frame = false;
-  long max_frames = 0;
+  FramePacer pacer;  // frame clock, the simulated time asked for, measurements
   bool initialized = false;
 
   void NewWorld() {
@@ -186,7 +180,7 @@ struct InteractiveView::Impl {
     world->AddBody(scene.body);
     world->SetState(0, scene.q0, scene.qd0);
     if (targets.size()) world->SetModeTargets(0, targets);
-    sim_goal = 0.0;
+    pacer.SetGoal(0.0);
     session_steps = 0;
     segments.clear();
     if (targets.size()) segments.push_back({0, targets});
@@ -227,18 +221,12 @@ struct InteractiveView::Impl {
       return false;
     }
     ++session_steps;
-    ++stats.steps;
+    ++pacer.stats.steps;
     return true;
   }
 
   void Advance(double duration) {
-    sim_goal += duration;
-    const double dt = scene.world.dt;
-    while (world->time() + 0.5 * dt < sim_goal)
-      if (!StepWorld()) {
-        sim_goal = world->time();
-        return;
-      }
+    pacer.Advance(duration, scene.world.dt, [&] { return world->time(); }, [&] { return StepWorld(); });
   }
 
   void RecordFrame() {
@@ -458,22 +446,48 @@ InteractiveView::~InteractiveView() {
   if (impl_->time_slider) impl_->time_slider->EnabledOff();
 }
 
-void InteractiveView::Run(long max_frames, const std::string& events_file, bool keep_open) {
-  Impl& m = *impl_;
-  m.max_frames = max_frames;
-  Initialize();
+double FramePacer::BeginFrame(double fps, bool fixed_frame_time) {
+  const auto now = std::chrono::steady_clock::now();
+  since_ = have_frame_ ? std::chrono::duration<double>(now - last_).count() : 1.0 / fps;
+  if (!have_frame_) first_ = now;
+  have_frame_ = true;
+  last_ = now;
+  return fixed_frame_time ? 1.0 / fps : std::min(since_, kMaxFrameTime);
+}
+
+void FramePacer::Played(double simulated) {
+  stats.simulated += simulated;
+  if (stats.frames > 0) stats.playing_wall += since_;
+  ++stats.playing_frames;
+}
+
+bool FramePacer::EndFrame() {
+  ++stats.frames;
+  stats.wall = std::chrono::duration<double>(last_ - first_).count();
+  return max_frames > 0 && stats.frames >= max_frames;
+}
+
+void RunViewerLoop(vtkRenderWindowInteractor* interactor, double fps, const FramePacer& pacer,
+                   const std::string& events_file, bool keep_open) {
   if (!events_file.empty()) {
     if (!std::filesystem::exists(events_file)) throw std::invalid_argument(events_file + ": no such events file");
     auto recorder = Ptr<vtkInteractorEventRecorder>::New();
-    recorder->SetInteractor(m.interactor);
+    recorder->SetInteractor(interactor);
     recorder->SetFileName(events_file.c_str());
     recorder->Play();
     recorder->Off();
     if (!keep_open) return;
   }
-  if (max_frames > 0 && m.stats.frames >= max_frames) return;
-  m.interactor->CreateRepeatingTimer(std::max(1UL, (unsigned long)std::lround(1000.0 / m.options.fps)));
-  m.interactor->Start();
+  if (pacer.max_frames > 0 && pacer.stats.frames >= pacer.max_frames) return;
+  interactor->CreateRepeatingTimer(std::max(1UL, (unsigned long)std::lround(1000.0 / fps)));
+  interactor->Start();
+}
+
+void InteractiveView::Run(long max_frames, const std::string& events_file, bool keep_open) {
+  Impl& m = *impl_;
+  m.pacer.max_frames = max_frames;
+  Initialize();
+  RunViewerLoop(m.interactor, m.options.fps, m.pacer, events_file, keep_open);
 }
 
 void InteractiveView::Initialize() {
@@ -486,27 +500,18 @@ void InteractiveView::Initialize() {
 
 void InteractiveView::Frame() {
   Impl& m = *impl_;
-  const Clock::time_point now = Clock::now();
-  const double since = m.have_frame ? std::chrono::duration<double>(now - m.last_frame).count() : 1.0 / m.options.fps;
-  if (!m.have_frame) m.first_frame = now;
-  m.have_frame = true;
-  m.last_frame = now;
+  const double frame_time = m.pacer.BeginFrame(m.options.fps, m.options.fixed_frame_time);
   if (m.playing && !m.scrubbing) {
-    const double frame_time = m.options.fixed_frame_time ? 1.0 / m.options.fps : std::min(since, kMaxFrameTime);
     const double before = m.world->time();
     m.Advance(m.speed * frame_time);
-    m.stats.simulated += m.world->time() - before;
-    if (m.stats.frames > 0) m.stats.playing_wall += since;
-    ++m.stats.playing_frames;
+    m.pacer.Played(m.world->time() - before);
     m.RecordFrame();
   }
   m.UpdateTimeSlider();
-  if (m.options.chart_every > 0 && m.stats.frames % m.options.chart_every == 0) m.UpdateCharts();
+  if (m.options.chart_every > 0 && m.pacer.stats.frames % m.options.chart_every == 0) m.UpdateCharts();
   m.UpdateStatus();
   m.view->Render();
-  ++m.stats.frames;
-  m.stats.wall = std::chrono::duration<double>(m.last_frame - m.first_frame).count();
-  if (m.max_frames > 0 && m.stats.frames >= m.max_frames) m.interactor->TerminateApp();
+  if (m.pacer.EndFrame()) m.interactor->TerminateApp();
 }
 
 bool InteractiveView::HandleKey(const std::string& k) {
@@ -570,7 +575,7 @@ void InteractiveView::StepOnce() {
     m.view->SetWorld(m.world.get());
   }
   if (m.StepWorld()) {
-    m.sim_goal = m.world->time();
+    m.pacer.SetGoal(m.world->time());
     m.RecordFrame();
   }
 }
@@ -726,7 +731,7 @@ const World& InteractiveView::world() const { return *impl_->world; }
 double InteractiveView::time() const { return impl_->scene.t0 + impl_->world->time(); }
 long InteractiveView::num_recorded_frames() const { return long(impl_->history.size()); }
 long InteractiveView::session_steps() const { return impl_->session_steps; }
-const ViewerStats& InteractiveView::stats() const { return impl_->stats; }
+const ViewerStats& InteractiveView::stats() const { return impl_->pacer.stats; }
 
 std::string InteractiveView::StatusLine() const {
   const Impl& m = *impl_;
@@ -740,9 +745,9 @@ std::string InteractiveView::StatusLine() const {
     s = "t = " + Fmt("%.3f s", time()) + "   E = " + Fmt("%.5g", e.total()) + " (kin " + Fmt("%.3g", e.kinetic) +
         ")\n" + (m.playing ? "playing" : "paused") + "   speed x" + Fmt("%g", m.speed);
     // measured rates only on the wall clock's runs: fixed-time runs draw the same pixels every time
-    if (!m.options.fixed_frame_time && m.stats.playing_wall > 0 && m.stats.playing_frames > 1)
-      s += "   " + Fmt("%.1f frames/s", (m.stats.playing_frames - 1) / m.stats.playing_wall) + ", " +
-           Fmt("%.1f steps/frame", double(m.stats.steps) / double(std::max(1L, m.stats.playing_frames)));
+    if (!m.options.fixed_frame_time && m.pacer.stats.playing_wall > 0 && m.pacer.stats.playing_frames > 1)
+      s += "   " + Fmt("%.1f frames/s", (m.pacer.stats.playing_frames - 1) / m.pacer.stats.playing_wall) + ", " +
+           Fmt("%.1f steps/frame", double(m.pacer.stats.steps) / double(std::max(1L, m.pacer.stats.playing_frames)));
     if (m.drag_spring >= 0) s += "   pulling";
   }
   if (!m.message.empty()) s += "\n" + m.message;

@@ -25,6 +25,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -83,9 +84,50 @@ struct ViewerStats {
   long playing_frames = 0;    // frames drawn while playing
 };
 
-class InteractiveView {
+// The real-time bookkeeping both viewers share (InteractiveView, InteractiveSceneView): the
+// frame clock, how much simulated time a frame asks for, stepping toward it, and the
+// statistics that --report-fps prints. Each viewer keeps its own world and step.
+class FramePacer {
  public:
   static constexpr double kMaxFrameTime = 0.25;  // a slow frame advances at most this (s)
+
+  // Starts a frame: the time it stands for, 1/fps with fixed_frame_time, otherwise the wall
+  // time since the last frame (at most kMaxFrameTime).
+  double BeginFrame(double fps, bool fixed_frame_time);
+  // Asks for `duration` more simulated time and steps toward it: step() takes one step of dt
+  // and returns false on trouble, which ends the request at the world's time, time().
+  template <class Time, class Step> void Advance(double duration, double dt, Time&& time, Step&& step) {
+    goal_ += duration;
+    while (time() + 0.5 * dt < goal_)
+      if (!step()) {
+        goal_ = time();
+        return;
+      }
+  }
+  void SetGoal(double t) { goal_ = t; }  // after a restart or a single step
+  // The frame advanced the world by `simulated` seconds while playing.
+  void Played(double simulated);
+  // Ends the frame; true once max_frames (> 0) frames have been drawn.
+  bool EndFrame();
+
+  ViewerStats stats;
+  long max_frames = 0;
+
+ private:
+  std::chrono::steady_clock::time_point first_, last_;
+  bool have_frame_ = false;
+  double since_ = 0.0;  // wall time of the current frame
+  double goal_ = 0.0;   // the world time the frames have asked for
+};
+
+// Both viewers' event loop: plays the events file (vtkInteractorEventRecorder format) first and
+// returns unless keep_open; otherwise runs the repeating timer at fps until quit or max_frames.
+void RunViewerLoop(vtkRenderWindowInteractor* interactor, double fps, const FramePacer& pacer,
+                   const std::string& events_file, bool keep_open);
+
+class InteractiveView {
+ public:
+  static constexpr double kMaxFrameTime = FramePacer::kMaxFrameTime;
 
   InteractiveView(ViewerScene scene, ViewerOptions options = {});
   ~InteractiveView();
