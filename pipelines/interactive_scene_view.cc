@@ -10,8 +10,6 @@
 #include <vtkActor.h>
 #include <vtkCellArray.h>
 #include <vtkImageData.h>
-#include <vtkInteractorStyleImage.h>
-#include <vtkObjectFactory.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
@@ -31,45 +29,6 @@ namespace {
 
 constexpr double kPickRadius = 30.0;  // pixels
 
-// The mouse and keys of the scene viewer; the timer draws frames. Middle/right buttons and the
-// wheel keep vtkInteractorStyleImage's pan and zoom; its left button and keys are replaced.
-class SceneViewerStyle : public vtkInteractorStyleImage {
- public:
-  static SceneViewerStyle* New();
-  vtkTypeMacro(SceneViewerStyle, vtkInteractorStyleImage);
-  InteractiveSceneView* view = nullptr;
-
-  void OnLeftButtonDown() override {
-    const int* p = GetInteractor()->GetEventPosition();
-    dragging_ = view->BeginDrag(p[0], p[1]);
-  }
-  void OnLeftButtonUp() override {
-    if (dragging_) view->EndDrag();
-    dragging_ = false;
-  }
-  void OnMouseMove() override {
-    if (dragging_) {
-      const int* p = GetInteractor()->GetEventPosition();
-      view->DragTo(p[0], p[1]);
-      return;
-    }
-    vtkInteractorStyleImage::OnMouseMove();
-  }
-  void OnChar() override {
-    const char code = GetInteractor()->GetKeyCode();
-    if (code > 32 && code < 127) view->HandleKey(std::string(1, code));
-    else if (code == ' ') view->HandleKey("space");
-  }
-  void OnKeyPress() override {
-    const char* sym = GetInteractor()->GetKeySym();
-    if (sym && std::string(sym) == "Escape") view->HandleKey("Escape");
-  }
-  void OnTimer() override { view->Frame(); }
-
- private:
-  bool dragging_ = false;
-};
-vtkStandardNewMacro(SceneViewerStyle);
 
 // The dragged point's path: a critically damped approach to the cursor c with time constant
 // tau that starts at the point's position n0 and velocity v0 (so the trajectory constraint
@@ -115,7 +74,6 @@ struct InteractiveSceneView::Impl {
   ViewerOptions options;
   std::unique_ptr<SceneView> view;
   Ptr<vtkRenderWindowInteractor> interactor;
-  Ptr<SceneViewerStyle> style;
   Ptr<vtkTextActor> status;
   // the drag: the line from the point to the cursor, drawn with the anchors
   Ptr<vtkPolyData> drag_line;
@@ -247,9 +205,7 @@ InteractiveSceneView::InteractiveSceneView(InteractiveSceneInput input, ViewerOp
 
   m.interactor = Ptr<vtkRenderWindowInteractor>::New();
   m.interactor->SetRenderWindow(m.view->window());
-  m.style = Ptr<SceneViewerStyle>::New();
-  m.style->view = this;
-  m.interactor->SetInteractorStyle(m.style);
+  AttachViewerStyle(m.interactor, this);
 }
 
 InteractiveSceneView::~InteractiveSceneView() {

@@ -42,7 +42,7 @@ struct InteractiveSceneInput {
   std::function<void()> step;
 };
 
-class InteractiveSceneView {
+class InteractiveSceneView : public ViewerControls {
  public:
   static constexpr double kMaxFrameTime = FramePacer::kMaxFrameTime;
   // Time constant (s) of the path that takes a dragged point to the cursor.
@@ -50,7 +50,7 @@ class InteractiveSceneView {
 
   // Uses width, height, fps, speed, fixed_frame_time, start_playing and point sizes of options.
   InteractiveSceneView(InteractiveSceneInput input, ViewerOptions options = {});
-  ~InteractiveSceneView();
+  ~InteractiveSceneView() override;
   InteractiveSceneView(const InteractiveSceneView&) = delete;
   InteractiveSceneView& operator=(const InteractiveSceneView&) = delete;
 
@@ -58,9 +58,9 @@ class InteractiveSceneView {
   void Run(long max_frames = 0, const std::string& events_file = "", bool keep_open = false);
   void Initialize();
   // Advances the scene by the frame's share of time when playing, draws.
-  void Frame();
+  void Frame() override;
 
-  bool HandleKey(const std::string& keysym);
+  bool HandleKey(const std::string& keysym) override;
   void SetPlaying(bool playing);
   bool playing() const;
   void StepOnce();
@@ -72,9 +72,9 @@ class InteractiveSceneView {
   // Dragging, in display pixels (origin bottom left). BeginDrag picks the nearest mass point
   // or named point of a body within 30 pixels and adds the trajectory constraint; false when
   // none is near.
-  bool BeginDrag(int x, int y);
-  void DragTo(int x, int y);
-  void EndDrag();
+  bool BeginDrag(int x, int y) override;
+  void DragTo(int x, int y) override;
+  void EndDrag() override;
   std::optional<MaterialPoint> dragged_point() const;
   int drag_constraint() const;  // the constraint id while dragging, else -1
   // Where the cursor is in the world (the point's dimension) while dragging.

@@ -42,14 +42,14 @@ namespace {
 constexpr double kPanelTop = 0.22;   // the sliders live below this
 constexpr double kSceneRight = 0.62;  // the charts live right of this
 
-// The mouse and the keys of the viewer; the timer draws frames. Middle/right buttons and the
-// wheel keep vtkInteractorStyleImage's pan and zoom; its window-level (left button) and its
-// keys are replaced.
+// The mouse and the keys of both viewers (AttachViewerStyle); the timer draws frames. Middle/
+// right buttons and the wheel keep vtkInteractorStyleImage's pan and zoom; its window-level
+// (left button) and its keys are replaced.
 class ViewerStyle : public vtkInteractorStyleImage {
  public:
   static ViewerStyle* New();
   vtkTypeMacro(ViewerStyle, vtkInteractorStyleImage);
-  InteractiveView* view = nullptr;
+  ViewerControls* view = nullptr;
 
   void OnLeftButtonDown() override {
     const int* p = GetInteractor()->GetEventPosition();
@@ -139,7 +139,6 @@ struct InteractiveView::Impl {
   std::unique_ptr<World> world, scrub_world;
   std::unique_ptr<SceneView> view;
   Ptr<vtkRenderWindowInteractor> interactor;
-  Ptr<ViewerStyle> style;
   Ptr<vtkRenderer> panel_renderer;
   Ptr<vtkTextActor> status;
   // charts
@@ -372,9 +371,7 @@ InteractiveView::InteractiveView(ViewerScene scene, ViewerOptions options) : imp
 
   m.interactor = Ptr<vtkRenderWindowInteractor>::New();
   m.interactor->SetRenderWindow(window);
-  m.style = Ptr<ViewerStyle>::New();
-  m.style->view = this;
-  m.interactor->SetInteractorStyle(m.style);
+  AttachViewerStyle(m.interactor, this);
 
   auto add_slider = [&](Ptr<vtkSliderRepresentation2D> rep, void (*fn)(vtkObject*, unsigned long, void*, void*),
                         void* data) {
@@ -465,6 +462,12 @@ bool FramePacer::EndFrame() {
   ++stats.frames;
   stats.wall = std::chrono::duration<double>(last_ - first_).count();
   return max_frames > 0 && stats.frames >= max_frames;
+}
+
+void AttachViewerStyle(vtkRenderWindowInteractor* interactor, ViewerControls* controls) {
+  auto style = Ptr<ViewerStyle>::New();
+  style->view = controls;
+  interactor->SetInteractorStyle(style);  // the interactor keeps it
 }
 
 void RunViewerLoop(vtkRenderWindowInteractor* interactor, double fps, const FramePacer& pacer,

@@ -125,12 +125,29 @@ class FramePacer {
 void RunViewerLoop(vtkRenderWindowInteractor* interactor, double fps, const FramePacer& pacer,
                    const std::string& events_file, bool keep_open);
 
-class InteractiveView {
+// What the mouse and keys of a viewer window reach; both viewers implement it, and
+// AttachViewerStyle wires one interactor style to it.
+class ViewerControls {
+ public:
+  virtual ~ViewerControls() = default;
+  virtual void Frame() = 0;                                // the repeating timer
+  virtual bool HandleKey(const std::string& keysym) = 0;  // printable keys, space, Escape, Left, Right
+  virtual bool BeginDrag(int x, int y) = 0;                // left button, display pixels
+  virtual void DragTo(int x, int y) = 0;
+  virtual void EndDrag() = 0;
+};
+
+// Sets the viewers' interactor style on `interactor`: the left button drags, keys go to
+// HandleKey, the timer calls Frame; middle/right buttons and the wheel keep
+// vtkInteractorStyleImage's pan and zoom.
+void AttachViewerStyle(vtkRenderWindowInteractor* interactor, ViewerControls* controls);
+
+class InteractiveView : public ViewerControls {
  public:
   static constexpr double kMaxFrameTime = FramePacer::kMaxFrameTime;
 
   InteractiveView(ViewerScene scene, ViewerOptions options = {});
-  ~InteractiveView();
+  ~InteractiveView() override;
   InteractiveView(const InteractiveView&) = delete;
   InteractiveView& operator=(const InteractiveView&) = delete;
 
@@ -144,10 +161,10 @@ class InteractiveView {
   void Initialize();
   // One frame: advance the world by the frame's share of time when playing, record the
   // frame, draw. The timer calls it; tests call it directly.
-  void Frame();
+  void Frame() override;
 
   // What the keys do.
-  bool HandleKey(const std::string& keysym);
+  bool HandleKey(const std::string& keysym) override;
   void SetPlaying(bool playing);
   bool playing() const;
   void StepOnce();  // one simulation step; pauses
@@ -170,9 +187,9 @@ class InteractiveView {
 
   // Pulling with the mouse, in display pixels (origin at the bottom left, as VTK's). Begin
   // picks the nearest mass point or drawing sample within 30 pixels; false when none.
-  bool BeginDrag(int x, int y);
-  void DragTo(int x, int y);
-  void EndDrag();
+  bool BeginDrag(int x, int y) override;
+  void DragTo(int x, int y) override;
+  void EndDrag() override;
   // Lattice coordinates of the point being pulled.
   std::optional<Eigen::Vector2d> dragged_point() const;
 
