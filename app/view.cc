@@ -188,27 +188,17 @@ int RunView(const ViewArgs& a) {
     if (stop > 0)
       std::cout << "wobble view: " << a.scene << " ran up to line " << stop
                 << "; the viewer plays its simulation from there\n";
-    scene.body = setup.body;
-    scene.world = setup.world;
-    scene.q0 = setup.q;
-    scene.qd0 = setup.qd;
-    scene.t0 = setup.time;
-    scene.graph = setup.graph;
-    scene.object_path = setup.object_path;
-    scene.mode_paths = setup.mode_paths;
+    scene = pl::ViewerScene::FromScript(setup);
   } else {
     BodyFiles files;
     files.object = a.object.empty() ? a.scene : a.object;
     files.modes = a.modes;
-    WorldOptions options;
-    options.params = MakeWorldParams(a.world);
-    options.integrator = ParseIntegratorFlag(a.integrator);
     RequirePositive(a.dt, "--dt");
-    options.dt = a.dt;
-    scene.body = LoadBody(files);
-    scene.world = options;
-    scene.q0 = ParseCoordinates(a.q, "--q", *scene.body);
-    scene.qd0 = ParseCoordinates(a.qdot, "--qdot", *scene.body);
+    const StartingWorld start = LoadStartingWorld(files, a.q, a.qdot, a.world, ParseIntegratorFlag(a.integrator), a.dt);
+    scene.body = start.body;
+    scene.world = start.options;
+    scene.q0 = start.q0;
+    scene.qd0 = start.qd0;
     scene.object_path = fs::absolute(files.object).string();
     for (const std::string& m : files.modes) scene.mode_paths.push_back(fs::absolute(m).string());
   }

@@ -464,6 +464,19 @@ bool FramePacer::EndFrame() {
   return max_frames > 0 && stats.frames >= max_frames;
 }
 
+ViewerScene ViewerScene::FromScript(const io::Interpreter::SimulationSetup& setup) {
+  ViewerScene scene;
+  scene.body = setup.body;
+  scene.world = setup.world;
+  scene.q0 = setup.q;
+  scene.qd0 = setup.qd;
+  scene.t0 = setup.time;
+  scene.graph = setup.graph;
+  scene.object_path = setup.object_path;
+  scene.mode_paths = setup.mode_paths;
+  return scene;
+}
+
 void AttachViewerStyle(vtkRenderWindowInteractor* interactor, ViewerControls* controls) {
   auto style = Ptr<ViewerStyle>::New();
   style->view = controls;

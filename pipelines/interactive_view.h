@@ -35,6 +35,7 @@
 #include "pipelines/scene_view.h"
 #include "wobble/control/control.h"
 #include "wobble/dynamics/world.h"
+#include "wobble/io/script.h"
 
 class vtkImageData;
 class vtkRenderWindow;
@@ -54,6 +55,9 @@ struct ViewerScene {
   // Files the body came from: the saved session script loads them again.
   std::string object_path;
   std::vector<std::string> mode_paths;
+
+  // What a script's next `simul` would run (io::Interpreter::CurrentSetup).
+  static ViewerScene FromScript(const io::Interpreter::SimulationSetup& setup);
 };
 
 struct ViewerOptions {

@@ -307,15 +307,7 @@ TEST(InteractiveView, ScriptPoseGraphDrivesTheTargetsAndReplays) {
   const io::Interpreter::SimulationSetup setup = interp.CurrentSetup();
   ASSERT_TRUE(setup.body);
   ASSERT_EQ(setup.world.params.springs.size(), 1u);
-  ViewerScene scene;
-  scene.body = setup.body;
-  scene.world = setup.world;
-  scene.q0 = setup.q;
-  scene.qd0 = setup.qd;
-  scene.t0 = setup.time;
-  scene.graph = setup.graph;
-  scene.object_path = setup.object_path;
-  scene.mode_paths = setup.mode_paths;
+  const ViewerScene scene = ViewerScene::FromScript(setup);
   InteractiveView view(scene, TestOptions());
   view.Initialize();
   for (int k = 0; k < 40; ++k) view.Frame();  // 1.33 s: poses 0..3 and 0 again
