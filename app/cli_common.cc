@@ -8,8 +8,8 @@
 #include <iostream>
 
 #include "wobble/analysis/conditioning.h"
-#include "wobble/io/deformation_file.h"
-#include "wobble/io/object_file.h"
+#include "wobble/formats/deformation_file.h"
+#include "wobble/formats/object_file.h"
 
 namespace wobble::app {
 
@@ -24,11 +24,11 @@ void AddBodyFlags(CLI::App* cmd, BodyFiles* files) {
 }
 
 std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_modes) {
-  BodyDef def = io::ReadObjectFile(files.object);
+  BodyDef def = formats::ReadObjectFile(files.object);
   std::vector<DeformationMode> modes;
   for (const std::string& path : files.modes) {
     if (path.empty()) throw UsageError("--modes: empty file name in the list");
-    std::vector<DeformationMode> more = io::ReadDeformationFile(path);
+    std::vector<DeformationMode> more = formats::ReadDeformationFile(path);
     modes.insert(modes.end(), more.begin(), more.end());
   }
   auto body = std::make_shared<const BodyModel>(std::move(def), std::move(modes));

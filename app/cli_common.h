@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "wobble/body/body_model.h"
-#include "wobble/dynamics/world.h"
+#include "wobble/world/world.h"
 
 namespace wobble::app {
 
@@ -36,7 +36,7 @@ struct BodyFiles {
   std::vector<std::string> modes;
 };
 void AddBodyFlags(CLI::App* cmd, BodyFiles* files);
-// Reads the files through wobble::io and builds the model. Throws io::ParseError for a bad
+// Reads the files through wobble::formats and builds the model. Throws formats::ParseError for a bad
 // file and std::invalid_argument when the modes do not fit the object.
 // With check_modes, the mode set is checked as it loads (analysis::CheckModeSet): warnings
 // (nearly dependent modes, modes the mass cannot see) go to stderr, and a dependent set — M

@@ -9,8 +9,8 @@
 
 #include "csv_writer.h"
 #include "wobble/analysis/conditioning.h"
-#include "wobble/io/atomic_file.h"
-#include "wobble/io/object_file.h"
+#include "wobble/formats/atomic_file.h"
+#include "wobble/formats/object_file.h"
 
 #ifdef WOBBLE_HAVE_PIPELINES
 #include <vtkDoubleArray.h>
@@ -143,7 +143,7 @@ ConditionCommands AddConditionCommand(CLI::App* app, ConditionSweepArgs* s, Cond
 }
 
 int RunConditionSweep(const ConditionSweepArgs& a) {
-  const BodyDef def = io::ReadObjectFile(a.object);
+  const BodyDef def = formats::ReadObjectFile(a.object);
   const std::vector<double> phis = Angles(a);
   RequirePositive(a.compress, "--compress");
   RequireFinite(a.expand, "--expand");

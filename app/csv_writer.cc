@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "wobble/io/atomic_file.h"
+#include "wobble/formats/atomic_file.h"
 
 namespace wobble::app {
 
@@ -21,8 +21,8 @@ std::string FormatDouble(double value) {
 }
 
 void CheckWritable(const std::string& path) {
-  io::CreateParentFolder(path);
-  const std::string tmp = io::TempPathFor(path);
+  formats::CreateParentFolder(path);
+  const std::string tmp = formats::TempPathFor(path);
   std::FILE* f = std::fopen(tmp.c_str(), "w");
   if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
   std::fclose(f);
@@ -31,7 +31,7 @@ void CheckWritable(const std::string& path) {
 
 void WriteCsvAtomically(const std::string& path, const std::vector<std::string>& header,
                         const std::vector<std::vector<double>>& rows) {
-  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+  formats::WriteFileAtomically(path, [&](const std::string& tmp) {
     std::FILE* f = std::fopen(tmp.c_str(), "w");
     if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
     std::string line;

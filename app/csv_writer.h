@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "wobble/io/atomic_file.h"
+#include "wobble/formats/atomic_file.h"
 
 namespace wobble::app {
 
@@ -24,5 +24,5 @@ std::string FormatDouble(double value);
 }  // namespace wobble::app
 
 namespace wobble::app {
-using io::WriteTextAtomically;  // JSON results and reports: lib/wobble/io/atomic_file.h
+using formats::WriteTextAtomically;  // JSON results and reports: lib/wobble/io/atomic_file.h
 }  // namespace wobble::app

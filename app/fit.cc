@@ -13,9 +13,9 @@
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/pose_fit.h"
 #include "wobble/fit/trajectory_fit.h"
-#include "wobble/io/simulation_csv.h"
-#include "wobble/io/parse_error.h"
-#include "wobble/io/target_file.h"
+#include "wobble/formats/simulation_csv.h"
+#include "wobble/formats/parse_error.h"
+#include "wobble/formats/target_file.h"
 
 #ifdef WOBBLE_HAVE_PIPELINES
 #include <filesystem>
@@ -258,10 +258,10 @@ int RunFitPose(const FitPoseArgs& a) {
   o.two_sided = !a.one_sided;
   o.joint_closest_points = !a.alternate;
   o.on_iteration = IterationLine();
-  const io::TargetFile targets = io::ReadTargetFile(a.targets);
-  io::CheckMassPointIndices(targets, body->num_points());
+  const formats::TargetFile targets = formats::ReadTargetFile(a.targets);
+  formats::CheckMassPointIndices(targets, body->num_points());
   if (targets.is_trajectory())
-    throw io::ParseError(a.targets, targets.frames[0].line, "this file has frames: use `wobble fit trajectory`");
+    throw formats::ParseError(a.targets, targets.frames[0].line, "this file has frames: use `wobble fit trajectory`");
 
   const bool curve = targets.has_curve();
   const fit::PoseFitResult r = curve ? fit::FitPoseToCurve(*body, fit::CurveTarget::From(targets), o)
@@ -299,14 +299,14 @@ int RunFitPose(const FitPoseArgs& a) {
   if (curve) {
     for (const fit::PointBasis& p : fit::CurveSamples::Of(*body, o).points)
       overlay["fitted"].push_back(Point(fit::PointPosition(p, r.q.data(), body->num_q())));
-    for (const io::TargetCurve& line : targets.polylines) {
+    for (const formats::TargetCurve& line : targets.polylines) {
       json pl = json::array();
       for (const Eigen::Vector2d& p : line.points) pl.push_back(Point(p));
       overlay["targets"].push_back({{"polyline", pl}, {"closed", line.closed}});
     }
     for (const Eigen::Vector2d& p : targets.cloud) overlay["targets"].push_back({{"point", Point(p)}});
   } else {
-    for (const io::PointTarget& t : targets.points) {
+    for (const formats::PointTarget& t : targets.points) {
       overlay["fitted"].push_back(
           Point(fit::PointPosition(fit::BasisOf(*body, t.mass_point, t.lattice_coords), r.q.data(), body->num_q())));
       overlay["targets"].push_back({{"point", Point(t.position)}});
@@ -406,16 +406,16 @@ int RunFitTrajectory(const FitTrajectoryArgs& a) {
   RequireNonNegative(a.smoothness, "--smoothness");
 
   // the reference: a simulation CSV or a target file with frames
-  std::vector<io::TargetFrame> frames;
+  std::vector<formats::TargetFrame> frames;
   if (EndsWith(a.reference, ".csv")) {
-    const io::SimulationCsv sim = io::ReadSimulationCsv(a.reference, body->num_modes());
+    const formats::SimulationCsv sim = formats::ReadSimulationCsv(a.reference, body->num_modes());
     frames = fit::FramesFromStates(*body, sim.t, sim.q, ParsePointList(a.points, body->num_points()), a.every);
   } else {
     if (!a.points.empty() || a.every != 1) throw UsageError("--points and --every apply to a CSV reference only");
-    const io::TargetFile t = io::ReadTargetFile(a.reference);
+    const formats::TargetFile t = formats::ReadTargetFile(a.reference);
     if (!t.is_trajectory())
-      throw io::ParseError(a.reference, 0, "no 'frame' lines: a trajectory needs frames (for one pose use `wobble fit pose`)");
-    io::CheckMassPointIndices(t, body->num_points());
+      throw formats::ParseError(a.reference, 0, "no 'frame' lines: a trajectory needs frames (for one pose use `wobble fit pose`)");
+    formats::CheckMassPointIndices(t, body->num_points());
     frames = t.frames;
   }
 

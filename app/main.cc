@@ -15,7 +15,7 @@
 #endif
 #include "run.h"
 #include "simulate.h"
-#include "wobble/io/object_file.h"
+#include "wobble/formats/object_file.h"
 
 int main(int argc, char** argv) {
   using namespace wobble::app;
@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
     if (fit.pose->parsed()) return RunFitPose(fit_pose_args);
     if (fit.trajectory->parsed()) return RunFitTrajectory(fit_trajectory_args);
     if (run->parsed()) return RunScript(run_args);
-  } catch (const wobble::io::ParseError& e) {
+  } catch (const wobble::formats::ParseError& e) {
     std::cerr << e.what() << std::endl;  // already "FILE:LINE: message"
     return kExitBadInput;
   } catch (const UsageError& e) {

@@ -20,7 +20,7 @@
 #include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
 #include "progress.h"
-#include "wobble/io/atomic_file.h"
+#include "wobble/formats/atomic_file.h"
 
 namespace wobble::app {
 namespace {

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "cli_common.h"
-#include "wobble/dynamics/world.h"
+#include "wobble/world/world.h"
 
 namespace wobble::app {
 

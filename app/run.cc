@@ -7,7 +7,7 @@
 
 #include "progress.h"
 #include "cli_common.h"
-#include "wobble/io/script.h"
+#include "wobble/script/interpreter.h"
 
 #ifdef WOBBLE_HAVE_PIPELINES
 #include <filesystem>
@@ -37,9 +37,9 @@ namespace {
 
 void PrintHelp(std::ostream& out) {
   out << "commands:\n";
-  for (const io::CommandInfo& c : io::Interpreter::Commands()) out << "  " << c.usage << "\n      " << c.summary << "\n";
+  for (const script::CommandInfo& c : script::Interpreter::Commands()) out << "  " << c.usage << "\n      " << c.summary << "\n";
   out << "parameters of set:";
-  for (const std::string& p : io::Interpreter::Parameters()) out << " " << p;
+  for (const std::string& p : script::Interpreter::Parameters()) out << " " << p;
   out << "\n";
 }
 
@@ -76,7 +76,7 @@ void PlotCostHistory(const std::string& csv_path, const std::string& optimiser,
 
 // `render DIR [WHAT]`: a script's recorded runs through the same driver as `wobble render`, the
 // states replayed instead of simulated. Without a display only vtp and disp can be written.
-void RenderRecordedRuns(const io::RenderRequest& r) {
+void RenderRecordedRuns(const script::RenderRequest& r) {
 #ifdef WOBBLE_HAVE_PIPELINES
   RenderArgs a;
   a.out = r.dir;
@@ -91,7 +91,7 @@ void RenderRecordedRuns(const io::RenderRequest& r) {
     a.what = kept;
   }
   const Motion replay = [&](World& world, const std::function<void(const World&)>& on_state) {
-    for (const io::TrackState& s : r.states) {
+    for (const script::TrackState& s : r.states) {
       world.SetModeTargets(0, s.targets);
       world.SetState(0, s.q, s.qd);
       world.SetTime(s.t);
@@ -111,7 +111,7 @@ void RenderRecordedRuns(const io::RenderRequest& r) {
 }
 
 // `render DIR` in a script: the recorded Witkin & Welch scene as frames, filmstrip and .pvd.
-std::vector<std::string> RenderScene(const io::SceneRenderRequest& r) {
+std::vector<std::string> RenderScene(const script::SceneRenderRequest& r) {
 #ifdef WOBBLE_HAVE_PIPELINES
   pipelines::SceneRunOutputs out;
   out.folder = r.folder;
@@ -139,7 +139,7 @@ std::vector<std::string> RenderScene(const io::SceneRenderRequest& r) {
 }  // namespace
 
 int RunScript(const RunArgs& a) {
-  io::Interpreter interp(std::cout);
+  script::Interpreter interp(std::cout);
   interp.SetHistoryHook(PlotCostHistory);
   interp.SetRenderHook(RenderRecordedRuns);
   interp.SetSceneRenderHook(RenderScene);
@@ -155,7 +155,7 @@ int RunScript(const RunArgs& a) {
   if (!a.script.empty()) {
     try {
       interp.RunFile(a.script);
-    } catch (const io::SimulationStopped& e) {
+    } catch (const script::SimulationStopped& e) {
       progress.Finish();
       std::cerr << e.what() << std::endl;
       return kExitSimStopped;
@@ -167,7 +167,7 @@ int RunScript(const RunArgs& a) {
   if (!interactive) {
     try {
       interp.RunStream(std::cin, "<stdin>", "");
-    } catch (const io::SimulationStopped& e) {
+    } catch (const script::SimulationStopped& e) {
       std::cerr << e.what() << std::endl;
       return kExitSimStopped;
     }

@@ -20,7 +20,7 @@ struct SimulateArgs {
 };
 
 CLI::App* AddSimulateCommand(CLI::App* app, SimulateArgs* args);
-// Runs it; returns the exit code. Throws UsageError / io::ParseError / std::invalid_argument
+// Runs it; returns the exit code. Throws UsageError / formats::ParseError / std::invalid_argument
 // for bad input.
 int RunSimulate(const SimulateArgs& args);
 

@@ -13,7 +13,7 @@
 #include "pipelines/interactive_view.h"
 #include "pipelines/scene_run.h"
 #include "pipelines/scene_view.h"
-#include "wobble/io/script.h"
+#include "wobble/script/interpreter.h"
 
 namespace wobble::app {
 namespace {
@@ -25,7 +25,7 @@ bool IsScript(const std::string& path) { return fs::path(path).extension() == ".
 
 // Runs the script in the interpreter up to (not including) its first `simul` or `keyframe`:
 // the viewer plays that simulation live. Returns the line it stopped at (0: the whole script).
-int RunScriptSetup(io::Interpreter* interp, const std::string& path) {
+int RunScriptSetup(script::Interpreter* interp, const std::string& path) {
   std::ifstream in(path);
   if (!in) throw UsageError(path + ": cannot open the script");
   const std::string dir = fs::path(path).parent_path().string();
@@ -78,11 +78,11 @@ pl::ViewerOptions MakeViewerOptions(const ViewArgs& a, int width, int height) {
   return vo;
 }
 
-// A script with a Witkin & Welch scene: its ConstrainedWorld live, stepped by the interpreter
+// A script with a Witkin & Welch scene: its World live, stepped by the interpreter
 // (the queued behaviours act between steps as in `simul`).
-int ViewScene(io::Interpreter* interp, const ViewArgs& a, int width, int height) {
+int ViewScene(script::Interpreter* interp, const ViewArgs& a, int width, int height) {
   if (!a.save_session.empty()) throw UsageError("--save-session: sessions are saved for FFD objects, not for scenes");
-  const io::SceneRenderRequest drawing = interp->SceneDrawing();
+  const script::SceneRenderRequest drawing = interp->SceneDrawing();
   pl::InteractiveSceneInput input;
   input.world = interp->mutable_scene();
   input.spec = pl::SceneSpecOf(*drawing.drawings, drawing.anchors);
@@ -174,7 +174,7 @@ int RunView(const ViewArgs& a) {
   if (script) {
     if (!a.q.empty() || !a.qdot.empty() || !a.modes.empty())
       throw UsageError("view: --q, --qdot and --modes apply to object files; a script sets them itself");
-    io::Interpreter interp(std::cout);
+    script::Interpreter interp(std::cout);
     if (!a.object.empty()) interp.LoadObject(a.object);
     const int stop = RunScriptSetup(&interp, a.scene);
     if (interp.scene() && interp.scene()->num_bodies() > 0) {
@@ -183,7 +183,7 @@ int RunView(const ViewArgs& a) {
                   << "; the viewer steps its scene from there\n";
       return ViewScene(&interp, a, width, height);
     }
-    io::Interpreter::SimulationSetup setup = interp.CurrentSetup();
+    script::Interpreter::SimulationSetup setup = interp.CurrentSetup();
     if (!setup.body) throw UsageError(a.scene + ": the script loads no object (load_obj FILE, or --object FILE)");
     if (stop > 0)
       std::cout << "wobble view: " << a.scene << " ran up to line " << stop

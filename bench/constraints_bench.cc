@@ -12,8 +12,8 @@
 #include <Eigen/Geometry>
 #include <memory>
 
-#include "../tests/test_bodies.h"
-#include "wobble/constraints/constrained_world.h"
+#include "support/test_bodies.h"
+#include "wobble/world/world.h"
 
 namespace wobble {
 namespace {
@@ -28,12 +28,12 @@ std::shared_ptr<const LinearBodyModel> Link() {
 // and the whole chain turns slowly about the nail instead (ω = 0.05 rad/s, installed by an
 // impulse): under gravity the top joints of a 1000-link chain would carry 1000 links' weight,
 // far too stiff for soft links at this step. The cost of a step does not depend on the motion.
-std::unique_ptr<ConstrainedWorld> Chain(int links, MultiplierMethod method, int* top_nail, bool gravity = false) {
-  ConstrainedWorldOptions opt;
+std::unique_ptr<World> Chain(int links, MultiplierMethod method, int* top_nail, bool gravity = false) {
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 1e-3;
   opt.method = method;
   opt.params.gravity_on = gravity;
-  auto world = std::make_unique<ConstrainedWorld>(opt);
+  auto world = std::make_unique<World>(opt);
   const AffineMaterial mat{200.0, 200.0, 0.01, 0.0};
   for (int i = 0; i < links; ++i) {
     const int b = world->AddLinearBody(Link(), mat);
@@ -117,12 +117,12 @@ BENCHMARK(BM_ChainRefactor)
     ->Unit(benchmark::kMicrosecond);
 
 void BM_FfdTableNailed(benchmark::State& state) {
-  ConstrainedWorldOptions opt;
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 0.005;
   opt.params.ground.enabled = false;
   auto make = [&] {
-    auto world = std::make_unique<ConstrainedWorld>(opt);
-    const int table = world->AddFfdBody(std::make_shared<BodyModel>(testing::TableDef(), testing::TableModes(4e6, 1e6)));
+    auto world = std::make_unique<World>(opt);
+    const int table = world->AddBody(std::make_shared<BodyModel>(testing::TableDef(), testing::TableModes(4e6, 1e6)));
     world->AddNail(At(table, Eigen::Vector2d(0.0, 1.0)));
     return world;
   };

@@ -5,8 +5,8 @@
 // conditioning analysis.
 #include <benchmark/benchmark.h>
 
-#include "../tests/test_bodies.h"
-#include "wobble/dynamics/world.h"
+#include "support/test_bodies.h"
+#include "wobble/world/world.h"
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/pose_fit.h"
 #include "wobble/fit/trajectory_fit.h"
@@ -20,10 +20,10 @@ Eigen::VectorXd KnownQ() {
   return q;
 }
 
-std::vector<io::PointTarget> MassTargets(const BodyModel& body, const Eigen::VectorXd& q) {
-  std::vector<io::PointTarget> t;
+std::vector<formats::PointTarget> MassTargets(const BodyModel& body, const Eigen::VectorXd& q) {
+  std::vector<formats::PointTarget> t;
   for (int k = 0; k < body.num_points(); ++k) {
-    io::PointTarget p;
+    formats::PointTarget p;
     p.mass_point = k;
     p.position = fit::PointPosition(fit::BasisOf(body, k, {}), q.data(), int(q.size()));
     t.push_back(p);
@@ -61,11 +61,11 @@ BENCHMARK(BM_PoseFit_Table11_Rigid)->Unit(benchmark::kMicrosecond);
 // 1,000 target points on three polylines (the table's drawing at KnownQ).
 void BM_CurveFit_Polyline1000(benchmark::State& state) {
   const BodyModel body(testing::TableDef(), testing::TableModes());
-  io::TargetFile f;
+  formats::TargetFile f;
   const int counts[3] = {400, 300, 300};
   for (int l = 0; l < 3; ++l) {
     const Polyline& line = body.def().shapes[l];
-    io::TargetCurve c;
+    formats::TargetCurve c;
     for (int i = 0; i < counts[l]; ++i) {
       const Eigen::Vector2d p = line.points[0] + (line.points[1] - line.points[0]) * (double(i) / (counts[l] - 1));
       c.points.push_back(fit::PointPosition(fit::BasisOf(body, -1, body.lattice().LocalCoords(p)), KnownQ().data(), 7));
@@ -97,7 +97,7 @@ BENCHMARK(BM_CurveFit_Polyline1000)
     ->Unit(benchmark::kMillisecond);
 
 // The table thrown without ground, 1,200 frames at dt 0.005, all 11 mass points observed.
-std::vector<io::TargetFrame> ThrownFrames(const std::shared_ptr<const BodyModel>& body, int frames, double dt) {
+std::vector<formats::TargetFrame> ThrownFrames(const std::shared_ptr<const BodyModel>& body, int frames, double dt) {
   WorldOptions wo;
   wo.params.ground.enabled = false;
   wo.dt = dt;
@@ -119,7 +119,7 @@ std::vector<io::TargetFrame> ThrownFrames(const std::shared_ptr<const BodyModel>
 
 void BM_KinematicTrajectory_1200Frames(benchmark::State& state) {
   const auto body = std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(4e6, 1e5));
-  const std::vector<io::TargetFrame> frames = ThrownFrames(body, 1200, 0.005);
+  const std::vector<formats::TargetFrame> frames = ThrownFrames(body, 1200, 0.005);
   fit::TrajectoryFitOptions o;
   o.smoothness = 1.0;
   o.pose.gamma_lower = -3;
@@ -139,8 +139,8 @@ BENCHMARK(BM_KinematicTrajectory_1200Frames)->Unit(benchmark::kMillisecond);
 // Dynamic fit of q0, q̇0, K, c to 100 steps (51 frames) from a start 40% off.
 void BM_DynamicFit_100Steps(benchmark::State& state) {
   const auto body = std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(3e6, 2e5));
-  const std::vector<io::TargetFrame> all = ThrownFrames(body, 101, 0.01);
-  std::vector<io::TargetFrame> frames;
+  const std::vector<formats::TargetFrame> all = ThrownFrames(body, 101, 0.01);
+  std::vector<formats::TargetFrame> frames;
   for (size_t i = 0; i < all.size(); i += 2) frames.push_back(all[i]);
   fit::DynamicParameters start;
   start.stiffness = Eigen::VectorXd::Constant(4, 3e6 * 1.4);
@@ -158,8 +158,8 @@ BENCHMARK(BM_DynamicFit_100Steps)->Unit(benchmark::kMillisecond);
 // compare with the Ceres fit's final cost, printed by tests/dynamic_fit_test (~1e-21).
 void BM_DynamicFit_Annealing(benchmark::State& state) {
   const auto body = std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(3e6, 2e5));
-  const std::vector<io::TargetFrame> all = ThrownFrames(body, 101, 0.01);
-  std::vector<io::TargetFrame> frames;
+  const std::vector<formats::TargetFrame> all = ThrownFrames(body, 101, 0.01);
+  std::vector<formats::TargetFrame> frames;
   for (size_t i = 0; i < all.size(); i += 2) frames.push_back(all[i]);
   fit::DynamicParameters start;
   start.stiffness = Eigen::VectorXd::Constant(4, 3e6 * 1.4);
@@ -182,7 +182,7 @@ struct PoseGraphProblem {
   std::shared_ptr<const BodyModel> body;
   fit::DynamicFitOptions o;
   fit::DynamicParameters truth, start;
-  std::vector<io::TargetFrame> frames;
+  std::vector<formats::TargetFrame> frames;
   PoseGraphProblem() {
     std::vector<DeformationMode> modes = testing::TableModes(4e7, 4e6);
     modes[0].active = modes[1].active = true;

@@ -15,8 +15,8 @@
 #include "pipelines/exports.h"
 #include "pipelines/interactive_view.h"
 #include "pipelines/scene_view.h"
-#include "wobble/io/deformation_file.h"
-#include "wobble/io/object_file.h"
+#include "wobble/formats/deformation_file.h"
+#include "wobble/formats/object_file.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -24,8 +24,8 @@ namespace {
 const std::string kData = WOBBLE_DATA_DIR;
 
 std::shared_ptr<const BodyModel> Table() {
-  static auto body = std::make_shared<const BodyModel>(io::ReadObjectFile(kData + "/table.obj"),
-                                                       io::ReadDeformationFile(kData + "/table_modes.def"));
+  static auto body = std::make_shared<const BodyModel>(formats::ReadObjectFile(kData + "/table.obj"),
+                                                       formats::ReadDeformationFile(kData + "/table_modes.def"));
   return body;
 }
 
@@ -173,8 +173,8 @@ void BM_ViewerFrame1280x720(benchmark::State& state) {
   if (!NeedDisplay(state)) return;
   const bool pot = state.range(0) == 1;
   ViewerScene scene;
-  scene.body = pot ? std::make_shared<const BodyModel>(io::ReadObjectFile(kData + "/pot.obj"),
-                                                       io::ReadDeformationFile(kData + "/def_pot"))
+  scene.body = pot ? std::make_shared<const BodyModel>(formats::ReadObjectFile(kData + "/pot.obj"),
+                                                       formats::ReadDeformationFile(kData + "/def_pot"))
                    : Table();
   scene.q0 = Eigen::VectorXd::Zero(scene.body->num_q());
   scene.q0[1] = 50;

@@ -9,7 +9,7 @@
 #include <sstream>
 #include <thread>
 
-#include "wobble/io/script.h"
+#include "wobble/script/interpreter.h"
 #include "wobble/synth/anneal.h"
 
 namespace wobble {
@@ -29,7 +29,7 @@ struct BoundingTable {
     graph = interp.pose_graph();
   }
   std::ostringstream sink;
-  io::Interpreter interp;
+  script::Interpreter interp;
   synth::Problem problem;
   control::PoseGraph graph;
 };

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "wobble/dynamics/reference.h"
-#include "wobble/dynamics/world.h"
-#include "wobble/io/deformation_file.h"
-#include "wobble/io/object_file.h"
+#include "support/reference.h"
+#include "wobble/world/world.h"
+#include "wobble/formats/deformation_file.h"
+#include "wobble/formats/object_file.h"
 
 namespace wobble {
 namespace {
@@ -68,12 +68,12 @@ const std::string kDataDir = WOBBLE_DATA_DIR;
 
 BodyDef TableDef() {
   const std::string path = kDataDir + "/table.obj";
-  return std::filesystem::exists(path) ? io::ReadObjectFile(path) : TableInCode();
+  return std::filesystem::exists(path) ? formats::ReadObjectFile(path) : TableInCode();
 }
 
 std::vector<DeformationMode> TableModes() {
   const std::string path = kDataDir + "/table_modes.def";
-  return std::filesystem::exists(path) ? io::ReadDeformationFile(path) : TableModesInCode();
+  return std::filesystem::exists(path) ? formats::ReadDeformationFile(path) : TableModesInCode();
 }
 
 // The same body with `n` mass points spread evenly (by length) along its drawing's segments,

@@ -26,7 +26,7 @@
 
 #include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
-#include "wobble/io/atomic_file.h"
+#include "wobble/formats/atomic_file.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -86,7 +86,7 @@ void Validate(const ChartSpec& spec) {
 bool Usable(double v, bool log) { return std::isfinite(v) && (!log || v > 0.0); }
 
 void WriteText(const std::string& path, const std::string& text) {
-  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+  formats::WriteFileAtomically(path, [&](const std::string& tmp) {
     std::FILE* f = std::fopen(tmp.c_str(), "w");
     if (!f) throw std::runtime_error("cannot open " + tmp);
     const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();

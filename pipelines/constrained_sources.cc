@@ -51,12 +51,12 @@ void UndeformedBox(const LinearBodyModel& model, Eigen::VectorXd* lo, Eigen::Vec
 
 }  // namespace
 
-Eigen::Vector3d LinearWorldPoint(const ConstrainedWorld& world, int body, const Eigen::VectorXd& u) {
+Eigen::Vector3d LinearWorldPoint(const World& world, int body, const Eigen::VectorXd& u) {
   const LinearBodyModel& model = world.linear_model(body);
   return To3(world.linear_R(body) * model.Basis(u));
 }
 
-Eigen::AlignedBox3d LinearBodyBounds(const ConstrainedWorld& world, int body, const LinearDrawing* drawing) {
+Eigen::AlignedBox3d LinearBodyBounds(const World& world, int body, const LinearDrawing* drawing) {
   const LinearBodyModel& model = world.linear_model(body);
   Eigen::AlignedBox3d box;
   for (const Eigen::VectorXd& u : model.def().points) box.extend(LinearWorldPoint(world, body, u));

@@ -1,6 +1,6 @@
-// VTK sources for the linear-deformation bodies of a ConstrainedWorld (Witkin & Welch 1990),
+// VTK sources for the linear-deformation bodies of a World (Witkin & Welch 1990),
 // 2D (z = 0) or 3D, in world coordinates; the FFD bodies of the same world are drawn by the
-// sources of world_sources.h on ConstrainedWorld::ffd_world(). Like those, each is a
+// sources of world_sources.h on World::ffd_world(). Like those, each is a
 // vtkPolyDataAlgorithm with no input: set the world and the body, call Modified() after the
 // world has changed.
 //
@@ -22,7 +22,7 @@
 #include <vtkPolyDataAlgorithm.h>
 
 #include "wobble/body/linear_shapes.h"
-#include "wobble/constraints/constrained_world.h"
+#include "wobble/world/world.h"
 
 namespace wobble::pipelines {
 
@@ -31,7 +31,7 @@ class ConstrainedSourceBase : public vtkPolyDataAlgorithm {
   vtkTypeMacro(ConstrainedSourceBase, vtkPolyDataAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
   // Not owned; must outlive the updates.
-  void SetWorld(const ConstrainedWorld* world) {
+  void SetWorld(const World* world) {
     world_ = world;
     Modified();
   }
@@ -42,7 +42,7 @@ class ConstrainedSourceBase : public vtkPolyDataAlgorithm {
   ConstrainedSourceBase() { SetNumberOfInputPorts(0); }
   // Reports and returns false without a world or when Body is not a linear body of it.
   bool CheckLinearBody();
-  const ConstrainedWorld* world_ = nullptr;
+  const World* world_ = nullptr;
   int Body = 0;
 };
 
@@ -110,11 +110,11 @@ class AnchorSource : public ConstrainedSourceBase {
 };
 
 // World position of undeformed point u of linear body `body` (x = R p(u)) as 3 numbers (z = 0 in 2D).
-Eigen::Vector3d LinearWorldPoint(const ConstrainedWorld& world, int body, const Eigen::VectorXd& u);
+Eigen::Vector3d LinearWorldPoint(const World& world, int body, const Eigen::VectorXd& u);
 
 // A box holding every point of the body now: its mass points and the corners of its drawing's
 // sampled points (a quadratic deformation can bulge beyond the mass points' hull, so the
 // drawing's own samples are included when given).
-Eigen::AlignedBox3d LinearBodyBounds(const ConstrainedWorld& world, int body, const LinearDrawing* drawing = nullptr);
+Eigen::AlignedBox3d LinearBodyBounds(const World& world, int body, const LinearDrawing* drawing = nullptr);
 
 }  // namespace wobble::pipelines

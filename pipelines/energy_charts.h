@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "pipelines/charts.h"
-#include "wobble/dynamics/world.h"
+#include "wobble/world/world.h"
 
 namespace wobble::pipelines {
 

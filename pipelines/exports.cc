@@ -14,7 +14,7 @@
 #include <vtkXMLPolyDataWriter.h>
 
 #include "wobble/dynamics/kinematics.h"
-#include "wobble/io/atomic_file.h"
+#include "wobble/formats/atomic_file.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -43,7 +43,7 @@ std::string XmlEscape(const std::string& s) {
 }  // namespace
 
 void WriteVtp(const std::string& path, vtkPolyData* data) {
-  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+  formats::WriteFileAtomically(path, [&](const std::string& tmp) {
     auto w = vtkSmartPointer<vtkXMLPolyDataWriter>::New();
     w->SetInputData(data);
     w->SetDataModeToAppended();
@@ -54,7 +54,7 @@ void WriteVtp(const std::string& path, vtkPolyData* data) {
 }
 
 void WriteVti(const std::string& path, vtkImageData* image) {
-  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+  formats::WriteFileAtomically(path, [&](const std::string& tmp) {
     auto w = vtkSmartPointer<vtkXMLImageDataWriter>::New();
     w->SetInputData(image);
     w->SetDataModeToAppended();
@@ -64,7 +64,7 @@ void WriteVti(const std::string& path, vtkImageData* image) {
 }
 
 void WritePng(const std::string& path, vtkImageData* image, int compression) {
-  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+  formats::WriteFileAtomically(path, [&](const std::string& tmp) {
     auto w = vtkSmartPointer<vtkPNGWriter>::New();
     w->SetInputData(image);
     w->SetCompressionLevel(std::clamp(compression, 0, 9));
@@ -93,7 +93,7 @@ void PvdCollection::Write(const std::string& pvd_path) const {
   }
   xml << "  </Collection>\n</VTKFile>\n";
   const std::string text = xml.str();
-  io::WriteFileAtomically(pvd_path, [&](const std::string& tmp) {
+  formats::WriteFileAtomically(pvd_path, [&](const std::string& tmp) {
     std::FILE* f = std::fopen(tmp.c_str(), "w");
     if (!f) throw std::runtime_error("cannot open " + tmp);
     const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();

@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "wobble/io/atomic_file.h"
+#include "wobble/formats/atomic_file.h"
 
 namespace wobble::pipelines {
 
@@ -21,7 +21,7 @@ void WriteExrChannels(const std::string& path, int width, int height, const std:
     if (c.data.size() != size_t(width) * size_t(height))
       throw std::invalid_argument(path + ": channel '" + c.name + "' has " + std::to_string(c.data.size()) +
                                   " values, expected " + std::to_string(size_t(width) * height));
-  io::WriteFileAtomically(path, [&](const std::string& tmp) {
+  formats::WriteFileAtomically(path, [&](const std::string& tmp) {
     Imf::Header header(width, height);
     switch (compression) {
       case ExrCompression::kNone: header.compression() = Imf::NO_COMPRESSION; break;

@@ -56,8 +56,8 @@ class ApproachPath : public PointPath {
   double tau_;
 };
 
-int NumMassPoints(const ConstrainedWorld& w, int b) {
-  return w.kind(b) == BodyKind::kLinear ? w.linear_model(b).num_points() : w.ffd_model(b).num_points();
+int NumMassPoints(const World& w, int b) {
+  return w.kind(b) == BodyKind::kLinear ? w.linear_model(b).num_points() : w.body(b).num_points();
 }
 
 Eigen::Vector3d To3(const Eigen::VectorXd& p) {
@@ -87,7 +87,7 @@ struct InteractiveSceneView::Impl {
   FramePacer pacer;  // frame clock, the simulated time asked for, measurements
   bool initialized = false;
 
-  ConstrainedWorld& world() { return *input.world; }
+  World& world() { return *input.world; }
 
   bool StepWorld() {
     try {
@@ -301,7 +301,7 @@ Eigen::Vector3d InteractiveSceneView::WorldToDisplay(const Eigen::VectorXd& p) c
 bool InteractiveSceneView::BeginDrag(int x, int y) {
   Impl& m = *impl_;
   if (m.dragged) EndDrag();
-  ConstrainedWorld& w = m.world();
+  World& w = m.world();
   // candidates: named points of bodies first (a tie goes to them), then every mass point
   std::vector<MaterialPoint> candidates;
   for (const AnchorSource::Anchor& a : m.input.spec.anchors)
@@ -330,7 +330,7 @@ bool InteractiveSceneView::BeginDrag(int x, int y) {
 void InteractiveSceneView::DragTo(int x, int y) {
   Impl& m = *impl_;
   if (!m.dragged) return;
-  ConstrainedWorld& w = m.world();
+  World& w = m.world();
   const Eigen::VectorXd now = w.PointPosition(*m.dragged);
   // the cursor on the plane through the point that faces the camera
   const Eigen::VectorXd target = m.DisplayToWorld(x, y, WorldToDisplay(now)[2], int(now.size()));
@@ -356,7 +356,7 @@ Eigen::VectorXd InteractiveSceneView::drag_target() const {
   return impl_->drag_path ? impl_->drag_path->target() : Eigen::VectorXd();
 }
 
-const ConstrainedWorld& InteractiveSceneView::world() const { return *impl_->input.world; }
+const World& InteractiveSceneView::world() const { return *impl_->input.world; }
 double InteractiveSceneView::time() const { return impl_->input.world->time(); }
 const ViewerStats& InteractiveSceneView::stats() const { return impl_->pacer.stats; }
 const std::string& InteractiveSceneView::message() const { return impl_->message; }

@@ -1,7 +1,7 @@
 // `wobble view` of a Witkin & Welch scene (a script with `linear` bodies, nails, attachments
-// and behaviours): the script's ConstrainedWorld in a window, stepped in real time by the
-// caller's step function (io::Interpreter::StepScene: the queued behaviours act between steps
-// as in `simul`), drawn by SceneView's ConstrainedWorld constructor (the drawing path of
+// and behaviours): the script's World in a window, stepped in real time by the
+// caller's step function (script::Interpreter::StepScene: the queued behaviours act between steps
+// as in `simul`), drawn by SceneView's World constructor (the drawing path of
 // `render`). The FFD viewer (interactive_view.h) keeps its mode sliders and charts; a scene has
 // no mode targets, so this window shows the scene alone.
 //
@@ -25,7 +25,7 @@
 
 #include "pipelines/interactive_view.h"
 #include "pipelines/scene_view.h"
-#include "wobble/constraints/constrained_world.h"
+#include "wobble/world/world.h"
 
 class vtkImageData;
 class vtkRenderWindow;
@@ -34,7 +34,7 @@ class vtkRenderWindowInteractor;
 namespace wobble::pipelines {
 
 struct InteractiveSceneInput {
-  ConstrainedWorld* world = nullptr;  // stepped by `step`; the viewer adds and removes its drag constraint
+  World* world = nullptr;  // stepped by `step`; the viewer adds and removes its drag constraint
   ConstrainedSceneSpec spec;          // drawings and named points
   double azimuth = 30.0, elevation = 20.0;  // 3D camera (degrees), as `render`
   // One step of world->options().dt. Throws (std::exception) when the world or a behaviour
@@ -80,7 +80,7 @@ class InteractiveSceneView : public ViewerControls {
   // Where the cursor is in the world (the point's dimension) while dragging.
   Eigen::VectorXd drag_target() const;
 
-  const ConstrainedWorld& world() const;
+  const World& world() const;
   double time() const;
   const ViewerStats& stats() const;
   const std::string& message() const;  // the last trouble (a stopped run), or empty

@@ -29,8 +29,8 @@
 
 #include "pipelines/charts.h"
 #include "pipelines/energy_charts.h"
-#include "wobble/io/atomic_file.h"
-#include "wobble/io/session_script.h"
+#include "wobble/formats/atomic_file.h"
+#include "wobble/script/session_script.h"
 
 namespace wobble::pipelines {
 
@@ -156,7 +156,7 @@ struct InteractiveView::Impl {
   double speed = 1.0;
   Eigen::VectorXd targets;
   long session_steps = 0;
-  std::vector<io::SessionRecord::Segment> segments;
+  std::vector<script::SessionRecord::Segment> segments;
   int drags = 0;
   long first_drag_step = -1;
   int drag_spring = -1;  // index in the world's springs while pulling
@@ -464,7 +464,7 @@ bool FramePacer::EndFrame() {
   return max_frames > 0 && stats.frames >= max_frames;
 }
 
-ViewerScene ViewerScene::FromScript(const io::Interpreter::SimulationSetup& setup) {
+ViewerScene ViewerScene::FromScript(const script::Interpreter::SimulationSetup& setup) {
   ViewerScene scene;
   scene.body = setup.body;
   scene.world = setup.world;
@@ -626,7 +626,7 @@ void InteractiveView::RecordPose() {
 
 std::string InteractiveView::SessionScriptText() const {
   const Impl& m = *impl_;
-  io::SessionRecord r;
+  script::SessionRecord r;
   r.object_path = m.scene.object_path;
   r.mode_paths = m.scene.mode_paths;
   r.body = m.scene.body.get();
@@ -638,16 +638,16 @@ std::string InteractiveView::SessionScriptText() const {
   r.steps = m.session_steps;
   r.drags = m.drags;
   r.first_drag_step = m.first_drag_step;
-  return io::SessionScript(r);
+  return script::SessionScript(r);
 }
 
 std::vector<std::string> InteractiveView::SaveSession(const std::string& path) {
   const Impl& m = *impl_;
   std::vector<std::string> written;
-  io::WriteTextAtomically(path, SessionScriptText());
+  formats::WriteTextAtomically(path, SessionScriptText());
   written.push_back(path);
   if (!m.recorded_poses.empty()) {
-    io::SessionRecord r;
+    script::SessionRecord r;
     r.object_path = m.scene.object_path;
     r.mode_paths = m.scene.mode_paths;
     r.body = m.scene.body.get();
@@ -657,7 +657,7 @@ std::vector<std::string> InteractiveView::SaveSession(const std::string& path) {
     r.t0 = m.scene.t0;
     std::filesystem::path p(path);
     const std::string poses = (p.parent_path() / (p.stem().string() + "_poses.wob")).string();
-    io::WriteTextAtomically(poses, io::PoseGraphScript(r, m.recorded_poses, m.recorded_durations));
+    formats::WriteTextAtomically(poses, script::PoseGraphScript(r, m.recorded_poses, m.recorded_durations));
     written.push_back(poses);
   }
   return written;
@@ -718,7 +718,7 @@ bool InteractiveView::BeginDrag(int x, int y) {
   sp.stiffness = k;
   sp.damping = c;
   m.world->AddSpring(sp);
-  m.drag_spring = int(m.world->params().springs.size()) - 1;
+  m.drag_spring = int(m.world->mutable_options().params.springs.size()) - 1;
   m.drag_st = sp.lattice_coords;
   if (m.drags++ == 0) m.first_drag_step = m.session_steps;
   return true;
@@ -727,13 +727,13 @@ bool InteractiveView::BeginDrag(int x, int y) {
 void InteractiveView::DragTo(int x, int y) {
   Impl& m = *impl_;
   if (m.drag_spring < 0) return;
-  m.world->params().springs[size_t(m.drag_spring)].anchor = DisplayToWorld(x, y);
+  m.world->mutable_options().params.springs[size_t(m.drag_spring)].anchor = DisplayToWorld(x, y);
 }
 
 void InteractiveView::EndDrag() {
   Impl& m = *impl_;
   if (m.drag_spring < 0) return;
-  auto& springs = m.world->params().springs;
+  auto& springs = m.world->mutable_options().params.springs;
   springs.erase(springs.begin() + m.drag_spring);
   m.drag_spring = -1;
 }

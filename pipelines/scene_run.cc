@@ -28,7 +28,7 @@ struct BodyParts {
   std::vector<std::string> names;
 };
 
-std::vector<BodyParts> MakeParts(const ConstrainedWorld& world, const ConstrainedSceneSpec& spec) {
+std::vector<BodyParts> MakeParts(const World& world, const ConstrainedSceneSpec& spec) {
   std::vector<BodyParts> parts;
   for (int b = 0; b < world.num_bodies(); ++b) {
     BodyParts p;
@@ -49,8 +49,8 @@ std::vector<BodyParts> MakeParts(const ConstrainedWorld& world, const Constraine
       auto points = Ptr<MassPointSource>::New();
       auto shape = Ptr<ShapeSource>::New();
       for (WorldSourceBase* s : {(WorldSourceBase*)lattice, (WorldSourceBase*)points, (WorldSourceBase*)shape}) {
-        s->SetWorld(&world.ffd_world());
-        s->SetBody(world.ffd_index(b));
+        s->SetWorld(&world);
+        s->SetBody(b);
       }
       p.sources = {lattice, points, shape};
       p.names = {stem + "_lattice", stem + "_points", stem + "_shape"};
@@ -75,15 +75,15 @@ ConstrainedSceneSpec SceneSpecOf(const std::vector<LinearDrawing>& drawings, con
   return spec;
 }
 
-std::vector<std::string> WriteSceneRun(ConstrainedWorld& world, const ConstrainedSceneSpec& spec,
-                                       const std::vector<control::SceneFrame>& frames, const SceneRunOutputs& out) {
+std::vector<std::string> WriteSceneRun(World& world, const ConstrainedSceneSpec& spec,
+                                       const std::vector<record::SceneFrame>& frames, const SceneRunOutputs& out) {
   if (frames.empty()) throw std::invalid_argument("nothing was recorded: no frames to render");
   std::vector<std::string> written;
 
   // the camera frames every recorded state
   Eigen::AlignedBox3d motion;
-  for (const control::SceneFrame& f : frames) {
-    control::RestoreFrame(world, f);
+  for (const record::SceneFrame& f : frames) {
+    record::RestoreFrame(world, f);
     motion.extend(SceneBounds(world, spec));
   }
   const bool flat = IsFlat(world);
@@ -130,7 +130,7 @@ std::vector<std::string> WriteSceneRun(ConstrainedWorld& world, const Constraine
 
   std::vector<vtkSmartPointer<vtkImageData>> panels(strip_frames.size());
   for (size_t k = 0; k < frames.size(); ++k) {
-    control::RestoreFrame(world, frames[k]);
+    record::RestoreFrame(world, frames[k]);
     if (view) {
       view->Render();
       view->WritePng(Numbered(out.folder + "/frames", "frame", int(k), "png"));

@@ -1,4 +1,4 @@
-// Pictures and exports of a recorded ConstrainedWorld run (Witkin & Welch scenes: `render` in
+// Pictures and exports of a recorded World run (Witkin & Welch scenes: `render` in
 // a script): PNG frames, a filmstrip and a ParaView .pvd series, through SceneView and the
 // writers of exports.h. The camera is fixed for the run and frames the whole recorded motion.
 #pragma once
@@ -8,7 +8,7 @@
 
 #include "pipelines/scene_view.h"
 #include "wobble/control/behaviours.h"
-#include "wobble/control/scene_recording.h"
+#include "wobble/record/scene_recording.h"
 
 namespace wobble::pipelines {
 
@@ -38,7 +38,7 @@ struct SceneRunOutputs {
 // and its named points (`point`, `place`) as anchors.
 ConstrainedSceneSpec SceneSpecOf(const std::vector<LinearDrawing>& drawings, const std::vector<control::Anchor>& anchors);
 
-std::vector<std::string> WriteSceneRun(ConstrainedWorld& world, const ConstrainedSceneSpec& spec,
-                                       const std::vector<control::SceneFrame>& frames, const SceneRunOutputs& out);
+std::vector<std::string> WriteSceneRun(World& world, const ConstrainedSceneSpec& spec,
+                                       const std::vector<record::SceneFrame>& frames, const SceneRunOutputs& out);
 
 }  // namespace wobble::pipelines

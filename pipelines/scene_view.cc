@@ -60,14 +60,14 @@ Eigen::AlignedBox2d BodyBounds(const World& world, int body_index) {
   return box;
 }
 
-Eigen::AlignedBox3d SceneBounds(const ConstrainedWorld& world, const ConstrainedSceneSpec& spec) {
+Eigen::AlignedBox3d SceneBounds(const World& world, const ConstrainedSceneSpec& spec) {
   Eigen::AlignedBox3d box;
   for (int b = 0; b < world.num_bodies(); ++b) {
     if (world.kind(b) == BodyKind::kLinear) {
       const LinearDrawing* d = b < int(spec.drawings.size()) ? &spec.drawings[b] : nullptr;
       box.extend(LinearBodyBounds(world, b, d));
     } else {
-      const Eigen::AlignedBox2d flat = BodyBounds(world.ffd_world(), world.ffd_index(b));
+      const Eigen::AlignedBox2d flat = BodyBounds(world, b);
       box.extend(Eigen::Vector3d(flat.min().x(), flat.min().y(), 0.0));
       box.extend(Eigen::Vector3d(flat.max().x(), flat.max().y(), 0.0));
     }
@@ -75,7 +75,7 @@ Eigen::AlignedBox3d SceneBounds(const ConstrainedWorld& world, const Constrained
   return box;
 }
 
-bool IsFlat(const ConstrainedWorld& world) {
+bool IsFlat(const World& world) {
   for (int b = 0; b < world.num_bodies(); ++b)
     if (world.dim(b) != 2) return false;
   return true;
@@ -84,7 +84,7 @@ bool IsFlat(const ConstrainedWorld& world) {
 struct SceneView::Impl {
   const World* world = nullptr;
   int body = 0;
-  const ConstrainedWorld* cworld = nullptr;            // the other kind of view
+  const World* cworld = nullptr;            // the other kind of view
   std::vector<Ptr<vtkPolyDataAlgorithm>> csources;     // its sources, re-run every Render()
   Ptr<vtkRenderWindow> window;
   Ptr<vtkRenderer> renderer;
@@ -101,7 +101,7 @@ struct SceneView::Impl {
   vtkPolyDataMapper* colored = nullptr;  // the mapper that shows color_by, if any
   Ptr<vtkImageData> last_rgb;            // read back from the window after the last Render()
   Ptr<vtkActor> layers[7];               // by SceneLayer (the FFD view: one actor a layer)
-  std::vector<Ptr<vtkActor>> clayers[7];  // by SceneLayer (a ConstrainedWorld's: one per body)
+  std::vector<Ptr<vtkActor>> clayers[7];  // by SceneLayer (a World's: one per body)
 
   Ptr<vtkActor> AddActor(vtkPolyDataAlgorithm* source, const double rgb[3], double line_width, double point_size,
                          Ptr<vtkPolyDataMapper>* mapper_out = nullptr) {
@@ -242,7 +242,7 @@ void SceneView::SetUpOverlay() {
   }
 }
 
-SceneView::SceneView(const ConstrainedWorld* world, ConstrainedSceneSpec spec, SceneOptions options)
+SceneView::SceneView(const World* world, ConstrainedSceneSpec spec, SceneOptions options)
     : impl_(new Impl), options_(std::move(options)) {
   if (!HasDisplay())
     throw std::runtime_error("rendering needs an X display (VTK 9.1): run under xvfb-run -a -s \"-screen 0 1280x1024x24\"");
@@ -275,8 +275,8 @@ SceneView::SceneView(const ConstrainedWorld* world, ConstrainedSceneSpec spec, S
       auto shape = Ptr<ShapeSource>::New();
       shape->SetSamplesPerSegment(options_.shape_samples);
       for (WorldSourceBase* s : {(WorldSourceBase*)lattice, (WorldSourceBase*)points, (WorldSourceBase*)shape}) {
-        s->SetWorld(&world->ffd_world());
-        s->SetBody(world->ffd_index(b));
+        s->SetWorld(world);
+        s->SetBody(b);
       }
       if (options_.show_lattice) add(SceneLayer::kLattice, lattice, box_rgb, 1.0, options_.point_size * 0.75, 1);
       if (options_.show_shape) add(SceneLayer::kShape, shape, shape_rgb, options_.line_width, 1.0, 2);

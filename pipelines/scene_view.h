@@ -56,25 +56,25 @@ struct SceneOptions {
   double view_angle = 30.0;  // perspective opening, degrees
 };
 
-// What a view of a ConstrainedWorld draws besides its bodies' mass points and control boxes.
+// What a view of a World draws besides its bodies' mass points and control boxes.
 struct ConstrainedSceneSpec {
   std::vector<LinearDrawing> drawings;        // per body index; empty or missing: no shape
   std::vector<AnchorSource::Anchor> anchors;  // named points, drawn as larger dots
 };
 
 // The layers a SceneView draws; each can be shown or hidden after construction. A view of a
-// ConstrainedWorld has kLattice (control boxes, FFD lattices), kShape, kPoints and kAnchors
+// World has kLattice (control boxes, FFD lattices), kShape, kPoints and kAnchors
 // (named points); the FFD view has all but kAnchors.
 enum class SceneLayer { kGround, kLattice, kPoints, kShape, kSprings, kTrails, kAnchors };
 
 // A box holding every point of the body now: its deformed control points (by the convex-hull
 // property of the Bernstein/B-spline weights no point of the body lies outside them).
 Eigen::AlignedBox2d BodyBounds(const World& world, int body);
-// A box holding every body of a ConstrainedWorld now (linear bodies with their drawings,
+// A box holding every body of a World now (linear bodies with their drawings,
 // FFD bodies by their control points; z = 0 for 2D bodies).
-Eigen::AlignedBox3d SceneBounds(const ConstrainedWorld& world, const ConstrainedSceneSpec& spec);
+Eigen::AlignedBox3d SceneBounds(const World& world, const ConstrainedSceneSpec& spec);
 // True when every body of the world is 2D (the parallel 2D view suits it).
-bool IsFlat(const ConstrainedWorld& world);
+bool IsFlat(const World& world);
 
 class SceneView {
  public:
@@ -84,11 +84,11 @@ class SceneView {
   SceneView(const SceneView&) = delete;
   SceneView& operator=(const SceneView&) = delete;
 
-  // Every body of a ConstrainedWorld (Witkin & Welch bodies, 2D or 3D, and FFD bodies): linear
+  // Every body of a World (Witkin & Welch bodies, 2D or 3D, and FFD bodies): linear
   // bodies as control box, mass points and shape (LinearDrawing; a lit surface in 3D), FFD
   // bodies with the sources above, anchors as dots. The camera starts on the world's bodies:
   // FrameBox for a world of 2D bodies, FrameBox3d when any body is 3D. No ground is drawn.
-  SceneView(const ConstrainedWorld* world, ConstrainedSceneSpec spec, SceneOptions options = {});
+  SceneView(const World* world, ConstrainedSceneSpec spec, SceneOptions options = {});
 
   // A parallel camera looking down −z that shows `box` (world units) with a margin
   // (fraction of the box) around it, keeping the aspect ratio of the image.

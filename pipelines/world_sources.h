@@ -21,7 +21,7 @@
 #include <vector>
 #include <vtkPolyDataAlgorithm.h>
 
-#include "wobble/dynamics/world.h"
+#include "wobble/world/world.h"
 
 namespace wobble::pipelines {
 

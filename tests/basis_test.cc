@@ -4,7 +4,7 @@
 
 #include <numeric>
 
-#include "wobble/basis/basis.h"
+#include "wobble/core/basis.h"
 #include "wobble/body/lattice.h"
 
 namespace wobble {

@@ -9,9 +9,9 @@
 #include <cmath>
 #include <random>
 
-#include "test_bodies.h"
+#include "support/test_bodies.h"
 #include "wobble/analysis/conditioning.h"
-#include "wobble/dynamics/reference.h"
+#include "support/reference.h"
 
 namespace wobble::analysis {
 namespace {

@@ -9,8 +9,8 @@
 #include <cmath>
 #include <random>
 
-#include "test_bodies.h"
-#include "wobble/constraints/constrained_world.h"
+#include "support/test_bodies.h"
+#include "wobble/world/world.h"
 
 namespace wobble {
 namespace {
@@ -34,10 +34,10 @@ double InertiaAbout(const LinearBodyModel& m, const Eigen::VectorXd& pivot) {
 
 // ---------------------------------------------------------------- the canonical example
 
-TEST(ConstrainedWorld, HelloPendulum) {
-  ConstrainedWorldOptions opt;
+TEST(World, HelloPendulum) {
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 1e-3;
-  ConstrainedWorld world(opt);
+  World world(opt);
   const int bar = world.AddLinearBody(Bar2D(), AffineMaterial{200.0, 200.0, 0.0, 0.0});
   const int nail = world.AddNail(At(bar, Eigen::Vector2d(-0.5, 0.0)));  // left end stays where it is
   ASSERT_TRUE(world.RunUntil(0.5)) << world.status().message;  // about a quarter swing
@@ -73,7 +73,7 @@ TEST(LinearBody, BasisSizesAndMassMatrix) {
   EXPECT_LT((M - body->mass_matrix()).norm(), 1e-12);
   EXPECT_LT((body->inverse_mass_matrix() * M - Eigen::MatrixXd::Identity(10, 10)).norm(), 1e-9);
   // kinetic energy ½ tr(Ṙ M Ṙᵀ) equals Σ ½ m |Ṙ p_k|² over the points
-  ConstrainedWorld world;
+  World world(testing::WitkinWelchOptions());
   const int b = world.AddLinearBody(body);
   std::mt19937 rng(3);
   std::normal_distribution<double> n01;
@@ -105,9 +105,9 @@ TEST(LinearBody, RefusesPointsThatDoNotSpan) {
 
 // A free body in gravity: every point falls with g (Q = g μᵀ, R̈ = Q W).
 TEST(LinearBody, FreeFallIsUniform3D) {
-  ConstrainedWorldOptions opt;
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 1e-3;
-  ConstrainedWorld world(opt);
+  World world(opt);
   const auto model = std::make_shared<LinearBodyModel>(
       MakeBoxBody("cube", 3, LinearOrder::kQuadratic, Eigen::Vector3d(1, 1, 1), 3, 5.0));
   const int b = world.AddLinearBody(model);
@@ -213,10 +213,10 @@ TEST(AffineEnergy, VibrationFrequencyMatchesSimulation) {
   for (int i = 0; i < 2; ++i) M.block(3 * i, 3 * i, 3, 3) = model->mass_matrix();
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (H + H.transpose()), M);
   const Eigen::VectorXd v = es.eigenvectors().col(N - 1);
-  ConstrainedWorldOptions opt;
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.params.gravity_on = false;
   opt.dt = 0.01 / w.maxCoeff();
-  ConstrainedWorld world(opt);
+  World world(opt);
   const int b = world.AddLinearBody(model, mat);
   Eigen::MatrixXd R = model->RestState();
   const double amp = 1e-4 / v.cwiseAbs().maxCoeff();
@@ -241,11 +241,11 @@ TEST(AffineEnergy, VibrationFrequencyMatchesSimulation) {
   ASSERT_GE(crossings.size(), 4u);
   EXPECT_NEAR((crossings.back() - crossings.front()) / (crossings.size() - 1), T, 1e-3 * T);
   // at the suggested step a 20 % stretch stays bounded over many vibration periods
-  ConstrainedWorldOptions fast;
+  WorldOptions fast = testing::WitkinWelchOptions();
   fast.params.gravity_on = false;
   fast.dt = StableTimeStep(*model, mat);
   EXPECT_NEAR(fast.dt, 1.0 / w.maxCoeff(), 1e-12);
-  ConstrainedWorld w2(fast);
+  World w2(fast);
   const int b2 = w2.AddLinearBody(model, mat);
   w2.SetLinearState(b2, model->PlacedState(Eigen::Vector2d(1.2, 0.8).asDiagonal().toDenseMatrix(), Eigen::Vector2d::Zero()),
                     Eigen::MatrixXd::Zero(2, 3));
@@ -258,10 +258,10 @@ TEST(AffineEnergy, VibrationFrequencyMatchesSimulation) {
 
 // A stiff affine bar nailed at one end swings as a physical pendulum: T = 2π √(I_pivot / (m g L))
 // (times 1 + θ0²/16 for the amplitude θ0), with I_pivot = Σ m_k |u_k − pivot|² of its points.
-TEST(ConstrainedWorld, SmallAnglePendulumPeriodMatchesPhysicalPendulum) {
-  ConstrainedWorldOptions opt;
+TEST(World, SmallAnglePendulumPeriodMatchesPhysicalPendulum) {
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 1e-4;
-  ConstrainedWorld world(opt);
+  World world(opt);
   const auto model = Bar2D(0.5, 0.1, 1.0);
   const int bar = world.AddLinearBody(model, AffineMaterial{2e4, 2e4, 0.0, 0.0});
   const Eigen::Vector2d pivot(-0.5, 0.0);
@@ -293,12 +293,12 @@ TEST(ConstrainedWorld, SmallAnglePendulumPeriodMatchesPhysicalPendulum) {
 
 // The constraint force does no work: a frictionless, undamped nailed pendulum (swinging 60°,
 // deforming) keeps its total energy; the bound is the O(Δt) oscillation of symplectic Euler.
-TEST(ConstrainedWorld, NailedPendulumConservesEnergy) {
+TEST(World, NailedPendulumConservesEnergy) {
   for (MultiplierMethod method : {MultiplierMethod::kDense, MultiplierMethod::kSparse}) {
-    ConstrainedWorldOptions opt;
+    WorldOptions opt = testing::WitkinWelchOptions();
     opt.dt = 5e-4;
     opt.method = method;
-    ConstrainedWorld world(opt);
+    World world(opt);
     const auto model = Bar2D(0.5, 0.1, 2.0);
     const int bar = world.AddLinearBody(model, AffineMaterial{500.0, 500.0, 0.0, 0.0});
     world.AddNail(At(bar, Eigen::Vector2d(-0.5, 0.0)));
@@ -307,7 +307,7 @@ TEST(ConstrainedWorld, NailedPendulumConservesEnergy) {
     const double E0 = world.TotalEnergy();
     const double scale = model->total_mass() * 9.81 * 0.5;  // m g L: the swing's energy scale
     double worst = 0, worst_c = 0;
-    ASSERT_TRUE(world.RunUntil(20.0, [&](ConstrainedWorld& w) {
+    ASSERT_TRUE(world.RunUntil(20.0, [&](World& w) {
       worst = std::max(worst, std::abs(w.TotalEnergy() - E0));
       worst_c = std::max(worst_c, w.MaxViolation());
     })) << world.status().message;
@@ -321,10 +321,10 @@ TEST(ConstrainedWorld, NailedPendulumConservesEnergy) {
 
 // The same in 3D: an affine slab nailed at a corner swings in space (a spherical pendulum that
 // also turns about its own axis), frictionless; the energy stays within the same kind of bound.
-TEST(ConstrainedWorld, NailedPendulumConservesEnergy3D) {
-  ConstrainedWorldOptions opt;
+TEST(World, NailedPendulumConservesEnergy3D) {
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 5e-4;
-  ConstrainedWorld world(opt);
+  World world(opt);
   const auto model = std::make_shared<LinearBodyModel>(
       MakeBoxBody("slab", 3, LinearOrder::kAffine, Eigen::Vector3d(0.5, 0.15, 0.25), 3, 2.0));
   const AffineMaterial mat{500.0, 500.0, 0.0, 0.0};
@@ -336,7 +336,7 @@ TEST(ConstrainedWorld, NailedPendulumConservesEnergy3D) {
   const double E0 = world.TotalEnergy();
   const double scale = model->total_mass() * 9.81 * 0.6;  // m g × pivot-to-centre distance
   double worst = 0, worst_c = 0;
-  ASSERT_TRUE(world.RunUntil(20.0, [&](ConstrainedWorld& w) {
+  ASSERT_TRUE(world.RunUntil(20.0, [&](World& w) {
     worst = std::max(worst, std::abs(w.TotalEnergy() - E0));
     worst_c = std::max(worst_c, w.MaxViolation());
   })) << world.status().message;
@@ -346,11 +346,11 @@ TEST(ConstrainedWorld, NailedPendulumConservesEnergy3D) {
 }
 
 // Fig. 2: a triple pendulum of affine parts attached end to end, nailed at the top; long run.
-ConstrainedWorld TriplePendulum(MultiplierMethod method, double dt, std::vector<int>* links) {
-  ConstrainedWorldOptions opt;
+World TriplePendulum(MultiplierMethod method, double dt, std::vector<int>* links) {
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = dt;
   opt.method = method;
-  ConstrainedWorld world(opt);
+  World world(opt);
   const auto model = Bar2D(0.5, 0.15, 1.0);
   for (int i = 0; i < 3; ++i) {
     const int b = world.AddLinearBody(model, AffineMaterial{300.0, 300.0, 0.05, 0.0});
@@ -363,11 +363,11 @@ ConstrainedWorld TriplePendulum(MultiplierMethod method, double dt, std::vector<
   return world;
 }
 
-TEST(ConstrainedWorld, TriplePendulumViolationStaysAtRoundOff) {
+TEST(World, TriplePendulumViolationStaysAtRoundOff) {
   std::vector<int> links;
-  ConstrainedWorld world = TriplePendulum(MultiplierMethod::kAuto, 1e-3, &links);
+  World world = TriplePendulum(MultiplierMethod::kAuto, 1e-3, &links);
   double worst = 0;
-  ASSERT_TRUE(world.RunUntil(30.0, [&](ConstrainedWorld& w) { worst = std::max(worst, w.MaxViolation()); }))
+  ASSERT_TRUE(world.RunUntil(30.0, [&](World& w) { worst = std::max(worst, w.MaxViolation()); }))
       << world.status().message;
   EXPECT_LT(worst, 1e-8);
   EXPECT_EQ(world.factorizations(), 1);  // 30000 steps, one factorization
@@ -376,10 +376,10 @@ TEST(ConstrainedWorld, TriplePendulumViolationStaysAtRoundOff) {
   EXPECT_LT(world.PointPosition(At(links[2], Eigen::Vector2d(0.5, 0)))[1], 0.0);
 }
 
-TEST(ConstrainedWorld, DenseAndSparsePathsAgree) {
+TEST(World, DenseAndSparsePathsAgree) {
   std::vector<int> l1, l2;
-  ConstrainedWorld dense = TriplePendulum(MultiplierMethod::kDense, 1e-3, &l1);
-  ConstrainedWorld sparse = TriplePendulum(MultiplierMethod::kSparse, 1e-3, &l2);
+  World dense = TriplePendulum(MultiplierMethod::kDense, 1e-3, &l1);
+  World sparse = TriplePendulum(MultiplierMethod::kSparse, 1e-3, &l2);
   ASSERT_TRUE(dense.RunUntil(2.0));
   ASSERT_TRUE(sparse.RunUntil(2.0));
   for (int b = 0; b < 3; ++b) EXPECT_LT((dense.linear_R(b) - sparse.linear_R(b)).norm(), 1e-8);
@@ -389,10 +389,10 @@ TEST(ConstrainedWorld, DenseAndSparsePathsAgree) {
 
 // Feedback pulls a violated start back: begin 5 cm off the nail; c decays like the critically
 // damped c̈ = −α c − β ċ (time constant Δt / rate = 10 steps).
-TEST(ConstrainedWorld, FeedbackRemovesAnInitialViolation) {
-  ConstrainedWorldOptions opt;
+TEST(World, FeedbackRemovesAnInitialViolation) {
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 1e-3;
-  ConstrainedWorld world(opt);
+  World world(opt);
   const int bar = world.AddLinearBody(Bar2D(), AffineMaterial{1000.0, 1000.0, 0.0, 0.0});
   const int nail = world.AddNail(At(bar, Eigen::Vector2d(-0.5, 0.0)), Eigen::Vector2d(-0.5, 0.05));
   EXPECT_NEAR(world.ConstraintError(nail).norm(), 0.05, 1e-12);
@@ -402,10 +402,10 @@ TEST(ConstrainedWorld, FeedbackRemovesAnInitialViolation) {
 
 // ---------------------------------------------------------------- trajectories and switching
 
-TEST(ConstrainedWorld, TrajectoryControlFollowsPathAndSwitchingRefactorsOnlyThen) {
-  ConstrainedWorldOptions opt;
+TEST(World, TrajectoryControlFollowsPathAndSwitchingRefactorsOnlyThen) {
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 1e-3;
-  ConstrainedWorld world(opt);
+  World world(opt);
   const int bar = world.AddLinearBody(Bar2D(), AffineMaterial{100.0, 100.0, 0.05, 0.0});
   const MaterialPoint tip = At(bar, Eigen::Vector2d(0.5, 0.0));
   // a circle of radius 0.3 through the tip's rest position, starting with the tip's velocity (0)
@@ -425,7 +425,7 @@ TEST(ConstrainedWorld, TrajectoryControlFollowsPathAndSwitchingRefactorsOnlyThen
   world.SetLinearState(other, Bar2D()->PlacedState(Eigen::Matrix2d::Identity(), Eigen::Vector2d(5, 0)), Eigen::MatrixXd::Zero(2, 3));
   const int other_nail = world.AddNail(At(other, Eigen::Vector2d(-0.5, 0.0)));
   double worst = 0;
-  ASSERT_TRUE(world.RunUntil(2.0, [&](ConstrainedWorld& wd) { worst = std::max(worst, wd.ConstraintError(control).norm()); }));
+  ASSERT_TRUE(world.RunUntil(2.0, [&](World& wd) { worst = std::max(worst, wd.ConstraintError(control).norm()); }));
   std::printf("circle path: max |c| = %.3g over 2 s\n", worst);
   // The largest error is the onset transient: the staggered start velocity 0 differs from
   // ṅ(−Δt/2) = −½Δt n̈(0), so it is O(Δt²) (9e-7 here, 2.3e-7 at half the step, 3.6e-6 at twice).
@@ -469,7 +469,7 @@ TEST(ConstrainedWorld, TrajectoryControlFollowsPathAndSwitchingRefactorsOnlyThen
 
 // One free body: the impulse I = λ pᵀ that changes the velocity at p by Δv is ΔṘ = Δv (W p)ᵀ / (pᵀ W p).
 TEST(Impulse, StopDeadOnAFreeBodyMatchesClosedForm) {
-  ConstrainedWorld world;
+  World world(testing::WitkinWelchOptions());
   const auto model = Bar2D();
   const int bar = world.AddLinearBody(model);
   Eigen::MatrixXd Rd(2, 3);
@@ -487,9 +487,9 @@ TEST(Impulse, StopDeadOnAFreeBodyMatchesClosedForm) {
 // Impulses with constraints: a pendulum's tip bounces (velocity reversed) and another is stopped
 // dead; the nail keeps ċ = 0 through the jumps; conflicting goals are refused with nothing changed.
 TEST(Impulse, BounceAndStopKeepConstraints3D) {
-  ConstrainedWorldOptions opt;
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 1e-3;
-  ConstrainedWorld world(opt);
+  World world(opt);
   const auto model = std::make_shared<LinearBodyModel>(
       MakeBoxBody("slab", 3, LinearOrder::kAffine, Eigen::Vector3d(0.5, 0.1, 0.2), 3, 1.0));
   const int a = world.AddLinearBody(model, AffineMaterial{500, 500, 0, 0});
@@ -516,9 +516,9 @@ TEST(Impulse, BounceAndStopKeepConstraints3D) {
 
 // Connect (§4.2): a velocity-matching impulse between two bodies, then an attachment.
 TEST(Impulse, ConnectMatchesVelocitiesThenAttaches) {
-  ConstrainedWorldOptions opt;
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 1e-3;
-  ConstrainedWorld world(opt);
+  World world(opt);
   const auto model = Bar2D();
   const int a = world.AddLinearBody(model, AffineMaterial{500, 500, 0, 0});
   const int b = world.AddLinearBody(model, AffineMaterial{500, 500, 0, 0});
@@ -540,8 +540,8 @@ TEST(Impulse, ConnectMatchesVelocitiesThenAttaches) {
 
 // ---------------------------------------------------------------- bad input
 
-TEST(ConstrainedWorld, BadInputIsReportedNotNaN) {
-  ConstrainedWorld world;
+TEST(World, BadInputIsReportedNotNaN) {
+  World world(testing::WitkinWelchOptions());
   const auto model = Bar2D();
   const int bar = world.AddLinearBody(model);
   EXPECT_THROW(world.AddNail(At(7, Eigen::Vector2d(0, 0))), std::invalid_argument);           // unknown body
@@ -563,7 +563,7 @@ TEST(ConstrainedWorld, BadInputIsReportedNotNaN) {
   const int extra = world.AddNail(At(bar, Eigen::Vector2d(0.0, 0.0)));
   const Eigen::MatrixXd R = world.linear_R(bar);
   EXPECT_FALSE(world.Step());
-  EXPECT_EQ(world.status().code, ConstrainedStatus::Code::kSingularConstraints);
+  EXPECT_EQ(world.status().code, WorldStatus::Code::kSingularConstraints);
   EXPECT_NE(world.status().message.find("redundant"), std::string::npos) << world.status().message;
   EXPECT_EQ(world.linear_R(bar), R);  // nothing moved, nothing NaN
   // switching the redundant nail off makes the set legal again
@@ -573,27 +573,27 @@ TEST(ConstrainedWorld, BadInputIsReportedNotNaN) {
   EXPECT_TRUE(world.linear_R(bar).allFinite());
   // a path that returns NaN stops the run with the cause, before anything moves
   {
-    ConstrainedWorld w3;
+    World w3(testing::WitkinWelchOptions());
     const int b = w3.AddLinearBody(model);
     w3.AddTrajectory(At(b, Eigen::Vector2d(0.5, 0)), std::make_shared<FunctionPath>(2, [](double t) {
       const double v = t > 0.01 ? std::nan("") : 0.0;
       return PathSample{Eigen::Vector2d(0.5, v), Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
     }));
     EXPECT_FALSE(w3.RunUntil(1.0));
-    EXPECT_EQ(w3.status().code, ConstrainedStatus::Code::kBadPath);
+    EXPECT_EQ(w3.status().code, WorldStatus::Code::kBadPath);
     EXPECT_NE(w3.status().message.find("non-finite sample"), std::string::npos) << w3.status().message;
     EXPECT_TRUE(w3.linear_R(b).allFinite());
   }
   // the same point nailed twice is also redundant (dense and sparse)
   for (MultiplierMethod method : {MultiplierMethod::kDense, MultiplierMethod::kSparse}) {
-    ConstrainedWorldOptions opt;
+    WorldOptions opt = testing::WitkinWelchOptions();
     opt.method = method;
-    ConstrainedWorld w2(opt);
+    World w2(opt);
     const int b = w2.AddLinearBody(model);
     w2.AddNail(At(b, Eigen::Vector2d(0.5, 0)));
     w2.AddNail(At(b, Eigen::Vector2d(0.5, 0)));
     EXPECT_FALSE(w2.Step());
-    EXPECT_EQ(w2.status().code, ConstrainedStatus::Code::kSingularConstraints) << MultiplierMethodName(method);
+    EXPECT_EQ(w2.status().code, WorldStatus::Code::kSingularConstraints) << MultiplierMethodName(method);
     EXPECT_TRUE(w2.linear_R(b).allFinite());
   }
 }
@@ -617,17 +617,17 @@ struct FfdRun {
 };
 
 FfdRun RunNailedTable(double dt) {
-  ConstrainedWorldOptions opt;
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = dt;
   opt.params.ground.enabled = false;
-  ConstrainedWorld world(opt);  // the project's units: g = 9.81, lattice units are metres
-  const int table = world.AddFfdBody(Table(4e6, 0.0));  // K of data/table_modes.def
+  World world(opt);  // the project's units: g = 9.81, lattice units are metres
+  const int table = world.AddBody(Table(4e6, 0.0));  // K of data/table_modes.def
   const int nail = world.AddNail(At(table, Eigen::Vector2d(0.0, 1.0)));  // top-left corner
   EXPECT_LT(world.ConstraintError(nail).norm(), 1e-12);
   const double E0 = world.TotalEnergy();
   const double scale = 550.0 * 9.81 * 150.0;  // m g × half the table: the swing's energy scale
   FfdRun r;
-  EXPECT_TRUE(world.RunUntil(20.0, [&](ConstrainedWorld& w) {
+  EXPECT_TRUE(world.RunUntil(20.0, [&](World& w) {
     r.energy = std::max(r.energy, std::abs(w.TotalEnergy() - E0) / scale);
     r.violation = std::max(r.violation, w.MaxViolation());
   })) << world.status().message;
@@ -652,11 +652,11 @@ TEST(FfdConstraints, TableNailedAtCornerHoldsAndConservesEnergy) {
 // Impulses on an FFD body (J at the current q, W through its mass solve): the swinging table's
 // far corner stops dead while the nailed corner keeps ċ = 0.
 TEST(FfdConstraints, ImpulseStopsAnFfdPointDead) {
-  ConstrainedWorldOptions opt;
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 0.005;
   opt.params.ground.enabled = false;
-  ConstrainedWorld world(opt);
-  const int table = world.AddFfdBody(Table(4e6, 0.0));
+  World world(opt);
+  const int table = world.AddBody(Table(4e6, 0.0));
   const int nail = world.AddNail(At(table, Eigen::Vector2d(0.0, 1.0)));
   ASSERT_TRUE(world.RunUntil(3.0)) << world.status().message;
   const MaterialPoint far = At(table, Eigen::Vector2d(1.0, 0.0));
@@ -669,11 +669,11 @@ TEST(FfdConstraints, ImpulseStopsAnFfdPointDead) {
 
 // An FFD table hanging by its top-right corner from the end of a nailed affine bar.
 double RunTableOnBar(double dt, Eigen::VectorXd* gap) {
-  ConstrainedWorldOptions opt;
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = dt;
   opt.params.ground.enabled = false;
-  ConstrainedWorld world(opt);
-  const int table = world.AddFfdBody(Table(4e6, 1e6));  // data/table_modes.def's K and c
+  World world(opt);
+  const int table = world.AddBody(Table(4e6, 1e6));  // data/table_modes.def's K and c
   const auto bar_model = Bar2D(100.0, 30.0, 200.0);
   const AffineMaterial stiff{1e7, 1e7, 0.0, 0.0};
   EXPECT_LE(dt, StableTimeStep(*bar_model, stiff));
@@ -685,7 +685,7 @@ double RunTableOnBar(double dt, Eigen::VectorXd* gap) {
   const int joint = world.AddAttachment(At(table, Eigen::Vector2d(1.0, 1.0)), At(bar, Eigen::Vector2d(-100, 0)));
   EXPECT_LT(world.ConstraintError(joint).norm(), 1e-9);
   double worst = 0, lowest = 1e9;
-  EXPECT_TRUE(world.RunUntil(20.0, [&](ConstrainedWorld& w) {
+  EXPECT_TRUE(world.RunUntil(20.0, [&](World& w) {
     worst = std::max(worst, w.MaxViolation());
     lowest = std::min(lowest, w.PointPosition(At(bar, Eigen::Vector2d(-100, 0)))[1]);
   })) << world.status().message;
@@ -704,18 +704,18 @@ TEST(FfdConstraints, TableAttachedToLinearBody) {
 }
 
 // Fig. 1: a 3D quadratic body held at its right corners and pulled left at its left end bends.
-TEST(ConstrainedWorld, QuadraticBodyHeldAndPulledBends3D) {
-  ConstrainedWorldOptions opt;
+TEST(World, QuadraticBodyHeldAndPulledBends3D) {
+  WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = 1e-3;
   opt.params.gravity_on = false;
-  ConstrainedWorld world(opt);
+  World world(opt);
   const auto model = std::make_shared<LinearBodyModel>(
       MakeBoxBody("block", 3, LinearOrder::kQuadratic, Eigen::Vector3d(1.0, 0.3, 0.3), 3, 10.0));
   const int b = world.AddLinearBody(model, AffineMaterial{200, 200, 2.0, 50});
   for (double y : {-0.3, 0.3})
     for (double z : {-0.3, 0.3}) world.AddNail(At(b, Eigen::Vector3d(1.0, y, z)));
   double worst = 0;
-  ASSERT_TRUE(world.RunUntil(3.0, [&](ConstrainedWorld& w) {
+  ASSERT_TRUE(world.RunUntil(3.0, [&](World& w) {
     w.ApplyPointForce(At(b, Eigen::Vector3d(-1.0, 0.3, 0.0)), Eigen::Vector3d(-40.0, 0, 0));
     worst = std::max(worst, w.MaxViolation());
   })) << world.status().message;

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <memory>
 
-#include "test_bodies.h"
+#include "support/test_bodies.h"
 #include "wobble/control/control.h"
-#include "wobble/dynamics/world.h"
+#include "wobble/world/world.h"
 
 namespace wobble {
 namespace {

@@ -7,17 +7,17 @@
 #include <random>
 #include <sstream>
 
-#include "test_bodies.h"
+#include "support/test_bodies.h"
 #include "wobble/fit/pose_fit.h"
-#include "wobble/io/parse_error.h"
-#include "wobble/io/target_file.h"
+#include "wobble/formats/parse_error.h"
+#include "wobble/formats/target_file.h"
 
 namespace wobble {
 namespace {
 
 using fit::PoseFitOptions;
 using fit::PoseFitResult;
-using io::PointTarget;
+using formats::PointTarget;
 
 BodyModel Table() { return BodyModel(testing::TableDef(), testing::TableModes()); }
 
@@ -217,12 +217,12 @@ TEST(PoseFit, NearlyDependentModesArePoorlyDetermined) {
 // ---- without correspondences ----
 
 // The table's drawing deformed by q, as polylines of `n` points each.
-io::TargetFile DrawnTarget(const BodyModel& body, const Eigen::VectorXd& q, int n, double noise, unsigned seed) {
+formats::TargetFile DrawnTarget(const BodyModel& body, const Eigen::VectorXd& q, int n, double noise, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> g(0.0, noise);
-  io::TargetFile f;
+  formats::TargetFile f;
   for (const Polyline& line : body.def().shapes) {
-    io::TargetCurve c;
+    formats::TargetCurve c;
     for (int i = 0; i < n; ++i) {
       const Eigen::Vector2d p = line.points[0] + (line.points[1] - line.points[0]) * (double(i) / (n - 1));
       c.points.push_back(Place(body, -1, body.lattice().LocalCoords(p), q) +
@@ -237,7 +237,7 @@ TEST(CurveFit, RecoversQFromTheDrawnShape) {
   const BodyModel body = Table();
   for (double noise : {0.0, 0.3})
   for (bool joint : {true, false}) {
-    const io::TargetFile target = DrawnTarget(body, KnownQ(), 60, noise, 5);
+    const formats::TargetFile target = DrawnTarget(body, KnownQ(), 60, noise, 5);
     PoseFitOptions o;
     o.joint_closest_points = joint;
     const PoseFitResult r = fit::FitPoseToCurve(body, fit::CurveTarget::From(target), o);
@@ -266,8 +266,8 @@ TEST(CurveFit, StartsFromThePrincipalAxisEvenUpsideDown) {
 TEST(CurveFit, CloudTargetAndUnreachableShape) {
   const BodyModel body = Table();
   // a point cloud: points of the drawing at the known pose, shuffled (no order, no segments)
-  io::TargetFile cloud;
-  for (const io::TargetCurve& c : DrawnTarget(body, KnownQ(), 20, 0.0, 1).polylines)
+  formats::TargetFile cloud;
+  for (const formats::TargetCurve& c : DrawnTarget(body, KnownQ(), 20, 0.0, 1).polylines)
     cloud.cloud.insert(cloud.cloud.end(), c.points.begin(), c.points.end());
   std::shuffle(cloud.cloud.begin(), cloud.cloud.end(), std::mt19937(3));
   const PoseFitResult r = fit::FitPoseToCurve(body, fit::CurveTarget::From(cloud), PoseFitOptions());
@@ -275,7 +275,7 @@ TEST(CurveFit, CloudTargetAndUnreachableShape) {
   // a body sample is as far as the nearest cloud point: at most half the spacing (300 / 19)
   EXPECT_LT(r.rms_residual, 0.5 * 300.0 / 19.0);
   // a short dash the 300-wide table cannot shrink to (|γ| <= 1): an honest residual, not a failure
-  io::TargetFile dash;
+  formats::TargetFile dash;
   dash.polylines.push_back({{{0, 0}, {10, 0}}, false});
   const PoseFitResult rc = fit::FitPoseToCurve(body, fit::CurveTarget::From(dash), PoseFitOptions());
   EXPECT_TRUE(rc.report.usable);
@@ -288,8 +288,8 @@ TEST(CurveFit, CloudTargetAndUnreachableShape) {
 std::string ParseMessage(const std::string& text) {
   std::istringstream in(text);
   try {
-    io::ParseTargets(in, "t.tgt");
-  } catch (const io::ParseError& e) {
+    formats::ParseTargets(in, "t.tgt");
+  } catch (const formats::ParseError& e) {
     return e.what();
   }
   return "no error";
@@ -300,7 +300,7 @@ TEST(TargetFile, ParsesEveryStatement) {
       "# a comment\n"
       "point 3 10 20\n"
       "sample 0.5 1 1.5 -2 weight 4   # the top's middle\n");
-  const io::TargetFile f = io::ParseTargets(in, "t.tgt");
+  const formats::TargetFile f = formats::ParseTargets(in, "t.tgt");
   ASSERT_EQ(f.points.size(), 2u);
   EXPECT_EQ(f.points[0].mass_point, 3);
   EXPECT_EQ(f.points[0].position, Eigen::Vector2d(10, 20));
@@ -309,10 +309,10 @@ TEST(TargetFile, ParsesEveryStatement) {
   EXPECT_EQ(f.points[1].weight, 4.0);
   EXPECT_EQ(f.points[1].line, 3);
   std::istringstream curve("polyline 0 0 1 0 1 1 closed\ncloud 5 5\n");
-  const io::TargetFile c = io::ParseTargets(curve, "c.tgt");
+  const formats::TargetFile c = formats::ParseTargets(curve, "c.tgt");
   EXPECT_EQ(fit::CurveTarget::From(c).a.size(), 4u);  // 3 closed segments + 1 cloud point
   std::istringstream traj("frame 0\npoint 0 1 2\nframe 0.5\npoint 0 1 3\nsample 0 0 1 1\n");
-  const io::TargetFile t = io::ParseTargets(traj, "k.tgt");
+  const formats::TargetFile t = formats::ParseTargets(traj, "k.tgt");
   ASSERT_EQ(t.frames.size(), 2u);
   EXPECT_EQ(t.frames[1].points.size(), 2u);
 }
@@ -331,11 +331,11 @@ TEST(TargetFile, RejectsMalformedInputWithFileAndLine) {
   EXPECT_EQ(ParseMessage("frame 1\nframe 2\npoint 0 0 0\n"), "t.tgt:1: frame has no point or sample lines");
   EXPECT_EQ(ParseMessage("wobble 1\n"), "t.tgt:1: unknown keyword 'wobble' (expected point, sample, polyline, cloud or frame)");
   std::istringstream in("point 0 1 2\n\npoint 11 1 2\n");
-  const io::TargetFile f = io::ParseTargets(in, "t.tgt");
+  const formats::TargetFile f = formats::ParseTargets(in, "t.tgt");
   try {
-    io::CheckMassPointIndices(f, 11);
+    formats::CheckMassPointIndices(f, 11);
     FAIL() << "index 11 accepted";
-  } catch (const io::ParseError& e) {
+  } catch (const formats::ParseError& e) {
     EXPECT_STREQ(e.what(), "t.tgt:3: mass point 11 does not exist: the body has 11 (numbered from 0)");
   }
 }

@@ -8,9 +8,9 @@
 #include <Eigen/SVD>
 #include <random>
 
-#include "test_bodies.h"
+#include "support/test_bodies.h"
 #include "wobble/dynamics/kinematics.h"
-#include "wobble/dynamics/reference.h"
+#include "support/reference.h"
 
 namespace wobble {
 namespace {

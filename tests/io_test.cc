@@ -9,10 +9,10 @@
 #include <sstream>
 
 #include "wobble/body/body_model.h"
-#include "wobble/io/deformation_file.h"
-#include "wobble/io/object_file.h"
+#include "wobble/formats/deformation_file.h"
+#include "wobble/formats/object_file.h"
 
-namespace wobble::io {
+namespace wobble::formats {
 namespace {
 
 const std::string kData = WOBBLE_DATA_DIR;
@@ -488,4 +488,4 @@ TEST(ioObjectFileErrors, MissingFile) {
 }
 
 }  // namespace
-}  // namespace wobble::io
+}  // namespace wobble::formats

@@ -6,7 +6,7 @@
 
 #include <memory>
 
-#include "test_bodies.h"
+#include "support/test_bodies.h"
 #include "wobble/dynamics/step.h"
 
 namespace wobble {

@@ -158,14 +158,15 @@ TEST(Preroll, MeetsThePointsStateNowAndThePathsStateAtOnset) {
 }  // namespace wobble::control
 
 // ---------------------------------------------------------------------------------------------
-// The same paths driving points of linear bodies in a ConstrainedWorld, and the behaviours.
+// The same paths driving points of linear bodies in a World, and the behaviours.
 #include "wobble/control/behaviours.h"
+#include "support/test_bodies.h"
 
 namespace wobble::control {
 namespace {
 
 // An affine block (3D when dim = 3) of unit mass centred at `at`, at rest, somewhat stiff.
-int AddBlock(ConstrainedWorld* w, int dim, const Eigen::VectorXd& at, const std::string& name,
+int AddBlock(World* w, int dim, const Eigen::VectorXd& at, const std::string& name,
              LinearOrder order = LinearOrder::kAffine) {
   Eigen::VectorXd half = Eigen::VectorXd::Constant(dim, 0.2);
   half[0] = 0.5;
@@ -180,8 +181,8 @@ int AddBlock(ConstrainedWorld* w, int dim, const Eigen::VectorXd& at, const std:
   return b;
 }
 
-ConstrainedWorldOptions Options(double dt, bool gravity) {
-  ConstrainedWorldOptions o;
+WorldOptions Options(double dt, bool gravity) {
+  WorldOptions o = testing::WitkinWelchOptions();
   o.dt = dt;
   o.params.gravity_on = gravity;
   return o;
@@ -194,7 +195,7 @@ struct FollowResult {
 // The left end of a block under gravity driven through four 3D keys from rest; the rest of
 // the block dangles from it.
 FollowResult FollowKeys(double dt) {
-  ConstrainedWorld w(Options(dt, true));
+  World w(Options(dt, true));
   const int b = AddBlock(&w, 3, V({0, 0, 0}), "block");
   const MaterialPoint end = At(b, V({-0.5, 0, 0}));
   // keys start where the point is, at rest (clamped start velocity 0): no preroll needed
@@ -249,7 +250,7 @@ struct PrerollResult {
 // A block is thrown (moving, spinning); 0.4 s before the path's onset control starts on a
 // preroll cubic from the point's state then.
 PrerollResult ThrowAndPreroll(double dt) {
-  ConstrainedWorld w(Options(dt, true));
+  World w(Options(dt, true));
   const int b = AddBlock(&w, 2, V({0, 0}), "block");
   Eigen::MatrixXd Rd = Eigen::MatrixXd::Zero(2, 3);
   Rd.col(2) = V({1.5, 3.0});  // translation velocity
@@ -306,7 +307,7 @@ TEST(TrajectoryControl, PrerollMeetsThePathsPositionAndVelocityAtOnset) {
 
 // A chaser block and a target block; the target moves at constant velocity (gravity off).
 struct ChaseScene {
-  ConstrainedWorld w;
+  World w(testing::WitkinWelchOptions());
   int chaser, target;
   MaterialPoint hand, handle;
   ConstraintNames names;
@@ -403,7 +404,7 @@ TEST(Sequencer, GrabReleaseAndWaitForChainInOrder) {
   s.seq.Add(std::make_unique<Wait>(0.5));            // holds until 1.5 s
   s.seq.Add(std::make_unique<Release>("connect:hand"));
   s.seq.Add(std::make_unique<Impulse>(hand, V({0, 1, 0})));  // the hand is thrown up, alone
-  s.seq.Add(std::make_unique<WaitFor>("hand above 1.8", [&](const ConstrainedWorld& cw) {
+  s.seq.Add(std::make_unique<WaitFor>("hand above 1.8", [&](const World& cw) {
     return cw.PointPosition(s.hand)[1] >= 1.8;
   }));
   s.seq.AddGrab(hand, sky, 1.0);

@@ -8,8 +8,8 @@
 #include <random>
 #include <algorithm>
 
-#include "test_bodies.h"
-#include "wobble/dynamics/world.h"
+#include "support/test_bodies.h"
+#include "wobble/world/world.h"
 
 namespace wobble {
 namespace {

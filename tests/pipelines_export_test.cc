@@ -26,12 +26,12 @@
 #include "pipelines/charts.h"
 #include "pipelines/energy_charts.h"
 #include "pipelines/exports.h"
-#include "wobble/dynamics/reference.h"
+#include "support/reference.h"
 #include <Eigen/Eigenvalues>
 #include "pipelines/exr_io.h"
 #include "pipelines/scene_view.h"
-#include "pipelines_test_util.h"
-#include "wobble/io/atomic_file.h"
+#include "support/pipelines_test_util.h"
+#include "wobble/formats/atomic_file.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -327,7 +327,7 @@ class FailedWrite : public ::testing::Test {
     ASSERT_NO_THROW(write());
     const std::string before = ReadAll(path);
     ASSERT_FALSE(before.empty());
-    const std::string tmp = io::TempPathFor(path);
+    const std::string tmp = formats::TempPathFor(path);
     if (disk_full) {
       fs::create_symlink("/dev/full", tmp);
     } else {

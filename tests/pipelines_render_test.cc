@@ -26,8 +26,9 @@
 #include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
 #include "wobble/body/linear_shapes.h"
-#include "pipelines_test_util.h"
-#include "render_baseline.h"
+#include "support/pipelines_test_util.h"
+#include "support/render_baseline.h"
+#include "support/test_bodies.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -193,7 +194,7 @@ TEST(RenderRegression, ScalarFieldWithColourLegend) {
 // and lifted, and two named points.
 TEST(RenderRegression, ConstrainedScene3d) {
   REQUIRE_DISPLAY();
-  ConstrainedWorld world;
+  World world(testing::WitkinWelchOptions());
   Eigen::VectorXd half(3);
   half << 1.0, 0.5, 0.5;
   auto block = std::make_shared<const LinearBodyModel>(MakeBoxBody("block", 3, LinearOrder::kQuadratic, half, 3, 1.0));

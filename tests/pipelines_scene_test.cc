@@ -20,6 +20,7 @@
 #include "pipelines/scene_run.h"
 #include "pipelines/scene_view.h"
 #include "wobble/body/linear_shapes.h"
+#include "support/test_bodies.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -41,7 +42,7 @@ Eigen::Vector3d PointOf(vtkPolyData* d, vtkIdType i) {
 }
 
 TEST(LinearSources, AffineMassPointsAreAuPlusT) {
-  ConstrainedWorld w;
+  World w(testing::WitkinWelchOptions());
   auto model = std::make_shared<const LinearBodyModel>(MakeBoxBody("b", 3, LinearOrder::kAffine, V({0.5, 0.3, 0.2}), 3, 2.0));
   const int b = w.AddLinearBody(model);
   Eigen::Matrix3d A;
@@ -75,7 +76,7 @@ TEST(LinearSources, AffineMassPointsAreAuPlusT) {
 TEST(LinearSources, QuadraticControlBoxAndShapeFollowTheSecondOrderTerms) {
   // 2D quadratic: x = R [x, y, 1, xy, x², y²]: a bend y += c x² moves the box's and the
   // drawing's sampled points by exactly c x²
-  ConstrainedWorld w;
+  World w(testing::WitkinWelchOptions());
   auto model = std::make_shared<const LinearBodyModel>(MakeBoxBody("q", 2, LinearOrder::kQuadratic, V({1.0, 0.25}), 3, 1.0));
   const int b = w.AddLinearBody(model);
   Eigen::MatrixXd R = model->RestState();
@@ -144,26 +145,26 @@ TEST(LinearSources, PyramidDrawingAndBodyAreConsistent) {
 }
 
 // Three frames of a body moving at constant velocity.
-std::vector<control::SceneFrame> MovingFrames(ConstrainedWorld* w, int b) {
-  std::vector<control::SceneFrame> frames;
+std::vector<record::SceneFrame> MovingFrames(World* w, int b) {
+  std::vector<record::SceneFrame> frames;
   Eigen::MatrixXd Rd = Eigen::MatrixXd::Zero(3, 4);
   Rd.col(3) << 1.0, 0.0, 0.0;
   w->SetLinearState(b, w->linear_R(b), Rd);
   for (int k = 0; k < 3; ++k) {
-    frames.push_back(control::CaptureFrame(*w));
+    frames.push_back(record::CaptureFrame(*w));
     w->RunUntil(w->time() + 0.1);
   }
   return frames;
 }
 
 TEST(SceneRun, WritesAPvdSeriesThatVtkReadsBack) {
-  ConstrainedWorldOptions o;
+  WorldOptions o = testing::WitkinWelchOptions();
   o.params.gravity_on = false;
   o.dt = 0.01;
-  ConstrainedWorld w(o);
+  World w(o);
   auto model = std::make_shared<const LinearBodyModel>(MakeBoxBody("cube", 3, LinearOrder::kAffine, V({0.5, 0.5, 0.5}), 2, 1.0));
   const int b = w.AddLinearBody(model);
-  const std::vector<control::SceneFrame> frames = MovingFrames(&w, b);
+  const std::vector<record::SceneFrame> frames = MovingFrames(&w, b);
   ConstrainedSceneSpec spec;
   spec.drawings = {MakeBoxDrawing(V({0.5, 0.5, 0.5}), 2)};
   SceneRunOutputs out;
@@ -200,10 +201,10 @@ TEST(SceneRun, WritesAPvdSeriesThatVtkReadsBack) {
 
 TEST(SceneRun, FramesAndFilmstripWithADisplay) {
   if (!HasDisplay()) GTEST_SKIP() << "no reachable X display: VTK 9.1 renders only through X";
-  ConstrainedWorld w;
+  World w(testing::WitkinWelchOptions());
   auto model = std::make_shared<const LinearBodyModel>(MakeBoxBody("cube", 3, LinearOrder::kAffine, V({0.5, 0.5, 0.5}), 2, 1.0));
   const int b = w.AddLinearBody(model);
-  const std::vector<control::SceneFrame> frames = MovingFrames(&w, b);
+  const std::vector<record::SceneFrame> frames = MovingFrames(&w, b);
   SceneRunOutputs out;
   out.folder = (fs::temp_directory_path() / "wobble_scene_run_png").string();
   fs::remove_all(out.folder);

@@ -12,7 +12,7 @@
 #include <vtkSmartPointer.h>
 
 #include "pipelines/world_sources.h"
-#include "pipelines_test_util.h"
+#include "support/pipelines_test_util.h"
 
 namespace wobble::pipelines {
 namespace {

@@ -32,9 +32,9 @@
 #include "pipelines/interactive_scene_view.h"
 #include "pipelines/interactive_view.h"
 #include "pipelines/scene_run.h"
-#include "pipelines_test_util.h"
-#include "render_baseline.h"
-#include "wobble/io/script.h"
+#include "support/pipelines_test_util.h"
+#include "support/render_baseline.h"
+#include "wobble/script/interpreter.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -260,7 +260,7 @@ void ExpectReplayMatches(InteractiveView& view, const std::string& name) {
   const std::string path = dir + "/session.wob";
   view.SaveSession(path);
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   interp.RunFile(path);
   const Eigen::VectorXd& q = interp.q();
   ASSERT_EQ(q.size(), view.world().state(0).q.size());
@@ -302,9 +302,9 @@ TEST(InteractiveView, ScriptPoseGraphDrivesTheTargetsAndReplays) {
                         << "pose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\npose 0 0.1 0.4\n"
                         << "spring 0.5 1 150 200 200 10\n";
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   interp.RunFile(script);
-  const io::Interpreter::SimulationSetup setup = interp.CurrentSetup();
+  const script::Interpreter::SimulationSetup setup = interp.CurrentSetup();
   ASSERT_TRUE(setup.body);
   ASSERT_EQ(setup.world.params.springs.size(), 1u);
   const ViewerScene scene = ViewerScene::FromScript(setup);
@@ -355,7 +355,7 @@ TEST(InteractiveView, RecordedPosesBecomeACyclicPoseGraphScript) {
   ASSERT_EQ(files.size(), 2u);
   EXPECT_EQ(files[1], dir + "/s_poses.wob");
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   interp.RunFile(files[1]);  // parses and runs: 2 poses, 3 periods
   EXPECT_EQ(interp.pose_graph().poses.size(), 2u);
   EXPECT_TRUE(interp.pose_graph().cyclic);
@@ -367,7 +367,7 @@ TEST(InteractiveView, RecordedPosesBecomeACyclicPoseGraphScript) {
 }
 
 // Runs a scene script up to its first `simul`, as `wobble view` does.
-void RunUpToSimul(io::Interpreter* interp, const std::string& path) {
+void RunUpToSimul(script::Interpreter* interp, const std::string& path) {
   std::ifstream in(path);
   ASSERT_TRUE(in) << path;
   std::string line;
@@ -380,8 +380,8 @@ void RunUpToSimul(io::Interpreter* interp, const std::string& path) {
   }
 }
 
-InteractiveSceneInput SceneInput(io::Interpreter* interp) {
-  const io::SceneRenderRequest d = interp->SceneDrawing();
+InteractiveSceneInput SceneInput(script::Interpreter* interp) {
+  const script::SceneRenderRequest d = interp->SceneDrawing();
   InteractiveSceneInput input;
   input.world = interp->mutable_scene();
   input.spec = SceneSpecOf(*d.drawings, d.anchors);
@@ -396,7 +396,7 @@ const std::string kFig2 = kData + "/fig2_triple_pendulum.wob";
 TEST(InteractiveSceneView, Fig2StepsTheScriptsSceneAsSimulDoes) {
   REQUIRE_DISPLAY();
   std::ostringstream log;
-  io::Interpreter interp(log);
+  script::Interpreter interp(log);
   RunUpToSimul(&interp, kFig2);
   ASSERT_NE(interp.scene(), nullptr);
   InteractiveSceneView view(SceneInput(&interp), TestOptions());
@@ -412,7 +412,7 @@ TEST(InteractiveSceneView, Fig2StepsTheScriptsSceneAsSimulDoes) {
   EXPECT_LT(interp.ScenePoint("tip")[1], -0.5);
   // an interpreter that runs `simul 1` itself ends in the same state
   std::ostringstream log2;
-  io::Interpreter ref(log2);
+  script::Interpreter ref(log2);
   RunUpToSimul(&ref, kFig2);
   ref.RunLine("simul 1", "<test>", 1, kData);
   for (const char* name : {"elbow1", "elbow2", "tip"})
@@ -422,7 +422,7 @@ TEST(InteractiveSceneView, Fig2StepsTheScriptsSceneAsSimulDoes) {
 TEST(InteractiveSceneView, DragTakesThePickedPointToTheCursorAndReleaseRemovesIt) {
   REQUIRE_DISPLAY();
   std::ostringstream log;
-  io::Interpreter interp(log);
+  script::Interpreter interp(log);
   RunUpToSimul(&interp, kFig2);
   InteractiveSceneView view(SceneInput(&interp), TestOptions());
   view.Initialize();
@@ -476,7 +476,7 @@ long CountColourEverywhere(vtkImageData* image, double r, double g, double b) {
 TEST(InteractiveSceneView, KeyTogglesTheAnchors) {
   REQUIRE_DISPLAY();
   std::ostringstream log;
-  io::Interpreter interp(log);
+  script::Interpreter interp(log);
   RunUpToSimul(&interp, kFig2);
   InteractiveSceneView view(SceneInput(&interp), TestOptions());
   view.Initialize();

@@ -8,8 +8,8 @@
 #include <cmath>
 #include <iostream>
 
-#include "test_bodies.h"
-#include "wobble/dynamics/world.h"
+#include "support/test_bodies.h"
+#include "wobble/world/world.h"
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/trajectory_fit.h"
 
@@ -39,7 +39,7 @@ struct Case {
   std::shared_ptr<const BodyModel> body = Table();
   fit::DynamicFitOptions options;
   fit::DynamicParameters truth;
-  std::vector<io::TargetFrame> frames;
+  std::vector<formats::TargetFrame> frames;
   std::vector<Eigen::VectorXd> q;  // World's states, every step
   Case(bool ground, int steps) {
     options.world.ground.enabled = ground;

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "wobble/io/script.h"
+#include "wobble/script/interpreter.h"
 
 namespace wobble {
 namespace {
@@ -14,11 +14,11 @@ namespace {
 const std::string kData = WOBBLE_DATA_DIR;
 
 // Runs `text` as a script named "s.wob"; returns the error message ("" when it ran).
-std::string RunScript(io::Interpreter& interp, const std::string& text) {
+std::string RunScript(script::Interpreter& interp, const std::string& text) {
   std::istringstream in(text);
   try {
     interp.RunStream(in, "s.wob", "");
-  } catch (const io::ParseError& e) {
+  } catch (const formats::ParseError& e) {
     return e.what();
   }
   return "";
@@ -26,7 +26,7 @@ std::string RunScript(io::Interpreter& interp, const std::string& text) {
 
 std::string RunFresh(const std::string& text) {
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   return RunScript(interp, text);
 }
 
@@ -141,11 +141,11 @@ TEST(SceneScript, Fig2PendulumKeepsItsNailJointsAndEnergyAndRendersEveryFrame) {
   // motion and constraint forces do no work, the total energy stays what it was: 0 (at rest,
   // at y = 0, undeformed). The scene's `render` reaches the hook with every recorded frame.
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   int hook_calls = 0;
   size_t frames = 0;
   std::string folder;
-  interp.SetSceneRenderHook([&](const io::SceneRenderRequest& r) {
+  interp.SetSceneRenderHook([&](const script::SceneRenderRequest& r) {
     ++hook_calls;
     frames = r.recorded->size();
     folder = r.folder;
@@ -158,7 +158,7 @@ TEST(SceneScript, Fig2PendulumKeepsItsNailJointsAndEnergyAndRendersEveryFrame) {
   EXPECT_EQ(hook_calls, 1);
   EXPECT_EQ(frames, 121u);  // 4 s at 30 per second, both ends
   EXPECT_EQ(folder, "out/fig2");
-  const ConstrainedWorld& w = *interp.scene();
+  const World& w = *interp.scene();
   EXPECT_NEAR(w.time(), 4.0, 1e-9);
   EXPECT_LT(interp.ScenePoint("top").norm(), 1e-6);
   EXPECT_LT((interp.ScenePoint("elbow1") - interp.ScenePoint("elbow1b")).norm(), 1e-6);
@@ -171,7 +171,7 @@ TEST(SceneScript, Fig2PendulumKeepsItsNailJointsAndEnergyAndRendersEveryFrame) {
 
 TEST(SceneScript, AThinStiffBodyWarnsAboutTheTimeStep) {
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   EXPECT_EQ(RunScript(interp, "set gravity F\nset dt 0.01\nlinear thin 2d affine box 1 0.01 ke 1000 kc 1000\nsimul 0.01\n"), "");
   EXPECT_NE(out.str().find("warning: dt 0.01 is above the stable step"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("of body 'thin'"), std::string::npos);
@@ -181,7 +181,7 @@ TEST(SceneScript, AnFfdTableJoinsTheSceneNailedAtACornerAndAttachedToALinearBloc
   // the same world holds both kinds: the table of data/ (lattice 300 x 100) hangs from its
   // top-left corner and carries an affine block attached at its top-right corner
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   const std::string script = "load_obj " + kData + "/table.obj\nload_def " + kData + "/table_modes.def\n" +
                              "set dt 0.0005\nset ground F\n"
                              "ffd table\n"
@@ -193,7 +193,7 @@ TEST(SceneScript, AnFfdTableJoinsTheSceneNailedAtACornerAndAttachedToALinearBloc
                              "attach joint right block_end\n"
                              "simul 1\n";
   ASSERT_EQ(RunScript(interp, script), "");
-  const ConstrainedWorld& w = *interp.scene();
+  const World& w = *interp.scene();
   ASSERT_EQ(w.num_bodies(), 2);
   EXPECT_EQ(w.kind(0), BodyKind::kFfd);
   EXPECT_LT((interp.ScenePoint("corner") - (Eigen::VectorXd(2) << 0, 100).finished()).norm(), 1e-3);
@@ -206,7 +206,7 @@ TEST(SceneScript, AnFfdTableJoinsTheSceneNailedAtACornerAndAttachedToALinearBloc
 
 TEST(SceneScript, GravitySetAfterTheBodiesAppliesToTheNextSimul) {
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   ASSERT_EQ(RunScript(interp, "linear b 3d affine box 0.5 0.5 0.5\npoint c b 0 0 0\nset gravity F\nsimul 1\n"), "");
   EXPECT_LT(interp.ScenePoint("c").norm(), 1e-12) << "no gravity: at rest where it was";
   ASSERT_EQ(RunScript(interp, "set gravity T\nsimul 1\n"), "");

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "wobble/dynamics/kinematics.h"
-#include "wobble/io/script.h"
+#include "wobble/script/interpreter.h"
 
 namespace wobble {
 namespace {
@@ -24,7 +24,7 @@ double KineticEnergy(const BodyModel& body, const Eigen::VectorXd& q, const Eige
 
 TEST(AppendixC, RunsUnchangedToAFiniteSettledEnd) {
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   interp.LoadObject(kData + "/pot.obj");
   interp.RunFile(kData + "/appendix_c.wob");
   EXPECT_DOUBLE_EQ(interp.time(), 25.0);
@@ -52,12 +52,12 @@ TEST(AppendixC, ExplicitSchemeAtItsTimeStepStopsWithAStatusNamingTheLine) {
   // `simul` is the last line
   const int simul_line = int(std::count(text.begin(), text.end(), '\n'));
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   interp.LoadObject(kData + "/pot.obj");
   try {
     interp.RunStream(script, "thesis.wob", kData);
     FAIL() << "expected the run to stop";
-  } catch (const io::SimulationStopped& e) {
+  } catch (const script::SimulationStopped& e) {
     const std::string where = "thesis.wob:" + std::to_string(simul_line) + ": simulation stopped";
     EXPECT_NE(std::string(e.what()).find(where), std::string::npos) << e.what();
   }
@@ -149,11 +149,11 @@ TEST(Interpreter, EveryCommandsErrorsNameTheLineAndWhatWasExpected) {
     const int bad_line = int(std::count(script.begin(), script.end(), '\n')) + 1;
     std::istringstream in(script);
     std::ostringstream out;
-    io::Interpreter interp(out);
+    script::Interpreter interp(out);
     try {
       interp.RunStream(in, "case.wob", kData);
       ADD_FAILURE() << "no error for:\n" << script << "\n(wanted " << c.expected << ")";
-    } catch (const io::ParseError& e) {
+    } catch (const formats::ParseError& e) {
       const std::string what = e.what();
       if (c.expected.find("cannot open") == std::string::npos) {
         EXPECT_EQ(e.file(), "case.wob") << what;
@@ -165,12 +165,12 @@ TEST(Interpreter, EveryCommandsErrorsNameTheLineAndWhatWasExpected) {
 }
 
 TEST(Interpreter, NearestUsesEditDistanceAndKnowsWhenNothingIsClose) {
-  EXPECT_EQ(io::Interpreter::Nearest("simu", {"simul", "set", "save"}), "simul");
-  EXPECT_EQ(io::Interpreter::Nearest("asign", {"assign", "anneal"}), "assign");
-  EXPECT_EQ(io::Interpreter::Nearest("xyzzyqwerty", {"assign", "anneal"}), "");
+  EXPECT_EQ(script::Interpreter::Nearest("simu", {"simul", "set", "save"}), "simul");
+  EXPECT_EQ(script::Interpreter::Nearest("asign", {"assign", "anneal"}), "assign");
+  EXPECT_EQ(script::Interpreter::Nearest("xyzzyqwerty", {"assign", "anneal"}), "");
   // every documented command and parameter is known to the interpreter: none is "unknown"
-  for (const io::CommandInfo& c : io::Interpreter::Commands())
-    EXPECT_EQ(io::Interpreter::Nearest(c.name, {c.name}), c.name);
+  for (const script::CommandInfo& c : script::Interpreter::Commands())
+    EXPECT_EQ(script::Interpreter::Nearest(c.name, {c.name}), c.name);
 }
 
 // §4.10.1: a keyframed run hands over to simulation with the q and q̇ it had.
@@ -180,7 +180,7 @@ TEST(Interpreter, KeyframesHandOverContinuouslyInQAndQdot) {
                             "trans 10 20 0\nhold 0 0\nkey 0\nkey 0.3 bend=0.1 shear=-0.05\nkey 0.5 bend=0.15 shear=0.1\n"
                             "keyframe\n";
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   std::istringstream in(setup);
   interp.RunStream(in, "keys.wob", kData);
   const Eigen::VectorXd q0 = interp.q(), qd0 = interp.qd();
@@ -207,7 +207,7 @@ TEST(Interpreter, SavedScriptReplaysTheSameMotion) {
                             "/table_modes.def\nset integrator thesis\nset dt 0.01\nset grconst 45000\nassign 1 4e7 4e6\n"
                             "trans 0 0.1 0\npose 0.2 -0.1 0.3\npose -0.1 0.1 0.4\nset end 3\nsave " + saved + "\nsimul\n";
   std::ostringstream out1, out2;
-  io::Interpreter a(out1), b(out2);
+  script::Interpreter a(out1), b(out2);
   std::istringstream in(setup);
   a.RunStream(in, "a.wob", kData);
   b.RunFile(saved);
@@ -224,7 +224,7 @@ TEST(Interpreter, OutputWritesOneRowPerRecordedStep) {
   const std::string setup = "load_obj " + kData + "/table.obj\nload_def " + kData +
                             "/table_modes.def\nset dt 0.01\ntrans 0 50 0\noutput " + csv + " 10\nsimul 1\n";
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   std::istringstream in(setup);
   interp.RunStream(in, "o.wob", kData);
   std::ifstream f(csv);
@@ -256,9 +256,9 @@ TEST(CliffJump, ClearsTheEdgeLandsUprightAndSettles) {
   const auto cwd = std::filesystem::current_path();
   std::filesystem::current_path(dir);
   std::ostringstream out;
-  io::Interpreter interp(out);
-  io::RenderRequest drawn;
-  interp.SetRenderHook([&](const io::RenderRequest& r) { drawn = r; });
+  script::Interpreter interp(out);
+  script::RenderRequest drawn;
+  interp.SetRenderHook([&](const script::RenderRequest& r) { drawn = r; });
   interp.RunFile(kData + "/table_cliff.wob");
   std::filesystem::current_path(cwd);
   ASSERT_TRUE(drawn.body);
@@ -317,27 +317,27 @@ TEST(CliffJump, ClearsTheEdgeLandsUprightAndSettles) {
 // or a program without a renderer, is told so with the line.
 TEST(ScriptRender, ErrorsNameTheLine) {
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   std::istringstream none("load_obj table.obj\nload_def bend.def\nrender out\n");
   try {
     interp.RunStream(none, "r.wob", kData);
     FAIL() << "expected an error";
-  } catch (const io::ParseError& e) {
+  } catch (const formats::ParseError& e) {
     EXPECT_NE(std::string(e.what()).find("r.wob:3: render: nothing to draw yet"), std::string::npos) << e.what();
   }
   std::istringstream no_hook("simul 0.1\nrender out\n");
   try {
     interp.RunStream(no_hook, "r.wob", kData);
     FAIL() << "expected an error";
-  } catch (const io::ParseError& e) {
+  } catch (const formats::ParseError& e) {
     EXPECT_NE(std::string(e.what()).find("r.wob:2: render: this program has no renderer"), std::string::npos) << e.what();
   }
-  interp.SetRenderHook([](const io::RenderRequest&) { throw std::runtime_error("disk full"); });
+  interp.SetRenderHook([](const script::RenderRequest&) { throw std::runtime_error("disk full"); });
   std::istringstream failing("render out vtp\n");
   try {
     interp.RunStream(failing, "r.wob", kData);
     FAIL() << "expected an error";
-  } catch (const io::ParseError& e) {
+  } catch (const formats::ParseError& e) {
     EXPECT_NE(std::string(e.what()).find("r.wob:1: render: disk full"), std::string::npos) << e.what();
   }
 }

@@ -1,4 +1,4 @@
-// io::SessionScript without VTK (so it also runs in the ASan build, which has no display): a
+// script::SessionScript without VTK (so it also runs in the ASan build, which has no display): a
 // World stepped by hand with PD targets changed at chosen steps, written as a script and run
 // by the interpreter, ends in the same state; a change on every step and a change on the
 // first step replay too; bad records are refused; the pull note is written.
@@ -9,10 +9,10 @@
 #include <sstream>
 
 #include "wobble/control/control.h"
-#include "wobble/io/deformation_file.h"
-#include "wobble/io/object_file.h"
-#include "wobble/io/script.h"
-#include "wobble/io/session_script.h"
+#include "wobble/formats/deformation_file.h"
+#include "wobble/formats/object_file.h"
+#include "wobble/script/interpreter.h"
+#include "wobble/script/session_script.h"
 
 namespace wobble {
 namespace {
@@ -21,7 +21,7 @@ const std::string kData = WOBBLE_DATA_DIR;
 
 struct Session {
   std::shared_ptr<const BodyModel> body;
-  io::SessionRecord record;
+  script::SessionRecord record;
   Eigen::VectorXd q;  // the state at the end
 };
 
@@ -29,8 +29,8 @@ struct Session {
 Session RunByHand(const WorldOptions& options, const Eigen::VectorXd& q0, long steps,
                   const std::map<long, Eigen::VectorXd>& changes) {
   Session s;
-  s.body = std::make_shared<const BodyModel>(io::ReadObjectFile(kData + "/table.obj"),
-                                             io::ReadDeformationFile(kData + "/table_modes.def"));
+  s.body = std::make_shared<const BodyModel>(formats::ReadObjectFile(kData + "/table.obj"),
+                                             formats::ReadDeformationFile(kData + "/table_modes.def"));
   World world(options);
   world.AddBody(s.body);
   world.SetState(0, q0, Eigen::VectorXd::Zero(q0.size()));
@@ -54,7 +54,7 @@ Session RunByHand(const WorldOptions& options, const Eigen::VectorXd& q0, long s
 
 Eigen::VectorXd Replay(const std::string& script) {
   std::ostringstream out;
-  io::Interpreter interp(out);
+  script::Interpreter interp(out);
   std::istringstream in(script);
   interp.RunStream(in, "<session>", "");
   return interp.q();
@@ -73,7 +73,7 @@ TEST(SessionScript, TargetChangesReplayToTheSameState) {
   const Session s = RunByHand(o, V({0, 40, 0, 0, 0, 0, 0}), 400,
                               {{0, V({0, 0, 0, 0})}, {37, V({0.2, 0, 0, 0})}, {151, V({0.2, -0.1, 0.05, 0})},
                                {152, V({-0.1, -0.1, 0.05, 0.02})}, {390, V({0, 0, 0, 0})}});
-  const Eigen::VectorXd q = Replay(io::SessionScript(s.record));
+  const Eigen::VectorXd q = Replay(script::SessionScript(s.record));
   ASSERT_EQ(q.size(), s.q.size());
   EXPECT_LT((q - s.q).cwiseAbs().maxCoeff(), 1e-12) << q.transpose() << "\n" << s.q.transpose();
 }
@@ -93,13 +93,13 @@ TEST(SessionScript, ChangesOnEveryStepAndSpringsAndAnotherIntegrator) {
   {
     // the World wants the spring's basis filled in: AddSpring does it, so build it that way
     World w(o);
-    w.AddBody(std::make_shared<const BodyModel>(io::ReadObjectFile(kData + "/table.obj"),
-                                                io::ReadDeformationFile(kData + "/table_modes.def")));
+    w.AddBody(std::make_shared<const BodyModel>(formats::ReadObjectFile(kData + "/table.obj"),
+                                                formats::ReadDeformationFile(kData + "/table_modes.def")));
     w.AddSpring(sp);
     with_spring = w.options();
   }
   const Session s = RunByHand(with_spring, V({0, 20, 0.05, 0, 0, 0, 0}), 120, every);
-  const Eigen::VectorXd q = Replay(io::SessionScript(s.record));
+  const Eigen::VectorXd q = Replay(script::SessionScript(s.record));
   EXPECT_LT((q - s.q).cwiseAbs().maxCoeff(), 1e-12) << q.transpose() << "\n" << s.q.transpose();
 }
 
@@ -107,17 +107,17 @@ TEST(SessionScript, RefusesBadRecordsAndNotesPulls) {
   Session s = RunByHand(WorldOptions{}, V({0, 0, 0, 0, 0, 0, 0}), 10, {{0, V({0.1, 0, 0, 0})}, {5, V({0, 0, 0, 0})}});
   s.record.drags = 2;
   s.record.first_drag_step = 4;
-  EXPECT_NE(io::SessionScript(s.record).find("2 pull(s) by the mouse"), std::string::npos);
-  io::SessionRecord bad = s.record;
+  EXPECT_NE(script::SessionScript(s.record).find("2 pull(s) by the mouse"), std::string::npos);
+  script::SessionRecord bad = s.record;
   bad.segments[1].step = 0;  // out of order
-  EXPECT_THROW(io::SessionScript(bad), std::invalid_argument);
+  EXPECT_THROW(script::SessionScript(bad), std::invalid_argument);
   bad = s.record;
   bad.segments[0].targets = V({1, 2});  // wrong size
-  EXPECT_THROW(io::SessionScript(bad), std::invalid_argument);
+  EXPECT_THROW(script::SessionScript(bad), std::invalid_argument);
   bad = s.record;
   bad.object_path.clear();
-  EXPECT_THROW(io::SessionScript(bad), std::invalid_argument);
-  EXPECT_THROW(io::PoseGraphScript(s.record, {V({0.1, 0, 0, 0})}, {0.0}), std::invalid_argument);
+  EXPECT_THROW(script::SessionScript(bad), std::invalid_argument);
+  EXPECT_THROW(script::PoseGraphScript(s.record, {V({0.1, 0, 0, 0})}, {0.0}), std::invalid_argument);
 }
 
 }  // namespace

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "wobble/io/script.h"
+#include "wobble/script/interpreter.h"
 #include "wobble/synth/anneal.h"
 #ifdef WOBBLE_HAVE_PAGMO
 #include "wobble/synth/cmaes.h"
@@ -30,7 +30,7 @@ struct Scene {
     std::filesystem::current_path(cwd);
   }
   std::ostringstream out;
-  io::Interpreter interp;
+  script::Interpreter interp;
   std::filesystem::path dir;
 };
 
@@ -39,7 +39,7 @@ TEST(Annealing, SameSeedSameResultWhateverTheThreadCount) {
   std::vector<synth::AnnealResult> results;
   for (int threads : {1, 2, 2}) {
     std::ostringstream out;
-    io::Interpreter interp(out);
+    script::Interpreter interp(out);
     std::istringstream in("load_obj table.obj\nload_def table_modes.def\nassign bend 4e7 4e6\nassign shear 4e7 4e6\n"
                           "set integrator thesis\nset dt 0.01\nset grconst 45000\nset grdam 3000\nset frconst 3000\n"
                           "set frsin 0.5\npose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\npose 0 0.1 0.4\n"
@@ -116,7 +116,7 @@ TEST(BoundingTable, AnnealingImprovesAndFindsAStableForwardGaitThatTheSavedScrip
 
   // the saved controller replays the best trial exactly
   std::ostringstream out;
-  io::Interpreter replay(out);
+  script::Interpreter replay(out);
   replay.RunFile((scene.dir / "out/bounding_table/best.wob").string());
   double x0, v0, x1, v1;
   synth::CenterOfMassX(*replay.body(), problem.q0, problem.qd0, &x0, &v0);
@@ -132,7 +132,7 @@ TEST(Cmaes, ReproducibleFromItsSeedAndImprovesOnTheInitialController) {
   std::vector<synth::AnnealResult> results;
   for (int run = 0; run < 2; ++run) {
     std::ostringstream out;
-    io::Interpreter interp(out);
+    script::Interpreter interp(out);
     std::istringstream in("load_obj table.obj\nload_def table_modes.def\nassign bend 4e7 4e6\nassign shear 4e7 4e6\n"
                           "set integrator thesis\nset dt 0.01\nset grconst 45000\nset grdam 3000\nset frconst 3000\n"
                           "set frsin 0.5\npose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\npose 0 0.1 0.4\n"

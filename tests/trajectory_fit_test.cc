@@ -6,11 +6,11 @@
 #include <random>
 #include <sstream>
 
-#include "test_bodies.h"
-#include "wobble/dynamics/world.h"
+#include "support/test_bodies.h"
+#include "wobble/world/world.h"
 #include "wobble/fit/trajectory_fit.h"
-#include "wobble/io/parse_error.h"
-#include "wobble/io/simulation_csv.h"
+#include "wobble/formats/parse_error.h"
+#include "wobble/formats/simulation_csv.h"
 
 namespace wobble {
 namespace {
@@ -55,7 +55,7 @@ double MaxModeError(const fit::TrajectoryFitResult& r, const Reference& ref) {
 TEST(TrajectoryFit, RecoversSimulatedQFromMassPoints) {
   const auto body = Table();
   const Reference ref = Simulated(body);
-  const std::vector<io::TargetFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {});
+  const std::vector<formats::TargetFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {});
   fit::TrajectoryFitOptions o;
   o.smoothness = 0.0;  // exact data: nothing to smooth
   o.pose.gamma_lower = -3;  // the thrown table's amplitudes reach -1.3
@@ -73,11 +73,11 @@ TEST(TrajectoryFit, SmoothnessReducesTheErrorFromNoise) {
   const auto body = Table();
   const Reference ref = Simulated(body);
   // only 5 of the 11 points are observed (both feet, the top's ends and middle), with noise 2
-  std::vector<io::TargetFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {0, 2, 4, 5, 8});
+  std::vector<formats::TargetFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {0, 2, 4, 5, 8});
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, 2.0);
-  for (io::TargetFrame& f : frames)
-    for (io::PointTarget& p : f.points) p.position += Eigen::Vector2d(noise(rng), noise(rng));
+  for (formats::TargetFrame& f : frames)
+    for (formats::PointTarget& p : f.points) p.position += Eigen::Vector2d(noise(rng), noise(rng));
   fit::TrajectoryFitOptions rough, smooth;
   rough.smoothness = 0.0;
   smooth.smoothness = 30.0;
@@ -121,8 +121,8 @@ TEST(TrajectoryFit, UnevenKeyframesAndBounds) {
 std::string CsvMessage(const std::string& text) {
   std::istringstream in(text);
   try {
-    io::ParseSimulationCsv(in, "ref.csv", 1);
-  } catch (const io::ParseError& e) {
+    formats::ParseSimulationCsv(in, "ref.csv", 1);
+  } catch (const formats::ParseError& e) {
     return e.what();
   }
   return "no error";
@@ -130,7 +130,7 @@ std::string CsvMessage(const std::string& text) {
 
 TEST(SimulationCsv, ReadsWobbleSimulateOutputAndRejectsBadRows) {
   std::istringstream good("t,tx,ty,theta,g1,dtx,dty,dtheta,dg1,kinetic\n0,1,2,3,4,5,6,7,8,9\n0.5,1,2,3,4.5,5,6,7,8,9\n");
-  const io::SimulationCsv s = io::ParseSimulationCsv(good, "ref.csv", 1);
+  const formats::SimulationCsv s = formats::ParseSimulationCsv(good, "ref.csv", 1);
   ASSERT_EQ(s.t.size(), 2u);
   EXPECT_EQ(s.q[1][3], 4.5);
   EXPECT_EQ(s.qd[0][0], 5.0);

@@ -1,6 +1,6 @@
 #include "wobble/body/body_model.h"
 
-#include "wobble/numeric/cholesky.h"
+#include "wobble/core/cholesky.h"
 
 #include <algorithm>
 #include <cmath>

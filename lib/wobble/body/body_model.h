@@ -11,7 +11,7 @@
 
 #include "wobble/body/lattice.h"
 #include "wobble/body/mode.h"
-#include "wobble/body/types.h"
+#include "wobble/core/types.h"
 
 namespace wobble {
 

@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "wobble/basis/basis.h"
+#include "wobble/core/basis.h"
 
 namespace wobble {
 

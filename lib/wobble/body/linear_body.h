@@ -7,7 +7,7 @@
 // u gives the generalized force Q = f pᵀ (end of §2.2).
 //
 // Dimension is a run-time value (2 or 3) with Eigen dynamic sizes rather than a template
-// parameter: one ConstrainedWorld holds 2D and 3D bodies side by side (and the 2D FFD bodies),
+// parameter: one World holds 2D and 3D bodies side by side (and the 2D FFD bodies),
 // and the multiplier solve flattens every body into one global vector anyway, so a template
 // would only move the dimension switch into type erasure. The sizes are tiny (n ≤ 10).
 //

@@ -14,7 +14,7 @@ std::string Num(double v) {
 }
 
 // Half a step: "now" for comparisons of times on the step grid.
-double HalfStep(const ConstrainedWorld& w) { return 0.5 * w.options().dt; }
+double HalfStep(const World& w) { return 0.5 * w.options().dt; }
 
 int FindConstraint(const BehaviourContext& ctx, const std::string& name, const std::string& who) {
   const auto it = ctx.names->find(name);
@@ -31,9 +31,9 @@ void Name(BehaviourContext& ctx, const std::string& name, int id) { (*ctx.names)
 
 }  // namespace
 
-Eigen::VectorXd Anchor::Position(const ConstrainedWorld& w) const { return point ? w.PointPosition(*point) : place; }
+Eigen::VectorXd Anchor::Position(const World& w) const { return point ? w.PointPosition(*point) : place; }
 
-Eigen::VectorXd Anchor::Velocity(const ConstrainedWorld& w) const {
+Eigen::VectorXd Anchor::Velocity(const World& w) const {
   return point ? w.PointVelocity(*point) : Eigen::VectorXd::Zero(place.size());
 }
 
@@ -46,7 +46,7 @@ Chase::Chase(Anchor chaser, Anchor target, double duration, std::optional<Eigen:
 std::string Chase::Describe() const { return "chase " + chaser_.name + " -> " + target_.name + " in " + Num(duration_); }
 
 void Chase::Start(BehaviourContext& ctx) {
-  ConstrainedWorld& w = *ctx.world;
+  World& w = *ctx.world;
   if (chaser_.fixed()) throw BehaviourError(Describe() + ": the chaser must be a point of a body");
   if (!(duration_ > 0)) throw BehaviourError(Describe() + ": the duration must be positive");
   const double t = w.time();
@@ -64,7 +64,7 @@ void Chase::Start(BehaviourContext& ctx) {
   Name(ctx, "chase:" + chaser_.name, constraint_);
 }
 
-void Chase::Plan(ConstrainedWorld& w, const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
+void Chase::Plan(World& w, const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
   const double t = w.time(), tau = contact_time_ - t;
   const Eigen::VectorXd y = target_.Position(w) + target_.Velocity(w) * tau;
   segment_ = std::make_shared<HermiteSegment>(t, x, v, contact_time_, y, v1_);
@@ -72,7 +72,7 @@ void Chase::Plan(ConstrainedWorld& w, const Eigen::VectorXd& x, const Eigen::Vec
 }
 
 bool Chase::Update(BehaviourContext& ctx) {
-  ConstrainedWorld& w = *ctx.world;
+  World& w = *ctx.world;
   const double t = w.time();
   if (t + HalfStep(w) >= contact_time_) {
     // contact: the chase is over and the point is free for what comes next (Connect)
@@ -99,7 +99,7 @@ Connect::Connect(Anchor point, Anchor target, std::string name)
 std::string Connect::Describe() const { return "connect " + point_.name + " -> " + target_.name; }
 
 void Connect::Start(BehaviourContext& ctx) {
-  ConstrainedWorld& w = *ctx.world;
+  World& w = *ctx.world;
   if (point_.fixed()) throw BehaviourError(Describe() + ": the connecting point must be a point of a body");
   // velocity matching: afterwards v(point) − v(target) = 0 (v(point) = 0 for a fixed place)
   VelocityGoal goal;
@@ -152,7 +152,7 @@ std::string Follow::Describe() const {
 }
 
 bool Follow::Update(BehaviourContext& ctx) {
-  ConstrainedWorld& w = *ctx.world;
+  World& w = *ctx.world;
   const double t = w.time();
   if (t + HalfStep(w) < onset_ - preroll_) return false;  // not yet
   if (point_.fixed()) throw BehaviourError(Describe() + ": needs a point of a body");

@@ -31,7 +31,7 @@
 #include <optional>
 #include <string>
 
-#include "wobble/constraints/constrained_world.h"
+#include "wobble/world/world.h"
 #include "wobble/control/paths.h"
 
 namespace wobble::control {
@@ -42,8 +42,8 @@ struct Anchor {
   std::string name;
   std::optional<MaterialPoint> point;  // empty: a fixed place
   Eigen::VectorXd place;               // the fixed place
-  Eigen::VectorXd Position(const ConstrainedWorld& w) const;
-  Eigen::VectorXd Velocity(const ConstrainedWorld& w) const;
+  Eigen::VectorXd Position(const World& w) const;
+  Eigen::VectorXd Velocity(const World& w) const;
   bool fixed() const { return !point.has_value(); }
 };
 inline Anchor PointAnchor(std::string name, MaterialPoint p) { return {std::move(name), std::move(p), {}}; }
@@ -54,7 +54,7 @@ using ConstraintNames = std::map<std::string, int>;
 
 // What a behaviour may touch while it runs.
 struct BehaviourContext {
-  ConstrainedWorld* world = nullptr;
+  World* world = nullptr;
   ConstraintNames* names = nullptr;
 };
 
@@ -91,7 +91,7 @@ class Chase : public Behaviour {
   static constexpr double kMinReplanTime = 1e-6;
 
  private:
-  void Plan(ConstrainedWorld& w, const Eigen::VectorXd& x, const Eigen::VectorXd& v);
+  void Plan(World& w, const Eigen::VectorXd& x, const Eigen::VectorXd& v);
   Anchor chaser_, target_;
   double duration_;
   std::optional<Eigen::VectorXd> final_velocity_;
@@ -146,7 +146,7 @@ class Switch : public Behaviour {
 // Blocks until `predicate(world)` holds (checked before every step).
 class WaitFor : public Behaviour {
  public:
-  WaitFor(std::string description, std::function<bool(const ConstrainedWorld&)> predicate)
+  WaitFor(std::string description, std::function<bool(const World&)> predicate)
       : description_(std::move(description)), predicate_(std::move(predicate)) {}
   std::string Describe() const override { return "wait_for " + description_; }
   void Start(BehaviourContext&) override {}
@@ -154,7 +154,7 @@ class WaitFor : public Behaviour {
 
  private:
   std::string description_;
-  std::function<bool(const ConstrainedWorld&)> predicate_;
+  std::function<bool(const World&)> predicate_;
 };
 
 // Blocks for a duration from its start.

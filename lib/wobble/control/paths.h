@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "wobble/constraints/point_path.h"
+#include "wobble/world/point_path.h"
 
 namespace wobble::control {
 

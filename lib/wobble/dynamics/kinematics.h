@@ -8,8 +8,8 @@
 #pragma once
 
 #include "wobble/body/body_model.h"
-#include "wobble/body/types.h"
-#include "wobble/numeric/cholesky.h"
+#include "wobble/core/types.h"
+#include "wobble/core/cholesky.h"
 
 namespace wobble {
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "wobble/dynamics/forces.h"
-#include "wobble/numeric/cholesky.h"
+#include "wobble/core/cholesky.h"
 
 namespace wobble {
 
@@ -23,14 +23,26 @@ enum class Integrator {
 std::string IntegratorName(Integrator integrator);
 bool ParseIntegrator(const std::string& text, Integrator* integrator);
 
-// Why a run stopped. Never a silent NaN: the step loop checks every accepted state.
+// Why a run stopped: one list of causes for a body's step (StepStatus) and the world's
+// (WorldStatus, wobble/world). Never a silent NaN: the step loop checks every accepted state.
+enum class StatusCode {
+  kOk,
+  kNonFinite,
+  kSingularMass,
+  kIllConditioned,
+  kPenetration,
+  kSolverFailed,
+  kSingularConstraints,  // redundant or conflicting constraints (J W Jᵀ singular)
+  kBadPath,              // a trajectory's path returned a non-finite or wrongly sized sample
+};
+std::string StatusCodeName(StatusCode code);
+
 struct StepStatus {
-  enum class Code { kOk, kNonFinite, kSingularMass, kIllConditioned, kPenetration, kSolverFailed };
+  using Code = StatusCode;
   Code code = Code::kOk;
   double value = 0.0;  // the offending number (condition estimate, depth, ...)
   bool ok() const { return code == Code::kOk; }
 };
-std::string StatusCodeName(StepStatus::Code code);
 
 // An extra generalized force added to Q at every force evaluation, as extra(s, &Q) with s the
 // state being evaluated (every stage of a multi-stage integrator). The World adds none; the

@@ -9,7 +9,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "wobble/fit/solve_common.h"
+#include "wobble/fit/internal/solve_common.h"
 
 namespace wobble::fit {
 
@@ -104,14 +104,14 @@ void FillAtBound(const BodyModel& body, const PoseFitOptions& o, PoseFitResult* 
 
 }  // namespace
 
-PoseFitResult FitPose(const BodyModel& body, const std::vector<io::PointTarget>& targets, const PoseFitOptions& o) {
+PoseFitResult FitPose(const BodyModel& body, const std::vector<formats::PointTarget>& targets, const PoseFitOptions& o) {
   const std::string error = ValidateOptions(o, body.num_modes());
   if (!error.empty()) throw std::invalid_argument("pose fit: " + error);
   if (targets.empty()) throw std::invalid_argument("pose fit: no target points");
   std::vector<SegmentResidual> data;
   std::vector<Eigen::Vector2d> rest, goal;
   std::vector<double> weights;
-  for (const io::PointTarget& t : targets) {
+  for (const formats::PointTarget& t : targets) {
     if (t.mass_point >= body.num_points())
       throw std::invalid_argument("pose fit: mass point " + std::to_string(t.mass_point) + " does not exist");
     SegmentResidual r;
@@ -136,9 +136,9 @@ PoseFitResult FitPose(const BodyModel& body, const std::vector<io::PointTarget>&
   return result;
 }
 
-CurveTarget CurveTarget::From(const io::TargetFile& file) {
+CurveTarget CurveTarget::From(const formats::TargetFile& file) {
   CurveTarget c;
-  for (const io::TargetCurve& line : file.polylines) {
+  for (const formats::TargetCurve& line : file.polylines) {
     const size_t n = line.points.size();
     for (size_t i = 0; i + 1 < n + (line.closed ? 1 : 0); ++i) {
       c.a.push_back(line.points[i]);

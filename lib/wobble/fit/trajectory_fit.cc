@@ -3,7 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "wobble/fit/solve_common.h"
+#include "wobble/fit/internal/solve_common.h"
 
 namespace wobble::fit {
 
@@ -25,19 +25,19 @@ VecQ<double> SmoothnessScales(const BodyModel& body) {
   return L;
 }
 
-std::vector<io::TargetFrame> FramesFromStates(const BodyModel& body, const std::vector<double>& times,
+std::vector<formats::TargetFrame> FramesFromStates(const BodyModel& body, const std::vector<double>& times,
                                               const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
                                               int every) {
   std::vector<int> which = points;
   if (which.empty())
     for (int k = 0; k < body.num_points(); ++k) which.push_back(k);
-  std::vector<io::TargetFrame> frames;
+  std::vector<formats::TargetFrame> frames;
   for (size_t f = 0; f < q.size(); f += size_t(std::max(1, every))) {
-    io::TargetFrame frame;
+    formats::TargetFrame frame;
     frame.time = times[f];
     for (int k : which) {
       if (k < 0 || k >= body.num_points()) throw std::invalid_argument("mass point " + std::to_string(k) + " does not exist");
-      io::PointTarget p;
+      formats::PointTarget p;
       p.mass_point = k;
       p.position = PointPosition(BasisOf(body, k, {}), q[f].data(), body.num_q());
       frame.points.push_back(p);
@@ -47,7 +47,7 @@ std::vector<io::TargetFrame> FramesFromStates(const BodyModel& body, const std::
   return frames;
 }
 
-TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vector<io::TargetFrame>& frames,
+TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vector<formats::TargetFrame>& frames,
                                            const TrajectoryFitOptions& o) {
   const PoseFitOptions& po = o.pose;
   const std::string error = ValidateOptions(po, body.num_modes());
@@ -68,7 +68,7 @@ TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vec
     result.times.push_back(frames[f].time);
     std::vector<Eigen::Vector2d> rest, goal;
     std::vector<double> w;
-    for (const io::PointTarget& t : frames[f].points) {
+    for (const formats::PointTarget& t : frames[f].points) {
       if (t.mass_point >= body.num_points())
         throw std::invalid_argument("trajectory fit: mass point " + std::to_string(t.mass_point) + " does not exist");
       SegmentResidual r;

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "wobble/control/control.h"
-#include "wobble/dynamics/world.h"
+#include "wobble/world/world.h"
 
 namespace wobble::synth {
 

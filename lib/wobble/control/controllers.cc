@@ -1,0 +1,56 @@
+#include "wobble/control/controllers.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace wobble::control {
+
+PoseGraphController::PoseGraphController(const World& world, int body, PoseGraph graph, double switch_width)
+    : body_(body), graph_(std::move(graph)), width_(switch_width) {
+  const std::string invalid = graph_.Validate(int(ActiveModes(world.body(body)).size()));
+  if (!invalid.empty()) throw std::invalid_argument("pose graph: " + invalid);
+  if (!(width_ >= 0.0)) throw std::invalid_argument("pose graph: the switch width must be 0 or positive");
+}
+
+void PoseGraphController::BeforeStep(World& world) {
+  const double t = double(steps_++) * world.options().dt;
+  const BodyModel& body = world.body(body_);
+  if (width_ > 0) {
+    pose_ = graph_.PoseAt(t);
+    world.SetModeTargets(body_, SmoothPoseTargets(body, graph_, t, width_));
+    return;
+  }
+  const int now = graph_.PoseAt(t);
+  if (now != pose_) {
+    pose_ = now;
+    world.SetModeTargets(body_, TargetsFromPose(body, graph_.poses[pose_]));
+  }
+}
+
+KeyframeController::KeyframeController(World& world, int body, Keyframes keys, HeldPoint hold)
+    : body_(body), keys_(std::move(keys)), hold_(hold), dt_(world.options().dt) {
+  const BodyModel& model = world.body(body);
+  const std::string invalid = keys_.Validate(model.num_modes());
+  if (!invalid.empty()) throw std::invalid_argument("keyframe: " + invalid);
+  const Eigen::VectorXd q = world.state(body).q;
+  // the held point stays where it is at the start; θ and, without a hold, t stay as they are
+  anchor_ = hold_.enabled ? PointAt(model, hold_.lattice_coords, q) : Eigen::Vector2d::Zero();
+  translation_ = q.head<2>();
+  theta_ = q[2];
+  world.SetKinematic(body, true);
+  Place(world, 0.0);
+}
+
+void KeyframeController::AfterStep(World& world) {
+  ++steps_;
+  Place(world, std::min(double(steps_) * dt_, keys_.Duration()));
+}
+
+void KeyframeController::Place(World& world, double t) const {
+  Eigen::VectorXd gamma, gamma_dot, q, qd;
+  keys_.Evaluate(t, &gamma, &gamma_dot);
+  KeyframedState(world.body(body_), hold_, anchor_, translation_, theta_, gamma, gamma_dot, &q, &qd);
+  world.SetState(body_, q, qd);
+}
+
+}  // namespace wobble::control

@@ -1,0 +1,170 @@
+#include "wobble/fit/internal/solve_common.h"
+
+#include <Eigen/SVD>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace wobble::fit {
+
+ceres::LossFunction* MakeLoss(Loss loss, double scale) {
+  switch (loss) {
+    case Loss::kSquared: return nullptr;
+    case Loss::kHuber: return new ceres::HuberLoss(scale);
+    case Loss::kCauchy: return new ceres::CauchyLoss(scale);
+  }
+  return nullptr;
+}
+
+std::vector<ceres::ResidualBlockId> AddPoseTerms(const BodyModel& body, const std::vector<SegmentResidual>& data,
+                                                 const std::vector<ReverseSegmentResidual>& reverse,
+                                                 const PoseFitOptions& o, double* q, ceres::Problem* problem) {
+  std::vector<ceres::ResidualBlockId> ids;
+  // one loss object shared by every data term (Ceres deletes it once); none without terms
+  ceres::LossFunction* loss = data.empty() && reverse.empty() ? nullptr : MakeLoss(o.loss, o.loss_scale);
+  for (const SegmentResidual& d : data) ids.push_back(problem->AddResidualBlock(MakeSegmentCost(d), loss, q));
+  for (const ReverseSegmentResidual& d : reverse)
+    ids.push_back(problem->AddResidualBlock(MakeReverseSegmentCost(d), loss, q));
+  if (o.prior_weight > 0 && body.num_modes() > 0) {
+    RestPrior prior;
+    prior.sqrt_weight = std::sqrt(o.prior_weight);
+    prior.num_q = body.num_q();
+    problem->AddResidualBlock(MakeRestPriorCost(prior), nullptr, q);
+  }
+  if (!problem->HasParameterBlock(q)) problem->AddParameterBlock(q, body.num_q());
+  for (int d = 0; d < body.num_modes(); ++d) {
+    problem->SetParameterLowerBound(q, kRigidDofs + d, ModeLower(o, d));
+    problem->SetParameterUpperBound(q, kRigidDofs + d, ModeUpper(o, d));
+  }
+  return ids;
+}
+
+void FillReport(const ceres::Solver::Summary& summary, bool full, double seconds, FitReport* report) {
+  report->usable = summary.IsSolutionUsable();
+  report->termination = ceres::TerminationTypeToString(summary.termination_type);
+  report->brief_report = summary.BriefReport();
+  if (full) report->full_report = summary.FullReport();
+  report->initial_cost = summary.initial_cost;
+  report->final_cost = summary.final_cost;
+  report->cost_per_iteration.clear();
+  for (const ceres::IterationSummary& it : summary.iterations) report->cost_per_iteration.push_back(it.cost);
+  report->iterations = int(summary.iterations.size()) - 1;
+  report->solve_seconds = seconds;
+}
+
+void SolvePoseProblem(const PoseFitOptions& o, ceres::Problem* problem, FitReport* report) {
+  ceres::Solver::Options options;
+  // normal equations: J has 2 rows per target but only num_q <= 15 columns; LM's damping keeps
+  // them positive definite even when a mode is undetermined
+  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = o.max_iterations;
+  options.function_tolerance = 1e-12;
+  options.gradient_tolerance = 1e-14;
+  options.parameter_tolerance = 1e-12;
+  SolveAndReport(options, problem, o.on_iteration, o.full_report, report);
+}
+
+void SolveAndReport(ceres::Solver::Options options, ceres::Problem* problem,
+                    const std::function<void(int, double)>& on_iteration, bool full_report, FitReport* report) {
+  options.logging_type = ceres::SILENT;
+  IterationForwarder forward(on_iteration);
+  forward.Attach(&options);
+  ceres::Solver::Summary summary;
+  const auto start = std::chrono::steady_clock::now();
+  ceres::Solve(options, problem, &summary);
+  FillReport(summary, full_report, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+             report);
+}
+
+void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
+               const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o, Eigen::VectorXd* q,
+               FitReport* report) {
+  ceres::Problem problem;
+  AddPoseTerms(body, data, reverse, o, q->data(), &problem);
+  SolvePoseProblem(o, &problem, report);
+}
+
+Conditioning ComputeConditioning(const BodyModel& body, const std::vector<SegmentResidual>& data,
+                                 const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o,
+                                 const Eigen::VectorXd& q_in) {
+  const int n = body.num_q();
+  const std::vector<std::string> names = CoordinateNames(body);
+  Conditioning c;
+  // the Jacobian of the data terms alone (the prior would hide what the data cannot see)
+  Eigen::VectorXd q = q_in;
+  ceres::Problem problem;
+  PoseFitOptions data_only = o;
+  data_only.prior_weight = 0;
+  ceres::Problem::EvaluateOptions eval;
+  eval.residual_blocks = AddPoseTerms(body, data, reverse, data_only, q.data(), &problem);
+  ceres::CRSMatrix crs;
+  problem.Evaluate(eval, nullptr, nullptr, nullptr, &crs);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int r = 0; r < crs.num_rows; ++r)
+    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) J(r, crs.cols[k]) = crs.values[k];
+
+  // raw condition number of JᵀJ
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(J).singularValues();
+  const double smax = sv.size() ? sv[0] : 0.0, smin = sv.size() == n ? sv[n - 1] : 0.0;
+  c.condition_number = smin > 0 ? (smax / smin) * (smax / smin) : std::numeric_limits<double>::infinity();
+
+  // column scaling; columns far below the largest are coordinates the data cannot see
+  c.column_norms.resize(n);
+  double max_norm = 0;
+  for (int i = 0; i < n; ++i) max_norm = std::max(max_norm, c.column_norms[i] = J.col(i).norm());
+  std::vector<int> seen;
+  std::vector<bool> undetermined(n, false), poor(n, false);
+  for (int i = 0; i < n; ++i) {
+    if (c.column_norms[i] > Conditioning::kUndetermined * max_norm) {
+      seen.push_back(i);
+    } else {
+      undetermined[i] = true;
+      WeakDirection w;
+      w.relative_singular_value = max_norm > 0 ? c.column_norms[i] / max_norm : 0.0;
+      w.coordinates = {names[i]};
+      w.vector = Eigen::VectorXd::Unit(n, i);
+      c.weak.push_back(w);
+    }
+  }
+  if (!seen.empty()) {
+    Eigen::MatrixXd Js(J.rows(), seen.size());
+    for (size_t j = 0; j < seen.size(); ++j) Js.col(j) = J.col(seen[j]) / c.column_norms[seen[j]];
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeFullV);
+    const Eigen::VectorXd s = svd.singularValues();
+    const int m = int(seen.size());
+    // a tall J has m singular values; fewer rows than columns leave the rest zero
+    Eigen::VectorXd s_full = Eigen::VectorXd::Zero(m);
+    s_full.head(s.size()) = s;
+    c.scaled_condition_number =
+        s_full[m - 1] > 0 ? std::pow(s_full[0] / s_full[m - 1], 2) : std::numeric_limits<double>::infinity();
+    for (int j = m - 1; j >= 0; --j) {
+      const double rel = s_full[0] > 0 ? s_full[j] / s_full[0] : 0.0;
+      if (rel >= Conditioning::kPoorlyDetermined) break;
+      WeakDirection w;
+      w.relative_singular_value = rel;
+      w.vector = Eigen::VectorXd::Zero(n);
+      for (int k = 0; k < m; ++k) w.vector[seen[k]] = svd.matrixV()(k, j);
+      for (int i = 0; i < n; ++i)
+        if (std::abs(w.vector[i]) > 0.3) {
+          w.coordinates.push_back(names[i]);
+          (rel < Conditioning::kUndetermined ? undetermined : poor)[i] = true;
+        }
+      c.weak.push_back(w);
+    }
+  } else {
+    c.scaled_condition_number = std::numeric_limits<double>::infinity();
+  }
+  std::sort(c.weak.begin(), c.weak.end(),
+            [](const WeakDirection& a, const WeakDirection& b) { return a.relative_singular_value < b.relative_singular_value; });
+  for (int d = 0; d < body.num_modes(); ++d) {
+    const int i = kRigidDofs + d;
+    if (undetermined[i]) {
+      c.undetermined.push_back(names[i]);
+    } else if (poor[i]) {
+      c.poorly_determined.push_back(names[i]);
+    }
+  }
+  return c;
+}
+
+}  // namespace wobble::fit

@@ -1,0 +1,27 @@
+// Atomic file output: every file wobble writes goes to a temporary file in the same folder
+// (FILE.tmp) and is renamed over FILE only once it is complete, so a reader never sees half
+// a file and a failed write leaves any earlier FILE untouched.
+#pragma once
+
+#include <functional>
+#include <string>
+
+namespace wobble::formats {
+
+// The temporary name used for `path`: "path.tmp", in the same folder (rename stays atomic).
+std::string TempPathFor(const std::string& path);
+
+// Creates the folder of `path` if needed. Throws std::runtime_error naming the path and reason.
+void CreateParentFolder(const std::string& path);
+
+// Writes `path` atomically: creates its folder, checks that the temporary file can be
+// created (a clear error with the system's reason if not), calls write(temp_path) to fill
+// it, and renames it over `path`. When `write` throws, or leaves no file behind, or the
+// rename fails, the temporary file is removed, `path` is left as it was, and a
+// std::runtime_error naming `path` and the reason is thrown.
+void WriteFileAtomically(const std::string& path, const std::function<void(const std::string& temp_path)>& write);
+
+// The common case: `text` becomes the whole file (JSON, CSV, scripts), by the function above.
+void WriteTextAtomically(const std::string& path, const std::string& text);
+
+}  // namespace wobble::formats

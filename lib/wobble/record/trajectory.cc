@@ -1,0 +1,194 @@
+#include "wobble/record/trajectory.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace wobble::record {
+
+namespace {
+const char* const kEnergyNames[] = {"kinetic", "gravity", "modes", "ground", "springs", "total"};
+constexpr int kNumEnergies = 6;
+using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+}  // namespace
+
+BodyInfo DescribeBody(const World& world, int body) {
+  BodyInfo info;
+  info.name = world.body_name(body);
+  info.kind = world.kind(body);
+  info.dim = world.dim(body);
+  if (info.kind == BodyKind::kFfd) {
+    const BodyModel& m = world.body(body);
+    info.ffd = world.shared_body(body);  // drawing after the world is gone
+    info.coordinate_names = {"tx", "ty", "theta"};
+    for (const DeformationMode& mode : m.modes()) info.coordinate_names.push_back(mode.name);
+  } else {
+    const LinearBodyModel& m = world.linear_model(body);
+    info.linear = world.shared_linear_model(body);
+    for (int i = 0; i < m.dim(); ++i)
+      for (int s = 0; s < m.basis_size(); ++s) info.coordinate_names.push_back("r" + std::to_string(i) + "_" + std::to_string(s));
+  }
+  info.num_q = int(info.coordinate_names.size());
+  return info;
+}
+
+Trajectory::Trajectory(const World& world) {
+  for (int b = 0; b < world.num_bodies(); ++b) bodies_.push_back(DescribeBody(world, b));
+  Build();
+}
+
+Trajectory::Trajectory(std::vector<BodyInfo> bodies) : bodies_(std::move(bodies)) { Build(); }
+
+void Trajectory::Build() {
+  columns_ = {"t"};
+  layout_.clear();
+  const bool prefixed = bodies_.size() > 1;
+  for (const BodyInfo& b : bodies_) {
+    const std::string p = prefixed ? b.name + "." : "";
+    Layout l;
+    l.q = int(columns_.size());
+    for (const std::string& c : b.coordinate_names) columns_.push_back(p + c);
+    l.qd = int(columns_.size());
+    for (const std::string& c : b.coordinate_names) columns_.push_back(p + "d" + c);
+    l.targets = int(columns_.size());
+    if (b.kind == BodyKind::kFfd) {
+      l.num_targets = b.num_q - kRigidDofs;
+      for (int d = kRigidDofs; d < b.num_q; ++d) columns_.push_back(p + "target_" + b.coordinate_names[d]);
+    }
+    l.energies = int(columns_.size());
+    for (const char* e : kEnergyNames) columns_.push_back(p + e);
+    l.contacts = int(columns_.size());
+    columns_.push_back(p + "contacts");
+    columns_.push_back(p + "penetration");
+    layout_.push_back(l);
+  }
+  for (const char* c : {"control_energy", "pose", "violation"}) columns_.push_back(c);
+  width_ = int(columns_.size());
+  data_.clear();
+}
+
+int Trajectory::Column(const std::string& name) const {
+  for (int i = 0; i < num_columns(); ++i)
+    if (columns_[i] == name) return i;
+  return -1;
+}
+
+void Trajectory::Append(const World& world, double control_energy, int pose) {
+  if (world.num_bodies() != num_bodies())
+    throw std::invalid_argument("Trajectory::Append: the world has " + std::to_string(world.num_bodies()) +
+                                " bodies, the trajectory " + std::to_string(num_bodies()));
+  const size_t start = data_.size();
+  data_.resize(start + size_t(width_), 0.0);
+  double* row = data_.data() + start;
+  row[0] = world.time();
+  for (int b = 0; b < num_bodies(); ++b) {
+    const Layout& l = layout_[b];
+    const int nq = bodies_[b].num_q;
+    if (bodies_[b].kind == BodyKind::kFfd) {
+      const BodyState<double>& s = world.state(b);
+      Eigen::Map<Eigen::VectorXd>(row + l.q, nq) = s.q;
+      Eigen::Map<Eigen::VectorXd>(row + l.qd, nq) = s.qd;
+      if (s.mode_target.size() == l.num_targets) Eigen::Map<Eigen::VectorXd>(row + l.targets, l.num_targets) = s.mode_target;
+      row[l.contacts] = double(s.contacts.size());
+      row[l.contacts + 1] = s.penetration;
+    } else {
+      const Eigen::MatrixXd& R = world.linear_R(b);
+      const Eigen::MatrixXd& Rd = world.linear_R_dot(b);
+      Eigen::Map<RowMajor>(row + l.q, R.rows(), R.cols()) = R;
+      Eigen::Map<RowMajor>(row + l.qd, R.rows(), R.cols()) = Rd;
+    }
+    const Energies e = world.ComputeEnergies(b);
+    const double values[kNumEnergies] = {e.kinetic, e.gravity, e.modes, e.ground, e.springs, e.total()};
+    for (int i = 0; i < kNumEnergies; ++i) row[l.energies + i] = values[i];
+  }
+  row[width_ - 3] = control_energy;
+  row[width_ - 2] = pose;
+  row[width_ - 1] = world.num_enabled_constraints() > 0 ? world.MaxViolation() : 0.0;
+}
+
+void Trajectory::AppendRow(const std::vector<double>& row) {
+  if (int(row.size()) != width_)
+    throw std::invalid_argument("Trajectory::AppendRow: " + std::to_string(row.size()) + " values for " +
+                                std::to_string(width_) + " columns");
+  data_.insert(data_.end(), row.begin(), row.end());
+}
+
+Eigen::Map<const Eigen::VectorXd> Trajectory::q(int k, int body) const {
+  return {Row(k) + layout_[body].q, bodies_[body].num_q};
+}
+Eigen::Map<const Eigen::VectorXd> Trajectory::qd(int k, int body) const {
+  return {Row(k) + layout_[body].qd, bodies_[body].num_q};
+}
+Eigen::Map<const Eigen::VectorXd> Trajectory::targets(int k, int body) const {
+  return {Row(k) + layout_[body].targets, layout_[body].num_targets};
+}
+
+Energies Trajectory::energies(int k, int body) const {
+  const double* e = Row(k) + layout_[body].energies;
+  Energies out;
+  out.kinetic = e[0];
+  out.gravity = e[1];
+  out.modes = e[2];
+  out.ground = e[3];
+  out.springs = e[4];
+  const BodyInfo& b = bodies_[body];
+  if (b.kind == BodyKind::kFfd && b.ffd) {  // K (γ − γ0)² per mode, from the recorded q and γ0
+    const Eigen::Map<const Eigen::VectorXd> qk = q(k, body), tk = targets(k, body);
+    for (int d = 0; d < b.ffd->num_modes(); ++d) {
+      const double offset = qk[kRigidDofs + d] - tk[d];
+      out.per_mode.push_back(b.ffd->modes()[d].stiffness * offset * offset);
+    }
+  }
+  return out;
+}
+
+int Trajectory::contacts(int k, int body) const { return int(Row(k)[layout_[body].contacts]); }
+double Trajectory::penetration(int k, int body) const { return Row(k)[layout_[body].contacts + 1]; }
+
+void Trajectory::Restore(int k, World& world) const {
+  if (world.num_bodies() != num_bodies()) throw std::invalid_argument("Trajectory::Restore: another world's trajectory");
+  for (int b = 0; b < num_bodies(); ++b) {
+    if (bodies_[b].kind == BodyKind::kFfd) {
+      world.SetState(b, q(k, b), qd(k, b));
+      const Eigen::VectorXd t = targets(k, b);
+      world.SetModeTargets(b, t.isZero(0.0) ? Eigen::VectorXd() : t);
+    } else {
+      const int d = bodies_[b].dim, n = bodies_[b].num_q / d;
+      world.SetLinearState(b, Eigen::Map<const RowMajor>(q(k, b).data(), d, n),
+                           Eigen::Map<const RowMajor>(qd(k, b).data(), d, n));
+    }
+  }
+  world.SetTime(time(k));
+}
+
+int Trajectory::Nearest(double t) const {
+  int best = 0;
+  for (int k = 1; k < size(); ++k)
+    if (std::abs(time(k) - t) < std::abs(time(best) - t)) best = k;
+  return best;
+}
+
+// ---------------------------------------------------------------- recorder
+
+Recorder::Recorder(std::shared_ptr<Trajectory> trajectory, int every) : trajectory_(std::move(trajectory)), every_(every) {
+  if (!trajectory_) throw std::invalid_argument("Recorder: no trajectory");
+  if (every_ < 1) throw std::invalid_argument("Recorder: every must be at least 1");
+}
+
+void Recorder::Start(const World& world) {
+  counter_ = 0;
+  trajectory_->Append(world, energy_.consumed, pose_ ? pose_->pose() : -1);
+}
+
+void Recorder::AfterStep(World& world) {
+  const double dt = world.options().dt;
+  for (int b = 0; b < world.num_bodies(); ++b)
+    if (world.kind(b) == BodyKind::kFfd) energy_.Accumulate(world.body(b), world.state(b), dt);
+  if (++counter_ % every_ == 0) trajectory_->Append(world, energy_.consumed, pose_ ? pose_->pose() : -1);
+}
+
+void Recorder::Finish(const World& world) {
+  const Trajectory& t = *trajectory_;
+  if (t.empty() || t.time(t.size() - 1) != world.time()) trajectory_->Append(world, energy_.consumed, pose_ ? pose_->pose() : -1);
+}
+
+}  // namespace wobble::record

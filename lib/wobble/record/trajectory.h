@@ -1,0 +1,128 @@
+// The one recorder of wobble: a Trajectory is what a run leaves behind (t, q and q̇ of every
+// body, every energy term, contacts, control energy, the active pose, the constraint
+// violation), filled by the world's step through a Recorder, written and read as one CSV
+// schema (record/trajectory_csv.h), drawn by the one render driver (pipelines/).
+//
+// Storage is one flat row of numbers per sample (the CSV's row), so recording a step appends
+// to one vector and allocates nothing once it has grown; Sample() views a row.
+//
+// Columns (Columns()), for each body b in order, prefixed "NAME." when the world has more than
+// one body:
+//   FFD body:     tx ty theta <mode names> | dtx dty dtheta d<mode names> | target_<mode names>
+//   linear body:  r<i>_<s> (R row i, basis s) | dr<i>_<s>
+//   every body:   kinetic gravity modes ground springs total | contacts penetration
+// then, once: t first, and at the end control_energy pose violation.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "wobble/control/control.h"
+#include "wobble/control/controllers.h"
+#include "wobble/world/controller.h"
+#include "wobble/world/world.h"
+
+namespace wobble::record {
+
+// What a trajectory knows of each body: enough to name its columns and to draw it again.
+struct BodyInfo {
+  std::string name;
+  BodyKind kind = BodyKind::kFfd;
+  int dim = 2;
+  int num_q = 0;
+  std::shared_ptr<const BodyModel> ffd;           // FFD bodies: the model (modes included)
+  std::shared_ptr<const LinearBodyModel> linear;  // linear bodies
+  std::vector<std::string> coordinate_names;      // one per q entry
+};
+
+class Trajectory {
+ public:
+  Trajectory() = default;
+  // The bodies of `world` (in its numbering) define the columns.
+  explicit Trajectory(const World& world);
+  // The bodies given (a trajectory read from a file, or one built by hand).
+  explicit Trajectory(std::vector<BodyInfo> bodies);
+
+  const std::vector<BodyInfo>& bodies() const { return bodies_; }
+  int num_bodies() const { return int(bodies_.size()); }
+  const std::vector<std::string>& Columns() const { return columns_; }
+  int num_columns() const { return int(columns_.size()); }
+  // The column's index, or -1.
+  int Column(const std::string& name) const;
+
+  int size() const { return width_ == 0 ? 0 : int(data_.size() / size_t(width_)); }
+  bool empty() const { return size() == 0; }
+  void clear() { data_.clear(); }
+  void reserve(int samples) { data_.reserve(size_t(samples) * size_t(width_)); }
+
+  // Appends the world's state now (its bodies must be those of the constructor). `pose` and
+  // `control_energy` come from the controllers (control::PoseGraphController, ControlEnergy).
+  void Append(const World& world, double control_energy = 0.0, int pose = -1);
+  // Appends a row of Columns() values (a file being read).
+  void AppendRow(const std::vector<double>& row);
+
+  // Read access to sample k.
+  double time(int k) const { return Row(k)[0]; }
+  Eigen::Map<const Eigen::VectorXd> q(int k, int body) const;
+  Eigen::Map<const Eigen::VectorXd> qd(int k, int body) const;
+  // PD targets γ0 of an FFD body's modes (empty map for a linear body).
+  Eigen::Map<const Eigen::VectorXd> targets(int k, int body) const;
+  Energies energies(int k, int body) const;  // per_mode is recomputed for FFD bodies
+  int contacts(int k, int body) const;
+  double penetration(int k, int body) const;
+  double control_energy(int k) const { return Row(k)[width_ - 3]; }
+  int pose(int k) const { return int(Row(k)[width_ - 2]); }
+  double violation(int k) const { return Row(k)[width_ - 1]; }
+  const double* Row(int k) const { return data_.data() + size_t(k) * size_t(width_); }
+
+  // Puts the bodies of sample k back into `world` (same bodies) and its clock at the sample's
+  // time; PD targets too. Constraints are not touched.
+  void Restore(int k, World& world) const;
+  // The sample nearest to time t (the first of equals).
+  int Nearest(double t) const;
+
+ private:
+  struct Layout {
+    int q = 0, qd = 0, targets = 0, energies = 0, contacts = 0;
+    int num_targets = 0;
+  };
+  void Build();
+
+  std::vector<BodyInfo> bodies_;
+  std::vector<Layout> layout_;
+  std::vector<std::string> columns_;
+  int width_ = 0;
+  std::vector<double> data_;
+};
+
+// Names of a body's generalized coordinates: tx ty theta <mode names> (FFD) or r<i>_<s> (linear).
+BodyInfo DescribeBody(const World& world, int body);
+
+// The recorder: a Controller the world calls after every accepted step (World::SetRecorder),
+// appending every `every`-th step to its trajectory. Start() records the first sample. It also
+// integrates the control energy of the FFD bodies (control::ControlEnergy, every step).
+class Recorder : public Controller {
+ public:
+  explicit Recorder(std::shared_ptr<Trajectory> trajectory, int every = 1);
+  // The sample at the world's state now (the run's start); resets the step counter.
+  void Start(const World& world);
+  void AfterStep(World& world) override;
+  // Records the state now unless it is the last sample (the end of a run recorded every N).
+  void Finish(const World& world);
+  // The pose to write in each sample (a pose-graph controller's), or none.
+  void SetPoseSource(std::shared_ptr<const control::PoseSource> source) { pose_ = std::move(source); }
+  const std::shared_ptr<Trajectory>& trajectory() const { return trajectory_; }
+  const control::ControlEnergy& control_energy() const { return energy_; }
+  void set_control_energy(const control::ControlEnergy& e) { energy_ = e; }
+
+ private:
+  std::shared_ptr<Trajectory> trajectory_;
+  int every_ = 1;
+  long counter_ = 0;
+  control::ControlEnergy energy_;
+  std::shared_ptr<const control::PoseSource> pose_;
+};
+
+}  // namespace wobble::record

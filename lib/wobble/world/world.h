@@ -1,0 +1,346 @@
+// THE world: every kind of body (FFD bodies of the thesis, Witkin & Welch linear bodies in 2D
+// and 3D), the ground, springs, constraints and impulses, one clock and one status.
+//
+// Usage (tests/constraints_test.cc, HelloPendulum; tests/physics_test.cc for FFD bodies):
+//   World w({.params = ..., .dt = 0.002});
+//   int table = w.AddBody(ffd_model);                     // an FFD body, at q = 0, at rest
+//   int link = w.AddLinearBody(model, material);          // a linear body, at its rest state
+//   int nail = w.AddNail({link, top_u});                  // nailed where the point is now
+//   while (w.time() < 5) if (!w.Step()) report(w.status().message);
+//   w.SetEnabled(nail, false);                            // the link falls; refactors once
+//
+// One body numbering for both kinds. FFD bodies have q = [tx, ty, θ, γ1..γD] (Eq. 4.4) and
+// their accessors (body, state, SetState, SetModeTargets, ComputeEnergies, Forces, ...);
+// linear bodies x = R p(u) have R and Ṙ (linear_model, linear_R, SetLinearState).
+//
+// Stepping. While no constraint is enabled, every FFD body is advanced on its own by the
+// templated StepBody (wobble/dynamics/step.h) with the world's integrator: the per-body fast
+// path of the thesis, which the fits differentiate with Ceres Jets, and whose cost is O(D²)
+// from the mass moments (ARCHITECTURE.md). Linear bodies take semi-implicit Euler on their
+// constant, pre-inverted mass matrix. While a constraint is enabled, every body is advanced
+// together through the multipliers (world_constraints.cc):
+//   J W Jᵀ λ = −(J W Q + J̇ q̇ − n̈ + α c + β ċ),   q̈ = W (Q + Jᵀ λ)   (Witkin & Welch Eq. 6–10)
+// and semi-implicit Euler, velocity first: q̇ₙ₊₁ = q̇ₙ + Δt q̈, qₙ₊₁ = qₙ + Δt q̇ₙ₊₁, which is the
+// Störmer form of the thesis integrator (Eq. 4.22/4.23) for FFD bodies. c̈ = −α c − β ċ makes a
+// violation decay like a critically damped spring instead of drifting.
+//
+// Linear bodies: ∂x/∂R = δ_ir p_s (§3.3) is constant, so J is constant and J̇ = 0, and A = J W Jᵀ
+// is factored once per change of the enabled set (dense inverse or sparse LDLT,
+// MultiplierSolver). While a constraint touches an FFD body, A is rebuilt from M(q) per step.
+//
+// Every accepted state is checked; the first trouble stops the world with a status naming the
+// step, the time, the body and the cause (never a silent NaN).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "wobble/body/affine_energy.h"
+#include "wobble/body/linear_body.h"
+#include "wobble/dynamics/step.h"
+#include "wobble/world/controller.h"
+#include "wobble/world/multiplier_solver.h"
+#include "wobble/world/point_path.h"
+
+namespace wobble {
+
+enum class BodyKind { kLinear, kFfd };
+enum class ConstraintKind { kNail, kAttachment, kTrajectory };
+const char* ConstraintKindName(ConstraintKind kind);
+
+// Energy terms of one body. Linear bodies: kinetic, gravity and their affine energy in `modes`.
+struct Energies {
+  double kinetic = 0, gravity = 0, modes = 0, ground = 0, springs = 0;
+  std::vector<double> per_mode;  // each FFD mode's K (γ − γ0)²; `modes` is their sum
+  double total() const { return kinetic + gravity + modes + ground + springs; }
+};
+
+// Why the world stopped, and where. The cause is one StatusCode for per-body and world trouble.
+struct WorldStatus {
+  using Code = StatusCode;
+  Code code = Code::kOk;
+  long step = 0;      // the step that failed (1-based), or steps taken
+  double time = 0.0;  // simulated time at the start of that step
+  int body = -1;      // -1: not one body's (the constraints)
+  std::string message;  // one line for people
+  bool ok() const { return code == Code::kOk; }
+};
+
+struct WorldOptions {
+  // 2D gravity (params.gravity; gravity_3d for 3D bodies; both off with params.gravity_on),
+  // the ground, springs and max_condition of the FFD bodies.
+  WorldParams params;
+  Eigen::Vector3d gravity_3d = Eigen::Vector3d(0.0, -9.81, 0.0);
+  // The FFD bodies' integrator while no constraint is enabled.
+  Integrator integrator = Integrator::kThesis;
+  double dt = 0.01;
+  // Default constraint feedback: α = (rate/Δt)², β = 2 rate/Δt (critically damped).
+  double feedback_rate = 0.1;
+  // Dense pre-inverted A up to this many constraint rows, sparse LDLT above (kAuto). Measured
+  // (bench/constraints_bench): per step the two are equal within 5 % up to 200 rows and the
+  // dense solve grows quadratically beyond; refactoring is cheaper sparse from about 20 rows on.
+  MultiplierMethod method = MultiplierMethod::kAuto;
+  int dense_max_rows = 24;
+};
+
+// A material point of a body. Linear bodies: u in undeformed coordinates (any point, inside
+// or outside the mass points). FFD bodies: u = lattice coordinates (s, t) in [0, 1]². Or
+// mass_point = k ≥ 0: the body's k-th mass point (u is then ignored).
+struct MaterialPoint {
+  int body = -1;
+  Eigen::VectorXd u;
+  int mass_point = -1;
+};
+inline MaterialPoint At(int body, Eigen::VectorXd u) { return {body, std::move(u), -1}; }
+inline MaterialPoint MassPointOf(int body, int k) { return {body, Eigen::VectorXd(), k}; }
+
+// Drift feedback of one constraint: c̈ = −α c − β ċ. Negative means the world's default.
+struct Feedback {
+  double alpha = -1.0, beta = -1.0;
+};
+
+// A velocity goal for ApplyImpulse: after the jump, v(a) − v(b) = v (b.body < 0: v(a) = v).
+struct VelocityGoal {
+  MaterialPoint a;
+  MaterialPoint b;  // body −1: none
+  Eigen::VectorXd v;
+};
+
+class World {
+ public:
+  explicit World(WorldOptions options = {});
+
+  // ---- bodies (one numbering for both kinds) ----
+  // An FFD body starts at q = 0 (the body frame), at rest.
+  int AddBody(std::shared_ptr<const BodyModel> model);
+  // A linear body starts at its rest state R = [I | 0 | 0], at rest.
+  int AddLinearBody(std::shared_ptr<const LinearBodyModel> model, AffineMaterial material = {});
+  int num_bodies() const { return int(slots_.size()); }
+  BodyKind kind(int body) const;
+  int dim(int body) const;  // 2 or 3
+  const std::string& body_name(int body) const;
+
+  // FFD bodies (std::invalid_argument for a linear one or a wrong size). Setting a state does
+  // not enforce constraints: follow with ProjectVelocities() or let the feedback pull it in.
+  const BodyModel& body(int i) const;
+  const std::shared_ptr<const BodyModel>& shared_body(int i) const;  // for whoever outlives the world
+  const BodyState<double>& state(int i) const;
+  void SetState(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  // PD targets γ0 of the body's modes (one per mode; empty: all zero). See wobble/control.
+  void SetModeTargets(int body, const Eigen::VectorXd& targets);
+  ForceBreakdown<double> Forces(int body) const;
+  Eigen::VectorXd Accelerations(int body) const;     // free q̈ (no constraint forces)
+  std::vector<Eigen::Vector2d> PointPositions(int body) const;  // world positions of its mass points
+
+  // Linear bodies: R and Ṙ (d×n).
+  const LinearBodyModel& linear_model(int body) const;
+  const std::shared_ptr<const LinearBodyModel>& shared_linear_model(int body) const;
+  void SetLinearState(int body, const Eigen::MatrixXd& R, const Eigen::MatrixXd& R_dot);
+  const Eigen::MatrixXd& linear_R(int body) const;
+  const Eigen::MatrixXd& linear_R_dot(int body) const;
+  void SetMaterial(int body, const AffineMaterial& material);
+  const AffineMaterial& material(int body) const;
+
+  // Springs hold a point of an FFD body given by lattice coordinates (Fig. 4.4).
+  void AddSpring(Spring spring);
+
+  // ---- material points ----
+  // Throws std::invalid_argument: unknown body, wrong size, lattice coordinates outside
+  // [0, 1]², or a mass point index out of range.
+  Eigen::VectorXd PointPosition(const MaterialPoint& point) const;
+  Eigen::VectorXd PointVelocity(const MaterialPoint& point) const;
+  // A world force at a point during the next step only (Q = f pᵀ, or Jᵀ f for FFD bodies).
+  void ApplyPointForce(const MaterialPoint& point, const Eigen::VectorXd& f);
+
+  // ---- constraints: each returns an id, enabled at once ----
+  // Nail the point at `where` (empty: where the point is now).
+  int AddNail(const MaterialPoint& point, Eigen::VectorXd where = Eigen::VectorXd(), Feedback fb = {});
+  int AddAttachment(const MaterialPoint& a, const MaterialPoint& b, Feedback fb = {});
+  int AddTrajectory(const MaterialPoint& point, std::shared_ptr<const PointPath> path, Feedback fb = {});
+  // Moving a nail or replacing a path keeps the factorization (J does not change).
+  void SetNailPosition(int id, const Eigen::VectorXd& where);
+  void SetPath(int id, std::shared_ptr<const PointPath> path);
+  void SetFeedback(int id, Feedback fb);
+  // Switching on or off (or removing) refactors A at the next step. Removed ids stay invalid.
+  void SetEnabled(int id, bool enabled);
+  void Remove(int id);
+  bool enabled(int id) const;
+  bool exists(int id) const;
+  ConstraintKind constraint_kind(int id) const;
+  int num_constraints() const { return int(constraints_.size()); }  // ids are 0..n−1
+  int num_enabled_constraints() const { return enabled_count_; }
+  // c = x_a − x_b (or x_a − n(t)) now, and its largest norm over the enabled constraints.
+  Eigen::VectorXd ConstraintError(int id) const;
+  Eigen::VectorXd ConstraintVelocityError(int id) const;
+  double MaxViolation() const;
+  // The multiplier λ (the constraint force on point a, world units) of the last step.
+  Eigen::VectorXd Multiplier(int id) const;
+
+  // ---- impulses (§3.2, Eq. 9) ----
+  // One velocity jump Δq̇ = W Jᵀ λ, with J W Jᵀ λ = (wanted − current velocity of each row):
+  // every enabled constraint ends with ċ = 0 (a trajectory: the point moves with ṅ(t)), and
+  // every goal is met exactly. Non-impulsive forces are ignored (§3.2). Returns false with
+  // *error (and nothing changed) when the goals conflict with each other or with the
+  // constraints, or name an unknown body or point.
+  bool ApplyImpulse(const std::vector<VelocityGoal>& goals, std::string* error = nullptr);
+  // ApplyImpulse({}): makes the velocities legal (e.g. after SetLinearState or a path switch).
+  bool ProjectVelocities(std::string* error = nullptr) { return ApplyImpulse({}, error); }
+
+  // ---- controllers (controller.h) and the recorder ----
+  // Every Step calls the controllers in the order added, then the recorder (one, or none:
+  // wobble/record's Recorder). The world shares their ownership.
+  void AddController(std::shared_ptr<Controller> controller);
+  void RemoveController(const Controller* controller);  // no-op when absent
+  void ClearControllers() { controllers_.clear(); }
+  const std::vector<std::shared_ptr<Controller>>& controllers() const { return controllers_; }
+  void SetRecorder(std::shared_ptr<Controller> recorder) { recorder_ = std::move(recorder); }
+  Controller* recorder() const { return recorder_.get(); }
+  // A kinematic body is not moved by Step (Box2D's kinematic bodies): controllers set its
+  // state, as keyframes do. It is not moved by constraint forces either.
+  void SetKinematic(int body, bool kinematic);
+  bool kinematic(int body) const;
+
+  // ---- stepping ----
+  // One step of every body. Returns false and keeps status() at the first trouble (the body's
+  // state before the step is kept); later calls return false until ClearStatus().
+  bool Step();
+  // Steps until time >= t_end or trouble; calls on_step(world) after every accepted step.
+  template <class F> bool RunUntil(double t_end, F&& on_step) {
+    while (time_ + 0.5 * options_.dt < t_end) {
+      if (!Step()) return false;
+      on_step(*this);
+    }
+    return true;
+  }
+  bool RunUntil(double t_end) {
+    return RunUntil(t_end, [](World&) {});
+  }
+  const WorldStatus& status() const { return status_; }
+  void ClearStatus() { status_ = WorldStatus(); }
+  // Sets the clock (replays of recorded states, scenes that start later); steps continue from t.
+  void SetTime(double t) {
+    time_ = time_origin_ = t;
+    origin_steps_ = 0;
+  }
+  double time() const { return time_; }
+  long steps() const { return steps_; }
+  const WorldOptions& options() const { return options_; }
+  // Changing dt, gravity, the ground, springs or the integrator between steps is allowed
+  // (scripts and the viewer do).
+  WorldOptions& mutable_options() { return options_; }
+
+  // ---- energies ----
+  // Every term of one body (Energies); kinetic ½ q̇ᵀ M q̇ (FFD, Eq. 4.9) or ½ tr(Ṙ M Ṙᵀ) (linear).
+  Energies ComputeEnergies(int body) const;
+  double KineticEnergy(int body) const { return ComputeEnergies(body).kinetic; }
+  double PotentialEnergy(int body) const;
+  double TotalEnergy() const;
+
+  // ---- statistics ----
+  // Factorizations of the constant A (linear bodies only): one per change of the enabled set.
+  long factorizations() const { return constant_solver_.factorizations(); }
+  // Factorizations made because an enabled constraint touches an FFD body (one per step).
+  long per_step_factorizations() const { return dynamic_solver_.factorizations(); }
+  // The method of the last factorization (dense or sparse) and A's size.
+  MultiplierMethod last_method() const { return last_method_; }
+  int constraint_rows() const;
+
+ private:
+  struct Slot {
+    BodyKind kind;
+    int index;  // into ffd_ or linear_
+    bool kinematic = false;
+  };
+  // A point or constraint value (d ≤ 3) on the stack: the per-step loops allocate nothing.
+  using PointVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
+  struct FfdEntry {
+    std::shared_ptr<const BodyModel> model;
+    BodyState<double> state;
+    Eigen::VectorXd applied;  // Σ Jᵀ f of ApplyPointForce for the next step
+  };
+  struct LinearEntry {
+    std::shared_ptr<const LinearBodyModel> model;
+    AffineMaterial material;
+    Eigen::MatrixXd R, R_dot, applied;  // applied: Σ f pᵀ of ApplyPointForce for the next step
+    Eigen::MatrixXd Q;                  // per-step work: the body's generalized force
+  };
+  // A resolved material point: linear bodies keep p(u) and W p; FFD bodies b0 and B.
+  struct End {
+    int body = -1;
+    Eigen::VectorXd p, Wp;  // linear
+    Eigen::Vector2d b0;     // FFD
+    Mat2D<double> B;        // FFD
+  };
+  struct Constraint {
+    ConstraintKind kind;
+    End a, b;  // b.body < 0: nail/trajectory
+    Eigen::VectorXd where;
+    std::shared_ptr<const PointPath> path;
+    Feedback fb;
+    bool enabled = true, removed = false;
+    Eigen::VectorXd lambda;
+    int row = -1;  // first row in A while enabled
+  };
+
+  // world.cc: bodies, the per-body step, checks, energies
+  void CheckBody(int body) const;
+  FfdEntry& Ffd(int body);
+  const FfdEntry& Ffd(int body) const;
+  const LinearEntry& Linear(int body) const;
+  bool StepEachBody();
+  bool StepFfdBody(int body);
+  void LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const;
+  double PenetrationLimit(const BodyModel& model) const;
+  bool CheckFfdState(int body, const VecQ<double>& q_before, const VecQ<double>& qd_before, StepStatus st);
+  bool Fail(StatusCode code, int body, const std::string& detail = "", double value = 0.0);
+  void FinishStep();
+
+  // world_constraints.cc: points, constraints, the multiplier step, impulses
+  End Resolve(const MaterialPoint& point) const;
+  const Constraint& Get(int id) const;
+  Constraint& Get(int id);
+  int AddConstraint(Constraint c);
+  PointVec EndPosition(const End& e) const;
+  PointVec EndVelocity(const End& e) const;
+  // Jᵀ f as the body's generalized force (flattened for linear bodies: row-major R).
+  void AddEndForce(const End& e, const Eigen::VectorXd& f, std::vector<Eigen::VectorXd>* Q) const;
+  PointVec EndJdotQdot(const End& e) const;  // J̇ q̇ (zero for linear bodies)
+  // W Jᵀ e_i (nq × d) for an end, and J of another end times that.
+  Eigen::MatrixXd EndWJt(const End& e) const;
+  Eigen::MatrixXd EndJacobian(const End& e) const;  // d × nq of the body
+  void Targets(const Constraint& c, double t, Eigen::VectorXd* n, Eigen::VectorXd* n_dot, Eigen::VectorXd* n_ddot) const;
+  double FeedbackAlpha(const Constraint& c) const;
+  double FeedbackBeta(const Constraint& c) const;
+  bool AnyFfdConstrained() const;
+  int AssignRows();
+  // A = J W Jᵀ over the given rows.
+  Eigen::SparseMatrix<double> AssembleA(const std::vector<const Constraint*>& rows) const;
+  bool EnsureFactored(std::string* why);
+  // Free accelerations of every body (flattened), or false with the failing body and status.
+  bool FreeAccelerations(std::vector<Eigen::VectorXd>* a, int* failed_body, StepStatus* st);
+  void ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const;  // += W Q
+  bool StepConstrained();
+  int num_q(int body) const;
+
+  WorldOptions options_;
+  std::vector<Slot> slots_;
+  std::vector<std::shared_ptr<Controller>> controllers_;
+  std::shared_ptr<Controller> recorder_;
+  std::vector<FfdEntry> ffd_;
+  std::vector<LinearEntry> linear_;
+  std::vector<Constraint> constraints_;
+  int enabled_count_ = 0;
+  std::vector<Eigen::VectorXd> acc_, force_;  // per-step work, kept to reuse their storage
+  MultiplierSolver constant_solver_, dynamic_solver_;
+  bool structure_dirty_ = true;
+  MultiplierMethod last_method_ = MultiplierMethod::kAuto;
+  double time_ = 0.0;
+  // time = origin + n dt (no drift from summing dt) since the clock was set or dt changed
+  double time_origin_ = 0.0, origin_dt_ = 0.0;
+  long origin_steps_ = 0;
+  long steps_ = 0;
+  WorldStatus status_;
+};
+
+}  // namespace wobble
