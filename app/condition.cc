@@ -7,7 +7,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "csv_writer.h"
+#include "wobble/formats/atomic_file.h"
+#include "wobble/formats/csv.h"
 #include "wobble/analysis/conditioning.h"
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/object_file.h"
@@ -165,7 +166,7 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
                     sv.minCoeff()});
   }
   const std::string csv = (out / "sweep.csv").string();
-  WriteCsvAtomically(csv, {"phi_deg", "phi_rad", "cond", "cond_scaled", "singular", "sigma_max", "sigma_min"}, rows);
+  formats::WriteCsvAtomically(csv, {"phi_deg", "phi_rad", "cond", "cond_scaled", "singular", "sigma_max", "sigma_min"}, rows);
 
   std::cout << "phi (deg)   cond(M)        cond(scaled)\n";
   for (const analysis::SweepSample& s : samples)
@@ -217,7 +218,7 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
     for (const std::vector<double>& r : map_rows) grid.cond.push_back(r[2]);
     WriteMapFiles(out, grid);
 #endif
-    WriteCsvAtomically((out / "map.csv").string(), {"phi_deg", "gamma1", "cond", "log10cond"}, map_rows);
+    formats::WriteCsvAtomically((out / "map.csv").string(), {"phi_deg", "gamma1", "cond", "log10cond"}, map_rows);
     std::cout << "map: " << (out / "map.csv").string() << "\n";
   }
   std::cout << "wrote " << out.string() << "/: sweep.csv";
@@ -307,7 +308,7 @@ int RunConditionCheck(const ConditionCheckArgs& a) {
       j["modes"].push_back({{"mode", f.mode}, {"visibility", f.visibility},
                             {"angle_to_others_deg", f.angle_to_others_deg}, {"closest_combination", combo}});
     }
-    WriteTextAtomically(a.json, j.dump(2) + "\n");
+    formats::WriteTextAtomically(a.json, j.dump(2) + "\n");
   }
   return r.level == analysis::ModeSetReport::Level::kError ? kExitBadInput : kExitOk;
 }

@@ -9,7 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "csv_writer.h"
+#include "wobble/formats/atomic_file.h"
+#include "wobble/formats/csv.h"
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/pose_fit.h"
 #include "wobble/fit/trajectory_fit.h"
@@ -74,7 +75,7 @@ void CheckOutputs(const FitFlags& f) {
   for (const std::string* path : {&f.out, &f.costs}) {
     if (path->empty()) continue;
     try {
-      CheckWritable(*path);
+      formats::CheckWritable(*path);
     } catch (const std::runtime_error& e) {
       throw UsageError(std::string(path == &f.out ? "--out: " : "--costs: ") + e.what());
     }
@@ -166,9 +167,9 @@ void WriteOutputs(const FitFlags& f, const json& result, const fit::FitReport& r
   if (!f.costs.empty()) {
     std::vector<std::vector<double>> rows;
     for (size_t i = 0; i < r.cost_per_iteration.size(); ++i) rows.push_back({double(i), r.cost_per_iteration[i]});
-    WriteCsvAtomically(f.costs, {"iteration", "cost"}, rows);
+    formats::WriteCsvAtomically(f.costs, {"iteration", "cost"}, rows);
   }
-  if (!f.out.empty()) WriteTextAtomically(f.out, result.dump(2) + "\n");
+  if (!f.out.empty()) formats::WriteTextAtomically(f.out, result.dump(2) + "\n");
 #ifdef WOBBLE_HAVE_PIPELINES
   WritePictures(f, result, r);
 #endif

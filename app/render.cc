@@ -15,7 +15,8 @@
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 
-#include "csv_writer.h"
+#include "wobble/formats/atomic_file.h"
+#include "wobble/formats/csv.h"
 #include "pipelines/energy_charts.h"
 #include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
@@ -166,7 +167,7 @@ void CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
                      "  xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble ...\n"
                      "or ask only for --what vtp,disp");
   try {
-    CheckWritable(a.out + "/.wobble-probe");  // creates the folder, leaves nothing else
+    formats::CheckWritable(a.out + "/.wobble-probe");  // creates the folder, leaves nothing else
   } catch (const std::runtime_error& e) {
     throw UsageError(std::string("--out: ") + e.what());
   }

@@ -9,7 +9,8 @@
 #include <memory>
 #include <sstream>
 
-#include "csv_writer.h"
+#include "wobble/formats/atomic_file.h"
+#include "wobble/formats/csv.h"
 #include "progress.h"
 
 namespace wobble::app {
@@ -92,7 +93,7 @@ int RunSimulate(const SimulateArgs& a) {
 
   if (!a.out.empty()) {
     try {
-      CheckWritable(a.out);
+      formats::CheckWritable(a.out);
     } catch (const std::runtime_error& e) {
       throw UsageError(std::string("--out: ") + e.what());
     }
@@ -140,7 +141,7 @@ int RunSimulate(const SimulateArgs& a) {
   if (world.steps() != last_recorded) rows.push_back(CsvRow(final_world, world.time()));
 
   // the trajectory, also when the run stopped: it shows what led there
-  if (!a.out.empty()) WriteCsvAtomically(a.out, CsvHeader(body->num_modes()), rows);
+  if (!a.out.empty()) formats::WriteCsvAtomically(a.out, CsvHeader(body->num_modes()), rows);
 
   // the summary: one paragraph, a sentence per line
   const BodyState<double>& s = final_world.state(0);

@@ -307,7 +307,7 @@ TEST(TrajectoryControl, PrerollMeetsThePathsPositionAndVelocityAtOnset) {
 
 // A chaser block and a target block; the target moves at constant velocity (gravity off).
 struct ChaseScene {
-  World w(testing::WitkinWelchOptions());
+  World w{testing::WitkinWelchOptions()};
   int chaser, target;
   MaterialPoint hand, handle;
   ConstraintNames names;

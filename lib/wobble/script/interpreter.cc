@@ -1,4 +1,6 @@
 #include "wobble/script/interpreter.h"
+
+#include "wobble/formats/csv.h"
 #include "wobble/script/internal/interpreter_internal.h"
 
 #include "wobble/formats/atomic_file.h"
@@ -142,17 +144,6 @@ void Place(const Eigen::Vector3d& placement, Eigen::VectorXd* q, Eigen::VectorXd
 
 }  // namespace
 
-
-std::string CsvText(const std::vector<std::string>& header, const std::vector<std::vector<double>>& rows) {
-  std::string text;
-  for (size_t i = 0; i < header.size(); ++i) text += (i ? "," : "") + header[i];
-  text += '\n';
-  for (const std::vector<double>& row : rows) {
-    for (size_t i = 0; i < row.size(); ++i) text += (i ? "," : "") + Num(row[i]);
-    text += '\n';
-  }
-  return text;
-}
 
 // ---------------------------------------------------------------------------------------------
 // running scripts
@@ -464,7 +455,7 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
     if (!anneal_csv_.empty()) {
       // cost against iteration (Fig. 5.4/5.5); the hook draws it
       try {
-        formats::WriteTextAtomically(anneal_csv_, CsvText(synth::HistoryHeader(), synth::HistoryRows(r.history)));
+        formats::WriteTextAtomically(anneal_csv_, formats::CsvText(synth::HistoryHeader(), synth::HistoryRows(r.history)));
         if (history_hook_) history_hook_(anneal_csv_, "simulated annealing", r.history);
       } catch (const std::runtime_error& e) {
         ctx.Fail(e.what());
@@ -504,7 +495,7 @@ void Interpreter::Execute(const std::vector<std::string>& w, const Context& ctx)
     });
     if (!cmaes_csv_.empty()) {
       try {
-        formats::WriteTextAtomically(cmaes_csv_, CsvText(synth::HistoryHeader(), synth::HistoryRows(r.history)));
+        formats::WriteTextAtomically(cmaes_csv_, formats::CsvText(synth::HistoryHeader(), synth::HistoryRows(r.history)));
         if (history_hook_) history_hook_(cmaes_csv_, "CMA-ES", r.history);
       } catch (const std::runtime_error& e) {
         ctx.Fail(e.what());
@@ -794,7 +785,7 @@ std::vector<std::vector<double>> Interpreter::OutputRows() const {
 void Interpreter::FlushOutput(const Context& ctx) {
   if (output_path_.empty()) return;
   try {
-    formats::WriteTextAtomically(output_path_, CsvText(OutputHeader(int(output_modes_.size())), OutputRows()));
+    formats::WriteTextAtomically(output_path_, formats::CsvText(OutputHeader(int(output_modes_.size())), OutputRows()));
   } catch (const std::runtime_error& e) {
     ctx.Fail(std::string("output: ") + e.what());
   }

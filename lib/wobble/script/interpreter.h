@@ -253,7 +253,4 @@ class Interpreter {
   std::vector<TrackEntry> track_;
 };
 
-// The CSV text of a table (numbers in shortest round-trip form).
-std::string CsvText(const std::vector<std::string>& header, const std::vector<std::vector<double>>& rows);
-
 }  // namespace wobble::script

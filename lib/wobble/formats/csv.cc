@@ -1,16 +1,15 @@
-#include "csv_writer.h"
+#include "wobble/formats/csv.h"
 
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <stdexcept>
 
 #include "wobble/formats/atomic_file.h"
 
-namespace wobble::app {
+namespace wobble::formats {
 
 std::string FormatDouble(double value) {
   if (std::isnan(value)) return "nan";
@@ -20,9 +19,26 @@ std::string FormatDouble(double value) {
   return std::string(buf, res.ptr);
 }
 
+std::string CsvText(const std::vector<std::string>& header, const std::vector<std::vector<double>>& rows) {
+  std::string text;
+  for (size_t i = 0; i < header.size(); ++i) {
+    if (i) text += ',';
+    text += header[i];
+  }
+  text += '\n';
+  for (const std::vector<double>& row : rows) {
+    for (size_t i = 0; i < row.size(); ++i) {
+      if (i) text += ',';
+      text += FormatDouble(row[i]);
+    }
+    text += '\n';
+  }
+  return text;
+}
+
 void CheckWritable(const std::string& path) {
-  formats::CreateParentFolder(path);
-  const std::string tmp = formats::TempPathFor(path);
+  CreateParentFolder(path);
+  const std::string tmp = TempPathFor(path);
   std::FILE* f = std::fopen(tmp.c_str(), "w");
   if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
   std::fclose(f);
@@ -31,7 +47,7 @@ void CheckWritable(const std::string& path) {
 
 void WriteCsvAtomically(const std::string& path, const std::vector<std::string>& header,
                         const std::vector<std::vector<double>>& rows) {
-  formats::WriteFileAtomically(path, [&](const std::string& tmp) {
+  WriteFileAtomically(path, [&](const std::string& tmp) {
     std::FILE* f = std::fopen(tmp.c_str(), "w");
     if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
     std::string line;
@@ -41,17 +57,11 @@ void WriteCsvAtomically(const std::string& path, const std::vector<std::string>&
     }
     line += '\n';
     bool ok = std::fputs(line.c_str(), f) >= 0;
-    char buf[64];
-    for (const std::vector<double>& row : rows) {
+    for (const std::vector<double>& row : rows) {  // a line at a time: long runs stay small in memory
       line.clear();
       for (size_t i = 0; i < row.size(); ++i) {
         if (i) line += ',';
-        if (std::isfinite(row[i])) {
-          const auto res = std::to_chars(buf, buf + sizeof(buf), row[i]);
-          line.append(buf, res.ptr);
-        } else {
-          line += FormatDouble(row[i]);
-        }
+        line += FormatDouble(row[i]);
       }
       line += '\n';
       ok = ok && std::fputs(line.c_str(), f) >= 0;
@@ -62,5 +72,4 @@ void WriteCsvAtomically(const std::string& path, const std::vector<std::string>&
   });
 }
 
-}  // namespace wobble::app
-
+}  // namespace wobble::formats
