@@ -55,7 +55,7 @@ double MaxModeError(const fit::TrajectoryFitResult& r, const Reference& ref) {
 TEST(TrajectoryFit, RecoversSimulatedQFromMassPoints) {
   const auto body = Table();
   const Reference ref = Simulated(body);
-  const std::vector<formats::TargetFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {});
+  const std::vector<fit::ReferenceFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {});
   fit::TrajectoryFitOptions o;
   o.smoothness = 0.0;  // exact data: nothing to smooth
   o.pose.gamma_lower = -3;  // the thrown table's amplitudes reach -1.3
@@ -73,11 +73,11 @@ TEST(TrajectoryFit, SmoothnessReducesTheErrorFromNoise) {
   const auto body = Table();
   const Reference ref = Simulated(body);
   // only 5 of the 11 points are observed (both feet, the top's ends and middle), with noise 2
-  std::vector<formats::TargetFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {0, 2, 4, 5, 8});
+  std::vector<fit::ReferenceFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {0, 2, 4, 5, 8});
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, 2.0);
-  for (formats::TargetFrame& f : frames)
-    for (formats::PointTarget& p : f.points) p.position += Eigen::Vector2d(noise(rng), noise(rng));
+  for (fit::ReferenceFrame& f : frames)
+    for (fit::Correspondence& p : f.points) p.position += Eigen::Vector2d(noise(rng), noise(rng));
   fit::TrajectoryFitOptions rough, smooth;
   rough.smoothness = 0.0;
   smooth.smoothness = 30.0;
