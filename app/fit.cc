@@ -14,7 +14,7 @@
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/pose_fit.h"
 #include "wobble/fit/trajectory_fit.h"
-#include "wobble/formats/simulation_csv.h"
+#include "wobble/record/trajectory_csv.h"
 #include "wobble/formats/parse_error.h"
 #include "wobble/formats/target_file.h"
 
@@ -428,8 +428,14 @@ int RunFitTrajectory(const FitTrajectoryArgs& a) {
   // the reference: a simulation CSV or a target file with frames
   std::vector<fit::ReferenceFrame> frames;
   if (EndsWith(a.reference, ".csv")) {
-    const formats::SimulationCsv sim = formats::ReadSimulationCsv(a.reference, body->num_modes());
-    frames = fit::FramesFromStates(*body, sim.t, sim.q, ParsePointList(a.points, body->num_points()), a.every);
+    const record::Trajectory sim = record::ReadTrajectoryCsv(a.reference, {record::DescribeFfdBody(body)}).trajectory;
+    std::vector<double> t;
+    std::vector<Eigen::VectorXd> q;
+    for (int k = 0; k < sim.size(); ++k) {
+      t.push_back(sim.time(k));
+      q.push_back(sim.q(k, 0));
+    }
+    frames = fit::FramesFromStates(*body, t, q, ParsePointList(a.points, body->num_points()), a.every);
   } else {
     if (!a.points.empty() || a.every != 1) throw UsageError("--points and --every apply to a CSV reference only");
     const formats::TargetFile t = formats::ReadTargetFile(a.reference);

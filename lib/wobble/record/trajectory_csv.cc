@@ -23,6 +23,15 @@ std::vector<std::string> SplitCommas(const std::string& text) {
   return cells;
 }
 
+// " (a body with D modes)" for one FFD body, the bodies' names otherwise.
+std::string BodiesText(const Trajectory& t) {
+  if (t.num_bodies() == 1 && t.bodies()[0].kind == BodyKind::kFfd)
+    return " (a body with " + std::to_string(t.bodies()[0].num_q - kRigidDofs) + " modes)";
+  std::string names;
+  for (const BodyInfo& b : t.bodies()) names += (names.empty() ? "" : ", ") + b.name;
+  return " (bodies " + names + ")";
+}
+
 }  // namespace
 
 BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel> body) {
@@ -53,13 +62,13 @@ ReadTrajectory ParseTrajectoryCsv(std::istream& in, const std::string& file, std
         if (schema[i] == prefix + c) required.push_back(i);
     }
   std::string text;
-  if (!std::getline(in, text)) throw formats::ParseError(file, 0, "file is empty: expected the header of a wobble trajectory");
+  if (!std::getline(in, text)) throw formats::ParseError(file, 0, "file is empty: expected the header of `wobble simulate`");
   const std::vector<std::string> header = SplitCommas(text);
   std::string expected_text;
   for (int i : required) expected_text += (expected_text.empty() ? "" : ",") + schema[i];
   for (size_t i = 0; i < required.size(); ++i)
     if (i >= header.size() || header[i] != schema[required[i]])
-      throw formats::ParseError(file, 1, "expected the header to start with " + expected_text + ", got '" + text + "'");
+      throw formats::ParseError(file, 1, "expected the header to start with " + expected_text + BodiesText(traj) + ", got '" + text + "'");
   // where each schema column is in the file (−1: absent)
   std::vector<int> source(schema.size(), -1);
   for (size_t h = 0; h < header.size(); ++h)
