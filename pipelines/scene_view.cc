@@ -407,18 +407,21 @@ void SceneView::Render() {
   m.last_rgb = nullptr;
 }
 
-vtkSmartPointer<vtkImageData> SceneView::Capture() {
-  if (impl_->last_rgb) return impl_->last_rgb;
+vtkSmartPointer<vtkImageData> ReadWindowRgb(vtkRenderWindow* window, bool rerender) {
   auto grab = Ptr<vtkWindowToImageFilter>::New();
-  grab->SetInput(impl_->window);
+  grab->SetInput(window);
   grab->SetInputBufferTypeToRGB();
   grab->ReadFrontBufferOff();
-  grab->ShouldRerenderOff();
+  grab->SetShouldRerender(rerender);
   grab->Update();
   auto image = Ptr<vtkImageData>::New();
   image->DeepCopy(grab->GetOutput());
-  impl_->last_rgb = image;
   return image;
+}
+
+vtkSmartPointer<vtkImageData> SceneView::Capture() {
+  if (!impl_->last_rgb) impl_->last_rgb = ReadWindowRgb(impl_->window);
+  return impl_->last_rgb;
 }
 
 void SceneView::WritePng(const std::string& path, BackgroundWriter* writer) {

@@ -147,6 +147,10 @@ class SceneView {
   Eigen::AlignedBox2d framed_;
 };
 
+// The pixels of a window's back buffer as an RGB image (bottom row first), read after its last
+// render (rerender: renders once more first).
+vtkSmartPointer<vtkImageData> ReadWindowRgb(vtkRenderWindow* window, bool rerender = false);
+
 // Puts images of one size side by side, `columns` per row (0: all in one row), with a thin
 // gap of background colour: the papers' strips of snapshots (thesis Fig. 4.10–4.12).
 vtkSmartPointer<vtkImageData> TileImages(const std::vector<vtkSmartPointer<vtkImageData>>& images, int columns,
