@@ -139,12 +139,11 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
     progress.Update(a.duration > 0 ? w.time() / a.duration : 1.0, w.time());
   });
   progress.Finish();
-  world.SetRecorder(nullptr);
-  const WorldStatus status = world.status();
 
-  RenderRun(a, default_what, world, *run, a.duration);
+  World start = setup.MakeWorld();  // the run is drawn from its start, ground contacts as they were
+  RenderRun(a, default_what, start, *run, a.duration);
   if (!ok) {
-    std::cerr << "wobble: simulation stopped: " << status.message << std::endl;
+    std::cerr << "wobble: simulation stopped: " << world.status().message << std::endl;
     return kExitSimStopped;
   }
   return kExitOk;

@@ -151,9 +151,12 @@ World WorldFor(const record::Trajectory& run, const WorldOptions& options) {
   return world;
 }
 
-RenderReport RenderTrajectory(World& world, const record::Trajectory& run, const SceneSpec& spec, const RenderOutputs& out) {
+RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, const SceneSpec& spec, const RenderOutputs& out) {
   if (run.empty()) throw std::invalid_argument("nothing was recorded: no frames to render");
-  if (world.num_bodies() != run.num_bodies()) throw std::invalid_argument("RenderTrajectory: the world's bodies are not the run's");
+  if (caller.num_bodies() != run.num_bodies()) throw std::invalid_argument("RenderTrajectory: the world's bodies are not the run's");
+  // each pass replays the run in a copy of the caller's world as it is now (which is left
+  // untouched but for the state of the last sample drawn, put back at the end)
+  World world = caller;
   const double dt = world.options().dt;
   long num_frames = 0;
   const std::vector<Visit> visits = PlanVisits(run, out, dt, &num_frames);
@@ -173,7 +176,6 @@ RenderReport RenderTrajectory(World& world, const record::Trajectory& run, const
   }
 
   // the camera's pass: the box of every drawn state (and the ground below it), the colour range
-  const World start = world;
   if (view || strip_view) {
     Eigen::AlignedBox3d motion;
     double lo = 1e300, hi = -1e300;
@@ -199,7 +201,7 @@ RenderReport RenderTrajectory(World& world, const record::Trajectory& run, const
       v->FrameBounds(motion);
       if (lo < hi) v->SetColorRange(lo, hi);  // one colour scale for the whole run
     }
-    world = start;  // the writing pass replays the run from the start again
+    world = caller;  // the writing pass replays the run from the start again
   }
   for (SceneView* v : {view.get(), strip_view.get()})
     if (v && !out.trail.empty() && v->trails()) v->trails()->SetTrackedPoints(out.trail);
@@ -231,6 +233,7 @@ RenderReport RenderTrajectory(World& world, const record::Trajectory& run, const
     if (out.progress) out.progress(double(report.frames) / double(num_frames), world.time());
   }
   writer.Wait();
+  if (!visits.empty()) run.Restore(visits.back().sample, caller);
 
   if (out.frames) report.files.push_back({out.folder + "/frames/frame_NNNN.png", ""});
   if (out.exr) report.files.push_back({out.folder + "/exr/frame_NNNN.exr", "R, G, B, A, depth.Z"});
