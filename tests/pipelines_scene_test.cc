@@ -237,10 +237,11 @@ TEST(SceneRun, FramesAndFilmstripWithADisplay) {
   EXPECT_EQ(dims[1], 24);
 }
 
-// A world of both kinds: the FFD table falling onto the ground beside a falling linear box,
-// recorded every 25 steps (0.05 s) and exported. Issue 13: an FFD body in a scene was exported
-// with TimeValue 0 in every .vtp while the .pvd had the right time; with one world and one
-// clock every part of every frame carries its sample's time.
+// A constraint scene of both kinds: the FFD table falling with a linear box attached below the
+// middle of its bottom edge (the multiplier step, A rebuilt per step), recorded every 25 steps
+// (0.05 s) and exported. Issue 13: an FFD body in a scene was exported with TimeValue 0 in every
+// .vtp while the .pvd had the right time; with one world and one clock every part of every
+// frame carries its sample's time.
 struct MixedRun {
   WorldOptions options = testing::WitkinWelchOptions();
   std::shared_ptr<record::Trajectory> run;
@@ -251,6 +252,10 @@ struct MixedRun {
     w.SetState(table, testing::Vec({0, 50, 0, 0, 0, 0, 0}), Eigen::VectorXd::Zero(7));
     const int box = w.AddLinearBody(
         std::make_shared<const LinearBodyModel>(MakeBoxBody("box", 2, LinearOrder::kAffine, V({50, 30}), 3, 10.0)));
+    Eigen::MatrixXd R = w.linear_R(box);
+    R.col(2) << 150, 20;  // the box's top middle (0, 30) at the table's bottom middle (150, 50)
+    w.SetLinearState(box, R, Eigen::MatrixXd::Zero(2, 3));
+    w.AddAttachment(At(table, V({0.5, 0.0})), At(box, V({0.0, 30.0})));
     spec.drawings.resize(2);
     spec.drawings[box] = MakeBoxDrawing(V({50, 30}), 2);
     run = std::make_shared<record::Trajectory>(w);
@@ -258,6 +263,8 @@ struct MixedRun {
     w.SetRecorder(recorder);
     recorder->Start(w);
     EXPECT_TRUE(w.RunUntil(0.5)) << w.status().message;
+    EXPECT_LT(w.MaxViolation(), 1e-6);
+    EXPECT_GT(w.per_step_factorizations(), 0);  // the constrained step moved the FFD body
   }
 };
 
