@@ -2,6 +2,7 @@
 // Constraints, the multiplier step and impulses are in world_constraints.cc.
 #include "wobble/world/world.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -186,11 +187,27 @@ std::vector<Eigen::Vector2d> World::PointPositions(int i) const {
 
 bool World::Step() {
   if (!status_.ok()) return false;
-  // by index, each held while it runs: a controller may add or remove controllers
-  for (size_t i = 0; i < controllers_.size(); ++i) std::shared_ptr<Controller>(controllers_[i])->BeforeStep(*this);
-  if (!(enabled_count_ == 0 ? StepEachBody() : StepConstrained())) return false;
-  FinishStep();
-  for (size_t i = 0; i < controllers_.size(); ++i) std::shared_ptr<Controller>(controllers_[i])->AfterStep(*this);
+  if (controllers_.empty()) {  // the fast path of a world nobody drives
+    if (!(enabled_count_ == 0 ? StepEachBody() : StepConstrained())) return false;
+    FinishStep();
+  } else {
+    // by index: a controller may add controllers; removals wait until the step is over (also
+    // when a controller throws)
+    struct Stepping {
+      World& w;
+      explicit Stepping(World& world) : w(world) { w.stepping_ = true; }
+      ~Stepping() {
+        w.stepping_ = false;
+        w.controllers_.erase(std::remove(w.controllers_.begin(), w.controllers_.end(), nullptr), w.controllers_.end());
+      }
+    } stepping(*this);
+    for (size_t i = 0; i < controllers_.size(); ++i)
+      if (controllers_[i]) controllers_[i]->BeforeStep(*this);
+    if (!(enabled_count_ == 0 ? StepEachBody() : StepConstrained())) return false;
+    FinishStep();
+    for (size_t i = 0; i < controllers_.size(); ++i)
+      if (controllers_[i]) controllers_[i]->AfterStep(*this);
+  }
   if (recorder_) recorder_->AfterStep(*this);
   return true;
 }
@@ -203,7 +220,10 @@ void World::AddController(std::shared_ptr<Controller> controller) {
 void World::RemoveController(const Controller* controller) {
   for (size_t i = 0; i < controllers_.size(); ++i)
     if (controllers_[i].get() == controller) {
-      controllers_.erase(controllers_.begin() + long(i));
+      if (stepping_)
+        controllers_[i] = nullptr;  // it may be running now: released when the step is over
+      else
+        controllers_.erase(controllers_.begin() + long(i));
       return;
     }
 }

@@ -192,8 +192,10 @@ class World {
   // wobble/record's Recorder). The world shares their ownership.
   void AddController(std::shared_ptr<Controller> controller);
   void RemoveController(const Controller* controller);  // no-op when absent
-  void ClearControllers() { controllers_.clear(); }
-  const std::vector<std::shared_ptr<Controller>>& controllers() const { return controllers_; }
+  void ClearControllers() {
+    for (auto& c : controllers_) c = nullptr;
+    if (!stepping_) controllers_.clear();
+  }
   void SetRecorder(std::shared_ptr<Controller> recorder) { recorder_ = std::move(recorder); }
   Controller* recorder() const { return recorder_.get(); }
   // A kinematic body is not moved by Step (Box2D's kinematic bodies): controllers set its
@@ -325,8 +327,9 @@ class World {
 
   WorldOptions options_;
   std::vector<Slot> slots_;
-  std::vector<std::shared_ptr<Controller>> controllers_;
+  std::vector<std::shared_ptr<Controller>> controllers_;  // null: removed during this step
   std::shared_ptr<Controller> recorder_;
+  bool stepping_ = false;
   std::vector<FfdEntry> ffd_;
   std::vector<LinearEntry> linear_;
   std::vector<Constraint> constraints_;
