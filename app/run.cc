@@ -35,14 +35,6 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* a) {
 
 namespace {
 
-void PrintHelp(std::ostream& out) {
-  out << "commands:\n";
-  for (const script::CommandInfo& c : script::Interpreter::Commands()) out << "  " << c.usage << "\n      " << c.summary << "\n";
-  out << "parameters of set:";
-  for (const std::string& p : script::Interpreter::Parameters()) out << " " << p;
-  out << "\n";
-}
-
 // Fig. 5.4/5.5: cost against iteration, as FILE.png beside the optimiser's FILE.csv.
 void PlotCostHistory(const std::string& csv_path, const std::string& optimiser,
                      const std::vector<synth::IterationRecord>& history) {
@@ -90,17 +82,16 @@ void RenderRecordedRuns(const script::RenderRequest& r) {
     if (kept.empty()) return;
     a.what = kept;
   }
+  const record::Trajectory& run = *r.trajectory;
   const Motion replay = [&](World& world, const std::function<void(const World&)>& on_state) {
-    for (const script::TrackState& s : r.states) {
-      world.SetModeTargets(0, s.targets);
-      world.SetState(0, s.q, s.qd);
-      world.SetTime(s.t);
+    for (int k = 0; k < run.size(); ++k) {
+      run.Restore(k, world);
       on_state(world);
     }
     return true;
   };
   try {
-    RenderMotion(a, "frames,filmstrip,charts", r.body, r.world, r.states.front().t, r.states.back().t, replay);
+    RenderMotion(a, "frames,filmstrip,charts", run.bodies()[0].ffd, r.world, run.time(0), run.time(run.size() - 1), replay);
   } catch (const UsageError& e) {
     throw std::runtime_error(e.what());
   }
@@ -124,12 +115,22 @@ std::vector<std::string> RenderScene(const script::SceneRenderRequest& r) {
     std::cout << "no X display: frames and filmstrip skipped (run under xvfb-run -a -s \"-screen 0 1280x1024x24\")\n";
     out.frames = out.filmstrip = false;
   }
-  out.view.azimuth = r.azimuth;
-  out.view.elevation = r.elevation;
+  out.view.azimuth = r.drawing.azimuth;
+  out.view.elevation = r.drawing.elevation;
   out.view.title = r.name;
-  const pipelines::ConstrainedSceneSpec spec = pipelines::SceneSpecOf(*r.drawings, r.anchors);
+  const pipelines::ConstrainedSceneSpec spec = pipelines::SceneSpecOf(r.drawing.drawings, r.drawing.anchors);
   if (!out.frames && !out.filmstrip && !out.vtp) return {};
-  return pipelines::WriteSceneRun(*r.world, spec, *r.recorded, out);
+  // WriteSceneRun draws snapshots of a world: the recorded bodies in a world of their own
+  World world;
+  for (const record::BodyInfo& b : r.recorded->bodies())
+    if (b.kind == BodyKind::kFfd) world.AddBody(b.ffd);
+    else world.AddLinearBody(b.linear);
+  std::vector<record::SceneFrame> frames;
+  for (int k = 0; k < r.recorded->size(); ++k) {
+    r.recorded->Restore(k, world);
+    frames.push_back(record::CaptureFrame(world));
+  }
+  return pipelines::WriteSceneRun(world, spec, frames, out);
 #else
   (void)r;
   throw std::runtime_error("this wobble was built without pipelines/ (VTK): nothing can be drawn");
@@ -178,10 +179,6 @@ int RunScript(const RunArgs& a) {
   for (int number = 1;; ++number) {
     std::cout << "wobble> " << std::flush;
     if (!std::getline(std::cin, line)) break;
-    if (line == "help") {
-      PrintHelp(std::cout);
-      continue;
-    }
     try {
       if (!interp.RunLine(line, "<prompt>", number, "")) break;
     } catch (const std::exception& e) {

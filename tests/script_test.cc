@@ -261,8 +261,9 @@ TEST(CliffJump, ClearsTheEdgeLandsUprightAndSettles) {
   interp.SetRenderHook([&](const script::RenderRequest& r) { drawn = r; });
   interp.RunFile(kData + "/table_cliff.wob");
   std::filesystem::current_path(cwd);
-  ASSERT_TRUE(drawn.body);
-  const BodyModel& table = *drawn.body;  // bend, shear, vsquash: every mode of the two runs
+  ASSERT_TRUE(drawn.trajectory);
+  const record::Trajectory& states = *drawn.trajectory;
+  const BodyModel& table = *states.bodies()[0].ffd;  // bend, shear, vsquash: every mode of the two runs
   ASSERT_EQ(table.num_modes(), 3);
   EXPECT_EQ(drawn.dir, "out/demo");
   const double hand_over = 1.5;  // the last key
@@ -279,9 +280,9 @@ TEST(CliffJump, ClearsTheEdgeLandsUprightAndSettles) {
     ASSERT_EQ(v.size(), size_t(1 + 2 * table.num_q() + 9));
     const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(v.data() + 1, table.num_q());
     ASSERT_TRUE(q.allFinite());
-    ASSERT_LT(rows, drawn.states.size());
-    EXPECT_NEAR(drawn.states[rows].t, v[0], 1e-12);
-    EXPECT_LT((drawn.states[rows].q - q).norm(), 1e-9 * (1 + q.norm()));
+    ASSERT_LT(rows, size_t(states.size()));
+    EXPECT_NEAR(states.time(int(rows)), v[0], 1e-12);
+    EXPECT_LT((states.q(int(rows), 0) - q).norm(), 1e-9 * (1 + q.norm()));
     ++rows;
     if (v[0] <= hand_over + 1e-9) continue;
     EXPECT_EQ(q[kRigidDofs + 1], 0.0);  // the shear left at the hand-over, at 0
@@ -293,7 +294,7 @@ TEST(CliffJump, ClearsTheEdgeLandsUprightAndSettles) {
     }
   }
   EXPECT_EQ(rows, size_t(151 + 1350));  // keyframes at t = 0 .. 1.5, then 13.5 s of simulation
-  EXPECT_EQ(drawn.states.size(), rows);
+  EXPECT_EQ(size_t(states.size()), rows);
   EXPECT_GT(lowest_over_cliff, 0.0);
   EXPECT_GT(landed_at, hand_over);
   EXPECT_LT(max_tilt, 0.01);
@@ -309,7 +310,7 @@ TEST(CliffJump, ClearsTheEdgeLandsUprightAndSettles) {
   w.SetState(0, q, qd);
   const double mgh = table.moments().m * 9.81 * 100.0;
   EXPECT_LT(w.ComputeEnergies(0).kinetic, 1e-4 * mgh);
-  const Eigen::VectorXd q3 = drawn.states.back().q;
+  const Eigen::VectorXd q3 = states.q(states.size() - 1, 0);
   for (int foot : {5, 8}) EXPECT_NEAR(control::PointAt(table, table.lattice_coords(foot), q3).y(), 0.0, 1.0);
 }
 
