@@ -173,6 +173,24 @@ TEST(Interpreter, NearestUsesEditDistanceAndKnowsWhenNothingIsClose) {
     EXPECT_EQ(script::Interpreter::Nearest(c.name, {c.name}), c.name);
 }
 
+// `help` is a command like any other, so a script, piped stdin and the prompt all print the
+// command table: every command's usage and help once, and the parameters of set.
+TEST(Interpreter, HelpPrintsTheCommandTable) {
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  std::istringstream in("help\n");
+  interp.RunStream(in, "h.wob", "");
+  EXPECT_EQ(out.str(), script::Interpreter::Help());
+  for (const script::CommandInfo& c : script::Interpreter::Commands()) {
+    EXPECT_NE(out.str().find("  " + c.usage + "\n      " + c.summary + "\n"), std::string::npos) << c.name;
+    EXPECT_EQ(std::count_if(script::Interpreter::Commands().begin(), script::Interpreter::Commands().end(),
+                            [&](const script::CommandInfo& d) { return d.name == c.name; }),
+              1)
+        << c.name << " is listed twice";
+  }
+  EXPECT_NE(out.str().find("parameters of set: gravity ground"), std::string::npos) << out.str();
+}
+
 // §4.10.1: a keyframed run hands over to simulation with the q and q̇ it had.
 TEST(Interpreter, KeyframesHandOverContinuouslyInQAndQdot) {
   const std::string setup = "load_obj " + kData + "/table.obj\nload_def " + kData +
