@@ -37,23 +37,27 @@ struct ModeColumns {
   }
 };
 
-// q, q̇ and the PD targets of sample k of a run, on the motion's modes.
-struct MappedState {
-  Eigen::VectorXd q, qd, targets;
-  MappedState(const record::Trajectory& run, int k, const std::vector<int>& columns, int num_modes)
-      : q(Eigen::VectorXd::Zero(kRigidDofs + num_modes)),
-        qd(Eigen::VectorXd::Zero(kRigidDofs + num_modes)),
-        targets(Eigen::VectorXd::Zero(num_modes)) {
-    const auto rq = run.q(k, 0), rqd = run.qd(k, 0), rt = run.targets(k, 0);
-    q.head<kRigidDofs>() = rq.head<kRigidDofs>();
-    qd.head<kRigidDofs>() = rqd.head<kRigidDofs>();
-    for (size_t d = 0; d < columns.size(); ++d) {
-      q[kRigidDofs + columns[d]] = rq[kRigidDofs + int(d)];
-      qd[kRigidDofs + columns[d]] = rqd[kRigidDofs + int(d)];
-      targets[columns[d]] = rt[int(d)];
-    }
+// t, q and q̇ of sample k of a run on the motion's modes, and its PD targets on them.
+std::vector<double> MappedState(const record::Trajectory& run, int k, const std::vector<int>& columns, int num_modes,
+                                Eigen::VectorXd* targets = nullptr) {
+  const int nq = kRigidDofs + num_modes;
+  std::vector<double> row(1 + 2 * nq, 0.0);
+  row[0] = run.time(k);
+  const auto q = run.q(k, 0), qd = run.qd(k, 0);
+  for (int i = 0; i < kRigidDofs; ++i) {
+    row[1 + i] = q[i];
+    row[1 + nq + i] = qd[i];
   }
-};
+  for (size_t d = 0; d < columns.size(); ++d) {
+    row[1 + kRigidDofs + columns[d]] = q[kRigidDofs + int(d)];
+    row[1 + nq + kRigidDofs + columns[d]] = qd[kRigidDofs + int(d)];
+  }
+  if (targets) {
+    targets->setZero(num_modes);
+    for (size_t d = 0; d < columns.size(); ++d) (*targets)[columns[d]] = run.targets(k, 0)[int(d)];
+  }
+  return row;
+}
 
 }  // namespace
 
@@ -74,12 +78,10 @@ record::Trajectory MergeRuns(const ObjectRuns& runs) {
   record::Trajectory merged({info});
   for (const auto& [r, k] : Samples(runs)) {
     const record::Trajectory& run = *runs[r];
-    const MappedState s(run, k, columns.of_run[r], N);
+    Eigen::VectorXd targets;
+    std::vector<double> row = MappedState(run, k, columns.of_run[r], N, &targets);
+    row.insert(row.end(), targets.data(), targets.data() + N);
     const Energies e = run.energies(k, 0);
-    std::vector<double> row = {run.time(k)};
-    row.insert(row.end(), s.q.data(), s.q.data() + s.q.size());
-    row.insert(row.end(), s.qd.data(), s.qd.data() + s.qd.size());
-    row.insert(row.end(), s.targets.data(), s.targets.data() + N);
     for (double v : {e.kinetic, e.gravity, e.modes, e.ground, e.springs, e.total(), double(run.contacts(k, 0)),
                      run.penetration(k, 0), run.control_energy(k), double(run.pose(k)), run.violation(k)})
       row.push_back(v);
@@ -102,11 +104,8 @@ Table OutputTable(const ObjectRuns& runs, int every) {
   for (size_t i = 0; i < samples.size(); i += size_t(every)) {
     const auto [r, k] = samples[i];
     const record::Trajectory& run = *runs[r];
-    const MappedState s(run, k, columns.of_run[r], N);
+    std::vector<double> row = MappedState(run, k, columns.of_run[r], N);
     const Energies e = run.energies(k, 0);
-    std::vector<double> row = {run.time(k)};
-    row.insert(row.end(), s.q.data(), s.q.data() + s.q.size());
-    row.insert(row.end(), s.qd.data(), s.qd.data() + s.qd.size());
     for (double v : {e.kinetic, e.gravity, e.modes, e.ground, e.springs, e.total(), run.control_energy(k),
                      double(run.pose(k)), double(run.contacts(k, 0))})
       row.push_back(v);
