@@ -76,6 +76,35 @@ struct ScratchFolder {
   fs::path path, cwd;
 };
 
+// The scene runtime without the interpreter (scene.h's usage): kTableScript's setup through the
+// API, run whole, is the interpreter's run.
+TEST(Scene, HelloTable) {
+  scene::Scene s;
+  s.options().integrator = Integrator::kThesis;
+  s.options().dt = 0.01;
+  s.options().params.ground.stiffness = 45000;
+  s.object().Load(kData + "/table.obj");
+  s.object().LoadModes({kData + "/table_modes.def"});
+  s.object().Assign(0, 4e7, 4e6);
+  s.object().SetPlacement({0, 0.1, 0});
+  control::PoseGraph& graph = s.control().graph;
+  graph.poses = {Eigen::Vector2d(0.2, -0.1), Eigen::Vector2d(-0.1, 0.1)};
+  graph.durations = {0.3, 0.4};
+  const scene::RunReport r = s.Simulate(3.0);
+  ASSERT_TRUE(r.ok()) << r.status.message;
+  EXPECT_EQ(r.steps, 300);
+  const record::Trajectory& run = *s.last_object_run();
+  EXPECT_EQ(run.size(), 301);
+  EXPECT_DOUBLE_EQ(s.time(), 3.0);
+
+  ScratchFolder scratch("wobble_scene_test_hello");
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  std::istringstream in(kTableScript);
+  interp.RunStream(in, "table.wob", kData);
+  EXPECT_EQ(MaxDifference(run, *interp.scene().last_object_run()), 0.0);
+}
+
 TEST(Scene, TheInterpretersSimulAndTheSceneSteppedByHandGiveTheSameTrajectory) {
   ScratchFolder scratch("wobble_scene_test_by_hand");
   std::ostringstream out;

@@ -1,5 +1,6 @@
 #include "wobble/scene/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -222,7 +223,8 @@ void Scene::Finish(bool act_due_behaviours) {
 }
 
 RunReport Scene::Advance(long steps, const StepCallback& on_step) {
-  if (run_->recorder) run_->recorder->trajectory()->reserve(int(steps) + 1);
+  // every step is kept: room for them at once (up to a million; beyond, it grows)
+  if (run_->recorder) run_->recorder->trajectory()->reserve(int(std::min(steps, 1000000L)) + 1);
   try {
     for (long n = 1; n <= steps && Step(); ++n)
       if (on_step) on_step(n, steps, *run_->world);

@@ -16,12 +16,12 @@
 // (BeginRun, Step, EndRun: the viewer steps one step at a time), or run whole (Simulate,
 // Keyframe). Both ways give the same trajectory.
 //
-// Usage (tests/scene_test.cc):
+// Usage (tests/scene_test.cc, Scene.HelloTable):
 //   scene::Scene s;
 //   s.object().Load("data/table.obj");
 //   s.object().LoadModes({"data/table_modes.def"});
 //   s.control().graph.poses = {...};  s.control().graph.durations = {...};
-//   const scene::RunReport r = s.Simulate(3.0);          // or BeginRun(); while (...) Step(); EndRun();
+//   const scene::RunReport r = s.Simulate(3.0);  // or BeginRun(); Step() ...; EndRun();
 //   if (!r.ok()) report(r.status.message);
 //   const record::Trajectory& run = *s.last_object_run();  // every step of that run
 #pragma once
