@@ -242,16 +242,19 @@ int RunConditionTime(const ConditionTimeArgs& a) {
   const std::shared_ptr<const BodyModel>& body = setup.body;
   World world = setup.MakeWorld();
 
-  pipelines::RunRecorder recorder;  // cond₂(M) and the contact events, as for wobble render
-  recorder.Sample(world);
-  const bool ok = world.RunUntil(a.duration, [&](const World& w) { recorder.Sample(w); });
+  // the run's trajectory: cond₂(M) and the contact events come from it, as for wobble render
+  auto run = std::make_shared<record::Trajectory>(world);
+  auto recorder = std::make_shared<record::Recorder>(run);
+  world.SetRecorder(recorder);
+  recorder->Start(world);
+  const bool ok = world.RunUntil(a.duration);
   const std::filesystem::path out(a.out);
   const pipelines::ChartSpec spec =
-      recorder.ConditionChart("cond(M) vs time: " + body->name() + " falling onto the ground (Fig. 4.9)");
+      pipelines::ConditionChart(*run, 0, "cond(M) vs time: " + body->name() + " falling onto the ground (Fig. 4.9)");
   const std::string png = pipelines::HasDisplay() ? (out / "cond_time.png").string() : "";
   pipelines::WriteChart(spec, png, (out / "cond_time.csv").string());
-  std::cout << "wrote " << (out / "cond_time.csv").string() << " (" << recorder.time().size() << " samples, "
-            << recorder.contact_events().size() << " contact events, in cond_time_markers.csv)\n";
+  std::cout << "wrote " << (out / "cond_time.csv").string() << " (" << run->size() << " samples, "
+            << spec.markers.size() << " contact events, in cond_time_markers.csv)\n";
   if (png.empty())
     std::cout << "no X display: chart skipped (run under xvfb-run -a)\n";
   else

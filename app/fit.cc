@@ -14,7 +14,7 @@
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/pose_fit.h"
 #include "wobble/fit/trajectory_fit.h"
-#include "wobble/formats/simulation_csv.h"
+#include "wobble/record/trajectory_csv.h"
 #include "wobble/formats/parse_error.h"
 #include "wobble/formats/target_file.h"
 
@@ -186,6 +186,24 @@ std::string List(const std::vector<std::string>& names) {
   return s.empty() ? "none" : s;
 }
 
+// The file records as fit's input types (lib/wobble/fit does not read files).
+std::vector<fit::Correspondence> Correspondences(const std::vector<formats::PointTarget>& points) {
+  std::vector<fit::Correspondence> out;
+  for (const formats::PointTarget& p : points) out.push_back({p.mass_point, p.lattice_coords, p.position, p.weight});
+  return out;
+}
+std::vector<fit::ReferenceFrame> ReferenceFrames(const std::vector<formats::TargetFrame>& frames) {
+  std::vector<fit::ReferenceFrame> out;
+  for (const formats::TargetFrame& f : frames) out.push_back({f.time, Correspondences(f.points)});
+  return out;
+}
+fit::CurveTarget CurveTargetOf(const formats::TargetFile& file) {
+  fit::CurveTarget c;
+  for (const formats::TargetCurve& line : file.polylines) c.AddPolyline(line.points, line.closed);
+  for (const Eigen::Vector2d& p : file.cloud) c.AddPoint(p);
+  return c;
+}
+
 }  // namespace
 
 FitCommands AddFitCommand(CLI::App* app, FitPoseArgs* pose, FitTrajectoryArgs* traj) {
@@ -265,8 +283,9 @@ int RunFitPose(const FitPoseArgs& a) {
     throw formats::ParseError(a.targets, targets.frames[0].line, "this file has frames: use `wobble fit trajectory`");
 
   const bool curve = targets.has_curve();
-  const fit::PoseFitResult r = curve ? fit::FitPoseToCurve(*body, fit::CurveTarget::From(targets), o)
-                                     : fit::FitPose(*body, targets.points, o);
+  const std::vector<fit::Correspondence> points = Correspondences(targets.points);
+  const fit::PoseFitResult r =
+      curve ? fit::FitPoseToCurve(*body, CurveTargetOf(targets), o) : fit::FitPose(*body, points, o);
   EndIterationLine();
   const std::vector<std::string> names = fit::CoordinateNames(*body);
 
@@ -307,7 +326,7 @@ int RunFitPose(const FitPoseArgs& a) {
     }
     for (const Eigen::Vector2d& p : targets.cloud) overlay["targets"].push_back({{"point", Point(p)}});
   } else {
-    for (const formats::PointTarget& t : targets.points) {
+    for (const fit::Correspondence& t : points) {
       overlay["fitted"].push_back(
           Point(fit::PointPosition(fit::BasisOf(*body, t.mass_point, t.lattice_coords), r.q.data(), body->num_q())));
       overlay["targets"].push_back({{"point", Point(t.position)}});
@@ -407,17 +426,23 @@ int RunFitTrajectory(const FitTrajectoryArgs& a) {
   RequireNonNegative(a.smoothness, "--smoothness");
 
   // the reference: a simulation CSV or a target file with frames
-  std::vector<formats::TargetFrame> frames;
+  std::vector<fit::ReferenceFrame> frames;
   if (EndsWith(a.reference, ".csv")) {
-    const formats::SimulationCsv sim = formats::ReadSimulationCsv(a.reference, body->num_modes());
-    frames = fit::FramesFromStates(*body, sim.t, sim.q, ParsePointList(a.points, body->num_points()), a.every);
+    const record::Trajectory sim = record::ReadTrajectoryCsv(a.reference, {record::DescribeFfdBody(body)}).trajectory;
+    std::vector<double> t;
+    std::vector<Eigen::VectorXd> q;
+    for (int k = 0; k < sim.size(); ++k) {
+      t.push_back(sim.time(k));
+      q.push_back(sim.q(k, 0));
+    }
+    frames = fit::FramesFromStates(*body, t, q, ParsePointList(a.points, body->num_points()), a.every);
   } else {
     if (!a.points.empty() || a.every != 1) throw UsageError("--points and --every apply to a CSV reference only");
     const formats::TargetFile t = formats::ReadTargetFile(a.reference);
     if (!t.is_trajectory())
       throw formats::ParseError(a.reference, 0, "no 'frame' lines: a trajectory needs frames (for one pose use `wobble fit pose`)");
     formats::CheckMassPointIndices(t, body->num_points());
-    frames = t.frames;
+    frames = ReferenceFrames(t.frames);
   }
 
   json j;

@@ -10,18 +10,10 @@
 #include <set>
 #include <sstream>
 
-#include <vtkDataArray.h>
-#include <vtkImageData.h>
-#include <vtkPointData.h>
-#include <vtkPolyData.h>
-
-#include "wobble/formats/atomic_file.h"
-#include "wobble/formats/csv.h"
-#include "pipelines/energy_charts.h"
-#include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
+#include "pipelines/trajectory_render.h"
+#include "wobble/formats/csv.h"
 #include "progress.h"
-#include "wobble/formats/atomic_file.h"
 
 namespace wobble::app {
 namespace {
@@ -75,12 +67,6 @@ std::set<std::string> ParseWhat(const std::string& text) {
   }
   if (what.empty()) throw UsageError("--what: nothing to write");
   return what;
-}
-
-std::string FrameName(const std::string& folder, const char* stem, int frame, const char* ext) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%s_%04d.%s", stem, frame, ext);
-  return folder + "/" + buf;
 }
 
 std::string Num(double v) {
@@ -141,15 +127,26 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   if (a.duration * a.fps > 1e6) throw UsageError("--duration * --fps asks for more than a million frames");
   CheckRenderOptions(a, default_what);
 
-  // the body and its world
+  // the body in its world, simulated from (q0, q̇0) into a trajectory of every step
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, integrator, a.dt);
-  // the motion: a simulation from (q0, q̇0), run the same way in both passes
-  const Motion simulate = [&](World& world, const std::function<void(const World&)>& on_state) {
-    world.SetState(0, setup.q0, setup.qd0);
-    on_state(world);
-    return world.RunUntil(a.duration + 0.5 * a.dt, on_state);
-  };
-  return RenderMotion(a, default_what, setup.body, setup.options, 0.0, a.duration, simulate);
+  World world = setup.MakeWorld();
+  auto run = std::make_shared<record::Trajectory>(world);
+  auto recorder = std::make_shared<record::Recorder>(run);
+  world.SetRecorder(recorder);
+  recorder->Start(world);
+  Progress progress(isatty(STDERR_FILENO) == 1);
+  const bool ok = world.RunUntil(a.duration + 0.5 * a.dt, [&](const World& w) {
+    progress.Update(a.duration > 0 ? w.time() / a.duration : 1.0, w.time());
+  });
+  progress.Finish();
+
+  World start = setup.MakeWorld();  // the run is drawn from its start, ground contacts as they were
+  RenderRun(a, default_what, start, *run, a.duration);
+  if (!ok) {
+    std::cerr << "wobble: simulation stopped: " << world.status().message << std::endl;
+    return kExitSimStopped;
+  }
+  return kExitOk;
 }
 
 void CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
@@ -173,171 +170,61 @@ void CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
   }
 }
 
-int RenderMotion(const RenderArgs& a, const std::string& default_what, const std::shared_ptr<const BodyModel>& body,
-                 const WorldOptions& options, double t_begin, double t_end, const Motion& motion) {
+pl::RenderOutputs RenderOutputsOf(const RenderArgs& a, const std::string& default_what, const std::string& name) {
   CheckRenderOptions(a, default_what);
   const std::set<std::string> what = ParseWhat(a.what.empty() ? default_what : a.what);
+  pl::RenderOutputs out;
+  out.folder = a.out;
+  out.name = name;
+  out.frames = what.count("frames") > 0;
+  out.filmstrip = what.count("filmstrip") > 0;
+  out.charts = what.count("charts") > 0;
+  out.vtp = what.count("vtp") > 0;
+  out.exr = what.count("exr") > 0;
+  out.disp = what.count("disp") > 0;
+  out.fps = a.fps;
   const Size frame_size = ParseSize(a.size, "--size");
+  out.view.width = frame_size.w;
+  out.view.height = frame_size.h;
+  out.view.color_by = a.color_by;
+  out.view.shape_samples = a.shape_samples;
+  out.view.title = name;
   const Size strip_size = ParseSize(a.filmstrip_size, "--filmstrip-size");
-  const Size chart_size = ParseSize(a.chart_size, "--chart-size");
-  std::vector<double> strip_times = ParseNumbers(a.filmstrip_times, "--filmstrip");
-  const std::vector<double> trail_coords = ParseNumbers(a.trail, "--trail");
-  const double duration = t_end - t_begin;
-  const double dt = options.dt;
-  const long num_frames = long(std::floor(duration * a.fps + 1e-9)) + 1;
-  auto frame_time = [&](long k) { return t_begin + double(k) / a.fps; };
-  // a frame shows the first state at or after its time (within half a step)
-  auto due = [&](long k, double t) { return k < num_frames && frame_time(k) <= t + 0.5 * dt; };
-  if (strip_times.empty())
-    for (int k = 0; k < 6; ++k) strip_times.push_back(t_begin + duration * k / 5.0);
-
-  // pass 1: where the body goes (the camera keeps all of it in view) and the colour range
-  Eigen::AlignedBox2d swept;
-  double color_lo = 1e300, color_hi = -1e300;
-  {
-    World world(options);
-    world.AddBody(body);
-    auto probe = vtkSmartPointer<pl::MassPointSource>::New();
-    auto lattice_probe = vtkSmartPointer<pl::LatticeSource>::New();
-    probe->SetWorld(&world);
-    lattice_probe->SetWorld(&world);
-    long k = 0;
-    auto look = [&](const World& w) {
-      while (due(k, w.time())) {
-        swept.extend(pl::BodyBounds(w, 0));
-        if (!a.color_by.empty()) {
-          vtkPolyDataAlgorithm* src = a.color_by == "displacement" ? (vtkPolyDataAlgorithm*)lattice_probe : probe.Get();
-          src->Modified();
-          src->Update();
-          if (vtkDataArray* arr = src->GetOutput()->GetPointData()->GetArray(a.color_by.c_str())) {
-            double r[2];
-            arr->GetRange(r, arr->GetNumberOfComponents() > 1 ? -1 : 0);
-            color_lo = std::min(color_lo, r[0]);
-            color_hi = std::max(color_hi, r[1]);
-          }
-        }
-        ++k;
-      }
-    };
-    motion(world, look);
-  }
-
-  // pass 2: the same run, writing as it goes
-  World world(options);
-  world.AddBody(body);
-  pl::SceneOptions scene;
-  scene.width = frame_size.w;
-  scene.height = frame_size.h;
-  scene.color_by = a.color_by;
-  if (color_lo < color_hi) {
-    scene.color_range[0] = color_lo;
-    scene.color_range[1] = color_hi;
-  }
-  scene.shape_samples = a.shape_samples;
-  scene.show_trails = !trail_coords.empty();
-  scene.title = body->name();
-  // the ground seen below the body: frame the motion plus a band under its lowest point
-  Eigen::AlignedBox2d view_box = swept;
-  view_box.extend(swept.min() - Eigen::Vector2d(0, 0.1 * swept.sizes().maxCoeff()));
-  std::unique_ptr<pl::SceneView> view, strip_view;
-  if (what.count("frames") || what.count("exr")) {
-    view = std::make_unique<pl::SceneView>(&world, 0, scene);
-    view->FrameBox(view_box);
-  }
-  if (what.count("filmstrip")) {
-    pl::SceneOptions s = scene;
-    s.width = strip_size.w;
-    s.height = strip_size.h;
-    s.show_color_bar = false;
-    s.overlay_energy = false;  // panels are small: the time only
-    s.title.clear();
-    strip_view = std::make_unique<pl::SceneView>(&world, 0, s);
-    strip_view->FrameBox(view_box);
-  }
-  std::vector<Eigen::Vector2d> tracked;
-  for (size_t i = 0; i + 1 < trail_coords.size(); i += 2) tracked.emplace_back(trail_coords[i], trail_coords[i + 1]);
-  for (pl::SceneView* v : {view.get(), strip_view.get()})
-    if (v && !tracked.empty()) v->trails()->SetTrackedPoints(tracked);
-  std::unique_ptr<pl::VtpSeriesWriter> vtp;
-  if (what.count("vtp")) vtp = std::make_unique<pl::VtpSeriesWriter>(&world, 0, a.out + "/vtp", body->name(), a.shape_samples);
-  Size disp_size{256, 0};
+  out.filmstrip_times = ParseNumbers(a.filmstrip_times, "--filmstrip");
+  out.filmstrip_width = strip_size.w;
+  out.filmstrip_height = strip_size.h;
+  out.filmstrip_columns = a.filmstrip_columns;
   if (!a.disp_size.empty()) {
-    disp_size = ParseSize(a.disp_size, "--disp-size");
-  } else {
-    const Lattice& lat = body->lattice();
-    disp_size.h = std::max(1, int(std::lround(256.0 * lat.axis_t().norm() / lat.axis_s().norm())));
+    const Size disp = ParseSize(a.disp_size, "--disp-size");
+    out.disp_width = disp.w;
+    out.disp_height = disp.h;
   }
-  pl::RunRecorder recorder(0);
+  const Size chart_size = ParseSize(a.chart_size, "--chart-size");
+  out.chart_width = chart_size.w;
+  out.chart_height = chart_size.h;
+  const std::vector<double> trail = ParseNumbers(a.trail, "--trail");
+  for (size_t i = 0; i + 1 < trail.size(); i += 2) out.trail.emplace_back(trail[i], trail[i + 1]);
+  out.view.show_trails = !out.trail.empty();
+  return out;
+}
 
-  long next_frame = 0;
-  size_t next_strip = 0;
-  std::vector<vtkSmartPointer<vtkImageData>> strip_images;
-  long written = 0;
-  pl::BackgroundWriter writer;  // files are compressed and written while the next frame renders
-  Progress progress(isatty(STDERR_FILENO) == 1);
+void RenderRun(const RenderArgs& a, const std::string& default_what, World& world, const record::Trajectory& run,
+               double t_end) {
+  if (run.empty()) throw std::invalid_argument("nothing was recorded: no frames to render");
+  const std::string name = run.bodies().empty() ? "run" : run.bodies()[0].name;
+  pl::RenderOutputs out = RenderOutputsOf(a, default_what, name);
+  out.t_end = t_end;
+  Progress progress(isatty(STDERR_FILENO) == 1, "t");
+  out.progress = [&](double fraction, double t) { progress.Update(fraction, t); };
   const auto start = std::chrono::steady_clock::now();
-  auto on_state = [&](const World& w) {
-    if (what.count("charts")) recorder.Sample(w);
-    while (due(next_frame, w.time())) {
-      const int k = int(next_frame++);
-      for (pl::SceneView* v : {view.get(), strip_view.get()})
-        if (v && !tracked.empty()) v->trails()->Record();
-      if (view) {
-        view->Render();
-        if (what.count("frames")) view->WritePng(FrameName(a.out + "/frames", "frame", k, "png"), &writer);
-        if (what.count("exr")) view->WriteExr(FrameName(a.out + "/exr", "frame", k, "exr"), &writer);
-      }
-      if (vtp) vtp->WriteFrame(k, &writer);
-      if (what.count("disp"))
-        pl::WriteDisplacementExr(FrameName(a.out + "/exr", "disp", k, "exr"), w, 0, disp_size.w, disp_size.h, &writer);
-      ++written;
-      progress.Update(double(next_frame) / double(num_frames), w.time());
-    }
-    while (strip_view && next_strip < strip_times.size() && strip_times[next_strip] <= w.time() + 0.5 * dt) {
-      strip_view->Render();
-      strip_images.push_back(strip_view->Capture());
-      ++next_strip;
-    }
-  };
-  const bool ok = motion(world, on_state);
-  writer.Wait();
+  const pl::RenderReport report = pl::RenderTrajectory(world, run, pl::SceneSpec{}, out);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.Finish();
-
-  // what is collected over the run, also when it stopped early
-  std::vector<std::string> files;
-  if (what.count("frames")) files.push_back(a.out + "/frames/frame_NNNN.png");
-  if (what.count("exr")) files.push_back(a.out + "/exr/frame_NNNN.exr  (R, G, B, A, depth.Z)");
-  if (what.count("disp")) files.push_back(a.out + "/exr/disp_NNNN.exr  (disp.X, disp.Y over the rest lattice)");
-  if (vtp) files.push_back(vtp->WriteCollection() + "  (ParaView time series of lattice, points, shape)");
-  if (strip_view && !strip_images.empty()) {
-    const std::string path = a.out + "/filmstrip.png";
-    pl::WritePng(path, pl::TileImages(strip_images, a.filmstrip_columns));
-    files.push_back(path);
-  }
-  if (what.count("charts")) {
-    pl::ChartSpec energy = recorder.EnergyChart(body->name() + ": energy");
-    pl::ChartSpec cond = recorder.ConditionChart(body->name() + ": condition number of M (Fig. 4.9)");
-    for (pl::ChartSpec* c : {&energy, &cond}) {
-      c->width = chart_size.w;
-      c->height = chart_size.h;
-    }
-    pl::WriteChart(energy, a.out + "/energy.png", a.out + "/energy.csv");
-    pl::WriteChart(cond, a.out + "/condition.png", a.out + "/condition.csv");
-    files.push_back(a.out + "/energy.png, energy.csv");
-    files.push_back(a.out + "/condition.png, condition.csv");
-  }
-
-  std::cout << body->name() << ": " << written << " frames at " << Num(a.fps) << " fps over " << Num(world.time())
-            << " s, " << Num(wall) << " s wall (" << (wall > 0 ? Num(written / wall) : std::string("-"))
-            << " frames/s).\n";
-  for (const std::string& f : files) std::cout << "  " << f << "\n";
+  std::cout << name << ": " << report.frames << " frames at " << Num(a.fps) << " fps over "
+            << Num(run.time(run.size() - 1)) << " s, " << Num(wall) << " s wall ("
+            << (wall > 0 ? Num(report.frames / wall) : std::string("-")) << " frames/s).\n";
+  for (const pl::RenderReport::File& f : report.files) std::cout << "  " << f.Line() << "\n";
   std::cout << std::flush;
-  if (!ok) {
-    std::cerr << "wobble: simulation stopped: " << world.status().message << std::endl;
-    return kExitSimStopped;
-  }
-  return kExitOk;
 }
 
 }  // namespace wobble::app

@@ -1,6 +1,7 @@
-// `wobble render` and `wobble export`: simulate one body like `wobble simulate` and turn the
-// run into pictures and files (pipelines/). Both share one driver; they differ in what they
-// write by default (--what):
+// `wobble render` and `wobble export`: simulate one body like `wobble simulate` into a
+// record::Trajectory and turn it into pictures and files through the one render driver
+// (pipelines/trajectory_render.h), which a script's `render` uses too (app/script_render.h).
+// They differ in what they write by default (--what):
 //   render: frames (PNG sequence), filmstrip (one PNG of chosen frames), charts (energy and
 //           cond(M) against time, PNG + CSV)
 //   export: vtp (.vtp per frame + .pvd), exr (R,G,B,A + depth.Z per frame), disp (disp.X,
@@ -10,13 +11,15 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <functional>
-#include <memory>
 #include <string>
-#include <vector>
 
 #include "cli_common.h"
+#include "wobble/record/trajectory.h"
 #include "wobble/world/world.h"
+
+namespace wobble::pipelines {
+struct RenderOutputs;
+}
 
 namespace wobble::app {
 
@@ -46,14 +49,14 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
                            const std::string& default_what, RenderArgs* args);
 int RunRender(const RenderArgs& args, const std::string& default_what);
 
-// The render driver both commands share, and `wobble run`'s `render` (a script's recorded runs):
-// a motion puts a world holding `body` (index 0) through its states, calling on_state after each,
-// the first included; it runs twice (the camera's pass, then the writing pass) and must give the
-// same states both times. Returns false when it stopped early (world.status() says why).
-using Motion = std::function<bool(World& world, const std::function<void(const World&)>& on_state)>;
-int RenderMotion(const RenderArgs& args, const std::string& default_what, const std::shared_ptr<const BodyModel>& body,
-                 const WorldOptions& options, double t_begin, double t_end, const Motion& motion);
 // Checks the picture options (--what, sizes, display, --out) before anything is simulated.
 void CheckRenderOptions(const RenderArgs& args, const std::string& default_what);
+// What the picture options ask of the render driver; `name` is the .pvd's stem and the title.
+pipelines::RenderOutputs RenderOutputsOf(const RenderArgs& args, const std::string& default_what, const std::string& name);
+// Draws `run` (put back into `world`, a world of its bodies) as the options ask and prints
+// what was written: `wobble render`/`export` and a script's `render` of its FFD runs. Frames
+// at --fps from the first sample up to t_end (the run's intended end), those the run reached.
+void RenderRun(const RenderArgs& args, const std::string& default_what, World& world, const record::Trajectory& run,
+               double t_end);
 
 }  // namespace wobble::app

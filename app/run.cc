@@ -13,9 +13,8 @@
 #include <filesystem>
 
 #include "pipelines/charts.h"
-#include "pipelines/scene_run.h"
 #include "pipelines/scene_view.h"
-#include "render.h"
+#include "script_render.h"
 #endif
 
 namespace wobble::app {
@@ -70,31 +69,7 @@ void PlotCostHistory(const std::string& csv_path, const std::string& optimiser,
 // states replayed instead of simulated. Without a display only vtp and disp can be written.
 void RenderRecordedRuns(const script::RenderRequest& r) {
 #ifdef WOBBLE_HAVE_PIPELINES
-  RenderArgs a;
-  a.out = r.dir;
-  a.what = r.what.empty() ? "frames,filmstrip,charts" : r.what;
-  if (!pipelines::HasDisplay()) {
-    std::string kept;
-    for (const char* w : {"vtp", "disp"})
-      if (("," + a.what + ",").find(std::string(",") + w + ",") != std::string::npos) kept += (kept.empty() ? "" : ",") + std::string(w);
-    std::cout << "no X display: render draws no pictures (run under xvfb-run -a -s \"-screen 0 1280x1024x24\")"
-              << (kept.empty() ? "" : "; writing " + kept + " only") << "\n";
-    if (kept.empty()) return;
-    a.what = kept;
-  }
-  const record::Trajectory& run = *r.trajectory;
-  const Motion replay = [&](World& world, const std::function<void(const World&)>& on_state) {
-    for (int k = 0; k < run.size(); ++k) {
-      run.Restore(k, world);
-      on_state(world);
-    }
-    return true;
-  };
-  try {
-    RenderMotion(a, "frames,filmstrip,charts", run.bodies()[0].ffd, r.world, run.time(0), run.time(run.size() - 1), replay);
-  } catch (const UsageError& e) {
-    throw std::runtime_error(e.what());
-  }
+  RenderScriptRuns(r);
 #else
   (void)r;
   throw std::runtime_error("this wobble was built without pipelines/ (VTK): it cannot render");
@@ -104,33 +79,7 @@ void RenderRecordedRuns(const script::RenderRequest& r) {
 // `render DIR` in a script: the recorded Witkin & Welch scene as frames, filmstrip and .pvd.
 std::vector<std::string> RenderScene(const script::SceneRenderRequest& r) {
 #ifdef WOBBLE_HAVE_PIPELINES
-  pipelines::SceneRunOutputs out;
-  out.folder = r.folder;
-  out.name = r.name;
-  out.frames = r.frames;
-  out.filmstrip = r.filmstrip;
-  out.vtp = r.vtp;
-  if ((out.frames || out.filmstrip) && !pipelines::HasDisplay()) {
-    // as for the cost charts: the exports that need no display are still written
-    std::cout << "no X display: frames and filmstrip skipped (run under xvfb-run -a -s \"-screen 0 1280x1024x24\")\n";
-    out.frames = out.filmstrip = false;
-  }
-  out.view.azimuth = r.drawing.azimuth;
-  out.view.elevation = r.drawing.elevation;
-  out.view.title = r.name;
-  const pipelines::ConstrainedSceneSpec spec = pipelines::SceneSpecOf(r.drawing.drawings, r.drawing.anchors);
-  if (!out.frames && !out.filmstrip && !out.vtp) return {};
-  // WriteSceneRun draws snapshots of a world: the recorded bodies in a world of their own
-  World world;
-  for (const record::BodyInfo& b : r.recorded->bodies())
-    if (b.kind == BodyKind::kFfd) world.AddBody(b.ffd);
-    else world.AddLinearBody(b.linear);
-  std::vector<record::SceneFrame> frames;
-  for (int k = 0; k < r.recorded->size(); ++k) {
-    r.recorded->Restore(k, world);
-    frames.push_back(record::CaptureFrame(world));
-  }
-  return pipelines::WriteSceneRun(world, spec, frames, out);
+  return RenderScriptScene(r);
 #else
   (void)r;
   throw std::runtime_error("this wobble was built without pipelines/ (VTK): nothing can be drawn");

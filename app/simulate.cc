@@ -11,6 +11,7 @@
 
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/csv.h"
+#include "wobble/record/trajectory_csv.h"
 #include "progress.h"
 
 namespace wobble::app {
@@ -29,31 +30,6 @@ std::string VectorText(const Eigen::VectorXd& v) {
   std::string s = "[";
   for (int i = 0; i < v.size(); ++i) s += (i ? " " : "") + Num(v[i]);
   return s + "]";
-}
-
-std::vector<std::string> CsvHeader(int D) {
-  std::vector<std::string> h = {"t", "tx", "ty", "theta"};
-  for (int d = 1; d <= D; ++d) h.push_back("g" + std::to_string(d));
-  for (const char* name : {"dtx", "dty", "dtheta"}) h.push_back(name);
-  for (int d = 1; d <= D; ++d) h.push_back("dg" + std::to_string(d));
-  for (const char* name : {"kinetic", "gravity", "modes", "ground", "springs", "total", "contacts", "penetration"})
-    h.push_back(name);
-  return h;
-}
-
-// One CSV row of body 0 of `world` at time t.
-std::vector<double> CsvRow(const World& world, double t) {
-  const BodyState<double>& s = world.state(0);
-  const Energies e = world.ComputeEnergies(0);
-  std::vector<double> row;
-  row.reserve(1 + 2 * s.q.size() + 8);
-  row.push_back(t);
-  row.insert(row.end(), s.q.data(), s.q.data() + s.q.size());
-  row.insert(row.end(), s.qd.data(), s.qd.data() + s.qd.size());
-  for (double v : {e.kinetic, e.gravity, e.modes, e.ground, e.springs, e.total()}) row.push_back(v);
-  row.push_back(double(s.contacts.size()));
-  row.push_back(s.penetration);
-  return row;
 }
 
 }  // namespace
@@ -105,11 +81,11 @@ int RunSimulate(const SimulateArgs& a) {
   World world = setup.MakeWorld();
   const Energies e0 = world.ComputeEnergies(0);
 
-  // step, recording every Nth state and the deepest penetration
-  std::vector<std::vector<double>> rows;
-  rows.push_back(CsvRow(world, world.time()));
-  long last_recorded = 0;
-  BodyState<double> last_good = world.state(0);
+  // step, recording every Nth state (record::Recorder) and the deepest penetration
+  auto trajectory = std::make_shared<record::Trajectory>(world);
+  auto recorder = std::make_shared<record::Recorder>(trajectory, a.every);
+  recorder->Start(world);
+  world.SetRecorder(recorder);
   double max_pen = world.state(0).penetration, max_pen_time = 0.0;
   const long expected_steps = std::max(1L, long(std::llround(a.duration / a.dt)));
   Progress progress(isatty(STDERR_FILENO) == 1);
@@ -120,28 +96,16 @@ int RunSimulate(const SimulateArgs& a) {
       max_pen = pen;
       max_pen_time = w.time();
     }
-    if (w.steps() % a.every == 0) {
-      rows.push_back(CsvRow(w, w.time()));
-      last_recorded = w.steps();
-    }
-    last_good = w.state(0);
     progress.Update(double(w.steps()) / double(expected_steps), w.time());
   });
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.Finish();
-  // a stopped world may hold the state of the failed step: report the last accepted one
-  // (a fresh world at that state; its contact anchors restart at the entry points)
-  std::unique_ptr<World> restored;
-  if (!ok && (world.state(0).q != last_good.q || world.state(0).qd != last_good.qd)) {
-    restored = std::make_unique<World>(setup.options);
-    restored->AddBody(body);
-    restored->SetState(0, last_good.q, last_good.qd);
-  }
-  const World& final_world = restored ? *restored : world;
-  if (world.steps() != last_recorded) rows.push_back(CsvRow(final_world, world.time()));
+  // a stopped world keeps its last accepted state; the last state is always recorded
+  recorder->Finish(world);
+  const World& final_world = world;
 
   // the trajectory, also when the run stopped: it shows what led there
-  if (!a.out.empty()) formats::WriteCsvAtomically(a.out, CsvHeader(body->num_modes()), rows);
+  if (!a.out.empty()) record::WriteTrajectoryCsv(a.out, *trajectory);
 
   // the summary: one paragraph, a sentence per line
   const BodyState<double>& s = final_world.state(0);
@@ -171,7 +135,7 @@ int RunSimulate(const SimulateArgs& a) {
   if (max_pen > 0) out << " at t = " << Num(max_pen_time);
   out << ".\n";
   if (!a.out.empty()) {
-    out << "Wrote " << rows.size() << " rows to " << a.out << ".";
+    out << "Wrote " << trajectory->size() << " rows to " << a.out << ".";
   } else {
     out << "No --out given: nothing written.";
   }

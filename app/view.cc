@@ -11,7 +11,6 @@
 #include "pipelines/exports.h"
 #include "pipelines/interactive_scene_view.h"
 #include "pipelines/interactive_view.h"
-#include "pipelines/scene_run.h"
 #include "pipelines/scene_view.h"
 #include "wobble/script/interpreter.h"
 

@@ -20,10 +20,10 @@ Eigen::VectorXd KnownQ() {
   return q;
 }
 
-std::vector<formats::PointTarget> MassTargets(const BodyModel& body, const Eigen::VectorXd& q) {
-  std::vector<formats::PointTarget> t;
+std::vector<fit::Correspondence> MassTargets(const BodyModel& body, const Eigen::VectorXd& q) {
+  std::vector<fit::Correspondence> t;
   for (int k = 0; k < body.num_points(); ++k) {
-    formats::PointTarget p;
+    fit::Correspondence p;
     p.mass_point = k;
     p.position = fit::PointPosition(fit::BasisOf(body, k, {}), q.data(), int(q.size()));
     t.push_back(p);
@@ -61,18 +61,17 @@ BENCHMARK(BM_PoseFit_Table11_Rigid)->Unit(benchmark::kMicrosecond);
 // 1,000 target points on three polylines (the table's drawing at KnownQ).
 void BM_CurveFit_Polyline1000(benchmark::State& state) {
   const BodyModel body(testing::TableDef(), testing::TableModes());
-  formats::TargetFile f;
+  fit::CurveTarget target;
   const int counts[3] = {400, 300, 300};
   for (int l = 0; l < 3; ++l) {
     const Polyline& line = body.def().shapes[l];
-    formats::TargetCurve c;
+    std::vector<Eigen::Vector2d> points;
     for (int i = 0; i < counts[l]; ++i) {
       const Eigen::Vector2d p = line.points[0] + (line.points[1] - line.points[0]) * (double(i) / (counts[l] - 1));
-      c.points.push_back(fit::PointPosition(fit::BasisOf(body, -1, body.lattice().LocalCoords(p)), KnownQ().data(), 7));
+      points.push_back(fit::PointPosition(fit::BasisOf(body, -1, body.lattice().LocalCoords(p)), KnownQ().data(), 7));
     }
-    f.polylines.push_back(c);
+    target.AddPolyline(points, false);
   }
-  const fit::CurveTarget target = fit::CurveTarget::From(f);
   fit::PoseFitOptions o;
   o.two_sided = state.range(0) != 0;
   o.joint_closest_points = state.range(1) != 0;
@@ -97,7 +96,7 @@ BENCHMARK(BM_CurveFit_Polyline1000)
     ->Unit(benchmark::kMillisecond);
 
 // The table thrown without ground, 1,200 frames at dt 0.005, all 11 mass points observed.
-std::vector<formats::TargetFrame> ThrownFrames(const std::shared_ptr<const BodyModel>& body, int frames, double dt) {
+std::vector<fit::ReferenceFrame> ThrownFrames(const std::shared_ptr<const BodyModel>& body, int frames, double dt) {
   WorldOptions wo;
   wo.params.ground.enabled = false;
   wo.dt = dt;
@@ -119,7 +118,7 @@ std::vector<formats::TargetFrame> ThrownFrames(const std::shared_ptr<const BodyM
 
 void BM_KinematicTrajectory_1200Frames(benchmark::State& state) {
   const auto body = std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(4e6, 1e5));
-  const std::vector<formats::TargetFrame> frames = ThrownFrames(body, 1200, 0.005);
+  const std::vector<fit::ReferenceFrame> frames = ThrownFrames(body, 1200, 0.005);
   fit::TrajectoryFitOptions o;
   o.smoothness = 1.0;
   o.pose.gamma_lower = -3;
@@ -139,8 +138,8 @@ BENCHMARK(BM_KinematicTrajectory_1200Frames)->Unit(benchmark::kMillisecond);
 // Dynamic fit of q0, q̇0, K, c to 100 steps (51 frames) from a start 40% off.
 void BM_DynamicFit_100Steps(benchmark::State& state) {
   const auto body = std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(3e6, 2e5));
-  const std::vector<formats::TargetFrame> all = ThrownFrames(body, 101, 0.01);
-  std::vector<formats::TargetFrame> frames;
+  const std::vector<fit::ReferenceFrame> all = ThrownFrames(body, 101, 0.01);
+  std::vector<fit::ReferenceFrame> frames;
   for (size_t i = 0; i < all.size(); i += 2) frames.push_back(all[i]);
   fit::DynamicParameters start;
   start.stiffness = Eigen::VectorXd::Constant(4, 3e6 * 1.4);
@@ -158,8 +157,8 @@ BENCHMARK(BM_DynamicFit_100Steps)->Unit(benchmark::kMillisecond);
 // compare with the Ceres fit's final cost, printed by tests/dynamic_fit_test (~1e-21).
 void BM_DynamicFit_Annealing(benchmark::State& state) {
   const auto body = std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(3e6, 2e5));
-  const std::vector<formats::TargetFrame> all = ThrownFrames(body, 101, 0.01);
-  std::vector<formats::TargetFrame> frames;
+  const std::vector<fit::ReferenceFrame> all = ThrownFrames(body, 101, 0.01);
+  std::vector<fit::ReferenceFrame> frames;
   for (size_t i = 0; i < all.size(); i += 2) frames.push_back(all[i]);
   fit::DynamicParameters start;
   start.stiffness = Eigen::VectorXd::Constant(4, 3e6 * 1.4);
@@ -182,7 +181,7 @@ struct PoseGraphProblem {
   std::shared_ptr<const BodyModel> body;
   fit::DynamicFitOptions o;
   fit::DynamicParameters truth, start;
-  std::vector<formats::TargetFrame> frames;
+  std::vector<fit::ReferenceFrame> frames;
   PoseGraphProblem() {
     std::vector<DeformationMode> modes = testing::TableModes(4e7, 4e6);
     modes[0].active = modes[1].active = true;

@@ -66,7 +66,7 @@ bool NeedDisplay(benchmark::State& state) {
 void BM_RenderFrame640x480(benchmark::State& state) {
   if (!NeedDisplay(state)) return;
   auto world = DemoWorld();
-  SceneView view(world.get(), 0);
+  SceneView view(world.get());
   view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-50, -80), Eigen::Vector2d(350, 160)));
   long frame = 0;
   for (auto _ : state) {
@@ -81,7 +81,7 @@ BENCHMARK(BM_RenderFrame640x480)->Unit(benchmark::kMillisecond)->UseRealTime();
 void BM_WritePngFrame640x480(benchmark::State& state) {
   if (!NeedDisplay(state)) return;
   auto world = DemoWorld();
-  SceneView view(world.get(), 0);
+  SceneView view(world.get());
   long frame = 0;
   const std::string path = OutDir() + "/frame.png";
   for (auto _ : state) {
@@ -96,7 +96,7 @@ BENCHMARK(BM_WritePngFrame640x480)->Unit(benchmark::kMillisecond)->UseRealTime()
 void BM_WriteExrFrame640x480(benchmark::State& state) {
   if (!NeedDisplay(state)) return;
   auto world = DemoWorld();
-  SceneView view(world.get(), 0);
+  SceneView view(world.get());
   long frame = 0;
   const std::string path = OutDir() + "/frame.exr";
   for (auto _ : state) {
@@ -110,7 +110,7 @@ BENCHMARK(BM_WriteExrFrame640x480)->Unit(benchmark::kMillisecond)->UseRealTime()
 
 void BM_WriteVtpFrame(benchmark::State& state) {
   auto world = DemoWorld();
-  VtpSeriesWriter writer(world.get(), 0, OutDir() + "/vtp", "table");
+  VtpSeriesWriter writer(world.get(), OutDir() + "/vtp", "table");
   long frame = 0;
   for (auto _ : state) {
     Advance(&world, &frame);
@@ -139,9 +139,9 @@ void BM_Demo300FramesAllOutputs(benchmark::State& state) {
   const std::string dir = OutDir() + "/demo";
   for (auto _ : state) {
     auto world = DemoWorld();
-    SceneView view(world.get(), 0);
+    SceneView view(world.get());
     view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-50, -80), Eigen::Vector2d(350, 160)));
-    VtpSeriesWriter vtp(world.get(), 0, dir + "/vtp", "table");
+    VtpSeriesWriter vtp(world.get(), dir + "/vtp", "table");
     BackgroundWriter writer;  // as `wobble render`/`export` do: write while the next frame renders
     for (int k = 0; k < 300; ++k) {
       world->RunUntil(k / 30.0, [](const World&) {});

@@ -22,7 +22,6 @@
 #include <vtkRenderer.h>
 #include <vtkTable.h>
 #include <vtkTextProperty.h>
-#include <vtkWindowToImageFilter.h>
 
 #include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
@@ -53,15 +52,7 @@ Ptr<vtkContextView> MakeView(int width, int height) {
 
 Ptr<vtkImageData> Grab(vtkContextView* view) {
   view->GetRenderWindow()->Render();
-  auto grab = Ptr<vtkWindowToImageFilter>::New();
-  grab->SetInput(view->GetRenderWindow());
-  grab->SetInputBufferTypeToRGB();
-  grab->ReadFrontBufferOff();
-  grab->ShouldRerenderOff();
-  grab->Update();
-  auto image = Ptr<vtkImageData>::New();
-  image->DeepCopy(grab->GetOutput());
-  return image;
+  return ReadWindowRgb(view->GetRenderWindow());
 }
 
 // VTK 9.1's log axes (vtkAxis::SetLogScale) left the lines of our charts undrawn, so a log

@@ -1,72 +1,119 @@
 #include "pipelines/energy_charts.h"
 
 #include <algorithm>
-#include <limits>
+#include <stdexcept>
 
 #include "wobble/analysis/conditioning.h"
 
 namespace wobble::pipelines {
+namespace {
 
-void RunRecorder::Sample(const World& world) {
-  const BodyModel& body = world.body(body_);
-  if (mode_names_.empty() && body.num_modes() > 0) {
-    for (const DeformationMode& m : body.modes()) mode_names_.push_back(m.name);
-    modes_.resize(body.num_modes());
-  }
-  const Energies e = world.ComputeEnergies(body_);
-  t_.push_back(world.time());
-  kinetic_.push_back(e.kinetic);
-  gravity_.push_back(e.gravity);
-  ground_.push_back(e.ground);
-  springs_.push_back(e.springs);
-  total_.push_back(e.total());
-  for (int d = 0; d < body.num_modes(); ++d) modes_[d].push_back(e.per_mode[d]);  // K (γ − γ0)² (§4.7)
-  // +∞ when M is singular (analysis::Condition's numerical-rank test)
-  cond_.push_back(analysis::MassMatrixCondition(body, world.state(body_).q).cond);
-  const bool touching = !world.state(body_).contacts.empty();
-  if (touching && !touching_ && t_.size() > 1) events_.push_back(world.time());
-  touching_ = touching;
+std::vector<double> Times(const record::Trajectory& run) {
+  std::vector<double> t(run.size());
+  for (int k = 0; k < run.size(); ++k) t[k] = run.time(k);
+  return t;
 }
 
-ChartSpec RunRecorder::EnergyChart(const std::string& title) const {
-  ChartSpec spec;
-  spec.title = title;
-  spec.x_title = "time (s)";
-  spec.y_title = "energy";
-  auto add = [&](const std::string& name, const std::vector<double>& y, bool always) {
-    if (!always && std::all_of(y.begin(), y.end(), [](double v) { return v == 0.0; })) return;
-    ChartSeries s;
-    s.name = name;
-    s.x = t_;
-    s.y = y;
-    spec.series.push_back(std::move(s));
-  };
-  add("kinetic", kinetic_, true);
-  add("gravity", gravity_, true);
-  for (size_t d = 0; d < modes_.size(); ++d)
-    add("mode " + (mode_names_[d].empty() ? std::to_string(d + 1) : mode_names_[d]), modes_[d], false);
-  add("ground", ground_, false);
-  add("springs", springs_, false);
-  add("total", total_, true);
-  spec.series.back().width = 3.0f;
-  spec.markers = events_;
-  spec.markers_name = "contact";
-  return spec;
+const BodyModel& FfdModel(const record::Trajectory& run, int body) {
+  if (body < 0 || body >= run.num_bodies() || run.bodies()[body].kind != BodyKind::kFfd || !run.bodies()[body].ffd)
+    throw std::invalid_argument("cond(M): body " + std::to_string(body) + " is not an FFD body of the run");
+  return *run.bodies()[body].ffd;
 }
 
-ChartSpec RunRecorder::ConditionChart(const std::string& title) const {
+ChartSpec ConditionChartOf(const record::Trajectory& run, int body, const std::vector<double>& cond, const std::string& title) {
   ChartSpec spec;
   spec.title = title;
   spec.x_title = "time (s)";
   spec.y_title = "cond(M)";  // linear like Fig. 4.9: over a run it varies by percents, not decades
   ChartSeries s;
   s.name = "cond(M)";
-  s.x = t_;
-  s.y = cond_;
+  s.x = Times(run);
+  s.y = cond;
   spec.series.push_back(std::move(s));
-  spec.markers = events_;
+  spec.markers = ContactEvents(run, body);
   spec.markers_name = "contact";
   return spec;
 }
+
+}  // namespace
+
+std::vector<double> ContactEvents(const record::Trajectory& run, int body) {
+  std::vector<double> events;
+  bool touching = false;
+  for (int k = 0; k < run.size(); ++k) {
+    const bool now = run.contacts(k, body) > 0;
+    if (now && !touching && k > 0) events.push_back(run.time(k));
+    touching = now;
+  }
+  return events;
+}
+
+std::vector<double> ConditionNumbers(const record::Trajectory& run, int body, int first) {
+  const BodyModel& model = FfdModel(run, body);
+  std::vector<double> cond;
+  for (int k = std::max(0, first); k < run.size(); ++k)
+    cond.push_back(analysis::MassMatrixCondition(model, run.q(k, body)).cond);  // +∞ when M is singular
+  return cond;
+}
+
+ChartSpec EnergyChart(const record::Trajectory& run, int body, const std::string& title) {
+  if (body < 0 || body >= run.num_bodies()) throw std::invalid_argument("energy chart: no body " + std::to_string(body));
+  const record::BodyInfo& info = run.bodies()[body];
+  const int num_modes = info.kind == BodyKind::kFfd && info.ffd ? info.ffd->num_modes() : 0;
+  std::vector<double> kinetic, gravity, deformation, ground, springs, total;
+  std::vector<std::vector<double>> modes(num_modes);  // [mode][sample]
+  for (int k = 0; k < run.size(); ++k) {
+    const Energies e = run.energies(k, body);
+    kinetic.push_back(e.kinetic);
+    gravity.push_back(e.gravity);
+    deformation.push_back(e.modes);
+    ground.push_back(e.ground);
+    springs.push_back(e.springs);
+    total.push_back(e.total());
+    for (int d = 0; d < num_modes; ++d) modes[d].push_back(e.per_mode[d]);  // K (γ − γ0)² (§4.7)
+  }
+  ChartSpec spec;
+  spec.title = title;
+  spec.x_title = "time (s)";
+  spec.y_title = "energy";
+  const std::vector<double> t = Times(run);
+  auto add = [&](const std::string& name, const std::vector<double>& y, bool always) {
+    if (!always && std::all_of(y.begin(), y.end(), [](double v) { return v == 0.0; })) return;
+    ChartSeries s;
+    s.name = name;
+    s.x = t;
+    s.y = y;
+    spec.series.push_back(std::move(s));
+  };
+  add("kinetic", kinetic, true);
+  add("gravity", gravity, true);
+  for (int d = 0; d < num_modes; ++d) {
+    const std::string& name = info.ffd->modes()[d].name;
+    add("mode " + (name.empty() ? std::to_string(d + 1) : name), modes[d], false);
+  }
+  if (info.kind == BodyKind::kLinear) add("deformation", deformation, false);
+  add("ground", ground, false);
+  add("springs", springs, false);
+  add("total", total, true);
+  spec.series.back().width = 3.0f;
+  spec.markers = ContactEvents(run, body);
+  spec.markers_name = "contact";
+  return spec;
+}
+
+ChartSpec ConditionChart(const record::Trajectory& run, int body, const std::string& title) {
+  return ConditionChartOf(run, body, ConditionNumbers(run, body), title);
+}
+
+void RunRecorder::Sample(const World& world) {
+  if (run_.num_bodies() == 0) run_ = record::Trajectory(world);
+  run_.Append(world);
+  const std::vector<double> now = ConditionNumbers(run_, body_, run_.size() - 1);
+  cond_.insert(cond_.end(), now.begin(), now.end());
+}
+
+std::vector<double> RunRecorder::time() const { return Times(run_); }
+
+ChartSpec RunRecorder::ConditionChart(const std::string& title) const { return ConditionChartOf(run_, body_, cond_, title); }
 
 }  // namespace wobble::pipelines

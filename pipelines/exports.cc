@@ -151,39 +151,44 @@ void WriteDisplacementExr(const std::string& path, const World& world, int body,
   });
 }
 
-VtpSeriesWriter::VtpSeriesWriter(const World* world, int body, std::string folder, std::string stem, int shape_samples)
+VtpSeriesWriter::VtpSeriesWriter(const World* world, std::string folder, std::string stem, std::vector<LinearDrawing> drawings,
+                                 int shape_samples)
     : world_(world), folder_(std::move(folder)), stem_(std::move(stem)) {
   if (!world_) throw std::invalid_argument("VtpSeriesWriter needs a world");
-  lattice_ = vtkSmartPointer<LatticeSource>::New();
-  points_ = vtkSmartPointer<MassPointSource>::New();
-  shape_ = vtkSmartPointer<ShapeSource>::New();
-  shape_->SetSamplesPerSegment(shape_samples);
-  for (WorldSourceBase* s : {static_cast<WorldSourceBase*>(lattice_), static_cast<WorldSourceBase*>(points_),
-                             static_cast<WorldSourceBase*>(shape_)}) {
-    s->SetWorld(world_);
-    s->SetBody(body);
+  for (int b = 0; b < world_->num_bodies(); ++b) {
+    const bool ffd = world_->kind(b) == BodyKind::kFfd;
+    const std::string body = world_->body_name(b).empty() ? "body" + std::to_string(b) : world_->body_name(b);
+    auto lattice = vtkSmartPointer<LatticeSource>::New();
+    auto points = vtkSmartPointer<MassPointSource>::New();
+    auto shape = vtkSmartPointer<ShapeSource>::New();
+    shape->SetSamplesPerSegment(shape_samples);
+    if (!ffd && b < int(drawings.size())) shape->SetDrawing(drawings[b]);
+    parts_.push_back({lattice, body + (ffd ? "_lattice" : "_box")});
+    parts_.push_back({points, body + "_points"});
+    parts_.push_back({shape, body + "_shape"});
+  }
+  for (Part& p : parts_) {
+    p.source->SetWorld(world_);
+    p.source->SetBody(int(&p - parts_.data()) / 3);
   }
 }
 
 void VtpSeriesWriter::WriteFrame(int frame, BackgroundWriter* writer) {
   char number[32];
-  std::snprintf(number, sizeof(number), "%04d", frame);
-  const struct {
-    WorldSourceBase* source;
-    const char* part;
-  } parts[3] = {{lattice_, "lattice"}, {points_, "points"}, {shape_, "shape"}};
-  for (int p = 0; p < 3; ++p) {
-    parts[p].source->Modified();
-    parts[p].source->Update();
-    const std::string file = folder_ + "/" + stem_ + "_" + parts[p].part + "_" + number + ".vtp";
+  std::snprintf(number, sizeof(number), "_%04d.vtp", frame);
+  for (size_t p = 0; p < parts_.size(); ++p) {
+    WorldSourceBase* source = parts_[p].source;
+    source->Modified();
+    source->Update();
+    const std::string file = folder_ + "/" + parts_[p].name + number;
     if (writer) {
       auto copy = vtkSmartPointer<vtkPolyData>::New();  // the source's output changes next frame
-      copy->DeepCopy(parts[p].source->GetOutput());
+      copy->DeepCopy(source->GetOutput());
       writer->Submit([file, copy] { WriteVtp(file, copy); });
     } else {
-      WriteVtp(file, parts[p].source->GetOutput());
+      WriteVtp(file, source->GetOutput());
     }
-    pvd_.Add(world_->time(), p, file, parts[p].part);
+    pvd_.Add(world_->time(), int(p), file, parts_[p].name);
   }
 }
 

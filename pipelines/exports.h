@@ -1,4 +1,4 @@
-// Files people open elsewhere, every one written atomically (wobble/io/atomic_file.h):
+// Files people open elsewhere, every one written atomically (wobble/formats/atomic_file.h):
 //   .vtp  one vtkPolyData (VTK XML, raw appended binary), with its TimeValue field array
 //   .pvd  a ParaView collection listing .vtp files per time step (and part): a time series
 //   .vti  one vtkImageData (VTK XML)
@@ -53,25 +53,31 @@ std::vector<ExrChannel> DisplacementImage(const World& world, int body, int widt
 void WriteDisplacementExr(const std::string& path, const World& world, int body, int width, int height,
                           BackgroundWriter* writer = nullptr);
 
-// Writes the lattice, mass points and shape of one body per frame as three .vtp files
-// (<folder>/<stem>_lattice_NNNN.vtp, _points_, _shape_) and keeps <folder>/<stem>.pvd listing
-// them as parts 0, 1, 2 of each time step (rewritten by WriteCollection()).
+// Writes every body of a world per frame as three .vtp files, <folder>/<body>_<part>_NNNN.vtp
+// with <body> the body's name ("body<b>" when it has none) and <part> lattice (FFD bodies) or
+// box (linear bodies: the control box), points and shape, and keeps <folder>/<stem>.pvd
+// listing them as parts 3b, 3b+1, 3b+2 of each time step (rewritten by WriteCollection()).
+// Linear bodies are drawn with drawings[b] (none: an empty shape); FFD bodies with their own
+// drawing resampled shape_samples times per segment.
 class VtpSeriesWriter {
  public:
-  VtpSeriesWriter(const World* world, int body, std::string folder, std::string stem, int shape_samples = 16);
-  // Writes the current state as frame number `frame` (the file names' NNNN); with a
-  // BackgroundWriter the polydata are copied now and written by its thread.
+  VtpSeriesWriter(const World* world, std::string folder, std::string stem, std::vector<LinearDrawing> drawings = {},
+                  int shape_samples = 16);
+  // Writes the current state as frame number `frame` (the file names' NNNN) at the world's
+  // time; with a BackgroundWriter the polydata are copied now and written by its thread.
   void WriteFrame(int frame, BackgroundWriter* writer = nullptr);
   // Writes the .pvd; returns its path.
   std::string WriteCollection() const;
   std::string CollectionPath() const { return folder_ + "/" + stem_ + ".pvd"; }
 
  private:
+  struct Part {
+    vtkSmartPointer<WorldSourceBase> source;
+    std::string name;  // <body>_<part>
+  };
   const World* world_;
   std::string folder_, stem_;
-  vtkSmartPointer<LatticeSource> lattice_;
-  vtkSmartPointer<MassPointSource> points_;
-  vtkSmartPointer<ShapeSource> shape_;
+  std::vector<Part> parts_;  // 3 per body, in part order
   PvdCollection pvd_;
 };
 

@@ -179,7 +179,7 @@ InteractiveSceneView::InteractiveSceneView(InteractiveSceneInput input, ViewerOp
   so.shape_samples = options.shape_samples;
   so.azimuth = m.input.azimuth;
   so.elevation = m.input.elevation;
-  m.view = std::make_unique<SceneView>(m.input.world, m.input.spec, so);
+  m.view = std::make_unique<SceneView>(m.input.world, so, m.input.spec);
   m.view->window()->SetWindowName("wobble view");
   m.FrameScene();
 

@@ -35,7 +35,7 @@ namespace wobble::pipelines {
 
 struct InteractiveSceneInput {
   World* world = nullptr;  // stepped by `step`; the viewer adds and removes its drag constraint
-  ConstrainedSceneSpec spec;          // drawings and named points
+  SceneSpec spec;                     // drawings and named points
   double azimuth = 30.0, elevation = 20.0;  // 3D camera (degrees), as `render`
   // One step of world->options().dt. Throws (std::exception) when the world or a behaviour
   // stops the run: the viewer pauses and shows the message.

@@ -330,7 +330,7 @@ InteractiveView::InteractiveView(ViewerScene scene, ViewerOptions options) : imp
   so.viewport[3] = 1.0;
   so.overlay = false;  // the viewer's own status text says more (and the scrubbed time)
   so.shape_samples = options.shape_samples;
-  m.view = std::make_unique<SceneView>(m.world.get(), 0, so);
+  m.view = std::make_unique<SceneView>(m.world.get(), so);
   vtkRenderWindow* window = m.view->window();
   window->SetWindowName("wobble view");
   m.FrameBody();

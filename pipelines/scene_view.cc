@@ -60,7 +60,7 @@ Eigen::AlignedBox2d BodyBounds(const World& world, int body_index) {
   return box;
 }
 
-Eigen::AlignedBox3d SceneBounds(const World& world, const ConstrainedSceneSpec& spec) {
+Eigen::AlignedBox3d SceneBounds(const World& world, const SceneSpec& spec) {
   Eigen::AlignedBox3d box;
   for (int b = 0; b < world.num_bodies(); ++b) {
     if (world.kind(b) == BodyKind::kLinear) {
@@ -81,30 +81,41 @@ bool IsFlat(const World& world) {
   return true;
 }
 
+SceneSpec SceneSpecOf(const std::vector<LinearDrawing>& drawings, const std::vector<control::Anchor>& anchors) {
+  SceneSpec spec;
+  spec.drawings = drawings;
+  for (const control::Anchor& a : anchors) {
+    AnchorSource::Anchor d;
+    d.name = a.name;
+    if (a.point) d.point = *a.point;
+    d.place = a.place;
+    spec.anchors.push_back(d);
+  }
+  return spec;
+}
+
 struct SceneView::Impl {
   const World* world = nullptr;
-  int body = 0;
-  const World* cworld = nullptr;            // the other kind of view
-  std::vector<Ptr<vtkPolyDataAlgorithm>> csources;     // its sources, re-run every Render()
+  std::vector<Ptr<WorldSourceBase>> sources;  // re-run every Render() (the trails only on Record())
   Ptr<vtkRenderWindow> window;
   Ptr<vtkRenderer> renderer;
   Ptr<GroundSource> ground;
-  Ptr<LatticeSource> lattice;
-  Ptr<MassPointSource> points;
-  Ptr<ShapeSource> shape;
-  Ptr<SpringSource> springs;
   Ptr<TrailSource> trails;
-  Ptr<vtkPolyDataMapper> points_mapper, lattice_points_mapper;
+  // per body: the sources and mappers that color_by can colour
+  std::vector<Ptr<MassPointSource>> points;
+  std::vector<Ptr<LatticeSource>> lattices;
+  std::vector<vtkPolyDataMapper*> colored;     // the mappers that show color_by
+  std::vector<vtkPolyDataAlgorithm*> colored_sources;
   Ptr<vtkLookupTable> lut;
   Ptr<vtkScalarBarActor> bar;
   Ptr<vtkTextActor> overlay;
-  vtkPolyDataMapper* colored = nullptr;  // the mapper that shows color_by, if any
-  Ptr<vtkImageData> last_rgb;            // read back from the window after the last Render()
-  Ptr<vtkActor> layers[7];               // by SceneLayer (the FFD view: one actor a layer)
-  std::vector<Ptr<vtkActor>> clayers[7];  // by SceneLayer (a World's: one per body)
+  Ptr<vtkImageData> last_rgb;                   // read back from the window after the last Render()
+  std::vector<Ptr<vtkActor>> layers[7];         // by SceneLayer
+  double z_scale = 1.0;  // 2D: z offsets keep points above lines above the ground; 3D: depth decides
 
-  Ptr<vtkActor> AddActor(vtkPolyDataAlgorithm* source, const double rgb[3], double line_width, double point_size,
-                         Ptr<vtkPolyDataMapper>* mapper_out = nullptr) {
+  // An actor for `source` in `layer`, z_offset above the plane in 2D, flat colours unless lit.
+  vtkActor* Add(SceneLayer layer, WorldSourceBase* source, const double rgb[3], double line_width, double point_size,
+                double z_offset, bool lit = false) {
     auto mapper = Ptr<vtkPolyDataMapper>::New();
     mapper->SetInputConnection(source->GetOutputPort());
     mapper->ScalarVisibilityOff();
@@ -113,56 +124,79 @@ struct SceneView::Impl {
     actor->GetProperty()->SetColor(rgb[0], rgb[1], rgb[2]);
     actor->GetProperty()->SetLineWidth(float(line_width));
     actor->GetProperty()->SetPointSize(float(point_size));
-    actor->GetProperty()->SetLighting(false);  // flat 2D colours
+    actor->GetProperty()->SetLighting(lit);
+    actor->SetPosition(0, 0, z_offset * z_scale);
     renderer->AddActor(actor);
-    if (mapper_out) *mapper_out = mapper;
+    layers[int(layer)].push_back(actor);
+    if (source != trails.Get()) sources.push_back(source);
     return actor;
   }
 };
 
-SceneView::SceneView(const World* world, int body, SceneOptions options) : impl_(new Impl), options_(std::move(options)) {
+SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) : impl_(new Impl), options_(std::move(options)) {
   if (!HasDisplay())
     throw std::runtime_error("rendering needs an X display (VTK 9.1): run under xvfb-run -a -s \"-screen 0 1280x1024x24\"");
-  if (!world || body < 0 || body >= world->num_bodies()) throw std::invalid_argument("SceneView: no such world/body");
+  if (!world) throw std::invalid_argument("SceneView: no world");
   if (options_.width < 16 || options_.height < 16 || options_.width > 8192 || options_.height > 8192)
     throw std::invalid_argument("image size must be between 16 and 8192 pixels a side");
   Impl& m = *impl_;
   m.world = world;
-  m.body = body;
+  m.z_scale = IsFlat(*world) ? 1.0 : 0.0;
   SetUpWindow();
 
-  auto attach = [&](WorldSourceBase* s) {
+  const double ground_rgb[3] = {0.55, 0.47, 0.38}, lattice_rgb[3] = {0.45, 0.6, 0.85}, shape_rgb[3] = {0.1, 0.1, 0.1},
+               surface_rgb[3] = {0.95, 0.75, 0.35}, points_rgb[3] = {0.85, 0.2, 0.15}, spring_rgb[3] = {0.2, 0.6, 0.2},
+               trail_rgb[3] = {0.6, 0.3, 0.7}, anchor_rgb[3] = {0.1, 0.55, 0.2};
+  auto on = [&](WorldSourceBase* s, int body) {
     s->SetWorld(world);
     s->SetBody(body);
+    return s;
   };
-  m.ground = Ptr<GroundSource>::New();
-  m.lattice = Ptr<LatticeSource>::New();
-  m.points = Ptr<MassPointSource>::New();
-  m.shape = Ptr<ShapeSource>::New();
-  m.shape->SetSamplesPerSegment(options_.shape_samples);
-  m.springs = Ptr<SpringSource>::New();
-  m.trails = Ptr<TrailSource>::New();
-  for (WorldSourceBase* s : {(WorldSourceBase*)m.ground, (WorldSourceBase*)m.lattice, (WorldSourceBase*)m.points,
-                             (WorldSourceBase*)m.shape, (WorldSourceBase*)m.springs, (WorldSourceBase*)m.trails})
-    attach(s);
-
-  // drawn back to front: painter's order does not matter in a flat 2D scene with a depth
-  // buffer, but the z offsets below keep points above lines above the ground
-  const double ground_rgb[3] = {0.55, 0.47, 0.38}, lattice_rgb[3] = {0.45, 0.6, 0.85}, shape_rgb[3] = {0.1, 0.1, 0.1},
-               points_rgb[3] = {0.85, 0.2, 0.15}, spring_rgb[3] = {0.2, 0.6, 0.2}, trail_rgb[3] = {0.6, 0.3, 0.7};
-  // every layer gets its actor; the show_* options only set whether it starts visible
-  m.layers[int(SceneLayer::kGround)] = m.AddActor(m.ground, ground_rgb, 1.0, 1.0);
-  m.layers[int(SceneLayer::kTrails)] = m.AddActor(m.trails, trail_rgb, 1.5, 1.0);
-  m.layers[int(SceneLayer::kTrails)]->SetPosition(0, 0, 0.5);
-  m.layers[int(SceneLayer::kLattice)] =
-      m.AddActor(m.lattice, lattice_rgb, 1.0, options_.point_size * 0.75, &m.lattice_points_mapper);
-  m.layers[int(SceneLayer::kLattice)]->SetPosition(0, 0, 1);
-  m.layers[int(SceneLayer::kSprings)] = m.AddActor(m.springs, spring_rgb, 1.5, 1.0);
-  m.layers[int(SceneLayer::kSprings)]->SetPosition(0, 0, 1.5);
-  m.layers[int(SceneLayer::kShape)] = m.AddActor(m.shape, shape_rgb, options_.line_width, 1.0);
-  m.layers[int(SceneLayer::kShape)]->SetPosition(0, 0, 2);
-  m.layers[int(SceneLayer::kPoints)] = m.AddActor(m.points, points_rgb, 1.0, options_.point_size, &m.points_mapper);
-  m.layers[int(SceneLayer::kPoints)]->SetPosition(0, 0, 3);
+  // the world's layers, where FFD bodies live: ground, trails, springs
+  int first_ffd = -1;
+  for (int b = world->num_bodies() - 1; b >= 0; --b)
+    if (world->kind(b) == BodyKind::kFfd) first_ffd = b;
+  if (first_ffd >= 0) {
+    m.ground = Ptr<GroundSource>::New();
+    m.Add(SceneLayer::kGround, on(m.ground, 0), ground_rgb, 1.0, 1.0, 0.0);
+    m.trails = Ptr<TrailSource>::New();
+    m.Add(SceneLayer::kTrails, on(m.trails, first_ffd), trail_rgb, 1.5, 1.0, 0.5);
+    m.Add(SceneLayer::kSprings, on(Ptr<SpringSource>::New(), 0), spring_rgb, 1.5, 1.0, 1.5);
+  }
+  // every body: lattice (or control box), shape, mass points
+  std::vector<vtkPolyDataMapper*> point_mappers, lattice_mappers;
+  for (int b = 0; b < world->num_bodies(); ++b) {
+    m.lattices.push_back(Ptr<LatticeSource>::New());
+    m.points.push_back(Ptr<MassPointSource>::New());
+    lattice_mappers.push_back(vtkPolyDataMapper::SafeDownCast(
+        m.Add(SceneLayer::kLattice, on(m.lattices[b], b), lattice_rgb, 1.0, options_.point_size * 0.75, 1)->GetMapper()));
+    if (world->kind(b) == BodyKind::kFfd) {
+      auto shape = Ptr<ShapeSource>::New();
+      shape->SetSamplesPerSegment(options_.shape_samples);
+      m.Add(SceneLayer::kShape, on(shape, b), shape_rgb, options_.line_width, 1.0, 2);
+    } else if (b < int(spec.drawings.size()) && spec.drawings[b].dim() != 0) {
+      const LinearDrawing& d = spec.drawings[b];
+      if (!d.triangles.empty()) {
+        // a lit, slightly transparent surface under the outline so the mass points show through
+        auto surface = Ptr<ShapeSource>::New();
+        surface->SetDrawing(d);
+        surface->SetLines(false);
+        m.Add(SceneLayer::kShape, on(surface, b), surface_rgb, 1.0, 1.0, 0.5, true)->GetProperty()->SetOpacity(0.55);
+      }
+      auto lines = Ptr<ShapeSource>::New();
+      lines->SetDrawing(d);
+      lines->SetSurface(false);
+      m.Add(SceneLayer::kShape, on(lines, b), shape_rgb, options_.line_width, 1.0, 2);
+    }
+    point_mappers.push_back(vtkPolyDataMapper::SafeDownCast(
+        m.Add(SceneLayer::kPoints, on(m.points[b], b), points_rgb, 1.0, options_.point_size, 3)->GetMapper()));
+  }
+  if (!spec.anchors.empty()) {
+    auto anchors = Ptr<AnchorSource>::New();
+    anchors->SetAnchors(spec.anchors);
+    m.Add(SceneLayer::kAnchors, on(anchors, 0), anchor_rgb, 1.0, options_.point_size * 1.6, 4);
+  }
+  // every layer has its actors; the show_* options only set whether they start visible
   SetLayerVisible(SceneLayer::kGround, options_.show_ground);
   SetLayerVisible(SceneLayer::kTrails, options_.show_trails);
   SetLayerVisible(SceneLayer::kLattice, options_.show_lattice);
@@ -179,20 +213,23 @@ SceneView::SceneView(const World* world, int body, SceneOptions options) : impl_
     if (!known)
       throw std::invalid_argument("color by '" + options_.color_by +
                                   "': not one of mass, velocity, applied_force, in_contact, displacement");
-    if (!(on_lattice ? options_.show_lattice : options_.show_points))
+    if (!(on_lattice ? options_.show_lattice : options_.show_points) || world->num_bodies() == 0)
       throw std::invalid_argument("color by '" + options_.color_by + "': that layer is hidden");
-    m.colored = on_lattice ? m.lattice_points_mapper.Get() : m.points_mapper.Get();
-    if (!m.colored) throw std::invalid_argument("color by '" + options_.color_by + "': that layer is hidden");
+    m.colored = on_lattice ? lattice_mappers : point_mappers;
+    for (int b = 0; b < world->num_bodies(); ++b)
+      m.colored_sources.push_back(on_lattice ? static_cast<vtkPolyDataAlgorithm*>(m.lattices[b].Get()) : m.points[b].Get());
     m.lut = Ptr<vtkLookupTable>::New();
     m.lut->SetHueRange(0.667, 0.0);  // blue (low) to red (high)
     m.lut->SetVectorModeToMagnitude();
     m.lut->Build();
-    m.colored->ScalarVisibilityOn();
-    m.colored->SetScalarModeToUsePointFieldData();
-    m.colored->SelectColorArray(options_.color_by.c_str());
-    m.colored->SetColorModeToMapScalars();
-    m.colored->SetLookupTable(m.lut);
-    m.colored->UseLookupTableScalarRangeOn();
+    for (vtkPolyDataMapper* mapper : m.colored) {
+      mapper->ScalarVisibilityOn();
+      mapper->SetScalarModeToUsePointFieldData();
+      mapper->SelectColorArray(options_.color_by.c_str());
+      mapper->SetColorModeToMapScalars();
+      mapper->SetLookupTable(m.lut);
+      mapper->UseLookupTableScalarRangeOn();
+    }
     if (options_.show_color_bar) {
       m.bar = Ptr<vtkScalarBarActor>::New();
       m.bar->SetLookupTable(m.lut);
@@ -210,7 +247,7 @@ SceneView::SceneView(const World* world, int body, SceneOptions options) : impl_
     }
   }
   SetUpOverlay();
-  FrameBox(BodyBounds(*world, body));
+  FrameBounds(SceneBounds(*world, spec));
 }
 
 void SceneView::SetUpWindow() {
@@ -242,86 +279,11 @@ void SceneView::SetUpOverlay() {
   }
 }
 
-SceneView::SceneView(const World* world, ConstrainedSceneSpec spec, SceneOptions options)
-    : impl_(new Impl), options_(std::move(options)) {
-  if (!HasDisplay())
-    throw std::runtime_error("rendering needs an X display (VTK 9.1): run under xvfb-run -a -s \"-screen 0 1280x1024x24\"");
-  if (!world) throw std::invalid_argument("SceneView: no world");
-  if (options_.width < 16 || options_.height < 16 || options_.width > 8192 || options_.height > 8192)
-    throw std::invalid_argument("image size must be between 16 and 8192 pixels a side");
-  Impl& m = *impl_;
-  m.cworld = world;
-  SetUpWindow();
-  const bool flat = IsFlat(*world);
-  // the same colours and layering as the FFD view: control box, shape, mass points, anchors
-  const double box_rgb[3] = {0.45, 0.6, 0.85}, shape_rgb[3] = {0.1, 0.1, 0.1}, surface_rgb[3] = {0.95, 0.75, 0.35},
-               points_rgb[3] = {0.85, 0.2, 0.15}, anchor_rgb[3] = {0.1, 0.55, 0.2};
-  // in 2D the z offsets keep points above lines (as in the FFD view); in 3D depth decides
-  const double z = flat ? 1.0 : 0.0;
-  auto add = [&](SceneLayer layer, vtkPolyDataAlgorithm* src, const double rgb[3], double line_width,
-                 double point_size, double z_offset, bool lit = false) {
-    Ptr<vtkActor> a = m.AddActor(src, rgb, line_width, point_size);
-    m.clayers[int(layer)].push_back(a);
-    a->SetPosition(0, 0, z_offset * z);
-    if (lit) a->GetProperty()->SetLighting(true);
-    m.csources.push_back(src);
-    return a;
-  };
-  for (int b = 0; b < world->num_bodies(); ++b) {
-    if (world->kind(b) == BodyKind::kFfd) {
-      // FFD bodies through the sources of world_sources.h on the world that steps them
-      auto lattice = Ptr<LatticeSource>::New();
-      auto points = Ptr<MassPointSource>::New();
-      auto shape = Ptr<ShapeSource>::New();
-      shape->SetSamplesPerSegment(options_.shape_samples);
-      for (WorldSourceBase* s : {(WorldSourceBase*)lattice, (WorldSourceBase*)points, (WorldSourceBase*)shape}) {
-        s->SetWorld(world);
-        s->SetBody(b);
-      }
-      if (options_.show_lattice) add(SceneLayer::kLattice, lattice, box_rgb, 1.0, options_.point_size * 0.75, 1);
-      if (options_.show_shape) add(SceneLayer::kShape, shape, shape_rgb, options_.line_width, 1.0, 2);
-      if (options_.show_points) add(SceneLayer::kPoints, points, points_rgb, 1.0, options_.point_size, 3);
-      continue;
-    }
-    auto box = Ptr<LinearBoxSource>::New();
-    auto points = Ptr<LinearMassPointSource>::New();
-    for (ConstrainedSourceBase* s : {(ConstrainedSourceBase*)box, (ConstrainedSourceBase*)points}) {
-      s->SetWorld(world);
-      s->SetBody(b);
-    }
-    if (options_.show_lattice) add(SceneLayer::kLattice, box, box_rgb, 1.0, options_.point_size * 0.75, 1);
-    if (options_.show_shape && b < int(spec.drawings.size()) && spec.drawings[b].dim() != 0) {
-      const LinearDrawing& d = spec.drawings[b];
-      if (!d.triangles.empty()) {
-        // a lit, slightly transparent surface under the outline so the mass points show through
-        auto surface = Ptr<LinearShapeSource>::New();
-        surface->SetWorld(world);
-        surface->SetBody(b);
-        surface->SetDrawing(d);
-        surface->SetLines(false);
-        add(SceneLayer::kShape, surface, surface_rgb, 1.0, 1.0, 0.5, true)->GetProperty()->SetOpacity(0.55);
-      }
-      auto lines = Ptr<LinearShapeSource>::New();
-      lines->SetWorld(world);
-      lines->SetBody(b);
-      lines->SetDrawing(d);
-      lines->SetSurface(false);
-      add(SceneLayer::kShape, lines, shape_rgb, options_.line_width, 1.0, 2);
-    }
-    if (options_.show_points) add(SceneLayer::kPoints, points, points_rgb, 1.0, options_.point_size, 3);
-  }
-  if (!spec.anchors.empty()) {
-    auto anchors = Ptr<AnchorSource>::New();
-    anchors->SetWorld(world);
-    anchors->SetAnchors(spec.anchors);
-    add(SceneLayer::kAnchors, anchors, anchor_rgb, 1.0, options_.point_size * 1.6, 4);
-  }
-  SetUpOverlay();
-  const Eigen::AlignedBox3d bounds = SceneBounds(*world, spec);
-  if (flat)
-    FrameBox(Eigen::AlignedBox2d(bounds.min().head<2>(), bounds.max().head<2>()));
+void SceneView::FrameBounds(const Eigen::AlignedBox3d& box, double margin) {
+  if (IsFlat(*impl_->world))
+    FrameBox(box.isEmpty() ? Eigen::AlignedBox2d() : Eigen::AlignedBox2d(box.min().head<2>(), box.max().head<2>()), margin);
   else
-    FrameBox3d(bounds);
+    FrameBox3d(box, margin);
 }
 
 void SceneView::FrameBox3d(const Eigen::AlignedBox3d& box_in, double margin) {
@@ -407,21 +369,12 @@ void SceneView::FrameBox(const Eigen::AlignedBox2d& box_in, double margin) {
 
 void SceneView::Render() {
   Impl& m = *impl_;
-  if (m.world)
-    for (WorldSourceBase* s : {(WorldSourceBase*)m.ground, (WorldSourceBase*)m.lattice, (WorldSourceBase*)m.points,
-                               (WorldSourceBase*)m.shape, (WorldSourceBase*)m.springs})
-      s->Modified();
-  for (vtkPolyDataAlgorithm* s : m.csources) s->Modified();
-  if (m.colored) {
+  for (WorldSourceBase* s : m.sources) s->Modified();
+  if (!m.colored.empty()) {
     double lo = options_.color_range[0], hi = options_.color_range[1];
     if (!(lo < hi)) {
-      // this frame's range of the array (magnitude for vectors)
-      vtkPolyDataAlgorithm* src = options_.color_by == "displacement" ? (vtkPolyDataAlgorithm*)m.lattice
-                                                                       : (vtkPolyDataAlgorithm*)m.points;
-      src->Update();
-      vtkDataArray* a = src->GetOutput()->GetPointData()->GetArray(options_.color_by.c_str());
-      double r[2] = {0, 1};
-      if (a) a->GetRange(r, a->GetNumberOfComponents() > 1 ? -1 : 0);
+      double r[2];
+      ColorRangeNow(r);
       lo = r[0];
       hi = r[1] > r[0] ? r[1] : r[0] + 1.0;
     }
@@ -431,17 +384,20 @@ void SceneView::Render() {
     std::string text = options_.title.empty() ? "" : options_.title + "\n";
     if (options_.overlay) {
       char buf[256];
-      std::snprintf(buf, sizeof(buf), "t = %.3f s", m.world ? m.world->time() : m.cworld->time());
+      std::snprintf(buf, sizeof(buf), "t = %.3f s", m.world->time());
       text += buf;
-      if (options_.overlay_energy && m.cworld) {
-        double kinetic = 0.0;
-        for (int b = 0; b < m.cworld->num_bodies(); ++b) kinetic += m.cworld->KineticEnergy(b);
-        std::snprintf(buf, sizeof(buf), "\nE = %.4g (kin %.3g)", m.cworld->TotalEnergy(), kinetic);
-        text += buf;
-      } else if (options_.overlay_energy) {
-        const Energies e = m.world->ComputeEnergies(m.body);
-        std::snprintf(buf, sizeof(buf), "\nE = %.4g (kin %.3g, grav %.3g, modes %.3g)", e.total(), e.kinetic,
-                      e.gravity, e.modes);
+      if (options_.overlay_energy) {
+        Energies sum;
+        double total = 0.0;
+        for (int b = 0; b < m.world->num_bodies(); ++b) {
+          const Energies e = m.world->ComputeEnergies(b);
+          sum.kinetic += e.kinetic;
+          sum.gravity += e.gravity;
+          sum.modes += e.modes;
+          total += e.total();
+        }
+        std::snprintf(buf, sizeof(buf), "\nE = %.4g (kin %.3g, grav %.3g, modes %.3g)", total, sum.kinetic, sum.gravity,
+                      sum.modes);
         text += buf;
       }
     }
@@ -451,18 +407,21 @@ void SceneView::Render() {
   m.last_rgb = nullptr;
 }
 
-vtkSmartPointer<vtkImageData> SceneView::Capture() {
-  if (impl_->last_rgb) return impl_->last_rgb;
+vtkSmartPointer<vtkImageData> ReadWindowRgb(vtkRenderWindow* window, bool rerender) {
   auto grab = Ptr<vtkWindowToImageFilter>::New();
-  grab->SetInput(impl_->window);
+  grab->SetInput(window);
   grab->SetInputBufferTypeToRGB();
   grab->ReadFrontBufferOff();
-  grab->ShouldRerenderOff();
+  grab->SetShouldRerender(rerender);
   grab->Update();
   auto image = Ptr<vtkImageData>::New();
   image->DeepCopy(grab->GetOutput());
-  impl_->last_rgb = image;
   return image;
+}
+
+vtkSmartPointer<vtkImageData> SceneView::Capture() {
+  if (!impl_->last_rgb) impl_->last_rgb = ReadWindowRgb(impl_->window);
+  return impl_->last_rgb;
 }
 
 void SceneView::WritePng(const std::string& path, BackgroundWriter* writer) {
@@ -517,23 +476,46 @@ void SceneView::WriteExr(const std::string& path, BackgroundWriter* writer) {
   writer->Submit([path, w, h, compression, ch = CaptureRgbaDepth()] { WriteExrChannels(path, w, h, ch, compression); });
 }
 
+bool SceneView::ColorRangeNow(double range[2]) {
+  range[0] = 0.0;
+  range[1] = 1.0;
+  double lo = 1e300, hi = -1e300;
+  for (vtkPolyDataAlgorithm* src : impl_->colored_sources) {
+    src->Modified();
+    src->Update();
+    vtkDataArray* a = src->GetOutput()->GetPointData()->GetArray(options_.color_by.c_str());
+    if (!a) continue;
+    double r[2];
+    a->GetRange(r, a->GetNumberOfComponents() > 1 ? -1 : 0);  // magnitude for vectors
+    lo = std::min(lo, r[0]);
+    hi = std::max(hi, r[1]);
+  }
+  if (!(lo <= hi)) return false;
+  range[0] = lo;
+  range[1] = hi;
+  return true;
+}
+
+void SceneView::SetColorRange(double lo, double hi) {
+  options_.color_range[0] = lo;
+  options_.color_range[1] = hi;
+}
+
 void SceneView::SetLayerVisible(SceneLayer layer, bool visible) {
-  if (impl_->layers[int(layer)]) impl_->layers[int(layer)]->SetVisibility(visible);
-  for (vtkActor* a : impl_->clayers[int(layer)]) a->SetVisibility(visible);
+  for (vtkActor* a : impl_->layers[int(layer)]) a->SetVisibility(visible);
 }
 bool SceneView::LayerVisible(SceneLayer layer) const {
-  if (impl_->layers[int(layer)]) return impl_->layers[int(layer)]->GetVisibility() != 0;
-  const auto& c = impl_->clayers[int(layer)];
-  return !c.empty() && c.front()->GetVisibility() != 0;  // a layer the view does not draw: hidden
+  const auto& actors = impl_->layers[int(layer)];
+  return !actors.empty() && actors.front()->GetVisibility() != 0;  // a layer the view does not draw: hidden
 }
 
 void SceneView::SetWorld(const World* world) {
-  if (!world || impl_->body >= world->num_bodies()) throw std::invalid_argument("SceneView::SetWorld: no such world/body");
+  if (!world || world->num_bodies() != impl_->world->num_bodies())
+    throw std::invalid_argument("SceneView::SetWorld: not a world of the same bodies");
   Impl& m = *impl_;
   m.world = world;
-  for (WorldSourceBase* s : {(WorldSourceBase*)m.ground, (WorldSourceBase*)m.lattice, (WorldSourceBase*)m.points,
-                             (WorldSourceBase*)m.shape, (WorldSourceBase*)m.springs, (WorldSourceBase*)m.trails})
-    s->SetWorld(world);
+  for (WorldSourceBase* s : m.sources) s->SetWorld(world);
+  if (m.trails) m.trails->SetWorld(world);
 }
 
 TrailSource* SceneView::trails() { return impl_->trails; }

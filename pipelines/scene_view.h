@@ -1,6 +1,8 @@
-// The offscreen renderer: one body of a World drawn with the sources of world_sources.h
-// (ground, deformed lattice, mass points, resampled shape, springs, trails) in a parallel
-// 2D view, with an overlay of the time and the energy, into PNG or EXR frames.
+// The offscreen renderer: every body of a World (FFD and linear, 2D and 3D) drawn with the
+// sources of world_sources.h (per body its lattice or control box, mass points and shape; the
+// ground, springs, trails and named points of the world), with an overlay of the time and the
+// energy, into PNG or EXR frames. A world of 2D bodies is seen by a parallel camera (FrameBox),
+// one with a 3D body in perspective (FrameBox3d).
 //
 // VTK 9.1 as Debian ships it renders only through X: call HasDisplay() first and run under
 // `xvfb-run -a -s "-screen 0 1280x1024x24"` when there is no screen; without a display VTK
@@ -14,9 +16,9 @@
 #include <vtkSmartPointer.h>
 
 #include "pipelines/background_writer.h"
-#include "pipelines/constrained_sources.h"
 #include "pipelines/exr_io.h"
 #include "pipelines/world_sources.h"
+#include "wobble/control/behaviours.h"
 
 class vtkImageData;
 class vtkRenderWindow;
@@ -56,15 +58,19 @@ struct SceneOptions {
   double view_angle = 30.0;  // perspective opening, degrees
 };
 
-// What a view of a World draws besides its bodies' mass points and control boxes.
-struct ConstrainedSceneSpec {
-  std::vector<LinearDrawing> drawings;        // per body index; empty or missing: no shape
+// What a view of a World draws besides what its bodies carry (FFD bodies their drawing):
+// the drawings of linear bodies and named points.
+struct SceneSpec {
+  std::vector<LinearDrawing> drawings;        // per body index (linear bodies); empty or missing: no shape
   std::vector<AnchorSource::Anchor> anchors;  // named points, drawn as larger dots
 };
+// What a script's scene draws besides its bodies (`render` and `wobble view`): its drawings
+// and its named points (`point`, `place`) as anchors.
+SceneSpec SceneSpecOf(const std::vector<LinearDrawing>& drawings, const std::vector<control::Anchor>& anchors);
 
-// The layers a SceneView draws; each can be shown or hidden after construction. A view of a
-// World has kLattice (control boxes, FFD lattices), kShape, kPoints and kAnchors
-// (named points); the FFD view has all but kAnchors.
+// The layers a SceneView draws; each can be shown or hidden after construction. kLattice (FFD
+// lattices, control boxes), kPoints and kShape are drawn per body; kGround, kSprings and kTrails
+// when the world has an FFD body; kAnchors when the spec names points.
 enum class SceneLayer { kGround, kLattice, kPoints, kShape, kSprings, kTrails, kAnchors };
 
 // A box holding every point of the body now: its deformed control points (by the convex-hull
@@ -72,23 +78,22 @@ enum class SceneLayer { kGround, kLattice, kPoints, kShape, kSprings, kTrails, k
 Eigen::AlignedBox2d BodyBounds(const World& world, int body);
 // A box holding every body of a World now (linear bodies with their drawings,
 // FFD bodies by their control points; z = 0 for 2D bodies).
-Eigen::AlignedBox3d SceneBounds(const World& world, const ConstrainedSceneSpec& spec);
+Eigen::AlignedBox3d SceneBounds(const World& world, const SceneSpec& spec = {});
 // True when every body of the world is 2D (the parallel 2D view suits it).
 bool IsFlat(const World& world);
 
 class SceneView {
  public:
-  // Needs a display (HasDisplay()); throws std::runtime_error without one.
-  SceneView(const World* world, int body, SceneOptions options = {});
+  // Every body of the world: FFD bodies as lattice, mass points and their resampled drawing;
+  // linear bodies as control box, mass points and the spec's drawing (a lit surface in 3D);
+  // with an FFD body also the ground, the springs and trails (of the first FFD body: see
+  // trails()); the spec's anchors as dots. The camera starts on the world's bodies
+  // (FrameBounds(SceneBounds(world, spec))). Needs a display (HasDisplay()); throws
+  // std::runtime_error without one.
+  SceneView(const World* world, SceneOptions options = {}, SceneSpec spec = {});
   ~SceneView();
   SceneView(const SceneView&) = delete;
   SceneView& operator=(const SceneView&) = delete;
-
-  // Every body of a World (Witkin & Welch bodies, 2D or 3D, and FFD bodies): linear
-  // bodies as control box, mass points and shape (LinearDrawing; a lit surface in 3D), FFD
-  // bodies with the sources above, anchors as dots. The camera starts on the world's bodies:
-  // FrameBox for a world of 2D bodies, FrameBox3d when any body is 3D. No ground is drawn.
-  SceneView(const World* world, ConstrainedSceneSpec spec, SceneOptions options = {});
 
   // A parallel camera looking down −z that shows `box` (world units) with a margin
   // (fraction of the box) around it, keeping the aspect ratio of the image.
@@ -96,6 +101,8 @@ class SceneView {
   // A perspective camera from options().azimuth/elevation, looking at the centre of `box`
   // from the nearest distance that keeps all its corners in view (plus the margin): the 3D view.
   void FrameBox3d(const Eigen::AlignedBox3d& box, double margin = 0.08);
+  // FrameBox of the box's x-y extent for a world of 2D bodies, FrameBox3d otherwise.
+  void FrameBounds(const Eigen::AlignedBox3d& box, double margin = 0.08);
   const Eigen::AlignedBox2d& framed_box() const { return framed_; }
 
   // Rebuilds every source from the world's current state and renders.
@@ -113,12 +120,19 @@ class SceneView {
   std::vector<ExrChannel> CaptureRgbaDepth();
   void WriteExr(const std::string& path, BackgroundWriter* writer = nullptr);
 
+  // The range of options().color_by over every body in the world's state now (magnitudes
+  // for vectors); false (and 0..1) when nothing is coloured or no body has the array.
+  bool ColorRangeNow(double range[2]);
+  // A fixed colour range from now on (lo >= hi: each frame's own range).
+  void SetColorRange(double lo, double hi);
+
   // Shows or hides one layer (the interactive viewer's keys). The show_* options set the start.
   void SetLayerVisible(SceneLayer layer, bool visible);
   bool LayerVisible(SceneLayer layer) const;
-  // Draws another world from now on (same body index; e.g. a recorded state while scrubbing).
+  // Draws another world from now on (the same bodies; e.g. a recorded state while scrubbing).
   void SetWorld(const World* world);
 
+  // The trails of the first FFD body (SetBody picks another); nullptr without an FFD body.
   TrailSource* trails();
   vtkRenderWindow* window();
   vtkRenderer* renderer();
@@ -132,6 +146,10 @@ class SceneView {
   SceneOptions options_;
   Eigen::AlignedBox2d framed_;
 };
+
+// The pixels of a window's back buffer as an RGB image (bottom row first), read after its last
+// render (rerender: renders once more first).
+vtkSmartPointer<vtkImageData> ReadWindowRgb(vtkRenderWindow* window, bool rerender = false);
 
 // Puts images of one size side by side, `columns` per row (0: all in one row), with a thin
 // gap of background colour: the papers' strips of snapshots (thesis Fig. 4.10–4.12).

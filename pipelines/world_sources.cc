@@ -41,12 +41,30 @@ Ptr<vtkDoubleArray> Scalars(const char* name, vtkIdType n) {
   return a;
 }
 
+Ptr<vtkPoints> DoublePoints() {
+  auto points = Ptr<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  return points;
+}
+
 // Every output carries the world's time as field data (ParaView reads TimeValue).
 void AddTimeValue(vtkPolyData* out, double time) {
   auto t = Ptr<vtkDoubleArray>::New();
   t->SetName("TimeValue");
   t->InsertNextValue(time);
   out->GetFieldData()->AddArray(t);
+}
+
+Eigen::Vector3d To3(const Eigen::VectorXd& x) { return Eigen::Vector3d(x[0], x[1], x.size() > 2 ? x[2] : 0.0); }
+
+// The box a linear body's mass points span in undeformed coordinates.
+void UndeformedBox(const LinearBodyModel& model, Eigen::VectorXd* lo, Eigen::VectorXd* hi) {
+  *lo = model.def().points[0];
+  *hi = *lo;
+  for (const Eigen::VectorXd& u : model.def().points) {
+    *lo = lo->cwiseMin(u);
+    *hi = hi->cwiseMax(u);
+  }
 }
 
 }  // namespace
@@ -59,29 +77,62 @@ Eigen::Vector2d WorldPositionOf(const World& world, int body, const Eigen::Vecto
   return WorldFromLocal(Frame<double>(q), LocalPosition<double>(b0, B, q));
 }
 
+Eigen::Vector3d LinearWorldPoint(const World& world, int body, const Eigen::VectorXd& u) {
+  const LinearBodyModel& model = world.linear_model(body);
+  return To3(world.linear_R(body) * model.Basis(u));
+}
+
+Eigen::AlignedBox3d LinearBodyBounds(const World& world, int body, const LinearDrawing* drawing) {
+  const LinearBodyModel& model = world.linear_model(body);
+  Eigen::AlignedBox3d box;
+  for (const Eigen::VectorXd& u : model.def().points) box.extend(LinearWorldPoint(world, body, u));
+  if (drawing) {
+    for (const auto& line : drawing->polylines)
+      for (const Eigen::VectorXd& u : line.points) box.extend(LinearWorldPoint(world, body, u));
+    for (const Eigen::VectorXd& u : drawing->vertices) box.extend(LinearWorldPoint(world, body, u));
+  }
+  return box;
+}
+
 void WorldSourceBase::PrintSelf(ostream& os, vtkIndent indent) {
   Superclass::PrintSelf(os, indent);
   os << indent << "World: " << world_ << "\n" << indent << "Body: " << Body << "\n";
 }
 
-bool WorldSourceBase::CheckWorld() {
+bool WorldSourceBase::Check(Needs needs) {
   if (!world_) {
     vtkErrorMacro("no world set");
     return false;
   }
+  if (needs == Needs::kWorld) return true;
   if (Body < 0 || Body >= world_->num_bodies()) {
     vtkErrorMacro("body " << Body << " not in the world (" << world_->num_bodies() << " bodies)");
+    return false;
+  }
+  const BodyKind kind = world_->kind(Body);
+  if (needs == Needs::kFfdBody && kind != BodyKind::kFfd) {
+    vtkErrorMacro("body " << Body << " is not an FFD body of the world");
+    return false;
+  }
+  if (needs == Needs::kLinearBody && kind != BodyKind::kLinear) {
+    vtkErrorMacro("body " << Body << " is not a linear body of the world");
     return false;
   }
   return true;
 }
 
+int BodyPartSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
+  if (!Check(Needs::kAnyBody)) return 0;
+  vtkPolyData* out = OutputOf(out_vec);
+  if (!(world_->kind(Body) == BodyKind::kFfd ? DrawFfd(out) : DrawLinear(out))) return 0;
+  AddTimeValue(out, world_->time());
+  return 1;
+}
+
 // ---------------------------------------------------------------------------------------
 vtkStandardNewMacro(LatticeSource);
 
-int LatticeSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
-  if (!CheckWorld()) return 0;
-  vtkPolyData* out = OutputOf(out_vec);
+bool LatticeSource::DrawFfd(vtkPolyData* out) {
   const BodyModel& body = world_->body(Body);
   const VecQ<double>& q = world_->state(Body).q;
   const Lattice& lat = body.lattice();
@@ -89,8 +140,7 @@ int LatticeSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInfor
   const int n = lat.size();
 
   // deformed control points: L_ij + Σ γ_d d^d_ij (Eq. 4.2), then into the world
-  auto points = Ptr<vtkPoints>::New();
-  points->SetDataTypeToDouble();
+  auto points = DoublePoints();
   points->SetNumberOfPoints(n);
   auto rest = Vectors("rest_position", n);
   auto disp = Vectors("displacement", n);
@@ -121,16 +171,63 @@ int LatticeSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInfor
   out->SetLines(lines);
   out->GetPointData()->AddArray(rest);
   out->GetPointData()->AddArray(disp);
-  AddTimeValue(out, world_->time());
-  return 1;
+  return true;
+}
+
+bool LatticeSource::DrawLinear(vtkPolyData* out) {
+  const LinearBodyModel& model = world_->linear_model(Body);
+  const int d = model.dim();
+  Eigen::VectorXd lo, hi;
+  UndeformedBox(model, &lo, &hi);
+  auto level = [&](int axis, int k) { return lo[axis] + 0.5 * k * (hi[axis] - lo[axis]); };  // k = 0, 1, 2
+
+  auto points = DoublePoints();
+  auto rest = Ptr<vtkDoubleArray>::New();
+  rest->SetName("rest_position");
+  rest->SetNumberOfComponents(3);
+  auto add = [&](const Eigen::VectorXd& u) {
+    const Eigen::Vector3d x = LinearWorldPoint(*world_, Body, u);
+    const Eigen::Vector3d r = To3(u);
+    rest->InsertNextTuple3(r.x(), r.y(), r.z());
+    return points->InsertNextPoint(x.x(), x.y(), x.z());
+  };
+  // the 3^d grid nodes as vertices
+  auto verts = Ptr<vtkCellArray>::New();
+  const int nodes = d == 2 ? 9 : 27;
+  for (int i = 0; i < nodes; ++i) {
+    Eigen::VectorXd u(d);
+    for (int a = 0, rest_i = i; a < d; ++a, rest_i /= 3) u[a] = level(a, rest_i % 3);
+    const vtkIdType id = add(u);
+    verts->InsertNextCell(1, &id);
+  }
+  // lines along every axis through the other axes' three levels, cut into Pieces
+  auto lines = Ptr<vtkCellArray>::New();
+  const int others = d == 2 ? 3 : 9;
+  for (int axis = 0; axis < d; ++axis)
+    for (int o = 0; o < others; ++o) {
+      Eigen::VectorXd u(d);
+      for (int a = 0, rest_o = o; a < d; ++a) {
+        if (a == axis) continue;
+        u[a] = level(a, rest_o % 3);
+        rest_o /= 3;
+      }
+      lines->InsertNextCell(Pieces + 1);
+      for (int p = 0; p <= Pieces; ++p) {
+        u[axis] = lo[axis] + (hi[axis] - lo[axis]) * double(p) / Pieces;
+        lines->InsertCellPoint(add(u));
+      }
+    }
+  out->SetPoints(points);
+  out->SetVerts(verts);
+  out->SetLines(lines);
+  out->GetPointData()->AddArray(rest);
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------
 vtkStandardNewMacro(MassPointSource);
 
-int MassPointSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
-  if (!CheckWorld()) return 0;
-  vtkPolyData* out = OutputOf(out_vec);
+bool MassPointSource::DrawFfd(vtkPolyData* out) {
   const BodyModel& body = world_->body(Body);
   const BodyState<double>& s = world_->state(Body);
   const WorldParams& params = world_->options().params;
@@ -138,8 +235,7 @@ int MassPointSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInf
   const GroundFrame gf(params.ground);
   const int n = body.num_points();
 
-  auto points = Ptr<vtkPoints>::New();
-  points->SetDataTypeToDouble();
+  auto points = DoublePoints();
   points->SetNumberOfPoints(n);
   auto mass = Scalars("mass", n);
   auto velocity = Vectors("velocity", n);
@@ -177,8 +273,32 @@ int MassPointSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInf
   for (vtkDataArray* a : {static_cast<vtkDataArray*>(mass), static_cast<vtkDataArray*>(velocity),
                           static_cast<vtkDataArray*>(force), static_cast<vtkDataArray*>(contact)})
     out->GetPointData()->AddArray(a);
-  AddTimeValue(out, world_->time());
-  return 1;
+  return true;
+}
+
+bool MassPointSource::DrawLinear(vtkPolyData* out) {
+  const LinearBodyModel& model = world_->linear_model(Body);
+  const Eigen::MatrixXd& R = world_->linear_R(Body);
+  const Eigen::MatrixXd& R_dot = world_->linear_R_dot(Body);
+  const int n = model.num_points();
+  auto points = DoublePoints();
+  points->SetNumberOfPoints(n);
+  auto mass = Scalars("mass", n);
+  auto velocity = Vectors("velocity", n);
+  auto verts = Ptr<vtkCellArray>::New();
+  for (vtkIdType k = 0; k < n; ++k) {
+    const Eigen::VectorXd p = model.Basis(model.def().points[k]);
+    const Eigen::Vector3d x = To3(R * p), v = To3(R_dot * p);  // x = R p, ẋ = Ṙ p (§2.2)
+    points->SetPoint(k, x.x(), x.y(), x.z());
+    velocity->SetTuple3(k, v.x(), v.y(), v.z());
+    mass->SetValue(k, model.def().masses[k]);
+    verts->InsertNextCell(1, &k);
+  }
+  out->SetPoints(points);
+  out->SetVerts(verts);
+  out->GetPointData()->AddArray(mass);
+  out->GetPointData()->AddArray(velocity);
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -223,15 +343,12 @@ void ShapeSource::UpdateCache() {
 
 std::vector<Eigen::Vector2d> ShapeSource::SampleLatticeCoords() const { return sample_st_; }
 
-int ShapeSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
-  if (!CheckWorld()) return 0;
+bool ShapeSource::DrawFfd(vtkPolyData* out) {
   UpdateCache();
-  vtkPolyData* out = OutputOf(out_vec);
   const VecQ<double>& q = world_->state(Body).q;
   const Frame<double> frame(q);
   const vtkIdType n = vtkIdType(sample_st_.size());
-  auto points = Ptr<vtkPoints>::New();
-  points->SetDataTypeToDouble();
+  auto points = DoublePoints();
   points->SetNumberOfPoints(n);
   auto st_array = Ptr<vtkDoubleArray>::New();
   st_array->SetName("lattice_coords");
@@ -253,8 +370,41 @@ int ShapeSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInforma
   out->SetPoints(points);
   out->SetLines(lines);
   out->GetPointData()->AddArray(st_array);
-  AddTimeValue(out, world_->time());
-  return 1;
+  return true;
+}
+
+bool ShapeSource::DrawLinear(vtkPolyData* out) {
+  const int d = world_->linear_model(Body).dim();
+  if (drawing_.dim() != 0 && drawing_.dim() != d) {
+    vtkErrorMacro("the drawing is " << drawing_.dim() << "D, the body " << d << "D");
+    return false;
+  }
+  auto points = DoublePoints();
+  auto add = [&](const Eigen::VectorXd& u) {
+    const Eigen::Vector3d x = LinearWorldPoint(*world_, Body, u);
+    return points->InsertNextPoint(x.x(), x.y(), x.z());
+  };
+  auto lines = Ptr<vtkCellArray>::New();
+  if (Lines)
+    for (const LinearDrawing::Polyline& line : drawing_.polylines) {
+      const vtkIdType first = points->GetNumberOfPoints();
+      lines->InsertNextCell(vtkIdType(line.points.size()) + (line.closed ? 1 : 0));
+      for (const Eigen::VectorXd& u : line.points) lines->InsertCellPoint(add(u));
+      if (line.closed) lines->InsertCellPoint(first);
+    }
+  auto polys = Ptr<vtkCellArray>::New();
+  if (Surface && !drawing_.triangles.empty()) {
+    const vtkIdType base = points->GetNumberOfPoints();
+    for (const Eigen::VectorXd& u : drawing_.vertices) add(u);
+    for (const auto& t : drawing_.triangles) {
+      const vtkIdType ids[3] = {base + t[0], base + t[1], base + t[2]};
+      polys->InsertNextCell(3, ids);
+    }
+  }
+  out->SetPoints(points);
+  out->SetLines(lines);
+  out->SetPolys(polys);
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -267,14 +417,10 @@ void GroundSource::PrintSelf(ostream& os, vtkIndent indent) {
 }
 
 int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
-  if (!world_) {
-    vtkErrorMacro("no world set");
-    return 0;
-  }
+  if (!Check(Needs::kWorld)) return 0;
   vtkPolyData* out = OutputOf(out_vec);
   const Ground& g = world_->options().params.ground;
-  auto points = Ptr<vtkPoints>::New();
-  points->SetDataTypeToDouble();
+  auto points = DoublePoints();
   AddTimeValue(out, world_->time());
   if (!g.enabled) {
     out->SetPoints(points);
@@ -306,18 +452,14 @@ int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
 vtkStandardNewMacro(SpringSource);
 
 int SpringSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
-  if (!world_) {
-    vtkErrorMacro("no world set");
-    return 0;
-  }
+  if (!Check(Needs::kWorld)) return 0;
   vtkPolyData* out = OutputOf(out_vec);
-  auto points = Ptr<vtkPoints>::New();
-  points->SetDataTypeToDouble();
+  auto points = DoublePoints();
   auto lines = Ptr<vtkCellArray>::New();
   auto stretch = Ptr<vtkDoubleArray>::New();
   stretch->SetName("stretch");  // length minus rest length, per line
   for (const Spring& sp : world_->options().params.springs) {
-    if (sp.body < 0 || sp.body >= world_->num_bodies()) continue;
+    if (sp.body < 0 || sp.body >= world_->num_bodies() || world_->kind(sp.body) != BodyKind::kFfd) continue;
     const VecQ<double>& q = world_->state(sp.body).q;
     const Eigen::Vector2d x = WorldFromLocal(Frame<double>(q), LocalPosition<double>(sp.rest_local, sp.mode_matrix, q));
     const vtkIdType ids[2] = {points->InsertNextPoint(sp.anchor.x(), sp.anchor.y(), 0.0),
@@ -347,7 +489,7 @@ void TrailSource::ClearHistory() {
 }
 
 void TrailSource::Record() {
-  if (!CheckWorld()) return;
+  if (!Check(Needs::kFfdBody)) return;
   std::vector<Eigen::Vector2d> now;
   for (const Eigen::Vector2d& st : tracked_) now.push_back(WorldPositionOf(*world_, Body, st));
   times_.push_back(world_->time());
@@ -357,8 +499,7 @@ void TrailSource::Record() {
 
 int TrailSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
   vtkPolyData* out = OutputOf(out_vec);
-  auto points = Ptr<vtkPoints>::New();
-  points->SetDataTypeToDouble();
+  auto points = DoublePoints();
   auto lines = Ptr<vtkCellArray>::New();
   auto time = Ptr<vtkDoubleArray>::New();
   time->SetName("time");
@@ -376,6 +517,25 @@ int TrailSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInforma
   out->SetLines(lines);
   out->GetPointData()->AddArray(time);
   AddTimeValue(out, world_ ? world_->time() : 0.0);
+  return 1;
+}
+
+// ---------------------------------------------------------------------------------------
+vtkStandardNewMacro(AnchorSource);
+
+int AnchorSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
+  if (!Check(Needs::kWorld)) return 0;
+  vtkPolyData* out = OutputOf(out_vec);
+  auto points = DoublePoints();
+  auto verts = Ptr<vtkCellArray>::New();
+  for (const Anchor& a : anchors_) {
+    const Eigen::Vector3d x = To3(a.point.body >= 0 ? world_->PointPosition(a.point) : a.place);
+    const vtkIdType id = points->InsertNextPoint(x.x(), x.y(), x.z());
+    verts->InsertNextCell(1, &id);
+  }
+  out->SetPoints(points);
+  out->SetVerts(verts);
+  AddTimeValue(out, world_->time());
   return 1;
 }
 

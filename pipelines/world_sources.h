@@ -1,26 +1,47 @@
-// VTK sources that turn one body of a wobble::World into vtkPolyData, in world coordinates
-// (z = 0: wobble is 2D). Each is a vtkPolyDataAlgorithm with no input: set the world and the
-// body, and call Modified() after the world has stepped so that the next Update() redraws.
+// VTK sources that turn a wobble::World into vtkPolyData, in world coordinates (2D bodies at
+// z = 0; 3D linear bodies in 3D). One hierarchy for every body kind: each source is a
+// vtkPolyDataAlgorithm with no input over a World and a body index (WorldSourceBase); set the
+// world and the body, and call Modified() after the world has changed so that the next
+// Update() redraws. A source asked for a body of a kind it cannot draw (or for no world, or a
+// body the world does not have) reports it with vtkErrorMacro and outputs nothing.
 //
-//   LatticeSource    deformed control lattice: control points (vertices) and grid lines;
-//                    point arrays rest_position (body frame) and displacement (body frame,
-//                    Σ γ_d d^d_ij of Eq. 4.2: the deformation alone, without the rigid motion)
-//   MassPointSource  mass points as vertices; arrays mass, velocity, applied_force (gravity
-//                    plus the ground's penalty force of Eq. 4.24/4.25, world frame) and
-//                    in_contact (1 for a point tied to the ground)
-//   ShapeSource      the drawing polylines, resampled finer than the mass points: each segment
-//                    is cut into SamplesPerSegment pieces and every sample is moved by the FFD
-//                    (the thesis simulates few points and draws many, §4.10)
+// Per body, for both kinds (FFD bodies of the thesis, Witkin & Welch linear bodies; each a
+// BodyPartSource, which dispatches on the body's kind):
+//   LatticeSource    the control structure, as vertices and grid lines.
+//                    FFD: the deformed control lattice; point arrays rest_position (body
+//                    frame) and displacement (body frame, Σ γ_d d^d_ij of Eq. 4.2: the
+//                    deformation alone, without the rigid motion).
+//                    Linear: the "control box", a grid of lines over the box the mass points
+//                    span (3 lines per direction and face), each cut into Pieces and carried
+//                    by x = R p(u), so a quadratic body's bend shows; the grid's nodes as
+//                    vertices; point array rest_position (u).
+//   MassPointSource  the mass points as vertices; arrays mass and velocity, and for FFD
+//                    bodies applied_force (gravity plus the ground's penalty force of
+//                    Eq. 4.24/4.25, world frame) and in_contact (1 for a point tied to the ground)
+//   ShapeSource      the body's drawing.
+//                    FFD: the drawing polylines of the body's file, resampled finer than the
+//                    mass points: each segment is cut into SamplesPerSegment pieces and every
+//                    sample is moved by the FFD (the thesis simulates few points and draws
+//                    many, §4.10); point array lattice_coords.
+//                    Linear: a LinearDrawing (SetDrawing: polylines and, in 3D, a triangle
+//                    surface) carried by x = R p(u).
+//   TrailSource      (FFD bodies) trajectories of chosen points (lattice coordinates): call
+//                    Record() after each frame; polylines with a point array time
+// Of the world (Body is not used):
 //   GroundSource     the ground line with its slope, as a filled band of given length and depth
-//   SpringSource     the world's springs as lines anchor → held point; array stretch
-//   TrailSource      trajectories of chosen points (lattice coordinates): call Record() after
-//                    each frame; polylines with a point array time
+//   SpringSource     the world's springs as lines anchor → held point; cell array stretch
+//   AnchorSource     named points (material points of any body, fixed places) as vertices,
+//                    e.g. the control points of a script
+// Every output has a TimeValue field array: the world's time.
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
 #include <vector>
 #include <vtkPolyDataAlgorithm.h>
 
+#include "wobble/body/linear_shapes.h"
 #include "wobble/world/world.h"
 
 namespace wobble::pipelines {
@@ -41,48 +62,81 @@ class WorldSourceBase : public vtkPolyDataAlgorithm {
 
  protected:
   WorldSourceBase() { SetNumberOfInputPorts(0); }
-  // Reports (vtkErrorMacro) and returns false when there is no world or no such body.
-  bool CheckWorld();
+  // What a source needs: a world, or also Body as a body of it (of any kind, or of one kind).
+  enum class Needs { kWorld, kAnyBody, kFfdBody, kLinearBody };
+  // Reports (vtkErrorMacro) and returns false when the world or the body is not what `needs` says.
+  bool Check(Needs needs);
   const World* world_ = nullptr;
   int Body = 0;
 };
 
-class LatticeSource : public WorldSourceBase {
+// A part of one body of either kind: RequestData checks the body and draws it with the
+// kind's own function (false: nothing drawn, already reported).
+class BodyPartSource : public WorldSourceBase {
+ public:
+  vtkTypeMacro(BodyPartSource, WorldSourceBase);
+
+ protected:
+  BodyPartSource() = default;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) final;
+  virtual bool DrawFfd(vtkPolyData* out) = 0;
+  virtual bool DrawLinear(vtkPolyData* out) = 0;
+};
+
+class LatticeSource : public BodyPartSource {
  public:
   static LatticeSource* New();
-  vtkTypeMacro(LatticeSource, WorldSourceBase);
+  vtkTypeMacro(LatticeSource, BodyPartSource);
+  // Linear bodies: pieces each grid line is cut into (>= 1).
+  vtkSetClampMacro(Pieces, int, 1, 10000);
+  vtkGetMacro(Pieces, int);
 
  protected:
   LatticeSource() = default;
-  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  bool DrawFfd(vtkPolyData* out) override;
+  bool DrawLinear(vtkPolyData* out) override;
+  int Pieces = 12;
 };
 
-class MassPointSource : public WorldSourceBase {
+class MassPointSource : public BodyPartSource {
  public:
   static MassPointSource* New();
-  vtkTypeMacro(MassPointSource, WorldSourceBase);
+  vtkTypeMacro(MassPointSource, BodyPartSource);
 
  protected:
   MassPointSource() = default;
-  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  bool DrawFfd(vtkPolyData* out) override;
+  bool DrawLinear(vtkPolyData* out) override;
 };
 
-class ShapeSource : public WorldSourceBase {
+class ShapeSource : public BodyPartSource {
  public:
   static ShapeSource* New();
-  vtkTypeMacro(ShapeSource, WorldSourceBase);
+  vtkTypeMacro(ShapeSource, BodyPartSource);
   void PrintSelf(ostream& os, vtkIndent indent) override;
-  // Pieces each drawing segment is cut into (>= 1).
+  // FFD bodies: pieces each drawing segment is cut into (>= 1).
   vtkSetClampMacro(SamplesPerSegment, int, 1, 100000);
   vtkGetMacro(SamplesPerSegment, int);
-
-  // Lattice coordinates of every sample, in output order (one polyline after the other).
+  // FFD bodies: lattice coordinates of every sample, in output order (one polyline after the
+  // other), as of the last update.
   std::vector<Eigen::Vector2d> SampleLatticeCoords() const;
+
+  // Linear bodies: the drawing (in the body's undeformed coordinates), and which part of it:
+  // lines (polylines), surface (triangles) or both (default).
+  void SetDrawing(const LinearDrawing& drawing) {
+    drawing_ = drawing;
+    Modified();
+  }
+  vtkSetMacro(Lines, bool);
+  vtkSetMacro(Surface, bool);
 
  protected:
   ShapeSource() = default;
-  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  bool DrawFfd(vtkPolyData* out) override;
+  bool DrawLinear(vtkPolyData* out) override;
   int SamplesPerSegment = 16;
+  LinearDrawing drawing_;
+  bool Lines = true, Surface = true;
 
  private:
   // b0 and B of every sample (BodyModel::LocalBasis), cached per body and sample count:
@@ -130,7 +184,7 @@ class TrailSource : public WorldSourceBase {
  public:
   static TrailSource* New();
   vtkTypeMacro(TrailSource, WorldSourceBase);
-  // The points to follow, by lattice coordinates (s, t); clears the history.
+  // The points to follow, by lattice coordinates (s, t) of the FFD body Body; clears the history.
   void SetTrackedPoints(const std::vector<Eigen::Vector2d>& lattice_coords);
   // Appends the tracked points' current world positions at the world's time.
   void Record();
@@ -147,8 +201,36 @@ class TrailSource : public WorldSourceBase {
   std::vector<std::vector<Eigen::Vector2d>> history_;  // [sample][tracked point]
 };
 
-// World position of lattice coordinates st of body `body` at the world's current state
+class AnchorSource : public WorldSourceBase {
+ public:
+  static AnchorSource* New();
+  vtkTypeMacro(AnchorSource, WorldSourceBase);
+  struct Anchor {
+    std::string name;
+    MaterialPoint point;    // body < 0: a fixed place
+    Eigen::VectorXd place;  // the fixed place
+  };
+  void SetAnchors(std::vector<Anchor> anchors) {
+    anchors_ = std::move(anchors);
+    Modified();
+  }
+
+ protected:
+  AnchorSource() = default;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  std::vector<Anchor> anchors_;
+};
+
+// World position of lattice coordinates st of FFD body `body` at the world's current state
 // (Eq. 4.2 through BodyModel::LocalBasis).
 Eigen::Vector2d WorldPositionOf(const World& world, int body, const Eigen::Vector2d& st);
+
+// World position of undeformed point u of linear body `body` (x = R p(u)) as 3 numbers (z = 0 in 2D).
+Eigen::Vector3d LinearWorldPoint(const World& world, int body, const Eigen::VectorXd& u);
+
+// A box holding every point of a linear body now: its mass points and the corners of its
+// drawing's sampled points (a quadratic deformation can bulge beyond the mass points' hull, so
+// the drawing's own samples are included when given).
+Eigen::AlignedBox3d LinearBodyBounds(const World& world, int body, const LinearDrawing* drawing = nullptr);
 
 }  // namespace wobble::pipelines

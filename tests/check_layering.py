@@ -19,11 +19,11 @@ import sys
 LAYERS = [
     ("core", []),
     ("body", ["core"]),
+    ("formats", ["core", "body"]),
     ("dynamics", ["core", "body"]),
     ("world", ["core", "body", "dynamics"]),
     ("control", ["core", "body", "dynamics", "world"]),
-    ("record", ["core", "body", "dynamics", "world", "control"]),
-    ("formats", ["core", "body"]),
+    ("record", ["core", "body", "formats", "dynamics", "world", "control"]),
     ("scene", ["core", "body", "dynamics", "world", "control", "record", "formats"]),
     ("analysis", ["core", "body", "dynamics", "world"]),
     ("synth", ["core", "body", "dynamics", "world", "control", "record", "scene"]),

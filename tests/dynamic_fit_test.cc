@@ -84,7 +84,7 @@ fit::DynamicParameters Perturbed(const fit::DynamicParameters& truth) {
 
 TEST(DynamicFit, RecoversTheParametersThatGeneratedTheReference) {
   Case c(100);  // 1 s
-  const std::vector<formats::TargetFrame> frames = fit::FramesFromStates(*c.body, c.t, c.q, {}, 2);  // every 2nd step
+  const std::vector<fit::ReferenceFrame> frames = fit::FramesFromStates(*c.body, c.t, c.q, {}, 2);  // every 2nd step
   const fit::DynamicParameters start = Perturbed(c.truth);
   const fit::DynamicFitResult r = fit::FitDynamicTrajectory(*c.body, frames, start, c.options);
   ASSERT_TRUE(r.report.usable) << r.report.brief_report;
@@ -111,7 +111,7 @@ TEST(DynamicFit, RecoversTheParametersThatGeneratedTheReference) {
 
 TEST(DynamicFit, EstimatesTheInitialStateFromTheFirstFrames) {
   Case c(60);
-  const std::vector<formats::TargetFrame> frames = fit::FramesFromStates(*c.body, c.t, c.q, {});
+  const std::vector<fit::ReferenceFrame> frames = fit::FramesFromStates(*c.body, c.t, c.q, {});
   fit::DynamicParameters start;  // q0, q̇0 from pose fits; K, c from the body's modes ...
   fit::DynamicFitOptions o = c.options;
   o.fit_stiffness = o.fit_damping = false;  // ... and kept: only the initial state is fitted
@@ -123,7 +123,7 @@ TEST(DynamicFit, EstimatesTheInitialStateFromTheFirstFrames) {
 
 TEST(DynamicFit, RejectsFramesOffTheStepGridAndBadStarts) {
   Case c(10);
-  std::vector<formats::TargetFrame> frames = fit::FramesFromStates(*c.body, c.t, c.q, {});
+  std::vector<fit::ReferenceFrame> frames = fit::FramesFromStates(*c.body, c.t, c.q, {});
   frames[3].time += 0.004;
   EXPECT_THROW(fit::FitDynamicTrajectory(*c.body, frames, c.truth, c.options), std::invalid_argument);
   frames = fit::FramesFromStates(*c.body, c.t, c.q, {});

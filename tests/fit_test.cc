@@ -17,7 +17,7 @@ namespace {
 
 using fit::PoseFitOptions;
 using fit::PoseFitResult;
-using formats::PointTarget;
+using fit::Correspondence;
 
 BodyModel Table() { return BodyModel(testing::TableDef(), testing::TableModes()); }
 
@@ -32,17 +32,17 @@ Eigen::Vector2d Place(const BodyModel& body, int k, const Eigen::Vector2d& st, c
 }
 
 // Targets for every mass point and 5 samples along each drawn segment of the table.
-std::vector<PointTarget> TargetsFrom(const BodyModel& body, const Eigen::VectorXd& q) {
-  std::vector<PointTarget> t;
+std::vector<Correspondence> TargetsFrom(const BodyModel& body, const Eigen::VectorXd& q) {
+  std::vector<Correspondence> t;
   for (int k = 0; k < body.num_points(); ++k) {
-    PointTarget p;
+    Correspondence p;
     p.mass_point = k;
     p.position = Place(body, k, {}, q);
     t.push_back(p);
   }
   for (double u : {0.1, 0.3, 0.5, 0.7, 0.9})
     for (Eigen::Vector2d st : {Eigen::Vector2d(u, 1.0), Eigen::Vector2d(0.0, u), Eigen::Vector2d(1.0, u)}) {
-      PointTarget p;
+      Correspondence p;
       p.lattice_coords = st;
       p.position = Place(body, -1, st, q);
       t.push_back(p);
@@ -64,11 +64,11 @@ TEST(PoseFit, ExactTargetsRecoverQ) {
 }
 
 // Gaussian noise of 0.5 (lattice 300 x 100) and three outliers moved by 60-90 units.
-std::vector<PointTarget> NoisyTargets(const BodyModel& body, unsigned seed) {
-  std::vector<PointTarget> t = TargetsFrom(body, KnownQ());
+std::vector<Correspondence> NoisyTargets(const BodyModel& body, unsigned seed) {
+  std::vector<Correspondence> t = TargetsFrom(body, KnownQ());
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 0.5);
-  for (PointTarget& p : t) p.position += Eigen::Vector2d(noise(rng), noise(rng));
+  for (Correspondence& p : t) p.position += Eigen::Vector2d(noise(rng), noise(rng));
   t[2].position += Eigen::Vector2d(80, -30);
   t[7].position += Eigen::Vector2d(-60, 40);
   t[15].position += Eigen::Vector2d(0, 90);
@@ -105,7 +105,7 @@ TEST(PoseFit, BoundsHoldAndUnreachableTargetsEndWithHonestResidual) {
   Eigen::VectorXd far = KnownQ();
   far[3] = 1.8;  // bend beyond the bound 1
   far[5] = -1.5;
-  const std::vector<PointTarget> t = TargetsFrom(body, far);
+  const std::vector<Correspondence> t = TargetsFrom(body, far);
   const PoseFitResult r = fit::FitPose(body, t, PoseFitOptions());
   ASSERT_TRUE(r.report.usable) << r.report.brief_report;
   for (int d = 3; d < 7; ++d) {
@@ -128,9 +128,9 @@ TEST(PoseFit, BoundsHoldAndUnreachableTargetsEndWithHonestResidual) {
   for (int i = 0; i < 7; ++i) EXPECT_NEAR(w.q[i], far[i], 1e-7);
 
   // a shape the table cannot take (a circle): no failure, the residual says how far it is
-  std::vector<PointTarget> circle;
+  std::vector<Correspondence> circle;
   for (int k = 0; k < body.num_points(); ++k) {
-    PointTarget p;
+    Correspondence p;
     p.mass_point = k;
     p.position = 100.0 * Eigen::Vector2d(std::cos(k * 2 * M_PI / 11), std::sin(k * 2 * M_PI / 11));
     circle.push_back(p);
@@ -143,7 +143,7 @@ TEST(PoseFit, BoundsHoldAndUnreachableTargetsEndWithHonestResidual) {
 
 TEST(PoseFit, PriorPullsTowardRest) {
   const BodyModel body = Table();
-  const std::vector<PointTarget> t = TargetsFrom(body, KnownQ());
+  const std::vector<Correspondence> t = TargetsFrom(body, KnownQ());
   PoseFitOptions o;
   o.prior_weight = 1e5;
   const PoseFitResult r = fit::FitPose(body, t, o);
@@ -168,9 +168,9 @@ TEST(PoseFit, ModeTheMassPointsCannotSeeIsReportedUndetermined) {
   const BodyModel body(testing::TableDef(), modes);
   Eigen::VectorXd q(8);
   q << 40, -25, 0.3, 0.35, -0.2, 0.15, 0.25, 0.0;
-  std::vector<PointTarget> t;
+  std::vector<Correspondence> t;
   for (int k = 0; k < body.num_points(); ++k) {
-    PointTarget p;
+    Correspondence p;
     p.mass_point = k;
     p.position = Place(body, k, {}, q);
     t.push_back(p);
@@ -183,12 +183,12 @@ TEST(PoseFit, ModeTheMassPointsCannotSeeIsReportedUndetermined) {
   for (int i = 0; i < 7; ++i) EXPECT_NEAR(r.q[i], q[i], 1e-7) << i;
 
   // a target inside the lattice (under the table top) makes it visible
-  PointTarget inside;
+  Correspondence inside;
   inside.lattice_coords = {0.5, 0.3};
   q[7] = 0.4;
   inside.position = Place(body, -1, inside.lattice_coords, q);
   t.push_back(inside);
-  for (PointTarget& p : t)
+  for (Correspondence& p : t)
     if (p.mass_point >= 0) p.position = Place(body, p.mass_point, {}, q);
   const PoseFitResult seen = fit::FitPose(body, t, PoseFitOptions());
   EXPECT_TRUE(seen.conditioning.undetermined.empty());
@@ -207,7 +207,7 @@ TEST(PoseFit, NearlyDependentModesArePoorlyDetermined) {
   const BodyModel body(testing::TableDef(), modes);
   Eigen::VectorXd q = Eigen::VectorXd::Zero(8);
   q.head(7) = KnownQ();
-  std::vector<PointTarget> t = TargetsFrom(body, q);
+  std::vector<Correspondence> t = TargetsFrom(body, q);
   const PoseFitResult r = fit::FitPose(body, t, PoseFitOptions());
   EXPECT_EQ(r.conditioning.poorly_determined, (std::vector<std::string>{"bend", "bend_twin"}));
   ASSERT_FALSE(r.conditioning.weak.empty());
@@ -217,18 +217,18 @@ TEST(PoseFit, NearlyDependentModesArePoorlyDetermined) {
 // ---- without correspondences ----
 
 // The table's drawing deformed by q, as polylines of `n` points each.
-formats::TargetFile DrawnTarget(const BodyModel& body, const Eigen::VectorXd& q, int n, double noise, unsigned seed) {
+fit::CurveTarget DrawnTarget(const BodyModel& body, const Eigen::VectorXd& q, int n, double noise, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> g(0.0, noise);
-  formats::TargetFile f;
+  fit::CurveTarget f;
   for (const Polyline& line : body.def().shapes) {
-    formats::TargetCurve c;
+    std::vector<Eigen::Vector2d> points;
     for (int i = 0; i < n; ++i) {
       const Eigen::Vector2d p = line.points[0] + (line.points[1] - line.points[0]) * (double(i) / (n - 1));
-      c.points.push_back(Place(body, -1, body.lattice().LocalCoords(p), q) +
-                         (noise > 0 ? Eigen::Vector2d(g(rng), g(rng)) : Eigen::Vector2d::Zero()));
+      points.push_back(Place(body, -1, body.lattice().LocalCoords(p), q) +
+                       (noise > 0 ? Eigen::Vector2d(g(rng), g(rng)) : Eigen::Vector2d::Zero()));
     }
-    f.polylines.push_back(c);
+    f.AddPolyline(points, false);
   }
   return f;
 }
@@ -237,10 +237,10 @@ TEST(CurveFit, RecoversQFromTheDrawnShape) {
   const BodyModel body = Table();
   for (double noise : {0.0, 0.3})
   for (bool joint : {true, false}) {
-    const formats::TargetFile target = DrawnTarget(body, KnownQ(), 60, noise, 5);
+    const fit::CurveTarget target = DrawnTarget(body, KnownQ(), 60, noise, 5);
     PoseFitOptions o;
     o.joint_closest_points = joint;
-    const PoseFitResult r = fit::FitPoseToCurve(body, fit::CurveTarget::From(target), o);
+    const PoseFitResult r = fit::FitPoseToCurve(body, target, o);
     ASSERT_TRUE(r.report.usable);
     // stated tolerances: translation 1, angle 5e-3 rad, amplitudes 0.02 (the polyline is a
     // chord approximation of the deformed curve, and points may slide along it)
@@ -257,8 +257,7 @@ TEST(CurveFit, StartsFromThePrincipalAxisEvenUpsideDown) {
   const BodyModel body = Table();
   Eigen::VectorXd q = KnownQ();
   q[2] = 3.0;  // nearly upside down: the other orientation of the axis must win
-  const PoseFitResult r =
-      fit::FitPoseToCurve(body, fit::CurveTarget::From(DrawnTarget(body, q, 60, 0.0, 1)), PoseFitOptions());
+  const PoseFitResult r = fit::FitPoseToCurve(body, DrawnTarget(body, q, 60, 0.0, 1), PoseFitOptions());
   EXPECT_NEAR(r.q[2], 3.0, 5e-3);
   EXPECT_LT(r.rms_residual, 0.5);
 }
@@ -266,18 +265,18 @@ TEST(CurveFit, StartsFromThePrincipalAxisEvenUpsideDown) {
 TEST(CurveFit, CloudTargetAndUnreachableShape) {
   const BodyModel body = Table();
   // a point cloud: points of the drawing at the known pose, shuffled (no order, no segments)
-  formats::TargetFile cloud;
-  for (const formats::TargetCurve& c : DrawnTarget(body, KnownQ(), 20, 0.0, 1).polylines)
-    cloud.cloud.insert(cloud.cloud.end(), c.points.begin(), c.points.end());
-  std::shuffle(cloud.cloud.begin(), cloud.cloud.end(), std::mt19937(3));
-  const PoseFitResult r = fit::FitPoseToCurve(body, fit::CurveTarget::From(cloud), PoseFitOptions());
+  std::vector<Eigen::Vector2d> points = DrawnTarget(body, KnownQ(), 20, 0.0, 1).vertices;
+  std::shuffle(points.begin(), points.end(), std::mt19937(3));
+  fit::CurveTarget cloud;
+  for (const Eigen::Vector2d& p : points) cloud.AddPoint(p);
+  const PoseFitResult r = fit::FitPoseToCurve(body, cloud, PoseFitOptions());
   for (int d = 3; d < 7; ++d) EXPECT_NEAR(r.q[d], KnownQ()[d], 0.05) << d;
   // a body sample is as far as the nearest cloud point: at most half the spacing (300 / 19)
   EXPECT_LT(r.rms_residual, 0.5 * 300.0 / 19.0);
   // a short dash the 300-wide table cannot shrink to (|γ| <= 1): an honest residual, not a failure
-  formats::TargetFile dash;
-  dash.polylines.push_back({{{0, 0}, {10, 0}}, false});
-  const PoseFitResult rc = fit::FitPoseToCurve(body, fit::CurveTarget::From(dash), PoseFitOptions());
+  fit::CurveTarget dash;
+  dash.AddPolyline({{0, 0}, {10, 0}}, false);
+  const PoseFitResult rc = fit::FitPoseToCurve(body, dash, PoseFitOptions());
   EXPECT_TRUE(rc.report.usable);
   EXPECT_GT(rc.rms_residual, 20.0);
   for (int d = 3; d < 7; ++d) EXPECT_LE(std::abs(rc.q[d]), 1.0);
@@ -310,7 +309,10 @@ TEST(TargetFile, ParsesEveryStatement) {
   EXPECT_EQ(f.points[1].line, 3);
   std::istringstream curve("polyline 0 0 1 0 1 1 closed\ncloud 5 5\n");
   const formats::TargetFile c = formats::ParseTargets(curve, "c.tgt");
-  EXPECT_EQ(fit::CurveTarget::From(c).a.size(), 4u);  // 3 closed segments + 1 cloud point
+  fit::CurveTarget target;  // as `wobble fit pose` makes it
+  for (const formats::TargetCurve& line : c.polylines) target.AddPolyline(line.points, line.closed);
+  for (const Eigen::Vector2d& p : c.cloud) target.AddPoint(p);
+  EXPECT_EQ(target.a.size(), 4u);  // 3 closed segments + 1 cloud point
   std::istringstream traj("frame 0\npoint 0 1 2\nframe 0.5\npoint 0 1 3\nsample 0 0 1 1\n");
   const formats::TargetFile t = formats::ParseTargets(traj, "k.tgt");
   ASSERT_EQ(t.frames.size(), 2u);

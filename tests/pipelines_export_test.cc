@@ -84,7 +84,7 @@ void ExpectSamePolyData(vtkPolyData* a, vtkPolyData* b) {
 TEST(VtpExport, SeriesReadsBackThroughThePvdWithEveryPointAndArray) {
   const std::string dir = TempDir("vtp");
   auto world = AirborneWorld();
-  VtpSeriesWriter series(world.get(), 0, dir, "table");
+  VtpSeriesWriter series(world.get(), dir, "table");
   std::vector<std::vector<vtkSmartPointer<vtkPolyData>>> expected;  // [frame][part]
   std::vector<double> times;
   for (int frame = 0; frame < 3; ++frame) {
@@ -199,7 +199,7 @@ TEST(RenderedExr, ColourAlphaAndDepthAtKnownPixels) {
   opt.width = 160;
   opt.height = 120;
   opt.overlay = false;
-  SceneView view(&world, 0, opt);
+  SceneView view(&world, opt);
   // 400 x 300 world units around (150, 50): 2.5 units per pixel
   view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-50, -100), Eigen::Vector2d(350, 200)), 0.0);
   view.Render();
@@ -253,29 +253,35 @@ TEST(VtiExport, ImageReadsBackWithItsGeometryAndValues) {
   fs::remove_all(dir);
 }
 
-TEST(RunRecorder, EnergiesConditionAndContactEventsAgreeWithIndependentSums) {
+TEST(TrajectoryCharts, EnergiesConditionAndContactEventsAgreeWithIndependentSums) {
   WorldOptions o;
   o.params.ground.slope = -5.0 * M_PI / 180.0;
   World world(o);
   world.AddBody(testing::Table());
   world.SetState(0, testing::Vec({0, 50, 0, 0, 0, 0, 0}), Eigen::VectorXd::Zero(7));
-  RunRecorder rec;
-  rec.Sample(world);
+  auto run = std::make_shared<record::Trajectory>(world);
+  auto recorder = std::make_shared<record::Recorder>(run);
+  world.SetRecorder(recorder);
+  recorder->Start(world);
   double first_contact = -1;
+  std::vector<double> reference_cond = {NAN};  // after every step (the start is not checked)
   world.RunUntil(4.0, [&](const World& w) {
-    rec.Sample(w);
     if (first_contact < 0 && !w.state(0).contacts.empty()) first_contact = w.time();
     // cond₂ of the per-point reference M (Eq. 4.10), by eigenvalues: M is symmetric positive definite
     const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
         reference::MassMatrix(w.body(0), w.state(0).q)).eigenvalues();
-    EXPECT_NEAR(rec.condition().back(), ev.maxCoeff() / ev.minCoeff(), 1e-8 * rec.condition().back());
+    reference_cond.push_back(ev.maxCoeff() / ev.minCoeff());
   });
+  const std::vector<double> cond = ConditionNumbers(*run, 0);
+  ASSERT_EQ(cond.size(), reference_cond.size());
+  for (size_t k = 1; k < cond.size(); ++k) EXPECT_NEAR(cond[k], reference_cond[k], 1e-8 * cond[k]);
+  const std::vector<double> events = ContactEvents(*run, 0);
   // a fall from 50 lands after about sqrt(2 * 50 / g) = 3.19 s; the first event is that step
-  ASSERT_FALSE(rec.contact_events().empty());
-  EXPECT_EQ(rec.contact_events().front(), first_contact);
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events.front(), first_contact);
   EXPECT_NEAR(first_contact, std::sqrt(2 * 50 / 9.81), 0.05);
 
-  const ChartSpec spec = rec.EnergyChart("e");
+  const ChartSpec spec = EnergyChart(*run, 0, "e");
   auto series = [&](const std::string& name) -> const std::vector<double>& {
     for (const ChartSeries& s : spec.series)
       if (s.name == name) return s.y;

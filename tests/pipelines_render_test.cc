@@ -53,7 +53,7 @@ SceneOptions OnlyLayer(const std::string& layer) {
 
 vtkSmartPointer<vtkImageData> RenderLayer(const SceneOptions& options) {
   auto world = AirborneWorld();
-  SceneView view(world.get(), 0, options);
+  SceneView view(world.get(), options);
   view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-100, 0), Eigen::Vector2d(400, 350)));
   view.Render();
   return view.Capture();
@@ -93,7 +93,7 @@ TEST(RenderRegression, FullSceneWithOverlayAndColourBar) {
   o.color_range[0] = 0;
   o.color_range[1] = 2000;
   auto world = testing::TouchingWorld();
-  SceneView view(world.get(), 0, o);
+  SceneView view(world.get(), o);
   view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-50, -150), Eigen::Vector2d(350, 150)));
   view.Render();
   CompareWithBaseline("full_scene", view.Capture());
@@ -102,10 +102,12 @@ TEST(RenderRegression, FullSceneWithOverlayAndColourBar) {
 TEST(RenderRegression, EnergyChart) {
   REQUIRE_DISPLAY();
   auto world = testing::AirborneWorld();
-  RunRecorder rec;
-  rec.Sample(*world);
-  world->RunUntil(1.0, [&](const World& w) { rec.Sample(w); });
-  ChartSpec spec = rec.EnergyChart("energy");
+  auto run = std::make_shared<record::Trajectory>(*world);
+  auto recorder = std::make_shared<record::Recorder>(run);
+  world->SetRecorder(recorder);
+  recorder->Start(*world);
+  world->RunUntil(1.0);
+  ChartSpec spec = EnergyChart(*run, 0, "energy");
   spec.width = 320;
   spec.height = 200;
   CompareWithBaseline("energy_chart", RenderChart(spec));
@@ -118,7 +120,7 @@ TEST(RenderRegression, Filmstrip) {
   o.width = 96;
   o.height = 72;
   o.overlay = false;
-  SceneView view(world.get(), 0, o);
+  SceneView view(world.get(), o);
   view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-100, -100), Eigen::Vector2d(500, 350)));
   std::vector<vtkSmartPointer<vtkImageData>> panels;
   for (double t : {0.0, 1.5, 3.0, 4.5}) {
@@ -208,7 +210,7 @@ TEST(RenderRegression, ConstrainedScene3d) {
   Rp(0, 1) = 0.3;  // x += 0.3 y: leaning
   Rp.col(3) << 2.2, -0.5, 0.3;
   world.SetLinearState(p, Rp, Eigen::MatrixXd::Zero(3, 4));
-  ConstrainedSceneSpec spec;
+  SceneSpec spec;
   spec.drawings = {MakeBoxDrawing(half, 6), MakePyramidDrawing(3, 0.5, 1.0, 6)};
   AnchorSource::Anchor corner, sky;
   corner.point = At(b, (Eigen::VectorXd(3) << 1, 0.5, 0.5).finished());
@@ -220,7 +222,7 @@ TEST(RenderRegression, ConstrainedScene3d) {
   o.overlay = false;
   o.azimuth = 30;
   o.elevation = 20;
-  SceneView view(&world, spec, o);
+  SceneView view(&world, o, spec);
   view.Render();
   CompareWithBaseline("constrained_scene_3d", view.Capture());
 }

@@ -1,6 +1,7 @@
-// VTK sources of Witkin & Welch bodies against an independent evaluation of x = R p(u) written
-// out by hand (affine: A u + t; quadratic 2D: the six terms), and WriteSceneRun's .pvd/.vtp
-// read back with VTK's readers (frames and filmstrip only with an X display).
+// The sources of world_sources.h on Witkin & Welch bodies against an independent evaluation of
+// x = R p(u) written out by hand (affine: A u + t; quadratic 2D: the six terms), and the render
+// driver's (RenderTrajectory) .pvd/.vtp read back with VTK's readers, for linear bodies and for
+// a world of both kinds (frames and filmstrip only with an X display).
 #include <gtest/gtest.h>
 #include <vtkCellArray.h>
 #include <vtkDataArray.h>
@@ -16,10 +17,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "pipelines/constrained_sources.h"
-#include "pipelines/scene_run.h"
 #include "pipelines/scene_view.h"
+#include "pipelines/trajectory_render.h"
+#include "pipelines/world_sources.h"
 #include "wobble/body/linear_shapes.h"
+#include "wobble/record/trajectory.h"
+#include "support/pipelines_test_util.h"
 #include "support/test_bodies.h"
 
 namespace wobble::pipelines {
@@ -53,7 +56,7 @@ TEST(LinearSources, AffineMassPointsAreAuPlusT) {
   R << A, t;  // columns [m | t] (basis [x y z 1])
   Rd << A_dot, t_dot;
   w.SetLinearState(b, R, Rd);
-  auto src = Ptr<LinearMassPointSource>::New();
+  auto src = Ptr<MassPointSource>::New();
   src->SetWorld(&w);
   src->SetBody(b);
   src->Update();
@@ -86,7 +89,7 @@ TEST(LinearSources, QuadraticControlBoxAndShapeFollowTheSecondOrderTerms) {
   w.SetLinearState(b, R, Eigen::MatrixXd::Zero(2, 6));
   auto bend = [&](const Eigen::Vector3d& u) { return Eigen::Vector3d(u.x() + s * u.x() * u.y(), u.y() + c * u.x() * u.x(), 0.0); };
 
-  auto box = Ptr<LinearBoxSource>::New();
+  auto box = Ptr<LatticeSource>::New();
   box->SetWorld(&w);
   box->SetBody(b);
   box->SetPieces(8);
@@ -108,7 +111,7 @@ TEST(LinearSources, QuadraticControlBoxAndShapeFollowTheSecondOrderTerms) {
   EXPECT_DOUBLE_EQ(r0[0], -1.0);
   EXPECT_DOUBLE_EQ(r0[1], -0.25);
 
-  auto shape = Ptr<LinearShapeSource>::New();
+  auto shape = Ptr<ShapeSource>::New();
   shape->SetWorld(&w);
   shape->SetBody(b);
   const LinearDrawing d = MakeBoxDrawing(V({1.0, 0.25}), 4);
@@ -144,17 +147,24 @@ TEST(LinearSources, PyramidDrawingAndBodyAreConsistent) {
   EXPECT_NO_THROW(LinearBodyModel{body});  // spans the quadratic basis
 }
 
-// Three frames of a body moving at constant velocity.
-std::vector<record::SceneFrame> MovingFrames(World* w, int b) {
-  std::vector<record::SceneFrame> frames;
+// Three samples of a body moving at constant velocity.
+record::Trajectory MovingFrames(World* w, int b) {
+  record::Trajectory frames(*w);
   Eigen::MatrixXd Rd = Eigen::MatrixXd::Zero(3, 4);
   Rd.col(3) << 1.0, 0.0, 0.0;
   w->SetLinearState(b, w->linear_R(b), Rd);
   for (int k = 0; k < 3; ++k) {
-    frames.push_back(record::CaptureFrame(*w));
+    frames.Append(*w);
     w->RunUntil(w->time() + 0.1);
   }
   return frames;
+}
+
+// The paths of the driver's report.
+std::vector<std::string> Paths(const RenderReport& report) {
+  std::vector<std::string> paths;
+  for (const RenderReport::File& f : report.files) paths.push_back(f.path);
+  return paths;
 }
 
 TEST(SceneRun, WritesAPvdSeriesThatVtkReadsBack) {
@@ -164,15 +174,15 @@ TEST(SceneRun, WritesAPvdSeriesThatVtkReadsBack) {
   World w(o);
   auto model = std::make_shared<const LinearBodyModel>(MakeBoxBody("cube", 3, LinearOrder::kAffine, V({0.5, 0.5, 0.5}), 2, 1.0));
   const int b = w.AddLinearBody(model);
-  const std::vector<record::SceneFrame> frames = MovingFrames(&w, b);
-  ConstrainedSceneSpec spec;
+  const record::Trajectory frames = MovingFrames(&w, b);
+  SceneSpec spec;
   spec.drawings = {MakeBoxDrawing(V({0.5, 0.5, 0.5}), 2)};
-  SceneRunOutputs out;
+  RenderOutputs out;
   out.folder = (fs::temp_directory_path() / "wobble_scene_run_vtp").string();
   fs::remove_all(out.folder);
   out.name = "cube_run";
   out.frames = out.filmstrip = false;  // no display needed
-  const std::vector<std::string> written = WriteSceneRun(w, spec, frames, out);
+  const std::vector<std::string> written = Paths(RenderTrajectory(w, frames, spec, out));
   ASSERT_EQ(written.size(), 1u);
   EXPECT_EQ(written[0], out.folder + "/vtp/cube_run.pvd");
   std::ifstream pvd(written[0]);
@@ -204,18 +214,18 @@ TEST(SceneRun, FramesAndFilmstripWithADisplay) {
   World w(testing::WitkinWelchOptions());
   auto model = std::make_shared<const LinearBodyModel>(MakeBoxBody("cube", 3, LinearOrder::kAffine, V({0.5, 0.5, 0.5}), 2, 1.0));
   const int b = w.AddLinearBody(model);
-  const std::vector<record::SceneFrame> frames = MovingFrames(&w, b);
-  SceneRunOutputs out;
+  const record::Trajectory frames = MovingFrames(&w, b);
+  RenderOutputs out;
   out.folder = (fs::temp_directory_path() / "wobble_scene_run_png").string();
   fs::remove_all(out.folder);
-  out.width = 64;
-  out.height = 48;
+  out.view.width = 64;
+  out.view.height = 48;
   out.filmstrip_width = 32;
   out.filmstrip_height = 24;
   out.filmstrip_columns = 3;
   out.filmstrip_times = {0.0, 0.1, 0.2};
   out.vtp = false;
-  WriteSceneRun(w, ConstrainedSceneSpec{}, frames, out);
+  RenderTrajectory(w, frames, SceneSpec{}, out);
   for (int k = 0; k < 3; ++k) EXPECT_TRUE(fs::exists(out.folder + "/frames/frame_000" + std::to_string(k) + ".png"));
   EXPECT_FALSE(fs::exists(out.folder + "/frames/frame_0003.png"));
   auto reader = Ptr<vtkPNGReader>::New();
@@ -225,6 +235,103 @@ TEST(SceneRun, FramesAndFilmstripWithADisplay) {
   reader->GetOutput()->GetDimensions(dims);
   EXPECT_EQ(dims[0], 3 * 32 + 2 * 4);
   EXPECT_EQ(dims[1], 24);
+}
+
+// A constraint scene of both kinds: the FFD table falling with a linear box attached below the
+// middle of its bottom edge (the multiplier step, A rebuilt per step), recorded every 25 steps
+// (0.05 s) and exported. Issue 13: an FFD body in a scene was exported with TimeValue 0 in every
+// .vtp while the .pvd had the right time; with one world and one clock every part of every
+// frame carries its sample's time.
+struct MixedRun {
+  WorldOptions options = testing::WitkinWelchOptions();
+  std::shared_ptr<record::Trajectory> run;
+  SceneSpec spec;
+  MixedRun() {
+    World w(options);
+    const int table = w.AddBody(testing::Table());
+    w.SetState(table, testing::Vec({0, 50, 0, 0, 0, 0, 0}), Eigen::VectorXd::Zero(7));
+    const int box = w.AddLinearBody(
+        std::make_shared<const LinearBodyModel>(MakeBoxBody("box", 2, LinearOrder::kAffine, V({50, 30}), 3, 10.0)));
+    Eigen::MatrixXd R = w.linear_R(box);
+    R.col(2) << 150, 20;  // the box's top middle (0, 30) at the table's bottom middle (150, 50)
+    w.SetLinearState(box, R, Eigen::MatrixXd::Zero(2, 3));
+    w.AddAttachment(At(table, V({0.5, 0.0})), At(box, V({0.0, 30.0})));
+    spec.drawings.resize(2);
+    spec.drawings[box] = MakeBoxDrawing(V({50, 30}), 2);
+    run = std::make_shared<record::Trajectory>(w);
+    auto recorder = std::make_shared<record::Recorder>(run, 25);
+    w.SetRecorder(recorder);
+    recorder->Start(w);
+    EXPECT_TRUE(w.RunUntil(0.5)) << w.status().message;
+    EXPECT_LT(w.MaxViolation(), 1e-6);
+    EXPECT_GT(w.per_step_factorizations(), 0);  // the constrained step moved the FFD body
+  }
+};
+
+double TimeValueOf(const std::string& vtp) {
+  auto reader = Ptr<vtkXMLPolyDataReader>::New();
+  reader->SetFileName(vtp.c_str());
+  reader->Update();
+  vtkDataArray* tv = reader->GetOutput()->GetFieldData()->GetArray("TimeValue");
+  return tv ? tv->GetTuple1(0) : NAN;
+}
+
+TEST(SceneRun, AWorldOfBothKindsExportsEachSamplesTimeValue) {
+  const MixedRun mixed;
+  const record::Trajectory& run = *mixed.run;
+  ASSERT_EQ(run.size(), 11);
+  RenderOutputs out;
+  out.folder = testing::TempDir("scene_mixed_vtp");
+  out.name = "mixed";
+  out.frames = out.filmstrip = false;  // no display needed
+  World world = WorldFor(run, mixed.options);
+  const std::vector<std::string> written = Paths(RenderTrajectory(world, run, mixed.spec, out));
+  ASSERT_EQ(written.size(), 1u);
+  EXPECT_EQ(written[0], out.folder + "/vtp/mixed.pvd");
+  const char* parts[] = {"table_lattice", "table_points", "table_shape", "box_box", "box_points", "box_shape"};
+  for (int k = 0; k < run.size(); ++k) {
+    if (k > 0) {
+      EXPECT_GT(run.time(k), 0.0);
+    }
+    char number[16];
+    std::snprintf(number, sizeof(number), "_%04d.vtp", k);
+    for (const char* part : parts)
+      EXPECT_NEAR(TimeValueOf(out.folder + "/vtp/" + part + number), run.time(k), 1e-12) << part << " frame " << k;
+  }
+  // the .pvd says the same times, six parts a frame
+  std::ifstream pvd(written[0]);
+  std::stringstream text;
+  text << pvd.rdbuf();
+  std::vector<double> times;
+  const std::string xml = text.str();
+  for (size_t at = xml.find("timestep=\""); at != std::string::npos; at = xml.find("timestep=\"", at + 1))
+    times.push_back(std::stod(xml.substr(at + 10)));
+  ASSERT_EQ(times.size(), 6u * run.size());
+  for (size_t i = 0; i < times.size(); ++i) EXPECT_NEAR(times[i], run.time(int(i / 6)), 1e-12) << i;
+  // the world is left at the last sample
+  EXPECT_EQ(world.time(), run.time(run.size() - 1));
+  fs::remove_all(out.folder);
+}
+
+TEST(SceneRun, FramesAtAnFpsShowTheSampleNearestTheirTime) {
+  const MixedRun mixed;
+  const record::Trajectory& run = *mixed.run;
+  RenderOutputs out;
+  out.folder = testing::TempDir("scene_mixed_fps");
+  out.name = "mixed";
+  out.frames = out.filmstrip = false;
+  out.fps = 7;  // frames at k/7 s up to 0.5; samples every 0.05 s: the nearest are 0, 0.15, 0.3, 0.45
+  World world = WorldFor(run, mixed.options);
+  const RenderReport report = RenderTrajectory(world, run, mixed.spec, out);
+  EXPECT_EQ(report.frames, 4);
+  const double expected[] = {0.0, 0.15, 0.3, 0.45};
+  for (int k = 0; k < 4; ++k) {
+    char number[16];
+    std::snprintf(number, sizeof(number), "_%04d.vtp", k);
+    EXPECT_NEAR(TimeValueOf(out.folder + "/vtp/table_points" + number), expected[k], 1e-9) << k;
+  }
+  EXPECT_FALSE(fs::exists(out.folder + "/vtp/table_points_0004.vtp"));
+  fs::remove_all(out.folder);
 }
 
 }  // namespace

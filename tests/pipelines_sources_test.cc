@@ -1,4 +1,5 @@
-// The VTK sources of pipelines/world_sources.h against independent evaluations: Eq. 4.2
+// The VTK sources of pipelines/world_sources.h on FFD bodies against independent evaluations
+// (linear bodies: pipelines_scene_test.cc): Eq. 4.2
 // through Lattice::Evaluate on deformed control points, finite differences of positions for
 // velocities, and the generalized force's translation rows for the applied forces.
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 
 #include "pipelines/world_sources.h"
 #include "support/pipelines_test_util.h"
+#include "wobble/body/linear_body.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -228,6 +230,38 @@ TEST(WorldSources, WithoutAWorldTheyFailInsteadOfCrashing) {
   src->SetBody(0);
   src->Update();
   EXPECT_EQ(src->GetOutput()->GetNumberOfPoints(), 0);
+}
+
+TEST(WorldSources, OneSourceDrawsEitherKindAndRefusesWhatItCannotDraw) {
+  auto world = AirborneWorld();
+  const int box = world->AddLinearBody(std::make_shared<const LinearBodyModel>(
+      MakeBoxBody("box", 2, LinearOrder::kAffine, testing::Vec({50, 30}), 3, 9.0)));
+  // the same MassPointSource draws the FFD table (with its force arrays) and the linear box
+  auto ffd = Source<MassPointSource>(*world);
+  EXPECT_EQ(ffd->GetOutput()->GetNumberOfPoints(), world->body(0).num_points());
+  EXPECT_NE(ffd->GetOutput()->GetPointData()->GetArray("applied_force"), nullptr);
+  auto linear = vtkSmartPointer<MassPointSource>::New();
+  linear->SetWorld(world.get());
+  linear->SetBody(box);
+  linear->Update();
+  EXPECT_EQ(linear->GetOutput()->GetNumberOfPoints(), 9);
+  EXPECT_NE(linear->GetOutput()->GetPointData()->GetArray("velocity"), nullptr);
+  EXPECT_EQ(linear->GetOutput()->GetPointData()->GetArray("in_contact"), nullptr);
+  // trails follow lattice coordinates of an FFD body: asked for the linear box, they report
+  // (vtkErrorMacro) and record nothing; a body the world does not have draws nothing
+  auto trail = vtkSmartPointer<TrailSource>::New();
+  trail->GetExecutive();
+  trail->SetWorld(world.get());
+  trail->SetBody(box);
+  trail->SetTrackedPoints({{0.5, 0.5}});
+  trail->Record();
+  EXPECT_EQ(trail->GetNumberOfSamples(), 0);
+  auto missing = vtkSmartPointer<LatticeSource>::New();
+  missing->GetExecutive();
+  missing->SetWorld(world.get());
+  missing->SetBody(7);
+  missing->Update();
+  EXPECT_EQ(missing->GetOutput()->GetNumberOfPoints(), 0);
 }
 
 }  // namespace

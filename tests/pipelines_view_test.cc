@@ -31,7 +31,6 @@
 
 #include "pipelines/interactive_scene_view.h"
 #include "pipelines/interactive_view.h"
-#include "pipelines/scene_run.h"
 #include "support/pipelines_test_util.h"
 #include "support/render_baseline.h"
 #include "wobble/script/interpreter.h"

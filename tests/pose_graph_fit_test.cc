@@ -39,7 +39,7 @@ struct Case {
   std::shared_ptr<const BodyModel> body = Table();
   fit::DynamicFitOptions options;
   fit::DynamicParameters truth;
-  std::vector<formats::TargetFrame> frames;
+  std::vector<fit::ReferenceFrame> frames;
   std::vector<Eigen::VectorXd> q;  // World's states, every step
   Case(bool ground, int steps) {
     options.world.ground.enabled = ground;

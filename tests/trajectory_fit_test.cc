@@ -10,7 +10,6 @@
 #include "wobble/world/world.h"
 #include "wobble/fit/trajectory_fit.h"
 #include "wobble/formats/parse_error.h"
-#include "wobble/formats/simulation_csv.h"
 
 namespace wobble {
 namespace {
@@ -55,7 +54,7 @@ double MaxModeError(const fit::TrajectoryFitResult& r, const Reference& ref) {
 TEST(TrajectoryFit, RecoversSimulatedQFromMassPoints) {
   const auto body = Table();
   const Reference ref = Simulated(body);
-  const std::vector<formats::TargetFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {});
+  const std::vector<fit::ReferenceFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {});
   fit::TrajectoryFitOptions o;
   o.smoothness = 0.0;  // exact data: nothing to smooth
   o.pose.gamma_lower = -3;  // the thrown table's amplitudes reach -1.3
@@ -73,11 +72,11 @@ TEST(TrajectoryFit, SmoothnessReducesTheErrorFromNoise) {
   const auto body = Table();
   const Reference ref = Simulated(body);
   // only 5 of the 11 points are observed (both feet, the top's ends and middle), with noise 2
-  std::vector<formats::TargetFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {0, 2, 4, 5, 8});
+  std::vector<fit::ReferenceFrame> frames = fit::FramesFromStates(*body, ref.t, ref.q, {0, 2, 4, 5, 8});
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, 2.0);
-  for (formats::TargetFrame& f : frames)
-    for (formats::PointTarget& p : f.points) p.position += Eigen::Vector2d(noise(rng), noise(rng));
+  for (fit::ReferenceFrame& f : frames)
+    for (fit::Correspondence& p : f.points) p.position += Eigen::Vector2d(noise(rng), noise(rng));
   fit::TrajectoryFitOptions rough, smooth;
   rough.smoothness = 0.0;
   smooth.smoothness = 30.0;
@@ -116,35 +115,6 @@ TEST(TrajectoryFit, UnevenKeyframesAndBounds) {
       EXPECT_LE(qf[d], 0.1);
     }
   EXPECT_GT(r.rms_residual, 1.0);  // the reference leaves the bounds: an honest residual
-}
-
-std::string CsvMessage(const std::string& text) {
-  std::istringstream in(text);
-  try {
-    formats::ParseSimulationCsv(in, "ref.csv", 1);
-  } catch (const formats::ParseError& e) {
-    return e.what();
-  }
-  return "no error";
-}
-
-TEST(SimulationCsv, ReadsWobbleSimulateOutputAndRejectsBadRows) {
-  std::istringstream good("t,tx,ty,theta,g1,dtx,dty,dtheta,dg1,kinetic\n0,1,2,3,4,5,6,7,8,9\n0.5,1,2,3,4.5,5,6,7,8,9\n");
-  const formats::SimulationCsv s = formats::ParseSimulationCsv(good, "ref.csv", 1);
-  ASSERT_EQ(s.t.size(), 2u);
-  EXPECT_EQ(s.q[1][3], 4.5);
-  EXPECT_EQ(s.qd[0][0], 5.0);
-  EXPECT_EQ(CsvMessage(""), "ref.csv:0: file is empty: expected the header of `wobble simulate`");
-  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g2\n"),
-            "ref.csv:1: expected the header to start with t,tx,ty,theta,g1 (a body with 1 modes), got 't,tx,ty,theta,g2'");
-  EXPECT_EQ(CsvMessage("t,tx,ty,theta\n"),
-            "ref.csv:1: expected the header to start with t,tx,ty,theta,g1 (a body with 1 modes), got 't,tx,ty,theta'");
-  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1\n0,1,2,3,4\n1,1,2,x,4\n"),
-            "ref.csv:3: expected a number in column 4 (theta), got 'x'");
-  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1\n0,1,2,3\n"), "ref.csv:2: expected 5 values like the header, got 4");
-  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1\n1,1,2,3,4\n1,1,2,3,4\n"),
-            "ref.csv:3: times must strictly increase (previous row: t = 1)");
-  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1\n"), "ref.csv:0: no rows after the header");
 }
 
 }  // namespace

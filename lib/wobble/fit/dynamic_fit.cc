@@ -127,12 +127,12 @@ struct Reference {
   std::vector<std::vector<SegmentResidual>> points;
   int num_residuals = 0;
 };
-Reference MakeReference(const BodyModel& body, const std::vector<formats::TargetFrame>& frames, double dt) {
+Reference MakeReference(const BodyModel& body, const std::vector<ReferenceFrame>& frames, double dt) {
   Reference r;
   r.steps = FrameSteps(frames, dt);
-  for (const formats::TargetFrame& f : frames) {
+  for (const ReferenceFrame& f : frames) {
     std::vector<SegmentResidual> pts;
-    for (const formats::PointTarget& t : f.points) {
+    for (const Correspondence& t : f.points) {
       if (t.mass_point >= body.num_points())
         throw std::invalid_argument("dynamic fit: mass point " + std::to_string(t.mass_point) + " does not exist");
       SegmentResidual s;
@@ -220,7 +220,7 @@ void CheckParameters(const BodyModel& body, const DynamicParameters& p) {
 }
 
 // Fills an empty q0 / q̇0 from pose fits of the first two frames.
-DynamicParameters Completed(const BodyModel& body, const std::vector<formats::TargetFrame>& frames, DynamicParameters p) {
+DynamicParameters Completed(const BodyModel& body, const std::vector<ReferenceFrame>& frames, DynamicParameters p) {
   if (p.stiffness.size() == 0 && p.damping.size() == 0) {
     p.stiffness.resize(body.num_modes());
     p.damping.resize(body.num_modes());
@@ -249,11 +249,11 @@ DynamicParameters Completed(const BodyModel& body, const std::vector<formats::Ta
 
 }  // namespace
 
-std::vector<int> FrameSteps(const std::vector<formats::TargetFrame>& frames, double dt) {
+std::vector<int> FrameSteps(const std::vector<ReferenceFrame>& frames, double dt) {
   if (!(dt > 0)) throw std::invalid_argument("dynamic fit: dt must be positive");
   if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
   std::vector<int> steps;
-  for (const formats::TargetFrame& f : frames) {
+  for (const ReferenceFrame& f : frames) {
     const double n = (f.time - frames[0].time) / dt;
     const double rounded = std::round(n);
     if (std::abs(n - rounded) > 1e-6 * std::max(1.0, n))
@@ -277,7 +277,7 @@ bool SimulateWithParameters(const BodyModel& body, const DynamicFitOptions& o, c
                   [&](int f, const VecQ<double>& q) { on_frame(f, Eigen::VectorXd(q)); });
 }
 
-double DynamicCost(const BodyModel& body, const std::vector<formats::TargetFrame>& frames, const DynamicParameters& p,
+double DynamicCost(const BodyModel& body, const std::vector<ReferenceFrame>& frames, const DynamicParameters& p,
                    const DynamicFitOptions& o) {
   const Reference ref = MakeReference(body, frames, o.dt);
   double cost = 0;
@@ -288,7 +288,7 @@ double DynamicCost(const BodyModel& body, const std::vector<formats::TargetFrame
   return ok ? cost : std::numeric_limits<double>::infinity();
 }
 
-DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<formats::TargetFrame>& frames,
+DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
                                       const DynamicParameters& initial, const DynamicFitOptions& o) {
   if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
   const DynamicParameters start = Completed(body, frames, initial);
@@ -355,7 +355,7 @@ DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<f
   return result;
 }
 
-AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<formats::TargetFrame>& frames,
+AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
                                 const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
                                 std::uint64_t seed) {
   const DynamicParameters start = Completed(body, frames, initial);
@@ -390,7 +390,7 @@ AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<formats
   return out;
 }
 
-AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<formats::TargetFrame>& frames,
+AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
                                         const DynamicParameters& initial, const DynamicFitOptions& o,
                                         long budget, unsigned seed) {
   const DynamicParameters start = Completed(body, frames, initial);

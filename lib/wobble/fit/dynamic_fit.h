@@ -59,7 +59,7 @@ struct DynamicFitResult {
 
 // The reference's frame times as step counts from its first frame; throws
 // std::invalid_argument when a time is not a whole number of steps of dt.
-std::vector<int> FrameSteps(const std::vector<formats::TargetFrame>& frames, double dt);
+std::vector<int> FrameSteps(const std::vector<ReferenceFrame>& frames, double dt);
 
 // Runs the simulation with `p` (the body's own K and c are replaced by p's) and calls
 // on_frame(f, q) at every frame step. Returns false on numerical trouble (singular M,
@@ -72,7 +72,7 @@ bool SimulateWithParameters(const BodyModel& body, const DynamicFitOptions& opti
 // pose fits of the first two frames. Stiffness starts must be > 0 (it is fitted as log K);
 // damping is fitted as the ratio ζ_d = c_d / (2 sqrt(2 K_d G_dd)) (G_dd the mode's
 // generalized mass), bounded below by 0.
-DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<formats::TargetFrame>& frames,
+DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
                                       const DynamicParameters& initial, const DynamicFitOptions& options);
 
 // Baseline: simulated annealing on the same parameters and the same cost (½ Σ |x − target|²),
@@ -85,15 +85,15 @@ struct AnnealingResult {
 // Simulated annealing of the controller (lib/wobble/synth, Fig. 5.2) on the same cost: the
 // poses and/or times (options.fit_poses/fit_times) of initial.graph, the rest of `initial`
 // fixed, with `simulation_budget` simulations (batch 1). The best graph is in result.params.
-AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<formats::TargetFrame>& frames,
+AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
                                 const DynamicParameters& initial, const DynamicFitOptions& options,
                                 long simulation_budget, std::uint64_t seed = 1);
-AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<formats::TargetFrame>& frames,
+AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
                                         const DynamicParameters& initial, const DynamicFitOptions& options,
                                         long simulation_budget, unsigned seed = 1);
 
 // ½ Σ w |x − target|² of a parameter set (one plain simulation); +inf on numerical trouble.
-double DynamicCost(const BodyModel& body, const std::vector<formats::TargetFrame>& frames, const DynamicParameters& p,
+double DynamicCost(const BodyModel& body, const std::vector<ReferenceFrame>& frames, const DynamicParameters& p,
                    const DynamicFitOptions& options);
 
 }  // namespace wobble::fit

@@ -104,14 +104,14 @@ void FillAtBound(const BodyModel& body, const PoseFitOptions& o, PoseFitResult* 
 
 }  // namespace
 
-PoseFitResult FitPose(const BodyModel& body, const std::vector<formats::PointTarget>& targets, const PoseFitOptions& o) {
+PoseFitResult FitPose(const BodyModel& body, const std::vector<Correspondence>& targets, const PoseFitOptions& o) {
   const std::string error = ValidateOptions(o, body.num_modes());
   if (!error.empty()) throw std::invalid_argument("pose fit: " + error);
   if (targets.empty()) throw std::invalid_argument("pose fit: no target points");
   std::vector<SegmentResidual> data;
   std::vector<Eigen::Vector2d> rest, goal;
   std::vector<double> weights;
-  for (const formats::PointTarget& t : targets) {
+  for (const Correspondence& t : targets) {
     if (t.mass_point >= body.num_points())
       throw std::invalid_argument("pose fit: mass point " + std::to_string(t.mass_point) + " does not exist");
     SegmentResidual r;
@@ -134,24 +134,6 @@ PoseFitResult FitPose(const BodyModel& body, const std::vector<formats::PointTar
   FillAtBound(body, o, &result);
   if (o.analyze_conditioning) result.conditioning = ComputeConditioning(body, data, {}, o, result.q);
   return result;
-}
-
-CurveTarget CurveTarget::From(const formats::TargetFile& file) {
-  CurveTarget c;
-  for (const formats::TargetCurve& line : file.polylines) {
-    const size_t n = line.points.size();
-    for (size_t i = 0; i + 1 < n + (line.closed ? 1 : 0); ++i) {
-      c.a.push_back(line.points[i]);
-      c.b.push_back(line.points[(i + 1) % n]);
-    }
-    c.vertices.insert(c.vertices.end(), line.points.begin(), line.points.end());
-  }
-  for (const Eigen::Vector2d& p : file.cloud) {
-    c.a.push_back(p);
-    c.b.push_back(p);
-    c.vertices.push_back(p);
-  }
-  return c;
 }
 
 CurveSamples CurveSamples::Of(const BodyModel& body, const PoseFitOptions& o) {

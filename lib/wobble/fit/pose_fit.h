@@ -14,11 +14,11 @@
 #include <Eigen/Core>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "wobble/body/body_model.h"
-#include "wobble/fit/internal/residuals.h"
-#include "wobble/formats/target_file.h"
+#include "wobble/fit/targets.h"
 
 namespace wobble::fit {
 
@@ -116,16 +116,8 @@ std::vector<std::string> CoordinateNames(const BodyModel& body);
 // placement of the rest shape onto the targets (weighted Procrustes), γ = 0.
 // Throws std::invalid_argument for invalid options, no targets or a mass point index the body
 // does not have.
-PoseFitResult FitPose(const BodyModel& body, const std::vector<formats::PointTarget>& targets,
+PoseFitResult FitPose(const BodyModel& body, const std::vector<Correspondence>& targets,
                       const PoseFitOptions& options);
-
-// A curve target: segments (a == b for a cloud point) and its vertices (polyline points
-// and cloud points, each once).
-struct CurveTarget {
-  std::vector<Eigen::Vector2d> a, b;
-  std::vector<Eigen::Vector2d> vertices;
-  static CurveTarget From(const formats::TargetFile& file);
-};
 
 // Body samples of a curve fit: the mass points (if options.use_mass_points) and
 // options.samples_per_segment + 1 points along every segment of the drawing; `segments`

@@ -25,19 +25,19 @@ VecQ<double> SmoothnessScales(const BodyModel& body) {
   return L;
 }
 
-std::vector<formats::TargetFrame> FramesFromStates(const BodyModel& body, const std::vector<double>& times,
-                                              const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
-                                              int every) {
+std::vector<ReferenceFrame> FramesFromStates(const BodyModel& body, const std::vector<double>& times,
+                                             const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
+                                             int every) {
   std::vector<int> which = points;
   if (which.empty())
     for (int k = 0; k < body.num_points(); ++k) which.push_back(k);
-  std::vector<formats::TargetFrame> frames;
+  std::vector<ReferenceFrame> frames;
   for (size_t f = 0; f < q.size(); f += size_t(std::max(1, every))) {
-    formats::TargetFrame frame;
+    ReferenceFrame frame;
     frame.time = times[f];
     for (int k : which) {
       if (k < 0 || k >= body.num_points()) throw std::invalid_argument("mass point " + std::to_string(k) + " does not exist");
-      formats::PointTarget p;
+      Correspondence p;
       p.mass_point = k;
       p.position = PointPosition(BasisOf(body, k, {}), q[f].data(), body.num_q());
       frame.points.push_back(p);
@@ -47,7 +47,7 @@ std::vector<formats::TargetFrame> FramesFromStates(const BodyModel& body, const 
   return frames;
 }
 
-TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vector<formats::TargetFrame>& frames,
+TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
                                            const TrajectoryFitOptions& o) {
   const PoseFitOptions& po = o.pose;
   const std::string error = ValidateOptions(po, body.num_modes());
@@ -68,7 +68,7 @@ TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vec
     result.times.push_back(frames[f].time);
     std::vector<Eigen::Vector2d> rest, goal;
     std::vector<double> w;
-    for (const formats::PointTarget& t : frames[f].points) {
+    for (const Correspondence& t : frames[f].points) {
       if (t.mass_point >= body.num_points())
         throw std::invalid_argument("trajectory fit: mass point " + std::to_string(t.mass_point) + " does not exist");
       SegmentResidual r;

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "wobble/fit/pose_fit.h"
-#include "wobble/formats/simulation_csv.h"
+#include "wobble/fit/targets.h"
 
 namespace wobble::fit {
 
@@ -33,13 +33,13 @@ VecQ<double> SmoothnessScales(const BodyModel& body);
 // Fits q(t). Frames need not be evenly spaced. Without options.pose.initial_q each frame
 // starts from its rigid Procrustes placement (angles unwrapped across frames), γ = 0.
 // Throws std::invalid_argument for invalid options, no frames or unknown mass points.
-TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vector<formats::TargetFrame>& frames,
+TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
                                            const TrajectoryFitOptions& options);
 
-// Reference frames from recorded states (e.g. formats::ReadSimulationCsv): the positions of the
-// listed mass points (all when empty) at every `every`-th state, weight 1.
-std::vector<formats::TargetFrame> FramesFromStates(const BodyModel& body, const std::vector<double>& times,
-                                              const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
-                                              int every = 1);
+// Reference frames from recorded states (a simulation, e.g. `wobble simulate`'s CSV): the
+// positions of the listed mass points (all when empty) at every `every`-th state, weight 1.
+std::vector<ReferenceFrame> FramesFromStates(const BodyModel& body, const std::vector<double>& times,
+                                             const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
+                                             int every = 1);
 
 }  // namespace wobble::fit

@@ -45,8 +45,10 @@ void CheckWritable(const std::string& path) {
   std::remove(tmp.c_str());
 }
 
-void WriteCsvAtomically(const std::string& path, const std::vector<std::string>& header,
-                        const std::vector<std::vector<double>>& rows) {
+namespace {
+// Writes the header and then row k = 0..n−1 (row(k) gives its numbers and their count).
+void WriteTable(const std::string& path, const std::vector<std::string>& header, int n,
+                const std::function<std::pair<const double*, size_t>(int)>& row) {
   WriteFileAtomically(path, [&](const std::string& tmp) {
     std::FILE* f = std::fopen(tmp.c_str(), "w");
     if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
@@ -57,11 +59,12 @@ void WriteCsvAtomically(const std::string& path, const std::vector<std::string>&
     }
     line += '\n';
     bool ok = std::fputs(line.c_str(), f) >= 0;
-    for (const std::vector<double>& row : rows) {  // a line at a time: long runs stay small in memory
+    for (int k = 0; k < n; ++k) {  // a line at a time: long runs stay small in memory
+      const auto [values, count] = row(k);
       line.clear();
-      for (size_t i = 0; i < row.size(); ++i) {
+      for (size_t i = 0; i < count; ++i) {
         if (i) line += ',';
-        line += FormatDouble(row[i]);
+        line += FormatDouble(values[i]);
       }
       line += '\n';
       ok = ok && std::fputs(line.c_str(), f) >= 0;
@@ -70,6 +73,17 @@ void WriteCsvAtomically(const std::string& path, const std::vector<std::string>&
     ok = (std::fclose(f) == 0) && ok;
     if (!ok) throw std::runtime_error(tmp + ": " + std::strerror(saved_errno));
   });
+}
+}  // namespace
+
+void WriteCsvAtomically(const std::string& path, const std::vector<std::string>& header,
+                        const std::vector<std::vector<double>>& rows) {
+  WriteTable(path, header, int(rows.size()), [&](int k) { return std::make_pair(rows[size_t(k)].data(), rows[size_t(k)].size()); });
+}
+
+void WriteCsvAtomically(const std::string& path, const std::vector<std::string>& header, int num_rows,
+                        const std::function<const double*(int)>& row) {
+  WriteTable(path, header, num_rows, [&](int k) { return std::make_pair(row(k), header.size()); });
 }
 
 }  // namespace wobble::formats

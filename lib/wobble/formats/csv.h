@@ -4,6 +4,7 @@
 // a file and a failed write leaves the old file in place.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,9 @@ std::string CsvText(const std::vector<std::string>& header, const std::vector<st
 // Throws std::runtime_error (with the path and the reason) when the file cannot be written.
 void WriteCsvAtomically(const std::string& path, const std::vector<std::string>& header,
                         const std::vector<std::vector<double>>& rows);
+// The same for `num_rows` rows of header.size() numbers each, row k at row(k) (flat storage).
+void WriteCsvAtomically(const std::string& path, const std::vector<std::string>& header, int num_rows,
+                        const std::function<const double*(int)>& row);
 
 // Checks early that `path` can be written (creating its folder): throws std::runtime_error
 // with the reason if not. Leaves nothing behind but the folder.

@@ -53,7 +53,8 @@ struct SceneRenderRequest {
   std::string folder, name;
   bool frames = true, filmstrip = true, vtp = true;
   scene::SceneDrawing drawing;
-  std::shared_ptr<const record::Trajectory> recorded;
+  std::shared_ptr<const record::Trajectory> recorded;  // the scene's bodies
+  WorldOptions world;  // the scene world's: ground, gravity, dt
 };
 
 struct CommandInfo {

@@ -424,6 +424,7 @@ void SceneRender(State& s, const Words& w, const Context& ctx) {
   if (!req.recorded || req.recorded->empty()) ctx.Fail("nothing was recorded: 'record FPS' before 'simul'");
   if (!s.scene_render_hook) ctx.Fail("render: this program cannot draw (wobble run draws through pipelines/, built with VTK)");
   req.drawing = s.scene.Drawing();
+  req.world = s.scene.world().options();
   std::vector<std::string> files;
   try {
     files = s.scene_render_hook(req);

@@ -1,5 +1,7 @@
 #include "wobble/synth/anneal.h"
 
+#include "wobble/control/controllers.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -86,18 +88,18 @@ TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
   World world(p.world);
   world.AddBody(p.body);
   world.SetState(0, p.q0, p.qd0);
+  if (!graph.empty()) {  // the pose graph picks the targets of every step (chapter 5)
+    try {
+      world.AddController(std::make_shared<control::PoseGraphController>(world, 0, graph));
+    } catch (const std::invalid_argument& e) {
+      out.failure = e.what();
+      out.cost = p.cost.high;
+      return out;
+    }
+  }
   const double dt = p.world.dt;
   control::ControlEnergy energy;
-  int pose = -1;
   for (long n = 0; n < p.steps; ++n) {
-    // the pose graph picks the targets for this step (chapter 5)
-    if (!graph.empty()) {
-      const int now = graph.PoseAt(n * dt);
-      if (now != pose) {
-        pose = now;
-        world.SetModeTargets(0, control::TargetsFromPose(*p.body, graph.poses[pose]));
-      }
-    }
     if (!world.Step()) {
       out.failure = world.status().message;
       out.cost = p.cost.high;

@@ -12,17 +12,6 @@
 
 namespace wobble::fit {
 
-PointBasis BasisOf(const BodyModel& body, int mass_point, const Eigen::Vector2d& lattice_coords) {
-  PointBasis p;
-  if (mass_point >= 0) {
-    p.b0 = body.rest_local(mass_point);
-    p.B = body.mode_matrix(mass_point);
-  } else {
-    body.LocalBasis(lattice_coords, &p.b0, &p.B);
-  }
-  return p;
-}
-
 ceres::CostFunction* MakeSegmentCost(const SegmentResidual& r) {
   return WithNumQ(r.num_q, [&](auto n) -> ceres::CostFunction* {
     return new ceres::AutoDiffCostFunction<SegmentResidual, 2, decltype(n)::value>(new SegmentResidual(r));

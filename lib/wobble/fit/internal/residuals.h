@@ -2,8 +2,8 @@
 // run-time number of coordinates into Ceres' compile-time block sizes.
 //
 // Every functor follows Ceres' pattern (examples/snavely_reprojection_error.h): it stores its
-// observation and has a templated operator(); positions come from the same scalar-templated
-// kinematics (Eq. 4.2, wobble/dynamics/kinematics.h) that the simulation uses.
+// observation and has a templated operator(); positions come from PointPosition (Eq. 4.2,
+// fit/targets.h), the simulation's kinematics read in place.
 #pragma once
 
 #include <ceres/autodiff_cost_function.h>
@@ -16,31 +16,9 @@
 
 #include "wobble/body/body_model.h"
 #include "wobble/dynamics/kinematics.h"
+#include "wobble/fit/targets.h"
 
 namespace wobble::fit {
-
-// What a body point needs to be placed: x(q) = t + R(θ)(b0 + B γ) (Eq. 4.2).
-struct PointBasis {
-  Eigen::Vector2d b0 = Eigen::Vector2d::Zero();
-  Mat2D<double> B;
-};
-// Mass point k, or the body point at lattice coordinates (s, t) when k < 0.
-PointBasis BasisOf(const BodyModel& body, int mass_point, const Eigen::Vector2d& lattice_coords);
-
-// World position of a body point, templated for autodiff: x = t + R(θ)(b0 + Σ_d γ_d b^d)
-// (Eq. 4.2), as LocalPosition/WorldFromLocal of kinematics.h but reading q in place (copying
-// q into a VecQ of Jets dominated the cost of a residual).
-template <class T> Vec2<T> PointPosition(const PointBasis& p, const T* q, int num_q) {
-  using std::cos;
-  using std::sin;
-  T lx(p.b0.x()), ly(p.b0.y());
-  for (int d = 0; d + kRigidDofs < num_q; ++d) {
-    lx += p.B(0, d) * q[kRigidDofs + d];
-    ly += p.B(1, d) * q[kRigidDofs + d];
-  }
-  const T c = cos(q[2]), s = sin(q[2]);
-  return Vec2<T>(q[0] + c * lx - s * ly, q[1] + s * lx + c * ly);
-}
 
 // The closest point of segment [a, b] to x (a == b: the point a). Where the projection is
 // clamped to an end the end is a constant, otherwise derivatives flow through the projection.

@@ -4,8 +4,10 @@
 
 #include <ceres/ceres.h>
 
+#include <functional>
 #include <vector>
 
+#include "wobble/fit/internal/residuals.h"
 #include "wobble/fit/pose_fit.h"
 
 namespace wobble::fit {

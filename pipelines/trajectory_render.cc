@@ -1,0 +1,252 @@
+#include "pipelines/trajectory_render.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#include <vtkImageData.h>
+#include <vtkSmartPointer.h>
+
+#include "pipelines/background_writer.h"
+#include "pipelines/energy_charts.h"
+#include "pipelines/exports.h"
+
+namespace wobble::pipelines {
+namespace {
+
+std::string Numbered(const std::string& folder, const std::string& stem, long frame, const char* ext) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "_%04ld.%s", frame, ext);
+  return folder + "/" + stem + buf;
+}
+
+// The first sample at or after time t (run.size() when none is): sample times never decrease.
+int FirstAtOrAfter(const record::Trajectory& run, double t) {
+  int lo = 0, hi = run.size();
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (run.time(mid) < t) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
+
+// The sample nearest time t (the first of equals), as Trajectory::Nearest but by bisection.
+int NearestSample(const record::Trajectory& run, double t) {
+  const int after = FirstAtOrAfter(run, t);
+  if (after == 0) return 0;
+  const double before = run.time(after - 1);
+  if (after == run.size() || std::abs(before - t) <= std::abs(run.time(after) - t)) return FirstAtOrAfter(run, before);
+  return after;
+}
+
+// Puts the run's samples back into a world one after the other up to the one asked for, so
+// that the ground contacts (whose anchors a trajectory does not hold) evolve from sample to
+// sample as they did in the run.
+class Replay {
+ public:
+  Replay(const record::Trajectory& run, World* world) : run_(run), world_(world) {}
+  void To(int k) {
+    if (k < at_) throw std::logic_error("Replay: samples are visited in order");
+    for (int i = at_ + 1; i <= k; ++i) run_.Restore(i, *world_);
+    at_ = k;
+  }
+
+ private:
+  const record::Trajectory& run_;
+  World* world_;
+  int at_ = -1;
+};
+
+// What is drawn at one sample: frames first, then filmstrip panels (so a panel's trails hold
+// the frames before it).
+struct Visit {
+  int sample;
+  long frame;  // -1: a panel
+  int panel;   // -1: a frame
+  bool operator<(const Visit& o) const {
+    if (sample != o.sample) return sample < o.sample;
+    if ((frame < 0) != (o.frame < 0)) return frame >= 0;
+    return frame < 0 ? panel < o.panel : frame < o.frame;
+  }
+};
+
+std::vector<Visit> PlanVisits(const record::Trajectory& run, const RenderOutputs& out, double dt, long* num_frames) {
+  std::vector<Visit> visits;
+  const double t0 = run.time(0), t_last = run.time(run.size() - 1), t1 = out.t_end.value_or(t_last);
+  auto reached = [&](double t) { return t >= t0 - 0.5 * dt && t <= t_last + 0.5 * dt; };
+  // the frames are visited whatever is written: the camera frames them, the trails follow them
+  if (out.fps > 0) {
+    const long wanted = long(std::floor((t1 - t0) * out.fps + 1e-9)) + 1;
+    for (long k = 0; k < wanted && reached(t0 + double(k) / out.fps); ++k)
+      visits.push_back({NearestSample(run, t0 + double(k) / out.fps), k, -1});
+    *num_frames = long(visits.size());
+  } else {
+    *num_frames = run.size();
+    for (int k = 0; k < run.size(); ++k) visits.push_back({k, k, -1});
+  }
+  if (out.filmstrip) {
+    std::vector<double> times = out.filmstrip_times;
+    if (times.empty())
+      for (int k = 0; k < 6; ++k) times.push_back(t0 + (t1 - t0) * k / 5.0);
+    int panel = 0;
+    for (double t : times)
+      if (reached(t)) visits.push_back({NearestSample(run, t), -1, panel++});
+  }
+  std::stable_sort(visits.begin(), visits.end());
+  return visits;
+}
+
+// The displacement image's name and size for each FFD body.
+struct DispTarget {
+  int body;
+  std::string stem;
+  int width, height;
+};
+
+std::vector<DispTarget> DispTargets(const World& world, const RenderOutputs& out) {
+  std::vector<int> ffd;
+  for (int b = 0; b < world.num_bodies(); ++b)
+    if (world.kind(b) == BodyKind::kFfd) ffd.push_back(b);
+  std::vector<DispTarget> targets;
+  for (int b : ffd) {
+    const Lattice& lat = world.body(b).lattice();
+    const int h = out.disp_height > 0 ? out.disp_height
+                                      : std::max(1, int(std::lround(out.disp_width * lat.axis_t().norm() / lat.axis_s().norm())));
+    targets.push_back({b, ffd.size() == 1 ? "disp" : "disp_" + world.body_name(b), out.disp_width, h});
+  }
+  return targets;
+}
+
+bool HasFfdBody(const World& world) {
+  for (int b = 0; b < world.num_bodies(); ++b)
+    if (world.kind(b) == BodyKind::kFfd) return true;
+  return false;
+}
+
+void WriteCharts(const record::Trajectory& run, const RenderOutputs& out, RenderReport* report) {
+  const int b = out.chart_body;
+  if (b < 0 || b >= run.num_bodies()) throw std::invalid_argument("charts: the run has no body " + std::to_string(b));
+  const std::string& name = run.bodies()[b].name;
+  std::vector<std::pair<ChartSpec, std::string>> charts = {{EnergyChart(run, b, name + ": energy"), "energy"}};
+  if (run.bodies()[b].kind == BodyKind::kFfd)
+    charts.push_back({ConditionChart(run, b, name + ": condition number of M (Fig. 4.9)"), "condition"});
+  for (auto& [spec, stem] : charts) {
+    spec.width = out.chart_width;
+    spec.height = out.chart_height;
+    WriteChart(spec, out.folder + "/" + stem + ".png", out.folder + "/" + stem + ".csv");
+    report->files.push_back({out.folder + "/" + stem + ".png", "numbers in " + stem + ".csv"});
+  }
+}
+
+}  // namespace
+
+World WorldFor(const record::Trajectory& run, const WorldOptions& options) {
+  World world(options);
+  for (const record::BodyInfo& b : run.bodies()) {
+    if (b.kind == BodyKind::kFfd) world.AddBody(b.ffd);
+    else world.AddLinearBody(b.linear);
+  }
+  return world;
+}
+
+RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, const SceneSpec& spec, const RenderOutputs& out) {
+  if (run.empty()) throw std::invalid_argument("nothing was recorded: no frames to render");
+  if (caller.num_bodies() != run.num_bodies()) throw std::invalid_argument("RenderTrajectory: the world's bodies are not the run's");
+  // each pass replays the run in a copy of the caller's world as it is now (which is left
+  // untouched but for the state of the last sample drawn, put back at the end)
+  World world = caller;
+  const double dt = world.options().dt;
+  long num_frames = 0;
+  const std::vector<Visit> visits = PlanVisits(run, out, dt, &num_frames);
+  RenderReport report;
+
+  std::unique_ptr<SceneView> view, strip_view;
+  if (out.frames || out.exr) view = std::make_unique<SceneView>(&world, out.view, spec);
+  if (out.filmstrip) {
+    SceneOptions s = out.view;
+    s.width = out.filmstrip_width;
+    s.height = out.filmstrip_height;
+    s.show_color_bar = false;
+    s.overlay_energy = false;  // panels are small: the time only
+    s.title.clear();
+    if (out.filmstrip_point_size > 0) s.point_size = out.filmstrip_point_size;
+    strip_view = std::make_unique<SceneView>(&world, s, spec);
+  }
+
+  // the camera's pass: the box of every drawn state (and the ground below it), the colour range
+  if (view || strip_view) {
+    Eigen::AlignedBox3d motion;
+    double lo = 1e300, hi = -1e300;
+    const bool fixed_range = out.view.color_range[0] < out.view.color_range[1];
+    Replay replay(run, &world);
+    for (const Visit& v : visits) {
+      replay.To(v.sample);
+      motion.extend(SceneBounds(world, spec));
+      double r[2];
+      if (!fixed_range && (view ? view : strip_view)->ColorRangeNow(r)) {
+        lo = std::min(lo, r[0]);
+        hi = std::max(hi, r[1]);
+      }
+    }
+    if (HasFfdBody(world) && out.view.show_ground && !motion.isEmpty()) {
+      // the ground seen below the bodies: a band under the lowest point
+      Eigen::Vector3d below = motion.min();
+      below.y() -= 0.1 * motion.sizes().head<2>().maxCoeff();
+      motion.extend(below);
+    }
+    for (SceneView* v : {view.get(), strip_view.get()}) {
+      if (!v) continue;
+      v->FrameBounds(motion);
+      if (lo < hi) v->SetColorRange(lo, hi);  // one colour scale for the whole run
+    }
+    world = caller;  // the writing pass replays the run from the start again
+  }
+  for (SceneView* v : {view.get(), strip_view.get()})
+    if (v && !out.trail.empty() && v->trails()) v->trails()->SetTrackedPoints(out.trail);
+
+  std::unique_ptr<VtpSeriesWriter> vtp;
+  if (out.vtp) vtp = std::make_unique<VtpSeriesWriter>(&world, out.folder + "/vtp", out.name, spec.drawings, out.view.shape_samples);
+  const std::vector<DispTarget> disp = out.disp ? DispTargets(world, out) : std::vector<DispTarget>();
+  std::vector<vtkSmartPointer<vtkImageData>> panels;
+  BackgroundWriter writer;  // files are compressed and written while the next frame renders
+  Replay replay(run, &world);
+  for (const Visit& v : visits) {
+    replay.To(v.sample);
+    if (v.frame < 0) {
+      strip_view->Render();
+      panels.push_back(strip_view->Capture());
+      continue;
+    }
+    for (SceneView* sv : {view.get(), strip_view.get()})
+      if (sv && !out.trail.empty() && sv->trails()) sv->trails()->Record();
+    if (view) {
+      view->Render();
+      if (out.frames) view->WritePng(Numbered(out.folder + "/frames", "frame", v.frame, "png"), &writer);
+      if (out.exr) view->WriteExr(Numbered(out.folder + "/exr", "frame", v.frame, "exr"), &writer);
+    }
+    if (vtp) vtp->WriteFrame(int(v.frame), &writer);
+    for (const DispTarget& d : disp)
+      WriteDisplacementExr(Numbered(out.folder + "/exr", d.stem, v.frame, "exr"), world, d.body, d.width, d.height, &writer);
+    ++report.frames;
+    if (out.progress) out.progress(double(report.frames) / double(num_frames), world.time());
+  }
+  writer.Wait();
+  if (!visits.empty()) run.Restore(visits.back().sample, caller);
+
+  if (out.frames) report.files.push_back({out.folder + "/frames/frame_NNNN.png", ""});
+  if (out.exr) report.files.push_back({out.folder + "/exr/frame_NNNN.exr", "R, G, B, A, depth.Z"});
+  for (const DispTarget& d : disp)
+    report.files.push_back({out.folder + "/exr/" + d.stem + "_NNNN.exr", "disp.X, disp.Y over the rest lattice"});
+  if (vtp) report.files.push_back({vtp->WriteCollection(), "ParaView time series of lattice, points, shape"});
+  if (strip_view && !panels.empty()) {
+    const std::string path = out.folder + "/filmstrip.png";
+    WritePng(path, TileImages(panels, out.filmstrip_columns));
+    report.files.push_back({path, ""});
+  }
+  if (out.charts) WriteCharts(run, out, &report);
+  return report;
+}
+
+}  // namespace wobble::pipelines

@@ -1,0 +1,83 @@
+// The one render driver: a recorded run (record::Trajectory) turned into PNG frames, a
+// filmstrip, a ParaView .vtp/.pvd series, EXR frames (R,G,B,A,depth.Z), displacement images
+// (disp.X, disp.Y over an FFD body's rest lattice) and charts (energy and cond(M) against
+// time, PNG + CSV), for `wobble render`/`export`, a script's `render` (its FFD runs and its
+// Witkin & Welch scenes) alike. Every sample is put back into a world (Trajectory::Restore)
+// and drawn by SceneView and the sources of world_sources.h; the camera is fixed for the run
+// and frames the whole motion.
+//
+// Layout under out.folder (what is asked for):
+//   frames/frame_NNNN.png   one per frame
+//   filmstrip.png           the panels side by side, filmstrip_columns per row
+//   vtp/NAME.pvd            per frame and body b parts 3b, 3b+1, 3b+2 (lattice or control
+//                           box, mass points, shape), files vtp/<body>_<part>_NNNN.vtp
+//   exr/frame_NNNN.exr      the frame's R, G, B, A, depth.Z
+//   exr/disp_NNNN.exr       each FFD body's displacement image (disp_<body>_NNNN.exr when
+//                           the world has more than one FFD body)
+//   energy.png/.csv, condition.png/.csv   charts of body chart_body (condition: FFD bodies)
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pipelines/scene_view.h"
+#include "wobble/record/trajectory.h"
+#include "wobble/world/world.h"
+
+namespace wobble::pipelines {
+
+struct RenderOutputs {
+  std::string folder;         // created if missing
+  std::string name = "run";   // stem of the .pvd
+  bool frames = true, filmstrip = true, charts = false, vtp = true, exr = false, disp = false;
+  // Frames at t0 + k/fps (t0 the first sample's time) up to t_end, those the run reached (up
+  // to half a step after its last sample), each showing the sample nearest its time; fps 0:
+  // every sample is a frame.
+  double fps = 0.0;
+  // The run's intended end, for the frames and the default filmstrip times; empty: the last
+  // sample's time. A run that stopped early is drawn as far as it went.
+  std::optional<double> t_end;
+  // The frames' view: size, colour by (a fixed colour_range, or the range over the frames),
+  // shape samples, point size, title, 3D camera angles.
+  SceneOptions view;
+  // Filmstrip panels: the samples nearest these times, in this order (empty: 6 evenly spaced
+  // from the first sample to t_end; times the run did not reach have no panel).
+  std::vector<double> filmstrip_times;
+  int filmstrip_width = 320, filmstrip_height = 240, filmstrip_columns = 3;
+  double filmstrip_point_size = 0.0;  // 0: the frames' point size
+  int disp_width = 256, disp_height = 0;  // height 0: the body's lattice aspect
+  int chart_width = 800, chart_height = 500;
+  int chart_body = 0;
+  // Points of the first FFD body, by lattice coordinates, traced in the pictures.
+  std::vector<Eigen::Vector2d> trail;
+  // Called after every frame with the fraction done and the frame's time.
+  std::function<void(double fraction, double t)> progress;
+};
+
+struct RenderReport {
+  struct File {
+    std::string path;  // a pattern (frame_NNNN.png) for a series
+    std::string note;  // what it holds, or empty
+    std::string Line() const { return note.empty() ? path : path + "  (" + note + ")"; }
+  };
+  long frames = 0;  // frames drawn
+  std::vector<File> files;
+};
+
+// Draws `run` into `world`, whose bodies are the run's (same numbering; its options give the
+// ground, springs and gravity drawn). The samples are put back in order from the world as it
+// is (a world as at the run's start draws the ground contacts as the run had them): the world
+// is left in the state of the last sample drawn.
+// `spec` draws the linear bodies' shapes and the named points. Pictures (frames, filmstrip,
+// exr, charts) need HasDisplay(); vtp and disp do not. Throws std::invalid_argument for an
+// empty run or a world of other bodies, std::runtime_error for a failed write (naming the file).
+RenderReport RenderTrajectory(World& world, const record::Trajectory& run, const SceneSpec& spec, const RenderOutputs& out);
+
+// A world holding the run's bodies (FFD bodies at their models, linear bodies with the default
+// material) with these options: somewhere to draw a run whose world is gone.
+World WorldFor(const record::Trajectory& run, const WorldOptions& options);
+
+}  // namespace wobble::pipelines

@@ -1,0 +1,172 @@
+// The one recorder (record::Trajectory, record::Recorder) and its CSV schema.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
+#include "support/test_bodies.h"
+#include "wobble/formats/parse_error.h"
+#include "wobble/record/trajectory_csv.h"
+#include "wobble/world/world.h"
+
+namespace wobble {
+namespace {
+
+std::shared_ptr<const BodyModel> Table() {
+  return std::make_shared<BodyModel>(testing::TableDef(), testing::TableModes(2e6, 5e4));
+}
+
+// A table dropped onto the ground, recorded every `every` steps.
+struct DroppedTable {
+  World world;
+  std::shared_ptr<record::Trajectory> trajectory;
+  std::shared_ptr<record::Recorder> recorder;
+  explicit DroppedTable(int every) : world(WorldOptions{}) {
+    world.AddBody(Table());
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(7), qd = Eigen::VectorXd::Zero(7);
+    q[1] = 10.0;
+    qd[0] = 3.0;
+    world.SetState(0, q, qd);
+    trajectory = std::make_shared<record::Trajectory>(world);
+    recorder = std::make_shared<record::Recorder>(trajectory, every);
+    recorder->Start(world);
+    world.SetRecorder(recorder);
+  }
+};
+
+TEST(Trajectory, ColumnsNameTheModes) {
+  DroppedTable d(1);
+  const std::vector<std::string>& c = d.trajectory->Columns();
+  ASSERT_GE(c.size(), 12u);
+  EXPECT_EQ(c[0], "t");
+  EXPECT_EQ(c[1], "tx");
+  EXPECT_EQ(c[4], "bend");  // mode names, not g1..gD
+  EXPECT_EQ(c[8], "dtx");
+  EXPECT_EQ(c[11], "dbend");
+  EXPECT_GE(d.trajectory->Column("target_bend"), 0);
+  EXPECT_GE(d.trajectory->Column("control_energy"), 0);
+  EXPECT_EQ(c.back(), "violation");
+}
+
+// The recorder keeps the start, every Nth step and (Finish) the end; each sample is the
+// world's state and energies at that step.
+TEST(Recorder, KeepsEveryNthStepAndTheEnd) {
+  DroppedTable d(7);
+  World reference(WorldOptions{});
+  reference.AddBody(d.world.shared_body(0));
+  reference.SetState(0, d.world.state(0).q, d.world.state(0).qd);
+  for (int n = 1; n <= 100; ++n) {
+    ASSERT_TRUE(d.world.Step()) << d.world.status().message;
+    ASSERT_TRUE(reference.Step());
+    if (n % 7 == 0) {
+      const record::Trajectory& t = *d.trajectory;
+      const int k = t.size() - 1;
+      EXPECT_EQ(t.time(k), reference.time());
+      EXPECT_EQ((t.q(k, 0) - reference.state(0).q).norm(), 0.0);
+      EXPECT_EQ((t.qd(k, 0) - reference.state(0).qd).norm(), 0.0);
+      EXPECT_EQ(t.energies(k, 0).total(), reference.ComputeEnergies(0).total());
+      EXPECT_EQ(t.contacts(k, 0), int(reference.state(0).contacts.size()));
+    }
+  }
+  d.recorder->Finish(d.world);
+  EXPECT_EQ(d.trajectory->size(), 1 + 100 / 7 + 1);
+  EXPECT_EQ(d.trajectory->time(d.trajectory->size() - 1), d.world.time());
+  d.recorder->Finish(d.world);  // twice: the end is not repeated
+  EXPECT_EQ(d.trajectory->size(), 1 + 100 / 7 + 1);
+}
+
+// Written and read back, a trajectory is the same to the last bit (shortest round-trip numbers).
+TEST(TrajectoryCsv, RoundTripsExactly) {
+  DroppedTable d(3);
+  for (int n = 0; n < 60; ++n) ASSERT_TRUE(d.world.Step());
+  const std::string path = (std::filesystem::temp_directory_path() / "wobble_record_test.csv").string();
+  record::WriteTrajectoryCsv(path, *d.trajectory);
+  const record::ReadTrajectory back = record::ReadTrajectoryCsv(path, {record::DescribeFfdBody(d.world.shared_body(0))});
+  std::remove(path.c_str());
+  ASSERT_TRUE(back.has_velocities);
+  ASSERT_EQ(back.trajectory.size(), d.trajectory->size());
+  ASSERT_EQ(back.trajectory.Columns(), d.trajectory->Columns());
+  for (int k = 0; k < d.trajectory->size(); ++k)
+    for (int c = 0; c < d.trajectory->num_columns(); ++c) EXPECT_EQ(back.trajectory.Row(k)[c], d.trajectory->Row(k)[c]);
+}
+
+// Restore puts a sample back: stepping on from it repeats the recorded run exactly.
+TEST(Trajectory, RestoreReplaysTheRun) {
+  DroppedTable d(1);
+  for (int n = 0; n < 80; ++n) ASSERT_TRUE(d.world.Step());
+  World again(WorldOptions{});
+  again.AddBody(d.world.shared_body(0));
+  d.trajectory->Restore(30, again);
+  EXPECT_EQ(again.time(), d.trajectory->time(30));
+  for (int n = 31; n <= 80; ++n) {
+    ASSERT_TRUE(again.Step());
+    EXPECT_EQ((again.state(0).q - d.trajectory->q(n, 0)).norm(), 0.0) << "step " << n;
+  }
+}
+
+// One clock for every body: an FFD body nailed to a linear block in one world moves with the
+// world's time (the old constrained world kept its FFD bodies on a clock that never moved).
+TEST(Trajectory, FfdBodyInAConstraintSceneHasTheWorldsTime) {
+  World w(testing::WitkinWelchOptions());
+  const int table = w.AddBody(Table());
+  Eigen::VectorXd half(2);
+  half << 0.5, 0.5;
+  const int block = w.AddLinearBody(std::make_shared<LinearBodyModel>(MakeBoxBody("block", 2, LinearOrder::kAffine, half, 2, 1.0)));
+  w.AddNail(At(table, Eigen::Vector2d(0.0, 1.0)));
+  // the block's material point at (300, 100) is where the table's top right corner is
+  w.AddAttachment(At(table, Eigen::Vector2d(1.0, 1.0)), At(block, Eigen::Vector2d(300.0, 100.0)));
+  record::Trajectory t(w);
+  EXPECT_EQ(t.Column("table.tx"), 1);  // two bodies: columns carry the body name
+  EXPECT_GE(t.Column("block.r0_0"), 0);
+  t.Append(w);
+  for (int n = 1; n <= 50; ++n) {
+    ASSERT_TRUE(w.Step()) << w.status().message;
+    t.Append(w);
+    EXPECT_NEAR(t.time(n), n * 0.002, 1e-15);
+  }
+  EXPECT_LT(t.violation(50), 1e-6);
+}
+
+std::string CsvMessage(const std::string& text) {
+  std::istringstream in(text);
+  record::BodyInfo one_mode;
+  one_mode.name = "body";
+  one_mode.coordinate_names = {"tx", "ty", "theta", "g1"};
+  one_mode.num_q = 4;
+  try {
+    record::ParseTrajectoryCsv(in, "ref.csv", {one_mode});
+  } catch (const formats::ParseError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// (moved from trajectory_fit_test: the reader of what `wobble simulate` writes)
+TEST(TrajectoryCsv, ReadsWobbleSimulateOutputAndRejectsBadRows) {
+  std::istringstream good("t,tx,ty,theta,g1,dtx,dty,dtheta,dg1,kinetic\n0,1,2,3,4,5,6,7,8,9\n0.5,1,2,3,4.5,5,6,7,8,9\n");
+  record::BodyInfo one_mode;
+  one_mode.coordinate_names = {"tx", "ty", "theta", "g1"};
+  one_mode.num_q = 4;
+  const record::ReadTrajectory s = record::ParseTrajectoryCsv(good, "ref.csv", {one_mode});
+  ASSERT_EQ(s.trajectory.size(), 2);
+  ASSERT_TRUE(s.has_velocities);
+  EXPECT_EQ(s.trajectory.q(1, 0)[3], 4.5);
+  EXPECT_EQ(s.trajectory.qd(0, 0)[0], 5.0);
+  EXPECT_EQ(s.trajectory.energies(0, 0).kinetic, 9.0);
+  EXPECT_EQ(CsvMessage(""), "ref.csv:0: file is empty: expected the header of `wobble simulate`");
+  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g2\n"),
+            "ref.csv:1: expected the header to start with t,tx,ty,theta,g1 (a body with 1 modes), got 't,tx,ty,theta,g2'");
+  EXPECT_EQ(CsvMessage("t,tx,ty,theta\n"),
+            "ref.csv:1: expected the header to start with t,tx,ty,theta,g1 (a body with 1 modes), got 't,tx,ty,theta'");
+  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1\n0,1,2,3,4\n1,1,2,x,4\n"),
+            "ref.csv:3: expected a number in column 4 (theta), got 'x'");
+  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1\n0,1,2,3\n"), "ref.csv:2: expected 5 values like the header, got 4");
+  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1\n1,1,2,3,4\n1,1,2,3,4\n"),
+            "ref.csv:3: times must strictly increase (previous row: t = 1)");
+  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1\n"), "ref.csv:0: no rows after the header");
+}
+
+}  // namespace
+}  // namespace wobble
