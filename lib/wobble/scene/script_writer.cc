@@ -1,19 +1,17 @@
 #include "wobble/scene/script_writer.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
+#include "wobble/formats/csv.h"
+
 namespace wobble::scene {
 namespace {
 
-std::string Num(double v) {
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof(buf), v);
-  return std::string(buf, res.ptr);
-}
+// Shortest round-trip form: the replay reads back the same doubles.
+std::string Num(double v) { return formats::FormatDouble(v); }
 
 void Vector(std::ostream& s, const char* name, const Eigen::VectorXd& v) {
   s << "set_vec " << name;

@@ -4,7 +4,6 @@
 // parameters.cc). Not part of the public API.
 #pragma once
 
-#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <iosfwd>
@@ -12,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "wobble/formats/csv.h"
 #include "wobble/formats/line_reader.h"
 #include "wobble/formats/parse_error.h"
 #include "wobble/scene/object_runs.h"
@@ -155,12 +155,8 @@ void SceneRender(State& s, const Words& w, const Context& ctx);
 // ---- word parsers ----
 namespace script_detail {
 
-// Shortest round-trip form of a number.
-inline std::string Num(double v) {
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof(buf), v);
-  return std::string(buf, res.ptr);
-}
+// Shortest round-trip form of a number, as every message prints it.
+inline std::string Num(double v) { return formats::FormatDouble(v); }
 
 inline double Number(const std::string& word, const std::string& what, const Context& ctx) {
   double v;
