@@ -23,8 +23,8 @@ namespace {
 const std::string kData = WOBBLE_DATA_DIR;
 
 // A script run up to (not including) its first `simul`, `render` or `anneal`.
-struct ScriptSetup {
-  explicit ScriptSetup(const std::string& name) : interp(sink) {
+struct ScriptUpToSimul {
+  explicit ScriptUpToSimul(const std::string& name) : interp(sink) {
     const std::string path = kData + "/" + name;
     std::ifstream f(path);
     std::string line;
@@ -45,7 +45,7 @@ constexpr long kPendulumSteps = 100000;  // simul 100 at dt 0.001
 void BM_Fig2ScriptSimul(benchmark::State& state) {
   for (auto _ : state) {
     state.PauseTiming();
-    ScriptSetup s("fig2_triple_pendulum.wob");
+    ScriptUpToSimul s("fig2_triple_pendulum.wob");
     state.ResumeTiming();
     s.interp.RunLine("simul 100", "<bench>", 1, kData);
     benchmark::DoNotOptimize(s.interp.scene().world().time());
@@ -58,7 +58,7 @@ BENCHMARK(BM_Fig2ScriptSimul)->Unit(benchmark::kMillisecond);
 void BM_Fig2WorldStepLoop(benchmark::State& state) {
   for (auto _ : state) {
     state.PauseTiming();
-    ScriptSetup s("fig2_triple_pendulum.wob");
+    ScriptUpToSimul s("fig2_triple_pendulum.wob");
     World& world = s.interp.scene().world();  // the scene's world, bare: no behaviours, no recorder
     world.ClearControllers();
     world.SetRecorder(nullptr);
@@ -76,7 +76,7 @@ constexpr long kTableSteps = 10000;  // simul 100 at dt 0.01
 void BM_BoundingTableScriptSimul(benchmark::State& state) {
   for (auto _ : state) {
     state.PauseTiming();
-    ScriptSetup s("bounding_table.wob");
+    ScriptUpToSimul s("bounding_table.wob");
     state.ResumeTiming();
     s.interp.RunLine("simul 100", "<bench>", 1, kData);
     benchmark::DoNotOptimize(s.interp.scene().last_object_run()->size());
@@ -88,7 +88,7 @@ BENCHMARK(BM_BoundingTableScriptSimul)->Unit(benchmark::kMillisecond);
 void BM_BoundingTableWorldStepLoop(benchmark::State& state) {
   for (auto _ : state) {
     state.PauseTiming();
-    ScriptSetup s("bounding_table.wob");
+    ScriptUpToSimul s("bounding_table.wob");
     const scene::SimulationSetup setup = s.interp.scene().CurrentSetup();
     World world(setup.world);
     world.AddBody(setup.body);
