@@ -36,14 +36,20 @@ Size ParseSize(const std::string& text, const std::string& flag) {
   return s;
 }
 
-std::vector<double> ParseNumbers(const std::string& text, const std::string& flag) {
-  std::vector<double> out;
+// The words of a list separated by commas and/or white space.
+std::vector<std::string> ListWords(const std::string& text) {
   std::string t = text;
   for (char& c : t)
     if (c == ',') c = ' ';
   std::istringstream in(t);
-  std::string word;
-  while (in >> word) {
+  std::vector<std::string> words;
+  for (std::string word; in >> word;) words.push_back(word);
+  return words;
+}
+
+std::vector<double> ParseNumbers(const std::string& text, const std::string& flag) {
+  std::vector<double> out;
+  for (const std::string& word : ListWords(text)) {
     char* end = nullptr;
     const double v = std::strtod(word.c_str(), &end);
     if (end == word.c_str() || *end != '\0' || !std::isfinite(v))
@@ -55,12 +61,7 @@ std::vector<double> ParseNumbers(const std::string& text, const std::string& fla
 
 std::set<std::string> ParseWhat(const std::string& text) {
   std::set<std::string> what;
-  std::string t = text;
-  for (char& c : t)
-    if (c == ',') c = ' ';
-  std::istringstream in(t);
-  std::string word;
-  while (in >> word) {
+  for (const std::string& word : ListWords(text)) {
     if (!kOutputs.count(word))
       throw UsageError("--what: '" + word + "' is not one of frames, filmstrip, charts, vtp, exr, disp");
     what.insert(word);

@@ -133,14 +133,7 @@ Reference MakeReference(const BodyModel& body, const std::vector<ReferenceFrame>
   for (const ReferenceFrame& f : frames) {
     std::vector<SegmentResidual> pts;
     for (const Correspondence& t : f.points) {
-      if (t.mass_point >= body.num_points())
-        throw std::invalid_argument("dynamic fit: mass point " + std::to_string(t.mass_point) + " does not exist");
-      SegmentResidual s;
-      s.point = BasisOf(body, t.mass_point, t.lattice_coords);
-      s.a = s.b = t.position;
-      s.sqrt_weight = std::sqrt(t.weight);
-      s.num_q = body.num_q();
-      pts.push_back(s);
+      pts.push_back(SegmentResidual::ToPoint(body, t, "dynamic fit"));
       r.num_residuals += 2;
     }
     r.points.push_back(pts);

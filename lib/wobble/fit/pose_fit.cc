@@ -112,13 +112,7 @@ PoseFitResult FitPose(const BodyModel& body, const std::vector<Correspondence>& 
   std::vector<Eigen::Vector2d> rest, goal;
   std::vector<double> weights;
   for (const Correspondence& t : targets) {
-    if (t.mass_point >= body.num_points())
-      throw std::invalid_argument("pose fit: mass point " + std::to_string(t.mass_point) + " does not exist");
-    SegmentResidual r;
-    r.point = BasisOf(body, t.mass_point, t.lattice_coords);
-    r.a = r.b = t.position;
-    r.sqrt_weight = std::sqrt(t.weight);
-    r.num_q = body.num_q();
+    const SegmentResidual r = SegmentResidual::ToPoint(body, t, "pose fit");
     data.push_back(r);
     rest.push_back(r.point.b0);
     goal.push_back(t.position);

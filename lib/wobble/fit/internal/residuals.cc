@@ -8,6 +8,8 @@
 #include "wobble/fit/internal/residuals.h"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 
 namespace wobble::fit {
@@ -104,5 +106,16 @@ ceres::CostFunction* MakeRestPriorCost(const RestPrior& r) {
 }
 
 ceres::CostFunction* MakeSecondDifferenceCost(const SecondDifference& r) { return new SecondDifferenceCost(r); }
+
+SegmentResidual SegmentResidual::ToPoint(const BodyModel& body, const Correspondence& target, const char* fit) {
+  if (target.mass_point >= body.num_points())
+    throw std::invalid_argument(std::string(fit) + ": mass point " + std::to_string(target.mass_point) + " does not exist");
+  SegmentResidual s;
+  s.point = BasisOf(body, target.mass_point, target.lattice_coords);
+  s.a = s.b = target.position;
+  s.sqrt_weight = std::sqrt(target.weight);
+  s.num_q = body.num_q();
+  return s;
+}
 
 }  // namespace wobble::fit

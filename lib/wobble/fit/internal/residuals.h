@@ -39,6 +39,9 @@ struct SegmentResidual {
   Eigen::Vector2d a, b;
   double sqrt_weight = 1.0;
   int num_q = kRigidDofs;
+  // A point target (a = b): the body point of `target` pulled to its position. Throws
+  // std::invalid_argument naming `fit` when the mass point does not exist.
+  static SegmentResidual ToPoint(const BodyModel& body, const Correspondence& target, const char* fit);
   template <class T> bool operator()(const T* q, T* r) const {
     const Vec2<T> x = PointPosition(point, q, num_q);
     const Vec2<T> e = (x - ClosestOnSegment(x, a, b)) * T(sqrt_weight);
