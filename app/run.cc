@@ -34,14 +34,6 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* a) {
 
 namespace {
 
-void PrintHelp(std::ostream& out) {
-  out << "commands:\n";
-  for (const script::CommandInfo& c : script::Interpreter::Commands()) out << "  " << c.usage << "\n      " << c.summary << "\n";
-  out << "parameters of set:";
-  for (const std::string& p : script::Interpreter::Parameters()) out << " " << p;
-  out << "\n";
-}
-
 // Fig. 5.4/5.5: cost against iteration, as FILE.png beside the optimiser's FILE.csv.
 void PlotCostHistory(const std::string& csv_path, const std::string& optimiser,
                      const std::vector<synth::IterationRecord>& history) {
@@ -77,7 +69,7 @@ void PlotCostHistory(const std::string& csv_path, const std::string& optimiser,
 // states replayed instead of simulated. Without a display only vtp and disp can be written.
 void RenderRecordedRuns(const script::RenderRequest& r) {
 #ifdef WOBBLE_HAVE_PIPELINES
-  RenderScriptRuns(r, TrajectoryOf(r));
+  RenderScriptRuns(r);
 #else
   (void)r;
   throw std::runtime_error("this wobble was built without pipelines/ (VTK): it cannot render");
@@ -87,7 +79,7 @@ void RenderRecordedRuns(const script::RenderRequest& r) {
 // `render DIR` in a script: the recorded Witkin & Welch scene as frames, filmstrip and .pvd.
 std::vector<std::string> RenderScene(const script::SceneRenderRequest& r) {
 #ifdef WOBBLE_HAVE_PIPELINES
-  return RenderScriptScene(r, TrajectoryOf(r));
+  return RenderScriptScene(r);
 #else
   (void)r;
   throw std::runtime_error("this wobble was built without pipelines/ (VTK): nothing can be drawn");
@@ -136,10 +128,6 @@ int RunScript(const RunArgs& a) {
   for (int number = 1;; ++number) {
     std::cout << "wobble> " << std::flush;
     if (!std::getline(std::cin, line)) break;
-    if (line == "help") {
-      PrintHelp(std::cout);
-      continue;
-    }
     try {
       if (!interp.RunLine(line, "<prompt>", number, "")) break;
     } catch (const std::exception& e) {

@@ -11,7 +11,8 @@ namespace wobble::app {
 
 namespace pl = wobble::pipelines;
 
-void RenderScriptRuns(const script::RenderRequest& r, const record::Trajectory& run) {
+void RenderScriptRuns(const script::RenderRequest& r) {
+  const record::Trajectory& run = *r.trajectory;
   const std::string default_what = "frames,filmstrip,charts";
   RenderArgs a;
   a.out = r.dir;
@@ -34,7 +35,8 @@ void RenderScriptRuns(const script::RenderRequest& r, const record::Trajectory& 
   }
 }
 
-std::vector<std::string> RenderScriptScene(const script::SceneRenderRequest& r, const record::Trajectory& run) {
+std::vector<std::string> RenderScriptScene(const script::SceneRenderRequest& r) {
+  const record::Trajectory& run = *r.recorded;
   pl::RenderOutputs out;
   out.folder = r.folder;
   out.name = r.name;
@@ -49,37 +51,14 @@ std::vector<std::string> RenderScriptScene(const script::SceneRenderRequest& r, 
   if (!out.frames && !out.filmstrip && !out.vtp) return {};
   out.view.point_size = 5.0;  // a scene has many mass points: smaller dots than the FFD view's
   out.filmstrip_point_size = 3.0;
-  out.view.azimuth = r.azimuth;
-  out.view.elevation = r.elevation;
+  out.view.azimuth = r.drawing.azimuth;
+  out.view.elevation = r.drawing.elevation;
   out.view.title = r.name;
-  const pl::RenderReport report = pl::RenderTrajectory(*r.world, run, pl::SceneSpecOf(*r.drawings, r.anchors), out);
+  World world = pl::WorldFor(run, r.world);
+  const pl::RenderReport report = pl::RenderTrajectory(world, run, pl::SceneSpecOf(r.drawing.drawings, r.drawing.anchors), out);
   std::vector<std::string> lines;
   for (const pl::RenderReport::File& f : report.files) lines.push_back(f.Line());
   return lines;
-}
-
-record::Trajectory TrajectoryOf(const script::RenderRequest& r) {
-  World world(r.world);
-  world.AddBody(r.body);
-  record::Trajectory run(world);
-  run.reserve(int(r.states.size()));
-  for (const script::TrackState& s : r.states) {
-    world.SetModeTargets(0, s.targets);
-    world.SetState(0, s.q, s.qd);
-    world.SetTime(s.t);
-    run.Append(world);
-  }
-  return run;
-}
-
-record::Trajectory TrajectoryOf(const script::SceneRenderRequest& r) {
-  record::Trajectory run(*r.world);
-  run.reserve(int(r.recorded->size()));
-  for (const record::SceneFrame& f : *r.recorded) {
-    record::RestoreFrame(*r.world, f);
-    run.Append(*r.world);
-  }
-  return run;
 }
 
 }  // namespace wobble::app

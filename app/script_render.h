@@ -6,22 +6,16 @@
 #include <string>
 #include <vector>
 
-#include "wobble/record/trajectory.h"
 #include "wobble/script/interpreter.h"
 
 namespace wobble::app {
 
-// `render DIR [WHAT]` of the FFD object's runs: `run` (of one body, request.body) drawn like
+// `render DIR [WHAT]` of the FFD object's runs: request.trajectory (one body) drawn like
 // `wobble render --what WHAT` (default frames,filmstrip,charts) in a world of request.world's
 // options. Without a display only vtp and disp are written, with a message.
-void RenderScriptRuns(const script::RenderRequest& request, const record::Trajectory& run);
-// `render DIR [WHAT]` with a Witkin & Welch scene: `run` (of the scene world's bodies) drawn
-// into request.world with the scene's drawings and named points. Returns what was written.
-std::vector<std::string> RenderScriptScene(const script::SceneRenderRequest& request, const record::Trajectory& run);
-
-// The request's recorded states as a Trajectory, until the interpreter records one itself.
-record::Trajectory TrajectoryOf(const script::RenderRequest& request);
-// The scene's recorded frames as a Trajectory (puts each into request.world on the way).
-record::Trajectory TrajectoryOf(const script::SceneRenderRequest& request);
+void RenderScriptRuns(const script::RenderRequest& request);
+// `render DIR [WHAT]` with a Witkin & Welch scene: the recorded frames (of the scene's bodies)
+// drawn with the scene's drawings and named points. Returns what was written.
+std::vector<std::string> RenderScriptScene(const script::SceneRenderRequest& request);
 
 }  // namespace wobble::app

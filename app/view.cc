@@ -77,17 +77,20 @@ pl::ViewerOptions MakeViewerOptions(const ViewArgs& a, int width, int height) {
   return vo;
 }
 
-// A script with a Witkin & Welch scene: its World live, stepped by the interpreter
-// (the queued behaviours act between steps as in `simul`).
-int ViewScene(script::Interpreter* interp, const ViewArgs& a, int width, int height) {
+// A script with a Witkin & Welch scene: its World live, stepped by the scene runtime as `simul`
+// steps it (the queued behaviours act between steps).
+int ViewScene(scene::Scene* scene, const ViewArgs& a, int width, int height) {
   if (!a.save_session.empty()) throw UsageError("--save-session: sessions are saved for FFD objects, not for scenes");
-  const script::SceneRenderRequest drawing = interp->SceneDrawing();
+  const scene::SceneDrawing drawing = scene->Drawing();
   pl::InteractiveSceneInput input;
-  input.world = interp->mutable_scene();
-  input.spec = pl::SceneSpecOf(*drawing.drawings, drawing.anchors);
+  input.world = &scene->world();
+  input.spec = pl::SceneSpecOf(drawing.drawings, drawing.anchors);
   input.azimuth = drawing.azimuth;
   input.elevation = drawing.elevation;
-  input.step = [interp] { interp->StepScene(); };
+  scene->BeginRun();
+  input.step = [scene] {
+    if (!scene->Step()) throw std::runtime_error("simulation stopped: " + scene->world().status().message);
+  };
   pl::InteractiveSceneView view(std::move(input), MakeViewerOptions(a, width, height));
   view.Run(a.frames, a.play_events, a.frames > 0);
   if (!a.screenshot.empty()) pl::WritePng(a.screenshot, view.Capture());
@@ -176,13 +179,13 @@ int RunView(const ViewArgs& a) {
     script::Interpreter interp(std::cout);
     if (!a.object.empty()) interp.LoadObject(a.object);
     const int stop = RunScriptSetup(&interp, a.scene);
-    if (interp.scene() && interp.scene()->num_bodies() > 0) {
+    if (interp.scene().has_bodies()) {
       if (stop > 0)
         std::cout << "wobble view: " << a.scene << " ran up to line " << stop
                   << "; the viewer steps its scene from there\n";
-      return ViewScene(&interp, a, width, height);
+      return ViewScene(&interp.scene(), a, width, height);
     }
-    script::Interpreter::SimulationSetup setup = interp.CurrentSetup();
+    const scene::SimulationSetup setup = interp.scene().CurrentSetup();
     if (!setup.body) throw UsageError(a.scene + ": the script loads no object (load_obj FILE, or --object FILE)");
     if (stop > 0)
       std::cout << "wobble view: " << a.scene << " ran up to line " << stop

@@ -1,6 +1,6 @@
 // `wobble view` of a Witkin & Welch scene (a script with `linear` bodies, nails, attachments
 // and behaviours): the script's World in a window, stepped in real time by the
-// caller's step function (script::Interpreter::StepScene: the queued behaviours act between steps
+// caller's step function (scene::Scene::Step: the queued behaviours act between steps
 // as in `simul`), drawn by SceneView's World constructor (the drawing path of
 // `render`). The FFD viewer (interactive_view.h) keeps its mode sliders and charts; a scene has
 // no mode targets, so this window shows the scene alone.

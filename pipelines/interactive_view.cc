@@ -30,7 +30,7 @@
 #include "pipelines/charts.h"
 #include "pipelines/energy_charts.h"
 #include "wobble/formats/atomic_file.h"
-#include "wobble/script/session_script.h"
+#include "wobble/scene/script_writer.h"
 
 namespace wobble::pipelines {
 
@@ -156,7 +156,7 @@ struct InteractiveView::Impl {
   double speed = 1.0;
   Eigen::VectorXd targets;
   long session_steps = 0;
-  std::vector<script::SessionRecord::Segment> segments;
+  std::vector<scene::SessionRecord::Segment> segments;
   int drags = 0;
   long first_drag_step = -1;
   int drag_spring = -1;  // index in the world's springs while pulling
@@ -464,7 +464,7 @@ bool FramePacer::EndFrame() {
   return max_frames > 0 && stats.frames >= max_frames;
 }
 
-ViewerScene ViewerScene::FromScript(const script::Interpreter::SimulationSetup& setup) {
+ViewerScene ViewerScene::FromScript(const scene::SimulationSetup& setup) {
   ViewerScene scene;
   scene.body = setup.body;
   scene.world = setup.world;
@@ -626,7 +626,7 @@ void InteractiveView::RecordPose() {
 
 std::string InteractiveView::SessionScriptText() const {
   const Impl& m = *impl_;
-  script::SessionRecord r;
+  scene::SessionRecord r;
   r.object_path = m.scene.object_path;
   r.mode_paths = m.scene.mode_paths;
   r.body = m.scene.body.get();
@@ -638,7 +638,7 @@ std::string InteractiveView::SessionScriptText() const {
   r.steps = m.session_steps;
   r.drags = m.drags;
   r.first_drag_step = m.first_drag_step;
-  return script::SessionScript(r);
+  return scene::SessionScript(r);
 }
 
 std::vector<std::string> InteractiveView::SaveSession(const std::string& path) {
@@ -647,7 +647,7 @@ std::vector<std::string> InteractiveView::SaveSession(const std::string& path) {
   formats::WriteTextAtomically(path, SessionScriptText());
   written.push_back(path);
   if (!m.recorded_poses.empty()) {
-    script::SessionRecord r;
+    scene::SessionRecord r;
     r.object_path = m.scene.object_path;
     r.mode_paths = m.scene.mode_paths;
     r.body = m.scene.body.get();
@@ -657,7 +657,7 @@ std::vector<std::string> InteractiveView::SaveSession(const std::string& path) {
     r.t0 = m.scene.t0;
     std::filesystem::path p(path);
     const std::string poses = (p.parent_path() / (p.stem().string() + "_poses.wob")).string();
-    formats::WriteTextAtomically(poses, script::PoseGraphScript(r, m.recorded_poses, m.recorded_durations));
+    formats::WriteTextAtomically(poses, scene::PoseGraphScript(r, m.recorded_poses, m.recorded_durations));
     written.push_back(poses);
   }
   return written;

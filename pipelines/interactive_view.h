@@ -35,7 +35,7 @@
 #include "pipelines/scene_view.h"
 #include "wobble/control/control.h"
 #include "wobble/world/world.h"
-#include "wobble/script/interpreter.h"
+#include "wobble/scene/scene.h"
 
 class vtkImageData;
 class vtkRenderWindow;
@@ -56,8 +56,8 @@ struct ViewerScene {
   std::string object_path;
   std::vector<std::string> mode_paths;
 
-  // What a script's next `simul` would run (script::Interpreter::CurrentSetup).
-  static ViewerScene FromScript(const script::Interpreter::SimulationSetup& setup);
+  // What a script's next `simul` would run (scene::Scene::CurrentSetup).
+  static ViewerScene FromScript(const scene::SimulationSetup& setup);
 };
 
 struct ViewerOptions {
@@ -178,7 +178,7 @@ class InteractiveView : public ViewerControls {
   void ToggleLayer(SceneLayer layer);
   bool LayerVisible(SceneLayer layer) const;
   void RecordPose();  // current amplitudes γ as a pose of a pose graph (held since the last)
-  // Writes the session script (script::SessionScript) atomically, and beside it, when poses were
+  // Writes the session script (scene::SessionScript) atomically, and beside it, when poses were
   // recorded, STEM_poses.wob with them as a cyclic pose graph. Returns the paths written.
   std::vector<std::string> SaveSession(const std::string& path);
   std::string SessionScriptText() const;

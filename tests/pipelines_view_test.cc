@@ -303,7 +303,7 @@ TEST(InteractiveView, ScriptPoseGraphDrivesTheTargetsAndReplays) {
   std::ostringstream out;
   script::Interpreter interp(out);
   interp.RunFile(script);
-  const script::Interpreter::SimulationSetup setup = interp.CurrentSetup();
+  const scene::SimulationSetup setup = interp.scene().CurrentSetup();
   ASSERT_TRUE(setup.body);
   ASSERT_EQ(setup.world.params.springs.size(), 1u);
   const ViewerScene scene = ViewerScene::FromScript(setup);
@@ -380,13 +380,17 @@ void RunUpToSimul(script::Interpreter* interp, const std::string& path) {
 }
 
 InteractiveSceneInput SceneInput(script::Interpreter* interp) {
-  const script::SceneRenderRequest d = interp->SceneDrawing();
+  scene::Scene* sc = &interp->scene();
+  const scene::SceneDrawing d = sc->Drawing();
   InteractiveSceneInput input;
-  input.world = interp->mutable_scene();
-  input.spec = SceneSpecOf(*d.drawings, d.anchors);
+  input.world = &sc->world();
+  input.spec = SceneSpecOf(d.drawings, d.anchors);
   input.azimuth = d.azimuth;
   input.elevation = d.elevation;
-  input.step = [interp] { interp->StepScene(); };
+  sc->BeginRun();
+  input.step = [sc] {
+    if (!sc->Step()) throw std::runtime_error("simulation stopped: " + sc->world().status().message);
+  };
   return input;
 }
 
@@ -397,25 +401,25 @@ TEST(InteractiveSceneView, Fig2StepsTheScriptsSceneAsSimulDoes) {
   std::ostringstream log;
   script::Interpreter interp(log);
   RunUpToSimul(&interp, kFig2);
-  ASSERT_NE(interp.scene(), nullptr);
+  ASSERT_TRUE(interp.scene().has_bodies());
   InteractiveSceneView view(SceneInput(&interp), TestOptions());
   view.Initialize();
   for (int k = 0; k < 30; ++k) view.Frame();  // 30 frames of 1/30 s: 1 s, 1000 steps of dt 0.001
   EXPECT_NEAR(view.time(), 1.0, 1e-9);
   EXPECT_EQ(view.stats().steps, 1000);
-  const int pivot = interp.SceneConstraint("pivot");
+  const int pivot = interp.scene().Constraint("pivot");
   ASSERT_GE(pivot, 0);
   EXPECT_LT(view.world().ConstraintError(pivot).norm(), 1e-4);
   EXPECT_LT(view.world().MaxViolation(), 1e-4);
   // the pendulum has swung down from the horizontal
-  EXPECT_LT(interp.ScenePoint("tip")[1], -0.5);
+  EXPECT_LT(interp.scene().Point("tip")[1], -0.5);
   // an interpreter that runs `simul 1` itself ends in the same state
   std::ostringstream log2;
   script::Interpreter ref(log2);
   RunUpToSimul(&ref, kFig2);
   ref.RunLine("simul 1", "<test>", 1, kData);
   for (const char* name : {"elbow1", "elbow2", "tip"})
-    EXPECT_LT((interp.ScenePoint(name) - ref.ScenePoint(name)).norm(), 1e-12) << name;
+    EXPECT_LT((interp.scene().Point(name) - ref.scene().Point(name)).norm(), 1e-12) << name;
 }
 
 TEST(InteractiveSceneView, DragTakesThePickedPointToTheCursorAndReleaseRemovesIt) {
@@ -426,7 +430,7 @@ TEST(InteractiveSceneView, DragTakesThePickedPointToTheCursorAndReleaseRemovesIt
   InteractiveSceneView view(SceneInput(&interp), TestOptions());
   view.Initialize();
   // press on the tip (3, 0) and pull it to (2.5, -1), within reach of the nailed chain
-  const Eigen::Vector3d press = view.WorldToDisplay(interp.ScenePoint("tip"));
+  const Eigen::Vector3d press = view.WorldToDisplay(interp.scene().Point("tip"));
   const Eigen::Vector3d cursor_px = view.WorldToDisplay(Vec({2.5, -1.0}));
   Play(&view, Event("MouseMoveEvent", press.x(), press.y()) + Event("LeftButtonPressEvent", press.x(), press.y()) +
                   Event("MouseMoveEvent", cursor_px.x(), cursor_px.y()));
@@ -435,7 +439,7 @@ TEST(InteractiveSceneView, DragTakesThePickedPointToTheCursorAndReleaseRemovesIt
   ASSERT_GE(id, 0);
   EXPECT_EQ(view.world().constraint_kind(id), ConstraintKind::kTrajectory);
   const MaterialPoint picked = *view.dragged_point();
-  EXPECT_LT((view.world().PointPosition(picked) - interp.ScenePoint("tip")).norm(), 1e-12) << "not the tip";
+  EXPECT_LT((view.world().PointPosition(picked) - interp.scene().Point("tip")).norm(), 1e-12) << "not the tip";
   const Eigen::VectorXd target = view.drag_target();
   EXPECT_LT((target - Vec({2.5, -1.0})).norm(), 0.02) << "the cursor in the world: " << target.transpose();
   const double before = (view.world().PointPosition(picked) - target).norm();

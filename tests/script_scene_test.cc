@@ -150,23 +150,23 @@ TEST(SceneScript, Fig2PendulumKeepsItsNailJointsAndEnergyAndRendersEveryFrame) {
     frames = r.recorded->size();
     folder = r.folder;
     EXPECT_TRUE(r.frames && r.filmstrip && r.vtp);
-    EXPECT_EQ(r.drawings->size(), 3u);
-    EXPECT_EQ(r.anchors.size(), 6u);
+    EXPECT_EQ(r.drawing.drawings.size(), 3u);
+    EXPECT_EQ(r.drawing.anchors.size(), 6u);
     return std::vector<std::string>{};
   });
   interp.RunFile(kData + "/fig2_triple_pendulum.wob");
   EXPECT_EQ(hook_calls, 1);
   EXPECT_EQ(frames, 121u);  // 4 s at 30 per second, both ends
   EXPECT_EQ(folder, "out/fig2");
-  const World& w = *interp.scene();
+  const World& w = interp.scene().world();
   EXPECT_NEAR(w.time(), 4.0, 1e-9);
-  EXPECT_LT(interp.ScenePoint("top").norm(), 1e-6);
-  EXPECT_LT((interp.ScenePoint("elbow1") - interp.ScenePoint("elbow1b")).norm(), 1e-6);
-  EXPECT_LT((interp.ScenePoint("elbow2") - interp.ScenePoint("elbow2b")).norm(), 1e-6);
+  EXPECT_LT(interp.scene().Point("top").norm(), 1e-6);
+  EXPECT_LT((interp.scene().Point("elbow1") - interp.scene().Point("elbow1b")).norm(), 1e-6);
+  EXPECT_LT((interp.scene().Point("elbow2") - interp.scene().Point("elbow2b")).norm(), 1e-6);
   std::cout << "energy after 4 s: " << w.TotalEnergy() << " (m g L = " << 3 * 9.81 * 1.5 << ")\n";
   EXPECT_LT(std::abs(w.TotalEnergy()), 0.01 * 3 * 9.81 * 1.5);
   // it swung: the tip is well below where it started
-  EXPECT_LT(interp.ScenePoint("tip")[1], -0.5);
+  EXPECT_LT(interp.scene().Point("tip")[1], -0.5);
 }
 
 TEST(SceneScript, AThinStiffBodyWarnsAboutTheTimeStep) {
@@ -193,13 +193,13 @@ TEST(SceneScript, AnFfdTableJoinsTheSceneNailedAtACornerAndAttachedToALinearBloc
                              "attach joint right block_end\n"
                              "simul 1\n";
   ASSERT_EQ(RunScript(interp, script), "");
-  const World& w = *interp.scene();
+  const World& w = interp.scene().world();
   ASSERT_EQ(w.num_bodies(), 2);
   EXPECT_EQ(w.kind(0), BodyKind::kFfd);
-  EXPECT_LT((interp.ScenePoint("corner") - (Eigen::VectorXd(2) << 0, 100).finished()).norm(), 1e-3);
-  EXPECT_LT((interp.ScenePoint("right") - interp.ScenePoint("block_end")).norm(), 1e-3);
+  EXPECT_LT((interp.scene().Point("corner") - (Eigen::VectorXd(2) << 0, 100).finished()).norm(), 1e-3);
+  EXPECT_LT((interp.scene().Point("right") - interp.scene().Point("block_end")).norm(), 1e-3);
   // it swings down about the nail: the far corner fell
-  EXPECT_LT(interp.ScenePoint("right")[1], 100 - 1.0);
+  EXPECT_LT(interp.scene().Point("right")[1], 100 - 1.0);
   EXPECT_NE(RunFresh("load_obj " + kData + "/table.obj\nffd t\npoint p t 1.5 0\n").find("s.wob:3: point p:"),
             std::string::npos);
 }
@@ -208,10 +208,10 @@ TEST(SceneScript, GravitySetAfterTheBodiesAppliesToTheNextSimul) {
   std::ostringstream out;
   script::Interpreter interp(out);
   ASSERT_EQ(RunScript(interp, "linear b 3d affine box 0.5 0.5 0.5\npoint c b 0 0 0\nset gravity F\nsimul 1\n"), "");
-  EXPECT_LT(interp.ScenePoint("c").norm(), 1e-12) << "no gravity: at rest where it was";
+  EXPECT_LT(interp.scene().Point("c").norm(), 1e-12) << "no gravity: at rest where it was";
   ASSERT_EQ(RunScript(interp, "set gravity T\nsimul 1\n"), "");
   // free fall for 1 s from rest: y = −g/2 (the semi-implicit step falls g Δt t further at most)
-  EXPECT_NEAR(interp.ScenePoint("c")[1], -0.5 * 9.81, 9.81 * 0.01 * 1.0 + 1e-9);
+  EXPECT_NEAR(interp.scene().Point("c")[1], -0.5 * 9.81, 9.81 * 0.01 * 1.0 + 1e-9);
 }
 
 }  // namespace

@@ -173,6 +173,24 @@ TEST(Interpreter, NearestUsesEditDistanceAndKnowsWhenNothingIsClose) {
     EXPECT_EQ(script::Interpreter::Nearest(c.name, {c.name}), c.name);
 }
 
+// `help` is a command like any other, so a script, piped stdin and the prompt all print the
+// command table: every command's usage and help once, and the parameters of set.
+TEST(Interpreter, HelpPrintsTheCommandTable) {
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  std::istringstream in("help\n");
+  interp.RunStream(in, "h.wob", "");
+  EXPECT_EQ(out.str(), script::Interpreter::Help());
+  for (const script::CommandInfo& c : script::Interpreter::Commands()) {
+    EXPECT_NE(out.str().find("  " + c.usage + "\n      " + c.summary + "\n"), std::string::npos) << c.name;
+    EXPECT_EQ(std::count_if(script::Interpreter::Commands().begin(), script::Interpreter::Commands().end(),
+                            [&](const script::CommandInfo& d) { return d.name == c.name; }),
+              1)
+        << c.name << " is listed twice";
+  }
+  EXPECT_NE(out.str().find("parameters of set: gravity ground"), std::string::npos) << out.str();
+}
+
 // §4.10.1: a keyframed run hands over to simulation with the q and q̇ it had.
 TEST(Interpreter, KeyframesHandOverContinuouslyInQAndQdot) {
   const std::string setup = "load_obj " + kData + "/table.obj\nload_def " + kData +
@@ -261,8 +279,9 @@ TEST(CliffJump, ClearsTheEdgeLandsUprightAndSettles) {
   interp.SetRenderHook([&](const script::RenderRequest& r) { drawn = r; });
   interp.RunFile(kData + "/table_cliff.wob");
   std::filesystem::current_path(cwd);
-  ASSERT_TRUE(drawn.body);
-  const BodyModel& table = *drawn.body;  // bend, shear, vsquash: every mode of the two runs
+  ASSERT_TRUE(drawn.trajectory);
+  const record::Trajectory& states = *drawn.trajectory;
+  const BodyModel& table = *states.bodies()[0].ffd;  // bend, shear, vsquash: every mode of the two runs
   ASSERT_EQ(table.num_modes(), 3);
   EXPECT_EQ(drawn.dir, "out/demo");
   const double hand_over = 1.5;  // the last key
@@ -279,9 +298,9 @@ TEST(CliffJump, ClearsTheEdgeLandsUprightAndSettles) {
     ASSERT_EQ(v.size(), size_t(1 + 2 * table.num_q() + 9));
     const Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(v.data() + 1, table.num_q());
     ASSERT_TRUE(q.allFinite());
-    ASSERT_LT(rows, drawn.states.size());
-    EXPECT_NEAR(drawn.states[rows].t, v[0], 1e-12);
-    EXPECT_LT((drawn.states[rows].q - q).norm(), 1e-9 * (1 + q.norm()));
+    ASSERT_LT(rows, size_t(states.size()));
+    EXPECT_NEAR(states.time(int(rows)), v[0], 1e-12);
+    EXPECT_LT((states.q(int(rows), 0) - q).norm(), 1e-9 * (1 + q.norm()));
     ++rows;
     if (v[0] <= hand_over + 1e-9) continue;
     EXPECT_EQ(q[kRigidDofs + 1], 0.0);  // the shear left at the hand-over, at 0
@@ -293,7 +312,7 @@ TEST(CliffJump, ClearsTheEdgeLandsUprightAndSettles) {
     }
   }
   EXPECT_EQ(rows, size_t(151 + 1350));  // keyframes at t = 0 .. 1.5, then 13.5 s of simulation
-  EXPECT_EQ(drawn.states.size(), rows);
+  EXPECT_EQ(size_t(states.size()), rows);
   EXPECT_GT(lowest_over_cliff, 0.0);
   EXPECT_GT(landed_at, hand_over);
   EXPECT_LT(max_tilt, 0.01);
@@ -309,7 +328,7 @@ TEST(CliffJump, ClearsTheEdgeLandsUprightAndSettles) {
   w.SetState(0, q, qd);
   const double mgh = table.moments().m * 9.81 * 100.0;
   EXPECT_LT(w.ComputeEnergies(0).kinetic, 1e-4 * mgh);
-  const Eigen::VectorXd q3 = drawn.states.back().q;
+  const Eigen::VectorXd q3 = states.q(states.size() - 1, 0);
   for (int foot : {5, 8}) EXPECT_NEAR(control::PointAt(table, table.lattice_coords(foot), q3).y(), 0.0, 1.0);
 }
 

@@ -1,4 +1,4 @@
-// script::SessionScript without VTK (so it also runs in the ASan build, which has no display): a
+// scene::SessionScript without VTK (so it also runs in the ASan build, which has no display): a
 // World stepped by hand with PD targets changed at chosen steps, written as a script and run
 // by the interpreter, ends in the same state; a change on every step and a change on the
 // first step replay too; bad records are refused; the pull note is written.
@@ -12,7 +12,7 @@
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
 #include "wobble/script/interpreter.h"
-#include "wobble/script/session_script.h"
+#include "wobble/scene/script_writer.h"
 
 namespace wobble {
 namespace {
@@ -21,7 +21,7 @@ const std::string kData = WOBBLE_DATA_DIR;
 
 struct Session {
   std::shared_ptr<const BodyModel> body;
-  script::SessionRecord record;
+  scene::SessionRecord record;
   Eigen::VectorXd q;  // the state at the end
 };
 
@@ -73,7 +73,7 @@ TEST(SessionScript, TargetChangesReplayToTheSameState) {
   const Session s = RunByHand(o, V({0, 40, 0, 0, 0, 0, 0}), 400,
                               {{0, V({0, 0, 0, 0})}, {37, V({0.2, 0, 0, 0})}, {151, V({0.2, -0.1, 0.05, 0})},
                                {152, V({-0.1, -0.1, 0.05, 0.02})}, {390, V({0, 0, 0, 0})}});
-  const Eigen::VectorXd q = Replay(script::SessionScript(s.record));
+  const Eigen::VectorXd q = Replay(scene::SessionScript(s.record));
   ASSERT_EQ(q.size(), s.q.size());
   EXPECT_LT((q - s.q).cwiseAbs().maxCoeff(), 1e-12) << q.transpose() << "\n" << s.q.transpose();
 }
@@ -99,7 +99,7 @@ TEST(SessionScript, ChangesOnEveryStepAndSpringsAndAnotherIntegrator) {
     with_spring = w.options();
   }
   const Session s = RunByHand(with_spring, V({0, 20, 0.05, 0, 0, 0, 0}), 120, every);
-  const Eigen::VectorXd q = Replay(script::SessionScript(s.record));
+  const Eigen::VectorXd q = Replay(scene::SessionScript(s.record));
   EXPECT_LT((q - s.q).cwiseAbs().maxCoeff(), 1e-12) << q.transpose() << "\n" << s.q.transpose();
 }
 
@@ -107,17 +107,17 @@ TEST(SessionScript, RefusesBadRecordsAndNotesPulls) {
   Session s = RunByHand(WorldOptions{}, V({0, 0, 0, 0, 0, 0, 0}), 10, {{0, V({0.1, 0, 0, 0})}, {5, V({0, 0, 0, 0})}});
   s.record.drags = 2;
   s.record.first_drag_step = 4;
-  EXPECT_NE(script::SessionScript(s.record).find("2 pull(s) by the mouse"), std::string::npos);
-  script::SessionRecord bad = s.record;
+  EXPECT_NE(scene::SessionScript(s.record).find("2 pull(s) by the mouse"), std::string::npos);
+  scene::SessionRecord bad = s.record;
   bad.segments[1].step = 0;  // out of order
-  EXPECT_THROW(script::SessionScript(bad), std::invalid_argument);
+  EXPECT_THROW(scene::SessionScript(bad), std::invalid_argument);
   bad = s.record;
   bad.segments[0].targets = V({1, 2});  // wrong size
-  EXPECT_THROW(script::SessionScript(bad), std::invalid_argument);
+  EXPECT_THROW(scene::SessionScript(bad), std::invalid_argument);
   bad = s.record;
   bad.object_path.clear();
-  EXPECT_THROW(script::SessionScript(bad), std::invalid_argument);
-  EXPECT_THROW(script::PoseGraphScript(s.record, {V({0.1, 0, 0, 0})}, {0.0}), std::invalid_argument);
+  EXPECT_THROW(scene::SessionScript(bad), std::invalid_argument);
+  EXPECT_THROW(scene::PoseGraphScript(s.record, {V({0.1, 0, 0, 0})}, {0.0}), std::invalid_argument);
 }
 
 }  // namespace

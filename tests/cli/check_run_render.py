@@ -3,9 +3,10 @@
 # a keyframed half second and a simulated half second become 31 frames (30 fps over 1 s) of
 # the ParaView series, with the keyframed and simulated states in order. Without a display only
 # vtp/disp are written (with a message); with one (make test runs under Xvfb) also PNG frames.
-import os, re, subprocess, sys
+import os, re, shutil, subprocess, sys
 
 wobble, data, work = sys.argv[1:4]
+shutil.rmtree(os.path.join(work, "pics"), ignore_errors=True)  # frames of a run with a display
 os.makedirs(work, exist_ok=True)
 failures = []
 

@@ -13,9 +13,10 @@ std::string TempPathFor(const std::string& path) { return path + ".tmp"; }
 void CreateParentFolder(const std::string& path) {
   namespace fs = std::filesystem;
   const fs::path target(path);
-  std::error_code ec;
+  std::error_code ec;  // a file that does not exist yet is no error here
   if (fs::is_directory(target, ec)) throw std::runtime_error(path + ": is a directory");
-  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+  if (!target.has_parent_path()) return;  // the working directory
+  fs::create_directories(target.parent_path(), ec);
   if (ec) throw std::runtime_error(path + ": cannot create its folder: " + ec.message());
 }
 

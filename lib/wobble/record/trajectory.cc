@@ -174,16 +174,39 @@ Recorder::Recorder(std::shared_ptr<Trajectory> trajectory, int every) : trajecto
   if (every_ < 1) throw std::invalid_argument("Recorder: every must be at least 1");
 }
 
+Recorder::Recorder(std::shared_ptr<Trajectory> trajectory, double fps, double from)
+    : trajectory_(std::move(trajectory)), period_(1.0 / fps), next_(from) {
+  if (!trajectory_) throw std::invalid_argument("Recorder: no trajectory");
+  if (!(fps > 0) || !std::isfinite(period_)) throw std::invalid_argument("Recorder: the frame rate must be positive");
+}
+
+void Recorder::Sample(const World& world) {
+  const Trajectory& t = *trajectory_;
+  if (!t.empty() && t.time(t.size() - 1) >= world.time() - 0.5 * world.options().dt) return;
+  trajectory_->Append(world, energy_.consumed, pose_ ? pose_->pose() : -1);
+}
+
 void Recorder::Start(const World& world) {
   counter_ = 0;
-  trajectory_->Append(world, energy_.consumed, pose_ ? pose_->pose() : -1);
+  if (period_ == 0.0) Sample(world);
+  else SampleFrame(world);
 }
 
 void Recorder::AfterStep(World& world) {
   const double dt = world.options().dt;
   for (int b = 0; b < world.num_bodies(); ++b)
-    if (world.kind(b) == BodyKind::kFfd) energy_.Accumulate(world.body(b), world.state(b), dt);
-  if (++counter_ % every_ == 0) trajectory_->Append(world, energy_.consumed, pose_ ? pose_->pose() : -1);
+    if (world.kind(b) == BodyKind::kFfd && !world.kinematic(b)) energy_.Accumulate(world.body(b), world.state(b), dt);
+  if (period_ > 0.0) SampleFrame(world);
+  else if (++counter_ % every_ == 0) Sample(world);
+}
+
+void Recorder::SampleFrame(const World& world) {
+  // the frame due now, then the next frame time after it (frames closer than a step are skipped)
+  const double t = world.time(), half_step = 0.5 * world.options().dt;
+  if (t + half_step < next_) return;
+  Sample(world);
+  next_ += period_;
+  while (next_ <= t + half_step) next_ += period_;
 }
 
 void Recorder::Finish(const World& world) {

@@ -101,12 +101,18 @@ class Trajectory {
 BodyInfo DescribeBody(const World& world, int body);
 
 // The recorder: a Controller the world calls after every accepted step (World::SetRecorder),
-// appending every `every`-th step to its trajectory. Start() records the first sample. It also
-// integrates the control energy of the FFD bodies (control::ControlEnergy, every step).
+// appending samples to its trajectory either every `every`-th step or at a frame rate. It also
+// integrates the control energy of the FFD bodies the world moves (control::ControlEnergy,
+// every step; kinematic bodies are moved by their controllers, not by the PD forces).
 class Recorder : public Controller {
  public:
+  // A sample after every `every`-th step.
   explicit Recorder(std::shared_ptr<Trajectory> trajectory, int every = 1);
-  // The sample at the world's state now (the run's start); resets the step counter.
+  // `fps` samples per simulated second, the first due at time `from` (a film's frame times
+  // from, from + 1/fps, ...): a sample of the first state at or past each (to half a step).
+  Recorder(std::shared_ptr<Trajectory> trajectory, double fps, double from);
+  // The start of a run: a sample of the state now when one is due (always when sampling every
+  // N steps, whose count restarts here), unless the trajectory ends at this time already.
   void Start(const World& world);
   void AfterStep(World& world) override;
   // Records the state now unless it is the last sample (the end of a run recorded every N).
@@ -118,9 +124,12 @@ class Recorder : public Controller {
   void set_control_energy(const control::ControlEnergy& e) { energy_ = e; }
 
  private:
+  void Sample(const World& world);       // appends unless the trajectory ends at this time already
+  void SampleFrame(const World& world);  // frame-rate sampling: a sample when a frame is due
   std::shared_ptr<Trajectory> trajectory_;
   int every_ = 1;
   long counter_ = 0;
+  double period_ = 0.0, next_ = 0.0;  // frame-rate sampling when period_ > 0
   control::ControlEnergy energy_;
   std::shared_ptr<const control::PoseSource> pose_;
 };

@@ -1,0 +1,117 @@
+#include "wobble/scene/object_runs.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <utility>
+
+namespace wobble::scene {
+
+namespace {
+
+// (run, sample) of every sample of the motion, each hand-over once.
+std::vector<std::pair<int, int>> Samples(const ObjectRuns& runs) {
+  std::vector<std::pair<int, int>> s;
+  for (int r = 0; r < int(runs.size()); ++r)
+    for (int k = 0; k < runs[r]->size(); ++k) {
+      if (k == 0 && !s.empty() && runs[s.back().first]->time(s.back().second) == runs[r]->time(0)) s.pop_back();
+      s.emplace_back(r, k);
+    }
+  return s;
+}
+
+// The motion's modes by name, first seen first, and each run's column for each of its modes.
+struct ModeColumns {
+  std::vector<std::string> names;
+  std::vector<std::vector<int>> of_run;
+  explicit ModeColumns(const ObjectRuns& runs) {
+    for (const auto& run : runs) {
+      const std::vector<std::string>& coords = run->bodies().at(0).coordinate_names;
+      std::vector<int> columns;
+      for (size_t c = kRigidDofs; c < coords.size(); ++c) {
+        const auto it = std::find(names.begin(), names.end(), coords[c]);
+        columns.push_back(int(it - names.begin()));
+        if (it == names.end()) names.push_back(coords[c]);
+      }
+      of_run.push_back(std::move(columns));
+    }
+  }
+};
+
+// t, q and q̇ of sample k of a run on the motion's modes, and its PD targets on them.
+std::vector<double> MappedState(const record::Trajectory& run, int k, const std::vector<int>& columns, int num_modes,
+                                Eigen::VectorXd* targets = nullptr) {
+  const int nq = kRigidDofs + num_modes;
+  std::vector<double> row(1 + 2 * nq, 0.0);
+  row[0] = run.time(k);
+  const auto q = run.q(k, 0), qd = run.qd(k, 0);
+  for (int i = 0; i < kRigidDofs; ++i) {
+    row[1 + i] = q[i];
+    row[1 + nq + i] = qd[i];
+  }
+  for (size_t d = 0; d < columns.size(); ++d) {
+    row[1 + kRigidDofs + columns[d]] = q[kRigidDofs + int(d)];
+    row[1 + nq + kRigidDofs + columns[d]] = qd[kRigidDofs + int(d)];
+  }
+  if (targets) {
+    targets->setZero(num_modes);
+    for (size_t d = 0; d < columns.size(); ++d) (*targets)[columns[d]] = run.targets(k, 0)[int(d)];
+  }
+  return row;
+}
+
+}  // namespace
+
+record::Trajectory MergeRuns(const ObjectRuns& runs) {
+  if (runs.empty()) throw std::invalid_argument("MergeRuns: no runs");
+  const ModeColumns columns(runs);
+  const int N = int(columns.names.size());
+  std::vector<DeformationMode> modes(N);
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const BodyModel& body = *runs[r]->bodies().at(0).ffd;
+    for (int d = 0; d < body.num_modes(); ++d) modes[columns.of_run[r][d]] = body.modes()[d];
+  }
+  record::BodyInfo info = runs[0]->bodies()[0];
+  info.ffd = std::make_shared<const BodyModel>(info.ffd->def(), modes);
+  info.coordinate_names.resize(kRigidDofs);
+  info.coordinate_names.insert(info.coordinate_names.end(), columns.names.begin(), columns.names.end());
+  info.num_q = kRigidDofs + N;
+  record::Trajectory merged({info});
+  for (const auto& [r, k] : Samples(runs)) {
+    const record::Trajectory& run = *runs[r];
+    Eigen::VectorXd targets;
+    std::vector<double> row = MappedState(run, k, columns.of_run[r], N, &targets);
+    row.insert(row.end(), targets.data(), targets.data() + N);
+    const Energies e = run.energies(k, 0);
+    for (double v : {e.kinetic, e.gravity, e.modes, e.ground, e.springs, e.total(), double(run.contacts(k, 0)),
+                     run.penetration(k, 0), run.control_energy(k), double(run.pose(k)), run.violation(k)})
+      row.push_back(v);
+    merged.AppendRow(row);
+  }
+  return merged;
+}
+
+Table OutputTable(const ObjectRuns& runs, int every) {
+  const ModeColumns columns(runs);
+  const int N = int(columns.names.size());
+  Table t;
+  t.header = {"t", "tx", "ty", "theta"};
+  for (int d = 1; d <= N; ++d) t.header.push_back("g" + std::to_string(d));
+  for (const char* n : {"dtx", "dty", "dtheta"}) t.header.push_back(n);
+  for (int d = 1; d <= N; ++d) t.header.push_back("dg" + std::to_string(d));
+  for (const char* n : {"kinetic", "gravity", "modes", "ground", "springs", "total", "control_energy", "pose", "contacts"})
+    t.header.push_back(n);
+  const std::vector<std::pair<int, int>> samples = Samples(runs);
+  for (size_t i = 0; i < samples.size(); i += size_t(every)) {
+    const auto [r, k] = samples[i];
+    const record::Trajectory& run = *runs[r];
+    std::vector<double> row = MappedState(run, k, columns.of_run[r], N);
+    const Energies e = run.energies(k, 0);
+    for (double v : {e.kinetic, e.gravity, e.modes, e.ground, e.springs, e.total(), run.control_energy(k),
+                     double(run.pose(k)), double(run.contacts(k, 0))})
+      row.push_back(v);
+    t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+
+}  // namespace wobble::scene

@@ -1,0 +1,252 @@
+#include "wobble/scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace wobble::scene {
+
+// A run going on: the world it steps, and for the FFD object's runs the recorder that keeps
+// every step (and integrates the control energy).
+struct Scene::Run {
+  RunKind kind = RunKind::kSimulate;
+  World* world = nullptr;
+  double start_time = 0.0;
+  long steps = 0;                              // taken
+  std::shared_ptr<record::Recorder> recorder;  // null for the scene's runs
+};
+
+// The behaviour Sequencer as a controller of the scene's world: before every step the current
+// behaviour acts (W&W §4: it may switch constraints or give impulses), then the names it
+// made are no longer promised.
+class Scene::Behaviours : public Controller {
+ public:
+  explicit Behaviours(Scene& scene) : scene_(scene) {}
+  void BeforeStep(World& world) override {
+    control::BehaviourContext ctx{&world, &scene_.constraints_};
+    scene_.sequencer_.BeforeStep(ctx, scene_.log_);
+    if (scene_.promised_.empty()) return;
+    for (const auto& kv : scene_.constraints_) scene_.promised_.erase(kv.first);
+  }
+
+ private:
+  Scene& scene_;
+};
+
+Scene::Scene() {
+  // the thesis' interpreter integrates with the explicit scheme; appendix C's dt = 0.1 with its
+  // mode damping (c/m_eff Δt > 2) is beyond that scheme's stability, so scenes default to
+  // implicit Euler (`set integrator thesis` switches back)
+  options_.integrator = Integrator::kImplicitEuler;
+  options_.dt = 0.01;
+}
+
+Scene::~Scene() = default;
+
+WorldOptions Scene::ObjectWorldOptions(const BodyModel& body) const {
+  WorldOptions o = options_;
+  o.params.springs.clear();
+  if (springs_.enabled)
+    for (Spring sp : springs_.list) {
+      body.LocalBasis(sp.lattice_coords, &sp.rest_local, &sp.mode_matrix);
+      o.params.springs.push_back(sp);
+    }
+  return o;
+}
+
+SimulationSetup Scene::CurrentSetup() const {
+  SimulationSetup setup;
+  setup.body = object_.Body();
+  if (!setup.body) return setup;
+  setup.world = ObjectWorldOptions(*setup.body);
+  setup.q = object_.q();
+  setup.qd = object_.qd();
+  setup.time = time_;
+  setup.end = end_;
+  if (control_.enabled) setup.graph = control_.graph;
+  setup.object_path = object_.path();
+  setup.mode_paths = object_.mode_paths();
+  return setup;
+}
+
+// ---------------------------------------------------------------- the Witkin & Welch scene
+
+World& Scene::world() {
+  if (!world_) {
+    WorldOptions o;
+    o.params = options_.params;
+    o.dt = options_.dt;
+    world_ = std::make_unique<World>(o);
+    world_->AddController(std::make_shared<Behaviours>(*this));
+  }
+  return *world_;
+}
+
+int Scene::AddLinearBody(const std::string& name, std::shared_ptr<const LinearBodyModel> model,
+                         const AffineMaterial& material, const Eigen::VectorXd& at, LinearDrawing drawing) {
+  if (bodies_.count(name)) throw std::invalid_argument("a body named '" + name + "' exists already");
+  World& w = world();
+  const int dim = model->dim(), n = model->basis_size();
+  const int b = w.AddLinearBody(model, material);
+  w.SetLinearState(b, model->PlacedState(Eigen::MatrixXd::Identity(dim, dim), at), Eigen::MatrixXd::Zero(dim, n));
+  bodies_[name] = b;
+  drawings_.resize(w.num_bodies());
+  drawings_[b] = std::move(drawing);
+  return b;
+}
+
+int Scene::AddObjectBody(const std::string& name) {
+  if (bodies_.count(name)) throw std::invalid_argument("a body named '" + name + "' exists already");
+  const std::shared_ptr<const BodyModel> body = object_.Body();
+  if (!body) throw std::logic_error("AddObjectBody: no FFD object is loaded");
+  World& w = world();
+  const int b = w.AddBody(body);
+  w.SetState(b, object_.q(), object_.qd());
+  bodies_[name] = b;
+  drawings_.resize(w.num_bodies());
+  return b;
+}
+
+void Scene::AddAnchor(control::Anchor anchor) {
+  if (anchors_.count(anchor.name)) throw std::invalid_argument("a point or place named '" + anchor.name + "' exists already");
+  const std::string name = anchor.name;
+  anchors_[name] = std::move(anchor);
+}
+
+Eigen::VectorXd Scene::Point(const std::string& name) const {
+  if (!world_ || !anchors_.count(name)) throw std::out_of_range("no scene point '" + name + "'");
+  return anchors_.at(name).Position(*world_);
+}
+
+int Scene::Constraint(const std::string& name) const {
+  const auto it = constraints_.find(name);
+  return !world_ || it == constraints_.end() || !world_->exists(it->second) ? -1 : it->second;
+}
+
+void Scene::SetCamera(double azimuth, double elevation) {
+  azimuth_ = azimuth;
+  elevation_ = elevation;
+}
+
+SceneDrawing Scene::Drawing() const {
+  SceneDrawing d;
+  d.drawings = drawings_;
+  for (const auto& [name, a] : anchors_) d.anchors.push_back(a);
+  d.azimuth = azimuth_;
+  d.elevation = elevation_;
+  return d;
+}
+
+void Scene::Record(double fps) {
+  record_fps_ = fps;
+  World& w = world();
+  recorder_.reset();
+  if (fps > 0) {
+    if (!recorded_ || recorded_->num_bodies() != w.num_bodies()) recorded_ = std::make_shared<record::Trajectory>(w);
+    recorder_ = std::make_shared<record::Recorder>(recorded_, fps, w.time());
+  }
+  w.SetRecorder(recorder_);
+}
+
+// ---------------------------------------------------------------- runs
+
+void Scene::BeginRun(RunKind kind) {
+  if (run_) throw std::logic_error("BeginRun: a run is going on (EndRun first)");
+  if (kind == RunKind::kKeyframes || !has_bodies()) {
+    BeginObjectRun(kind);
+    return;
+  }
+  World& w = *world_;
+  // the scene's parameters as they are now apply to its world
+  WorldOptions& o = w.mutable_options();
+  o.dt = options_.dt;
+  o.params.gravity_on = options_.params.gravity_on;
+  o.params.ground = options_.params.ground;
+  if (record_fps_ > 0 && recorded_->num_bodies() != w.num_bodies()) Record(record_fps_);
+  if (recorder_) recorder_->Start(w);
+  run_ = std::make_unique<Run>();
+  run_->world = run_world_ = &w;
+  run_->start_time = w.time();
+}
+
+void Scene::BeginObjectRun(RunKind kind) {
+  const std::shared_ptr<const BodyModel> body = object_.Body();
+  if (!body) throw std::logic_error("BeginRun: no FFD object is loaded");
+  auto w = std::make_unique<World>(ObjectWorldOptions(*body));
+  w->AddBody(body);
+  w->SetState(0, object_.q(), object_.qd());
+  w->SetTime(time_);
+  auto recorder = std::make_shared<record::Recorder>(std::make_shared<record::Trajectory>(*w));
+  recorder->set_control_energy(energy_);
+  if (kind == RunKind::kKeyframes) {
+    w->AddController(std::make_shared<control::KeyframeController>(*w, 0, control_.keys, control_.hold));
+  } else if (control_.enabled && !control_.graph.empty()) {
+    // the pose graph cycles from its first pose at the start of every run (chapter 5)
+    auto graph = std::make_shared<control::PoseGraphController>(*w, 0, control_.graph, control_.switch_width);
+    w->AddController(graph);
+    recorder->SetPoseSource(graph);
+  }
+  w->SetRecorder(recorder);
+  recorder->Start(*w);
+  object_world_ = std::move(w);
+  run_ = std::make_unique<Run>();
+  run_->kind = kind;
+  run_->world = run_world_ = object_world_.get();
+  run_->start_time = time_;
+  run_->recorder = std::move(recorder);
+}
+
+bool Scene::Step() {
+  if (!run_) throw std::logic_error("Step: no run (BeginRun first)");
+  if (!run_->world->Step()) return false;
+  ++run_->steps;
+  return true;
+}
+
+void Scene::EndRun() { Finish(true); }
+
+void Scene::Finish(bool act_due_behaviours) {
+  if (!run_) throw std::logic_error("EndRun: no run");
+  const std::unique_ptr<Run> run = std::move(run_);  // ended, even when a behaviour throws below
+  World& w = *run->world;
+  if (!run->recorder) {
+    time_ = w.time();
+    // behaviours due at the end time act now (a Connect at a chase's contact time at the end)
+    if (act_due_behaviours && run->steps > 0 && w.status().ok()) Behaviours(*this).BeforeStep(w);
+    return;
+  }
+  // the hand-over: the object goes on from the run's last state
+  object_.SetState(w.state(0).q, w.state(0).qd);
+  energy_ = run->recorder->control_energy();
+  time_ = run->kind == RunKind::kKeyframes ? run->start_time + control_.keys.Duration() : w.time();
+  last_object_run_ = run->recorder->trajectory();
+}
+
+RunReport Scene::Advance(long steps, const StepCallback& on_step) {
+  // every step is kept: room for them at once (up to a million; beyond, it grows)
+  if (run_->recorder) run_->recorder->trajectory()->reserve(int(std::min(steps, 1000000L)) + 1);
+  try {
+    for (long n = 1; n <= steps && Step(); ++n)
+      if (on_step) on_step(n, steps, *run_->world);
+  } catch (...) {
+    Finish(false);
+    throw;
+  }
+  RunReport report;
+  report.steps = steps;
+  report.status = run_->world->status();
+  Finish(true);
+  return report;
+}
+
+RunReport Scene::Simulate(double duration, const StepCallback& on_step) {
+  BeginRun(RunKind::kSimulate);
+  return Advance(std::lround(duration / options_.dt), on_step);
+}
+
+RunReport Scene::Keyframe(const StepCallback& on_step) {
+  BeginRun(RunKind::kKeyframes);
+  return Advance(std::lround(control_.keys.Duration() / options_.dt), on_step);
+}
+
+}  // namespace wobble::scene

@@ -1,0 +1,299 @@
+// The commands of the FFD object (thesis §4.10.2, appendix C): loading it, its modes and
+// state, its control (pose graphs, keyframes, springs), its runs and what they record
+// (`output`, `render`), and the few commands every mode shares (print, echo, help, quit).
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "wobble/formats/csv.h"
+#include "wobble/script/internal/interpreter_internal.h"
+
+namespace wobble::script {
+
+using namespace script_detail;
+
+namespace {
+
+int ModeIndex(const State& s, const std::string& word, const Context& ctx) {
+  const std::vector<DeformationMode>& modes = s.scene.object().modes();
+  int index;
+  if (formats::detail::ParseInt(word, &index)) {
+    if (index < 1 || index > int(modes.size()))
+      ctx.Fail("expected a mode number from 1 to " + std::to_string(modes.size()) + ", got " + word);
+    return index - 1;
+  }
+  std::vector<std::string> names;
+  for (const DeformationMode& m : modes) names.push_back(m.name);
+  const int d = s.scene.object().ModeIndex(word);
+  if (d < 0) {
+    const std::string near = Interpreter::Nearest(word, names);
+    ctx.Fail("no mode '" + word + "' (expected a mode number or one of the loaded names" +
+             (near.empty() ? std::string(")") : "; did you mean '" + near + "'?)"));
+  }
+  return d;
+}
+
+// Writes the `output` CSV from every run since `output` (the whole file after every run).
+void FlushOutput(const State& s, const Context& ctx) {
+  if (s.output_path.empty()) return;
+  const scene::Table table = scene::OutputTable(s.output_runs, s.output_every);
+  try {
+    formats::WriteCsvAtomically(s.output_path, table.header, table.rows);
+  } catch (const std::runtime_error& e) {
+    ctx.Fail(std::string("output: ") + e.what());
+  }
+}
+
+// The run just ended joins what `render` draws and what `output` writes.
+void KeepRun(State& s, const Context& ctx) {
+  s.track.push_back(s.scene.last_object_run());
+  if (!s.output_path.empty()) s.output_runs.push_back(s.scene.last_object_run());
+  FlushOutput(s, ctx);
+}
+
+}  // namespace
+
+void RequireObject(const State& s, const Context& ctx, const std::string& command) {
+  if (!s.scene.object().loaded())
+    ctx.Fail(command + " needs an object: 'load_obj FILE' first (or run with --object FILE)");
+}
+
+scene::StepCallback StepObserver(State& s, bool object) {
+  if (!s.progress && !(object && s.debug)) return nullptr;
+  return [&s, object](long n, long steps, const World& world) {
+    if (object && s.debug) {
+      s.out << "t " << Num(world.time()) << " q";
+      for (int i = 0; i < world.state(0).q.size(); ++i) s.out << " " << Num(world.state(0).q[i]);
+      s.out << "\n";
+    }
+    if (s.progress && ((n - 1) % 64 == 0 || n == steps)) s.progress(double(n) / double(steps), world.time());
+  };
+}
+
+void LoadObj(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 2, 2);
+  s.scene.object().Load(Resolve(w[1], ctx.dir));
+  s.track.clear();
+}
+
+void LoadDef(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 2, 64);
+  RequireObject(s, ctx, "load_def");
+  std::vector<std::string> paths;
+  for (size_t i = 1; i < w.size(); ++i) paths.push_back(Resolve(w[i], ctx.dir));
+  try {
+    s.scene.object().LoadModes(paths);
+  } catch (const std::invalid_argument& e) {
+    ctx.Fail(std::string("the modes do not fit the object: ") + e.what());
+  }
+  // poses list the active modes and keys every mode: they no longer fit (§4.10)
+  s.scene.control().graph = {};
+  s.scene.control().keys = {};
+}
+
+void Trans(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 4, 4);
+  s.scene.object().SetPlacement({Number(w[1], "X", ctx), Number(w[2], "Y", ctx), Number(w[3], "THETA", ctx)});
+}
+
+void Assign(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 4, 4);
+  RequireObject(s, ctx, "assign");
+  if (s.scene.object().modes().empty()) ctx.Fail("assign needs modes: 'load_def FILE' first");
+  const int d = ModeIndex(s, w[1], ctx);
+  const double k = Number(w[2], "STIFFNESS", ctx), c = Number(w[3], "DAMPING", ctx);
+  if (k < 0 || c < 0) ctx.Fail("expected a non-negative stiffness and damping");
+  s.scene.object().Assign(d, k, c);
+}
+
+void Mode(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 3, 3);
+  RequireObject(s, ctx, "mode");
+  if (s.scene.object().modes().empty()) ctx.Fail("mode needs modes: 'load_def FILE' first");
+  const int d = ModeIndex(s, w[1], ctx);
+  if (w[2] != "active" && w[2] != "passive") ctx.Fail("expected 'active' or 'passive', got '" + w[2] + "'");
+  const bool active = w[2] == "active";
+  if (s.scene.object().modes()[d].active != active) s.scene.control().graph = {};  // poses list the active modes
+  s.scene.object().SetActive(d, active);
+}
+
+void SetVec(State& s, const Words& w, const Context& ctx) {
+  RequireObject(s, ctx, "set_vec");
+  const int n = kRigidDofs + int(s.scene.object().modes().size());
+  if (w.size() < 2 || (w[1] != "q" && w[1] != "dq")) ctx.Fail("expected 'set_vec q V1 .. Vn' or 'set_vec dq V1 .. Vn'");
+  if (int(w.size()) - 2 != n)
+    ctx.Fail("expected " + std::to_string(n) + " numbers after 'set_vec " + w[1] + "' (tx ty theta and one per mode), got " +
+             std::to_string(w.size() - 2));
+  Eigen::VectorXd v(n);
+  for (int i = 0; i < n; ++i) v[i] = Number(w[2 + i], "a coordinate", ctx);
+  if (w[1] == "q") s.scene.object().SetRelativeQ(v);
+  else s.scene.object().SetRelativeQd(v);
+}
+
+void Simul(State& s, const Words& w, const Context& ctx) {
+  if (s.scene.has_bodies()) return SceneSimul(s, w, ctx);
+  ctx.ExpectWords(w, 1, 2);
+  RequireObject(s, ctx, "simul");
+  double duration = s.scene.end() - s.scene.time();
+  if (w.size() == 2) {
+    duration = Number(w[1], "DURATION", ctx);
+    if (duration < 0) ctx.Fail("expected a non-negative DURATION");
+  } else if (duration < 0) {
+    ctx.Fail("end (" + Num(s.scene.end()) + ") is before time (" + Num(s.scene.time()) +
+             "): set end later, or give a DURATION");
+  }
+  scene::RunReport r;
+  try {
+    r = s.scene.Simulate(duration, StepObserver(s, true));
+  } catch (const std::invalid_argument& e) {  // the pose graph does not fit the active modes
+    ctx.Fail(e.what());
+  }
+  KeepRun(s, ctx);
+  if (!r.ok())
+    throw SimulationStopped(ctx.file + ":" + std::to_string(ctx.line) + ": simulation stopped: " + r.status.message);
+  const Energies e = s.scene.run_world()->ComputeEnergies(0);
+  s.out << "simul: t = " << Num(s.scene.time()) << ", " << r.steps << " steps; kinetic " << Num(e.kinetic) << ", total "
+        << Num(e.total()) << ", control energy " << Num(s.scene.control_energy().consumed) << "\n";
+}
+
+void Pose(State& s, const Words& w, const Context& ctx) {
+  RequireObject(s, ctx, "pose");
+  const int k = int(control::ActiveModes(*s.scene.object().Body()).size());
+  if (k == 0) ctx.Fail("pose needs active modes: 'mode MODE active' first");
+  if (int(w.size()) != k + 2) ctx.Fail("expected 'pose' with " + std::to_string(k) + " targets (one per active mode) and a DURATION");
+  Eigen::VectorXd pose(k);
+  for (int i = 0; i < k; ++i) pose[i] = Number(w[1 + i], "a target amplitude", ctx);
+  const double duration = Number(w.back(), "DURATION", ctx);
+  if (!(duration > 0)) ctx.Fail("expected a positive DURATION, got " + w.back());
+  s.scene.control().graph.poses.push_back(pose);
+  s.scene.control().graph.durations.push_back(duration);
+}
+
+void Key(State& s, const Words& w, const Context& ctx) {
+  RequireObject(s, ctx, "key");
+  if (w.size() < 2) ctx.Fail("expected '" + ctx.usage + "'");
+  control::Keyframes& keys = s.scene.control().keys;
+  const double t = Number(w[1], "TIME", ctx);
+  if (keys.times.empty() && t != 0.0) ctx.Fail("the first key must be at time 0");
+  if (!keys.times.empty() && !(t > keys.times.back())) ctx.Fail("expected a key time after " + Num(keys.times.back()) + ", got " + w[1]);
+  const Eigen::VectorXd& q = s.scene.object().q();
+  Eigen::VectorXd a = keys.amplitudes.empty() ? Eigen::VectorXd(q.tail(q.size() - kRigidDofs)) : keys.amplitudes.back();
+  for (size_t i = 2; i < w.size(); ++i) {
+    const size_t eq = w[i].find('=');
+    if (eq == std::string::npos || eq == 0) ctx.Fail("expected MODE=VALUE, got '" + w[i] + "'");
+    a[ModeIndex(s, w[i].substr(0, eq), ctx)] = Number(w[i].substr(eq + 1), "an amplitude after '='", ctx);
+  }
+  keys.times.push_back(t);
+  keys.amplitudes.push_back(a);
+}
+
+void Hold(State& s, const Words& w, const Context& ctx) {
+  control::HeldPoint& hold = s.scene.control().hold;
+  if (w.size() == 2 && w[1] == "off") {
+    hold.enabled = false;
+    return;
+  }
+  ctx.ExpectWords(w, 3, 3);
+  const double u = Number(w[1], "S", ctx), v = Number(w[2], "T", ctx);
+  if (u < 0 || u > 1 || v < 0 || v > 1) ctx.Fail("expected lattice coordinates S and T in [0, 1]");
+  hold.enabled = true;
+  hold.lattice_coords = {u, v};
+}
+
+void Keyframe(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 1, 1);
+  RequireObject(s, ctx, "keyframe");
+  scene::RunReport r;
+  try {
+    r = s.scene.Keyframe(StepObserver(s, true));
+  } catch (const std::invalid_argument& e) {
+    ctx.Fail(std::string(e.what()) + " ('key TIME MODE=VALUE ...' lines first)");
+  }
+  KeepRun(s, ctx);
+  const Eigen::VectorXd& qd = s.scene.object().qd();
+  s.out << "keyframe: t = " << Num(s.scene.time()) << ", " << r.steps << " frames; handed over with dq = [";
+  for (int i = 0; i < qd.size(); ++i) s.out << (i ? " " : "") << Num(qd[i]);
+  s.out << "]\n";
+}
+
+void SpringCommand(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 5, 8);
+  RequireObject(s, ctx, "spring");
+  Spring sp;
+  sp.lattice_coords = {Number(w[1], "S", ctx), Number(w[2], "T", ctx)};
+  if (sp.lattice_coords.minCoeff() < 0 || sp.lattice_coords.maxCoeff() > 1)
+    ctx.Fail("expected lattice coordinates S and T in [0, 1]");
+  sp.anchor = {Number(w[3], "X", ctx), Number(w[4], "Y", ctx)};
+  sp.stiffness = w.size() > 5 ? Number(w[5], "K", ctx) : s.spring_stiffness;
+  sp.damping = w.size() > 6 ? Number(w[6], "C", ctx) : s.spring_damping;
+  sp.rest_length = w.size() > 7 ? Number(w[7], "REST", ctx) : 0.0;
+  if (sp.stiffness < 0 || sp.damping < 0 || sp.rest_length < 0) ctx.Fail("expected non-negative K, C and REST");
+  s.scene.springs().list.push_back(sp);
+}
+
+void Clear(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 2, 2);
+  if (w[1] == "poses") s.scene.control().graph = {};
+  else if (w[1] == "keys") s.scene.control().keys = {};
+  else if (w[1] == "springs") s.scene.springs().list.clear();
+  else if (w[1] == "output") s.output_runs.clear();
+  else if (w[1] == "energy") s.scene.control_energy() = {};
+  else if (w[1] == "track") s.track.clear();
+  else ctx.Fail("expected poses, keys, springs, output, energy or track after 'clear', got '" + w[1] + "'");
+}
+
+void Output(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 2, 3);
+  s.output_runs.clear();
+  if (w[1] == "off") {
+    s.output_path.clear();
+    return;
+  }
+  int every = 1;
+  if (w.size() == 3 && (!formats::detail::ParseInt(w[2], &every) || every < 1))
+    ctx.Fail("expected EVERY as a whole number >= 1, got '" + w[2] + "'");
+  s.output_path = w[1];
+  s.output_every = every;
+}
+
+void Print(State& s, const Words& w, const Context& ctx) {
+  if (s.scene.has_bodies()) return ScenePrint(s, w, ctx);
+  ctx.ExpectWords(w, 1, 1);
+  RequireObject(s, ctx, "print");
+  const Eigen::VectorXd &q = s.scene.object().q(), &qd = s.scene.object().qd();
+  s.out << "t = " << Num(s.scene.time()) << "  q = [";
+  for (int i = 0; i < q.size(); ++i) s.out << (i ? " " : "") << Num(q[i]);
+  s.out << "]  dq = [";
+  for (int i = 0; i < qd.size(); ++i) s.out << (i ? " " : "") << Num(qd[i]);
+  s.out << "]  control energy " << Num(s.scene.control_energy().consumed) << "\n";
+}
+
+void Render(State& s, const Words& w, const Context& ctx) {
+  if (s.scene.has_bodies()) return SceneRender(s, w, ctx);
+  ctx.ExpectWords(w, 2, 3);
+  RequireObject(s, ctx, "render");
+  if (s.track.empty()) ctx.Fail("render: nothing to draw yet (run 'simul' or 'keyframe' first)");
+  if (!s.render_hook) ctx.Fail("render: this program has no renderer ('wobble run' has one)");
+  RenderRequest request;
+  request.dir = w[1];
+  request.what = w.size() > 2 ? w[2] : "";
+  const auto merged = std::make_shared<const record::Trajectory>(scene::MergeRuns(s.track));
+  request.world = s.scene.ObjectWorldOptions(*merged->bodies()[0].ffd);
+  request.trajectory = merged;
+  try {
+    s.render_hook(request);
+  } catch (const std::exception& e) {
+    ctx.Fail(std::string("render: ") + e.what());
+  }
+}
+
+void Echo(State& s, const Words& w, const Context&) {
+  for (size_t i = 1; i < w.size(); ++i) s.out << (i > 1 ? " " : "") << w[i];
+  s.out << "\n";
+}
+
+void Help(State& s, const Words&, const Context&) { s.out << Interpreter::Help(); }
+
+void Quit(State& s, const Words&, const Context&) { s.quit = true; }
+
+}  // namespace wobble::script

@@ -1,0 +1,168 @@
+// Motion synthesis from a script (thesis §5.1–5.2): `anneal` and `cmaes` refine the scene's
+// pose graph by trials of the FFD object, `gait` measures it, `save` writes the script that
+// replays it.
+#include "wobble/formats/atomic_file.h"
+#include "wobble/formats/csv.h"
+#include "wobble/scene/script_writer.h"
+#include "wobble/script/internal/interpreter_internal.h"
+#ifdef WOBBLE_HAVE_PAGMO
+#include "wobble/synth/cmaes.h"
+#endif
+
+namespace wobble::script {
+
+using namespace script_detail;
+
+namespace {
+
+// The whole number after `command`, or the error naming what was expected.
+int Count(const Words& w, const std::string& what, const Context& ctx) {
+  int n;
+  if (!formats::detail::ParseInt(w[1], &n) || n < 0) ctx.Fail("expected " + what + " as a whole number >= 0, got '" + w[1] + "'");
+  return n;
+}
+
+// The optimiser's result becomes the scene's pose graph; its history goes to `csv` (and the
+// CLI's hook, which draws it beside: Fig. 5.4/5.5).
+void Adopt(State& s, synth::AnnealResult r, const std::string& csv, const std::string& optimiser, const char* command,
+           const Context& ctx) {
+  if (!csv.empty()) {
+    try {
+      formats::WriteCsvAtomically(csv, synth::HistoryHeader(), synth::HistoryRows(r.history));
+      if (s.history_hook) s.history_hook(csv, optimiser, r.history);
+    } catch (const std::runtime_error& e) {
+      ctx.Fail(e.what());
+    }
+  }
+  s.out << command << ": " << r.trials << " trials; cost " << Num(r.initial_outcome.cost) << " -> "
+        << Num(r.best_outcome.cost) << " (distance " << Num(r.best_outcome.distance) << ", end speed "
+        << Num(r.best_outcome.speed) << ", control energy " << Num(r.best_outcome.energy) << ")\n";
+  s.scene.control().graph = r.best;
+  s.anneal = std::move(r);
+}
+
+// The start of an optimisation: the graph cycles, the trials start from the state now.
+synth::Problem StartOptimising(State& s) {
+  const synth::Problem problem = MakeProblem(s, s.trial_steps);
+  s.scene.control().graph.cyclic = true;
+  s.anneal_start_q = s.scene.object().q();
+  s.anneal_start_qd = s.scene.object().qd();
+  return problem;
+}
+
+}  // namespace
+
+synth::Problem MakeProblem(const State& s, long steps) {
+  synth::Problem p;
+  p.body = s.scene.object().Body();
+  p.world = s.scene.ObjectWorldOptions(*p.body);
+  p.q0 = s.scene.object().q();
+  p.qd0 = s.scene.object().qd();
+  p.steps = steps;
+  p.cost = s.cost;
+  return p;
+}
+
+void Anneal(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 2, 2);
+  RequireObject(s, ctx, "anneal");
+  const int iterations = Count(w, "ITERATIONS", ctx);
+  if (s.scene.control().graph.empty()) ctx.Fail("anneal needs an initial pose graph: 'pose ...' lines first");
+  synth::AnnealOptions o = s.anneal_options;
+  o.iterations = iterations;
+  const std::string invalid = o.Validate();
+  if (!invalid.empty()) ctx.Fail("anneal: " + invalid);
+  const synth::Problem problem = StartOptimising(s);
+  synth::AnnealResult r = synth::Anneal(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
+    if (s.progress) s.progress(iterations ? double(rec.iteration) / iterations : 1.0, rec.best);
+  });
+  Adopt(s, std::move(r), s.anneal_csv, "simulated annealing", "anneal", ctx);
+}
+
+void Cmaes(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 2, 2);
+  RequireObject(s, ctx, "cmaes");
+  const int generations = Count(w, "GENERATIONS", ctx);
+  if (s.scene.control().graph.empty()) ctx.Fail("cmaes needs an initial pose graph: 'pose ...' lines first");
+#ifdef WOBBLE_HAVE_PAGMO
+  const synth::AnnealOptions& a = s.anneal_options;
+  synth::CmaesOptions o;
+  o.seed = a.seed;
+  o.generations = generations;
+  o.population = a.batch;
+  o.sigma0 = s.sigma0;
+  o.optimize = a.optimize;
+  o.min_amplitude = a.min_amplitude;
+  o.max_amplitude = a.max_amplitude;
+  o.min_time = a.min_time;
+  o.max_time = a.max_time;
+  const std::string invalid = o.Validate();
+  if (!invalid.empty()) ctx.Fail("cmaes: " + invalid + " (the population is `batch`)");
+  const synth::Problem problem = StartOptimising(s);
+  synth::AnnealResult r = synth::Cmaes(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
+    if (s.progress) s.progress(generations ? double(rec.iteration) / generations : 1.0, rec.best);
+  });
+  Adopt(s, std::move(r), s.cmaes_csv, "CMA-ES", "cmaes", ctx);
+#else
+  (void)generations;
+  ctx.Fail("cmaes: this wobble was built without pagmo2 (Debian: libpagmo-dev); use anneal");
+#endif
+}
+
+void Gait(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 3, 3);
+  RequireObject(s, ctx, "gait");
+  int skip, cycles;
+  if (!formats::detail::ParseInt(w[1], &skip) || skip < 0 || !formats::detail::ParseInt(w[2], &cycles) || cycles < 1)
+    ctx.Fail("expected 'gait SKIP CYCLES' with SKIP >= 0 and CYCLES >= 1 whole numbers");
+  const control::PoseGraph& graph = s.scene.control().graph;
+  if (graph.empty() || !graph.cyclic) ctx.Fail("gait needs a cyclic pose graph: 'pose ...' lines first");
+  const std::string invalid = graph.Validate(int(control::ActiveModes(*s.scene.object().Body()).size()));
+  if (!invalid.empty()) ctx.Fail("pose graph: " + invalid);
+  // from the anneal's start state when there was one: the gait the trials measured
+  const std::vector<double> d = synth::DistancePerCycle(SynthesisProblem(s), graph, skip, cycles);
+  s.out << "gait: period " << Num(graph.Period()) << ", distance per cycle:";
+  for (double x : d) s.out << " " << Num(x);
+  s.out << "\n";
+}
+
+synth::Problem SynthesisProblem(const State& s) {
+  synth::Problem p = MakeProblem(s, s.trial_steps);
+  if (s.anneal_start_q.size()) {
+    p.q0 = s.anneal_start_q;
+    p.qd0 = s.anneal_start_qd;
+  }
+  return p;
+}
+
+std::string ReplayScript(const State& s) {
+  const scene::Scene& sc = s.scene;
+  const scene::FfdObject& object = sc.object();
+  scene::ScriptSetup setup;
+  setup.object_path = object.path();
+  setup.mode_paths = object.mode_paths();
+  setup.modes = object.modes();
+  setup.codam_active = object.codam_active();
+  setup.world = sc.options();
+  setup.springs_on = sc.springs().enabled;
+  setup.springs = sc.springs().list;
+  // after an anneal: from the state its trials started from, for one trial's length (the
+  // motion the cost judged); otherwise from the current state over the current span
+  const bool annealed = s.anneal_start_q.size() > 0;
+  setup.q = annealed ? s.anneal_start_q : object.q();
+  setup.qd = annealed ? s.anneal_start_qd : object.qd();
+  const double t0 = annealed ? 0.0 : sc.time(), t1 = annealed ? double(s.trial_steps) * sc.options().dt : sc.end();
+  return scene::ReplayScript(setup, sc.control().graph, sc.control().switch_width, t0, t1);
+}
+
+void Save(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 2, 2);
+  RequireObject(s, ctx, "save");
+  try {
+    formats::WriteTextAtomically(w[1], ReplayScript(s));
+  } catch (const std::runtime_error& e) {
+    ctx.Fail(e.what());
+  }
+}
+
+}  // namespace wobble::script
