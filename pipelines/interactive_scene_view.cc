@@ -170,7 +170,7 @@ InteractiveSceneView::InteractiveSceneView(InteractiveSceneInput input, ViewerOp
   m.playing = options.start_playing;
   m.pacer.SetGoal(m.world().time());
 
-  // render's drawing path (scene_run.h's view options), on screen
+  // render's drawing path (trajectory_render.h's view options), on screen
   SceneOptions so;
   so.width = options.width;
   so.height = options.height;
@@ -374,16 +374,6 @@ vtkRenderWindowInteractor* InteractiveSceneView::interactor() { return impl_->in
 SceneView& InteractiveSceneView::scene() { return *impl_->view; }
 // An on-screen window's back buffer is undefined after the swap: draw again and read it (as
 // InteractiveView does), not SceneView::Capture's read-back of an offscreen render.
-vtkSmartPointer<vtkImageData> InteractiveSceneView::Capture() {
-  auto grab = Ptr<vtkWindowToImageFilter>::New();
-  grab->SetInput(window());
-  grab->SetInputBufferTypeToRGB();
-  grab->ReadFrontBufferOff();
-  grab->ShouldRerenderOn();
-  grab->Update();
-  auto image = Ptr<vtkImageData>::New();
-  image->DeepCopy(grab->GetOutput());
-  return image;
-}
+vtkSmartPointer<vtkImageData> InteractiveSceneView::Capture() { return CaptureWindow(window()); }
 
 }  // namespace wobble::pipelines

@@ -42,49 +42,6 @@ namespace {
 constexpr double kPanelTop = 0.22;   // the sliders live below this
 constexpr double kSceneRight = 0.62;  // the charts live right of this
 
-// The mouse and the keys of both viewers (AttachViewerStyle); the timer draws frames. Middle/
-// right buttons and the wheel keep vtkInteractorStyleImage's pan and zoom; its window-level
-// (left button) and its keys are replaced.
-class ViewerStyle : public vtkInteractorStyleImage {
- public:
-  static ViewerStyle* New();
-  vtkTypeMacro(ViewerStyle, vtkInteractorStyleImage);
-  ViewerControls* view = nullptr;
-
-  void OnLeftButtonDown() override {
-    const int* p = GetInteractor()->GetEventPosition();
-    dragging_ = view->BeginDrag(p[0], p[1]);
-  }
-  void OnLeftButtonUp() override {
-    if (dragging_) view->EndDrag();
-    dragging_ = false;
-  }
-  void OnMouseMove() override {
-    if (dragging_) {
-      const int* p = GetInteractor()->GetEventPosition();
-      view->DragTo(p[0], p[1]);
-      return;
-    }
-    vtkInteractorStyleImage::OnMouseMove();
-  }
-  void OnChar() override {
-    const char code = GetInteractor()->GetKeyCode();
-    if (code > 32 && code < 127) view->HandleKey(std::string(1, code));
-    else if (code == ' ') view->HandleKey("space");
-  }
-  void OnKeyPress() override {
-    const char* sym = GetInteractor()->GetKeySym();
-    if (!sym) return;
-    const std::string s = sym;
-    if (s == "Escape" || s == "Left" || s == "Right") view->HandleKey(s);
-  }
-  void OnTimer() override { view->Frame(); }
-
- private:
-  bool dragging_ = false;
-};
-vtkStandardNewMacro(ViewerStyle);
-
 std::string Fmt(const char* format, double v) {
   char buf[64];
   std::snprintf(buf, sizeof(buf), format, v);
@@ -443,27 +400,6 @@ InteractiveView::~InteractiveView() {
   if (impl_->time_slider) impl_->time_slider->EnabledOff();
 }
 
-double FramePacer::BeginFrame(double fps, bool fixed_frame_time) {
-  const auto now = std::chrono::steady_clock::now();
-  since_ = have_frame_ ? std::chrono::duration<double>(now - last_).count() : 1.0 / fps;
-  if (!have_frame_) first_ = now;
-  have_frame_ = true;
-  last_ = now;
-  return fixed_frame_time ? 1.0 / fps : std::min(since_, kMaxFrameTime);
-}
-
-void FramePacer::Played(double simulated) {
-  stats.simulated += simulated;
-  if (stats.frames > 0) stats.playing_wall += since_;
-  ++stats.playing_frames;
-}
-
-bool FramePacer::EndFrame() {
-  ++stats.frames;
-  stats.wall = std::chrono::duration<double>(last_ - first_).count();
-  return max_frames > 0 && stats.frames >= max_frames;
-}
-
 ViewerScene ViewerScene::FromScript(const scene::SimulationSetup& setup) {
   ViewerScene scene;
   scene.body = setup.body;
@@ -475,28 +411,6 @@ ViewerScene ViewerScene::FromScript(const scene::SimulationSetup& setup) {
   scene.object_path = setup.object_path;
   scene.mode_paths = setup.mode_paths;
   return scene;
-}
-
-void AttachViewerStyle(vtkRenderWindowInteractor* interactor, ViewerControls* controls) {
-  auto style = Ptr<ViewerStyle>::New();
-  style->view = controls;
-  interactor->SetInteractorStyle(style);  // the interactor keeps it
-}
-
-void RunViewerLoop(vtkRenderWindowInteractor* interactor, double fps, const FramePacer& pacer,
-                   const std::string& events_file, bool keep_open) {
-  if (!events_file.empty()) {
-    if (!std::filesystem::exists(events_file)) throw std::invalid_argument(events_file + ": no such events file");
-    auto recorder = Ptr<vtkInteractorEventRecorder>::New();
-    recorder->SetInteractor(interactor);
-    recorder->SetFileName(events_file.c_str());
-    recorder->Play();
-    recorder->Off();
-    if (!keep_open) return;
-  }
-  if (pacer.max_frames > 0 && pacer.stats.frames >= pacer.max_frames) return;
-  interactor->CreateRepeatingTimer(std::max(1UL, (unsigned long)std::lround(1000.0 / fps)));
-  interactor->Start();
 }
 
 void InteractiveView::Run(long max_frames, const std::string& events_file, bool keep_open) {
@@ -794,16 +708,6 @@ vtkSliderWidget* InteractiveView::mode_slider(int mode) { return impl_->mode_sli
 vtkSliderWidget* InteractiveView::time_slider() { return impl_->time_slider; }
 SceneView& InteractiveView::scene() { return *impl_->view; }
 
-vtkSmartPointer<vtkImageData> InteractiveView::Capture() {
-  auto grab = Ptr<vtkWindowToImageFilter>::New();
-  grab->SetInput(window());
-  grab->SetInputBufferTypeToRGB();
-  grab->ReadFrontBufferOff();
-  grab->ShouldRerenderOn();
-  grab->Update();
-  auto image = Ptr<vtkImageData>::New();
-  image->DeepCopy(grab->GetOutput());
-  return image;
-}
+vtkSmartPointer<vtkImageData> InteractiveView::Capture() { return CaptureWindow(window()); }
 
 }  // namespace wobble::pipelines

@@ -159,7 +159,7 @@ TEST(Scene, TheCliWritesTheTrajectoryOfTheInterpreterAsItsOutputCsv) {
   const auto cli = ReadCsv(scratch.path / "cli/out.csv", &header_cli);
   const auto mine = ReadCsv(scratch.path / "interp/out.csv", &header_interp);
   EXPECT_EQ(header_cli, header_interp);
-  EXPECT_EQ(header_cli.rfind("t,tx,ty,theta,g1,g2,g3,g4,dtx,", 0), 0u) << header_cli;
+  EXPECT_EQ(header_cli.rfind("t,tx,ty,theta,bend,shear,vsquash,hsquash,dtx,", 0), 0u) << header_cli;
   // the CSV is the run's trajectory: t, q, q̇ of every step
   const record::Trajectory& run = *interp.scene().last_object_run();
   ASSERT_EQ(cli.size(), size_t(run.size()));
@@ -201,10 +201,11 @@ TEST(ObjectRuns, ModesAreMatchedByNameAndTheHandOverIsCountedOnce) {
   EXPECT_EQ(merged.q(10, 0)[kRigidDofs + 1], runs[1]->q(0, 0)[kRigidDofs + 0]);
   EXPECT_EQ(merged.q(12, 0)[kRigidDofs + 0], 0.0);
   EXPECT_EQ(merged.q(5, 0)[kRigidDofs + 2], 0.0);
-  const scene::Table table = scene::OutputTable(runs, 5);
-  EXPECT_EQ(table.header.size(), size_t(1 + 2 * 6 + 9));
-  ASSERT_EQ(table.rows.size(), 4u);  // samples 0, 5, 10, 15
-  EXPECT_DOUBLE_EQ(table.rows[3][0], 0.15);
+  const record::Trajectory table = scene::OutputTrajectory(runs, 5);
+  EXPECT_EQ(table.Columns(), merged.Columns());  // the one schema, modes by name
+  ASSERT_EQ(table.size(), 4);  // samples 0, 5, 10, 15
+  EXPECT_DOUBLE_EQ(table.time(3), 0.15);
+  EXPECT_EQ(table.q(3, 0)[kRigidDofs + 1], merged.q(15, 0)[kRigidDofs + 1]);
 }
 
 }  // namespace

@@ -90,28 +90,12 @@ record::Trajectory MergeRuns(const ObjectRuns& runs) {
   return merged;
 }
 
-Table OutputTable(const ObjectRuns& runs, int every) {
-  const ModeColumns columns(runs);
-  const int N = int(columns.names.size());
-  Table t;
-  t.header = {"t", "tx", "ty", "theta"};
-  for (int d = 1; d <= N; ++d) t.header.push_back("g" + std::to_string(d));
-  for (const char* n : {"dtx", "dty", "dtheta"}) t.header.push_back(n);
-  for (int d = 1; d <= N; ++d) t.header.push_back("dg" + std::to_string(d));
-  for (const char* n : {"kinetic", "gravity", "modes", "ground", "springs", "total", "control_energy", "pose", "contacts"})
-    t.header.push_back(n);
-  const std::vector<std::pair<int, int>> samples = Samples(runs);
-  for (size_t i = 0; i < samples.size(); i += size_t(every)) {
-    const auto [r, k] = samples[i];
-    const record::Trajectory& run = *runs[r];
-    std::vector<double> row = MappedState(run, k, columns.of_run[r], N);
-    const Energies e = run.energies(k, 0);
-    for (double v : {e.kinetic, e.gravity, e.modes, e.ground, e.springs, e.total(), run.control_energy(k),
-                     double(run.pose(k)), double(run.contacts(k, 0))})
-      row.push_back(v);
-    t.rows.push_back(std::move(row));
-  }
-  return t;
+record::Trajectory OutputTrajectory(const ObjectRuns& runs, int every) {
+  if (every < 1) throw std::invalid_argument("OutputTrajectory: every must be at least 1");
+  const record::Trajectory merged = MergeRuns(runs);
+  record::Trajectory out(merged.bodies());
+  for (int k = 0; k < merged.size(); k += every) out.AppendRow(std::vector<double>(merged.Row(k), merged.Row(k) + merged.num_columns()));
+  return out;
 }
 
 }  // namespace wobble::scene

@@ -4,7 +4,7 @@
 // where a mode was not loaded it reads 0. A run's first sample at the time of the previous
 // run's last one replaces it (the hand-over: the later run goes on from there).
 //   MergeRuns    one trajectory on the object with every mode the runs used (`render`)
-//   OutputTable  the `output` CSV of the script language (README, "Scripts")
+//   OutputTrajectory  the `output` CSV of the script language (README, "Scripts")
 #pragma once
 
 #include <memory>
@@ -22,12 +22,8 @@ using ObjectRuns = std::vector<std::shared_ptr<const record::Trajectory>>;
 // last run that had it defined it. std::invalid_argument when `runs` is empty.
 record::Trajectory MergeRuns(const ObjectRuns& runs);
 
-struct Table {
-  std::vector<std::string> header;
-  std::vector<std::vector<double>> rows;
-};
-// Every `every`-th sample as t, tx ty theta g1..gN, dtx dty dtheta dg1..dgN, kinetic, gravity,
-// modes, ground, springs, total, control_energy, pose, contacts (g<i>: the i-th mode by name).
-Table OutputTable(const ObjectRuns& runs, int every);
+// Every `every`-th sample of MergeRuns: the `output` CSV of the script language, written in the
+// one trajectory schema (record/trajectory_csv.h; mode columns by name).
+record::Trajectory OutputTrajectory(const ObjectRuns& runs, int every);
 
 }  // namespace wobble::scene

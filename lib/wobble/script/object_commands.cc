@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "wobble/record/trajectory_csv.h"
 #include "wobble/formats/csv.h"
 #include "wobble/script/internal/interpreter_internal.h"
 
@@ -36,9 +37,8 @@ int ModeIndex(const State& s, const std::string& word, const Context& ctx) {
 // Writes the `output` CSV from every run since `output` (the whole file after every run).
 void FlushOutput(const State& s, const Context& ctx) {
   if (s.output_path.empty()) return;
-  const scene::Table table = scene::OutputTable(s.output_runs, s.output_every);
   try {
-    formats::WriteCsvAtomically(s.output_path, table.header, table.rows);
+    record::WriteTrajectoryCsv(s.output_path, scene::OutputTrajectory(s.output_runs, s.output_every));
   } catch (const std::runtime_error& e) {
     ctx.Fail(std::string("output: ") + e.what());
   }
