@@ -111,18 +111,6 @@ const BodyModel& World::body(int i) const { return *Ffd(i).model; }
 const std::shared_ptr<const BodyModel>& World::shared_body(int i) const { return Ffd(i).model; }
 const BodyState<double>& World::state(int i) const { return Ffd(i).state; }
 
-void World::SetState(int i, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  FfdEntry& e = Ffd(i);
-  const int nq = e.model->num_q();
-  if (q.size() != nq || qd.size() != nq)
-    throw std::invalid_argument("body '" + e.model->name() + "' has " + std::to_string(nq) +
-                                " generalized coordinates (tx ty theta and one per mode), got q of " +
-                                std::to_string(q.size()) + " and qdot of " + std::to_string(qd.size()));
-  e.state.q = q;
-  e.state.qd = qd;
-  UpdateContacts(*e.model, options_.params.ground, &e.state);
-}
-
 void World::SetModeTargets(int i, const Eigen::VectorXd& targets) {
   FfdEntry& e = Ffd(i);
   const int D = e.model->num_modes();
@@ -270,49 +258,6 @@ bool World::StepEachBody() {
     e.applied.setZero();
   }
   return true;
-}
-
-bool World::StepFfdBody(int body) {
-  FfdEntry& e = ffd_[slots_[body].index];
-  BodyState<double>& s = e.state;
-  const VecQ<double> q_before = s.q, qd_before = s.qd;
-  StepStatus st;
-  if (e.applied.isZero(0.0)) {
-    st = StepBody(*e.model, options_.params, body, options_.integrator, options_.dt, &s);
-  } else {  // a point force for this step (ApplyPointForce): an extra generalized force
-    const Eigen::VectorXd& applied = e.applied;
-    st = StepBody(*e.model, options_.params, body, options_.integrator, options_.dt, &s,
-                  [&applied](const BodyState<double>&, VecQ<double>* Q) { *Q += applied; });
-    e.applied.setZero();
-  }
-  return CheckFfdState(body, q_before, qd_before, st);
-}
-
-// Refuses a step that failed, left a non-finite state or sank a point too deep; the body keeps
-// its state before the step for whoever reports the failure.
-bool World::CheckFfdState(int body, const VecQ<double>& q_before, const VecQ<double>& qd_before, StepStatus st) {
-  FfdEntry& e = ffd_[slots_[body].index];
-  BodyState<double>& s = e.state;
-  const bool finite = s.q.allFinite() && s.qd.allFinite();
-  const double limit = PenetrationLimit(*e.model);
-  if (st.ok() && finite && s.penetration <= limit) return true;
-  const double depth = s.penetration;
-  s.q = q_before;
-  s.qd = qd_before;
-  UpdateContacts(*e.model, options_.params.ground, &s);
-  if (!st.ok()) return Fail(st.code, body, "", st.value);
-  if (!finite) return Fail(StatusCode::kNonFinite, body);
-  std::ostringstream d;
-  d << "a point is " << depth << " below the ground (limit " << limit
-    << "); reduce dt, or use a stiffer ground with the implicit integrator";
-  return Fail(StatusCode::kPenetration, body, d.str(), depth);
-}
-
-double World::PenetrationLimit(const BodyModel& model) const {
-  const Ground& g = options_.params.ground;
-  if (g.max_penetration > 0) return g.max_penetration;
-  const Lattice& lat = model.lattice();
-  return 0.5 * std::min(lat.axis_s().norm(), lat.axis_t().norm());
 }
 
 void World::LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const {

@@ -285,7 +285,7 @@ class World {
     int row = -1;  // first row in A while enabled
   };
 
-  // world.cc: bodies, the per-body step, checks, energies
+  // world.cc: bodies, controllers, energies; world_step.cc: the per-body step and its checks
   void CheckBody(int body) const;
   FfdEntry& Ffd(int body);
   const FfdEntry& Ffd(int body) const;
@@ -294,7 +294,9 @@ class World {
   bool StepFfdBody(int body);
   void LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const;
   double PenetrationLimit(const BodyModel& model) const;
-  bool CheckFfdState(int body, const VecQ<double>& q_before, const VecQ<double>& qd_before, StepStatus st);
+  // The ground contacts of an FFD body at its state now (world_step.cc).
+  void RefreshContacts(FfdEntry& e) const;
+  bool RefuseFfdStep(int body, const VecQ<double>& q_before, const VecQ<double>& qd_before, StepStatus st);
   bool Fail(StatusCode code, int body, const std::string& detail = "", double value = 0.0);
   void FinishStep();
 

@@ -552,9 +552,10 @@ bool World::StepConstrained() {
       const VecQ<double> q_before = e.state.q, qd_before = e.state.qd;
       e.state.qd += h * acc[body];
       e.state.q += h * e.state.qd;
-      UpdateContacts(*e.model, options_.params.ground, &e.state);
+      RefreshContacts(e);
       e.applied.setZero();
-      if (!CheckFfdState(body, q_before, qd_before, StepStatus{})) return false;
+      if (!e.state.q.allFinite() || !e.state.qd.allFinite() || e.state.penetration > PenetrationLimit(*e.model))
+        return RefuseFfdStep(body, q_before, qd_before, StepStatus{});
     }
   }
   return true;
@@ -650,7 +651,7 @@ bool World::ApplyImpulse(const std::vector<VelocityGoal>& goals, std::string* er
       } else {
         FfdEntry& e = ffd_[b.index];
         e.state.qd += dv[body];
-        UpdateContacts(*e.model, options_.params.ground, &e.state);
+        RefreshContacts(e);
       }
     }
   } catch (const std::invalid_argument& e) {
