@@ -23,7 +23,7 @@ OUT        ?= out/demo
 
 PACKAGES := libvtk9-dev libeigen3-dev libceres-dev libopenexr-dev libimath-dev \
             libgtest-dev libgmock-dev libbenchmark-dev xvfb xauth libcli11-dev \
-            nlohmann-json3-dev cmake g++ make libpagmo-dev
+            nlohmann-json3-dev cmake g++ make libpagmo-dev libpng-dev
 
 
 # The default scene: the table (lattice 300 x 100) dropped from 50 onto the ground sloped by

@@ -12,6 +12,9 @@
 #include <memory>
 #include <string>
 
+#include <vtkImageData.h>
+#include <vtkPNGWriter.h>
+
 #include "pipelines/exports.h"
 #include "pipelines/interactive_view.h"
 #include "pipelines/scene_view.h"
@@ -92,6 +95,34 @@ void BM_WritePngFrame640x480(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_WritePngFrame640x480)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Encoding one rendered 640x480 frame as PNG at the frames' level (1): wobble's libpng encoder
+// (pipelines/png_io.h, which runs on the writer threads) against vtkPNGWriter, the baseline
+// it replaced (VTK objects may not be used off the main thread).
+void BM_EncodePng640x480(benchmark::State& state) {
+  if (!NeedDisplay(state)) return;
+  auto world = DemoWorld();
+  SceneView view(world.get());
+  view.Render();
+  vtkSmartPointer<vtkImageData> image = view.Capture();
+  const PngPixels pixels = PixelsOf(image);
+  const std::string path = OutDir() + "/encode.png";
+  const bool vtk = state.range(0) == 1;
+  for (auto _ : state) {
+    if (vtk) {
+      auto w = vtkSmartPointer<vtkPNGWriter>::New();
+      w->SetInputData(image);
+      w->SetCompressionLevel(1);
+      w->SetFileName(path.c_str());
+      w->Write();
+    } else {
+      WritePngPixels(path, pixels, 1);
+    }
+  }
+  state.SetLabel(vtk ? "vtkPNGWriter (baseline)" : "wobble WritePngPixels");
+  state.SetBytesProcessed(state.iterations() * int64_t(pixels.bytes.size()));
+}
+BENCHMARK(BM_EncodePng640x480)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_WriteExrFrame640x480(benchmark::State& state) {
   if (!NeedDisplay(state)) return;

@@ -23,7 +23,9 @@ class BackgroundWriter {
   BackgroundWriter(const BackgroundWriter&) = delete;
   BackgroundWriter& operator=(const BackgroundWriter&) = delete;
 
-  // A job must own what it writes (copies, or smart pointers nobody else changes).
+  // A job must own what it writes (copies) and must not touch VTK objects, not even to
+  // release one: VTK's garbage collector is not thread-safe (a job that dropped the last
+  // reference to a vtkPolyData crashed in vtkGarbageCollector::Collect under ASan).
   void Submit(std::function<void()> job);
   // Blocks until every submitted job ran; rethrows the first error.
   void Wait();

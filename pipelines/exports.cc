@@ -8,7 +8,6 @@
 #include <stdexcept>
 #include <vtkErrorCode.h>
 #include <vtkImageData.h>
-#include <vtkPNGWriter.h>
 #include <vtkPolyData.h>
 #include <vtkXMLImageDataWriter.h>
 #include <vtkXMLPolyDataWriter.h>
@@ -42,16 +41,20 @@ std::string XmlEscape(const std::string& s) {
 
 }  // namespace
 
-void WriteVtp(const std::string& path, vtkPolyData* data) {
-  formats::WriteFileAtomically(path, [&](const std::string& tmp) {
-    auto w = vtkSmartPointer<vtkXMLPolyDataWriter>::New();
-    w->SetInputData(data);
-    w->SetDataModeToAppended();
-    w->EncodeAppendedDataOff();  // raw binary: smaller and faster than base64
-    w->SetCompressorTypeToNone();
-    RunWriter(w.Get(), tmp);
-  });
+std::string VtpBytes(vtkPolyData* data) {
+  auto w = vtkSmartPointer<vtkXMLPolyDataWriter>::New();
+  w->SetInputData(data);
+  w->SetDataModeToAppended();
+  w->EncodeAppendedDataOff();  // raw binary: smaller and faster than base64
+  w->SetCompressorTypeToNone();
+  w->WriteToOutputStringOn();
+  w->Write();
+  const unsigned long code = w->GetErrorCode();
+  if (code != 0) throw std::runtime_error(std::string("VTK writer: ") + vtkErrorCode::GetStringFromErrorCode(code));
+  return w->GetOutputString();
 }
+
+void WriteVtp(const std::string& path, vtkPolyData* data) { formats::WriteTextAtomically(path, VtpBytes(data)); }
 
 void WriteVti(const std::string& path, vtkImageData* image) {
   formats::WriteFileAtomically(path, [&](const std::string& tmp) {
@@ -63,13 +66,26 @@ void WriteVti(const std::string& path, vtkImageData* image) {
   });
 }
 
+PngPixels PixelsOf(vtkImageData* image) {
+  if (!image || image->GetScalarType() != VTK_UNSIGNED_CHAR)
+    throw std::invalid_argument("a PNG needs an image of unsigned char pixels");
+  int dims[3];
+  image->GetDimensions(dims);
+  PngPixels px;
+  px.width = dims[0];
+  px.height = dims[1];
+  px.channels = image->GetNumberOfScalarComponents();
+  if (px.channels < 1 || px.channels > 4) throw std::invalid_argument("a PNG needs 1 to 4 components per pixel");
+  const size_t stride = size_t(px.width) * size_t(px.channels);
+  px.bytes.resize(stride * size_t(std::max(0, px.height)));
+  const auto* in = static_cast<const uint8_t*>(image->GetScalarPointer());
+  for (int y = 0; y < px.height; ++y)  // VTK's rows start at the bottom
+    std::copy_n(in + size_t(px.height - 1 - y) * stride, stride, px.bytes.data() + size_t(y) * stride);
+  return px;
+}
+
 void WritePng(const std::string& path, vtkImageData* image, int compression) {
-  formats::WriteFileAtomically(path, [&](const std::string& tmp) {
-    auto w = vtkSmartPointer<vtkPNGWriter>::New();
-    w->SetInputData(image);
-    w->SetCompressionLevel(std::clamp(compression, 0, 9));
-    RunWriter(w.Get(), tmp);
-  });
+  WritePngPixels(path, PixelsOf(image), compression);
 }
 
 void PvdCollection::Add(double time, int part, const std::string& file, const std::string& name) {
@@ -92,13 +108,7 @@ void PvdCollection::Write(const std::string& pvd_path) const {
     xml << " file=\"" << XmlEscape(file) << "\"/>\n";
   }
   xml << "  </Collection>\n</VTKFile>\n";
-  const std::string text = xml.str();
-  formats::WriteFileAtomically(pvd_path, [&](const std::string& tmp) {
-    std::FILE* f = std::fopen(tmp.c_str(), "w");
-    if (!f) throw std::runtime_error("cannot open " + tmp);
-    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    if ((std::fclose(f) != 0) || !ok) throw std::runtime_error("short write to " + tmp);
-  });
+  formats::WriteTextAtomically(pvd_path, xml.str());
 }
 
 std::vector<ExrChannel> DisplacementImage(const World& world, int body_index, int width, int height) {
@@ -182,9 +192,8 @@ void VtpSeriesWriter::WriteFrame(int frame, BackgroundWriter* writer) {
     source->Update();
     const std::string file = folder_ + "/" + parts_[p].name + number;
     if (writer) {
-      auto copy = vtkSmartPointer<vtkPolyData>::New();  // the source's output changes next frame
-      copy->DeepCopy(source->GetOutput());
-      writer->Submit([file, copy] { WriteVtp(file, copy); });
+      // serialised here: VTK objects never reach the worker threads
+      writer->Submit([file, bytes = VtpBytes(source->GetOutput())] { formats::WriteTextAtomically(file, bytes); });
     } else {
       WriteVtp(file, source->GetOutput());
     }

@@ -2,7 +2,7 @@
 //   .vtp  one vtkPolyData (VTK XML, raw appended binary), with its TimeValue field array
 //   .pvd  a ParaView collection listing .vtp files per time step (and part): a time series
 //   .vti  one vtkImageData (VTK XML)
-//   .png  one RGB(A) vtkImageData
+//   .png  one RGB(A) vtkImageData (libpng, pipelines/png_io.h)
 //   .exr  the deformation as a data image over the body's rest lattice (disp.X, disp.Y)
 // Failures throw std::runtime_error naming the file and the reason; an earlier file of the
 // same name is left as it was.
@@ -14,6 +14,7 @@
 
 #include "pipelines/background_writer.h"
 #include "pipelines/exr_io.h"
+#include "pipelines/png_io.h"
 #include "pipelines/world_sources.h"
 
 class vtkImageData;
@@ -22,9 +23,14 @@ class vtkPolyData;
 namespace wobble::pipelines {
 
 void WriteVtp(const std::string& path, vtkPolyData* data);
+// The .vtp file's bytes: WriteVtp is formats::WriteTextAtomically(path, VtpBytes(data)), split
+// so that the VTK part runs on the caller's thread and only the file write on a BackgroundWriter.
+std::string VtpBytes(vtkPolyData* data);
 void WriteVti(const std::string& path, vtkImageData* image);
 // compression: zlib level 0 (none, fastest) to 9 (smallest); PNG is lossless at every level.
 void WritePng(const std::string& path, vtkImageData* image, int compression = 5);
+// An unsigned-char VTK image as PNG pixels (rows flipped to start at the top).
+PngPixels PixelsOf(vtkImageData* image);
 
 // A ParaView .pvd collection: <DataSet timestep=".." part=".." file=".."/> per entry; file
 // names are written relative to the .pvd's folder when they lie under it.

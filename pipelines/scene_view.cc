@@ -425,10 +425,10 @@ vtkSmartPointer<vtkImageData> SceneView::Capture() {
 }
 
 void SceneView::WritePng(const std::string& path, BackgroundWriter* writer) {
-  vtkSmartPointer<vtkImageData> image = Capture();  // a new image per Render(): safe to hand over
   const int level = options_.png_compression;
-  if (!writer) return pipelines::WritePng(path, image, level);
-  writer->Submit([path, image, level] { pipelines::WritePng(path, image, level); });
+  if (!writer) return pipelines::WritePng(path, Capture(), level);
+  // the pixels are copied out here: VTK objects never reach the worker threads
+  writer->Submit([path, pixels = PixelsOf(Capture()), level] { WritePngPixels(path, pixels, level); });
 }
 
 std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
