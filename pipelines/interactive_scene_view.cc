@@ -21,6 +21,8 @@
 #include <vtkTextProperty.h>
 #include <vtkWindowToImageFilter.h>
 
+#include "wobble/control/pulls.h"
+
 namespace wobble::pipelines {
 
 template <class T> using Ptr = vtkSmartPointer<T>;
@@ -29,32 +31,6 @@ namespace {
 
 constexpr double kPickRadius = 30.0;  // pixels
 
-
-// The dragged point's path: a critically damped approach to the cursor c with time constant
-// tau that starts at the point's position n0 and velocity v0 (so the trajectory constraint
-// holds when it is added or re-aimed, and no impulse is needed):
-//   n(s) = c + (A + B s) e^(-s/tau),  A = n0 - c,  B = v0 + A/tau,  s = t - t0.
-class ApproachPath : public PointPath {
- public:
-  ApproachPath(double t0, Eigen::VectorXd n0, const Eigen::VectorXd& v0, Eigen::VectorXd target, double tau)
-      : t0_(t0), c_(std::move(target)), a_(n0 - c_), b_(v0 + a_ / tau), tau_(tau) {}
-  int dim() const override { return int(c_.size()); }
-  PathSample Evaluate(double t) const override {
-    const double s = std::max(0.0, t - t0_), e = std::exp(-s / tau_);
-    const Eigen::VectorXd ab = a_ + b_ * s;
-    PathSample p;
-    p.n = c_ + ab * e;
-    p.n_dot = (b_ - ab / tau_) * e;
-    p.n_ddot = (-2.0 * b_ / tau_ + ab / (tau_ * tau_)) * e;
-    return p;
-  }
-  const Eigen::VectorXd& target() const { return c_; }
-
- private:
-  double t0_;
-  Eigen::VectorXd c_, a_, b_;
-  double tau_;
-};
 
 int NumMassPoints(const World& w, int b) {
   return w.kind(b) == BodyKind::kLinear ? w.linear_model(b).num_points() : w.body(b).num_points();
@@ -78,9 +54,7 @@ struct InteractiveSceneView::Impl {
   // the drag: the line from the point to the cursor, drawn with the anchors
   Ptr<vtkPolyData> drag_line;
   Ptr<vtkActor> drag_actor;
-  std::optional<MaterialPoint> dragged;
-  int drag_id = -1;
-  std::shared_ptr<const ApproachPath> drag_path;
+  std::shared_ptr<control::ConstraintPull> pull;  // the world's controller while dragging
   bool playing = true;
   double speed = 1.0;
   std::string message;
@@ -139,8 +113,8 @@ struct InteractiveSceneView::Impl {
   void UpdateDragLine() {
     auto points = Ptr<vtkPoints>::New();
     auto lines = Ptr<vtkCellArray>::New();
-    if (dragged && drag_path) {
-      const Eigen::Vector3d a = To3(world().PointPosition(*dragged)), c = To3(drag_path->target());
+    if (pull) {
+      const Eigen::Vector3d a = To3(world().PointPosition(pull->point())), c = To3(pull->aim());
       points->InsertNextPoint(a.data());
       points->InsertNextPoint(c.data());
       const vtkIdType ids[2] = {0, 1};
@@ -209,7 +183,7 @@ InteractiveSceneView::InteractiveSceneView(InteractiveSceneInput input, ViewerOp
 }
 
 InteractiveSceneView::~InteractiveSceneView() {
-  if (impl_->drag_id >= 0 && impl_->input.world->exists(impl_->drag_id)) impl_->input.world->Remove(impl_->drag_id);
+  EndDrag();
 }
 
 void InteractiveSceneView::Run(long max_frames, const std::string& events_file, bool keep_open) {
@@ -300,7 +274,7 @@ Eigen::Vector3d InteractiveSceneView::WorldToDisplay(const Eigen::VectorXd& p) c
 
 bool InteractiveSceneView::BeginDrag(int x, int y) {
   Impl& m = *impl_;
-  if (m.dragged) EndDrag();
+  EndDrag();
   World& w = m.world();
   // candidates: named points of bodies first (a tie goes to them), then every mass point
   std::vector<MaterialPoint> candidates;
@@ -319,42 +293,36 @@ bool InteractiveSceneView::BeginDrag(int x, int y) {
     }
   }
   if (!pick) return false;
-  m.dragged = pick;
-  const Eigen::VectorXd at = w.PointPosition(*pick);
-  m.drag_path = std::make_shared<ApproachPath>(w.time(), at, w.PointVelocity(*pick), at, kDragTime);
-  m.drag_id = w.AddTrajectory(*pick, m.drag_path);
+  m.pull = std::make_shared<control::ConstraintPull>(w, *pick, kDragTime);
+  w.AddController(m.pull);
   DragTo(x, y);
   return true;
 }
 
 void InteractiveSceneView::DragTo(int x, int y) {
   Impl& m = *impl_;
-  if (!m.dragged) return;
-  World& w = m.world();
-  const Eigen::VectorXd now = w.PointPosition(*m.dragged);
-  // the cursor on the plane through the point that faces the camera
-  const Eigen::VectorXd target = m.DisplayToWorld(x, y, WorldToDisplay(now)[2], int(now.size()));
-  // re-aimed from where the path is now, with its velocity: the constraint stays satisfied
-  const PathSample s = m.drag_path->Evaluate(w.time());
-  m.drag_path = std::make_shared<ApproachPath>(w.time(), s.n, s.n_dot, target, kDragTime);
-  w.SetPath(m.drag_id, m.drag_path);
+  if (!m.pull) return;
+  const Eigen::VectorXd now = m.world().PointPosition(m.pull->point());
+  // the cursor on the plane through the point that faces the camera; the next step's start takes it
+  m.pull->Aim(m.DisplayToWorld(x, y, WorldToDisplay(now)[2], int(now.size())));
   m.UpdateDragLine();
 }
 
 void InteractiveSceneView::EndDrag() {
   Impl& m = *impl_;
-  if (m.drag_id >= 0 && m.world().exists(m.drag_id)) m.world().Remove(m.drag_id);
-  m.drag_id = -1;
-  m.dragged.reset();
-  m.drag_path.reset();
+  if (!m.pull) return;
+  m.pull->Release(m.world());
+  m.world().RemoveController(m.pull.get());
+  m.pull.reset();
   m.UpdateDragLine();
 }
 
-std::optional<MaterialPoint> InteractiveSceneView::dragged_point() const { return impl_->dragged; }
-int InteractiveSceneView::drag_constraint() const { return impl_->drag_id; }
-Eigen::VectorXd InteractiveSceneView::drag_target() const {
-  return impl_->drag_path ? impl_->drag_path->target() : Eigen::VectorXd();
+std::optional<MaterialPoint> InteractiveSceneView::dragged_point() const {
+  if (!impl_->pull) return std::nullopt;
+  return impl_->pull->point();
 }
+int InteractiveSceneView::drag_constraint() const { return impl_->pull ? impl_->pull->constraint() : -1; }
+Eigen::VectorXd InteractiveSceneView::drag_target() const { return impl_->pull ? impl_->pull->aim() : Eigen::VectorXd(); }
 
 const World& InteractiveSceneView::world() const { return *impl_->input.world; }
 double InteractiveSceneView::time() const { return impl_->input.world->time(); }
@@ -365,7 +333,7 @@ std::string InteractiveSceneView::StatusLine() const {
   const Impl& m = *impl_;
   char buf[256];
   std::snprintf(buf, sizeof(buf), "%s x%g   largest constraint violation %.2g%s", m.playing ? "playing" : "paused",
-                m.speed, m.input.world->MaxViolation(), m.dragged ? "   dragging" : "");
+                m.speed, m.input.world->MaxViolation(), m.pull ? "   dragging" : "");
   return std::string(buf) + (m.message.empty() ? "" : "\n" + m.message);
 }
 

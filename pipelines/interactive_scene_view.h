@@ -10,7 +10,8 @@
 //   c recentre   h print the keys   q or Escape quit
 // Mouse: the left button picks the nearest mass point or named point of a body (within 30
 // pixels) and a trajectory constraint (Witkin & Welch §4) drives it toward the cursor, in the
-// plane through the point facing the camera; releasing the button removes the constraint.
+// plane through the point facing the camera (control::ConstraintPull, a World controller);
+// releasing the button removes the constraint.
 // Middle drag pans, the wheel or right drag zooms.
 //
 // Needs an X display (HasDisplay()); the constructor throws std::runtime_error without one.

@@ -29,6 +29,8 @@
 
 #include "pipelines/charts.h"
 #include "pipelines/energy_charts.h"
+#include "wobble/control/controllers.h"
+#include "wobble/control/pulls.h"
 #include "wobble/formats/atomic_file.h"
 #include "wobble/scene/script_writer.h"
 
@@ -111,13 +113,15 @@ struct InteractiveView::Impl {
   // state of the session
   bool playing = true, scrubbing = false, graph_drives = false;
   double speed = 1.0;
-  Eigen::VectorXd targets;
+  // what drives the world, as its controllers: the pose graph until a slider moves, the
+  // sliders (which also log every change of the targets for the session script), the mouse
+  std::shared_ptr<control::PoseGraphController> graph;
+  std::shared_ptr<control::ModeTargetController> sliders;
+  std::shared_ptr<control::SpringPull> pull;
+  Eigen::VectorXd slider_targets;  // kept over a restart
   long session_steps = 0;
-  std::vector<scene::SessionRecord::Segment> segments;
   int drags = 0;
   long first_drag_step = -1;
-  int drag_spring = -1;  // index in the world's springs while pulling
-  Eigen::Vector2d drag_st = Eigen::Vector2d::Zero();
   std::vector<Eigen::VectorXd> recorded_poses;
   std::vector<double> recorded_durations;
   double last_pose_time = 0.0;
@@ -135,14 +139,19 @@ struct InteractiveView::Impl {
     world = std::make_unique<World>(scene.world);
     world->AddBody(scene.body);
     world->SetState(0, scene.q0, scene.qd0);
-    if (targets.size()) world->SetModeTargets(0, targets);
+    world->SetModeTargets(0, slider_targets);
+    graph.reset();
+    if (graph_drives) {  // PoseAt(n dt) with n the steps since the start, as a script's run
+      graph = std::make_shared<control::PoseGraphController>(*world, 0, scene.graph);
+      world->AddController(graph);
+    }
+    sliders = std::make_shared<control::ModeTargetController>(*world, 0);  // after the graph: logs its switches
+    world->AddController(sliders);
+    pull.reset();
     pacer.SetGoal(0.0);
     session_steps = 0;
-    segments.clear();
-    if (targets.size()) segments.push_back({0, targets});
     drags = 0;
     first_drag_step = -1;
-    drag_spring = -1;
     recorded_poses.clear();
     recorded_durations.clear();
     last_pose_time = 0.0;
@@ -152,24 +161,7 @@ struct InteractiveView::Impl {
     scrubbing = false;
   }
 
-  // The targets for the next step: from the pose graph while it drives (the interpreter's
-  // rule: PoseAt(n dt) with n the steps since the start), then recorded when they change.
-  void ApplyTargets() {
-    if (!graph_drives || scene.graph.empty()) return;
-    const int pose = scene.graph.PoseAt(double(session_steps) * scene.world.dt);
-    const Eigen::VectorXd t = control::TargetsFromPose(*scene.body, scene.graph.poses[pose]);
-    if (t != targets) SetTargets(t);
-  }
-
-  void SetTargets(const Eigen::VectorXd& t) {
-    targets = t;
-    world->SetModeTargets(0, targets);
-    if (!segments.empty() && segments.back().step == session_steps) segments.back().targets = targets;
-    else segments.push_back({session_steps, targets});
-  }
-
   bool StepWorld() {
-    ApplyTargets();
     if (!world->Step()) {
       playing = false;
       message = "simulation stopped: " + world->status().message + " (r restarts)";
@@ -271,7 +263,7 @@ InteractiveView::InteractiveView(ViewerScene scene, ViewerOptions options) : imp
     if (!invalid.empty()) throw std::invalid_argument("pose graph: " + invalid);
   }
   const int D = m.scene.body->num_modes();
-  m.targets = Eigen::VectorXd::Zero(D);
+  m.slider_targets = Eigen::VectorXd::Zero(D);
   m.NewWorld();
   m.scrub_world = std::make_unique<World>(m.scene.world);
   m.scrub_world->AddBody(m.scene.body);
@@ -452,7 +444,7 @@ bool InteractiveView::HandleKey(const std::string& k) {
   else if (k == "+" || k == "=") SetSpeed(m.speed * 2.0);
   else if (k == "-") SetSpeed(m.speed / 2.0);
   else if (k == "0") {
-    for (int d = 0; d < m.targets.size(); ++d) SetModeTarget(d, 0.0);
+    for (int d = 0; d < m.slider_targets.size(); ++d) SetModeTarget(d, 0.0);
   } else if (k == "s") ToggleLayer(SceneLayer::kShape);
   else if (k == "l") ToggleLayer(SceneLayer::kLattice);
   else if (k == "m") ToggleLayer(SceneLayer::kPoints);
@@ -548,7 +540,7 @@ std::string InteractiveView::SessionScriptText() const {
   r.q0 = m.scene.q0;
   r.qd0 = m.scene.qd0;
   r.t0 = m.scene.t0;
-  r.segments = m.segments;
+  r.segments = m.sliders->segments();
   r.steps = m.session_steps;
   r.drags = m.drags;
   r.first_drag_step = m.first_drag_step;
@@ -594,16 +586,21 @@ void InteractiveView::ScrubTo(long frame) {
 
 void InteractiveView::SetModeTarget(int mode, double target) {
   Impl& m = *impl_;
-  if (mode < 0 || mode >= m.targets.size()) throw std::out_of_range("SetModeTarget: no such mode");
+  if (mode < 0 || mode >= m.slider_targets.size()) throw std::out_of_range("SetModeTarget: no such mode");
   if (!std::isfinite(target)) throw std::invalid_argument("SetModeTarget: the target must be finite");
-  m.graph_drives = false;  // the user takes over
-  Eigen::VectorXd t = m.targets;
+  if (m.graph) {  // the user takes over from the pose graph
+    m.world->RemoveController(m.graph.get());
+    m.graph.reset();
+  }
+  m.graph_drives = false;
+  Eigen::VectorXd t = m.sliders->targets();
   t[mode] = target;
-  m.SetTargets(t);
+  m.sliders->Set(t);
+  m.slider_targets = t;
   auto* rep = static_cast<vtkSliderRepresentation*>(m.mode_sliders[size_t(mode)]->GetRepresentation());
   if (rep->GetValue() != target) rep->SetValue(target);
 }
-const Eigen::VectorXd& InteractiveView::mode_targets() const { return impl_->targets; }
+const Eigen::VectorXd& InteractiveView::mode_targets() const { return impl_->sliders->targets(); }
 
 bool InteractiveView::BeginDrag(int x, int y) {
   Impl& m = *impl_;
@@ -631,30 +628,28 @@ bool InteractiveView::BeginDrag(int x, int y) {
   sp.anchor = DisplayToWorld(x, y);
   sp.stiffness = k;
   sp.damping = c;
-  m.world->AddSpring(sp);
-  m.drag_spring = int(m.world->mutable_options().params.springs.size()) - 1;
-  m.drag_st = sp.lattice_coords;
+  EndDrag();
+  m.pull = std::make_shared<control::SpringPull>(*m.world, sp);
+  m.world->AddController(m.pull);
   if (m.drags++ == 0) m.first_drag_step = m.session_steps;
   return true;
 }
 
 void InteractiveView::DragTo(int x, int y) {
-  Impl& m = *impl_;
-  if (m.drag_spring < 0) return;
-  m.world->mutable_options().params.springs[size_t(m.drag_spring)].anchor = DisplayToWorld(x, y);
+  if (impl_->pull) impl_->pull->Aim(*impl_->world, DisplayToWorld(x, y));
 }
 
 void InteractiveView::EndDrag() {
   Impl& m = *impl_;
-  if (m.drag_spring < 0) return;
-  auto& springs = m.world->mutable_options().params.springs;
-  springs.erase(springs.begin() + m.drag_spring);
-  m.drag_spring = -1;
+  if (!m.pull) return;
+  m.pull->Release(*m.world);
+  m.world->RemoveController(m.pull.get());
+  m.pull.reset();
 }
 
 std::optional<Eigen::Vector2d> InteractiveView::dragged_point() const {
-  if (impl_->drag_spring < 0) return std::nullopt;
-  return impl_->drag_st;
+  if (!impl_->pull) return std::nullopt;
+  return impl_->pull->lattice_coords();
 }
 
 const World& InteractiveView::world() const { return *impl_->world; }
@@ -678,7 +673,7 @@ std::string InteractiveView::StatusLine() const {
     if (!m.options.fixed_frame_time && m.pacer.stats.playing_wall > 0 && m.pacer.stats.playing_frames > 1)
       s += "   " + Fmt("%.1f frames/s", (m.pacer.stats.playing_frames - 1) / m.pacer.stats.playing_wall) + ", " +
            Fmt("%.1f steps/frame", double(m.pacer.stats.steps) / double(std::max(1L, m.pacer.stats.playing_frames)));
-    if (m.drag_spring >= 0) s += "   pulling";
+    if (m.pull) s += "   pulling";
   }
   if (!m.message.empty()) s += "\n" + m.message;
   s += "\nh: keys";

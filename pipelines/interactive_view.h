@@ -20,6 +20,11 @@
 // Mouse: left button on the body pulls the nearest point (mass point or drawing sample) with
 // a spring to the cursor; middle drag pans, wheel or right drag zooms.
 //
+// What drives the world are its controllers (wobble/control): the script's pose graph
+// (control::PoseGraphController) until a slider moves, the sliders
+// (control::ModeTargetController, which logs every target change for the session script) and
+// the mouse (control::SpringPull). The viewer never sets targets or springs between steps.
+//
 // VTK 9.1 needs an X display (HasDisplay()); the constructor throws std::runtime_error
 // without one. Tests and measurements run it under xvfb-run.
 #pragma once

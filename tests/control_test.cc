@@ -9,6 +9,8 @@
 
 #include "support/test_bodies.h"
 #include "wobble/control/control.h"
+#include "wobble/control/controllers.h"
+#include "wobble/control/pulls.h"
 #include "wobble/world/world.h"
 
 namespace wobble {
@@ -207,6 +209,144 @@ TEST(Keyframes, HeldPointStaysPutWhileTheBodyDeforms) {
   k.Evaluate(0.5, &g, &gd);
   control::KeyframedState(*body, hold, anchor, Eigen::Vector2d::Zero(), theta, g, gd, &q, &qd);
   EXPECT_GT((control::PointAt(*body, {1.0, 1.0}, q) - control::PointAt(*body, {1.0, 1.0}, Eigen::VectorXd::Zero(7))).norm(), 10.0);
+}
+
+// ---------------------------------------------------------------- controllers
+
+// The one pose-graph loop (control::PoseGraphController) against the rule written out here:
+// before step n the targets are those of pose PoseAt(n dt). The world with the controllers
+// and a world whose targets are set by hand before each step are identical, and the
+// ModeTargetController behind the graph logs exactly the steps where PoseAt changes.
+TEST(Controllers, PoseGraphControllerIsThePoseAtRuleAndTheTargetLogHasItsSwitches) {
+  auto modes = std::vector<DeformationMode>{testing::Bend(4e7, 8e6), testing::VerticalSquash(4e7, 8e6)};
+  modes[0].active = true;
+  auto body = std::make_shared<const BodyModel>(TableDef(), modes);
+  control::PoseGraph g;
+  g.poses = {Eigen::VectorXd::Constant(1, 0.01), Eigen::VectorXd::Constant(1, -0.01)};
+  g.durations = {0.7, 0.5};
+  const double dt = 1e-3;
+  const long steps = 2600;
+  World driven(FreeSpace(Integrator::kRK4, dt)), by_hand(FreeSpace(Integrator::kRK4, dt));
+  driven.AddBody(body);
+  by_hand.AddBody(body);
+  driven.AddController(std::make_shared<control::PoseGraphController>(driven, 0, g));
+  auto log = std::make_shared<control::ModeTargetController>(driven, 0);
+  driven.AddController(log);
+  std::vector<control::TargetSegment> expected;
+  for (long n = 0; n < steps; ++n) {
+    const Eigen::VectorXd t = control::TargetsFromPose(*body, g.poses[g.PoseAt(n * dt)]);
+    if (expected.empty() || expected.back().targets != t) expected.push_back({n, t});
+    by_hand.SetModeTargets(0, t);
+    ASSERT_TRUE(by_hand.Step());
+    ASSERT_TRUE(driven.Step());
+  }
+  EXPECT_EQ((driven.state(0).q - by_hand.state(0).q).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(log->steps(), steps);
+  ASSERT_EQ(log->segments().size(), expected.size());
+  EXPECT_GE(expected.size(), 5u);  // 2.6 s of a 1.2 s cycle: switches at about 0, 0.7, 1.2, 1.9, 2.4
+  for (size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(log->segments()[k].step, expected[k].step) << k;
+    EXPECT_EQ(log->segments()[k].targets, expected[k].targets) << k;
+  }
+}
+
+// A slider's Set acts from the next step on, not between steps, and is logged at that step;
+// two Sets before one step log once.
+TEST(Controllers, ModeTargetSetActsAtTheNextStep) {
+  auto body = std::make_shared<const BodyModel>(TableDef(), testing::TableModes(4e7, 8e6));
+  World world(FreeSpace(Integrator::kRK4, 1e-3));
+  world.AddBody(body);
+  auto sliders = std::make_shared<control::ModeTargetController>(world, 0);
+  world.AddController(sliders);
+  const int D = body->num_modes();
+  for (int n = 0; n < 3; ++n) ASSERT_TRUE(world.Step());
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(D), b = Eigen::VectorXd::Zero(D);
+  a[1] = 0.2;
+  b[1] = -0.1;
+  sliders->Set(a);
+  sliders->Set(b);
+  EXPECT_EQ(sliders->targets(), b);
+  EXPECT_EQ(world.state(0).mode_target.size() == 0 ? 0.0 : world.state(0).mode_target.cwiseAbs().maxCoeff(), 0.0)
+      << "the world's targets changed between steps";
+  ASSERT_TRUE(world.Step());
+  EXPECT_EQ(world.state(0).mode_target, b);
+  ASSERT_EQ(sliders->segments().size(), 2u);
+  EXPECT_EQ(sliders->segments()[0].step, 0);
+  EXPECT_EQ(sliders->segments()[0].targets, Eigen::VectorXd::Zero(D));
+  EXPECT_EQ(sliders->segments()[1].step, 3);
+  EXPECT_EQ(sliders->segments()[1].targets, b);
+  EXPECT_THROW(sliders->Set(Eigen::VectorXd::Zero(D + 1)), std::invalid_argument);
+}
+
+// The drag path is the critically damped approach: it starts at n0 with velocity v0 and obeys
+// n'' + 2 n'/tau + (n - c)/tau^2 = 0; its derivatives match central differences of n.
+TEST(Controllers, ApproachPathIsTheCriticallyDampedApproach) {
+  const double t0 = 0.4, tau = 0.08;
+  const Eigen::Vector3d n0(1, -2, 0.5), v0(3, 0.5, -1), c(-1, 1, 2);
+  const control::ApproachPath path(t0, n0, v0, c, tau);
+  const PathSample start = path.Evaluate(t0);
+  EXPECT_LT((start.n - n0).norm(), 1e-15);
+  EXPECT_LT((start.n_dot - v0).norm(), 1e-14);
+  for (double s : {0.01, 0.05, 0.1, 0.3}) {
+    const PathSample p = path.Evaluate(t0 + s);
+    EXPECT_LT((p.n_ddot + 2.0 * p.n_dot / tau + (p.n - c) / (tau * tau)).norm(), 1e-9) << s;
+    const double h = 1e-6;
+    const Eigen::VectorXd fd = (path.Evaluate(t0 + s + h).n - path.Evaluate(t0 + s - h).n) / (2 * h);
+    EXPECT_LT((fd - p.n_dot).norm(), 1e-6 * (1 + p.n_dot.norm())) << s;
+  }
+  EXPECT_LT((path.Evaluate(t0 + 40 * tau).n - c).norm(), 1e-12);
+}
+
+// A mouse pull by trajectory constraint takes a bar's end to the aim within a few time
+// constants while the constraint holds, and Release leaves the bar free again.
+TEST(Controllers, ConstraintPullTakesThePointToTheAimAndReleaseRemovesIt) {
+  WorldOptions o = testing::WitkinWelchOptions();
+  o.dt = 1e-3;
+  o.params.gravity_on = false;
+  World world(o);
+  const int bar = world.AddLinearBody(
+      std::make_shared<LinearBodyModel>(MakeBoxBody("bar", 2, LinearOrder::kAffine, Eigen::Vector2d(0.5, 0.1), 3, 1.0)),
+      AffineMaterial{200.0, 200.0, 0.0, 0.0});
+  const MaterialPoint end = MassPointOf(bar, 0);
+  const Eigen::VectorXd start = world.PointPosition(end);
+  auto pull = std::make_shared<control::ConstraintPull>(world, end, 0.08);
+  world.AddController(pull);
+  ASSERT_GE(pull->constraint(), 0);
+  const Eigen::Vector2d aim = start + Eigen::Vector2d(0.3, 0.2);
+  pull->Aim(aim);
+  double worst = 0;
+  for (int n = 0; n < 1000; ++n) {  // 1 s = 12.5 time constants
+    ASSERT_TRUE(world.Step()) << world.status().message;
+    worst = std::max(worst, world.MaxViolation());
+  }
+  EXPECT_LT((world.PointPosition(end) - aim).norm(), 1e-3);
+  EXPECT_LT(worst, 1e-4);
+  const int id = pull->constraint();
+  pull->Release(world);
+  world.RemoveController(pull.get());
+  EXPECT_FALSE(world.exists(id));
+  EXPECT_EQ(pull->constraint(), -1);
+  ASSERT_TRUE(world.Step());
+}
+
+TEST(Controllers, SpringPullMovesItsAnchorAndReleaseRemovesTheSpring) {
+  auto body = std::make_shared<const BodyModel>(TableDef(), testing::TableModes(4e7, 8e6));
+  World world(FreeSpace(Integrator::kRK4, 1e-3));
+  world.AddBody(body);
+  Spring s;
+  s.lattice_coords = Eigen::Vector2d(0.2, 1.0);
+  s.anchor = Eigen::Vector2d(1, 2);
+  s.stiffness = 10;
+  auto pull = std::make_shared<control::SpringPull>(world, s);
+  world.AddController(pull);
+  ASSERT_EQ(world.options().params.springs.size(), 1u);
+  pull->Aim(world, Eigen::Vector2d(3, 4));
+  EXPECT_EQ(world.options().params.springs[0].anchor, Eigen::Vector2d(3, 4));
+  EXPECT_EQ(world.options().params.springs[0].lattice_coords, s.lattice_coords);
+  ASSERT_TRUE(world.Step());
+  pull->Release(world);
+  world.RemoveController(pull.get());
+  EXPECT_TRUE(world.options().params.springs.empty());
 }
 
 }  // namespace

@@ -14,16 +14,15 @@ PoseGraphController::PoseGraphController(const World& world, int body, PoseGraph
 
 void PoseGraphController::BeforeStep(World& world) {
   const double t = double(steps_++) * world.options().dt;
-  const BodyModel& body = world.body(body_);
   if (width_ > 0) {
     pose_ = graph_.PoseAt(t);
-    world.SetModeTargets(body_, SmoothPoseTargets(body, graph_, t, width_));
+    world.SetModeTargets(body_, SmoothPoseTargets(world.body(body_), graph_, t, width_));
     return;
   }
   const int now = graph_.PoseAt(t);
-  if (now != pose_) {
+  if (now != pose_) {  // hard switches: the targets change only here
     pose_ = now;
-    world.SetModeTargets(body_, TargetsFromPose(body, graph_.poses[pose_]));
+    world.SetModeTargets(body_, TargetsFromPose(world.body(body_), graph_.poses[pose_]));
   }
 }
 
@@ -51,6 +50,33 @@ void KeyframeController::Place(World& world, double t) const {
   keys_.Evaluate(t, &gamma, &gamma_dot);
   KeyframedState(world.body(body_), hold_, anchor_, translation_, theta_, gamma, gamma_dot, &q, &qd);
   world.SetState(body_, q, qd);
+}
+
+ModeTargetController::ModeTargetController(const World& world, int body) : body_(body) {
+  const BodyModel& model = world.body(body);
+  Eigen::VectorXd now = world.state(body).mode_target;
+  if (now.size() == 0) now = Eigen::VectorXd::Zero(model.num_modes());  // empty means all zero
+  segments_.push_back({0, now});
+}
+
+void ModeTargetController::Set(const Eigen::VectorXd& targets) {
+  if (targets.size() != segments_.back().targets.size())
+    throw std::invalid_argument("ModeTargetController: one target per mode");
+  if (!targets.allFinite()) throw std::invalid_argument("ModeTargetController: targets must be finite");
+  next_ = targets;
+  pending_ = true;
+}
+
+void ModeTargetController::BeforeStep(World& world) {
+  if (pending_) {
+    world.SetModeTargets(body_, next_);
+    pending_ = false;
+  }
+  Eigen::VectorXd now = world.state(body_).mode_target;
+  if (now.size() == 0) now = Eigen::VectorXd::Zero(segments_.back().targets.size());
+  if (now == segments_.back().targets) return;
+  if (segments_.back().step == steps_) segments_.back().targets = now;  // changed again before a step
+  else segments_.push_back({steps_, now});
 }
 
 }  // namespace wobble::control

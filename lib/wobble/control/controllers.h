@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <vector>
 
 #include "wobble/control/control.h"
 #include "wobble/world/controller.h"
@@ -63,6 +64,35 @@ class KeyframeController : public Controller {
   double dt_;
   Eigen::Vector2d anchor_, translation_;
   double theta_;
+  long steps_ = 0;
+};
+
+// A body's PD targets γ0 as the viewer's sliders set them, and the record of every change of
+// them, whoever made it (a pose graph added before this controller, or Set): what a session
+// script replays. Set takes effect at the start of the next step.
+struct TargetSegment {
+  long step = 0;            // the targets hold from this step (0-based from the start) on
+  Eigen::VectorXd targets;  // one per mode
+};
+
+class ModeTargetController : public Controller {
+ public:
+  // Starts logging from the body's targets now (step 0).
+  ModeTargetController(const World& world, int body);
+  void Set(const Eigen::VectorXd& targets);  // one per mode; from the next step on
+  // The targets the next step will use as far as this controller knows (the pending Set, or
+  // the last logged).
+  const Eigen::VectorXd& targets() const { return pending_ ? next_ : segments_.back().targets; }
+  void BeforeStep(World& world) override;
+  void AfterStep(World&) override { ++steps_; }
+  const std::vector<TargetSegment>& segments() const { return segments_; }
+  long steps() const { return steps_; }  // steps taken since the start
+
+ private:
+  int body_;
+  bool pending_ = false;
+  Eigen::VectorXd next_;
+  std::vector<TargetSegment> segments_;
   long steps_ = 0;
 };
 

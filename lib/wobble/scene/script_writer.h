@@ -16,6 +16,7 @@
 
 #include "wobble/body/body_model.h"
 #include "wobble/control/control.h"
+#include "wobble/control/controllers.h"
 #include "wobble/world/world.h"
 
 namespace wobble::scene {
@@ -54,10 +55,7 @@ struct SessionRecord {
   WorldOptions world;                   // ground, gravity, integrator, dt, the scene's springs
   Eigen::VectorXd q0, qd0;              // state at the session's start
   double t0 = 0.0;                      // time at the session's start
-  struct Segment {
-    long step = 0;            // the targets hold from this step (0-based from the start) on
-    Eigen::VectorXd targets;  // one per mode
-  };
+  using Segment = control::TargetSegment;  // control::ModeTargetController logs them
   std::vector<Segment> segments;  // by step, the first at step 0 (none: targets stay zero)
   long steps = 0;                 // steps taken in the session
   // Pulls by the mouse (moving springs) cannot be written in the language: the script says how

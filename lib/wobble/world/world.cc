@@ -77,15 +77,12 @@ int World::AddLinearBody(std::shared_ptr<const LinearBodyModel> model, AffineMat
   return num_bodies() - 1;
 }
 
-void World::CheckBody(int body) const {
+void World::ThrowBadBody(int body, BodyKind wanted) const {
   if (body < 0 || body >= num_bodies())
     throw std::invalid_argument("unknown body " + std::to_string(body) + " (the world has " +
                                 std::to_string(num_bodies()) + " bodies)");
-}
-
-BodyKind World::kind(int body) const {
-  CheckBody(body);
-  return slots_[body].kind;
+  throw std::invalid_argument("body " + std::to_string(body) + " is not " +
+                              (wanted == BodyKind::kFfd ? "an FFD body" : "a linear body"));
 }
 
 int World::dim(int body) const { return kind(body) == BodyKind::kLinear ? Linear(body).model->dim() : 2; }
@@ -96,20 +93,12 @@ const std::string& World::body_name(int body) const {
   return kind(body) == BodyKind::kLinear ? Linear(body).model->name() : Ffd(body).model->name();
 }
 
-const World::FfdEntry& World::Ffd(int body) const {
-  if (kind(body) != BodyKind::kFfd) throw std::invalid_argument("body " + std::to_string(body) + " is not an FFD body");
-  return ffd_[slots_[body].index];
-}
-World::FfdEntry& World::Ffd(int body) { return const_cast<FfdEntry&>(static_cast<const World*>(this)->Ffd(body)); }
-
 const World::LinearEntry& World::Linear(int body) const {
-  if (kind(body) != BodyKind::kLinear) throw std::invalid_argument("body " + std::to_string(body) + " is not a linear body");
+  if (kind(body) != BodyKind::kLinear) ThrowBadBody(body, BodyKind::kLinear);
   return linear_[slots_[body].index];
 }
 
-const BodyModel& World::body(int i) const { return *Ffd(i).model; }
 const std::shared_ptr<const BodyModel>& World::shared_body(int i) const { return Ffd(i).model; }
-const BodyState<double>& World::state(int i) const { return Ffd(i).state; }
 
 void World::SetModeTargets(int i, const Eigen::VectorXd& targets) {
   FfdEntry& e = Ffd(i);
@@ -186,6 +175,8 @@ bool World::Step() {
       explicit Stepping(World& world) : w(world) { w.stepping_ = true; }
       ~Stepping() {
         w.stepping_ = false;
+        if (!w.removed_while_stepping_) return;
+        w.removed_while_stepping_ = false;
         w.controllers_.erase(std::remove(w.controllers_.begin(), w.controllers_.end(), nullptr), w.controllers_.end());
       }
     } stepping(*this);
@@ -208,10 +199,12 @@ void World::AddController(std::shared_ptr<Controller> controller) {
 void World::RemoveController(const Controller* controller) {
   for (size_t i = 0; i < controllers_.size(); ++i)
     if (controllers_[i].get() == controller) {
-      if (stepping_)
+      if (stepping_) {
         controllers_[i] = nullptr;  // it may be running now: released when the step is over
-      else
+        removed_while_stepping_ = true;
+      } else {
         controllers_.erase(controllers_.begin() + long(i));
+      }
       return;
     }
 }

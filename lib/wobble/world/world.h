@@ -194,7 +194,8 @@ class World {
   void RemoveController(const Controller* controller);  // no-op when absent
   void ClearControllers() {
     for (auto& c : controllers_) c = nullptr;
-    if (!stepping_) controllers_.clear();
+    if (stepping_) removed_while_stepping_ = true;
+    else controllers_.clear();
   }
   void SetRecorder(std::shared_ptr<Controller> recorder) { recorder_ = std::move(recorder); }
   Controller* recorder() const { return recorder_.get(); }
@@ -286,9 +287,11 @@ class World {
   };
 
   // world.cc: bodies, controllers, energies; world_step.cc: the per-body step and its checks
+  // inline (below the class): the per-step loops of controllers call body() and state()
   void CheckBody(int body) const;
   FfdEntry& Ffd(int body);
   const FfdEntry& Ffd(int body) const;
+  [[noreturn]] void ThrowBadBody(int body, BodyKind wanted) const;
   const LinearEntry& Linear(int body) const;
   bool StepEachBody();
   bool StepFfdBody(int body);
@@ -332,6 +335,7 @@ class World {
   std::vector<std::shared_ptr<Controller>> controllers_;  // null: removed during this step
   std::shared_ptr<Controller> recorder_;
   bool stepping_ = false;
+  bool removed_while_stepping_ = false;  // controllers_ has null entries to erase
   std::vector<FfdEntry> ffd_;
   std::vector<LinearEntry> linear_;
   std::vector<Constraint> constraints_;
@@ -347,5 +351,20 @@ class World {
   long steps_ = 0;
   WorldStatus status_;
 };
+
+inline void World::CheckBody(int body) const {
+  if (unsigned(body) >= slots_.size()) ThrowBadBody(body, BodyKind::kFfd);
+}
+inline BodyKind World::kind(int body) const {
+  CheckBody(body);
+  return slots_[size_t(body)].kind;
+}
+inline const World::FfdEntry& World::Ffd(int body) const {
+  if (unsigned(body) >= slots_.size() || slots_[size_t(body)].kind != BodyKind::kFfd) ThrowBadBody(body, BodyKind::kFfd);
+  return ffd_[size_t(slots_[size_t(body)].index)];
+}
+inline World::FfdEntry& World::Ffd(int body) { return const_cast<FfdEntry&>(static_cast<const World*>(this)->Ffd(body)); }
+inline const BodyModel& World::body(int i) const { return *Ffd(i).model; }
+inline const BodyState<double>& World::state(int i) const { return Ffd(i).state; }
 
 }  // namespace wobble
