@@ -9,7 +9,6 @@
 #include <vtkImageData.h>
 
 #include "pipelines/exports.h"
-#include "pipelines/interactive_scene_view.h"
 #include "pipelines/interactive_view.h"
 #include "pipelines/scene_view.h"
 #include "wobble/script/interpreter.h"
@@ -75,32 +74,6 @@ pl::ViewerOptions MakeViewerOptions(const ViewArgs& a, int width, int height) {
   vo.drag_stiffness = a.drag_stiffness;
   vo.session_path = a.session;
   return vo;
-}
-
-// A script with a Witkin & Welch scene: its World live, stepped by the scene runtime as `simul`
-// steps it (the queued behaviours act between steps).
-int ViewScene(scene::Scene* scene, const ViewArgs& a, int width, int height) {
-  if (!a.save_session.empty()) throw UsageError("--save-session: sessions are saved for FFD objects, not for scenes");
-  const scene::SceneDrawing drawing = scene->Drawing();
-  pl::InteractiveSceneInput input;
-  input.world = &scene->world();
-  input.spec = pl::SceneSpecOf(drawing.drawings, drawing.anchors);
-  input.azimuth = drawing.azimuth;
-  input.elevation = drawing.elevation;
-  scene->BeginRun();
-  input.step = [scene] {
-    if (!scene->Step()) throw std::runtime_error("simulation stopped: " + scene->world().status().message);
-  };
-  pl::InteractiveSceneView view(std::move(input), MakeViewerOptions(a, width, height));
-  view.Run(a.frames, a.play_events, a.frames > 0);
-  if (!a.screenshot.empty()) pl::WritePng(a.screenshot, view.Capture());
-  if (a.report_fps) ReportFps(view.stats(), a, view.world().options().dt);
-  std::printf("t = %.6g, largest constraint violation %.3g\n", view.time(), view.world().MaxViolation());
-  if (!view.message().empty()) {
-    std::cerr << "wobble: simulation " << view.message() << std::endl;
-    return kExitSimStopped;
-  }
-  return kExitOk;
 }
 
 }  // namespace
@@ -171,52 +144,53 @@ int RunView(const ViewArgs& a) {
     throw UsageError("view needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run it on a desktop,\n"
                      "or headless: xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble view ... --frames N");
 
-  pl::ViewerScene scene;
+  // the scene runtime the viewer runs: a script's (up to its first run), or an object file's
+  script::Interpreter interp(std::cout);
+  scene::Scene object_scene;
+  scene::Scene* scene = &object_scene;
   const bool script = !a.scene.empty() && IsScript(a.scene);
   if (script) {
     if (!a.q.empty() || !a.qdot.empty() || !a.modes.empty())
       throw UsageError("view: --q, --qdot and --modes apply to object files; a script sets them itself");
-    script::Interpreter interp(std::cout);
     if (!a.object.empty()) interp.LoadObject(a.object);
     const int stop = RunScriptSetup(&interp, a.scene);
-    if (interp.scene().has_bodies()) {
-      if (stop > 0)
-        std::cout << "wobble view: " << a.scene << " ran up to line " << stop
-                  << "; the viewer steps its scene from there\n";
-      return ViewScene(&interp.scene(), a, width, height);
-    }
-    const scene::SimulationSetup setup = interp.scene().CurrentSetup();
-    if (!setup.body) throw UsageError(a.scene + ": the script loads no object (load_obj FILE, or --object FILE)");
+    scene = &interp.scene();
+    if (!scene->has_bodies() && !scene->object().loaded())
+      throw UsageError(a.scene + ": the script loads no object (load_obj FILE, or --object FILE)");
     if (stop > 0)
-      std::cout << "wobble view: " << a.scene << " ran up to line " << stop
-                << "; the viewer plays its simulation from there\n";
-    scene = pl::ViewerScene::FromScript(setup);
+      std::cout << "wobble view: " << a.scene << " ran up to line " << stop << "; the viewer "
+                << (scene->has_bodies() ? "steps its scene" : "plays its simulation") << " from there\n";
   } else {
     BodyFiles files;
     files.object = a.object.empty() ? a.scene : a.object;
     files.modes = a.modes;
     RequirePositive(a.dt, "--dt");
+    // read and checked here (file, line, sizes), then loaded into the scene as a script would
     const StartingWorld start = LoadStartingWorld(files, a.q, a.qdot, a.world, ParseIntegratorFlag(a.integrator), a.dt);
-    scene.body = start.body;
-    scene.world = start.options;
-    scene.q0 = start.q0;
-    scene.qd0 = start.qd0;
-    scene.object_path = fs::absolute(files.object).string();
-    for (const std::string& m : files.modes) scene.mode_paths.push_back(fs::absolute(m).string());
+    object_scene.options() = start.options;
+    object_scene.object().Load(files.object);
+    object_scene.object().LoadModes(files.modes);
+    object_scene.object().SetState(start.q0, start.qd0);
   }
+  if (!a.save_session.empty() && scene->has_bodies())
+    throw UsageError("--save-session: sessions are saved for FFD objects, not for scenes");
 
-  pl::InteractiveView view(std::move(scene), MakeViewerOptions(a, width, height));
+  pl::InteractiveView view(*scene, MakeViewerOptions(a, width, height));
   view.Run(a.frames, a.play_events, a.frames > 0);
 
   if (!a.screenshot.empty()) pl::WritePng(a.screenshot, view.Capture());
   if (!a.save_session.empty())
     for (const std::string& f : view.SaveSession(a.save_session)) std::cout << "wrote " << f << "\n";
   if (a.report_fps) ReportFps(view.stats(), a, view.world().options().dt);
-  std::printf("t = %.6g, q =", view.time());
-  for (int i = 0; i < view.world().state(0).q.size(); ++i) std::printf(" %.17g", view.world().state(0).q[i]);
-  std::printf("\n");
-  if (!view.world().status().ok()) {
-    std::cerr << "wobble: simulation stopped: " << view.world().status().message << std::endl;
+  if (view.character()) {
+    std::printf("t = %.6g, q =", view.time());
+    for (int i = 0; i < view.world().state(0).q.size(); ++i) std::printf(" %.17g", view.world().state(0).q[i]);
+    std::printf("\n");
+  } else {
+    std::printf("t = %.6g, largest constraint violation %.3g\n", view.time(), view.world().MaxViolation());
+  }
+  if (view.stopped()) {
+    std::cerr << "wobble: " << view.message() << std::endl;
     return kExitSimStopped;
   }
   return kExitOk;

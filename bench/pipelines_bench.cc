@@ -203,14 +203,13 @@ namespace {
 void BM_ViewerFrame1280x720(benchmark::State& state) {
   if (!NeedDisplay(state)) return;
   const bool pot = state.range(0) == 1;
-  ViewerScene scene;
-  scene.body = pot ? std::make_shared<const BodyModel>(formats::ReadObjectFile(kData + "/pot.obj"),
-                                                       formats::ReadDeformationFile(kData + "/def_pot"))
-                   : Table();
-  scene.q0 = Eigen::VectorXd::Zero(scene.body->num_q());
-  scene.q0[1] = 50;
-  scene.qd0 = Eigen::VectorXd::Zero(scene.body->num_q());
-  scene.object_path = kData + (pot ? "/pot.obj" : "/table.obj");
+  scene::Scene scene;  // as `wobble view OBJECT --modes DEF --q "0 50 0 .."` loads it
+  scene.options() = WorldOptions();  // the World's defaults, as before the scene runtime
+  scene.object().Load(kData + (pot ? "/pot.obj" : "/table.obj"));
+  scene.object().LoadModes({kData + (pot ? "/def_pot" : "/table_modes.def")});
+  Eigen::VectorXd q0 = Eigen::VectorXd::Zero(scene.object().Body()->num_q());
+  q0[1] = 50;
+  scene.object().SetState(q0, Eigen::VectorXd::Zero(q0.size()));
   ViewerOptions o;
   o.fixed_frame_time = true;
   o.charts = state.range(1) == 1;

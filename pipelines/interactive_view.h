@@ -1,36 +1,42 @@
-// The interactive viewer behind `wobble view`: one body of a World in a VTK window, simulated
-// in real time (a repeating timer), with the mouse pulling points, one slider per deformation
-// mode setting its PD target (chapter 5), a time slider over the recorded frames, and live
-// charts of the energy terms and cond₂(M) beside the scene.
+// The interactive viewer behind `wobble view`: a scene::Scene (the scene runtime a script
+// builds, or an object file loaded into one) in a VTK window, simulated in real time by the
+// scene's own run (Scene::BeginRun / Step: the step `simul` takes), drawn by the offscreen
+// renderer's SceneView on screen. It shows what the scene holds:
 //
-// It draws with the offscreen renderer's own pieces: a SceneView (scene_view.h) set to draw
-// on screen in the left part of the window, fed by the sources of world_sources.h; the charts
-// are RunRecorder's (energy_charts.h) filled into vtkChartXY by FillChart (charts.h). There is
-// no second drawing path.
+//   - a Witkin & Welch scene (linear bodies, nails, attachments, behaviours; FFD bodies that
+//     joined it): the scene's world, the queued behaviours acting between steps as in `simul`,
+//     drawn as `render` draws it (3D bodies in perspective);
+//   - otherwise the scene's FFD object, a character session: one slider per deformation mode
+//     setting its PD target (chapter 5), a time slider over the recorded frames, live charts
+//     of the energy terms and cond₂(M) (RunRecorder, energy_charts.h), restart, poses recorded
+//     by key, and the session saved as a script that replays it.
 //
-// Window layout (fractions of the window): the scene at the top left, the energy chart and
-// the cond₂(M) chart stacked at the top right, the sliders along the bottom (mode targets
-// above, the time slider below).
+// What drives the world are its controllers (wobble/control): the scene's pose graph
+// (control::PoseGraphController, started by the scene's run) until a slider moves, the sliders
+// (control::ModeTargetController, which logs every target change for the session script) and
+// the mouse: on a character a damped spring to the cursor (control::SpringPull), in a scene a
+// trajectory constraint that leads the picked point to the cursor (control::ConstraintPull,
+// Witkin & Welch §4), in the plane through the point facing the camera. The viewer never sets
+// targets or springs between steps itself.
+//
+// Window layout of a character session (fractions of the window): the scene at the top left,
+// the energy chart and the cond₂(M) chart stacked at the top right, the sliders along the
+// bottom (mode targets above, the time slider below). A scene takes the whole window.
 //
 // Keys (also in README, "wobble view"):
-//   space play/pause   n one step (pauses)   r restart   + / - speed x2 / /2   0 targets to 0
-//   s shape   l lattice   m mass points   g ground   p springs (and constraints)   c recentre
-//   k record the current amplitudes as a pose   w write the session script   Left/Right scrub
-//   h print the keys   q or Escape quit
-// Mouse: left button on the body pulls the nearest point (mass point or drawing sample) with
-// a spring to the cursor; middle drag pans, wheel or right drag zooms.
-//
-// What drives the world are its controllers (wobble/control): the script's pose graph
-// (control::PoseGraphController) until a slider moves, the sliders
-// (control::ModeTargetController, which logs every target change for the session script) and
-// the mouse (control::SpringPull). The viewer never sets targets or springs between steps.
+//   space play/pause   n one step (pauses)   + / - speed x2 / /2   c recentre   h the keys
+//   s shapes   l lattice (control boxes)   m mass points   g ground   p springs and constraints
+//   a named points and the drag line      q or Escape quit
+//   character sessions: r restart   0 targets to 0   k record the current amplitudes as a pose
+//   w write the session script   Left/Right scrub the recorded frames
+// Mouse: the left button picks the nearest mass point, drawing sample or named point within
+// 30 pixels and pulls it; middle drag pans, wheel or right drag zooms.
 //
 // VTK 9.1 needs an X display (HasDisplay()); the constructor throws std::runtime_error
 // without one. Tests and measurements run it under xvfb-run.
 #pragma once
 
 #include <Eigen/Core>
-#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -39,9 +45,8 @@
 
 #include "pipelines/scene_view.h"
 #include "pipelines/viewer_loop.h"
-#include "wobble/control/control.h"
-#include "wobble/world/world.h"
 #include "wobble/scene/scene.h"
+#include "wobble/world/world.h"
 
 class vtkImageData;
 class vtkRenderWindow;
@@ -49,22 +54,6 @@ class vtkRenderWindowInteractor;
 class vtkSliderWidget;
 
 namespace wobble::pipelines {
-
-// What the viewer simulates: body 0 of a world built from these.
-struct ViewerScene {
-  std::shared_ptr<const BodyModel> body;
-  WorldOptions world;      // ground, gravity, integrator, dt and the scene's springs
-  Eigen::VectorXd q0, qd0;  // the start state (restart returns to it)
-  double t0 = 0.0;          // the time shown at the start (a script's `time`)
-  // Drives the targets of the active modes (a script's `pose` lines) until a slider moves.
-  control::PoseGraph graph;
-  // Files the body came from: the saved session script loads them again.
-  std::string object_path;
-  std::vector<std::string> mode_paths;
-
-  // What a script's next `simul` would run (scene::Scene::CurrentSetup).
-  static ViewerScene FromScript(const scene::SimulationSetup& setup);
-};
 
 struct ViewerOptions {
   int width = 1280, height = 720;  // the window
@@ -75,7 +64,7 @@ struct ViewerOptions {
   // time since the last frame (at most kMaxFrameTime) times speed.
   bool fixed_frame_time = false;
   double slider_range = 0.5;    // mode sliders go from -range to +range
-  double drag_stiffness = 0.0;  // 0: total mass x (2 pi x 1 Hz)^2
+  double drag_stiffness = 0.0;  // character pulls; 0: total mass x (2 pi x 1 Hz)^2
   double drag_damping = 0.0;    // 0: half of critical for the total mass on that spring
   bool charts = true;
   int chart_every = 10;  // frames between chart redraws
@@ -88,11 +77,19 @@ struct ViewerOptions {
 class InteractiveView : public ViewerControls {
  public:
   static constexpr double kMaxFrameTime = FramePacer::kMaxFrameTime;
+  // Time constant (s) of the path that takes a point pulled in a scene to the cursor.
+  static constexpr double kDragTime = 0.08;
 
-  InteractiveView(ViewerScene scene, ViewerOptions options = {});
+  // Starts the scene's run (Scene::BeginRun; the view ends it when it closes). The scene
+  // must outlive the view. Throws std::invalid_argument when the scene has neither bodies nor
+  // an FFD object, or for bad options.
+  InteractiveView(scene::Scene& scene, ViewerOptions options = {});
   ~InteractiveView() override;
   InteractiveView(const InteractiveView&) = delete;
   InteractiveView& operator=(const InteractiveView&) = delete;
+
+  // True for a character session (the scene's FFD object), false for a Witkin & Welch scene.
+  bool character() const;
 
   // The event loop: returns when the window closes, on q/Escape, or after max_frames frames
   // (when > 0). With an events file (vtkInteractorEventRecorder format: "EventName x y ctrl
@@ -111,50 +108,57 @@ class InteractiveView : public ViewerControls {
   void SetPlaying(bool playing);
   bool playing() const;
   void StepOnce();  // one simulation step; pauses
-  void Restart();   // the start state, a new session (the targets the sliders show stay)
   void SetSpeed(double speed);
   double speed() const;
-  void ToggleLayer(SceneLayer layer);
+  void ToggleLayer(SceneLayer layer);  // kAnchors also hides the drag line
   bool LayerVisible(SceneLayer layer) const;
+
+  // Character sessions (std::logic_error in a scene).
+  void Restart();     // the start state, a new session (the targets the sliders show stay)
   void RecordPose();  // current amplitudes γ as a pose of a pose graph (held since the last)
   // Writes the session script (scene::SessionScript) atomically, and beside it, when poses were
   // recorded, STEM_poses.wob with them as a cyclic pose graph. Returns the paths written.
   std::vector<std::string> SaveSession(const std::string& path);
   std::string SessionScriptText() const;
   void ScrubTo(long frame);  // shows a recorded frame; pauses
-
-  // PD target γ0 of a mode (World::SetModeTargets); moves its slider too. The pose graph, if
+  // PD target γ0 of a mode from the next step on; moves its slider too. The pose graph, if
   // any, stops driving the targets.
   void SetModeTarget(int mode, double target);
   const Eigen::VectorXd& mode_targets() const;
+  long num_recorded_frames() const;
+  long session_steps() const;
+  vtkSliderWidget* mode_slider(int mode);
+  vtkSliderWidget* time_slider();
 
   // Pulling with the mouse, in display pixels (origin at the bottom left, as VTK's). Begin
-  // picks the nearest mass point or drawing sample within 30 pixels; false when none.
+  // picks the nearest point within 30 pixels; false when none is near.
   bool BeginDrag(int x, int y) override;
   void DragTo(int x, int y) override;
   void EndDrag() override;
-  // Lattice coordinates of the point being pulled.
-  std::optional<Eigen::Vector2d> dragged_point() const;
+  // The point being pulled (an FFD point by its lattice coordinates u), if any.
+  std::optional<MaterialPoint> dragged_point() const;
+  int drag_constraint() const;  // a scene's pull: the constraint id while dragging, else -1
+  // Where the cursor is in the world (the point's dimension) while dragging, else empty.
+  Eigen::VectorXd drag_target() const;
 
-  // For tests and the CLI.
   const World& world() const;  // the live world
-  double time() const;         // t0 + the live world's time
-  long num_recorded_frames() const;
-  long session_steps() const;
+  double time() const;         // its time
   const ViewerStats& stats() const;
-  std::string StatusLine() const;  // what the status text shows
+  const std::string& message() const;  // the last trouble (a stopped run) or note, or empty
+  bool stopped() const;                // the run stopped (the world or a behaviour)
+  std::string StatusLine() const;      // what the status text shows
+  // Display pixels of a world point (2 or 3 coordinates), and back from pixels onto z = 0.
+  Eigen::Vector3d WorldToDisplay(const Eigen::VectorXd& p) const;
   Eigen::Vector2d DisplayToWorld(double x, double y) const;
-  Eigen::Vector2d WorldToDisplay(const Eigen::Vector2d& p) const;
   vtkRenderWindow* window();
   vtkRenderWindowInteractor* interactor();
-  vtkSliderWidget* mode_slider(int mode);
-  vtkSliderWidget* time_slider();
-  SceneView& scene();
+  SceneView& view();
   // The whole window as drawn last (RGB, bottom row first).
   vtkSmartPointer<vtkImageData> Capture();
 
+  struct Impl;  // interactive_view_impl.h: shared by the two source files of the viewer
+
  private:
-  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 

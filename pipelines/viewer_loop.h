@@ -1,4 +1,4 @@
-// What both viewers of `wobble view` share (InteractiveView, InteractiveSceneView): the frame
+// What the viewer of `wobble view` (InteractiveView) builds on: the frame
 // clock and its statistics, the event loop, the interactor style that sends mouse and keys to
 // a ViewerControls, and the capture of the on-screen window.
 #pragma once
@@ -22,7 +22,7 @@ struct ViewerStats {
   long playing_frames = 0;    // frames drawn while playing
 };
 
-// The real-time bookkeeping both viewers share (InteractiveView, InteractiveSceneView): the
+// The viewer's real-time bookkeeping: the
 // frame clock, how much simulated time a frame asks for, stepping toward it, and the
 // statistics that --report-fps prints. Each viewer keeps its own world and step.
 class FramePacer {

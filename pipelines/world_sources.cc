@@ -55,8 +55,6 @@ void AddTimeValue(vtkPolyData* out, double time) {
   out->GetFieldData()->AddArray(t);
 }
 
-Eigen::Vector3d To3(const Eigen::VectorXd& x) { return Eigen::Vector3d(x[0], x[1], x.size() > 2 ? x[2] : 0.0); }
-
 // The box a linear body's mass points span in undeformed coordinates.
 void UndeformedBox(const LinearBodyModel& model, Eigen::VectorXd* lo, Eigen::VectorXd* hi) {
   *lo = model.def().points[0];
@@ -68,6 +66,8 @@ void UndeformedBox(const LinearBodyModel& model, Eigen::VectorXd* lo, Eigen::Vec
 }
 
 }  // namespace
+
+Eigen::Vector3d To3(const Eigen::VectorXd& x) { return Eigen::Vector3d(x[0], x[1], x.size() > 2 ? x[2] : 0.0); }
 
 Eigen::Vector2d WorldPositionOf(const World& world, int body, const Eigen::Vector2d& st) {
   Eigen::Vector2d b0;

@@ -46,6 +46,9 @@
 
 namespace wobble::pipelines {
 
+// A point of a 2D or 3D world in VTK's three coordinates (z = 0 in 2D).
+Eigen::Vector3d To3(const Eigen::VectorXd& p);
+
 // What every source shares: the world and which body of it.
 class WorldSourceBase : public vtkPolyDataAlgorithm {
  public:

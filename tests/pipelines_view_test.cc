@@ -29,7 +29,6 @@
 #include <fstream>
 #include <sstream>
 
-#include "pipelines/interactive_scene_view.h"
 #include "pipelines/interactive_view.h"
 #include "support/pipelines_test_util.h"
 #include "support/render_baseline.h"
@@ -44,15 +43,15 @@ using testing_render::CompareWithBaseline;
 
 const std::string kData = WOBBLE_DATA_DIR;
 
-ViewerScene TableScene(const Eigen::VectorXd& q0) {
-  ViewerScene s;
-  s.body = Table();
-  s.world.integrator = Integrator::kThesis;
-  s.world.dt = 0.01;
-  s.q0 = q0;
-  s.qd0 = Eigen::VectorXd::Zero(q0.size());
-  s.object_path = kData + "/table.obj";
-  s.mode_paths = {kData + "/table_modes.def"};
+// The table of data/ in a scene, as `wobble view data/table.obj --modes data/table_modes.def`
+// loads it: the thesis integrator, dt 0.01, at rest at q0.
+std::unique_ptr<scene::Scene> TableScene(const Eigen::VectorXd& q0) {
+  auto s = std::make_unique<scene::Scene>();
+  s->object().Load(kData + "/table.obj");
+  s->object().LoadModes({kData + "/table_modes.def"});
+  s->options().integrator = Integrator::kThesis;
+  s->options().dt = 0.01;
+  s->object().SetState(q0, Eigen::VectorXd::Zero(q0.size()));
   return s;
 }
 
@@ -116,18 +115,19 @@ Eigen::Vector2d SliderPixel(InteractiveView* view, vtkSliderWidget* w, double va
 TEST(InteractiveView, RecordedDragPullsThePointLikeASpringToTheCursor) {
   REQUIRE_DISPLAY();
   // the table standing on its feet
-  InteractiveView view(TableScene(Vec({0, 0, 0, 0, 0, 0, 0})), TestOptions());
+  auto table = TableScene(Vec({0, 0, 0, 0, 0, 0, 0}));
+  InteractiveView view(*table, TestOptions());
   view.Initialize();  // opens the window and draws once; no event loop
   for (int k = 0; k < 10; ++k) view.Frame();  // let it settle a little
   // press on the top right corner of the table top, pull up and to the right
   const Eigen::Vector2d corner = WorldPositionOf(view.world(), 0, Eigen::Vector2d(1.0, 1.0));
-  const Eigen::Vector2d press = view.WorldToDisplay(corner);
+  const Eigen::Vector2d press = view.WorldToDisplay(corner).head<2>();
   const Eigen::Vector2d cursor_px = press + Eigen::Vector2d(40, 60);
   std::string events = Event("MouseMoveEvent", press.x(), press.y()) + Event("LeftButtonPressEvent", press.x(), press.y()) +
                        Event("MouseMoveEvent", cursor_px.x(), cursor_px.y());
   Play(&view, events);
   ASSERT_TRUE(view.dragged_point().has_value()) << "the press did not pick a point";
-  const Eigen::Vector2d st = *view.dragged_point();
+  const Eigen::Vector2d st = view.dragged_point()->u;
   const Eigen::Vector2d cursor = view.DisplayToWorld(std::lround(cursor_px.x()), std::lround(cursor_px.y()));
   const double before = (WorldPositionOf(view.world(), 0, st) - cursor).norm();
 
@@ -148,21 +148,22 @@ TEST(InteractiveView, RecordedDragPullsThePointLikeASpringToTheCursor) {
 TEST(InteractiveView, DragInTheAirMatchesAWorldWithASpring) {
   REQUIRE_DISPLAY();
   // no ground: the state is q and q̇ alone, so an independent World can follow exactly
-  ViewerScene scene = TableScene(Vec({0, 200, 0.1, 0, 0, 0, 0}));
-  scene.world.params.ground.enabled = false;
-  InteractiveView view(scene, TestOptions());
+  auto table = TableScene(Vec({0, 200, 0.1, 0, 0, 0, 0}));
+  table->options().params.ground.enabled = false;
+  const scene::SimulationSetup start = table->CurrentSetup();
+  InteractiveView view(*table, TestOptions());
   view.Initialize();
   const Eigen::Vector2d point = WorldPositionOf(view.world(), 0, Eigen::Vector2d(0.0, 1.0));
-  const Eigen::Vector2d press = view.WorldToDisplay(point);
+  const Eigen::Vector2d press = view.WorldToDisplay(point).head<2>();
   const Eigen::Vector2d cursor_px = press + Eigen::Vector2d(-50, 30);
   Play(&view, Event("LeftButtonPressEvent", press.x(), press.y()) + Event("MouseMoveEvent", cursor_px.x(), cursor_px.y()));
   ASSERT_TRUE(view.dragged_point().has_value());
-  const Eigen::Vector2d st = *view.dragged_point();
+  const Eigen::Vector2d st = view.dragged_point()->u;
   const Eigen::Vector2d cursor = view.DisplayToWorld(std::lround(cursor_px.x()), std::lround(cursor_px.y()));
 
-  World ref(scene.world);
-  ref.AddBody(scene.body);
-  ref.SetState(0, scene.q0, scene.qd0);
+  World ref(start.world);
+  ref.AddBody(start.body);
+  ref.SetState(0, start.q, start.qd);
   Spring sp = view.world().options().params.springs.at(0);
   EXPECT_EQ(sp.lattice_coords, st);
   EXPECT_NEAR((sp.anchor - cursor).norm(), 0.0, 1e-9);
@@ -184,7 +185,8 @@ TEST(InteractiveView, DragInTheAirMatchesAWorldWithASpring) {
 
 TEST(InteractiveView, SliderClickSetsTheModeTargetAndTheAmplitudeFollows) {
   REQUIRE_DISPLAY();
-  InteractiveView view(TableScene(Vec({0, 0, 0, 0, 0, 0, 0})), TestOptions());
+  auto table = TableScene(Vec({0, 0, 0, 0, 0, 0, 0}));
+  InteractiveView view(*table, TestOptions());
   view.Initialize();
   const int bend = 0;  // data/table_modes.def: bend is the first mode
   const Eigen::Vector2d at = SliderPixel(&view, view.mode_slider(bend), 0.25);
@@ -206,8 +208,8 @@ TEST(InteractiveView, SliderClickSetsTheModeTargetAndTheAmplitudeFollows) {
 
 TEST(InteractiveView, KeyTogglesTheLatticeAndScreenshotsMatchBaselines) {
   REQUIRE_DISPLAY();
-  ViewerScene scene = TableScene(Vec({0, 60, 0.1, 0.1, 0, 0, 0}));
-  InteractiveView view(scene, TestOptions());
+  auto table = TableScene(Vec({0, 60, 0.1, 0.1, 0, 0, 0}));
+  InteractiveView view(*table, TestOptions());
   view.Initialize();
   for (int k = 0; k < 15; ++k) view.Frame();
   auto with = view.Capture();
@@ -237,7 +239,8 @@ TEST(InteractiveView, KeyTogglesTheLatticeAndScreenshotsMatchBaselines) {
 
 TEST(InteractiveView, TimeSliderScrubsRecordedFrames) {
   REQUIRE_DISPLAY();
-  InteractiveView view(TableScene(Vec({0, 60, 0, 0, 0, 0, 0})), TestOptions());
+  auto table = TableScene(Vec({0, 60, 0, 0, 0, 0, 0}));
+  InteractiveView view(*table, TestOptions());
   view.Initialize();
   for (int k = 0; k < 20; ++k) view.Frame();
   ASSERT_EQ(view.num_recorded_frames(), 21);  // the start and 20 frames
@@ -273,7 +276,8 @@ TEST(InteractiveView, SavedSessionReplaysToTheSameState) {
   REQUIRE_DISPLAY();
   // dropped onto the ground; targets changed three times while it plays, once in the same
   // frame as a step boundary would be ambiguous without the half-step rule
-  InteractiveView view(TableScene(Vec({0, 30, 0, 0, 0, 0, 0})), TestOptions());
+  auto table = TableScene(Vec({0, 30, 0, 0, 0, 0, 0}));
+  InteractiveView view(*table, TestOptions());
   view.Initialize();
   for (int k = 0; k < 20; ++k) view.Frame();
   view.SetModeTarget(0, 0.2);
@@ -306,8 +310,7 @@ TEST(InteractiveView, ScriptPoseGraphDrivesTheTargetsAndReplays) {
   const scene::SimulationSetup setup = interp.scene().CurrentSetup();
   ASSERT_TRUE(setup.body);
   ASSERT_EQ(setup.world.params.springs.size(), 1u);
-  const ViewerScene scene = ViewerScene::FromScript(setup);
-  InteractiveView view(scene, TestOptions());
+  InteractiveView view(interp.scene(), TestOptions());
   view.Initialize();
   for (int k = 0; k < 40; ++k) view.Frame();  // 1.33 s: poses 0..3 and 0 again
   EXPECT_NE(view.mode_targets().norm(), 0.0);
@@ -318,12 +321,42 @@ TEST(InteractiveView, ScriptPoseGraphDrivesTheTargetsAndReplays) {
   ExpectReplayMatches(view, "view_script_replay");
 }
 
+// A character session is the scene's own run: a script whose pose graph switches smoothly
+// (`set switch_width`) plays in the viewer exactly as the interpreter's `simul` runs it.
+TEST(InteractiveView, CharacterSessionIsTheScenesRunAsSimulRunsIt) {
+  REQUIRE_DISPLAY();
+  const std::string dir = testing::TempDir("view_smooth");
+  const std::string script = dir + "/smooth.wob";
+  std::ofstream(script) << "load_obj " << kData << "/table.obj\nload_def " << kData << "/table_modes.def\n"
+                        << "set codamA 250000\nset integrator thesis\nset dt 0.01\nset switch_width 0.1\n"
+                        << "set_vec q 0 0 0 0 0 0 0\npose 0.1 0 0.3\npose 0 -0.1 0.3\n";
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  interp.RunFile(script);
+  Eigen::VectorXd q;
+  {
+    InteractiveView view(interp.scene(), TestOptions());
+    view.Initialize();
+    for (int k = 0; k < 30; ++k) view.Frame();  // 1 s: 100 steps
+    EXPECT_EQ(view.session_steps(), 100);
+    q = view.world().state(0).q;
+  }
+  script::Interpreter ref(out);
+  ref.RunFile(script);
+  ref.RunLine("simul 1", "<test>", 1, dir);
+  EXPECT_LT((ref.q() - q).cwiseAbs().maxCoeff(), 1e-12) << "simul " << ref.q().transpose() << "\nviewer " << q.transpose();
+  EXPECT_GT(q.tail(4).cwiseAbs().maxCoeff(), 1e-3);  // the graph moved the modes
+  // the view ended its run: the object goes on from where the viewer left it
+  EXPECT_LT((interp.q() - q).cwiseAbs().maxCoeff(), 1e-15);
+}
+
 TEST(InteractiveView, SessionWithADragSaysTheReplayStopsFollowing) {
   REQUIRE_DISPLAY();
-  InteractiveView view(TableScene(Vec({0, 0, 0, 0, 0, 0, 0})), TestOptions());
+  auto table = TableScene(Vec({0, 0, 0, 0, 0, 0, 0}));
+  InteractiveView view(*table, TestOptions());
   view.Initialize();
   for (int k = 0; k < 5; ++k) view.Frame();
-  const Eigen::Vector2d p = view.WorldToDisplay(WorldPositionOf(view.world(), 0, Eigen::Vector2d(0.5, 1.0)));
+  const Eigen::Vector3d p = view.WorldToDisplay(WorldPositionOf(view.world(), 0, Eigen::Vector2d(0.5, 1.0)));
   ASSERT_TRUE(view.BeginDrag(int(p.x()), int(p.y())));
   view.DragTo(int(p.x()), int(p.y()) + 40);
   for (int k = 0; k < 5; ++k) view.Frame();
@@ -335,9 +368,9 @@ TEST(InteractiveView, SessionWithADragSaysTheReplayStopsFollowing) {
 
 TEST(InteractiveView, RecordedPosesBecomeACyclicPoseGraphScript) {
   REQUIRE_DISPLAY();
-  ViewerScene scene = TableScene(Vec({0, 300, 0, 0, 0, 0, 0}));
-  scene.world.params.gravity_on = false;
-  InteractiveView view(scene, TestOptions());
+  auto table = TableScene(Vec({0, 300, 0, 0, 0, 0, 0}));
+  table->options().params.gravity_on = false;
+  InteractiveView view(*table, TestOptions());
   view.Initialize();
   // the table in the air, free of the ground: the bend follows its target within ~2 s (K 4e6 on G ~ 1e7)
   std::vector<Eigen::VectorXd> amplitudes;
@@ -379,30 +412,15 @@ void RunUpToSimul(script::Interpreter* interp, const std::string& path) {
   }
 }
 
-InteractiveSceneInput SceneInput(script::Interpreter* interp) {
-  scene::Scene* sc = &interp->scene();
-  const scene::SceneDrawing d = sc->Drawing();
-  InteractiveSceneInput input;
-  input.world = &sc->world();
-  input.spec = SceneSpecOf(d.drawings, d.anchors);
-  input.azimuth = d.azimuth;
-  input.elevation = d.elevation;
-  sc->BeginRun();
-  input.step = [sc] {
-    if (!sc->Step()) throw std::runtime_error("simulation stopped: " + sc->world().status().message);
-  };
-  return input;
-}
-
 const std::string kFig2 = kData + "/fig2_triple_pendulum.wob";
 
-TEST(InteractiveSceneView, Fig2StepsTheScriptsSceneAsSimulDoes) {
+TEST(InteractiveViewOfAScene, Fig2StepsTheScriptsSceneAsSimulDoes) {
   REQUIRE_DISPLAY();
   std::ostringstream log;
   script::Interpreter interp(log);
   RunUpToSimul(&interp, kFig2);
   ASSERT_TRUE(interp.scene().has_bodies());
-  InteractiveSceneView view(SceneInput(&interp), TestOptions());
+  InteractiveView view(interp.scene(), TestOptions());
   view.Initialize();
   for (int k = 0; k < 30; ++k) view.Frame();  // 30 frames of 1/30 s: 1 s, 1000 steps of dt 0.001
   EXPECT_NEAR(view.time(), 1.0, 1e-9);
@@ -422,12 +440,12 @@ TEST(InteractiveSceneView, Fig2StepsTheScriptsSceneAsSimulDoes) {
     EXPECT_LT((interp.scene().Point(name) - ref.scene().Point(name)).norm(), 1e-12) << name;
 }
 
-TEST(InteractiveSceneView, DragTakesThePickedPointToTheCursorAndReleaseRemovesIt) {
+TEST(InteractiveViewOfAScene, DragTakesThePickedPointToTheCursorAndReleaseRemovesIt) {
   REQUIRE_DISPLAY();
   std::ostringstream log;
   script::Interpreter interp(log);
   RunUpToSimul(&interp, kFig2);
-  InteractiveSceneView view(SceneInput(&interp), TestOptions());
+  InteractiveView view(interp.scene(), TestOptions());
   view.Initialize();
   // press on the tip (3, 0) and pull it to (2.5, -1), within reach of the nailed chain
   const Eigen::Vector3d press = view.WorldToDisplay(interp.scene().Point("tip"));
@@ -448,8 +466,8 @@ TEST(InteractiveSceneView, DragTakesThePickedPointToTheCursorAndReleaseRemovesIt
   Play(&view, frames);
   const double after = (view.world().PointPosition(picked) - target).norm();
   // the chain starts at rest, so the path is n(s) = c + A (1 + s/tau) e^(-s/tau) with
-  // |A| = before (interactive_scene_view.cc); after 15 frames (s = 0.5 s) the point is on it
-  const double s = 0.5, tau = InteractiveSceneView::kDragTime;
+  // |A| = before (control::ApproachPath); after 15 frames (s = 0.5 s) the point is on it
+  const double s = 0.5, tau = InteractiveView::kDragTime;
   EXPECT_GT(before, 0.9);
   EXPECT_NEAR(after, before * (1.0 + s / tau) * std::exp(-s / tau), 1e-4) << before << " -> " << after;
   EXPECT_LT(view.world().MaxViolation(), 1e-3);  // the nail and the joints hold meanwhile
@@ -476,12 +494,12 @@ long CountColourEverywhere(vtkImageData* image, double r, double g, double b) {
   return n;
 }
 
-TEST(InteractiveSceneView, KeyTogglesTheAnchors) {
+TEST(InteractiveViewOfAScene, KeyTogglesTheAnchors) {
   REQUIRE_DISPLAY();
   std::ostringstream log;
   script::Interpreter interp(log);
   RunUpToSimul(&interp, kFig2);
-  InteractiveSceneView view(SceneInput(&interp), TestOptions());
+  InteractiveView view(interp.scene(), TestOptions());
   view.Initialize();
   view.Frame();
   const double green[3] = {0.1, 0.55, 0.2};  // the anchors' colour (scene_view.cc)

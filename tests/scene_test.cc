@@ -208,5 +208,32 @@ TEST(ObjectRuns, ModesAreMatchedByNameAndTheHandOverIsCountedOnce) {
   EXPECT_EQ(table.q(3, 0)[kRigidDofs + 1], merged.q(15, 0)[kRigidDofs + 1]);
 }
 
+// The viewer's live runs keep no record (keep_steps false) and end in the state of a recorded
+// run; StopPoseGraph freezes the targets where the graph left them.
+TEST(Scene, RunsWithoutARecordAndAStoppedPoseGraph) {
+  std::ostringstream log;
+  script::Interpreter recorded(log), live(log);
+  RunUpToSimul(&recorded, kTableScript, kData);
+  RunUpToSimul(&live, kTableScript, kData);
+  StepByHand(&recorded.scene(), 150);
+  scene::Scene& s = live.scene();
+  s.BeginRun(scene::RunKind::kSimulate, /*keep_steps=*/false);
+  for (int n = 0; n < 150; ++n) ASSERT_TRUE(s.Step());
+  s.EndRun();
+  EXPECT_FALSE(s.last_object_run()) << "a run without a record kept one";
+  EXPECT_EQ((s.object().q() - recorded.scene().object().q()).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_DOUBLE_EQ(s.time(), recorded.scene().time());
+
+  // pose 1 holds 0.3 s (30 steps): stopped at step 10, the targets stay those of pose 1
+  s.BeginRun(scene::RunKind::kSimulate, false);
+  for (int n = 0; n < 10; ++n) ASSERT_TRUE(s.Step());
+  const Eigen::VectorXd held = s.run_world()->state(0).mode_target;
+  ASSERT_GT(held.cwiseAbs().maxCoeff(), 0.0);
+  s.StopPoseGraph();
+  for (int n = 0; n < 60; ++n) ASSERT_TRUE(s.Step());  // past the switch to pose 2 at step 30
+  EXPECT_EQ(s.run_world()->state(0).mode_target, held);
+  s.EndRun();
+}
+
 }  // namespace
 }  // namespace wobble

@@ -21,13 +21,15 @@ PathSample ApproachPath::Evaluate(double t) const {
   return p;
 }
 
-SpringPull::SpringPull(World& world, const Spring& spring) : lattice_coords_(spring.lattice_coords) {
+SpringPull::SpringPull(World& world, const Spring& spring)
+    : lattice_coords_(spring.lattice_coords), anchor_(spring.anchor) {
   world.AddSpring(spring);
   index_ = world.options().params.springs.size() - 1;
 }
 
 void SpringPull::Aim(World& world, const Eigen::Vector2d& anchor) {
   world.mutable_options().params.springs.at(index_).anchor = anchor;
+  anchor_ = anchor;
 }
 
 void SpringPull::Release(World& world) {

@@ -44,10 +44,11 @@ class SpringPull : public Controller {
   // Removes the spring (call once, before removing the controller).
   void Release(World& world);
   const Eigen::Vector2d& lattice_coords() const { return lattice_coords_; }
+  const Eigen::Vector2d& anchor() const { return anchor_; }
 
  private:
   size_t index_;  // in the world's springs
-  Eigen::Vector2d lattice_coords_;
+  Eigen::Vector2d lattice_coords_, anchor_;
 };
 
 class ConstraintPull : public Controller {

@@ -10,10 +10,12 @@ namespace wobble::scene {
 // every step (and integrates the control energy).
 struct Scene::Run {
   RunKind kind = RunKind::kSimulate;
+  bool object = false;  // a run of the FFD object (not of the scene's world)
   World* world = nullptr;
   double start_time = 0.0;
-  long steps = 0;                              // taken
-  std::shared_ptr<record::Recorder> recorder;  // null for the scene's runs
+  long steps = 0;                                  // taken
+  std::shared_ptr<record::Recorder> recorder;      // the object's runs that keep their steps
+  std::shared_ptr<control::PoseGraphController> graph;  // while a pose graph drives the object
 };
 
 // The behaviour Sequencer as a controller of the scene's world: before every step the current
@@ -150,10 +152,10 @@ void Scene::Record(double fps) {
 
 // ---------------------------------------------------------------- runs
 
-void Scene::BeginRun(RunKind kind) {
+void Scene::BeginRun(RunKind kind, bool keep_steps) {
   if (run_) throw std::logic_error("BeginRun: a run is going on (EndRun first)");
   if (kind == RunKind::kKeyframes || !has_bodies()) {
-    BeginObjectRun(kind);
+    BeginObjectRun(kind, keep_steps);
     return;
   }
   World& w = *world_;
@@ -169,31 +171,42 @@ void Scene::BeginRun(RunKind kind) {
   run_->start_time = w.time();
 }
 
-void Scene::BeginObjectRun(RunKind kind) {
+void Scene::BeginObjectRun(RunKind kind, bool keep_steps) {
   const std::shared_ptr<const BodyModel> body = object_.Body();
   if (!body) throw std::logic_error("BeginRun: no FFD object is loaded");
   auto w = std::make_unique<World>(ObjectWorldOptions(*body));
   w->AddBody(body);
   w->SetState(0, object_.q(), object_.qd());
   w->SetTime(time_);
-  auto recorder = std::make_shared<record::Recorder>(std::make_shared<record::Trajectory>(*w));
-  recorder->set_control_energy(energy_);
+  auto run = std::make_unique<Run>();
+  run->kind = kind;
+  run->object = true;
+  run->start_time = time_;
+  if (keep_steps) {
+    run->recorder = std::make_shared<record::Recorder>(std::make_shared<record::Trajectory>(*w));
+    run->recorder->set_control_energy(energy_);
+  }
   if (kind == RunKind::kKeyframes) {
     w->AddController(std::make_shared<control::KeyframeController>(*w, 0, control_.keys, control_.hold));
   } else if (control_.enabled && !control_.graph.empty()) {
     // the pose graph cycles from its first pose at the start of every run (chapter 5)
-    auto graph = std::make_shared<control::PoseGraphController>(*w, 0, control_.graph, control_.switch_width);
-    w->AddController(graph);
-    recorder->SetPoseSource(graph);
+    run->graph = std::make_shared<control::PoseGraphController>(*w, 0, control_.graph, control_.switch_width);
+    w->AddController(run->graph);
+    if (run->recorder) run->recorder->SetPoseSource(run->graph);
   }
-  w->SetRecorder(recorder);
-  recorder->Start(*w);
+  if (run->recorder) {
+    w->SetRecorder(run->recorder);
+    run->recorder->Start(*w);
+  }
   object_world_ = std::move(w);
-  run_ = std::make_unique<Run>();
-  run_->kind = kind;
-  run_->world = run_world_ = object_world_.get();
-  run_->start_time = time_;
-  run_->recorder = std::move(recorder);
+  run->world = run_world_ = object_world_.get();
+  run_ = std::move(run);
+}
+
+void Scene::StopPoseGraph() {
+  if (!run_ || !run_->graph) return;
+  run_->world->RemoveController(run_->graph.get());
+  run_->graph.reset();
 }
 
 bool Scene::Step() {
@@ -209,7 +222,7 @@ void Scene::Finish(bool act_due_behaviours) {
   if (!run_) throw std::logic_error("EndRun: no run");
   const std::unique_ptr<Run> run = std::move(run_);  // ended, even when a behaviour throws below
   World& w = *run->world;
-  if (!run->recorder) {
+  if (!run->object) {
     time_ = w.time();
     // behaviours due at the end time act now (a Connect at a chase's contact time at the end)
     if (act_due_behaviours && run->steps > 0 && w.status().ok()) Behaviours(*this).BeforeStep(w);
@@ -217,9 +230,11 @@ void Scene::Finish(bool act_due_behaviours) {
   }
   // the hand-over: the object goes on from the run's last state
   object_.SetState(w.state(0).q, w.state(0).qd);
-  energy_ = run->recorder->control_energy();
   time_ = run->kind == RunKind::kKeyframes ? run->start_time + control_.keys.Duration() : w.time();
-  last_object_run_ = run->recorder->trajectory();
+  if (run->recorder) {
+    energy_ = run->recorder->control_energy();
+    last_object_run_ = run->recorder->trajectory();
+  }
 }
 
 RunReport Scene::Advance(long steps, const StepCallback& on_step) {

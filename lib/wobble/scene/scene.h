@@ -170,7 +170,9 @@ class Scene {
   // ---- runs ----
   // Starts a run. Throws std::invalid_argument when the pose graph or the keys do not fit the
   // object's body, std::logic_error when there is nothing to run or a run is going on.
-  void BeginRun(RunKind kind = RunKind::kSimulate);
+  // keep_steps false: an FFD object's run keeps no record of its steps (last_object_run() is
+  // left as it was; the viewer's live runs, which can go on for hours, keep their own frames).
+  void BeginRun(RunKind kind = RunKind::kSimulate, bool keep_steps = true);
   // One step of the run; false when the world stopped (its status()). Throws
   // control::BehaviourError when a behaviour cannot act.
   bool Step();
@@ -178,6 +180,9 @@ class Scene {
   // kept (last_object_run()); in the scene, behaviours due at the end time act now.
   void EndRun();
   bool running() const { return bool(run_); }
+  // Ends the pose graph's drive of the current run: the targets stay as they are (the
+  // viewer's sliders take over). No-op when no pose graph drives it.
+  void StopPoseGraph();
   // The world of the current or the last run (nullptr before the first).
   World* run_world() { return run_world_; }
   // A run of round(duration/dt) steps / of the keys: BeginRun, Step, EndRun.
@@ -189,7 +194,7 @@ class Scene {
  private:
   struct Run;
   class Behaviours;  // the Sequencer as the scene world's controller
-  void BeginObjectRun(RunKind kind);
+  void BeginObjectRun(RunKind kind, bool keep_steps);
   // EndRun's work; an exception during a run skips the behaviours due at its end.
   void Finish(bool act_due_behaviours);
   RunReport Advance(long steps, const StepCallback& on_step);
