@@ -123,14 +123,24 @@ TEST(PoseGraph, CyclesFromTheFirstPoseWithItsPeriod) {
   EXPECT_NE(g.Validate(2), "");
 }
 
-// A damped body driven by a cyclic pose graph settles into a motion with the graph's period.
-TEST(PoseGraph, DrivenModeBecomesPeriodicWithTheGraphsPeriod) {
+// A table whose bend (stiff and damped) a pose graph drives, its squash passive; and a
+// cyclic graph of two bends held 0.7 s and 0.5 s.
+std::shared_ptr<const BodyModel> BendDrivenTable() {
   auto modes = std::vector<DeformationMode>{testing::Bend(4e7, 8e6), testing::VerticalSquash(4e7, 8e6)};
   modes[0].active = true;
-  auto body = std::make_shared<const BodyModel>(TableDef(), modes);
+  return std::make_shared<const BodyModel>(TableDef(), modes);
+}
+control::PoseGraph TwoPoseBendGraph() {
   control::PoseGraph g;
   g.poses = {Eigen::VectorXd::Constant(1, 0.01), Eigen::VectorXd::Constant(1, -0.01)};
   g.durations = {0.7, 0.5};
+  return g;
+}
+
+// A damped body driven by a cyclic pose graph settles into a motion with the graph's period.
+TEST(PoseGraph, DrivenModeBecomesPeriodicWithTheGraphsPeriod) {
+  const auto body = BendDrivenTable();
+  const control::PoseGraph g = TwoPoseBendGraph();
   const double dt = 1e-3;
   World world(FreeSpace(Integrator::kRK4, dt));
   world.AddBody(body);
@@ -218,12 +228,8 @@ TEST(Keyframes, HeldPointStaysPutWhileTheBodyDeforms) {
 // and a world whose targets are set by hand before each step are identical, and the
 // ModeTargetController behind the graph logs exactly the steps where PoseAt changes.
 TEST(Controllers, PoseGraphControllerIsThePoseAtRuleAndTheTargetLogHasItsSwitches) {
-  auto modes = std::vector<DeformationMode>{testing::Bend(4e7, 8e6), testing::VerticalSquash(4e7, 8e6)};
-  modes[0].active = true;
-  auto body = std::make_shared<const BodyModel>(TableDef(), modes);
-  control::PoseGraph g;
-  g.poses = {Eigen::VectorXd::Constant(1, 0.01), Eigen::VectorXd::Constant(1, -0.01)};
-  g.durations = {0.7, 0.5};
+  const auto body = BendDrivenTable();
+  const control::PoseGraph g = TwoPoseBendGraph();
   const double dt = 1e-3;
   const long steps = 2600;
   World driven(FreeSpace(Integrator::kRK4, dt)), by_hand(FreeSpace(Integrator::kRK4, dt));
