@@ -9,6 +9,7 @@
 #include <vtkImageData.h>
 
 #include "pipelines/exports.h"
+#include "wobble/formats/atomic_file.h"
 #include "pipelines/interactive_view.h"
 #include "pipelines/scene_view.h"
 #include "wobble/script/interpreter.h"
@@ -24,6 +25,8 @@ bool IsScript(const std::string& path) { return fs::path(path).extension() == ".
 // Runs the script in the interpreter up to (not including) its first `simul` or `keyframe`:
 // the viewer plays that simulation live. Returns the line it stopped at (0: the whole script).
 int RunScriptSetup(script::Interpreter* interp, const std::string& path) {
+  const std::string kind = formats::NonRegularKind(path);
+  if (!kind.empty()) throw UsageError(path + ": is " + kind + ", not a regular file");
   std::ifstream in(path);
   if (!in) throw UsageError(path + ": cannot open the script");
   const std::string dir = fs::path(path).parent_path().string();

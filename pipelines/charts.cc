@@ -76,14 +76,6 @@ void Validate(const ChartSpec& spec) {
 
 bool Usable(double v, bool log) { return std::isfinite(v) && (!log || v > 0.0); }
 
-void WriteText(const std::string& path, const std::string& text) {
-  formats::WriteFileAtomically(path, [&](const std::string& tmp) {
-    std::FILE* f = std::fopen(tmp.c_str(), "w");
-    if (!f) throw std::runtime_error("cannot open " + tmp);
-    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    if ((std::fclose(f) != 0) || !ok) throw std::runtime_error("short write to " + tmp);
-  });
-}
 
 std::string Num(double v) {
   if (std::isnan(v)) return "nan";
@@ -219,13 +211,13 @@ void WriteChartCsv(const ChartSpec& spec, const std::string& csv_path) {
     for (const ChartSeries& s : spec.series)
       for (size_t i = 0; i < s.x.size(); ++i) text += CsvField(s.name) + "," + Num(s.x[i]) + "," + Num(s.y[i]) + "\n";
   }
-  WriteText(csv_path, text);
+  formats::WriteTextAtomically(csv_path, text);
   if (!spec.markers.empty()) {
     namespace fs = std::filesystem;
     const fs::path p(csv_path);
     std::string markers = CsvField(x_name) + "\n";
     for (double m : spec.markers) markers += Num(m) + "\n";
-    WriteText((p.parent_path() / (p.stem().string() + "_markers.csv")).string(), markers);
+    formats::WriteTextAtomically((p.parent_path() / (p.stem().string() + "_markers.csv")).string(), markers);
   }
 }
 

@@ -44,6 +44,9 @@ void WriteExrChannels(const std::string& path, int width, int height, const std:
 }
 
 ExrImage ReadExrChannels(const std::string& path) {
+  // before opening: opening a FIFO waits for a writer
+  const std::string kind = formats::NonRegularKind(path);
+  if (!kind.empty()) throw std::runtime_error(path + ": is " + kind + ", not a regular file");
   try {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i dw = file.header().dataWindow();

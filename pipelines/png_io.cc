@@ -22,7 +22,10 @@ void PngWarning(png_structp, png_const_charp) {}  // warnings do not stop a writ
 
 bool EncodePng(std::FILE* file, const PngPixels& image, int compression, png_bytep* rows, char* message) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, message, PngError, PngWarning);
-  if (!png) return false;
+  if (!png) {
+    std::snprintf(message, 256, "out of memory");
+    return false;
+  }
   png_infop info = png_create_info_struct(png);
   if (!info || setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, info ? &info : nullptr);
@@ -56,13 +59,14 @@ void WritePngPixels(const std::string& path, const PngPixels& image, int compres
   std::vector<png_bytep> rows(size_t(image.height));
   for (size_t y = 0; y < rows.size(); ++y) rows[y] = const_cast<png_bytep>(image.bytes.data() + y * stride);
   formats::WriteFileAtomically(path, [&](const std::string& tmp) {
-    std::FILE* file = std::fopen(tmp.c_str(), "wb");
-    if (!file) throw std::runtime_error("cannot open " + tmp);
-    char message[256] = "out of memory";
-    const bool encoded = EncodePng(file, image, std::clamp(compression, 0, 9), rows.data(), message);
-    const bool closed = std::fclose(file) == 0;  // a full disk often shows only here
-    if (!encoded) throw std::runtime_error(std::string("PNG encoder: ") + message);
-    if (!closed) throw std::runtime_error("short write to " + tmp);
+    char message[256] = "";
+    try {
+      formats::WriteWithStdio(tmp, [&](std::FILE* file) {
+        return EncodePng(file, image, std::clamp(compression, 0, 9), rows.data(), message);
+      });
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(std::string(e.what()) + (message[0] ? std::string(" (PNG encoder: ") + message + ")" : ""));
+    }
   });
 }
 

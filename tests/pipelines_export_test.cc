@@ -20,6 +20,8 @@
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLUtilities.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -345,6 +347,10 @@ class FailedWrite : public ::testing::Test {
       ADD_FAILURE() << path << ": the write should have failed";
     } catch (const std::runtime_error& e) {
       EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      // the system's reason, not "Success" (errno read after fclose) or a writer's guess
+      if (disk_full) {
+        EXPECT_NE(std::string(e.what()).find(std::strerror(ENOSPC)), std::string::npos) << e.what();
+      }
     }
     EXPECT_EQ(ReadAll(path), before) << "the earlier file changed";
     EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(path))) << "the earlier file was replaced";

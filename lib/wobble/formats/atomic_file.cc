@@ -10,11 +10,27 @@ namespace wobble::formats {
 
 std::string TempPathFor(const std::string& path) { return path + ".tmp"; }
 
+std::string NonRegularKind(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;  // a file that does not exist (or cannot be looked at) has no kind here
+  switch (fs::status(path, ec).type()) {
+    case fs::file_type::directory: return "a directory";
+    case fs::file_type::fifo: return "a FIFO";
+    case fs::file_type::character: return "a character device";
+    case fs::file_type::block: return "a block device";
+    case fs::file_type::socket: return "a socket";
+    case fs::file_type::unknown: return "a special file";
+    default: return "";  // regular, or not there
+  }
+}
+
 void CreateParentFolder(const std::string& path) {
   namespace fs = std::filesystem;
   const fs::path target(path);
-  std::error_code ec;  // a file that does not exist yet is no error here
-  if (fs::is_directory(target, ec)) throw std::runtime_error(path + ": is a directory");
+  std::error_code ec;
+  const std::string kind = NonRegularKind(path);
+  if (kind == "a directory") throw std::runtime_error(path + ": is a directory");
+  if (!kind.empty()) throw std::runtime_error(path + ": is " + kind + ", not a regular file; wobble writes only regular files");
   if (!target.has_parent_path()) return;  // the working directory
   fs::create_directories(target.parent_path(), ec);
   if (ec) throw std::runtime_error(path + ": cannot create its folder: " + ec.message());
@@ -43,14 +59,25 @@ void WriteFileAtomically(const std::string& path, const std::function<void(const
   }
 }
 
+void WriteWithStdio(const std::string& tmp, const std::function<bool(std::FILE*)>& fill) {
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw std::runtime_error("cannot open " + tmp + ": " + std::strerror(errno));
+  errno = 0;
+  bool ok = false;
+  try {
+    ok = fill(f) && std::fflush(f) == 0;
+  } catch (...) {
+    std::fclose(f);
+    throw;
+  }
+  int error = ok ? 0 : errno;  // the first failure's reason, before fclose can change errno
+  if (std::fclose(f) != 0 && error == 0) error = errno;
+  if (!ok || error != 0) throw std::runtime_error(tmp + ": " + (error ? std::strerror(error) : "short write"));
+}
+
 void WriteTextAtomically(const std::string& path, const std::string& text) {
   WriteFileAtomically(path, [&](const std::string& tmp) {
-    std::FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw std::runtime_error(std::string("cannot open ") + tmp + ": " + std::strerror(errno));
-    bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    const int saved_errno = errno;
-    ok = (std::fclose(f) == 0) && ok;
-    if (!ok) throw std::runtime_error(std::strerror(saved_errno));
+    WriteWithStdio(tmp, [&](std::FILE* f) { return std::fwrite(text.data(), 1, text.size(), f) == text.size(); });
   });
 }
 

@@ -3,6 +3,7 @@
 // a file and a failed write leaves any earlier FILE untouched.
 #pragma once
 
+#include <cstdio>
 #include <functional>
 #include <string>
 
@@ -11,8 +12,19 @@ namespace wobble::formats {
 // The temporary name used for `path`: "path.tmp", in the same folder (rename stays atomic).
 std::string TempPathFor(const std::string& path);
 
-// Creates the folder of `path` if needed. Throws std::runtime_error naming the path and reason.
+// What `path` is when it exists and is not a regular file ("a directory", "a FIFO", "a
+// character device", ...), following symbolic links; empty for a regular file or nothing.
+std::string NonRegularKind(const std::string& path);
+
+// Creates the folder of `path` if needed. Throws std::runtime_error naming the path and reason,
+// also when `path` exists and is not a regular file: wobble replaces only regular files (a
+// rename over /dev/null or a FIFO would put a regular file in its place).
 void CreateParentFolder(const std::string& path);
+
+// Opens `temp_path` for writing, lets `fill` write it (false: a write fell short) and closes
+// it. Throws std::runtime_error with the system's reason for the first failure, the close
+// included (a full disk often shows only there).
+void WriteWithStdio(const std::string& temp_path, const std::function<bool(std::FILE*)>& fill);
 
 // Writes `path` atomically: creates its folder, checks that the temporary file can be
 // created (a clear error with the system's reason if not), calls write(temp_path) to fill

@@ -50,28 +50,26 @@ namespace {
 void WriteTable(const std::string& path, const std::vector<std::string>& header, int n,
                 const std::function<std::pair<const double*, size_t>(int)>& row) {
   WriteFileAtomically(path, [&](const std::string& tmp) {
-    std::FILE* f = std::fopen(tmp.c_str(), "w");
-    if (!f) throw std::runtime_error(tmp + ": cannot open for writing: " + std::strerror(errno));
-    std::string line;
-    for (size_t i = 0; i < header.size(); ++i) {
-      if (i) line += ',';
-      line += header[i];
-    }
-    line += '\n';
-    bool ok = std::fputs(line.c_str(), f) >= 0;
-    for (int k = 0; k < n; ++k) {  // a line at a time: long runs stay small in memory
-      const auto [values, count] = row(k);
-      line.clear();
-      for (size_t i = 0; i < count; ++i) {
+    WriteWithStdio(tmp, [&](std::FILE* f) {
+      std::string line;
+      for (size_t i = 0; i < header.size(); ++i) {
         if (i) line += ',';
-        line += FormatDouble(values[i]);
+        line += header[i];
       }
       line += '\n';
-      ok = ok && std::fputs(line.c_str(), f) >= 0;
-    }
-    const int saved_errno = errno;
-    ok = (std::fclose(f) == 0) && ok;
-    if (!ok) throw std::runtime_error(tmp + ": " + std::strerror(saved_errno));
+      bool ok = std::fputs(line.c_str(), f) >= 0;
+      for (int k = 0; k < n && ok; ++k) {  // a line at a time: long runs stay small in memory
+        const auto [values, count] = row(k);
+        line.clear();
+        for (size_t i = 0; i < count; ++i) {
+          if (i) line += ',';
+          line += FormatDouble(values[i]);
+        }
+        line += '\n';
+        ok = std::fputs(line.c_str(), f) >= 0;
+      }
+      return ok;
+    });
   });
 }
 }  // namespace

@@ -41,13 +41,17 @@ std::string FormatNumber(double value);
 #include <filesystem>
 #include <fstream>
 
+#include "wobble/formats/atomic_file.h"
 #include "wobble/formats/parse_error.h"
 
 namespace wobble::formats::detail {
 
 template <class F> auto WithFile(const std::string& path, F&& parse) {
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw ParseError(path, 0, "is a directory, not a file");
+  // before opening: opening a FIFO waits for a writer, a device may never end
+  const std::string kind = NonRegularKind(path);
+  if (kind == "a directory") throw ParseError(path, 0, "is a directory, not a file");
+  if (!kind.empty()) throw ParseError(path, 0, "is " + kind + ", not a regular file");
   std::ifstream in(path);
   if (!in) {
     if (!std::filesystem::exists(path, ec)) throw ParseError(path, 0, "cannot open file: no such file");
