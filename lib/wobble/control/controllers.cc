@@ -72,11 +72,13 @@ void ModeTargetController::BeforeStep(World& world) {
     world.SetModeTargets(body_, next_);
     pending_ = false;
   }
-  Eigen::VectorXd now = world.state(body_).mode_target;
-  if (now.size() == 0) now = Eigen::VectorXd::Zero(segments_.back().targets.size());
-  if (now == segments_.back().targets) return;
-  if (segments_.back().step == steps_) segments_.back().targets = now;  // changed again before a step
-  else segments_.push_back({steps_, now});
+  // compared in place: this runs every step, and the targets rarely change
+  const Eigen::VectorXd& now = world.state(body_).mode_target;
+  TargetSegment& last = segments_.back();
+  if (now.size() == 0 ? last.targets.isZero(0.0) : now == last.targets) return;
+  const Eigen::VectorXd logged = now.size() == 0 ? Eigen::VectorXd::Zero(last.targets.size()) : now;
+  if (last.step == steps_) last.targets = logged;  // changed again before a step
+  else segments_.push_back({steps_, logged});
 }
 
 }  // namespace wobble::control
