@@ -186,6 +186,9 @@ TEST(Inertia, KineticEnergyMatchesPointVelocities) {
     MatQ<double> M;
     MassMatrix(b.moments(), VecQ<double>(q), &M);
     EXPECT_NEAR(0.5 * qd.dot(M * qd), direct, 1e-7 * direct) << b.name();
+    // the block formula the step checks with, against the per-point M of Eq. 4.10
+    const double blocks = KineticEnergy(b.moments(), VecQ<double>(q), VecQ<double>(qd), Rotation(q[2]));
+    EXPECT_NEAR(blocks, 0.5 * qd.dot(reference::MassMatrix(b, q) * qd), 1e-12 * direct) << b.name();
   }
 }
 

@@ -9,6 +9,7 @@
 #include <algorithm>
 
 #include "support/test_bodies.h"
+#include "wobble/core/errors.h"
 #include "wobble/world/world.h"
 
 namespace wobble {
@@ -359,12 +360,53 @@ TEST(Status, RunawayPenetrationIsNamedWithStepAndTime) {
   EXPECT_GT(w.state(0).penetration, 40.0);
 }
 
-TEST(Status, NonFiniteStateIsCaught) {
+// A state is finite with finite energies, or refused: SetState refuses inf, and a finite q̇ of
+// 1e160 whose ½ m v² is not finite, leaving the state as it was.
+TEST(Status, StatesWithoutAFiniteEnergyAreRefused) {
   World w(NoGround(Integrator::kThesis, 0.01));
   w.AddBody(std::make_shared<BodyModel>(TableDef(), std::vector<DeformationMode>{}));
-  w.SetState(0, State({0, 0, 0}), State({0, std::numeric_limits<double>::infinity(), 0}));
+  EXPECT_THROW(w.SetState(0, State({0, 0, 0}), State({0, std::numeric_limits<double>::infinity(), 0})), InputError);
+  try {
+    w.SetState(0, State({0, 0, 0}), State({0, 1e160, 0}));
+    ADD_FAILURE() << "a state with an infinite kinetic energy was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("kinetic inf"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(w.state(0).qd, State({0, 0, 0}));
+  EXPECT_TRUE(std::isfinite(w.ComputeEnergies(0).total()));
+}
+
+// Under a gravity of 1e300 one step leaves a finite state (q̈ = g, q̇ = g Δt, q = g Δt²) whose
+// energies are not (m g y, ½ m q̇²): the step is refused with that cause and the body keeps its
+// state before it. Without the check the trajectory's energy columns read inf with status ok.
+TEST(Status, AStepToAnInfiniteEnergyIsRefusedWithThatCause) {
+  WorldOptions o = NoGround(Integrator::kThesis, 0.01);
+  o.params.gravity = Eigen::Vector2d(0.0, -1e300);
+  World w(o);
+  w.AddBody(std::make_shared<BodyModel>(TableDef(), std::vector<DeformationMode>{}));
   EXPECT_FALSE(w.Step());
-  EXPECT_EQ(w.status().code, StepStatus::Code::kNonFinite);
+  EXPECT_EQ(w.status().code, StepStatus::Code::kNonFiniteEnergy) << w.status().message;
+  EXPECT_NE(w.status().message.find("kinetic"), std::string::npos) << w.status().message;
+  EXPECT_EQ(w.state(0).q, State({0, 0, 0}));
+  EXPECT_EQ(w.state(0).qd, State({0, 0, 0}));
+}
+
+// A force past the largest double is named as such, not as a singular mass matrix (a ground
+// stiffness of 1e308 on a table landing at 1 unit/s: k d r for the torque overflows).
+TEST(Status, AnOverflowingForceIsNotASingularMassMatrix) {
+  WorldOptions o;
+  o.dt = 0.01;
+  o.params.gravity_on = false;
+  o.params.ground.stiffness = 1e308;
+  World w(o);
+  w.AddBody(std::make_shared<BodyModel>(TableDef(), std::vector<DeformationMode>{}));
+  w.SetState(0, State({0, 0.001, 0}), State({0, -1.0, 0}));
+  EXPECT_FALSE(w.RunUntil(1.0));
+  EXPECT_TRUE(w.status().code == StepStatus::Code::kOverflowingForce ||
+              w.status().code == StepStatus::Code::kNonFiniteEnergy)
+      << w.status().message;
+  EXPECT_TRUE(w.state(0).q.allFinite() && w.state(0).qd.allFinite());
+  EXPECT_TRUE(std::isfinite(w.ComputeEnergies(0).total()));
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "wobble/control/controllers.h"
 
+#include "wobble/core/errors.h"
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -42,7 +44,11 @@ KeyframeController::KeyframeController(World& world, int body, Keyframes keys, H
 
 void KeyframeController::AfterStep(World& world) {
   ++steps_;
-  Place(world, std::min(double(steps_) * dt_, keys_.Duration()));
+  try {
+    Place(world, std::min(double(steps_) * dt_, keys_.Duration()));
+  } catch (const InputError& e) {  // keys that lead to an infinite energy (a key of 1e300): a numerical stop
+    world.Stop(StatusCode::kNonFiniteEnergy, body_, std::string("the keyframed state: ") + e.what());
+  }
 }
 
 void KeyframeController::Place(World& world, double t) const {

@@ -34,6 +34,8 @@ enum class StatusCode {
   kSolverFailed,
   kSingularConstraints,  // redundant or conflicting constraints (J W Jᵀ singular)
   kBadPath,              // a trajectory's path returned a non-finite or wrongly sized sample
+  kOverflowingForce,     // a generalized force past the largest double (huge stiffness, speed, ...)
+  kNonFiniteEnergy,      // a finite state whose energy is not (q̇ = 1e160 squares to inf)
 };
 std::string StatusCodeName(StatusCode code);
 
@@ -67,8 +69,12 @@ StepStatus Accelerations(const BodyModel& body, const WorldParams& w, int body_i
   EvaluateForces(body, w, body_index, s, frame, &f, contact_set);
   extra(s, &f.total);
   double cond_estimate = 0.0;
-  if (!SolveMassSystem(body.moments(), s.q, frame.R, VecQ<T>(f.total - vel), qdd, &cond_estimate))
+  if (!SolveMassSystem(body.moments(), s.q, frame.R, VecQ<T>(f.total - vel), qdd, &cond_estimate)) {
+    // an infinite force is not a singular M (a stiffness of 1e300 is not the mass's fault)
+    for (int i = 0; i < f.total.size(); ++i)
+      if (!std::isfinite(double(ScalarValue(f.total[i])))) return {StepStatus::Code::kOverflowingForce, 0.0};
     return {StepStatus::Code::kSingularMass, 0.0};
+  }
   if (cond_estimate > w.max_condition) return {StepStatus::Code::kIllConditioned, cond_estimate};
   return {};
 }

@@ -1,5 +1,7 @@
 #include "wobble/record/trajectory.h"
 
+#include "wobble/core/errors.h"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -72,7 +74,7 @@ int Trajectory::Column(const std::string& name) const {
   return -1;
 }
 
-void Trajectory::Append(const World& world, double control_energy, int pose) {
+int Trajectory::Append(const World& world, double control_energy, int pose) {
   if (world.num_bodies() != num_bodies())
     throw std::invalid_argument("Trajectory::Append: the world has " + std::to_string(world.num_bodies()) +
                                 " bodies, the trajectory " + std::to_string(num_bodies()));
@@ -103,6 +105,12 @@ void Trajectory::Append(const World& world, double control_energy, int pose) {
   row[width_ - 3] = control_energy;
   row[width_ - 2] = pose;
   row[width_ - 1] = world.num_enabled_constraints() > 0 ? world.MaxViolation() : 0.0;
+  for (int c = 0; c < width_; ++c)
+    if (!std::isfinite(row[c])) {
+      data_.resize(start);
+      return c;
+    }
+  return -1;
 }
 
 void Trajectory::AppendRow(const std::vector<double>& row) {
@@ -180,38 +188,54 @@ Recorder::Recorder(std::shared_ptr<Trajectory> trajectory, double fps, double fr
   if (!(fps > 0) || !std::isfinite(period_)) throw std::invalid_argument("Recorder: the frame rate must be positive");
 }
 
-void Recorder::Sample(const World& world) {
+int Recorder::Sample(const World& world) {
   const Trajectory& t = *trajectory_;
-  if (!t.empty() && t.time(t.size() - 1) >= world.time() - 0.5 * world.options().dt) return;
-  trajectory_->Append(world, energy_.consumed, pose_ ? pose_->pose() : -1);
+  if (!t.empty() && t.time(t.size() - 1) >= world.time() - 0.5 * world.options().dt) return -1;
+  return trajectory_->Append(world, energy_.consumed, pose_ ? pose_->pose() : -1);
+}
+
+void Recorder::Refuse(const World& world, int column) const {
+  throw NumericalStop("the record's '" + trajectory_->Columns()[column] + "' is not finite at t = " +
+                      std::to_string(world.time()) + " (the row was not written)");
 }
 
 void Recorder::Start(const World& world) {
   counter_ = 0;
-  if (period_ == 0.0) Sample(world);
-  else SampleFrame(world);
+  const int bad = period_ == 0.0 ? Sample(world) : SampleFrame(world);
+  if (bad >= 0) Refuse(world, bad);
 }
 
 void Recorder::AfterStep(World& world) {
   const double dt = world.options().dt;
   for (int b = 0; b < world.num_bodies(); ++b)
     if (world.kind(b) == BodyKind::kFfd && !world.kinematic(b)) energy_.Accumulate(world.body(b), world.state(b), dt);
-  if (period_ > 0.0) SampleFrame(world);
-  else if (++counter_ % every_ == 0) Sample(world);
+  int bad = -1;
+  if (period_ > 0.0) bad = SampleFrame(world);
+  else if (++counter_ % every_ == 0) bad = Sample(world);
+  // the state is finite (the world refuses steps that are not); an overflowing row (a
+  // control energy past the largest double) stops the world after this step
+  if (bad >= 0)
+    world.Stop(StatusCode::kNonFiniteEnergy, -1, "the record's '" + trajectory_->Columns()[bad] + "' is not finite");
 }
 
-void Recorder::SampleFrame(const World& world) {
-  // the frame due now, then the next frame time after it (frames closer than a step are skipped)
+int Recorder::SampleFrame(const World& world) {
+  // the frame due now, then the next frame time after it (frames closer than a step are
+  // skipped, in closed form: a loop would turn dt·fps times, and forever once next_ + period_
+  // rounds to next_)
   const double t = world.time(), half_step = 0.5 * world.options().dt;
-  if (t + half_step < next_) return;
-  Sample(world);
+  if (t + half_step < next_) return -1;
+  const int bad = Sample(world);
   next_ += period_;
-  while (next_ <= t + half_step) next_ += period_;
+  if (next_ <= t + half_step) next_ += period_ * (std::floor((t + half_step - next_) / period_) + 1.0);
+  if (next_ <= t + half_step) next_ = std::nextafter(t + half_step, HUGE_VAL);
+  return bad;
 }
 
 void Recorder::Finish(const World& world) {
   const Trajectory& t = *trajectory_;
-  if (t.empty() || t.time(t.size() - 1) != world.time()) trajectory_->Append(world, energy_.consumed, pose_ ? pose_->pose() : -1);
+  if (!t.empty() && t.time(t.size() - 1) == world.time()) return;
+  const int bad = trajectory_->Append(world, energy_.consumed, pose_ ? pose_->pose() : -1);
+  if (bad >= 0 && world.status().ok()) Refuse(world, bad);
 }
 
 }  // namespace wobble::record

@@ -59,7 +59,9 @@ class Trajectory {
 
   // Appends the world's state now (its bodies must be those of the constructor). `pose` and
   // `control_energy` come from the controllers (control::PoseGraphController, ControlEnergy).
-  void Append(const World& world, double control_energy = 0.0, int pose = -1);
+  // Returns -1, or (the row is not kept) the first column whose value is not finite: every
+  // row kept is finite.
+  int Append(const World& world, double control_energy = 0.0, int pose = -1);
   // Appends a row of Columns() values (a file being read).
   void AppendRow(const std::vector<double>& row);
 
@@ -124,8 +126,11 @@ class Recorder : public Controller {
   void set_control_energy(const control::ControlEnergy& e) { energy_ = e; }
 
  private:
-  void Sample(const World& world);       // appends unless the trajectory ends at this time already
-  void SampleFrame(const World& world);  // frame-rate sampling: a sample when a frame is due
+  // Appends unless the trajectory ends at this time already; returns the non-finite column of
+  // a row it could not keep (Trajectory::Append), or -1.
+  int Sample(const World& world);
+  void Refuse(const World& world, int column) const;  // throws NumericalStop naming the column
+  int SampleFrame(const World& world);  // frame-rate sampling: a sample when a frame is due
   std::shared_ptr<Trajectory> trajectory_;
   int every_ = 1;
   long counter_ = 0;

@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
+#include "wobble/core/errors.h"
 #include "wobble/dynamics/kinematics.h"
 
 namespace wobble {
@@ -42,6 +44,8 @@ std::string StatusCodeName(StatusCode code) {
     case StatusCode::kSolverFailed: return "implicit solver did not converge";
     case StatusCode::kSingularConstraints: return "singular constraints";
     case StatusCode::kBadPath: return "bad trajectory path";
+    case StatusCode::kOverflowingForce: return "overflowing force";
+    case StatusCode::kNonFiniteEnergy: return "non-finite energy";
   }
   return "?";
 }
@@ -58,6 +62,7 @@ int World::AddBody(std::shared_ptr<const BodyModel> model) {
   e.state.q.setZero(model->num_q());
   e.state.qd.setZero(model->num_q());
   e.applied = Eigen::VectorXd::Zero(model->num_q());
+  e.scale = ModelScale(*model);
   e.model = std::move(model);
   ffd_.push_back(std::move(e));
   slots_.push_back({BodyKind::kFfd, int(ffd_.size()) - 1});
@@ -118,8 +123,16 @@ void World::SetLinearState(int body, const Eigen::MatrixXd& R, const Eigen::Matr
     throw std::invalid_argument("linear body '" + m.name() + "': R and R_dot must be " + std::to_string(m.dim()) + "x" +
                                 std::to_string(m.basis_size()));
   if (!R.allFinite() || !R_dot.allFinite()) throw std::invalid_argument("linear body '" + m.name() + "': non-finite state");
-  linear_[slots_[body].index].R = R;
-  linear_[slots_[body].index].R_dot = R_dot;
+  LinearEntry& e = linear_[slots_[body].index];
+  e.R_before = e.R;
+  e.R_dot_before = e.R_dot;
+  e.R = R;
+  e.R_dot = R_dot;
+  if (EnergyFinite(body)) return;
+  const std::string terms = EnergyTerms(ComputeEnergies(body));
+  e.R = e.R_before;
+  e.R_dot = e.R_dot_before;
+  throw InputError("linear body '" + m.name() + "': a state whose energy is not finite (" + terms + ")");
 }
 
 const Eigen::MatrixXd& World::linear_R(int body) const { return Linear(body).R; }
@@ -246,9 +259,12 @@ bool World::StepEachBody() {
     LinearFreeAcceleration(e, &acc);
     if (!acc.allFinite()) return Fail(StatusCode::kNonFinite, body, "non-finite acceleration");
     const int d = e.model->dim(), n = e.model->basis_size();
+    e.R_before = e.R;
+    e.R_dot_before = e.R_dot;
     e.R_dot += h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(acc.data(), d, n);
     e.R += h * e.R_dot;
     e.applied.setZero();
+    if (!AcceptLinearStep(body)) return false;
   }
   return true;
 }
@@ -269,6 +285,12 @@ void World::LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const {
   // R̈ = Q W (Eq. 5), flattened row by row
   Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(acc->data(), m.dim(), m.basis_size())
       .noalias() = Q * m.inverse_mass_matrix();
+}
+
+void World::ThrowInterrupted() const {
+  std::ostringstream msg;
+  msg << "stopped by Ctrl-C at t = " << time_ << " (after step " << steps_ << ")";
+  throw Interrupted(msg.str());
 }
 
 bool World::Fail(StatusCode code, int body, const std::string& detail, double value) {
@@ -300,30 +322,104 @@ Energies World::ComputeEnergies(int i) const {
     }
     return e;
   }
+  return FfdEnergies(i, ContactSet::kDetect, true);
+}
+
+// The FFD body's energies: Eq. 4.9's kinetic, gravity, K (γ − γ0)², the ground's penalty and
+// the springs. The step's finiteness check takes the contacts the step left (kFrozen: no scan
+// of every point) and no per-mode breakdown (no heap).
+Energies World::FfdEnergies(int i, ContactSet contacts, bool per_mode) const {
+  Energies e;
+  const WorldParams& p = options_.params;
   const BodyModel& b = body(i);
   const BodyState<double>& s = state(i);
-  MatQ<double> M;
-  MassMatrix(b.moments(), s.q, &M);
-  e.kinetic = 0.5 * s.qd.dot(M * s.qd);  // Eq. 4.9
+  const Frame<double> frame(s.q);
+  e.kinetic = wobble::KineticEnergy(b.moments(), s.q, s.qd, frame.R);  // Eq. 4.9
   if (p.gravity_on) e.gravity = GravityEnergy(b.moments(), s.q, p.gravity);
   // K (γ − γ0)²: the potential whose gradient is the mode force, PD target γ0 included
   const bool targeted = s.mode_target.size() == b.num_modes();
   for (int d = 0; d < b.num_modes(); ++d) {
     const double offset = s.q[kRigidDofs + d] - (targeted ? s.mode_target[d] : 0.0);
-    e.per_mode.push_back(b.modes()[d].stiffness * offset * offset);
-    e.modes += e.per_mode.back();
+    const double term = b.modes()[d].stiffness * offset * offset;
+    if (per_mode) e.per_mode.push_back(term);
+    e.modes += term;
   }
-  ForEachPointInContact(b, p.ground, s, Frame<double>(s.q),
+  ForEachPointInContact(b, p.ground, s, frame,
                         [&](int, const Vec2<double>&, const Vec2<double>& x, const Vec2<double>&, const Vec2<double>& anchor) {
                           e.ground += 0.5 * p.ground.stiffness * (x - anchor).squaredNorm();
-                        });
+                        }, contacts);
   for (const Spring& sp : p.springs) {
     if (sp.body != i) continue;
-    const Vec2<double> x = WorldFromLocal(Frame<double>(s.q), LocalPosition<double>(sp.rest_local, sp.mode_matrix, s.q));
+    const Vec2<double> x = WorldFromLocal(frame, LocalPosition<double>(sp.rest_local, sp.mode_matrix, s.q));
     const double stretch = (x - sp.anchor).norm() - sp.rest_length;
     e.springs += 0.5 * sp.stiffness * stretch * stretch;
   }
   return e;
+}
+
+// A finite acceleration can still overflow R, Ṙ or the energy: the step is refused then, and
+// the body keeps its state before it.
+bool World::AcceptLinearStep(int body) {
+  LinearEntry& e = linear_[slots_[body].index];
+  const bool finite = e.R.allFinite() && e.R_dot.allFinite();
+  if (finite && EnergyFinite(body)) return true;
+  const Energies energies = finite ? ComputeEnergies(body) : Energies();
+  e.R = e.R_before;
+  e.R_dot = e.R_dot_before;
+  return finite ? Fail(StatusCode::kNonFiniteEnergy, body, EnergyTerms(energies)) : Fail(StatusCode::kNonFinite, body);
+}
+
+bool World::EnergyFinite(int body) const {
+  if (kind(body) == BodyKind::kFfd) {
+    const FfdEntry& e = Ffd(body);
+    if (EnergySurelyFinite(e)) return true;
+    return std::isfinite(FfdEnergies(body, ContactSet::kFrozen, false).total());
+  }
+  return std::isfinite(ComputeEnergies(body).total());
+}
+
+// A screen with a proof, so that the step need not compute its energies (a quarter of a step's
+// work): when every factor is at most kScreen (the state, the PD targets, the contact anchors,
+// the model's moments, points and stiffnesses, the world's gravity, ground and springs), each
+// energy term is a sum of at most ~10^6 products of at most five factors (γᵀGγ θ̇², k |x − a|²
+// with x = t + R(b0 + Bγ)), so below 10^6 · 15^4 · kScreen^5, far from the largest double. A
+// normal step passes; one that does not has its energies computed (EnergyFinite).
+bool World::EnergySurelyFinite(const FfdEntry& e) const {
+  constexpr double kScreen = 1e30;
+  const BodyState<double>& s = e.state;
+  const WorldParams& p = options_.params;
+  if (!(e.scale <= kScreen && s.q.cwiseAbs().maxCoeff() <= kScreen && s.qd.cwiseAbs().maxCoeff() <= kScreen))
+    return false;
+  if (s.mode_target.size() > 0 && !(s.mode_target.cwiseAbs().maxCoeff() <= kScreen)) return false;
+  if (!(p.gravity.cwiseAbs().maxCoeff() <= kScreen && std::abs(p.ground.stiffness) <= kScreen)) return false;
+  for (const Contact<double>& c : s.contacts)
+    if (!(c.anchor.cwiseAbs().maxCoeff() <= kScreen)) return false;
+  for (const Spring& sp : p.springs)
+    if (!(std::abs(sp.stiffness) <= kScreen && std::abs(sp.rest_length) <= kScreen &&
+          sp.anchor.cwiseAbs().maxCoeff() <= kScreen && sp.rest_local.cwiseAbs().maxCoeff() <= kScreen &&
+          (sp.mode_matrix.size() == 0 || sp.mode_matrix.cwiseAbs().maxCoeff() <= kScreen)))
+      return false;
+  return true;
+}
+
+double ModelScale(const BodyModel& b) {
+  const MassMoments& m = b.moments();
+  double scale = std::max({std::abs(m.m), std::abs(m.I0), m.c0.cwiseAbs().maxCoeff()});
+  auto take = [&scale](const auto& x) {
+    if (x.size() > 0) scale = std::max(scale, double(x.cwiseAbs().maxCoeff()));
+  };
+  take(m.C);
+  take(m.e0);
+  take(m.h0);
+  take(m.G);
+  take(m.P);
+  for (int k = 0; k < b.num_points(); ++k) {
+    take(b.rest_local(k));
+    take(b.mode_matrix(k));
+  }
+  for (const DeformationMode& d : b.modes()) scale = std::max(scale, std::abs(d.stiffness));
+  // NaN anywhere fails every comparison with the screen
+  return std::isfinite(scale) ? scale : std::numeric_limits<double>::infinity();
 }
 
 double World::PotentialEnergy(int body) const {

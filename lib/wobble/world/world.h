@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "wobble/body/affine_energy.h"
+#include "wobble/core/interrupt.h"
 #include "wobble/body/linear_body.h"
 #include "wobble/dynamics/step.h"
 #include "wobble/world/controller.h"
@@ -66,6 +67,12 @@ struct WorldStatus {
   std::string message;  // one line for people
   bool ok() const { return code == Code::kOk; }
 };
+
+// The largest |number| of a model's moments, points and mode stiffnesses (inf for a NaN).
+double ModelScale(const BodyModel& b);
+
+// "kinetic K, gravity G, ..." of a refused step, for its status message.
+std::string EnergyTerms(const Energies& e);
 
 struct WorldOptions {
   // 2D gravity (params.gravity; gravity_3d for 3D bodies; both off with params.gravity_on),
@@ -209,8 +216,10 @@ class World {
   // state before the step is kept); later calls return false until ClearStatus().
   bool Step();
   // Steps until time >= t_end or trouble; calls on_step(world) after every accepted step.
+  // Ctrl-C (core/interrupt.h) between two steps throws Interrupted saying where.
   template <class F> bool RunUntil(double t_end, F&& on_step) {
     while (time_ + 0.5 * options_.dt < t_end) {
+      if (InterruptRequested()) ThrowInterrupted();
       if (!Step()) return false;
       on_step(*this);
     }
@@ -219,7 +228,11 @@ class World {
   bool RunUntil(double t_end) {
     return RunUntil(t_end, [](World&) {});
   }
+  [[noreturn]] void ThrowInterrupted() const;  // "stopped by Ctrl-C at t = T (step N)"
   const WorldStatus& status() const { return status_; }
+  // Stops the world after the step now (a controller's or the recorder's call: a record row
+  // that overflowed); the state stays. body -1: not one body's trouble.
+  void Stop(StatusCode code, int body, const std::string& detail) { Fail(code, body, detail); }
   void ClearStatus() { status_ = WorldStatus(); }
   // Sets the clock (replays of recorded states, scenes that start later); steps continue from t.
   void SetTime(double t) {
@@ -261,12 +274,14 @@ class World {
     std::shared_ptr<const BodyModel> model;
     BodyState<double> state;
     Eigen::VectorXd applied;  // Σ Jᵀ f of ApplyPointForce for the next step
+    double scale = 0.0;       // the largest |number| of the model (ModelScale), for EnergyFinite
   };
   struct LinearEntry {
     std::shared_ptr<const LinearBodyModel> model;
     AffineMaterial material;
     Eigen::MatrixXd R, R_dot, applied;  // applied: Σ f pᵀ of ApplyPointForce for the next step
     Eigen::MatrixXd Q;                  // per-step work: the body's generalized force
+    Eigen::MatrixXd R_before, R_dot_before;  // per-step work: the state a refused step restores
   };
   // A resolved material point: linear bodies keep p(u) and W p; FFD bodies b0 and B.
   struct End {
@@ -301,6 +316,13 @@ class World {
   void RefreshContacts(FfdEntry& e) const;
   bool RefuseFfdStep(int body, const VecQ<double>& q_before, const VecQ<double>& qd_before, StepStatus st);
   bool Fail(StatusCode code, int body, const std::string& detail = "", double value = 0.0);
+  Energies FfdEnergies(int body, ContactSet contacts, bool per_mode) const;
+  // Every energy term of the body is finite: a finite state can hold an infinite energy (a
+  // q̇ of 1e160 squares past the largest double), and no accepted step leaves one.
+  bool EnergyFinite(int body) const;
+  bool EnergySurelyFinite(const FfdEntry& e) const;
+  bool AcceptLinearStep(int body);
+  bool ForcesFinite(int body) const;  // an FFD body's generalized forces at its state now
   void FinishStep();
 
   // world_constraints.cc: points, constraints, the multiplier step, impulses

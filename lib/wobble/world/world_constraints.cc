@@ -544,9 +544,12 @@ bool World::StepConstrained() {
     if (b.kind == BodyKind::kLinear) {
       LinearEntry& e = linear_[b.index];
       const int d = e.model->dim(), n = e.model->basis_size();
+      e.R_before = e.R;
+      e.R_dot_before = e.R_dot;
       e.R_dot += h * AsMatrix(acc[body], d, n);
       e.R += h * e.R_dot;
       e.applied.setZero();
+      if (!AcceptLinearStep(body)) return false;
     } else {
       FfdEntry& e = ffd_[b.index];
       const VecQ<double> q_before = e.state.q, qd_before = e.state.qd;
@@ -554,7 +557,8 @@ bool World::StepConstrained() {
       e.state.q += h * e.state.qd;
       RefreshContacts(e);
       e.applied.setZero();
-      if (!e.state.q.allFinite() || !e.state.qd.allFinite() || e.state.penetration > PenetrationLimit(*e.model))
+      if (!e.state.q.allFinite() || !e.state.qd.allFinite() || e.state.penetration > PenetrationLimit(*e.model) ||
+          !EnergyFinite(body))
         return RefuseFfdStep(body, q_before, qd_before, StepStatus{});
     }
   }
