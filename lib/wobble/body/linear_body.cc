@@ -1,6 +1,10 @@
 #include "wobble/body/linear_body.h"
 
 #include <cmath>
+
+#include "wobble/core/limits.h"
+
+#include <cmath>
 #include <stdexcept>
 
 namespace wobble {
@@ -31,6 +35,7 @@ LinearBodyDef MakeBoxBody(const std::string& name, int dim, LinearOrder order, c
   if (half_extents.size() != dim) throw std::invalid_argument("box body '" + name + "': half extents need " +
                                                               std::to_string(dim) + " entries");
   if (per_side < 2) throw std::invalid_argument("box body '" + name + "': need at least 2 points per side");
+  CheckedCount(std::pow(double(per_side), dim), 1, kMaxLinearPoints, "box body '" + name + "': its mass points (grid^dim)");
   LinearBodyDef def;
   def.name = name;
   def.dim = dim;

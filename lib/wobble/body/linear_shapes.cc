@@ -1,5 +1,9 @@
 #include "wobble/body/linear_shapes.h"
 
+#include <cmath>
+
+#include "wobble/core/limits.h"
+
 #include <stdexcept>
 
 namespace wobble {
@@ -127,6 +131,8 @@ LinearBodyDef MakePyramidBody(const std::string& name, int dim, LinearOrder orde
   if (dim != 2 && dim != 3) throw std::invalid_argument("pyramid '" + name + "': dim must be 2 or 3");
   if (levels < 2 || per_side < 2) throw std::invalid_argument("pyramid '" + name + "': levels and per_side must be >= 2");
   if (!(w > 0) || !(height > 0)) throw std::invalid_argument("pyramid '" + name + "': sizes must be positive");
+  CheckedCount(double(levels) * std::pow(double(per_side), dim - 1), 1, kMaxLinearPoints,
+               "pyramid '" + name + "': its mass points (levels x grid^(dim-1))");
   LinearBodyDef def;
   def.name = name;
   def.dim = dim;

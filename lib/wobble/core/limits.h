@@ -9,6 +9,11 @@
 
 namespace wobble {
 
+// Fixed bounds on counts people set (a limit above can be raised; these are sanity bounds).
+constexpr long kMaxStepsLimit = 1'000'000'000'000'000;  // max_steps itself: 10^15 steps
+constexpr long kMaxThreads = 256;                        // worker threads of a synthesis
+constexpr long kMaxLinearPoints = 1'000'000;             // mass points of a Witkin & Welch body
+
 struct Limits {
   // Steps one command may simulate: one run (simul, keyframe, simulate --duration), or all
   // the trials of one anneal/cmaes together.

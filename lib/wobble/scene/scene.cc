@@ -1,5 +1,7 @@
 #include "wobble/scene/scene.h"
 
+#include "wobble/record/trajectory_csv.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -234,6 +236,10 @@ void Scene::Finish(bool act_due_behaviours) {
   if (run->recorder) {
     energy_ = run->recorder->control_energy();
     last_object_run_ = run->recorder->trajectory();
+    object_runs_.erase(std::remove_if(object_runs_.begin(), object_runs_.end(),
+                                      [](const auto& weak) { return weak.expired(); }),
+                       object_runs_.end());
+    object_runs_.push_back(last_object_run_);
   }
 }
 
@@ -241,8 +247,11 @@ RunReport Scene::Advance(long steps, const StepCallback& on_step) {
   // every step is kept: room for them at once (up to a million; beyond, it grows)
   if (run_->recorder) run_->recorder->trajectory()->reserve(int(std::min(steps, 1000000L)) + 1);
   try {
-    for (long n = 1; n <= steps && Step(); ++n)
+    for (long n = 1; n <= steps; ++n) {
+      if (InterruptRequested()) run_->world->ThrowInterrupted();  // the run ends where it is
+      if (!Step()) break;
       if (on_step) on_step(n, steps, *run_->world);
+    }
   } catch (...) {
     Finish(false);
     throw;
@@ -254,14 +263,44 @@ RunReport Scene::Advance(long steps, const StepCallback& on_step) {
   return report;
 }
 
+double Scene::KeptRecordValues() const {
+  double values = recorded_ ? double(recorded_->size()) * double(recorded_->Columns().size()) : 0.0;
+  for (const auto& weak : object_runs_)
+    if (const auto run = weak.lock()) values += double(run->size()) * double(run->Columns().size());
+  return values;
+}
+
+long Scene::CheckedRun(double duration, bool object_run) const {
+  const std::string hint = "raise it with `set max_steps N` in a script, or --max-steps N";
+  const long steps = RunSteps(duration, options_.dt, limits_, hint);
+  // the samples this run adds: every step of an object run, the frames of the scene's record
+  double rows = 0.0, width = 0.0;
+  if (object_run) {
+    const std::shared_ptr<const BodyModel> body = object_.Body();
+    if (body) {
+      rows = double(steps) + 1.0;
+      width = double(record::Trajectory({record::DescribeFfdBody(body)}).Columns().size());
+    }
+  } else if (recorded_ && record_fps_ > 0) {
+    rows = std::min(double(steps), duration * record_fps_) + 1.0;
+    width = double(recorded_->Columns().size());
+  }
+  CheckRecordSize(KeptRecordValues() + rows * width, limits_,
+                  "raise it with `set max_record_mb N` in a script or --max-record-mb N, or keep fewer "
+                  "runs (`clear track`)");
+  return steps;
+}
+
 RunReport Scene::Simulate(double duration, const StepCallback& on_step) {
+  const long steps = CheckedRun(duration, !has_bodies());
   BeginRun(RunKind::kSimulate);
-  return Advance(std::lround(duration / options_.dt), on_step);
+  return Advance(steps, on_step);
 }
 
 RunReport Scene::Keyframe(const StepCallback& on_step) {
+  const long steps = CheckedRun(control_.keys.Duration(), true);
   BeginRun(RunKind::kKeyframes);
-  return Advance(std::lround(control_.keys.Duration() / options_.dt), on_step);
+  return Advance(steps, on_step);
 }
 
 }  // namespace wobble::scene

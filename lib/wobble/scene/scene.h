@@ -39,6 +39,7 @@
 #include "wobble/control/control.h"
 #include "wobble/control/controllers.h"
 #include "wobble/control/paths.h"
+#include "wobble/core/limits.h"
 #include "wobble/record/trajectory.h"
 #include "wobble/scene/ffd_object.h"
 #include "wobble/world/world.h"
@@ -109,6 +110,11 @@ class Scene {
   // the thesis integrator.
   WorldOptions& options() { return options_; }
   const WorldOptions& options() const { return options_; }
+  // What one run may take (core/limits.h): Simulate and Keyframe refuse a run of more steps
+  // than limits().max_steps, or one whose record would take the records kept (every object
+  // run someone still holds, and the scene's `record`) past limits().max_record_mb.
+  Limits& limits() { return limits_; }
+  const Limits& limits() const { return limits_; }
   // The FFD object's clock: where its next run starts (a run leaves it at its end), and the
   // end `simul` without a duration runs to.
   double time() const { return time_; }
@@ -198,8 +204,14 @@ class Scene {
   // EndRun's work; an exception during a run skips the behaviours due at its end.
   void Finish(bool act_due_behaviours);
   RunReport Advance(long steps, const StepCallback& on_step);
+  // The steps of a run of `duration` within the limits (LimitExceeded otherwise).
+  long CheckedRun(double duration, bool object_run) const;
+  // The doubles the records still held take: the object runs (weak: whoever keeps them) and
+  // the scene's record.
+  double KeptRecordValues() const;
 
   WorldOptions options_;
+  Limits limits_;
   double time_ = 0.0, end_ = 10.0;
   FfdObject object_;
   ObjectSprings springs_;
@@ -224,6 +236,7 @@ class Scene {
   std::unique_ptr<World> object_world_;  // the FFD object's last run
   World* run_world_ = nullptr;
   std::shared_ptr<const record::Trajectory> last_object_run_;
+  std::vector<std::weak_ptr<const record::Trajectory>> object_runs_;  // every kept run, while held
 };
 
 }  // namespace wobble::scene

@@ -73,6 +73,12 @@ const std::vector<Parameter>& ParameterTable() {
       {"time", [](State& s, const Value& v) { s.scene.set_time(v.Number()); }},
       {"end", [](State& s, const Value& v) { s.scene.set_end(v.Number()); }},
       {"dt", [](State& s, const Value& v) { s.scene.options().dt = v.Positive(); }},
+      // work and memory limits (core/limits.h)
+      {"max_steps",
+       [](State& s, const Value& v) {
+         s.scene.limits().max_steps = CheckedCount(v.Number(), 1, kMaxStepsLimit, "max_steps");
+       }},
+      {"max_record_mb", [](State& s, const Value& v) { s.scene.limits().max_record_mb = v.Positive(); }},
       {"ground_height", [](State& s, const Value& v) { TheGround(s).point = Eigen::Vector2d(0.0, v.Number()); }},
       {"ground_slope",
        [](State& s, const Value& v) {
@@ -122,7 +128,10 @@ const std::vector<Parameter>& ParameterTable() {
       {"trial_steps", [](State& s, const Value& v) { s.trial_steps = v.Whole(1); }},
       {"pose_step", [](State& s, const Value& v) { Search(s).pose_step = v.NonNegative(); }},
       {"time_step", [](State& s, const Value& v) { Search(s).time_step = v.NonNegative(); }},
-      {"threads", [](State& s, const Value& v) { Search(s).threads = v.Whole(0); }},
+      {"threads",
+       [](State& s, const Value& v) {
+         Search(s).threads = int(CheckedCount(v.Number(), 0, kMaxThreads, "threads (0: one per core)"));
+       }},
       {"anneal_csv", [](State& s, const Value& v) { s.anneal_csv = v.text; }},
       {"cmaes_csv", [](State& s, const Value& v) { s.cmaes_csv = v.text; }},
       {"sigma0",

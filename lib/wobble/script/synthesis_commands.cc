@@ -42,6 +42,13 @@ void Adopt(State& s, synth::AnnealResult r, const std::string& csv, const std::s
 }
 
 // The start of an optimisation: the graph cycles, the trials start from the state now.
+// Refuses (LimitExceeded) an optimisation whose trials together would simulate more steps
+// than max_steps.
+void CheckTrialWork(const State& s, double trials, const std::string& what) {
+  CheckedCount(trials * double(s.trial_steps), 0, s.scene.limits().max_steps,
+               what + " (trials x trial_steps, in steps)", "raise it with `set max_steps N`, or lower trial_steps");
+}
+
 synth::Problem StartOptimising(State& s) {
   const synth::Problem problem = MakeProblem(s, s.trial_steps);
   s.scene.control().graph.cyclic = true;
@@ -72,11 +79,18 @@ void Anneal(State& s, const Words& w, const Context& ctx) {
   o.iterations = iterations;
   const std::string invalid = o.Validate();
   if (!invalid.empty()) ctx.Fail("anneal: " + invalid);
+  CheckTrialWork(s, double(iterations) * double(o.batch) + 1.0, "anneal's work");
   const synth::Problem problem = StartOptimising(s);
   synth::AnnealResult r = synth::Anneal(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
     if (s.progress) s.progress(iterations ? double(rec.iteration) / iterations : 1.0, rec.best);
   });
+  const bool interrupted = r.interrupted;
+  const int done = r.history.empty() ? 0 : r.history.back().iteration;
   Adopt(s, std::move(r), s.anneal_csv, "simulated annealing", "anneal", ctx);
+  if (interrupted)
+    throw Interrupted("anneal stopped by Ctrl-C after iteration " + std::to_string(done) + " of " +
+                      std::to_string(iterations) + "; the best pose graph so far is adopted" +
+                      (s.anneal_csv.empty() ? std::string() : ", its history written to " + s.anneal_csv));
 }
 
 void Cmaes(State& s, const Words& w, const Context& ctx) {
@@ -98,6 +112,7 @@ void Cmaes(State& s, const Words& w, const Context& ctx) {
   o.max_time = a.max_time;
   const std::string invalid = o.Validate();
   if (!invalid.empty()) ctx.Fail("cmaes: " + invalid + " (the population is `batch`)");
+  CheckTrialWork(s, (double(generations) + 1.0) * double(o.population), "cmaes' work");
   const synth::Problem problem = StartOptimising(s);
   synth::AnnealResult r = synth::Cmaes(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
     if (s.progress) s.progress(generations ? double(rec.iteration) / generations : 1.0, rec.best);
@@ -119,6 +134,8 @@ void Gait(State& s, const Words& w, const Context& ctx) {
   if (graph.empty() || !graph.cyclic) ctx.Fail("gait needs a cyclic pose graph: 'pose ...' lines first");
   const std::string invalid = graph.Validate(int(control::ActiveModes(*s.scene.object().Body()).size()));
   if (!invalid.empty()) ctx.Fail("pose graph: " + invalid);
+  CheckedCount((double(skip) + double(cycles)) * graph.Period() / s.scene.options().dt, 0, s.scene.limits().max_steps,
+               "gait's run (SKIP + CYCLES periods, in steps)", "raise it with `set max_steps N`");
   // from the anneal's start state when there was one: the gait the trials measured
   const std::vector<double> d = synth::DistancePerCycle(SynthesisProblem(s), graph, skip, cycles);
   s.out << "gait: period " << Num(graph.Period()) << ", distance per cycle:";

@@ -1,6 +1,7 @@
 #include "wobble/synth/anneal.h"
 
 #include "wobble/control/controllers.h"
+#include "wobble/core/interrupt.h"
 
 #include <algorithm>
 #include <atomic>
@@ -188,6 +189,10 @@ AnnealResult Anneal(const Problem& p, const control::PoseGraph& initial, const A
   record({0, r.trials, current_outcome.cost, current_outcome.cost, current_outcome.cost, T, true});
   // step 4: neighbours, acceptance, cooling
   for (int it = 1; it <= o.iterations; ++it) {
+    if (InterruptRequested()) {  // between two batches: what is best so far is a result
+      r.interrupted = true;
+      break;
+    }
     std::vector<control::PoseGraph> candidates;
     for (int b = 0; b < o.batch; ++b) candidates.push_back(Neighbour(current, o, &rng));
     const std::vector<TrialOutcome> outcomes = RunTrials(p, candidates, o.threads);

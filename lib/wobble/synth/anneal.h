@@ -111,6 +111,7 @@ struct AnnealResult {
   TrialOutcome best_outcome, initial_outcome;
   std::vector<IterationRecord> history;
   long trials = 0;
+  bool interrupted = false;  // Ctrl-C ended it early: the best so far, the history so far
 };
 
 // Fig. 5.2 from `initial`. on_iteration (optional) sees every record as it is made.
