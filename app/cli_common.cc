@@ -1,4 +1,7 @@
 #include "cli_common.h"
+#include "wobble/formats/csv.h"
+
+#include <filesystem>
 
 #include <cerrno>
 #include <cmath>
@@ -42,6 +45,30 @@ std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_mod
     for (const std::string& m : report.messages) std::cerr << "wobble: warning: " << m << "\n";
   }
   return body;
+}
+
+void CheckOutputFolder(const std::string& folder) {
+  try {
+    formats::CheckWritable((std::filesystem::path(folder) / ".wobble-probe").string());  // leaves nothing behind
+  } catch (const std::runtime_error& e) {
+    throw UsageError(std::string("--out: ") + e.what());
+  }
+}
+
+void AddLimitFlags(CLI::App* cmd, Limits* limits) {
+  cmd->add_option("--max-steps", limits->max_steps, "Refuse runs of more steps than this")->capture_default_str();
+  cmd->add_option("--max-record-mb", limits->max_record_mb, "Refuse runs whose record would take more MiB")
+      ->capture_default_str();
+}
+
+long CheckRunLimits(double duration, double dt, long every, int columns, const Limits& limits) {
+  if (limits.max_steps < 1 || limits.max_steps > kMaxStepsLimit)
+    throw UsageError("--max-steps must be between 1 and " + std::to_string(kMaxStepsLimit));
+  RequirePositive(limits.max_record_mb, "--max-record-mb");
+  const long steps = RunSteps(duration, dt, limits, "raise it with --max-steps N");
+  CheckRecordSize((double(steps) / double(std::max(1L, every)) + 2.0) * double(columns), limits,
+                  "raise it with --max-record-mb N" + std::string(every > 0 ? ", or keep fewer rows (--every)" : ""));
+  return steps;
 }
 
 void AddWorldFlags(CLI::App* cmd, WorldFlags* f) {

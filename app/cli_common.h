@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "wobble/body/body_model.h"
+#include "wobble/core/errors.h"
+#include "wobble/core/limits.h"
 #include "wobble/world/world.h"
 
 namespace wobble::app {
@@ -23,11 +25,12 @@ constexpr int kExitOk = 0;
 constexpr int kExitFailure = 1;     // anything unexpected
 constexpr int kExitBadInput = 2;    // a bad file or a bad command-line value
 constexpr int kExitSimStopped = 3;  // the world stopped with a status (numerical trouble)
+constexpr int kExitInterrupted = 130;  // Ctrl-C (128 + SIGINT)
 
 // A bad command-line value; what() is the whole message for people.
-class UsageError : public std::runtime_error {
+class UsageError : public InputError {
  public:
-  using std::runtime_error::runtime_error;
+  using InputError::InputError;
 };
 
 // The object file and its mode files (`--modes a.def,b.def`: modes of all files, in order).
@@ -58,6 +61,13 @@ void AddWorldFlags(CLI::App* cmd, WorldFlags* flags);
 // Validates the flags (finite, non-negative where it matters) and fills the params.
 WorldParams MakeWorldParams(const WorldFlags& flags);
 
+// --max-steps and --max-record-mb (core/limits.h): what one command may simulate and keep.
+void AddLimitFlags(CLI::App* cmd, Limits* limits);
+// The steps of a run of --duration at --dt within limits.max_steps, with a record of every
+// `every`-th step of `columns` values within limits.max_record_mb (LimitExceeded otherwise,
+// naming the flag that raises it).
+long CheckRunLimits(double duration, double dt, long every, int columns, const Limits& limits);
+
 // Parses a generalized-coordinate vector given as "1 2.5 -3" (spaces and/or commas) with
 // one number per coordinate of the body. `what` names the flag in messages. An empty text
 // gives zeros. Throws UsageError on a non-number, a non-finite number or a wrong count.
@@ -79,6 +89,10 @@ Integrator ParseIntegratorFlag(const std::string& name);
 
 // "tx ty theta g1 .. gD" for a body.
 std::string CoordinateNames(const BodyModel& body);
+
+// An output folder that can be written (made if missing): a UsageError (exit 2) before any work
+// otherwise, the same for every subcommand.
+void CheckOutputFolder(const std::string& folder);
 
 // Requires a finite number, optionally positive or non-negative.
 void RequireFinite(double value, const std::string& what);

@@ -1,5 +1,7 @@
 #include "condition.h"
 
+#include "wobble/core/interrupt.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -42,9 +44,10 @@ std::vector<double> Angles(const ConditionSweepArgs& a) {
   RequirePositive(a.step_deg, "--step");
   if (!(a.to_deg > a.from_deg)) throw UsageError("--to must be larger than --from");
   std::vector<double> phis;
-  const int n = int(std::floor((a.to_deg - a.from_deg) / a.step_deg + 1e-9));
-  if (n > 100000) throw UsageError("--step gives more than 100000 samples");
-  for (int i = 0; i <= n; ++i) phis.push_back(Rad(a.from_deg + i * a.step_deg));
+  // counted as a double first: a tiny --step would overflow an int and skip the check
+  const long n = CheckedCount(std::floor((a.to_deg - a.from_deg) / a.step_deg + 1e-9), 0, 100000,
+                              "the sweep's samples ((--to - --from) / --step)", "use a larger --step");
+  for (long i = 0; i <= n; ++i) phis.push_back(Rad(a.from_deg + double(i) * a.step_deg));
   if (Deg(phis.back()) < a.to_deg - 1e-9) phis.push_back(Rad(a.to_deg));
   if (std::abs(a.to_deg - 90.0) < 1e-12) phis.back() = kPi / 2;  // exactly the singular case
   return phis;
@@ -149,6 +152,7 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
   RequirePositive(a.compress, "--compress");
   RequireFinite(a.expand, "--expand");
   if (a.drop_last < 0) throw UsageError("--drop-last must be >= 0");
+  CheckOutputFolder(a.out);
   analysis::Squash squash;
   squash.compress = a.compress;
   squash.expand = a.expand;
@@ -199,6 +203,9 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
     RequirePositive(a.map_gamma, "--map-gamma");
     std::vector<std::vector<double>> map_rows;
     for (int j = 0; j < a.map_size; ++j) {
+      if (InterruptRequested())
+        throw Interrupted("the map stopped by Ctrl-C at row " + std::to_string(j) + " of " + std::to_string(a.map_size) +
+                          "; " + (out / "sweep.csv").string() + " is written, the map is not");
       Eigen::VectorXd qj = q;
       qj[3] = -a.map_gamma + 2.0 * a.map_gamma * j / (a.map_size - 1);
       std::vector<double> map_phis;
@@ -237,7 +244,8 @@ int RunConditionTime(const ConditionTimeArgs& a) {
 #else
   RequirePositive(a.dt, "--dt");
   RequirePositive(a.duration, "--duration");
-  if (a.duration / a.dt > 1e7) throw UsageError("--duration / --dt asks for more than 10^7 steps");
+  if (!(a.duration / a.dt <= 1e7)) throw UsageError("--duration / --dt asks for more than 10^7 steps");
+  CheckOutputFolder(a.out);
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, "", a.world, Integrator::kThesis, a.dt);
   const std::shared_ptr<const BodyModel>& body = setup.body;
   World world = setup.MakeWorld();

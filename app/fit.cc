@@ -349,9 +349,9 @@ int RunFitPose(const FitPoseArgs& a) {
       << "; poorly determined: " << List(r.conditioning.poorly_determined) << ".";
   std::cout << out.str() << std::endl;
   if (a.fit.full_report) std::cout << r.report.full_report << std::endl;
-  if (!r.report.usable) {
+  if (!r.report.usable) {  // the solver gave up on the numbers: a numerical stop
     std::cerr << "wobble: the fit failed: " << r.report.brief_report << std::endl;
-    return kExitFailure;
+    return kExitSimStopped;
   }
   return kExitOk;
 }
@@ -554,9 +554,9 @@ int RunFitTrajectory(const FitTrajectoryArgs& a) {
   WriteOutputs(a.fit, j, report);
   std::cout << out.str() << std::endl;
   if (a.fit.full_report) std::cout << report.full_report << std::endl;
-  if (!report.usable) {
+  if (!report.usable) {  // the solver gave up on the numbers: a numerical stop
     std::cerr << "wobble: the fit failed: " << report.brief_report << std::endl;
-    return kExitFailure;
+    return kExitSimStopped;
   }
   return kExitOk;
 }

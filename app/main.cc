@@ -1,7 +1,9 @@
 // The `wobble` command: parses the command line and hands over to a subcommand. All the work
-// is in libwobble; this file only maps failures to messages and exit codes:
-//   0 ok, 1 unexpected failure, 2 bad input (file or command line), 3 the simulation stopped.
+// is in libwobble; this file only maps failures to messages and exit codes, one table for
+// every subcommand (wobble/core/errors.h): 0 ok, 2 bad input of any kind (a file, a flag, a
+// script line, a limit), 3 a numerical stop, 130 Ctrl-C, 1 anything else.
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <iostream>
 #include <stdexcept>
 
@@ -15,10 +17,25 @@
 #endif
 #include "run.h"
 #include "simulate.h"
+#include "wobble/core/interrupt.h"
 #include "wobble/formats/object_file.h"
+
+namespace {
+// Ctrl-C asks the work to stop at its next step or frame (wobble/core/interrupt.h); the
+// handler is one-shot (SA_RESETHAND), so a second Ctrl-C kills a process that did not stop.
+void OnInterrupt(int) { wobble::RequestInterrupt(); }
+void CatchInterrupt() {
+  struct sigaction action {};
+  action.sa_handler = OnInterrupt;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &action, nullptr);
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace wobble::app;
+  CatchInterrupt();
   CLI::App app("wobble: dynamic free-form deformation characters (Faloutsos 1995)", "wobble");
   app.set_version_flag("--version", "wobble 0.1");
   app.require_subcommand(1);
@@ -74,11 +91,15 @@ int main(int argc, char** argv) {
   } catch (const wobble::formats::ParseError& e) {
     std::cerr << e.what() << std::endl;  // already "FILE:LINE: message"
     return kExitBadInput;
-  } catch (const UsageError& e) {
-    std::cerr << "wobble: " << e.what() << std::endl;
-    return kExitBadInput;
+  } catch (const wobble::NumericalStop& e) {
+    std::cerr << "wobble: " << e.what() << std::endl;  // the cause, and where
+    return kExitSimStopped;
+  } catch (const wobble::Interrupted& e) {
+    std::cerr << "\nwobble: " << e.what() << std::endl;
+    return kExitInterrupted;
   } catch (const std::invalid_argument& e) {
-    std::cerr << "wobble: " << e.what() << std::endl;  // the modes do not fit the object, ...
+    // UsageError, InputError, LimitExceeded: a value out of range, modes that do not fit, ...
+    std::cerr << "wobble: " << e.what() << std::endl;
     return kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << "wobble: " << e.what() << std::endl;

@@ -91,6 +91,7 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
   cmd->add_option("--duration", a->duration, "Simulated time")->capture_default_str();
   AddWorldFlags(cmd, &a->world);
   cmd->add_option("--out", a->out, "Output folder")->required()->type_name("DIR");
+  AddLimitFlags(cmd, &a->limits);
   cmd->add_option("--what", a->what,
                   "What to write, comma separated: frames, filmstrip, charts, vtp, exr, disp (default: " +
                       default_what + ")")
@@ -125,13 +126,14 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   RequirePositive(a.dt, "--dt");
   RequireNonNegative(a.duration, "--duration");
   RequirePositive(a.fps, "--fps");
-  if (a.duration * a.fps > 1e6) throw UsageError("--duration * --fps asks for more than a million frames");
+  if (!(a.duration * a.fps <= 1e6)) throw UsageError("--duration * --fps asks for more than a million frames");
   CheckRenderOptions(a, default_what);
 
   // the body in its world, simulated from (q0, q̇0) into a trajectory of every step
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, integrator, a.dt);
   World world = setup.MakeWorld();
   auto run = std::make_shared<record::Trajectory>(world);
+  CheckRunLimits(a.duration, a.dt, 1, int(run->Columns().size()), a.limits);
   auto recorder = std::make_shared<record::Recorder>(run);
   world.SetRecorder(recorder);
   recorder->Start(world);
@@ -164,11 +166,7 @@ void CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
     throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"
                      "  xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble ...\n"
                      "or ask only for --what vtp,disp");
-  try {
-    formats::CheckWritable(a.out + "/.wobble-probe");  // creates the folder, leaves nothing else
-  } catch (const std::runtime_error& e) {
-    throw UsageError(std::string("--out: ") + e.what());
-  }
+  CheckOutputFolder(a.out);
 }
 
 pl::RenderOutputs RenderOutputsOf(const RenderArgs& a, const std::string& default_what, const std::string& name) {

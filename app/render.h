@@ -42,6 +42,7 @@ struct RenderArgs {
   std::string disp_size;            // "WxH"; empty: 256 wide, lattice aspect
   std::string chart_size = "800x500";
   std::string trail;                // lattice coords "s t s t ..." of points to trace
+  Limits limits;
 };
 
 // `default_what` is "frames,filmstrip,charts" for render, "vtp,exr,disp" for export.

@@ -22,6 +22,7 @@ namespace wobble::app {
 CLI::App* AddRunCommand(CLI::App* app, RunArgs* a) {
   CLI::App* cmd = app->add_subcommand("run", "Run a command script (appendix C); no script on a terminal: a prompt");
   cmd->add_option("script", a->script, "Script file (see README: Scripts)")->type_name("SCRIPT");
+  AddLimitFlags(cmd, &a->limits);
   cmd->add_option("--object", a->object, "Object file loaded before the script (appendix C's script loads none)")
       ->type_name("FILE");
   cmd->footer(
@@ -89,7 +90,11 @@ std::vector<std::string> RenderScene(const script::SceneRenderRequest& r) {
 }  // namespace
 
 int RunScript(const RunArgs& a) {
+  if (a.limits.max_steps < 1 || a.limits.max_steps > kMaxStepsLimit)
+    throw UsageError("--max-steps must be between 1 and " + std::to_string(kMaxStepsLimit));
+  RequirePositive(a.limits.max_record_mb, "--max-record-mb");
   script::Interpreter interp(std::cout);
+  interp.scene().limits() = a.limits;
   interp.SetHistoryHook(PlotCostHistory);
   interp.SetRenderHook(RenderRecordedRuns);
   interp.SetSceneRenderHook(RenderScene);

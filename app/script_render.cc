@@ -28,11 +28,7 @@ void RenderScriptRuns(const script::RenderRequest& r) {
   }
   if (run.empty()) throw std::runtime_error("nothing was recorded: no frames to render");
   World world = pl::WorldFor(run, r.world);
-  try {
-    RenderRun(a, default_what, world, run, run.time(run.size() - 1));
-  } catch (const UsageError& e) {
-    throw std::runtime_error(e.what());
-  }
+  RenderRun(a, default_what, world, run, run.time(run.size() - 1));  // a bad option: the script's line
 }
 
 std::vector<std::string> RenderScriptScene(const script::SceneRenderRequest& r) {

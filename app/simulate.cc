@@ -18,7 +18,6 @@ namespace wobble::app {
 namespace {
 
 // Refuse runs whose CSV would not fit in memory comfortably.
-constexpr double kMaxRows = 2e7;
 
 std::string Num(double v) {
   char buf[32];
@@ -50,6 +49,7 @@ CLI::App* AddSimulateCommand(CLI::App* app, SimulateArgs* a) {
       ->type_name("N");
   AddWorldFlags(cmd, &a->world);
   cmd->add_option("--out", a->out, "CSV file to write (atomically: FILE.tmp, then renamed)")->type_name("FILE.csv");
+  AddLimitFlags(cmd, &a->limits);
   cmd->footer(
       "Example:\n"
       "  wobble simulate --object data/table.obj --modes data/table_modes.def \\\n"
@@ -63,9 +63,6 @@ int RunSimulate(const SimulateArgs& a) {
   RequirePositive(a.dt, "--dt");
   RequireNonNegative(a.duration, "--duration");
   if (a.every < 1) throw UsageError("--every must be at least 1");
-  if (a.duration / a.dt / double(a.every) > kMaxRows)
-    throw UsageError("--duration / --dt / --every asks for more than " + Num(kMaxRows) +
-                     " rows; raise --every or --dt");
 
   if (!a.out.empty()) {
     try {
@@ -79,6 +76,8 @@ int RunSimulate(const SimulateArgs& a) {
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, integrator, a.dt);
   const std::shared_ptr<const BodyModel>& body = setup.body;
   World world = setup.MakeWorld();
+  const long expected_steps =
+      std::max(1L, CheckRunLimits(a.duration, a.dt, a.every, int(record::Trajectory(world).Columns().size()), a.limits));
   const Energies e0 = world.ComputeEnergies(0);
 
   // step, recording every Nth state (record::Recorder) and the deepest penetration
@@ -87,17 +86,26 @@ int RunSimulate(const SimulateArgs& a) {
   recorder->Start(world);
   world.SetRecorder(recorder);
   double max_pen = world.state(0).penetration, max_pen_time = 0.0;
-  const long expected_steps = std::max(1L, long(std::llround(a.duration / a.dt)));
   Progress progress(isatty(STDERR_FILENO) == 1);
   const auto start = std::chrono::steady_clock::now();
-  const bool ok = world.RunUntil(a.duration, [&](const World& w) {
-    const double pen = w.state(0).penetration;
-    if (pen > max_pen) {
-      max_pen = pen;
-      max_pen_time = w.time();
-    }
-    progress.Update(double(w.steps()) / double(expected_steps), w.time());
-  });
+  bool ok = false;
+  try {
+    ok = world.RunUntil(a.duration, [&](const World& w) {
+      const double pen = w.state(0).penetration;
+      if (pen > max_pen) {
+        max_pen = pen;
+        max_pen_time = w.time();
+      }
+      progress.Update(double(w.steps()) / double(expected_steps), w.time());
+    });
+  } catch (const Interrupted& e) {
+    // Ctrl-C: the rows up to here are the file, and the message says so
+    progress.Finish();
+    recorder->Finish(world);
+    if (a.out.empty()) throw;
+    record::WriteTrajectoryCsv(a.out, *trajectory);
+    throw Interrupted(std::string(e.what()) + "; wrote its " + std::to_string(trajectory->size()) + " rows to " + a.out);
+  }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.Finish();
   // a stopped world keeps its last accepted state; the last state is always recorded

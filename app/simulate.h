@@ -17,6 +17,7 @@ struct SimulateArgs {
   double duration = 10.0;
   long every = 1;  // write every Nth step
   std::string out;
+  Limits limits;
 };
 
 CLI::App* AddSimulateCommand(CLI::App* app, SimulateArgs* args);

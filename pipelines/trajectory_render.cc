@@ -1,5 +1,8 @@
 #include "pipelines/trajectory_render.h"
 
+#include "wobble/core/errors.h"
+#include "wobble/core/interrupt.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -212,7 +215,12 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   std::vector<vtkSmartPointer<vtkImageData>> panels;
   BackgroundWriter writer;  // files are compressed and written while the next frame renders
   Replay replay(run, &world);
+  bool interrupted = false;
   for (const Visit& v : visits) {
+    if (InterruptRequested()) {  // Ctrl-C: the frames written so far are kept, and said
+      interrupted = true;
+      break;
+    }
     replay.To(v.sample);
     if (v.frame < 0) {
       strip_view->Render();
@@ -233,6 +241,11 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     if (out.progress) out.progress(double(report.frames) / double(num_frames), world.time());
   }
   writer.Wait();
+  if (interrupted) {
+    std::string where = std::to_string(report.frames) + " of " + std::to_string(num_frames) + " frames";
+    if (vtp) where += ", and " + vtp->WriteCollection() + " for them";
+    throw Interrupted("rendering stopped by Ctrl-C: " + where + " written in " + out.folder);
+  }
   if (!visits.empty()) run.Restore(visits.back().sample, caller);
 
   if (out.frames) report.files.push_back({out.folder + "/frames/frame_NNNN.png", ""});

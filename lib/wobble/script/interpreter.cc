@@ -109,7 +109,26 @@ bool Interpreter::RunLine(const std::string& line, const std::string& name, int 
     for (const Command& c : table) names.push_back(c.name);
     ctx.Fail("unknown command '" + word + "'" + DidYouMean(word, names));
   }
-  command->run(*state_, words, ctx);
+  // one exit-code policy (core/errors.h): whatever a command's parts throw leaves here as bad
+  // input (ParseError naming this line), a numerical stop (SimulationStopped), Interrupted, or
+  // an other failure, every message prefixed with this line
+  const std::string here = name + ":" + std::to_string(line_number) + ": ";
+  try {
+    command->run(*state_, words, ctx);
+  } catch (const formats::ParseError& e) {
+    if (e.file() == name && e.line() == line_number) throw;
+    throw formats::ParseError(name, line_number, e.what());  // a file the line loads: both places
+  } catch (const SimulationStopped&) {
+    throw;
+  } catch (const NumericalStop& e) {
+    throw SimulationStopped(here + e.what());
+  } catch (const Interrupted& e) {
+    throw Interrupted(here + e.what());
+  } catch (const std::invalid_argument& e) {  // InputError, LimitExceeded, values that do not fit
+    throw formats::ParseError(name, line_number, e.what());
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(here + e.what());
+  }
   return !state_->quit;
 }
 

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "wobble/core/errors.h"
 #include "wobble/formats/parse_error.h"
 #include "wobble/record/trajectory.h"
 #include "wobble/scene/scene.h"
@@ -31,9 +32,9 @@
 namespace wobble::script {
 
 // A simulation run by the script stopped (non-finite state, runaway penetration, ...).
-class SimulationStopped : public std::runtime_error {
+class SimulationStopped : public NumericalStop {
  public:
-  using std::runtime_error::runtime_error;
+  using NumericalStop::NumericalStop;
 };
 
 // What `render DIR [WHAT]` asks the CLI to draw of the FFD object: every run since the object

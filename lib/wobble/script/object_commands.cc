@@ -206,10 +206,14 @@ void Keyframe(State& s, const Words& w, const Context& ctx) {
   scene::RunReport r;
   try {
     r = s.scene.Keyframe(StepObserver(s, true));
+  } catch (const InputError& e) {  // keys asking for an infinite speed, ...
+    ctx.Fail(std::string("the keys lead to a state that cannot be: ") + e.what());
   } catch (const std::invalid_argument& e) {
     ctx.Fail(std::string(e.what()) + " ('key TIME MODE=VALUE ...' lines first)");
   }
   KeepRun(s, ctx);
+  if (!r.ok())
+    throw SimulationStopped(ctx.file + ":" + std::to_string(ctx.line) + ": keyframing stopped: " + r.status.message);
   const Eigen::VectorXd& qd = s.scene.object().qd();
   s.out << "keyframe: t = " << Num(s.scene.time()) << ", " << r.steps << " frames; handed over with dq = [";
   for (int i = 0; i < qd.size(); ++i) s.out << (i ? " " : "") << Num(qd[i]);

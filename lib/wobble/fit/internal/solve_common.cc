@@ -1,5 +1,9 @@
 #include "wobble/fit/internal/solve_common.h"
 
+#include <cmath>
+
+#include "wobble/core/errors.h"
+
 #include <Eigen/SVD>
 #include <chrono>
 #include <cmath>
@@ -70,10 +74,28 @@ void SolveAndReport(ceres::Solver::Options options, ceres::Problem* problem,
   IterationForwarder forward(on_iteration);
   forward.Attach(&options);
   ceres::Solver::Summary summary;
+  auto parameters_finite = [problem] {
+    std::vector<double*> blocks;
+    problem->GetParameterBlocks(&blocks);
+    for (double* b : blocks)
+      for (int i = 0; i < problem->ParameterBlockSize(b); ++i)
+        if (!std::isfinite(b[i])) return false;
+    return true;
+  };
+  if (!parameters_finite())
+    throw NumericalStop("the fit's start is not finite: targets or weights so large that the start computed from "
+                        "them overflowed");
   const auto start = std::chrono::steady_clock::now();
   ceres::Solve(options, problem, &summary);
   FillReport(summary, full_report, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
              report);
+  // a cost past the largest double is no fit: say why instead of reporting inf (or crashing in
+  // the conditioning's SVD of a NaN Jacobian)
+  if (!std::isfinite(summary.initial_cost) || !std::isfinite(summary.final_cost))
+    throw NumericalStop("the fit's cost is not finite (initial " + std::to_string(summary.initial_cost) + ", final " +
+                        std::to_string(summary.final_cost) +
+                        "): a target, weight or start so large that its squared residual overflows");
+  if (!parameters_finite()) throw NumericalStop("the fit ended at a non-finite result");
 }
 
 void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
@@ -103,6 +125,11 @@ Conditioning ComputeConditioning(const BodyModel& body, const std::vector<Segmen
   for (int r = 0; r < crs.num_rows; ++r)
     for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) J(r, crs.cols[k]) = crs.values[k];
 
+  if (!J.allFinite()) throw NumericalStop("the fit's Jacobian at its result is not finite: no conditioning to report");
+  // J / max|J|: the condition numbers do not change, and the SVD never squares a 1e160 (a
+  // target that far overflowed inside JacobiSVD, which then crashed on the NaN)
+  const double scale = J.size() ? J.cwiseAbs().maxCoeff() : 0.0;
+  if (scale > 0) J /= scale;
   // raw condition number of JᵀJ
   const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(J).singularValues();
   const double smax = sv.size() ? sv[0] : 0.0, smin = sv.size() == n ? sv[n - 1] : 0.0;
@@ -156,6 +183,8 @@ Conditioning ComputeConditioning(const BodyModel& body, const std::vector<Segmen
   }
   std::sort(c.weak.begin(), c.weak.end(),
             [](const WeakDirection& a, const WeakDirection& b) { return a.relative_singular_value < b.relative_singular_value; });
+  if (scale > 0)
+    for (double& norm : c.column_norms) norm *= scale;  // reported as the columns of J itself
   for (int d = 0; d < body.num_modes(); ++d) {
     const int i = kRigidDofs + d;
     if (undetermined[i]) {

@@ -1,0 +1,180 @@
+#!/usr/bin/env python3
+"""One exit-code policy for every subcommand and the interpreter (issue 14), at the CLI.
+
+usage: check_exit_codes.py WOBBLE DATA_DIR WORK_DIR
+
+  2  bad input of any kind, with FILE:LINE when it comes from a file or a script (and the
+     script's line when a file the script loads is bad); a request over a limit names the
+     limit and how to raise it, and is refused before the work starts;
+  3  a numerical stop, whose message names a true cause; every row written is finite and the
+     last row is the last finite state;
+  1  anything else;
+  130 Ctrl-C: the work stops at its next step, keeps what it wrote, and says where it stopped.
+
+The cases are the reproducers of the issue (hangs, overflows, inf energies with exit 0, a
+NaN Jacobian's segfault) and one of each class per subcommand.
+"""
+import csv
+import math
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+failures = []
+
+
+def expect(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        failures.append(what)
+
+
+def run(cmd, cwd, timeout=120):
+    try:
+        return subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        expect(False, f"{' '.join(cmd)}: returned within {timeout} s")
+        return None
+
+
+def case(label, cmd, cwd, code, *needles, timeout=120):
+    """Runs cmd; expects exit `code` and every needle in stderr."""
+    p = run(cmd, cwd, timeout)
+    if p is None:
+        return None
+    expect(p.returncode == code, f"{label}: exit {p.returncode} ({code} expected)")
+    for n in needles:
+        expect(n in p.stderr, f"{label}: stderr names {n!r}: {p.stderr.strip()[-300:]}")
+    return p
+
+
+def rows_finite(path):
+    """Every value of a CSV is finite; returns the rows (header excluded)."""
+    with open(path) as f:
+        rows = list(csv.reader(f))[1:]
+    bad = [r for r in rows if not all(math.isfinite(float(v)) for v in r)]
+    expect(not bad, f"{os.path.basename(path)}: all {len(rows)} rows finite ({len(bad)} not)")
+    return rows
+
+
+def write(path, text):
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+def main():
+    wobble, data, work = sys.argv[1], sys.argv[2], sys.argv[3]
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    obj, modes = os.path.join(data, "table.obj"), os.path.join(data, "table_modes.def")
+    body = ["--object", obj, "--modes", modes]
+    bad_obj = write(os.path.join(work, "bad.obj"), "lattice 2 2\nbasis bernstein\nsize 100 100\nmass x\n")
+    a_file = write(os.path.join(work, "a_file"), "not a folder\n")
+
+    # ---- simulate
+    sim = [wobble, "simulate"] + body
+    case("simulate: bad object file", [wobble, "simulate", "--object", bad_obj, "--modes", modes], work, 2, "bad.obj:")
+    case("simulate: --dt -1", sim + ["--dt", "-1"], work, 2, "--dt")
+    case("simulate: 1e11 steps", sim + ["--dt", "1e-9", "--duration", "100"], work, 2, "over the limit", "--max-steps")
+    case("simulate: --duration 1e300", sim + ["--duration", "1e300"], work, 2, "over the limit")
+    case("simulate: a record over --max-record-mb", sim + ["--duration", "10", "--max-record-mb", "0.01"], work, 2,
+         "MiB", "--max-record-mb")
+    case("simulate: q-dot 1e160 (infinite kinetic energy)", sim + ["--qdot", "1e160 0 0 0 0 0 0", "--no-ground"], work, 2,
+         "energy is not finite")
+    case("simulate: --out in a file's place", sim + ["--duration", "0.1", "--out", os.path.join(a_file, "x.csv")], work, 2,
+         "--out")
+    out = os.path.join(work, "stiff.csv")
+    p = case("simulate: ground stiffness 1e306 (an overflowing force)",
+             sim + ["--q", "0 50 0 0 0 0 0", "--ground-stiffness", "1e306", "--duration", "5", "--out", out], work, 3)
+    if p is not None:
+        expect(any(c in p.stderr for c in ("overflowing force", "non-finite energy", "non-finite state")),
+               f"simulate: the stop names the cause, not 'singular mass matrix': {p.stderr.strip()}")
+        expect("singular mass" not in p.stderr, "simulate: no 'singular mass matrix' for a huge stiffness")
+        rows = rows_finite(out)
+        expect(len(rows) > 1 and float(rows[-1][0]) < 5.0, "simulate: the rows end at the last finite state")
+
+    # ---- inspect
+    case("inspect: q-dot 1e160", [wobble, "inspect"] + body + ["--qdot", "0 0 1e160 0 0 0 0"], work, 2,
+         "energy is not finite")
+    case("inspect: bad modes file", [wobble, "inspect", "--object", obj, "--modes", bad_obj], work, 2, "bad.obj:")
+
+    # ---- condition
+    case("condition sweep: --step 1e-9 (an int overflow skipped the check)",
+         [wobble, "condition", "sweep", "--object", obj, "--step", "1e-9", "--out", work], work, 2, "samples")
+    case("condition sweep: --out in a file's place",
+         [wobble, "condition", "sweep", "--object", obj, "--out", os.path.join(a_file, "d")], work, 2, "--out")
+    case("condition check: bad object", [wobble, "condition", "check", "--object", bad_obj, "--modes", modes], work, 2,
+         "bad.obj:")
+
+    # ---- fit
+    far = write(os.path.join(work, "far.tgt"), "polyline 0 0 1e160 0 5 5\n")
+    case("fit pose: a target at 1e160 (NaN Jacobian, was a segfault)",
+         [wobble, "fit", "pose"] + body + ["--targets", far], work, 3, "not finite")
+    heavy = write(os.path.join(work, "heavy.tgt"), "point 0 0 100 weight 1e308\npoint 4 300 100\n")
+    case("fit pose: weight 1e308", [wobble, "fit", "pose"] + body + ["--targets", heavy], work, 3, "not finite")
+    bad_tgt = write(os.path.join(work, "bad.tgt"), "point 0 1 2\npoint zero 1 2\n")
+    case("fit pose: bad target file", [wobble, "fit", "pose"] + body + ["--targets", bad_tgt], work, 2, "bad.tgt:2:")
+
+    # ---- run (the interpreter)
+    def script(name, text):
+        return write(os.path.join(work, name), text)
+
+    start = time.time()
+    case("run: set dt 1e15 with a frame record (hung)",
+         [wobble, "run", script("dt.wob", "set dt 1e15\nlinear b 2d affine box 1 1 grid 2\nrecord 30\nsimul 1\n")],
+         work, 0, timeout=30)
+    expect(time.time() - start < 30, "run: set dt 1e15 returns at once")
+    case("run: 10^8 steps", [wobble, "run", script("steps.wob", f"load_obj {obj}\nload_def {modes}\nset dt 1e-7\nsimul 10\n")],
+         work, 2, "steps.wob:4:", "max_steps")
+    case("run: 10^8 steps allowed, their record is not",
+         [wobble, "run", script("record.wob", f"load_obj {obj}\nload_def {modes}\nset dt 1e-7\nset max_steps 1e9\nsimul 10\n")],
+         work, 2, "record.wob:5:", "max_record_mb")
+    case("run: --max-steps from the command line",
+         [wobble, "run", "--max-steps", "10", script("flag.wob", f"load_obj {obj}\nsimul 1\n")], work, 2, "flag.wob:2:",
+         "over the limit of 10")
+    case("run: a bad file the script loads", [wobble, "run", script("load.wob", f"# one\nload_obj {bad_obj}\n")], work, 2,
+         "load.wob:2:", "bad.obj:")
+    case("run: threads 100000", [wobble, "run", script("threads.wob", "set threads 100000\n")], work, 2, "threads.wob:1:")
+    case("run: grid 1000 in 3D", [wobble, "run", script("grid.wob", "linear b 3d affine box 1 1 1 grid 1000\n")], work, 2,
+         "grid.wob:1:", "mass points")
+    # keys from 0 to 1e300 in 0.5 s ask for an infinite speed at once: bad input, said so
+    case("run: key 0.5 bend=1e300",
+         [wobble, "run", script("key.wob", f"load_obj {obj}\nload_def {modes}\nkey 0 bend=0\nkey 0.5 bend=1e300\nkeyframe\n")],
+         work, 2, "key.wob:5:", "energy is not finite")
+    csv_out = os.path.join(work, "fr.csv")
+    # a table sliding on the ground at 30/s: friction damping 1e300 moves its anchors past any
+    # finite ground energy (the issue's `set frconst 1e300` wrote inf with exit 0)
+    p = case("run: set frconst 1e300 on a sliding table",
+             [wobble, "run", script("fr.wob", f"load_obj {obj}\nload_def {modes}\nset frconst 1e300\n"
+                                              f"set_vec q 0 0 0 0 0 0 0\nset_vec dq 30 -5 0 0 0 0 0\noutput {csv_out}\n"
+                                              f"simul 1\n")], work, 3, "fr.wob:7:", "non-finite energy")
+    if p is not None and os.path.exists(csv_out):
+        rows_finite(csv_out)
+
+    # ---- Ctrl-C: stops at the next step, keeps the rows, says where, exit 130
+    out = os.path.join(work, "long.csv")
+    proc = subprocess.Popen(sim + ["--q", "0 50 0 0 0 0 0", "--duration", "1e5", "--dt", "0.005", "--every", "100",
+                                   "--out", out], cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.5)
+    proc.send_signal(signal.SIGINT)
+    try:
+        _, err = proc.communicate(timeout=30)
+        expect(proc.returncode == 130, f"simulate + Ctrl-C: exit {proc.returncode} (130 expected)")
+        expect("stopped by Ctrl-C at t =" in err and out in err, f"simulate + Ctrl-C: says where: {err.strip()}")
+        expect(os.path.exists(out) and len(rows_finite(out)) > 1, "simulate + Ctrl-C: the rows so far are written")
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        expect(False, "simulate + Ctrl-C: stopped within 30 s")
+
+    if failures:
+        print(f"{len(failures)} failure(s)")
+        sys.exit(1)
+    print("all exit codes as the policy says")
+
+
+if __name__ == "__main__":
+    main()
