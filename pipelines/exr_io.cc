@@ -3,14 +3,43 @@
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
+#include <ImfIO.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <stdexcept>
 
 #include "wobble/formats/atomic_file.h"
 
 namespace wobble::pipelines {
+
+namespace {
+// Imf::OStream over a FILE*: a short write throws with the system's reason, and is
+// remembered for writes OpenEXR makes in destructors (which cannot throw).
+class StdioStream : public Imf::OStream {
+ public:
+  StdioStream(std::FILE* f, const std::string& name) : Imf::OStream(name.c_str()), f_(f) {}
+  void write(const char c[], int n) override {
+    if (n > 0 && std::fwrite(c, 1, size_t(n), f_) != size_t(n)) Fail();
+  }
+  uint64_t tellp() override { return uint64_t(ftello(f_)); }
+  void seekp(uint64_t pos) override {
+    if (fseeko(f_, off_t(pos), SEEK_SET) != 0) Fail();
+  }
+  bool failed() const { return failed_; }
+
+ private:
+  void Fail() {
+    failed_ = true;
+    throw std::runtime_error(std::string(fileName()) + ": " + std::strerror(errno));
+  }
+  std::FILE* f_;
+  bool failed_ = false;
+};
+}  // namespace
 
 void WriteExrChannels(const std::string& path, int width, int height, const std::vector<ExrChannel>& channels,
                       ExrCompression compression) {
@@ -37,9 +66,17 @@ void WriteExrChannels(const std::string& path, int width, int height, const std:
       header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
       fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.data.data(), sizeof(float), sizeof(float) * size_t(width)));
     }
-    Imf::OutputFile file(tmp.c_str(), header);
-    file.setFrameBuffer(fb);
-    file.writePixels(height);
+    // through stdio, whose every failure (the close's included) is reported with its errno:
+    // OpenEXR's own std::ofstream lost a full disk's error and left an empty file
+    formats::WriteWithStdio(tmp, [&](std::FILE* f) {
+      StdioStream stream(f, tmp);
+      {
+        Imf::OutputFile file(stream, header);
+        file.setFrameBuffer(fb);
+        file.writePixels(height);
+      }  // the destructor writes the line offsets
+      return !stream.failed();
+    });
   });
 }
 

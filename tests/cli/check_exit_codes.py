@@ -155,6 +155,34 @@ def main():
     if p is not None and os.path.exists(csv_out):
         rows_finite(csv_out)
 
+    # ---- a full disk (a 200 kB tmpfs, when this machine lets us mount one): exit 1 with the
+    # system's text, and the files of the earlier run unchanged (was: exit 0, empty EXRs)
+    full = os.path.join(work, "full")
+    os.makedirs(full)
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=200k", "tmpfs", full], capture_output=True).returncode == 0
+    if not mounted:
+        print("skip a full disk: cannot mount a tmpfs here")
+    else:
+        try:
+            # the same export twice: a file the second one replaces is byte for byte the first's,
+            # so any change is a truncated or emptied file
+            export = [wobble, "export"] + body + ["--q", "0 50 0 0 0 0 0", "--duration", "2", "--what", "disp",
+                                                  "--out", full]
+            case("export on a disk that fills up", export, work, 1, "No space left on device")
+            kept = {}
+            for root, _, files in os.walk(full):
+                for f in files:
+                    with open(os.path.join(root, f), "rb") as h:
+                        kept[os.path.join(root, f)] = h.read()
+            expect(kept and all(len(v) > 0 for v in kept.values()), f"full disk: {len(kept)} files written, none empty")
+            case("export again on the full disk", export, work, 1, "No space left on device")
+            same = all(open(k, "rb").read() == v for k, v in kept.items())
+            expect(same, "full disk: every file of the first export is unchanged")
+            left = [f for _, _, files in os.walk(full) for f in files if f.endswith(".tmp")]
+            expect(not left, f"full disk: no temporary file left ({left[:3]})")
+        finally:
+            subprocess.run(["umount", full])
+
     # ---- Ctrl-C: stops at the next step, keeps the rows, says where, exit 130
     out = os.path.join(work, "long.csv")
     proc = subprocess.Popen(sim + ["--q", "0 50 0 0 0 0 0", "--duration", "1e5", "--dt", "0.005", "--every", "100",
