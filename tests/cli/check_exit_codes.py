@@ -101,6 +101,9 @@ def main():
     case("inspect: q-dot 1e160", [wobble, "inspect"] + body + ["--qdot", "0 0 1e160 0 0 0 0"], work, 2,
          "energy is not finite")
     case("inspect: bad modes file", [wobble, "inspect", "--object", obj, "--modes", bad_obj], work, 2, "bad.obj:")
+    small = write(os.path.join(work, "m3.def"), "# a 3x3 mode\nmode small\nx: 1 2 3\n 4 5 6\n 7 8 9\ny: 1 2 3\n 4 5 6\n 7 8 9\n")
+    case("inspect: a mode of another lattice size names its file and line",
+         [wobble, "inspect", "--object", obj, "--modes", small], work, 2, "m3.def:2:", "3x3 lattice")
 
     # ---- condition
     case("condition sweep: --step 1e-9 (an int overflow skipped the check)",

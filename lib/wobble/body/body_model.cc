@@ -17,7 +17,7 @@ BodyModel::BodyModel(BodyDef def, std::vector<DeformationMode> modes) : def_(std
                                 std::to_string(kMaxModes) + " are supported");
   for (const DeformationMode& mode : modes_) {
     if (mode.num_s != lat.num_s() || mode.num_t != lat.num_t() || int(mode.displacement.size()) != lat.size())
-      throw std::invalid_argument("mode '" + mode.name + "' is defined on a " + std::to_string(mode.num_s) + "x" +
+      throw std::invalid_argument((mode.source.empty() ? "" : mode.source + ": ") + "mode '" + mode.name + "' is defined on a " + std::to_string(mode.num_s) + "x" +
                                   std::to_string(mode.num_t) + " lattice but body '" + def_.name + "' has a " +
                                   std::to_string(lat.num_s()) + "x" + std::to_string(lat.num_t()) + " lattice");
   }

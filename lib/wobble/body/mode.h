@@ -16,6 +16,7 @@ struct DeformationMode {
   double stiffness = 0.0;  // K in V = K γ²
   double damping = 0.0;    // c in Q = −c γ̇
   bool active = false;     // driven by a controller (chapter 5) rather than left passive
+  std::string source;      // "FILE:LINE" it was read from, for errors (empty: made in code)
 };
 
 }  // namespace wobble

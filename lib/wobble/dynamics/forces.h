@@ -305,7 +305,8 @@ template <class T> void UpdateContacts(const BodyModel& body, const Ground& g, B
     Vec2<T> f = GroundForce(g, gf, x, v, anchor, &slipping);
     if (slipping) {
       // choose Δt so that −K Δt − FR v_t equals the capped friction f·τ
-      const T dt = -(f.dot(tau) + T(g.friction_damping) * tau.dot(v)) / T(g.stiffness);
+      // (no stiffness, no spring to the anchor: it sits on the ground; 0/0 made it NaN)
+      const T dt = g.stiffness > 0.0 ? T(-(f.dot(tau) + T(g.friction_damping) * tau.dot(v)) / T(g.stiffness)) : T(0.0);
       const Vec2<T> on_ground = x - gf.Height(x) * n;
       anchor = on_ground - dt * tau;
       f = GroundForce(g, gf, x, v, anchor, &slipping);  // what the moved anchor exerts

@@ -237,6 +237,7 @@ class DeformationParser {
                                std::to_string(other.header_line) + " has that name; give it a 'mode <name>' header");
       mode.num_s = num_s_;
       mode.num_t = num_t_;
+      mode.source = file_ + ":" + std::to_string(p.header_line != 0 ? p.header_line : p.x.line);
       mode.displacement.resize(size_t(num_s_) * num_t_);
       for (int i = 0; i < num_s_; ++i)
         for (int j = 0; j < num_t_; ++j) mode.displacement[size_t(i) * num_t_ + j] = {p.x.rows[j][i], p.y.rows[j][i]};
