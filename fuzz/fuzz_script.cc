@@ -1,7 +1,10 @@
 // script::Interpreter::RunStream on arbitrary bytes: every command, scene commands and the
 // session scripts of scene::SessionScript included. Input files resolve against data/ (the
 // script's folder); output files land in a private temporary folder, the working directory.
+#include <signal.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <charconv>
 #include <cstdlib>
@@ -29,12 +32,21 @@ class NullBuffer : public std::streambuf {
   std::streamsize xsputn(const char*, std::streamsize n) override { return n; }
 };
 
-// The working directory of this process: created once, emptied after every input, removed at exit.
+// The working directory of this process, /tmp/wobble_fuzz_script_PID: created once, emptied
+// after every input. libFuzzer's jobs do not always exit through atexit, so each process
+// first removes the folders of processes that are gone.
 const fs::path& PrivateFolder() {
   static const fs::path folder = [] {
-    char name[] = "/tmp/wobble_fuzz_script_XXXXXX";
-    if (!mkdtemp(name)) std::abort();
-    const fs::path dir = name;
+    const std::string prefix = "wobble_fuzz_script_";
+    std::error_code ec;
+    for (const fs::directory_entry& e : fs::directory_iterator("/tmp", ec)) {
+      const std::string name = e.path().filename().string();
+      if (name.rfind(prefix, 0) != 0) continue;
+      const long pid = std::atol(name.c_str() + prefix.size());
+      if (pid > 0 && kill(pid_t(pid), 0) != 0 && errno == ESRCH) fs::remove_all(e.path(), ec);
+    }
+    const fs::path dir = "/tmp/" + prefix + std::to_string(getpid());
+    fs::create_directories(dir);
     fs::current_path(dir);
     std::atexit([] { std::error_code ec; fs::remove_all(PrivateFolder(), ec); });
     return dir;
