@@ -7,6 +7,7 @@
 #include <cerrno>
 
 #include <charconv>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <sstream>
@@ -48,7 +49,10 @@ const fs::path& PrivateFolder() {
     const fs::path dir = "/tmp/" + prefix + std::to_string(getpid());
     fs::create_directories(dir);
     fs::current_path(dir);
-    std::atexit([] { std::error_code ec; fs::remove_all(PrivateFolder(), ec); });
+    // a plain copy: atexit runs this after the static path below is destroyed
+    static char to_remove[256];
+    std::snprintf(to_remove, sizeof to_remove, "%s", dir.c_str());
+    std::atexit([] { std::error_code ec; fs::remove_all(to_remove, ec); });
     return dir;
   }();
   return folder;
