@@ -150,6 +150,9 @@ FUZZ_FLAGS_targets        := -max_len=4096
 FUZZ_FLAGS_trajectory_csv := -max_len=8192
 FUZZ_FLAGS_script         := -max_len=4096 -timeout=10
 FUZZ_FLAGS_world_step     := -max_len=128 -timeout=10
+# FUZZ_KEEP_GOING=1: go on past crashes and hangs (libFuzzer's fork mode; each is still saved
+# in artifacts/), for targets with open findings; executions then come from the progress lines
+FUZZ_KEEP_GOING ?=
 fuzz: deps fuzz-deps
 	CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -DWOBBLE_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DWOBBLE_BUILD_TESTS=OFF -DWOBBLE_BUILD_PIPELINES=OFF -DWOBBLE_BUILD_APP=OFF -DWOBBLE_BUILD_BENCH=OFF
@@ -166,14 +169,19 @@ fuzz: deps fuzz-deps
 	    script) flags="$(FUZZ_FLAGS_script)" ;; world_step) flags="$(FUZZ_FLAGS_world_step)" ;; *) flags="" ;;
 	  esac
 	  echo "== fuzz_$$t for $(FUZZ_SECONDS) s (log: $$log)"
+	  # world_step reads binary values: no dictionary
+	  if [ -f fuzz/dict/$$t.dict ]; then flags="$$flags -dict=$(CURDIR)/fuzz/dict/$$t.dict"; fi
+	  if [ -n "$(FUZZ_KEEP_GOING)" ]; then flags="$$flags -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1"; fi
 	  rc=0
 	  # absolute paths: fuzz_script changes its working directory, and libFuzzer reads the
 	  # corpus files after the first input ran
 	  $(FUZZ_BUILD)/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 $$flags \
-	    -dict=$(CURDIR)/fuzz/dict/$$t.dict -artifact_prefix=$(abspath $(FUZZ_BUILD))/artifacts/$$t- \
+	    -artifact_prefix=$(abspath $(FUZZ_BUILD))/artifacts/$$t- \
 	    $(abspath $(FUZZ_BUILD))/corpus/$$t $(CURDIR)/fuzz/corpus/$$t > $$log 2>&1 || rc=$$?
 	  execs=$$(sed -n 's/^stat::number_of_executed_units: *//p' $$log | tail -1)
 	  rate=$$(sed -n 's/^stat::average_exec_per_sec: *//p' $$log | tail -1)
+	  # no final stats after a crash or in fork mode: the last progress line's count
+	  if [ -z "$$execs" ]; then execs=$$(sed -n 's/^#\([0-9][0-9]*\).*/\1/p' $$log | tail -1); fi
 	  line="fuzz_$$t: $${execs:-?} executions, $${rate:-?} exec/s"
 	  if [ $$rc -ne 0 ]; then line="$$line, FAILED (exit $$rc; see $$log and $(FUZZ_BUILD)/artifacts/)"; status=1; fi
 	  echo "$$line"
