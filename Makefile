@@ -6,6 +6,7 @@
 #   make bench   build and run the benchmarks
 #   make build   configure and build only
 #   make deps    install the Debian packages that are missing (as root)
+#   make fuzz    build the libFuzzer targets of fuzz/ (clang) and run each FUZZ_SECONDS (60)
 #   make clean   remove the build folders and out/
 #
 # Build folders can be moved: make test BUILD=build-mine ASAN_BUILD=build-mine-asan
@@ -24,6 +25,8 @@ OUT        ?= out/demo
 PACKAGES := libvtk9-dev libeigen3-dev libceres-dev libopenexr-dev libimath-dev \
             libgtest-dev libgmock-dev libbenchmark-dev xvfb xauth libcli11-dev \
             nlohmann-json3-dev cmake g++ make libpagmo-dev libpng-dev
+# only `make fuzz` needs these (libFuzzer is clang's)
+FUZZ_PACKAGES := clang libclang-rt-14-dev
 
 
 # The default scene: the table (lattice 300 x 100) dropped from 50 onto the ground sloped by
@@ -36,7 +39,7 @@ DEMO_WHAT     ?= frames,filmstrip,charts,vtp,exr,disp
 WOBBLE        := $(BUILD)/app/wobble
 DEMO_SCRIPT   ?= data/table_cliff.wob  # writes and renders into out/demo (its `output` and `render` lines)
 
-.PHONY: all deps configure build demo-build demo test test-release asan bench clean
+.PHONY: all deps fuzz-deps configure build demo-build demo test test-release asan bench fuzz clean
 
 all: build
 
@@ -57,6 +60,9 @@ deps:
 	  echo "  sudo apt-get update && sudo apt-get install -y --no-install-recommends $${missing[*]}" >&2
 	  exit 1
 	fi
+
+fuzz-deps:
+	$(MAKE) deps PACKAGES="$(FUZZ_PACKAGES)"
 
 configure: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DWOBBLE_SANITIZE=OFF \
@@ -130,5 +136,60 @@ bench: configure
 	if [ -n "$${DISPLAY:-}" ]; then $(BUILD)/bench/wobble_pipelines_bench
 	else xvfb-run -a -s "-screen 0 1280x1024x24" $(BUILD)/bench/wobble_pipelines_bench; fi
 
+# libFuzzer (fuzz/, issue 14): every target for FUZZ_SECONDS, from the committed corpus and its
+# dictionary; new inputs go to $(FUZZ_BUILD)/corpus/TARGET (merge them into fuzz/corpus by hand,
+# with -merge=1), crashes to $(FUZZ_BUILD)/artifacts/. Prints the executions of each target.
+FUZZ_BUILD   ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS ?= object deformation targets trajectory_csv script world_step
+# the readers take files of any size; scripts and world states are kept short (each input is
+# a simulation), and a script that runs longer than 10 s is reported as a hang
+FUZZ_FLAGS_object         := -max_len=4096
+FUZZ_FLAGS_deformation    := -max_len=4096
+FUZZ_FLAGS_targets        := -max_len=4096
+FUZZ_FLAGS_trajectory_csv := -max_len=8192
+FUZZ_FLAGS_script         := -max_len=4096 -timeout=10
+FUZZ_FLAGS_world_step     := -max_len=128 -timeout=10
+# FUZZ_KEEP_GOING=1: go on past crashes and hangs (libFuzzer's fork mode; each is still saved
+# in artifacts/), for targets with open findings; executions then come from the progress lines
+FUZZ_KEEP_GOING ?=
+fuzz: deps fuzz-deps
+	CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -DWOBBLE_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DWOBBLE_BUILD_TESTS=OFF -DWOBBLE_BUILD_PIPELINES=OFF -DWOBBLE_BUILD_APP=OFF -DWOBBLE_BUILD_BENCH=OFF
+	cmake --build $(FUZZ_BUILD) -j $(JOBS) --target $(addprefix fuzz_,$(FUZZ_TARGETS))
+	mkdir -p $(FUZZ_BUILD)/artifacts
+	status=0
+	summary=""
+	for t in $(FUZZ_TARGETS); do
+	  mkdir -p $(FUZZ_BUILD)/corpus/$$t
+	  log=$(FUZZ_BUILD)/fuzz_$$t.log
+	  case $$t in
+	    object) flags="$(FUZZ_FLAGS_object)" ;; deformation) flags="$(FUZZ_FLAGS_deformation)" ;;
+	    targets) flags="$(FUZZ_FLAGS_targets)" ;; trajectory_csv) flags="$(FUZZ_FLAGS_trajectory_csv)" ;;
+	    script) flags="$(FUZZ_FLAGS_script)" ;; world_step) flags="$(FUZZ_FLAGS_world_step)" ;; *) flags="" ;;
+	  esac
+	  echo "== fuzz_$$t for $(FUZZ_SECONDS) s (log: $$log)"
+	  # world_step reads binary values: no dictionary
+	  if [ -f fuzz/dict/$$t.dict ]; then flags="$$flags -dict=$(CURDIR)/fuzz/dict/$$t.dict"; fi
+	  if [ -n "$(FUZZ_KEEP_GOING)" ]; then flags="$$flags -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1"; fi
+	  rc=0
+	  # absolute paths: fuzz_script changes its working directory, and libFuzzer reads the
+	  # corpus files after the first input ran
+	  $(FUZZ_BUILD)/fuzz/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 $$flags \
+	    -artifact_prefix=$(abspath $(FUZZ_BUILD))/artifacts/$$t- \
+	    $(abspath $(FUZZ_BUILD))/corpus/$$t $(CURDIR)/fuzz/corpus/$$t > $$log 2>&1 || rc=$$?
+	  execs=$$(sed -n 's/^stat::number_of_executed_units: *//p' $$log | tail -1)
+	  rate=$$(sed -n 's/^stat::average_exec_per_sec: *//p' $$log | tail -1)
+	  # no final stats after a crash or in fork mode: the last progress line's count
+	  if [ -z "$$execs" ]; then execs=$$(sed -n 's/^#\([0-9][0-9]*\).*/\1/p' $$log | tail -1); fi
+	  line="fuzz_$$t: $${execs:-?} executions, $${rate:-?} exec/s"
+	  if [ $$rc -ne 0 ]; then line="$$line, FAILED (exit $$rc; see $$log and $(FUZZ_BUILD)/artifacts/)"; status=1; fi
+	  echo "$$line"
+	  summary="$$summary$$line"$$'\n'
+	done
+	echo
+	printf '%s' "$$summary"
+	exit $$status
+
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) out
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) out

@@ -168,5 +168,17 @@ TEST(TrajectoryCsv, ReadsWobbleSimulateOutputAndRejectsBadRows) {
   EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1\n"), "ref.csv:0: no rows after the header");
 }
 
+// Found by fuzz_trajectory_csv: Trajectory::pose() reads the pose column as an int, so a pose
+// that is not a whole number an int holds was undefined behaviour; it is refused on its line.
+TEST(TrajectoryCsv, RefusesAPoseThatIsNoIndex) {
+  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1,pose\n0,1,2,3,4,2\n1,1,2,3,4,21474836483\n"),
+            "ref.csv:3: expected a whole number >= -1 in column 6 (pose), got '21474836483'");
+  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1,pose\n0,1,2,3,4,0.5\n"),
+            "ref.csv:2: expected a whole number >= -1 in column 6 (pose), got '0.5'");
+  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1,pose\n0,1,2,3,4,-2\n"),
+            "ref.csv:2: expected a whole number >= -1 in column 6 (pose), got '-2'");
+  EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1,pose\n0,1,2,3,4,-1\n1,1,2,3,4,3\n"), "no error");
+}
+
 }  // namespace
 }  // namespace wobble

@@ -1,5 +1,6 @@
 #include "wobble/record/trajectory_csv.h"
 
+#include <cmath>
 #include <sstream>
 
 #include "wobble/formats/csv.h"
@@ -98,6 +99,11 @@ ReadTrajectory ParseTrajectoryCsv(std::istream& in, const std::string& file, std
         throw formats::ParseError(file, number, "expected a number in column " + std::to_string(source[i] + 1) + " (" +
                                                     schema[i] + "), got '" + cells[size_t(source[i])] + "'");
     }
+    // the pose is an index (Trajectory::pose() reads it as an int; −1: none)
+    const size_t pose = schema.size() - 2;
+    if (source[pose] >= 0 && !(row[pose] >= -1 && row[pose] <= 1e9 && row[pose] == std::floor(row[pose])))
+      throw formats::ParseError(file, number, "expected a whole number >= -1 in column " + std::to_string(source[pose] + 1) +
+                                                  " (pose), got '" + cells[size_t(source[pose])] + "'");
     if (!traj.empty() && !(row[0] > last_t))
       throw formats::ParseError(file, number, "times must strictly increase (previous row: t = " +
                                                   formats::detail::FormatNumber(last_t) + ")");

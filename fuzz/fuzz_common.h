@@ -1,0 +1,77 @@
+// What every fuzz target shares: the one list of expected failures, the table body of data/,
+// and a reader of typed values from the fuzzer's bytes.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "wobble/body/body_model.h"
+#include "wobble/core/errors.h"
+#include "wobble/formats/deformation_file.h"
+#include "wobble/formats/object_file.h"
+#include "wobble/formats/parse_error.h"
+#include "wobble/script/interpreter.h"
+
+namespace wobble::fuzz {
+
+inline const std::string kDataDir = WOBBLE_DATA_DIR;
+
+// Runs f; the failures hostile input is allowed to cause (a named error of core/errors.h, a
+// reader's ParseError, a stopped simulation) are swallowed. Anything else escapes: an
+// uncaught exception aborts, and libFuzzer (or the replay test) reports it.
+template <class F> void IgnoringExpectedErrors(F&& f) {
+  try {
+    f();
+  } catch (const formats::ParseError&) {
+  } catch (const std::invalid_argument&) {  // wobble::InputError, LimitExceeded
+  } catch (const NumericalStop&) {
+  } catch (const script::SimulationStopped&) {
+  }
+}
+
+// The table of Fig. 1.2 with its four modes, read once per process.
+inline std::shared_ptr<const BodyModel> TableBody() {
+  static const std::shared_ptr<const BodyModel> body = std::make_shared<const BodyModel>(
+      formats::ReadObjectFile(kDataDir + "/table.obj"), formats::ReadDeformationFile(kDataDir + "/table_modes.def"));
+  return body;
+}
+
+// Typed values from the front of the input, like LLVM's FuzzedDataProvider but reading plain
+// bytes (its tail-first layout buys nothing here). Past the end every value is zero.
+class ByteReader {
+ public:
+  ByteReader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+
+  uint8_t Byte() { return pos_ < size_ ? data_[pos_++] : 0; }
+  // A finite value in [lo, hi] from two bytes.
+  double InRange(double lo, double hi) {
+    const unsigned raw = (unsigned(Byte()) << 8) | Byte();
+    return lo + (hi - lo) * (raw / 65535.0);
+  }
+  // Mostly a plausible value in [lo, hi]; sometimes one a thousand times out of it, or one of
+  // the values readers and steps must refuse or survive (NaN, infinities, the extremes). Not
+  // any bit pattern: huge finite values (1e300) are a known open class of their own.
+  double Value(double lo, double hi) {
+    const uint8_t kind = Byte();
+    if (kind < 208) return InRange(lo, hi);
+    if (kind < 240) return InRange(lo * 1e3, hi * 1e3);
+    static const double kSpecial[] = {std::nan(""), HUGE_VAL, -HUGE_VAL, 0.0, -0.0, 1e-300, -1e-300, 5e-324};
+    return kSpecial[kind % (sizeof kSpecial / sizeof kSpecial[0])];
+  }
+  int Int(int lo, int hi) { return lo + int(Byte() % unsigned(hi - lo + 1)); }
+  bool empty() const { return pos_ >= size_; }
+
+ private:
+  const uint8_t* data_;
+  size_t size_;
+  size_t pos_ = 0;
+};
+
+inline std::string AsText(const uint8_t* data, size_t size) { return std::string(reinterpret_cast<const char*>(data), size); }
+
+}  // namespace wobble::fuzz

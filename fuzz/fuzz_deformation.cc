@@ -1,0 +1,26 @@
+// formats::ParseDeformations on arbitrary bytes; modes that fit the table's 4 x 4 lattice are
+// then given to BodyModel as `load_def` and `wobble simulate --modes` do.
+#include <sstream>
+
+#include "fuzz_common.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  using namespace wobble;
+  fuzz::IgnoringExpectedErrors([&] {
+    std::istringstream in(fuzz::AsText(data, size));
+    std::vector<DeformationMode> modes = formats::ParseDeformations(in, "fuzz.def");
+    if (modes.empty()) std::abort();  // the reader promises at least one mode
+    for (const DeformationMode& m : modes) {
+      if (m.num_s < 2 || m.num_t < 2) std::abort();
+      if (!(m.stiffness >= 0) || !(m.damping >= 0)) std::abort();
+      if (m.displacement.size() != size_t(m.num_s) * size_t(m.num_t)) std::abort();
+      for (const Eigen::Vector2d& d : m.displacement)
+        if (!d.allFinite()) std::abort();
+    }
+    const BodyModel& table = *fuzz::TableBody();
+    if (modes.front().num_s == table.lattice().num_s() && modes.front().num_t == table.lattice().num_t() &&
+        modes.size() <= 8)
+      BodyModel body(table.def(), std::move(modes));
+  });
+  return 0;
+}
