@@ -77,6 +77,7 @@ int World::AddLinearBody(std::shared_ptr<const LinearBodyModel> model, AffineMat
   e.applied = e.R_dot;
   e.model = std::move(model);
   e.material = material;
+  e.scale = LinearScale(*e.model, material);
   linear_.push_back(std::move(e));
   slots_.push_back({BodyKind::kLinear, int(linear_.size()) - 1});
   return num_bodies() - 1;
@@ -140,7 +141,9 @@ const Eigen::MatrixXd& World::linear_R_dot(int body) const { return Linear(body)
 
 void World::SetMaterial(int body, const AffineMaterial& material) {
   linear_model(body);
-  linear_[slots_[body].index].material = material;
+  LinearEntry& e = linear_[slots_[body].index];
+  e.material = material;
+  e.scale = LinearScale(*e.model, material);
 }
 
 const AffineMaterial& World::material(int body) const { return Linear(body).material; }
@@ -259,10 +262,12 @@ bool World::StepEachBody() {
     LinearFreeAcceleration(e, &acc);
     if (!acc.allFinite()) return Fail(StatusCode::kNonFinite, body, "non-finite acceleration");
     const int d = e.model->dim(), n = e.model->basis_size();
-    e.R_before = e.R;
-    e.R_dot_before = e.R_dot;
-    e.R_dot += h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(acc.data(), d, n);
-    e.R += h * e.R_dot;
+    // the new state into the scratch, then swapped in (O(1)): a refused step swaps back
+    e.R_dot_before.noalias() =
+        e.R_dot + h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(acc.data(), d, n);
+    e.R_before.noalias() = e.R + h * e.R_dot_before;
+    e.R.swap(e.R_before);
+    e.R_dot.swap(e.R_dot_before);
     e.applied.setZero();
     if (!AcceptLinearStep(body)) return false;
   }
@@ -358,14 +363,22 @@ Energies World::FfdEnergies(int i, ContactSet contacts, bool per_mode) const {
 }
 
 // A finite acceleration can still overflow R, Ṙ or the energy: the step is refused then, and
-// the body keeps its state before it.
+// the body keeps its state before it (R_before, R_dot_before hold it: the step swapped them).
 bool World::AcceptLinearStep(int body) {
   LinearEntry& e = linear_[slots_[body].index];
+  // the screen of EnergySurelyFinite, for ½ tr(Ṙ M Ṙᵀ), −g·R m̄ and the affine energies (at
+  // most seven factors deep: k_c (det A − 1)² with a 3×3 A)
+  constexpr double kScreen = 1e30;
+  const double g = e.model->dim() == 2 ? options_.params.gravity.cwiseAbs().maxCoeff()
+                                       : options_.gravity_3d.cwiseAbs().maxCoeff();
+  if (e.scale <= kScreen && e.R.cwiseAbs().maxCoeff() <= kScreen && e.R_dot.cwiseAbs().maxCoeff() <= kScreen &&
+      g <= kScreen)
+    return true;
   const bool finite = e.R.allFinite() && e.R_dot.allFinite();
   if (finite && EnergyFinite(body)) return true;
   const Energies energies = finite ? ComputeEnergies(body) : Energies();
-  e.R = e.R_before;
-  e.R_dot = e.R_dot_before;
+  e.R.swap(e.R_before);
+  e.R_dot.swap(e.R_dot_before);
   return finite ? Fail(StatusCode::kNonFiniteEnergy, body, EnergyTerms(energies)) : Fail(StatusCode::kNonFinite, body);
 }
 
@@ -400,6 +413,13 @@ bool World::EnergySurelyFinite(const FfdEntry& e) const {
           (sp.mode_matrix.size() == 0 || sp.mode_matrix.cwiseAbs().maxCoeff() <= kScreen)))
       return false;
   return true;
+}
+
+double LinearScale(const LinearBodyModel& m, const AffineMaterial& material) {
+  const double scale = std::max({m.mass_matrix().cwiseAbs().maxCoeff(), m.first_moment().cwiseAbs().maxCoeff(),
+                                 std::abs(material.rigidity), std::abs(material.volume), std::abs(material.bending),
+                                 std::abs(material.damping)});
+  return std::isfinite(scale) ? scale : std::numeric_limits<double>::infinity();
 }
 
 double ModelScale(const BodyModel& b) {

@@ -70,6 +70,7 @@ struct WorldStatus {
 
 // The largest |number| of a model's moments, points and mode stiffnesses (inf for a NaN).
 double ModelScale(const BodyModel& b);
+double LinearScale(const LinearBodyModel& m, const AffineMaterial& material);  // the same, linear
 
 // "kinetic K, gravity G, ..." of a refused step, for its status message.
 std::string EnergyTerms(const Energies& e);
@@ -282,6 +283,7 @@ class World {
     Eigen::MatrixXd R, R_dot, applied;  // applied: Σ f pᵀ of ApplyPointForce for the next step
     Eigen::MatrixXd Q;                  // per-step work: the body's generalized force
     Eigen::MatrixXd R_before, R_dot_before;  // per-step work: the state a refused step restores
+    double scale = 0.0;  // the largest |number| of the mass matrix, first moment and material
   };
   // A resolved material point: linear bodies keep p(u) and W p; FFD bodies b0 and B.
   struct End {

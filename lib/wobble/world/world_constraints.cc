@@ -544,10 +544,10 @@ bool World::StepConstrained() {
     if (b.kind == BodyKind::kLinear) {
       LinearEntry& e = linear_[b.index];
       const int d = e.model->dim(), n = e.model->basis_size();
-      e.R_before = e.R;
-      e.R_dot_before = e.R_dot;
-      e.R_dot += h * AsMatrix(acc[body], d, n);
-      e.R += h * e.R_dot;
+      e.R_dot_before.noalias() = e.R_dot + h * AsMatrix(acc[body], d, n);  // swapped in below (O(1))
+      e.R_before.noalias() = e.R + h * e.R_dot_before;
+      e.R.swap(e.R_before);
+      e.R_dot.swap(e.R_dot_before);
       e.applied.setZero();
       if (!AcceptLinearStep(body)) return false;
     } else {
