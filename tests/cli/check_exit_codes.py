@@ -122,6 +122,27 @@ def main():
     bad_tgt = write(os.path.join(work, "bad.tgt"), "point 0 1 2\npoint zero 1 2\n")
     case("fit pose: bad target file", [wobble, "fit", "pose"] + body + ["--targets", bad_tgt], work, 2, "bad.tgt:2:")
 
+    bad_keys = write(os.path.join(work, "keys.tgt"), "frame 0\npoint 0 0 100\nframe zero\n")
+    case("fit trajectory: bad keys file", [wobble, "fit", "trajectory"] + body + ["--reference", bad_keys], work, 2,
+         "keys.tgt:3:")
+    case("fit trajectory: --every 0", [wobble, "fit", "trajectory"] + body +
+         ["--reference", os.path.join(data, "table_keys.tgt"), "--every", "0"], work, 2)
+    case("condition time: --dt 0", [wobble, "condition", "time"] + body + ["--dt", "0"], work, 2, "--dt")
+    case("condition time: 1e12 steps", [wobble, "condition", "time"] + body + ["--dt", "1e-9", "--duration", "1000"],
+         work, 2, "10^7 steps")
+
+    # ---- render, export, view: flags checked before any work
+    for sub in ("render", "export"):
+        case(f"{sub}: --fps 1e300", [wobble, sub] + body + ["--fps", "1e300", "--out", work], work, 2, "frames")
+        case(f"{sub}: 1e11 steps", [wobble, sub] + body + ["--dt", "1e-9", "--duration", "100", "--what", "vtp",
+                                                           "--out", work], work, 2, "--max-steps")
+        case(f"{sub}: --out in a file's place", [wobble, sub] + body + ["--what", "vtp", "--out", a_file], work, 2, "--out")
+    view = [wobble, "view", write(os.path.join(work, "v.wob"), "simull 1\n")]
+    if os.environ.get("DISPLAY"):
+        case("view: a bad script names its line", view, work, 2, "v.wob:1:")
+    else:
+        case("view without a display says so", view, work, 2, "X display")
+
     # ---- run (the interpreter)
     def script(name, text):
         return write(os.path.join(work, name), text)
