@@ -61,10 +61,14 @@ void AddLimitFlags(CLI::App* cmd, Limits* limits) {
       ->capture_default_str();
 }
 
-long CheckRunLimits(double duration, double dt, long every, int columns, const Limits& limits) {
+void CheckLimitFlags(const Limits& limits) {
   if (limits.max_steps < 1 || limits.max_steps > kMaxStepsLimit)
     throw UsageError("--max-steps must be between 1 and " + std::to_string(kMaxStepsLimit));
   RequirePositive(limits.max_record_mb, "--max-record-mb");
+}
+
+long CheckRunLimits(double duration, double dt, long every, int columns, const Limits& limits) {
+  CheckLimitFlags(limits);
   const long steps = RunSteps(duration, dt, limits, "raise it with --max-steps N");
   CheckRecordSize((double(steps) / double(std::max(1L, every)) + 2.0) * double(columns), limits,
                   "raise it with --max-record-mb N" + std::string(every > 0 ? ", or keep fewer rows (--every)" : ""));

@@ -63,6 +63,8 @@ WorldParams MakeWorldParams(const WorldFlags& flags);
 
 // --max-steps and --max-record-mb (core/limits.h): what one command may simulate and keep.
 void AddLimitFlags(CLI::App* cmd, Limits* limits);
+// The flags themselves: --max-steps in [1, kMaxStepsLimit], --max-record-mb positive.
+void CheckLimitFlags(const Limits& limits);
 // The steps of a run of --duration at --dt within limits.max_steps, with a record of every
 // `every`-th step of `columns` values within limits.max_record_mb (LimitExceeded otherwise,
 // naming the flag that raises it).

@@ -90,9 +90,7 @@ std::vector<std::string> RenderScene(const script::SceneRenderRequest& r) {
 }  // namespace
 
 int RunScript(const RunArgs& a) {
-  if (a.limits.max_steps < 1 || a.limits.max_steps > kMaxStepsLimit)
-    throw UsageError("--max-steps must be between 1 and " + std::to_string(kMaxStepsLimit));
-  RequirePositive(a.limits.max_record_mb, "--max-record-mb");
+  CheckLimitFlags(a.limits);
   script::Interpreter interp(std::cout);
   interp.scene().limits() = a.limits;
   interp.SetHistoryHook(PlotCostHistory);
