@@ -28,9 +28,8 @@ template <class F> void IgnoringExpectedErrors(F&& f) {
   try {
     f();
   } catch (const formats::ParseError&) {
-  } catch (const std::invalid_argument&) {  // wobble::InputError, LimitExceeded
-  } catch (const NumericalStop&) {
-  } catch (const script::SimulationStopped&) {
+  } catch (const std::invalid_argument&) {  // InputError and LimitExceeded (errors.h)
+  } catch (const NumericalStop&) {          // script::SimulationStopped too
   }
 }
 
