@@ -24,7 +24,8 @@ OUT        ?= out/demo
 
 PACKAGES := libvtk9-dev libeigen3-dev libceres-dev libopenexr-dev libimath-dev \
             libgtest-dev libgmock-dev libbenchmark-dev xvfb xauth libcli11-dev \
-            nlohmann-json3-dev cmake g++ make libpagmo-dev libpng-dev
+            nlohmann-json3-dev cmake g++ make libpagmo-dev libpng-dev \
+            pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
 # only `make fuzz` needs these (libFuzzer is clang's)
 FUZZ_PACKAGES := clang libclang-rt-14-dev
 
@@ -39,7 +40,7 @@ DEMO_WHAT     ?= frames,filmstrip,charts,vtp,exr,disp
 WOBBLE        := $(BUILD)/app/wobble
 DEMO_SCRIPT   ?= data/table_cliff.wob  # writes and renders into out/demo (its `output` and `render` lines)
 
-.PHONY: all deps fuzz-deps configure build demo-build demo test test-release asan bench fuzz clean
+.PHONY: all deps fuzz-deps configure build demo-build demo test test-release asan bench bench-python fuzz clean
 
 all: build
 
@@ -135,6 +136,11 @@ bench: configure
 	# rendering and export speed; VTK renders through X
 	if [ -n "$${DISPLAY:-}" ]; then $(BUILD)/bench/wobble_pipelines_bench
 	else xvfb-run -a -s "-screen 0 1280x1024x24" $(BUILD)/bench/wobble_pipelines_bench; fi
+
+# Python against C++ (issue 16): batched trials and the cost of one step() call
+bench-python: configure
+	cmake --build $(BUILD) -j $(JOBS) --target _wobble synth_bench
+	PYTHONPATH=$(BUILD)/python /usr/bin/python3 bench/python_bench.py $(BUILD)
 
 # libFuzzer (fuzz/, issue 14): every target for FUZZ_SECONDS, from the committed corpus and its
 # dictionary; new inputs go to $(FUZZ_BUILD)/corpus/TARGET (merge them into fuzz/corpus by hand,

@@ -192,11 +192,7 @@ void RequireNonNegative(double value, const std::string& what) {
 Integrator ParseIntegratorFlag(const std::string& name) {
   Integrator integrator;
   if (ParseIntegrator(name, &integrator)) return integrator;
-  std::string names;
-  for (Integrator i : {Integrator::kThesis, Integrator::kSymplecticEuler, Integrator::kRK4, Integrator::kImplicitEuler,
-                       Integrator::kVariational})
-    names += (names.empty() ? "" : ", ") + IntegratorName(i);
-  throw UsageError("--integrator: '" + name + "' is not one of " + names);
+  throw UsageError("--integrator: '" + name + "' is not one of " + IntegratorNames());
 }
 
 }  // namespace wobble::app

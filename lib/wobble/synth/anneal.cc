@@ -2,13 +2,12 @@
 
 #include "wobble/control/controllers.h"
 #include "wobble/core/interrupt.h"
+#include "wobble/core/parallel.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <random>
 #include <sstream>
-#include <thread>
 
 namespace wobble::synth {
 
@@ -122,20 +121,7 @@ TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
 
 std::vector<TrialOutcome> RunTrials(const Problem& p, const std::vector<control::PoseGraph>& graphs, int threads) {
   std::vector<TrialOutcome> out(graphs.size());
-  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-  threads = std::min<int>(threads, int(graphs.size()));
-  if (threads <= 1) {
-    for (size_t i = 0; i < graphs.size(); ++i) out[i] = RunTrial(p, graphs[i]);
-    return out;
-  }
-  // each trial is independent and writes its own slot: the order of work never matters
-  std::atomic<size_t> next{0};
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t)
-    pool.emplace_back([&] {
-      for (size_t i; (i = next.fetch_add(1)) < graphs.size();) out[i] = RunTrial(p, graphs[i]);
-    });
-  for (std::thread& th : pool) th.join();
+  ParallelFor(graphs.size(), threads, [&](size_t i) { out[i] = RunTrial(p, graphs[i]); });
   return out;
 }
 

@@ -24,14 +24,24 @@ std::string IntegratorName(Integrator integrator) {
   return "?";
 }
 
+namespace {
+constexpr Integrator kIntegrators[] = {Integrator::kThesis, Integrator::kSymplecticEuler, Integrator::kRK4,
+                                       Integrator::kImplicitEuler, Integrator::kVariational};
+}  // namespace
+
 bool ParseIntegrator(const std::string& text, Integrator* integrator) {
-  for (Integrator i : {Integrator::kThesis, Integrator::kSymplecticEuler, Integrator::kRK4, Integrator::kImplicitEuler,
-                       Integrator::kVariational})
+  for (Integrator i : kIntegrators)
     if (IntegratorName(i) == text) {
       *integrator = i;
       return true;
     }
   return false;
+}
+
+std::string IntegratorNames() {
+  std::string names;
+  for (Integrator i : kIntegrators) names += (names.empty() ? "" : ", ") + IntegratorName(i);
+  return names;
 }
 
 std::string StatusCodeName(StatusCode code) {

@@ -1,0 +1,31 @@
+// The pieces of the Python module `wobble` (module.cc puts them together), one per area of
+// libwobble. Shared helpers for numpy conversion live here too.
+#pragma once
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <Eigen/Core>
+#include <string>
+
+namespace wobble::python {
+
+namespace py = pybind11;
+
+void BindErrors(py::module_& m);   // exceptions (errors.cc)
+void BindBodies(py::module_& m);   // BodyModel, modes, loading (bodies.cc)
+void BindWorld(py::module_& m);    // WorldOptions, Ground, World, Energies (world.cc)
+void BindRecord(py::module_& m);   // Trajectory, simulate (record.cc)
+void BindRollout(py::module_& m);  // batched rollouts (rollout.cc)
+void BindScript(py::module_& m);   // Interpreter, scenes (script.cc)
+void BindSynth(py::module_& m);    // pose graphs, trials, annealing (synth.cc)
+void BindFit(py::module_& m);      // pose fits (fit.cc)
+void BindAnalysis(py::module_& m); // condition numbers, mode-set checks (analysis.cc)
+
+// A C-contiguous float64 array of `rows` x `cols` (cols < 0: a vector of `rows`), or
+// InputError naming `what` and the shape expected.
+py::array_t<double, py::array::c_style> AsMatrix(const py::handle& a, long rows, long cols, const std::string& what);
+
+}  // namespace wobble::python

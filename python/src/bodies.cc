@@ -1,0 +1,152 @@
+// FFD bodies (BodyModel, Faloutsos 1995 ch. 4): loading an object with its modes, and what a
+// body is made of, as numpy arrays.
+#include "bindings.h"
+
+#include "wobble/analysis/conditioning.h"
+#include "wobble/body/body_model.h"
+#include "wobble/core/errors.h"
+#include "wobble/core/types.h"
+#include "wobble/scene/ffd_object.h"
+
+namespace wobble::python {
+namespace {
+
+// The object file and its modes, read as a script's load_obj and load_def would (one loader:
+// scene::FfdObject), then the mode set checked as `wobble simulate` does.
+// (pybind11 holds bodies as shared_ptr<BodyModel>; Python never changes one.)
+std::shared_ptr<BodyModel> LoadBody(const std::string& object, const std::vector<std::string>& modes, bool check) {
+  scene::FfdObject o;
+  o.Load(object);
+  o.LoadModes(modes);
+  std::shared_ptr<const BodyModel> body = o.Body();
+  if (check) {
+    const analysis::ModeSetReport report = analysis::CheckModeSet(*body);
+    if (report.level == analysis::ModeSetReport::Level::kError) {
+      std::string msg = "the modes of " + object + " cannot be simulated:";
+      for (const std::string& line : report.messages) msg += "\n  " + line;
+      throw InputError(msg + "\n(wobble condition check explains the mode set)");
+    }
+    for (const std::string& line : report.messages)
+      PyErr_WarnEx(PyExc_UserWarning, line.c_str(), 1);
+  }
+  return std::const_pointer_cast<BodyModel>(body);
+}
+
+py::array_t<double> Points(const std::vector<Eigen::Vector2d>& points) {
+  py::array_t<double> out({py::ssize_t(points.size()), py::ssize_t(2)});
+  auto a = out.mutable_unchecked<2>();
+  for (size_t k = 0; k < points.size(); ++k) {
+    a(k, 0) = points[k].x();
+    a(k, 1) = points[k].y();
+  }
+  return out;
+}
+
+// The body's drawing at q: each polyline of the object file sampled `samples` times a segment
+// in lattice coordinates and carried by the FFD, x = t + R(θ) (b0 + B γ) (Eq. 4.4): straight
+// lines bend with the lattice.
+std::vector<Eigen::MatrixXd> Outline(const BodyModel& body, const py::object& q_in, int samples) {
+  if (samples < 1 || samples > 1000) throw InputError("samples_per_segment must be 1 to 1000");
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(body.num_q());
+  if (!q_in.is_none()) {
+    auto a = AsMatrix(q_in, body.num_q(), -1, "q");
+    q = Eigen::Map<const Eigen::VectorXd>(a.data(), body.num_q());
+  }
+  const Eigen::Matrix2d R = Rotation(q[2]);
+  const Eigen::VectorXd gamma = q.tail(body.num_modes());
+  std::vector<Eigen::MatrixXd> out;
+  for (const Polyline& pl : body.def().shapes) {
+    const int np = int(pl.points.size());
+    if (np < 2) continue;
+    const int segments = pl.closed ? np : np - 1;
+    Eigen::MatrixXd xy(segments * samples + 1, 2);
+    int row = 0;
+    auto put = [&](const Eigen::Vector2d& p) {
+      Eigen::Vector2d b0;
+      Mat2D<double> B;
+      body.LocalBasis(body.lattice().LocalCoords(p), &b0, &B);
+      xy.row(row++) = (q.head<2>() + R * (b0 + B * gamma)).transpose();
+    };
+    for (int seg = 0; seg < segments; ++seg) {
+      const Eigen::Vector2d a = pl.points[seg], b = pl.points[(seg + 1) % np];
+      for (int k = 0; k < samples; ++k) put(a + (b - a) * (double(k) / samples));
+    }
+    put(pl.closed ? pl.points.front() : pl.points.back());
+    out.push_back(xy);
+  }
+  return out;
+}
+
+}  // namespace
+
+py::array_t<double, py::array::c_style> AsMatrix(const py::handle& h, long rows, long cols, const std::string& what) {
+  auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
+  if (!a) throw InputError(what + ": expected an array of numbers");
+  const bool vector = cols < 0;
+  const bool shape_ok = vector ? (a.ndim() == 1 && a.shape(0) == rows)
+                               : (a.ndim() == 2 && a.shape(0) == rows && a.shape(1) == cols);
+  if (!shape_ok) {
+    std::string got = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) got += (i ? ", " : "") + std::to_string(a.shape(i));
+    got += a.ndim() == 1 ? ",)" : ")";
+    const std::string want =
+        vector ? "(" + std::to_string(rows) + ",)" : "(" + std::to_string(rows) + ", " + std::to_string(cols) + ")";
+    throw InputError(what + ": expected shape " + want + ", got " + got);
+  }
+  return a;
+}
+
+void BindBodies(py::module_& m) {
+  py::class_<DeformationMode>(m, "DeformationMode", "One user-drawn deformation mode (thesis §4.3) and its PD constants.")
+      .def_readonly("name", &DeformationMode::name)
+      .def_readonly("stiffness", &DeformationMode::stiffness, "K of the mode potential V = K γ²")
+      .def_readonly("damping", &DeformationMode::damping, "c of the mode damping Q = −c γ̇")
+      .def_readonly("active", &DeformationMode::active, "driven by a controller (chapter 5)")
+      .def_readonly("source", &DeformationMode::source, "FILE:LINE it was read from")
+      .def_property_readonly(
+          "displacement", [](const DeformationMode& d) { return Points(d.displacement); },
+          "(num_s·num_t, 2) control-point displacements, index i·num_t + j")
+      .def("__repr__", [](const DeformationMode& d) { return "<DeformationMode " + d.name + ">"; });
+
+  py::class_<BodyModel, std::shared_ptr<BodyModel>>(
+      m, "BodyModel",
+      "An FFD character: a Bernstein (or B-spline) lattice, mass points and deformation modes.\n"
+      "Immutable; q = [tx, ty, θ, γ1..γD] (Eq. 4.4). Make one with wobble.load_body.")
+      .def_property_readonly("name", &BodyModel::name)
+      .def_property_readonly("num_modes", &BodyModel::num_modes)
+      .def_property_readonly("num_q", &BodyModel::num_q, "3 rigid coordinates + one per mode")
+      .def_property_readonly("num_points", &BodyModel::num_points, "mass points")
+      .def_property_readonly("modes", &BodyModel::modes)
+      .def_property_readonly("mode_names",
+                             [](const BodyModel& b) {
+                               std::vector<std::string> names;
+                               for (const DeformationMode& d : b.modes()) names.push_back(d.name);
+                               return names;
+                             })
+      .def_property_readonly("total_mass", [](const BodyModel& b) { return b.moments().m; })
+      .def_property_readonly(
+          "masses", [](const BodyModel& b) { return py::array_t<double>(b.def().masses.size(), b.def().masses.data()); },
+          "(num_points,) the mass of each point")
+      .def_property_readonly(
+          "mass_positions", [](const BodyModel& b) { return Points(b.def().mass_positions); },
+          "(num_points, 2) mass points in the body frame")
+      .def_property_readonly("rest_control", [](const BodyModel& b) { return Points(b.rest_control()); },
+                             "(num_s·num_t, 2) control points of the undeformed lattice")
+      .def_property_readonly("lattice_shape",
+                             [](const BodyModel& b) { return py::make_tuple(b.lattice().num_s(), b.lattice().num_t()); })
+      .def("outline", &Outline, py::arg("q") = py::none(), py::arg("samples_per_segment") = 8,
+           "The drawing at q (None: at rest) as world-space polylines, each (M, 2), bent by the FFD.")
+      .def("__repr__", [](const BodyModel& b) {
+        return "<BodyModel " + b.name() + ": " + std::to_string(b.num_points()) + " mass points, " +
+               std::to_string(b.num_modes()) + " modes>";
+      });
+
+  m.def("load_body", &LoadBody, py::arg("object"), py::arg("modes") = std::vector<std::string>(),
+        py::arg("check") = true,
+        "Reads an object file (.obj: lattice, mass points, drawing) and deformation files (.def),\n"
+        "the modes of all files in order. check: refuse a mode set that cannot be simulated\n"
+        "(InputError, as `wobble simulate`), and warn about a poorly conditioned one.\n"
+        "Errors name FILE:LINE (wobble.ParseError).");
+}
+
+}  // namespace wobble::python

@@ -1,0 +1,18 @@
+// PYBIND11_MODULE: the extension `wobble._wobble`; python/wobble/__init__.py re-exports it.
+#include "bindings.h"
+
+PYBIND11_MODULE(_wobble, m) {
+  using namespace wobble::python;
+  m.doc() =
+      "wobble: soft, cartoon-like characters by dynamic free-form deformation (Faloutsos 1995)\n"
+      "and Witkin & Welch (1990) linear bodies. The C++ library, from Python.";
+  BindErrors(m);
+  BindBodies(m);
+  BindWorld(m);
+  BindRecord(m);
+  BindRollout(m);
+  BindScript(m);
+  BindSynth(m);
+  BindFit(m);
+  BindAnalysis(m);
+}

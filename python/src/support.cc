@@ -1,0 +1,80 @@
+// libwobble's errors (core/errors.h, formats/parse_error.h) as Python exceptions with the same
+// messages: bad input is a ValueError (InputError; ParseError and LimitExceeded are kinds of
+// it), numerical trouble a RuntimeError (NumericalStop; SimulationStopped carries the world's
+// status), Ctrl-C a KeyboardInterrupt.
+#include "support.h"
+
+#include <thread>
+
+#include "wobble/core/errors.h"
+#include "wobble/formats/parse_error.h"
+#include "wobble/script/interpreter.h"
+
+namespace wobble::python {
+namespace {
+
+// wobble.SimulationStopped; the module holds it, so a borrowed handle (never freed at exit)
+py::handle stopped_type;
+
+// The thread the module was imported on: Python's main thread, the one signals reach.
+std::thread::id main_thread;
+
+}  // namespace
+
+bool CtrlCPressed() {
+  if (std::this_thread::get_id() != main_thread) return false;
+  py::gil_scoped_acquire gil;
+  if (PyErr_CheckSignals() == 0) return false;
+  PyErr_Clear();
+  return true;
+}
+
+void RunWorld(World& w, double t_end, long steps) {
+  constexpr long kPollEvery = 2000;  // steps between looks at Ctrl-C (a few ms)
+  bool ok = true;
+  {
+    py::gil_scoped_release release;
+    for (long n = 0; ok && (steps < 0 || n < steps) && w.time() + 0.5 * w.options().dt < t_end; ++n) {
+      if (n % kPollEvery == kPollEvery - 1 && CtrlCPressed()) w.ThrowInterrupted();
+      ok = w.Step();
+    }
+  }
+  if (!ok) RaiseStopped(w.status());
+}
+
+void RaiseStopped(const WorldStatus& status) {
+  py::object exc = stopped_type(status.message);
+  exc.attr("cause") = StatusCodeName(status.code);
+  exc.attr("step") = status.step;
+  exc.attr("time") = status.time;
+  exc.attr("body") = status.body;
+  PyErr_SetObject(stopped_type.ptr(), exc.ptr());
+  throw py::error_already_set();
+}
+
+void BindErrors(py::module_& m) {
+  main_thread = std::this_thread::get_id();
+  // pybind11 tries the translators last registered first: bases before what derives from them
+  auto& input = py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+  input.doc() = "Bad input: a file, a value or a shape that is not what was expected (the message says which).";
+  auto& parse = py::register_exception<formats::ParseError>(m, "ParseError", input.ptr());
+  parse.doc() = "A file or script line that does not parse: the message starts with FILE:LINE.";
+  auto& limit = py::register_exception<LimitExceeded>(m, "LimitExceeded", input.ptr());
+  limit.doc() = "A run or record larger than the limits allow (max_steps, max_record_mb).";
+  auto& numerical = py::register_exception<NumericalStop>(m, "NumericalStop", PyExc_RuntimeError);
+  numerical.doc() = "A computation stopped on numerical trouble instead of returning NaN or inf.";
+  auto& stopped = py::register_exception<script::SimulationStopped>(m, "SimulationStopped", numerical.ptr());
+  stopped.doc() =
+      "A simulation stopped (non-finite state, runaway penetration, singular mass, ...). When raised\n"
+      "by World.step or simulate it has .cause (the status code's name), .step, .time and .body.";
+  stopped_type = stopped;
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const Interrupted& e) {
+      PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
+    }
+  });
+}
+
+}  // namespace wobble::python

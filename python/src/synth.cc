@@ -1,0 +1,193 @@
+// Motion synthesis (Faloutsos 1995 ch. 5) from Python: pose graphs, a synthesis problem (the
+// one a script's `anneal` would solve), batches of trials on every core, and annealing.
+#include "support.h"
+
+#include "wobble/core/errors.h"
+#include "wobble/core/limits.h"
+#include "wobble/synth/anneal.h"
+
+namespace wobble::python {
+namespace {
+
+using control::PoseGraph;
+using synth::Problem;
+
+PoseGraph MakeGraph(const Eigen::MatrixXd& poses, const std::vector<double>& durations, bool cyclic) {
+  PoseGraph g;
+  for (int p = 0; p < poses.rows(); ++p) g.poses.push_back(poses.row(p).transpose());
+  g.durations = durations;
+  g.cyclic = cyclic;
+  if (g.poses.empty()) throw InputError("a pose graph needs at least one pose");
+  const std::string error = g.Validate(int(poses.cols()));
+  if (!error.empty()) throw InputError("pose graph: " + error);
+  return g;
+}
+
+Eigen::MatrixXd PosesOf(const PoseGraph& g) {
+  Eigen::MatrixXd out(g.poses.size(), g.poses.empty() ? 0 : g.poses[0].size());
+  for (size_t p = 0; p < g.poses.size(); ++p) out.row(p) = g.poses[p].transpose();
+  return out;
+}
+
+int NumActive(const Problem& p) {
+  int active = 0;
+  for (const DeformationMode& d : p.body->modes()) active += d.active;
+  return active;
+}
+
+struct TrialResults {
+  py::array_t<double> cost, distance, speed, energy;
+  py::array_t<bool> ok;
+  std::vector<std::string> failures;
+};
+
+// The trials of `graphs` (a list of PoseGraph), or of a batch of poses (N, P, A) with shared
+// (P,) or per-trial (N, P) durations, on `threads` threads.
+TrialResults RunTrials(const Problem& problem, const py::object& graphs_or_poses, const py::object& durations_in,
+                       bool cyclic, int threads) {
+  if (threads < 0 || threads > kMaxThreads) throw InputError("threads must be 0 (every core) to " + std::to_string(kMaxThreads));
+  const int A = NumActive(problem);
+  std::vector<PoseGraph> graphs;
+  if (py::isinstance<py::list>(graphs_or_poses) || py::isinstance<py::tuple>(graphs_or_poses)) {
+    for (const py::handle& h : graphs_or_poses) graphs.push_back(h.cast<PoseGraph>());
+  } else {
+    auto poses = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(graphs_or_poses);
+    if (!poses || poses.ndim() != 3 || poses.shape(2) != A)
+      throw InputError("poses: expected a list of PoseGraph or an array (N, poses, " + std::to_string(A) +
+                       " active modes)");
+    const long N = poses.shape(0), P = poses.shape(1);
+    if (durations_in.is_none()) throw InputError("durations: needed with an array of poses, (P,) or (N, P)");
+    auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(durations_in);
+    const bool shared = d && d.ndim() == 1;
+    if (!d || !(shared ? d.shape(0) == P : (d.ndim() == 2 && d.shape(0) == N && d.shape(1) == P)))
+      throw InputError("durations: expected shape (" + std::to_string(P) + ",) or (" + std::to_string(N) + ", " +
+                       std::to_string(P) + ")");
+    for (long i = 0; i < N; ++i) {
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> pi(poses.data() + i * P * A, P, A);
+      const double* di = d.data() + (shared ? 0 : i * P);
+      try {
+        graphs.push_back(MakeGraph(pi, std::vector<double>(di, di + P), cyclic));
+      } catch (const InputError& e) {
+        throw InputError("trial " + std::to_string(i) + ": " + e.what());
+      }
+    }
+  }
+  for (size_t i = 0; i < graphs.size(); ++i) {
+    const std::string error = graphs[i].Validate(A);
+    if (!error.empty()) throw InputError("trial " + std::to_string(i) + ": " + error);
+  }
+  std::vector<synth::TrialOutcome> out;
+  {
+    py::gil_scoped_release release;
+    out = synth::RunTrials(problem, graphs, threads);
+  }
+  TrialResults r;
+  const py::ssize_t N = py::ssize_t(out.size());
+  r.cost = py::array_t<double>(N);
+  r.distance = py::array_t<double>(N);
+  r.speed = py::array_t<double>(N);
+  r.energy = py::array_t<double>(N);
+  r.ok = py::array_t<bool>(N);
+  for (py::ssize_t i = 0; i < N; ++i) {
+    r.cost.mutable_data()[i] = out[i].cost;
+    r.distance.mutable_data()[i] = out[i].distance;
+    r.speed.mutable_data()[i] = out[i].speed;
+    r.energy.mutable_data()[i] = out[i].energy;
+    r.ok.mutable_data()[i] = out[i].ok;
+    r.failures.push_back(out[i].failure);
+  }
+  return r;
+}
+
+}  // namespace
+
+void BindSynth(py::module_& m) {
+  py::class_<PoseGraph>(m, "PoseGraph",
+                        "A pose-graph controller (§5.1): PD targets of the active modes, one row per pose, held\n"
+                        "for each pose's duration, in a cycle when cyclic.")
+      .def(py::init(&MakeGraph), py::arg("poses"), py::arg("durations"), py::arg("cyclic") = true,
+           "poses: (P, active modes); durations: P transition times > 0")
+      .def_property_readonly("poses", &PosesOf)
+      .def_readonly("durations", &PoseGraph::durations)
+      .def_readonly("cyclic", &PoseGraph::cyclic)
+      .def_property_readonly("period", &PoseGraph::Period)
+      .def("pose_at", &PoseGraph::PoseAt, py::arg("t"), "index of the pose active at time t");
+
+  py::class_<synth::TrialOutcome>(m, "TrialOutcome", "One synthesis trial: its cost (Table 5.1) and what went into it.")
+      .def_readonly("ok", &synth::TrialOutcome::ok)
+      .def_readonly("distance", &synth::TrialOutcome::distance, "q_x: the centre of mass' travel along x")
+      .def_readonly("speed", &synth::TrialOutcome::speed, "q̇_x at the end")
+      .def_readonly("energy", &synth::TrialOutcome::energy, "control energy consumed")
+      .def_readonly("cost", &synth::TrialOutcome::cost)
+      .def_readonly("failure", &synth::TrialOutcome::failure);
+
+  py::class_<Problem>(m, "SynthesisProblem",
+                      "A body, its world and start state, the trial length and the cost: what `anneal` solves.\n"
+                      "Get the one a script set up with Interpreter.synthesis_problem().")
+      .def_property_readonly("body", [](const Problem& p) { return std::const_pointer_cast<BodyModel>(p.body); })
+      .def_readwrite("options", &Problem::world)
+      .def_readwrite("q0", &Problem::q0)
+      .def_readwrite("qd0", &Problem::qd0)
+      .def_readwrite("steps", &Problem::steps, "steps of one trial (thesis: 1200 of 0.01)")
+      .def_property_readonly("num_active", &NumActive, "active modes: the columns of a pose")
+      .def("run", [](const Problem& p, const PoseGraph& g) {
+        py::gil_scoped_release release;
+        return synth::RunTrial(p, g);
+      }, py::arg("graph"), "One trial.");
+
+  py::class_<TrialResults>(m, "TrialResults", "The outcomes of a batch of trials, as arrays in input order.")
+      .def_readonly("cost", &TrialResults::cost)
+      .def_readonly("distance", &TrialResults::distance)
+      .def_readonly("speed", &TrialResults::speed)
+      .def_readonly("energy", &TrialResults::energy)
+      .def_readonly("ok", &TrialResults::ok)
+      .def_readonly("failures", &TrialResults::failures, "why each trial stopped ('' when it ran to the end)");
+
+  m.def("run_trials", &RunTrials, py::arg("problem"), py::arg("graphs"), py::arg("durations") = py::none(),
+        py::kw_only(), py::arg("cyclic") = true, py::arg("threads") = 0,
+        "Simulates a batch of controllers from the problem's start, on `threads` threads (0: every\n"
+        "core) with the GIL released: `graphs` is a list of PoseGraph, or an array (N, P, active modes)\n"
+        "of poses with `durations` (P,) shared or (N, P). The same outcomes as one trial at a time.");
+
+  py::class_<synth::AnnealResult>(m, "AnnealResult", "The best controller annealing found, and how it got there.")
+      .def_readonly("best", &synth::AnnealResult::best)
+      .def_readonly("best_outcome", &synth::AnnealResult::best_outcome)
+      .def_readonly("initial_outcome", &synth::AnnealResult::initial_outcome)
+      .def_readonly("trials", &synth::AnnealResult::trials)
+      .def_readonly("interrupted", &synth::AnnealResult::interrupted)
+      .def_property_readonly(
+          "history",
+          [](const synth::AnnealResult& r) {
+            const std::vector<std::vector<double>> rows = synth::HistoryRows(r.history);
+            Eigen::MatrixXd out(rows.size(), synth::HistoryHeader().size());
+            for (size_t i = 0; i < rows.size(); ++i)
+              for (size_t j = 0; j < rows[i].size(); ++j) out(i, j) = rows[i][j];
+            return out;
+          },
+          "(iterations + 1, 7): iteration, trials, candidate, current, best, temperature, accepted");
+
+  m.def(
+      "anneal",
+      [](const Problem& p, const PoseGraph& initial, std::uint64_t seed, int iterations, int batch, double cooling,
+         const std::string& optimize, int threads) {
+        synth::AnnealOptions o;
+        o.seed = seed;
+        o.iterations = iterations;
+        o.batch = batch;
+        o.cooling = cooling;
+        o.threads = threads;
+        if (!synth::ParseOptimize(optimize, &o.optimize)) throw InputError("optimize: '" + optimize + "' is not poses, times or both");
+        const std::string error = o.Validate();
+        if (!error.empty()) throw InputError("anneal: " + error);
+        CheckedCount(double(iterations * double(batch) + 1) * double(p.steps), 0, Limits().max_steps,
+                     "anneal's trials x steps", "lower iterations or batch");
+        py::gil_scoped_release release;
+        return synth::Anneal(p, initial, o);
+      },
+      py::arg("problem"), py::arg("initial"), py::kw_only(), py::arg("seed") = 1, py::arg("iterations") = 60,
+      py::arg("batch") = 1, py::arg("cooling") = 0.9, py::arg("optimize") = "both", py::arg("threads") = 0,
+      "Simulated annealing of a pose graph (Fig. 5.2), `batch` neighbours per iteration in parallel.\n"
+      "The same seed gives the same result, on any number of threads.");
+}
+
+}  // namespace wobble::python

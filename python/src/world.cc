@@ -1,0 +1,206 @@
+// The one World (world/world.h) from Python: options, the ground, FFD bodies, stepping,
+// energies, contacts and constraints. States cross as numpy arrays (copies: a body's q has a
+// few numbers, and the world reuses its buffers between steps).
+#include "support.h"
+
+#include <limits>
+
+#include "wobble/core/errors.h"
+#include "wobble/world/world.h"
+
+namespace wobble::python {
+namespace {
+
+Eigen::VectorXd AsVector(const py::handle& h, long n, const std::string& what) {
+  auto a = AsMatrix(h, n, -1, what);
+  return Eigen::Map<const Eigen::VectorXd>(a.data(), n);
+}
+
+void CheckBody(const World& w, int body) {
+  if (body < 0 || body >= w.num_bodies())
+    throw InputError("body " + std::to_string(body) + ": the world has " + std::to_string(w.num_bodies()) + " bodies");
+  if (w.kind(body) != BodyKind::kFfd) throw InputError("body " + std::to_string(body) + " is not an FFD body");
+}
+
+py::dict ForcesDict(const ForceBreakdown<double>& f) {
+  py::dict d;
+  d["gravity"] = Eigen::VectorXd(f.gravity);
+  d["modes"] = Eigen::VectorXd(f.modes);
+  d["ground"] = Eigen::VectorXd(f.ground);
+  d["springs"] = Eigen::VectorXd(f.springs);
+  d["total"] = Eigen::VectorXd(f.total);
+  return d;
+}
+
+}  // namespace
+
+void BindWorld(py::module_& m) {
+  py::class_<Ground>(m, "Ground",
+                     "The ground line of §4.9: a penalty spring–damper (Eq. 4.24/4.25) with friction capped\n"
+                     "at friction_cap times the normal force.")
+      .def(py::init<>())
+      .def_readwrite("enabled", &Ground::enabled)
+      .def_readwrite("point", &Ground::point, "a point of the ground line")
+      .def_readwrite("slope", &Ground::slope, "radians, counter-clockwise")
+      .def_readwrite("stiffness", &Ground::stiffness, "K_d (appendix C: grconst)")
+      .def_readwrite("normal_damping", &Ground::normal_damping, "C_dam (grdam)")
+      .def_readwrite("friction_damping", &Ground::friction_damping, "FR_dam (frconst)")
+      .def_readwrite("friction_cap", &Ground::friction_cap, "tan θ: |friction| / normal force never exceeds it")
+      .def_readwrite("max_penetration", &Ground::max_penetration, "deeper stops the run; 0: half the shorter lattice side")
+      .def_property_readonly("normal", &Ground::normal)
+      .def_property_readonly("tangent", &Ground::tangent);
+
+  py::class_<WorldOptions>(m, "WorldOptions", "What a World is made with; every field is also a keyword of the constructor.")
+      .def(py::init<>())
+      .def_readwrite("dt", &WorldOptions::dt, "time step (s)")
+      .def_property(
+          "integrator", [](const WorldOptions& o) { return IntegratorName(o.integrator); },
+          [](WorldOptions& o, const std::string& name) {
+            if (!ParseIntegrator(name, &o.integrator))
+              throw InputError("integrator: '" + name + "' is not one of " + IntegratorNames());
+          },
+          "the FFD bodies' integrator: thesis (Eq. 4.22/4.23), symplectic_euler, rk4, implicit_euler, variational")
+      .def_property(
+          "gravity", [](const WorldOptions& o) { return Eigen::Vector2d(o.params.gravity); },
+          [](WorldOptions& o, const Eigen::Vector2d& g) { o.params.gravity = g; }, "2D gravity (m/s²)")
+      .def_property(
+          "gravity_on", [](const WorldOptions& o) { return o.params.gravity_on; },
+          [](WorldOptions& o, bool on) { o.params.gravity_on = on; })
+      .def_property(
+          "ground", [](WorldOptions& o) -> Ground& { return o.params.ground; },
+          [](WorldOptions& o, const Ground& g) { o.params.ground = g; }, py::return_value_policy::reference_internal,
+          "the ground (changed in place: options.ground.stiffness = ...)")
+      .def_property(
+          "max_condition", [](const WorldOptions& o) { return o.params.max_condition; },
+          [](WorldOptions& o, double c) { o.params.max_condition = c; },
+          "runs stop when the estimated condition number of M exceeds this")
+      .def_readwrite("feedback_rate", &WorldOptions::feedback_rate, "constraint drift feedback (Witkin & Welch Eq. 10)");
+
+  py::class_<Energies>(m, "Energies", "Every energy term of one body (J); total() is their sum.")
+      .def_readonly("kinetic", &Energies::kinetic, "½ q̇ᵀ M q̇ (Eq. 4.9)")
+      .def_readonly("gravity", &Energies::gravity)
+      .def_readonly("modes", &Energies::modes, "Σ K (γ − γ0)²")
+      .def_readonly("ground", &Energies::ground, "the penalty springs of the contacts")
+      .def_readonly("springs", &Energies::springs)
+      .def_readonly("per_mode", &Energies::per_mode)
+      .def("total", &Energies::total)
+      .def("__repr__", [](const Energies& e) { return "<Energies " + EnergyTerms(e) + ">"; });
+
+  py::class_<WorldStatus>(m, "WorldStatus", "Why the world stopped, and where (ok when it did not).")
+      .def_property_readonly("ok", &WorldStatus::ok)
+      .def_property_readonly("cause", [](const WorldStatus& s) { return StatusCodeName(s.code); })
+      .def_readonly("step", &WorldStatus::step)
+      .def_readonly("time", &WorldStatus::time)
+      .def_readonly("body", &WorldStatus::body)
+      .def_readonly("message", &WorldStatus::message);
+
+  py::class_<World>(m, "World",
+                    "THE world: FFD bodies (q = [tx, ty, θ, γ1..γD], Eq. 4.4), the ground, springs, constraints,\n"
+                    "one clock and one status. Every accepted state is finite, or the world stops and\n"
+                    "step() raises SimulationStopped.")
+      .def(py::init<WorldOptions>(), py::arg("options") = WorldOptions())
+      .def("add_body", [](World& w, std::shared_ptr<BodyModel> body) { return w.AddBody(body); }, py::arg("body"),
+           "Adds an FFD body at q = 0, at rest; returns its index.")
+      .def_property_readonly("num_bodies", &World::num_bodies)
+      .def_property_readonly("time", &World::time)
+      .def_property_readonly("steps", &World::steps)
+      .def_property(
+          "options", [](const World& w) { return w.options(); },
+          [](World& w, const WorldOptions& o) { w.mutable_options() = o; },
+          "a copy; assign a changed one to change dt, gravity, the ground or the integrator between steps")
+      .def_property_readonly("status", &World::status)
+      .def(
+          "body", [](const World& w, int body) {
+            CheckBody(w, body);
+            return std::const_pointer_cast<BodyModel>(w.shared_body(body));
+          },
+          py::arg("body"))
+      .def(
+          "q", [](const World& w, int body) { CheckBody(w, body); return Eigen::VectorXd(w.state(body).q); },
+          py::arg("body") = 0, "a copy of the body's q")
+      .def(
+          "qd", [](const World& w, int body) { CheckBody(w, body); return Eigen::VectorXd(w.state(body).qd); },
+          py::arg("body") = 0, "a copy of the body's q̇")
+      .def(
+          "set_state",
+          [](World& w, int body, const py::object& q, const py::object& qd) {
+            CheckBody(w, body);
+            const long n = w.body(body).num_q();
+            w.SetState(body, AsVector(q, n, "q"), qd.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(qd, n, "qd"));
+          },
+          py::arg("body"), py::arg("q"), py::arg("qd") = py::none(),
+          "Sets q and q̇ (zero when not given); InputError for a wrong shape or a non-finite value.")
+      .def(
+          "set_mode_targets",
+          [](World& w, int body, const py::object& targets) {
+            CheckBody(w, body);
+            w.SetModeTargets(body, AsVector(targets, w.body(body).num_modes(), "targets"));
+          },
+          py::arg("body"), py::arg("targets"), "PD targets γ0 of the body's modes (chapter 5)")
+      .def(
+          "step",
+          [](World& w, long n) {
+            if (n < 0) throw InputError("step: n must be at least 0, got " + std::to_string(n));
+            RunWorld(w, std::numeric_limits<double>::infinity(), n);
+          },
+          py::arg("n") = 1, "Takes n steps of dt (the GIL is released meanwhile).")
+      .def(
+          "run_until",
+          [](World& w, double t_end) { RunWorld(w, t_end, -1); },
+          py::arg("t_end"), "Steps until the time reaches t_end (to half a step).")
+      .def(
+          "energies", [](const World& w, int body) { return w.ComputeEnergies(body); }, py::arg("body") = 0)
+      .def("total_energy", &World::TotalEnergy, "every body's every term")
+      .def(
+          "contacts",
+          [](const World& w, int body) {
+            CheckBody(w, body);
+            const auto& contacts = w.state(body).contacts;
+            py::array_t<int> points(contacts.size());
+            py::array_t<double> anchors({py::ssize_t(contacts.size()), py::ssize_t(2)});
+            auto p = points.mutable_unchecked<1>();
+            auto a = anchors.mutable_unchecked<2>();
+            for (size_t k = 0; k < contacts.size(); ++k) {
+              p(k) = contacts[k].point;
+              a(k, 0) = contacts[k].anchor.x();
+              a(k, 1) = contacts[k].anchor.y();
+            }
+            return py::make_tuple(points, anchors);
+          },
+          py::arg("body") = 0, "(points, anchors): the mass points below the ground and their entry points (Fig. 4.5)")
+      .def(
+          "penetration", [](const World& w, int body) { CheckBody(w, body); return w.state(body).penetration; },
+          py::arg("body") = 0, "the deepest contact")
+      .def(
+          "point_positions",
+          [](const World& w, int body) {
+            CheckBody(w, body);
+            const std::vector<Eigen::Vector2d> x = w.PointPositions(body);
+            Eigen::MatrixXd out(x.size(), 2);
+            for (size_t k = 0; k < x.size(); ++k) out.row(k) = x[k].transpose();
+            return out;
+          },
+          py::arg("body") = 0, "(num_points, 2) world positions of the mass points")
+      .def(
+          "forces", [](const World& w, int body) { CheckBody(w, body); return ForcesDict(w.Forces(body)); },
+          py::arg("body") = 0, "generalized forces by source: gravity, modes, ground, springs, total")
+      .def(
+          "accelerations", [](const World& w, int body) { CheckBody(w, body); return w.Accelerations(body); },
+          py::arg("body") = 0, "free q̈ = M⁻¹ (Q − velocity terms), no constraint forces")
+      .def(
+          "add_nail",
+          [](World& w, int body, int mass_point, const py::object& where) {
+            CheckBody(w, body);
+            if (mass_point < 0 || mass_point >= w.body(body).num_points())
+              throw InputError("mass_point " + std::to_string(mass_point) + ": the body has " +
+                               std::to_string(w.body(body).num_points()) + " mass points");
+            return w.AddNail(MassPointOf(body, mass_point), where.is_none() ? Eigen::VectorXd() : AsVector(where, 2, "where"));
+          },
+          py::arg("body"), py::arg("mass_point"), py::arg("where") = py::none(),
+          "Nails a mass point where it is now (or at `where`); returns the constraint's id.")
+      .def("set_enabled", &World::SetEnabled, py::arg("id"), py::arg("enabled"))
+      .def("max_violation", &World::MaxViolation, "the largest |c| of the enabled constraints")
+      .def("constraint_error", &World::ConstraintError, py::arg("id"));
+}
+
+}  // namespace wobble::python

@@ -1,0 +1,266 @@
+# Type stub of the wobble package (the extension wobble._wobble and __init__.py), for editors
+# and type checkers. tests/python/test_api.py checks that it names exactly what the module has.
+from typing import Any, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+ArrayLike = npt.ArrayLike
+NDArray = npt.NDArray[np.float64]
+
+class InputError(ValueError): ...
+class ParseError(InputError): ...
+class LimitExceeded(InputError): ...
+class NumericalStop(RuntimeError): ...
+class SimulationStopped(NumericalStop):
+    cause: str
+    step: int
+    time: float
+    body: int
+    trajectory: "Trajectory"
+
+class DeformationMode:
+    name: str
+    stiffness: float
+    damping: float
+    active: bool
+    source: str
+    displacement: NDArray
+
+class BodyModel:
+    name: str
+    num_modes: int
+    num_q: int
+    num_points: int
+    modes: list[DeformationMode]
+    mode_names: list[str]
+    total_mass: float
+    masses: NDArray
+    mass_positions: NDArray
+    rest_control: NDArray
+    lattice_shape: tuple[int, int]
+    def outline(self, q: Optional[ArrayLike] = None, samples_per_segment: int = 8) -> list[NDArray]: ...
+
+def load_body(object: str, modes: Sequence[str] = ..., check: bool = True) -> BodyModel: ...
+
+class Ground:
+    enabled: bool
+    point: NDArray
+    slope: float
+    stiffness: float
+    normal_damping: float
+    friction_damping: float
+    friction_cap: float
+    max_penetration: float
+    normal: NDArray
+    tangent: NDArray
+    def __init__(self, **fields: Any) -> None: ...
+
+class WorldOptions:
+    dt: float
+    integrator: str
+    gravity: NDArray
+    gravity_on: bool
+    ground: Ground
+    max_condition: float
+    feedback_rate: float
+    def __init__(self, **fields: Any) -> None: ...
+
+class Energies:
+    kinetic: float
+    gravity: float
+    modes: float
+    ground: float
+    springs: float
+    per_mode: list[float]
+    def total(self) -> float: ...
+
+class WorldStatus:
+    ok: bool
+    cause: str
+    step: int
+    time: float
+    body: int
+    message: str
+
+class World:
+    num_bodies: int
+    time: float
+    steps: int
+    options: WorldOptions
+    status: WorldStatus
+    def __init__(self, options: WorldOptions = ...) -> None: ...
+    def add_body(self, body: BodyModel) -> int: ...
+    def body(self, body: int) -> BodyModel: ...
+    def q(self, body: int = 0) -> NDArray: ...
+    def qd(self, body: int = 0) -> NDArray: ...
+    def set_state(self, body: int, q: ArrayLike, qd: Optional[ArrayLike] = None) -> None: ...
+    def set_mode_targets(self, body: int, targets: ArrayLike) -> None: ...
+    def step(self, n: int = 1) -> None: ...
+    def run_until(self, t_end: float) -> None: ...
+    def energies(self, body: int = 0) -> Energies: ...
+    def total_energy(self) -> float: ...
+    def contacts(self, body: int = 0) -> tuple[npt.NDArray[np.int32], NDArray]: ...
+    def penetration(self, body: int = 0) -> float: ...
+    def point_positions(self, body: int = 0) -> NDArray: ...
+    def forces(self, body: int = 0) -> dict[str, NDArray]: ...
+    def accelerations(self, body: int = 0) -> NDArray: ...
+    def add_nail(self, body: int, mass_point: int, where: Optional[ArrayLike] = None) -> int: ...
+    def set_enabled(self, id: int, enabled: bool) -> None: ...
+    def max_violation(self) -> float: ...
+    def constraint_error(self, id: int) -> NDArray: ...
+
+class Trajectory:
+    columns: list[str]
+    num_bodies: int
+    array: NDArray
+    time: NDArray
+    def __len__(self) -> int: ...
+    def column(self, name: str) -> NDArray: ...
+    def q(self, body: int = 0) -> NDArray: ...
+    def qd(self, body: int = 0) -> NDArray: ...
+    def write_csv(self, path: str) -> None: ...
+
+def simulate(world: World, duration: float, *, every: int = 1, fps: float = 0.0, max_steps: int = ...,
+             max_record_mb: float = ...) -> Trajectory: ...
+def read_trajectory_csv(path: str, body: BodyModel) -> Trajectory: ...
+
+class RolloutResult:
+    time: NDArray
+    q: NDArray
+    qd: NDArray
+    energy: NDArray
+    steps_taken: npt.NDArray[np.int64]
+    status: list[str]
+    messages: list[str]
+
+def rollout(body: BodyModel, q0: ArrayLike, qd0: Optional[ArrayLike] = None, steps: int = 1, *,
+            options: WorldOptions = ..., mode_targets: Optional[ArrayLike] = None, every: int = 1,
+            threads: int = 0, energies: bool = False, max_steps: int = ...,
+            max_record_mb: float = ...) -> RolloutResult: ...
+
+class PoseGraph:
+    poses: NDArray
+    durations: list[float]
+    cyclic: bool
+    period: float
+    def __init__(self, poses: ArrayLike, durations: Sequence[float], cyclic: bool = True) -> None: ...
+    def pose_at(self, t: float) -> int: ...
+
+class TrialOutcome:
+    ok: bool
+    distance: float
+    speed: float
+    energy: float
+    cost: float
+    failure: str
+
+class SynthesisProblem:
+    body: BodyModel
+    options: WorldOptions
+    q0: NDArray
+    qd0: NDArray
+    steps: int
+    num_active: int
+    def run(self, graph: PoseGraph) -> TrialOutcome: ...
+
+class TrialResults:
+    cost: NDArray
+    distance: NDArray
+    speed: NDArray
+    energy: NDArray
+    ok: npt.NDArray[np.bool_]
+    failures: list[str]
+
+def run_trials(problem: SynthesisProblem, graphs: Union[Sequence[PoseGraph], ArrayLike],
+               durations: Optional[ArrayLike] = None, *, cyclic: bool = True, threads: int = 0) -> TrialResults: ...
+
+class AnnealResult:
+    best: PoseGraph
+    best_outcome: TrialOutcome
+    initial_outcome: TrialOutcome
+    trials: int
+    interrupted: bool
+    history: NDArray
+
+def anneal(problem: SynthesisProblem, initial: PoseGraph, *, seed: int = 1, iterations: int = 60, batch: int = 1,
+           cooling: float = 0.9, optimize: str = "both", threads: int = 0) -> AnnealResult: ...
+
+class Interpreter:
+    body: Optional[BodyModel]
+    q: NDArray
+    qd: NDArray
+    time: float
+    control_energy: float
+    pose_graph: PoseGraph
+    world_options: WorldOptions
+    max_steps: int
+    max_record_mb: float
+    last_run: Optional[Trajectory]
+    last_anneal: Optional[AnnealResult]
+    def __init__(self, echo: bool = False) -> None: ...
+    def run_file(self, path: str) -> None: ...
+    def run(self, text: str, name: str = "<python>", dir: str = ".") -> None: ...
+    def take_output(self) -> str: ...
+    def synthesis_problem(self) -> SynthesisProblem: ...
+    def replay_script(self) -> str: ...
+    @staticmethod
+    def help() -> str: ...
+
+class FitReport:
+    usable: bool
+    termination: str
+    brief_report: str
+    initial_cost: float
+    final_cost: float
+    cost_per_iteration: list[float]
+    iterations: int
+    solve_seconds: float
+
+class FitConditioning:
+    condition_number: float
+    scaled_condition_number: float
+    column_norms: list[float]
+    undetermined: list[str]
+    poorly_determined: list[str]
+
+class PoseFitResult:
+    q: NDArray
+    report: FitReport
+    point_residuals: list[float]
+    rms_residual: float
+    at_bound: list[str]
+    conditioning: FitConditioning
+    rounds: int
+
+def fit_pose(body: BodyModel, points: ArrayLike, *, mass_points: Optional[Sequence[int]] = None,
+             lattice_coords: Optional[ArrayLike] = None, weights: Optional[ArrayLike] = None,
+             initial_q: Optional[ArrayLike] = None, loss: str = "squared", loss_scale: float = 1.0,
+             prior_weight: float = 0.0, mode_bounds: tuple[float, float] = (-1.0, 1.0),
+             max_iterations: int = 200) -> PoseFitResult: ...
+def fit_pose_to_curves(body: BodyModel, polylines: Sequence[ArrayLike], *, closed: bool = False,
+                       initial_q: Optional[ArrayLike] = None, loss: str = "squared", loss_scale: float = 1.0,
+                       prior_weight: float = 0.0, mode_bounds: tuple[float, float] = (-1.0, 1.0),
+                       max_iterations: int = 200) -> PoseFitResult: ...
+
+class ConditionNumber:
+    singular: bool
+    cond: float
+    cond_scaled: float
+    singular_values: NDArray
+
+class ModeSetReport:
+    level: str
+    messages: list[str]
+    dofs: list[str]
+    pair_angle_deg: NDArray
+    smallest_angle_deg: float
+    smallest_mode: str
+    condition: ConditionNumber
+
+def condition_number(body: BodyModel, q: Optional[ArrayLike] = None) -> ConditionNumber: ...
+def mass_matrix(body: BodyModel, q: Optional[ArrayLike] = None) -> NDArray: ...
+def angle_sweep(object: str, phis: Sequence[float], *, compress: float = 1.0,
+                expand: float = 0.5) -> tuple[NDArray, NDArray]: ...
+def check_mode_set(body: BodyModel) -> ModeSetReport: ...

@@ -1,0 +1,65 @@
+"""Scripts from Python (the same runs as the interpreter's), and motion synthesis: batched
+trials equal single ones on any thread count, annealing reproducible from its seed."""
+import numpy as np
+import pytest
+
+import wobble
+
+
+def bounding_table(data):
+    """data/bounding_table.wob up to (not including) its anneal: the synthesis problem of §5.2."""
+    interp = wobble.Interpreter()
+    lines = []
+    for line in (data / "bounding_table.wob").read_text().splitlines():
+        if line.startswith("anneal"):
+            break
+        lines.append(line)
+    interp.run("\n".join(lines), name=str(data / "bounding_table.wob"), dir=str(data))
+    return interp
+
+
+def test_a_script_run_equals_the_world_from_python(data, table):
+    interp = wobble.Interpreter()
+    interp.run(f"load_obj table.obj\nload_def table_modes.def\nset dt 0.01\nset_vec q 0 50 0 0 0 0 0\nsimul 2\n", dir=str(data))
+    assert interp.time == pytest.approx(2.0)
+    world = wobble.World(interp.world_options)
+    world.add_body(interp.body)
+    world.set_state(0, [0, 50, 0, 0, 0, 0, 0])
+    world.step(200)
+    np.testing.assert_array_equal(interp.q, world.q(0))
+    run = interp.last_run
+    assert len(run) > 2
+    np.testing.assert_array_equal(run.q()[-1], world.q(0))
+
+
+def test_trials_in_a_batch_equal_single_trials(data):
+    interp = bounding_table(data)
+    problem = interp.synthesis_problem()
+    graph = interp.pose_graph
+    rng = np.random.default_rng(2)
+    poses = graph.poses[None] + rng.normal(0, 0.1, (8,) + graph.poses.shape)
+    batch = wobble.run_trials(problem, poses, graph.durations, threads=2)
+    serial = wobble.run_trials(problem, poses, graph.durations, threads=1)
+    np.testing.assert_array_equal(batch.cost, serial.cost)
+    graphs = [wobble.PoseGraph(p, graph.durations) for p in poses]
+    listed = wobble.run_trials(problem, graphs)
+    np.testing.assert_array_equal(listed.cost, batch.cost)
+    for i in (0, 5):
+        one = problem.run(graphs[i])
+        assert one.cost == batch.cost[i] and one.distance == batch.distance[i]
+    with pytest.raises(wobble.InputError, match="durations"):
+        wobble.run_trials(problem, poses)
+    with pytest.raises(wobble.InputError, match="active modes"):
+        wobble.run_trials(problem, poses[:, :, :1], graph.durations)
+
+
+def test_anneal_is_reproducible_and_never_worse_than_its_start(data):
+    interp = bounding_table(data)
+    problem = interp.synthesis_problem()
+    problem.steps = 300  # a short trial: this is about the binding, not the gait
+    a = wobble.anneal(problem, interp.pose_graph, seed=7, iterations=4, batch=2, threads=2)
+    b = wobble.anneal(problem, interp.pose_graph, seed=7, iterations=4, batch=2, threads=1)
+    assert a.best_outcome.cost == b.best_outcome.cost
+    np.testing.assert_array_equal(a.best.poses, b.best.poses)
+    assert a.best_outcome.cost <= a.initial_outcome.cost
+    assert a.history.shape == (5, 7) and a.trials == 9
