@@ -2,6 +2,8 @@
 // one a script's `anneal` would solve), batches of trials on every core, and annealing.
 #include "support.h"
 
+#include <chrono>
+
 #include "wobble/core/errors.h"
 #include "wobble/core/limits.h"
 #include "wobble/synth/anneal.h"
@@ -39,6 +41,7 @@ struct TrialResults {
   py::array_t<double> cost, distance, speed, energy;
   py::array_t<bool> ok;
   std::vector<std::string> failures;
+  double seconds = 0;  // wall time of the simulations alone (synth::RunTrials)
 };
 
 // The trials of `graphs` (a list of PoseGraph), or of a batch of poses (N, P, A) with shared
@@ -77,11 +80,13 @@ TrialResults RunTrials(const Problem& problem, const py::object& graphs_or_poses
     if (!error.empty()) throw InputError("trial " + std::to_string(i) + ": " + error);
   }
   std::vector<synth::TrialOutcome> out;
+  TrialResults r;
   {
     py::gil_scoped_release release;
+    const auto start = std::chrono::steady_clock::now();
     out = synth::RunTrials(problem, graphs, threads);
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
-  TrialResults r;
   const py::ssize_t N = py::ssize_t(out.size());
   r.cost = py::array_t<double>(N);
   r.distance = py::array_t<double>(N);
@@ -141,7 +146,9 @@ void BindSynth(py::module_& m) {
       .def_readonly("speed", &TrialResults::speed)
       .def_readonly("energy", &TrialResults::energy)
       .def_readonly("ok", &TrialResults::ok)
-      .def_readonly("failures", &TrialResults::failures, "why each trial stopped ('' when it ran to the end)");
+      .def_readonly("failures", &TrialResults::failures, "why each trial stopped ('' when it ran to the end)")
+      .def_readonly("seconds", &TrialResults::seconds,
+                    "wall time of the simulations alone, without the conversions (what Python adds is the rest)");
 
   m.def("run_trials", &RunTrials, py::arg("problem"), py::arg("graphs"), py::arg("durations") = py::none(),
         py::kw_only(), py::arg("cyclic") = true, py::arg("threads") = 0,

@@ -172,6 +172,7 @@ class TrialResults:
     energy: NDArray
     ok: npt.NDArray[np.bool_]
     failures: list[str]
+    seconds: float
 
 def run_trials(problem: SynthesisProblem, graphs: Union[Sequence[PoseGraph], ArrayLike],
                durations: Optional[ArrayLike] = None, *, cyclic: bool = True, threads: int = 0) -> TrialResults: ...
