@@ -23,6 +23,7 @@ void BindScript(py::module_& m);   // Interpreter, scenes (script.cc)
 void BindSynth(py::module_& m);    // pose graphs, trials, annealing (synth.cc)
 void BindFit(py::module_& m);      // pose fits (fit.cc)
 void BindAnalysis(py::module_& m); // condition numbers, mode-set checks (analysis.cc)
+void BindRender(py::module_& m);   // pictures and exports through pipelines/ (render.cc; with VTK)
 
 // A C-contiguous float64 array of `rows` x `cols` (cols < 0: a vector of `rows`), or
 // InputError naming `what` and the shape expected.

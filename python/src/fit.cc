@@ -6,7 +6,9 @@
 #include <cmath>
 
 #include "wobble/core/errors.h"
+#include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/pose_fit.h"
+#include "wobble/fit/trajectory_fit.h"
 
 namespace wobble::python {
 namespace {
@@ -72,6 +74,40 @@ std::vector<fit::Correspondence> Targets(const BodyModel& body, const py::object
   return out;
 }
 
+Eigen::VectorXd OptionalVector(const py::object& v, long n, const std::string& what) {
+  if (v.is_none()) return Eigen::VectorXd();
+  auto a = AsMatrix(v, n, -1, what);
+  Eigen::VectorXd out = Eigen::Map<const Eigen::VectorXd>(a.data(), n);
+  if (!out.allFinite()) throw InputError(what + " must be finite");
+  return out;
+}
+
+// Reference frames: times (F,), world positions (F, K, 2) of the mass points mass_points (K,).
+std::vector<fit::ReferenceFrame> Frames(const BodyModel& body, const py::object& times_in, const py::object& points_in,
+                                        const std::vector<long>& mass_points) {
+  auto probe = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(times_in);
+  if (!probe || probe.ndim() != 1 || probe.shape(0) < 1) throw InputError("times: expected (F,) frame times, F >= 1");
+  const long F = probe.shape(0), K = long(mass_points.size());
+  auto points = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(points_in);
+  if (!points || points.ndim() != 3 || points.shape(0) != F || points.shape(1) != K || points.shape(2) != 2)
+    throw InputError("points: expected shape (" + std::to_string(F) + ", " + std::to_string(K) + ", 2): frames x mass_points x (x, y)");
+  std::vector<fit::ReferenceFrame> frames(F);
+  for (long f = 0; f < F; ++f) {
+    frames[f].time = probe.at(f);
+    if (!std::isfinite(frames[f].time)) throw InputError("times[" + std::to_string(f) + "] is not finite");
+    for (long k = 0; k < K; ++k) {
+      fit::Correspondence c;
+      if (mass_points[k] < 0 || mass_points[k] >= body.num_points())
+        throw InputError("mass_points[" + std::to_string(k) + "]: the body has " + std::to_string(body.num_points()) + " mass points");
+      c.mass_point = int(mass_points[k]);
+      c.position = Eigen::Vector2d(points.at(f, k, 0), points.at(f, k, 1));
+      if (!c.position.allFinite()) throw InputError("points[" + std::to_string(f) + ", " + std::to_string(k) + "] is not finite");
+      frames[f].points.push_back(c);
+    }
+  }
+  return frames;
+}
+
 }  // namespace
 
 void BindFit(py::module_& m) {
@@ -108,8 +144,7 @@ void BindFit(py::module_& m) {
          double loss_scale, double prior_weight, std::pair<double, double> bounds, int max_iterations) {
         const auto targets = Targets(*body, points, mass_points, lattice_coords, weights);
         const auto o = Options(*body, initial_q, loss, loss_scale, prior_weight, bounds, max_iterations);
-        py::gil_scoped_release release;
-        return fit::FitPose(*body, targets, o);
+        return WithCtrlC([&] { return fit::FitPose(*body, targets, o); });
       },
       py::arg("body"), py::arg("points"), py::kw_only(), py::arg("mass_points") = py::none(),
       py::arg("lattice_coords") = py::none(), py::arg("weights") = py::none(), py::arg("initial_q") = py::none(),
@@ -118,6 +153,89 @@ void BindFit(py::module_& m) {
       "Fits q = [tx, ty, θ, γ...] so that the body's points land on `points` (K, 2): point k is mass\n"
       "point mass_points[k], or the lattice point lattice_coords[k] = (s, t). Like `wobble fit pose`.\n"
       "loss: squared, huber or cauchy (robust, scale loss_scale); prior_weight pulls γ to 0.");
+
+  py::class_<fit::TrajectoryFitResult>(m, "TrajectoryFitResult", "One pose per frame, fitted together with a smoothness term.")
+      .def_readonly("times", &fit::TrajectoryFitResult::times)
+      .def_property_readonly("q",
+                             [](const fit::TrajectoryFitResult& r) {
+                               Eigen::MatrixXd out(r.q.size(), r.q.empty() ? 0 : r.q[0].size());
+                               for (size_t f = 0; f < r.q.size(); ++f) out.row(f) = r.q[f].transpose();
+                               return out;
+                             },
+                             "(frames, num_q)")
+      .def_readonly("report", &fit::TrajectoryFitResult::report)
+      .def_readonly("frame_rms", &fit::TrajectoryFitResult::frame_rms)
+      .def_readonly("rms_residual", &fit::TrajectoryFitResult::rms_residual)
+      .def_readonly("linear_solver", &fit::TrajectoryFitResult::linear_solver);
+
+  m.def(
+      "fit_trajectory",
+      [](std::shared_ptr<BodyModel> body, const py::object& times, const py::object& points,
+         const std::vector<long>& mass_points, double smoothness, const std::string& loss, double loss_scale,
+         double prior_weight, std::pair<double, double> bounds, int max_iterations) {
+        const auto frames = Frames(*body, times, points, mass_points);
+        if (!(smoothness >= 0) || !std::isfinite(smoothness)) throw InputError("smoothness must be a finite number >= 0");
+        fit::TrajectoryFitOptions o;
+        o.pose = Options(*body, py::none(), loss, loss_scale, prior_weight, bounds, max_iterations);
+        o.smoothness = smoothness;
+        return WithCtrlC([&] { return fit::FitKinematicTrajectory(*body, frames, o); });
+      },
+      py::arg("body"), py::arg("times"), py::arg("points"), py::arg("mass_points"), py::kw_only(),
+      py::arg("smoothness") = 1.0, py::arg("loss") = "squared", py::arg("loss_scale") = 1.0,
+      py::arg("prior_weight") = 0.0, py::arg("mode_bounds") = std::make_pair(-1.0, 1.0), py::arg("max_iterations") = 200,
+      "Fits a pose per frame to mass points mass_points (K,) seen at `points` (F, K, 2), all frames\n"
+      "in one problem with ½ w Σ |L Δ²q|² (w = smoothness) tying neighbours. Like `wobble fit trajectory`.");
+
+  py::class_<fit::DynamicParameters>(m, "DynamicParameters", "What a dynamic fit fits: start state, mode constants, controller.")
+      .def_readonly("q0", &fit::DynamicParameters::q0)
+      .def_readonly("qd0", &fit::DynamicParameters::qd0)
+      .def_readonly("stiffness", &fit::DynamicParameters::stiffness, "per mode K")
+      .def_readonly("damping", &fit::DynamicParameters::damping, "per mode c")
+      .def_readonly("graph", &fit::DynamicParameters::graph);
+  py::class_<fit::DynamicFitResult>(m, "DynamicFitResult", "A dynamic fit's parameters, report and residual.")
+      .def_readonly("params", &fit::DynamicFitResult::params)
+      .def_readonly("report", &fit::DynamicFitResult::report)
+      .def_readonly("rms_residual", &fit::DynamicFitResult::rms_residual, "simulated points to the reference, all frames")
+      .def_readonly("simulations", &fit::DynamicFitResult::simulations);
+
+  m.def(
+      "fit_dynamic",
+      [](std::shared_ptr<BodyModel> body, const py::object& times, const py::object& points,
+         const std::vector<long>& mass_points, const py::object& q0, const py::object& qd0, const py::object& stiffness,
+         const py::object& damping, const py::object& graph, const WorldOptions& world, bool fit_q0, bool fit_qd0,
+         bool fit_stiffness, bool fit_damping, bool fit_poses, bool fit_times, double switch_width, int max_iterations) {
+        const auto frames = Frames(*body, times, points, mass_points);
+        fit::DynamicParameters start;
+        start.q0 = OptionalVector(q0, body->num_q(), "q0");
+        start.qd0 = OptionalVector(qd0, body->num_q(), "qd0");
+        start.stiffness = OptionalVector(stiffness, body->num_modes(), "stiffness");
+        start.damping = OptionalVector(damping, body->num_modes(), "damping");
+        if (!graph.is_none()) start.graph = graph.cast<control::PoseGraph>();
+        if (world.integrator != Integrator::kThesis)
+          throw InputError("fit_dynamic simulates with the thesis integrator (options.integrator = 'thesis')");
+        fit::DynamicFitOptions o;
+        o.world = world.params;
+        o.dt = world.dt;
+        o.fit_q0 = fit_q0;
+        o.fit_qd0 = fit_qd0;
+        o.fit_stiffness = fit_stiffness;
+        o.fit_damping = fit_damping;
+        o.fit_poses = fit_poses;
+        o.fit_times = fit_times;
+        o.switch_width = switch_width;
+        o.max_iterations = max_iterations;
+        return WithCtrlC([&] { return fit::FitDynamicTrajectory(*body, frames, start, o); });
+      },
+      py::arg("body"), py::arg("times"), py::arg("points"), py::arg("mass_points"), py::kw_only(),
+      py::arg("q0") = py::none(), py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(),
+      py::arg("damping") = py::none(), py::arg("graph") = py::none(), py::arg("options") = WorldOptions(),
+      py::arg("fit_q0") = true, py::arg("fit_qd0") = true, py::arg("fit_stiffness") = true, py::arg("fit_damping") = true,
+      py::arg("fit_poses") = false, py::arg("fit_times") = false, py::arg("switch_width") = 0.05,
+      py::arg("max_iterations") = 50,
+      "Fits the start state, mode stiffness and damping (and a pose graph's poses and times) so that\n"
+      "a simulation puts mass points mass_points (K,) where `points` (F, K, 2) has them at `times`\n"
+      "(F,, on the step grid). Starts: q0/qd0 None: from pose fits of the first frames; stiffness\n"
+      "and damping None: the body's. Like `wobble fit dynamic`; differentiates with Ceres Jets.");
 
   m.def(
       "fit_pose_to_curves",
@@ -136,8 +254,7 @@ void BindFit(py::module_& m) {
         }
         if (polylines.empty()) throw InputError("fit_pose_to_curves: no polylines");
         const auto o = Options(*body, initial_q, loss, loss_scale, prior_weight, bounds, max_iterations);
-        py::gil_scoped_release release;
-        return fit::FitPoseToCurve(*body, target, o);
+        return WithCtrlC([&] { return fit::FitPoseToCurve(*body, target, o); });
       },
       py::arg("body"), py::arg("polylines"), py::kw_only(), py::arg("closed") = false, py::arg("initial_q") = py::none(),
       py::arg("loss") = "squared", py::arg("loss_scale") = 1.0, py::arg("prior_weight") = 0.0,

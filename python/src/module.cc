@@ -15,4 +15,7 @@ PYBIND11_MODULE(_wobble, m) {
   BindSynth(m);
   BindFit(m);
   BindAnalysis(m);
+#ifdef WOBBLE_PYTHON_RENDER
+  BindRender(m);
+#endif
 }

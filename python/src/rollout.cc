@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "wobble/core/errors.h"
+#include "wobble/core/interrupt.h"
 #include "wobble/core/limits.h"
 #include "wobble/core/parallel.h"
 
@@ -73,6 +74,10 @@ RolloutResult Rollout(std::shared_ptr<BodyModel> body, const py::object& q0_in, 
   long* taken = r.steps_taken.mutable_data();
   const double *q0_p = q0.data(), *qd0_p = qd0.data(), *t_p = targets_in.is_none() ? nullptr : targets.data();
   const std::shared_ptr<const BodyModel> model = body;
+  ClearInterrupt();
+  struct ClearAtEnd {
+    ~ClearAtEnd() { ClearInterrupt(); }
+  } clear_at_end;
   {
     py::gil_scoped_release release;
     ParallelFor(size_t(N), threads, [&](size_t i) {

@@ -4,6 +4,8 @@
 // status), Ctrl-C a KeyboardInterrupt.
 #include "support.h"
 
+#include "wobble/core/interrupt.h"
+
 #include <thread>
 
 #include "wobble/core/errors.h"
@@ -13,8 +15,9 @@
 namespace wobble::python {
 namespace {
 
-// wobble.SimulationStopped; the module holds it, so a borrowed handle (never freed at exit)
-py::handle stopped_type;
+// wobble.SimulationStopped and wobble.InputError; the module holds them, so borrowed handles
+// (never freed at exit)
+py::handle stopped_type, input_type;
 
 // The thread the module was imported on: Python's main thread, the one signals reach.
 std::thread::id main_thread;
@@ -22,20 +25,26 @@ std::thread::id main_thread;
 }  // namespace
 
 bool CtrlCPressed() {
+  if (InterruptRequested()) return true;  // seen by another thread already
   if (std::this_thread::get_id() != main_thread) return false;
   py::gil_scoped_acquire gil;
   if (PyErr_CheckSignals() == 0) return false;
   PyErr_Clear();
+  RequestInterrupt();  // every worker of the call sees it
   return true;
 }
 
 void RunWorld(World& w, double t_end, long steps) {
   constexpr long kPollEvery = 2000;  // steps between looks at Ctrl-C (a few ms)
   bool ok = true;
+  ClearInterrupt();
   {
     py::gil_scoped_release release;
     for (long n = 0; ok && (steps < 0 || n < steps) && w.time() + 0.5 * w.options().dt < t_end; ++n) {
-      if (n % kPollEvery == kPollEvery - 1 && CtrlCPressed()) w.ThrowInterrupted();
+      if (n % kPollEvery == kPollEvery - 1 && CtrlCPressed()) {
+        ClearInterrupt();
+        w.ThrowInterrupted();
+      }
       ok = w.Step();
     }
   }
@@ -54,8 +63,18 @@ void RaiseStopped(const WorldStatus& status) {
 
 void BindErrors(py::module_& m) {
   main_thread = std::this_thread::get_id();
+  // Registered first, so tried last: any other std::invalid_argument of the library (a pose
+  // graph that does not fit, a bad keyframe, ...) is bad input too, as for the CLI (exit 2).
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const std::invalid_argument& e) {
+      PyErr_SetString(input_type.ptr(), e.what());
+    }
+  });
   // pybind11 tries the translators last registered first: bases before what derives from them
   auto& input = py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+  input_type = input;
   input.doc() = "Bad input: a file, a value or a shape that is not what was expected (the message says which).";
   auto& parse = py::register_exception<formats::ParseError>(m, "ParseError", input.ptr());
   parse.doc() = "A file or script line that does not parse: the message starts with FILE:LINE.";

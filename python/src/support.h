@@ -2,7 +2,11 @@
 // running C++ loops with the GIL released while still answering Ctrl-C.
 #pragma once
 
+#include <chrono>
+#include <future>
+
 #include "bindings.h"
+#include "wobble/core/interrupt.h"
 #include "wobble/world/world.h"
 
 namespace wobble::python {
@@ -10,9 +14,10 @@ namespace wobble::python {
 // Raises wobble.SimulationStopped for a stopped world, with .cause, .step, .time and .body.
 [[noreturn]] void RaiseStopped(const WorldStatus& status);
 
-// On Python's main thread: takes the GIL and runs Python's signal handlers; true when one
-// raised (Ctrl-C: KeyboardInterrupt), whose error is then cleared for the caller to raise its
-// own. Elsewhere (worker threads): false. Call it every few thousand steps, without the GIL.
+// Whether the call should stop for Ctrl-C: the library's flag (core/interrupt.h) is up, or, on
+// Python's main thread, Python's signal handlers (run here with the GIL) raised
+// KeyboardInterrupt, which is cleared and raises the flag for every worker. Call it every few
+// thousand steps, without the GIL; the caller clears the flag when its call ends.
 bool CtrlCPressed();
 
 // Steps `world` until its time reaches t_end (to half a step) or `steps` more steps were taken
@@ -20,5 +25,30 @@ bool CtrlCPressed();
 // SimulationStopped when the world stops and KeyboardInterrupt on Ctrl-C (the world keeps the
 // state it reached).
 void RunWorld(World& world, double t_end, long steps);
+
+// Runs f (which must not touch Python) on a worker thread while the calling thread waits
+// without the GIL, taking it every 50 ms to run Python's signal handlers: Ctrl-C raises the
+// library's own flag (core/interrupt.h), which anneal, cmaes and the fits poll between
+// iterations and batches. f's result or exception comes back here.
+template <class F> auto WithCtrlC(F&& f) -> decltype(f()) {
+  ClearInterrupt();
+  auto done = std::async(std::launch::async, std::forward<F>(f));
+  for (;;) {
+    bool finished;
+    {
+      py::gil_scoped_release release;
+      finished = done.wait_for(std::chrono::milliseconds(50)) == std::future_status::ready;
+    }
+    if (finished) break;
+    if (PyErr_CheckSignals() != 0) {
+      PyErr_Clear();
+      RequestInterrupt();
+    }
+  }
+  struct Clear {
+    ~Clear() { ClearInterrupt(); }
+  } clear;
+  return done.get();
+}
 
 }  // namespace wobble::python

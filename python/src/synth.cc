@@ -7,6 +7,9 @@
 #include "wobble/core/errors.h"
 #include "wobble/core/limits.h"
 #include "wobble/synth/anneal.h"
+#ifdef WOBBLE_HAVE_PAGMO
+#include "wobble/synth/cmaes.h"
+#endif
 
 namespace wobble::python {
 namespace {
@@ -176,7 +179,7 @@ void BindSynth(py::module_& m) {
   m.def(
       "anneal",
       [](const Problem& p, const PoseGraph& initial, std::uint64_t seed, int iterations, int batch, double cooling,
-         const std::string& optimize, int threads) {
+         const std::string& optimize, int threads, long max_steps) {
         synth::AnnealOptions o;
         o.seed = seed;
         o.iterations = iterations;
@@ -186,15 +189,40 @@ void BindSynth(py::module_& m) {
         if (!synth::ParseOptimize(optimize, &o.optimize)) throw InputError("optimize: '" + optimize + "' is not poses, times or both");
         const std::string error = o.Validate();
         if (!error.empty()) throw InputError("anneal: " + error);
-        CheckedCount(double(iterations * double(batch) + 1) * double(p.steps), 0, Limits().max_steps,
-                     "anneal's trials x steps", "lower iterations or batch");
-        py::gil_scoped_release release;
-        return synth::Anneal(p, initial, o);
+        CheckedCount((double(iterations) * double(batch) + 1) * double(p.steps), 0, max_steps,
+                     "anneal's trials x steps", "lower iterations or batch, or raise max_steps");
+        return WithCtrlC([&] { return synth::Anneal(p, initial, o); });
       },
       py::arg("problem"), py::arg("initial"), py::kw_only(), py::arg("seed") = 1, py::arg("iterations") = 60,
       py::arg("batch") = 1, py::arg("cooling") = 0.9, py::arg("optimize") = "both", py::arg("threads") = 0,
+      py::arg("max_steps") = Limits().max_steps,
       "Simulated annealing of a pose graph (Fig. 5.2), `batch` neighbours per iteration in parallel.\n"
-      "The same seed gives the same result, on any number of threads.");
+      "The same seed gives the same result, on any number of threads. Ctrl-C ends it after the\n"
+      "batch running then: the result has the best so far and interrupted = True.");
+
+#ifdef WOBBLE_HAVE_PAGMO
+  m.def(
+      "cmaes",
+      [](const Problem& p, const PoseGraph& initial, std::uint64_t seed, int generations, int population, double sigma0,
+         const std::string& optimize, long max_steps) {
+        synth::CmaesOptions o;
+        o.seed = seed;
+        o.generations = generations;
+        o.population = population;
+        o.sigma0 = sigma0;
+        if (!synth::ParseOptimize(optimize, &o.optimize)) throw InputError("optimize: '" + optimize + "' is not poses, times or both");
+        const std::string error = o.Validate();
+        if (!error.empty()) throw InputError("cmaes: " + error);
+        CheckedCount((double(generations) + 1) * double(population) * double(p.steps), 0, max_steps,
+                     "cmaes' trials x steps", "lower generations or population, or raise max_steps");
+        return WithCtrlC([&] { return synth::Cmaes(p, initial, o); });
+      },
+      py::arg("problem"), py::arg("initial"), py::kw_only(), py::arg("seed") = 1, py::arg("generations") = 60,
+      py::arg("population") = 8, py::arg("sigma0") = 0.1, py::arg("optimize") = "both",
+      py::arg("max_steps") = Limits().max_steps,
+      "CMA-ES (pagmo2) over a pose graph's poses and times: the alternative to anneal, same result type\n"
+      "(Ctrl-C: the best so far, interrupted = True).");
+#endif
 }
 
 }  // namespace wobble::python

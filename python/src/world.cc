@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "wobble/core/errors.h"
+#include "wobble/control/controllers.h"
 #include "wobble/world/world.h"
 
 namespace wobble::python {
@@ -93,6 +94,51 @@ void BindWorld(py::module_& m) {
       .def_readonly("time", &WorldStatus::time)
       .def_readonly("body", &WorldStatus::body)
       .def_readonly("message", &WorldStatus::message);
+
+  py::class_<Controller, std::shared_ptr<Controller>>(
+      m, "Controller",
+      "Something the world calls before and after every step (world/controller.h). Made by the\n"
+      "library (pose graphs); controllers written in Python are not supported: steps run without\n"
+      "the GIL.");
+  py::class_<control::PoseGraphController, Controller, std::shared_ptr<control::PoseGraphController>>(
+      m, "PoseGraphController", "Drives a body's active modes through a pose graph (§5.1); add it with World.add_controller.")
+      .def(py::init([](const World& w, int body, const control::PoseGraph& graph, double switch_width) {
+             CheckBody(w, body);
+             if (!(switch_width >= 0)) throw InputError("switch_width must be at least 0");
+             return std::make_shared<control::PoseGraphController>(w, body, graph, switch_width);
+           }),
+           py::arg("world"), py::arg("body"), py::arg("graph"), py::arg("switch_width") = 0.0,
+           "switch_width > 0: smoothed switches (the set point moves in about 4 widths)")
+      .def_property_readonly("pose", &control::PoseGraphController::pose, "the pose active now")
+      .def_property_readonly("steps", &control::PoseGraphController::steps);
+
+  py::class_<control::KeyframeController, Controller, std::shared_ptr<control::KeyframeController>>(
+      m, "KeyframeController",
+      "Keyframed mode amplitudes (§4.10.1) on one body, which it makes kinematic; a held point stays\n"
+      "in place (a foot on the ground). When finished(), release(world) hands the body back to the\n"
+      "simulation with its keyframed q and q̇.")
+      .def(py::init([](World& w, int body, const std::vector<double>& times, const Eigen::MatrixXd& amplitudes,
+                       const std::string& interpolation, const py::object& hold) {
+             CheckBody(w, body);
+             control::Keyframes keys;
+             keys.times = times;
+             for (int k = 0; k < amplitudes.rows(); ++k) keys.amplitudes.push_back(amplitudes.row(k).transpose());
+             if (interpolation == "smooth") keys.interpolation = control::Interpolation::kSmooth;
+             else if (interpolation != "linear") throw InputError("interpolation: '" + interpolation + "' is not linear or smooth");
+             const std::string error = keys.Validate(w.body(body).num_modes());
+             if (!error.empty()) throw InputError("keyframes: " + error);
+             control::HeldPoint held;
+             if (!hold.is_none()) {
+               held.enabled = true;
+               held.lattice_coords = AsVector(hold, 2, "hold");
+             }
+             return std::make_shared<control::KeyframeController>(w, body, keys, held);
+           }),
+           py::arg("world"), py::arg("body"), py::arg("times"), py::arg("amplitudes"), py::arg("interpolation") = "linear",
+           py::arg("hold") = py::none(),
+           "times: K key times from 0, increasing; amplitudes: (K, num_modes); hold: lattice (s, t) of the held point")
+      .def("finished", &control::KeyframeController::Finished)
+      .def("release", &control::KeyframeController::Release, py::arg("world"));
 
   py::class_<World>(m, "World",
                     "THE world: FFD bodies (q = [tx, ty, θ, γ1..γD], Eq. 4.4), the ground, springs, constraints,\n"
@@ -198,6 +244,11 @@ void BindWorld(py::module_& m) {
           },
           py::arg("body"), py::arg("mass_point"), py::arg("where") = py::none(),
           "Nails a mass point where it is now (or at `where`); returns the constraint's id.")
+      .def("add_controller", &World::AddController, py::arg("controller"), py::keep_alive<1, 2>(),
+           "Calls the controller around every step from now on.")
+      .def(
+          "remove_controller", [](World& w, const std::shared_ptr<Controller>& c) { w.RemoveController(c.get()); },
+          py::arg("controller"))
       .def("set_enabled", &World::SetEnabled, py::arg("id"), py::arg("enabled"))
       .def("max_violation", &World::MaxViolation, "the largest |c| of the enabled constraints")
       .def("constraint_error", &World::ConstraintError, py::arg("id"));

@@ -84,6 +84,19 @@ class WorldStatus:
     body: int
     message: str
 
+class Controller: ...
+
+class PoseGraphController(Controller):
+    pose: int
+    steps: int
+    def __init__(self, world: "World", body: int, graph: "PoseGraph", switch_width: float = 0.0) -> None: ...
+
+class KeyframeController(Controller):
+    def __init__(self, world: "World", body: int, times: Sequence[float], amplitudes: ArrayLike,
+                 interpolation: str = "linear", hold: Optional[ArrayLike] = None) -> None: ...
+    def finished(self) -> bool: ...
+    def release(self, world: "World") -> None: ...
+
 class World:
     num_bodies: int
     time: float
@@ -107,6 +120,8 @@ class World:
     def forces(self, body: int = 0) -> dict[str, NDArray]: ...
     def accelerations(self, body: int = 0) -> NDArray: ...
     def add_nail(self, body: int, mass_point: int, where: Optional[ArrayLike] = None) -> int: ...
+    def add_controller(self, controller: Controller) -> None: ...
+    def remove_controller(self, controller: Controller) -> None: ...
     def set_enabled(self, id: int, enabled: bool) -> None: ...
     def max_violation(self) -> float: ...
     def constraint_error(self, id: int) -> NDArray: ...
@@ -186,7 +201,11 @@ class AnnealResult:
     history: NDArray
 
 def anneal(problem: SynthesisProblem, initial: PoseGraph, *, seed: int = 1, iterations: int = 60, batch: int = 1,
-           cooling: float = 0.9, optimize: str = "both", threads: int = 0) -> AnnealResult: ...
+           cooling: float = 0.9, optimize: str = "both", threads: int = 0, max_steps: int = ...) -> AnnealResult: ...
+
+# present when wobble was built with pagmo2 (Debian: libpagmo-dev)
+def cmaes(problem: SynthesisProblem, initial: PoseGraph, *, seed: int = 1, generations: int = 60, population: int = 8,
+          sigma0: float = 0.1, optimize: str = "both", max_steps: int = ...) -> AnnealResult: ...
 
 class Interpreter:
     body: Optional[BodyModel]
@@ -240,6 +259,37 @@ def fit_pose(body: BodyModel, points: ArrayLike, *, mass_points: Optional[Sequen
              initial_q: Optional[ArrayLike] = None, loss: str = "squared", loss_scale: float = 1.0,
              prior_weight: float = 0.0, mode_bounds: tuple[float, float] = (-1.0, 1.0),
              max_iterations: int = 200) -> PoseFitResult: ...
+class TrajectoryFitResult:
+    times: list[float]
+    q: NDArray
+    report: FitReport
+    frame_rms: list[float]
+    rms_residual: float
+    linear_solver: str
+
+def fit_trajectory(body: BodyModel, times: ArrayLike, points: ArrayLike, mass_points: Sequence[int], *,
+                   smoothness: float = 1.0, loss: str = "squared", loss_scale: float = 1.0, prior_weight: float = 0.0,
+                   mode_bounds: tuple[float, float] = (-1.0, 1.0), max_iterations: int = 200) -> TrajectoryFitResult: ...
+
+class DynamicParameters:
+    q0: NDArray
+    qd0: NDArray
+    stiffness: NDArray
+    damping: NDArray
+    graph: PoseGraph
+
+class DynamicFitResult:
+    params: DynamicParameters
+    report: FitReport
+    rms_residual: float
+    simulations: int
+
+def fit_dynamic(body: BodyModel, times: ArrayLike, points: ArrayLike, mass_points: Sequence[int], *,
+                q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None, stiffness: Optional[ArrayLike] = None,
+                damping: Optional[ArrayLike] = None, graph: Optional[PoseGraph] = None, options: WorldOptions = ...,
+                fit_q0: bool = True, fit_qd0: bool = True, fit_stiffness: bool = True, fit_damping: bool = True,
+                fit_poses: bool = False, fit_times: bool = False, switch_width: float = 0.05,
+                max_iterations: int = 50) -> DynamicFitResult: ...
 def fit_pose_to_curves(body: BodyModel, polylines: Sequence[ArrayLike], *, closed: bool = False,
                        initial_q: Optional[ArrayLike] = None, loss: str = "squared", loss_scale: float = 1.0,
                        prior_weight: float = 0.0, mode_bounds: tuple[float, float] = (-1.0, 1.0),
@@ -265,3 +315,12 @@ def mass_matrix(body: BodyModel, q: Optional[ArrayLike] = None) -> NDArray: ...
 def angle_sweep(object: str, phis: Sequence[float], *, compress: float = 1.0,
                 expand: float = 0.5) -> tuple[NDArray, NDArray]: ...
 def check_mode_set(body: BodyModel) -> ModeSetReport: ...
+
+# pictures (present when wobble was built with its VTK pipelines)
+def has_display() -> bool: ...
+def render_world(world: World, *, width: int = 640, height: int = 480, lattice: bool = True, points: bool = True,
+                 shape: bool = True, ground: bool = True, overlay: bool = True, color_by: str = "",
+                 frame: Optional[Sequence[float]] = None) -> npt.NDArray[np.uint8]: ...
+def render(run: Trajectory, options: WorldOptions, folder: str, *, name: str = "run",
+           what: Sequence[str] = ("frames", "filmstrip", "vtp"), fps: float = 30.0, width: int = 640,
+           height: int = 480, filmstrip_times: Sequence[float] = (), color_by: str = "") -> list[str]: ...

@@ -179,6 +179,14 @@ def main():
     if p is not None and os.path.exists(csv_out):
         rows_finite(csv_out)
 
+    # ---- output files a script cannot write at all (a folder where a file is): bad input, exit 2
+    blocker = write(os.path.join(work, "a_file"), "x")
+    for line, needle in ((f"output {blocker}/x.csv", "output:"), (f"save {blocker}/x.wob", "save:"),
+                         (f"set anneal_csv {blocker}/h.csv", "anneal_csv:")):
+        case(f"run: {line.split()[0]} under a regular file",
+             [wobble, "run", script("unwritable.wob", f"load_obj {obj}\nload_def {modes}\n{line}\n")], work, 2,
+             "unwritable.wob:3:", needle)
+
     # ---- a full disk (a 200 kB tmpfs, when this machine lets us mount one): exit 1 with the
     # system's text, and the files of the earlier run unchanged (was: exit 0, empty EXRs)
     full = os.path.join(work, "full")
@@ -204,6 +212,24 @@ def main():
             expect(same, "full disk: every file of the first export is unchanged")
             left = [f for _, _, files in os.walk(full) for f in files if f.endswith(".tmp")]
             expect(not left, f"full disk: no temporary file left ({left[:3]})")
+            # a script's own writes: the disk failing is exit 1 (not bad input), naming the line;
+            # first the disk is filled to its last byte
+            with open(os.path.join(full, "filler"), "wb", buffering=0) as f:
+                for size in (65536, 4096, 1):
+                    try:
+                        while f.write(b"\0" * size):
+                            pass
+                    except OSError:
+                        continue
+            out_csv = os.path.join(full, "run.csv")
+            case("run: output onto the full disk",
+                 [wobble, "run", script("full_out.wob", f"load_obj {obj}\nload_def {modes}\nset_vec q 0 50 0 0 0 0 0\n"
+                                                        f"output {out_csv}\nsimul 5\n")],
+                 work, 1, "full_out.wob:5:", "output:", "No space left on device")
+            case("run: save onto the full disk",
+                 [wobble, "run", script("full_save.wob", f"load_obj {obj}\nload_def {modes}\n"
+                                                         f"save {os.path.join(full, 'replay.wob')}\n")],
+                 work, 1, "full_save.wob:3:", "save:", "No space left on device")
         finally:
             subprocess.run(["umount", full])
 

@@ -34,7 +34,9 @@ def test_the_stub_names_exactly_what_the_module_has():
     top, members = stub_names()
     module = public(wobble) - {"Any"}
     assert module - top == set(), "in the module, not in the stub"
-    assert top - module - {"ArrayLike", "NDArray", "__version__"} == set(), "in the stub, not in the module"
+    optional = set() if hasattr(wobble, "render") else {"has_display", "render_world", "render"}  # built without VTK
+    optional |= set() if hasattr(wobble, "cmaes") else {"cmaes"}  # built without pagmo
+    assert top - module - {"ArrayLike", "NDArray", "__version__"} - optional == set(), "in the stub, not in the module"
     for name, names in members.items():
         cls = getattr(wobble, name)
         if issubclass(cls, BaseException):

@@ -81,3 +81,49 @@ def test_fit_inputs_are_checked(table):
         wobble.fit_pose(table, pts, mass_points=[0, 1, 2], loss="l1")
     with pytest.raises(wobble.InputError, match=r"weights\[0\]"):
         wobble.fit_pose(table, pts, mass_points=[0, 1, 2], weights=[0, 1, 1])
+
+
+def test_a_dynamic_fit_recovers_what_generated_its_reference(table):
+    # the reference: the table's own modes (table_modes.def) from a known start, no ground
+    options = no_ground("thesis", 0.01)
+    q0 = np.array([0, 100, 0.1, 0.2, -0.1, 0.1, 0.05])
+    qd0 = np.array([30, 60, 1.0, 0.5, -0.8, 0.6, 0.4])
+    world = wobble.World(options)
+    world.add_body(table)
+    world.set_state(0, q0, qd0)
+    times, points = [], []
+    for frame in range(26):  # every 2nd step of 0.5 s
+        times.append(world.time)
+        points.append(world.point_positions(0))
+        world.step(2)
+    K = np.array([m.stiffness for m in table.modes])
+    c = np.array([m.damping for m in table.modes])
+    fit = wobble.fit_dynamic(table, times, np.array(points), list(range(table.num_points)), options=options,
+                             q0=q0 + [2, -1, 0.01, 0.02, -0.02, 0.01, 0.02], qd0=qd0 + [-3, 2, 0.1, 0.1, 0.1, -0.1, 0.1],
+                             stiffness=1.4 * K, damping=0.6 * c + 1.0)
+    assert fit.report.usable, fit.report.brief_report
+    np.testing.assert_allclose(fit.params.q0, q0, atol=1e-6)
+    np.testing.assert_allclose(fit.params.qd0, qd0, atol=1e-5)
+    np.testing.assert_allclose(fit.params.stiffness, K, rtol=1e-5)
+    assert fit.rms_residual < 1e-5
+    with pytest.raises(wobble.InputError, match="thesis"):
+        wobble.fit_dynamic(table, times, np.array(points), list(range(table.num_points)),
+                           options=wobble.WorldOptions(integrator="rk4"))
+
+
+def test_a_trajectory_fit_follows_the_frames(table):
+    # a simulated run's points, fitted frame by frame with a light smoothness term
+    options = no_ground("thesis", 0.01)
+    world = wobble.World(options)
+    world.add_body(table)
+    world.set_state(0, [0, 100, 0.1, 0.2, -0.1, 0.1, 0.05], [30, 60, 1.0, 0.5, -0.8, 0.6, 0.4])
+    times, points, qs = [], [], []
+    for frame in range(10):
+        times.append(world.time)
+        points.append(world.point_positions(0))
+        qs.append(world.q(0))
+        world.step(3)
+    fit = wobble.fit_trajectory(table, times, np.array(points), list(range(table.num_points)), smoothness=1e-6)
+    assert fit.report.usable and fit.q.shape == (10, 7)
+    np.testing.assert_allclose(fit.q, np.array(qs), atol=1e-3)
+    assert fit.rms_residual < 0.05

@@ -63,3 +63,18 @@ def test_anneal_is_reproducible_and_never_worse_than_its_start(data):
     np.testing.assert_array_equal(a.best.poses, b.best.poses)
     assert a.best_outcome.cost <= a.initial_outcome.cost
     assert a.history.shape == (5, 7) and a.trials == 9
+
+
+@pytest.mark.skipif(not hasattr(wobble, "cmaes"), reason="built without pagmo2")
+def test_cmaes_is_reproducible_and_never_worse_than_its_start(data):
+    interp = bounding_table(data)
+    problem = interp.synthesis_problem()
+    problem.steps = 300
+    a = wobble.cmaes(problem, interp.pose_graph, seed=3, generations=3, population=6)
+    b = wobble.cmaes(problem, interp.pose_graph, seed=3, generations=3, population=6)
+    assert a.best_outcome.cost == b.best_outcome.cost
+    assert a.best_outcome.cost <= a.initial_outcome.cost
+    with pytest.raises(wobble.InputError, match="cmaes"):
+        wobble.cmaes(problem, interp.pose_graph, population=0)
+    with pytest.raises(wobble.LimitExceeded, match="max_steps"):
+        wobble.cmaes(problem, interp.pose_graph, generations=100, population=6, max_steps=1000)

@@ -34,13 +34,14 @@ int ModeIndex(const State& s, const std::string& word, const Context& ctx) {
   return d;
 }
 
-// Writes the `output` CSV from every run since `output` (the whole file after every run).
-void FlushOutput(const State& s, const Context& ctx) {
+// Writes the `output` CSV from every run since `output` (the whole file after every run). The
+// path was checked by `output`: a failure now is the disk's (exit 1, not bad input).
+void FlushOutput(const State& s, const Context&) {
   if (s.output_path.empty()) return;
   try {
     record::WriteTrajectoryCsv(s.output_path, scene::OutputTrajectory(s.output_runs, s.output_every));
   } catch (const std::runtime_error& e) {
-    ctx.Fail(std::string("output: ") + e.what());
+    throw std::runtime_error("output: " + std::string(e.what()));
   }
 }
 
@@ -256,6 +257,11 @@ void Output(State& s, const Words& w, const Context& ctx) {
   int every = 1;
   if (w.size() == 3 && (!formats::detail::ParseInt(w[2], &every) || every < 1))
     ctx.Fail("expected EVERY as a whole number >= 1, got '" + w[2] + "'");
+  try {
+    formats::CheckWritable(w[1]);
+  } catch (const std::runtime_error& e) {
+    ctx.Fail(std::string("output: ") + e.what());
+  }
   s.output_path = w[1];
   s.output_every = every;
 }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "wobble/core/errors.h"
+#include "wobble/formats/csv.h"
 #include "wobble/script/internal/interpreter_internal.h"
 
 namespace wobble::script {
@@ -42,6 +44,17 @@ namespace {
 
 Ground& TheGround(State& s) { return s.scene.options().params.ground; }
 synth::AnnealOptions& Search(State& s) { return s.anneal_options; }
+
+// A file a later command writes, checked now: a path that cannot be written is bad input of
+// this line (exit 2); the disk failing at the write is not (exit 1).
+std::string WritablePath(const std::string& path, const std::string& name) {
+  try {
+    formats::CheckWritable(path);
+  } catch (const std::runtime_error& e) {
+    throw InputError(name + ": " + e.what());
+  }
+  return path;
+}
 
 }  // namespace
 
@@ -132,8 +145,8 @@ const std::vector<Parameter>& ParameterTable() {
        [](State& s, const Value& v) {
          Search(s).threads = int(CheckedCount(v.Number(), 0, kMaxThreads, "threads (0: one per core)"));
        }},
-      {"anneal_csv", [](State& s, const Value& v) { s.anneal_csv = v.text; }},
-      {"cmaes_csv", [](State& s, const Value& v) { s.cmaes_csv = v.text; }},
+      {"anneal_csv", [](State& s, const Value& v) { s.anneal_csv = WritablePath(v.text, "anneal_csv"); }},
+      {"cmaes_csv", [](State& s, const Value& v) { s.cmaes_csv = WritablePath(v.text, "cmaes_csv"); }},
       {"sigma0",
        [](State& s, const Value& v) {
          s.sigma0 = v.Positive();

@@ -24,14 +24,14 @@ int Count(const Words& w, const std::string& what, const Context& ctx) {
 
 // The optimiser's result becomes the scene's pose graph; its history goes to `csv` (and the
 // CLI's hook, which draws it beside: Fig. 5.4/5.5).
-void Adopt(State& s, synth::AnnealResult r, const std::string& csv, const std::string& optimiser, const char* command,
-           const Context& ctx) {
+void Adopt(State& s, synth::AnnealResult r, const std::string& csv, const std::string& optimiser, const char* command) {
   if (!csv.empty()) {
+    // the path was checked when it was set: a failure now is the disk's (exit 1, not bad input)
     try {
       formats::WriteCsvAtomically(csv, synth::HistoryHeader(), synth::HistoryRows(r.history));
       if (s.history_hook) s.history_hook(csv, optimiser, r.history);
     } catch (const std::runtime_error& e) {
-      ctx.Fail(e.what());
+      throw std::runtime_error(std::string(command) + ": writing its history: " + e.what());
     }
   }
   s.out << command << ": " << r.trials << " trials; cost " << Num(r.initial_outcome.cost) << " -> "
@@ -39,6 +39,19 @@ void Adopt(State& s, synth::AnnealResult r, const std::string& csv, const std::s
         << Num(r.best_outcome.speed) << ", control energy " << Num(r.best_outcome.energy) << ")\n";
   s.scene.control().graph = r.best;
   s.anneal = std::move(r);
+}
+
+// Adopt, then, when Ctrl-C ended the optimisation early (between two batches), Interrupted
+// saying how far it got: the best pose graph so far is kept either way.
+void AdoptOrStop(State& s, synth::AnnealResult r, const std::string& csv, const std::string& optimiser,
+                 const char* command, const char* round, int rounds) {
+  const bool interrupted = r.interrupted;
+  const int done = r.history.empty() ? 0 : r.history.back().iteration;
+  Adopt(s, std::move(r), csv, optimiser, command);
+  if (interrupted)
+    throw Interrupted(std::string(command) + " stopped by Ctrl-C after " + round + " " + std::to_string(done) + " of " +
+                      std::to_string(rounds) + "; the best pose graph so far is adopted" +
+                      (csv.empty() ? std::string() : ", its history written to " + csv));
 }
 
 // The start of an optimisation: the graph cycles, the trials start from the state now.
@@ -84,13 +97,7 @@ void Anneal(State& s, const Words& w, const Context& ctx) {
   synth::AnnealResult r = synth::Anneal(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
     if (s.progress) s.progress(iterations ? double(rec.iteration) / iterations : 1.0, rec.best);
   });
-  const bool interrupted = r.interrupted;
-  const int done = r.history.empty() ? 0 : r.history.back().iteration;
-  Adopt(s, std::move(r), s.anneal_csv, "simulated annealing", "anneal", ctx);
-  if (interrupted)
-    throw Interrupted("anneal stopped by Ctrl-C after iteration " + std::to_string(done) + " of " +
-                      std::to_string(iterations) + "; the best pose graph so far is adopted" +
-                      (s.anneal_csv.empty() ? std::string() : ", its history written to " + s.anneal_csv));
+  AdoptOrStop(s, std::move(r), s.anneal_csv, "simulated annealing", "anneal", "iteration", iterations);
 }
 
 void Cmaes(State& s, const Words& w, const Context& ctx) {
@@ -117,7 +124,7 @@ void Cmaes(State& s, const Words& w, const Context& ctx) {
   synth::AnnealResult r = synth::Cmaes(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
     if (s.progress) s.progress(generations ? double(rec.iteration) / generations : 1.0, rec.best);
   });
-  Adopt(s, std::move(r), s.cmaes_csv, "CMA-ES", "cmaes", ctx);
+  AdoptOrStop(s, std::move(r), s.cmaes_csv, "CMA-ES", "cmaes", "generation", generations);
 #else
   (void)generations;
   ctx.Fail("cmaes: this wobble was built without pagmo2 (Debian: libpagmo-dev); use anneal");
@@ -176,9 +183,14 @@ void Save(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 2, 2);
   RequireObject(s, ctx, "save");
   try {
+    formats::CheckWritable(w[1]);
+  } catch (const std::runtime_error& e) {
+    ctx.Fail(std::string("save: ") + e.what());  // a path that cannot be written: bad input
+  }
+  try {
     formats::WriteTextAtomically(w[1], ReplayScript(s));
   } catch (const std::runtime_error& e) {
-    ctx.Fail(e.what());
+    throw std::runtime_error(std::string("save: ") + e.what());  // the disk failed (full, ...): exit 1
   }
 }
 

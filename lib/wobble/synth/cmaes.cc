@@ -1,5 +1,7 @@
 #include "wobble/synth/cmaes.h"
 
+#include "wobble/core/interrupt.h"
+
 #include <algorithm>
 #include <cmath>
 #include <mutex>
@@ -120,6 +122,10 @@ AnnealResult Cmaes(const Problem& p, const control::PoseGraph& initial, const Cm
   // one generation per evolve call, with the adapted state kept between calls (memory = true)
   pagmo::cmaes algo(1u, -1, -1, -1, -1, o.sigma0, 0.0, 0.0, true, true, static_cast<unsigned>(o.seed));
   for (int g = 1; g <= o.generations; ++g) {
+    if (InterruptRequested()) {  // between two generations: what is best so far is a result
+      r.interrupted = true;
+      break;
+    }
     const long before = tally->trials;
     pop = algo.evolve(pop);
     if (tally->trials == before) break;  // cmaes stopped (converged)

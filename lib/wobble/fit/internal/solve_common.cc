@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "wobble/core/errors.h"
+#include "wobble/core/interrupt.h"
 
 #include <Eigen/SVD>
 #include <chrono>
@@ -89,6 +90,9 @@ void SolveAndReport(ceres::Solver::Options options, ceres::Problem* problem,
   ceres::Solve(options, problem, &summary);
   FillReport(summary, full_report, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
              report);
+  if (InterruptRequested())
+    throw Interrupted("the fit stopped by Ctrl-C after " + std::to_string(std::max(report->iterations, 0)) +
+                      " iterations (cost " + std::to_string(summary.final_cost) + ")");
   // a cost past the largest double is no fit: say why instead of reporting inf (or crashing in
   // the conditioning's SVD of a NaN Jacobian)
   if (!std::isfinite(summary.initial_cost) || !std::isfinite(summary.final_cost))

@@ -4,6 +4,8 @@
 
 #include <ceres/ceres.h>
 
+#include "wobble/core/interrupt.h"
+
 #include <functional>
 #include <vector>
 
@@ -31,16 +33,17 @@ std::vector<ceres::ResidualBlockId> AddPoseTerms(const BodyModel& body, const st
                                                  const PoseFitOptions& o, double* q, ceres::Problem* problem);
 
 // Forwards Ceres' iterations to an on_iteration function; attach with Attach().
+// Every fit's iteration callback: forwards (iteration, cost) to on_iteration when there is one,
+// and aborts the solve on Ctrl-C (core/interrupt.h) between two iterations; SolveAndReport then
+// throws Interrupted.
 class IterationForwarder : public ceres::IterationCallback {
  public:
   explicit IterationForwarder(std::function<void(int, double)> f) : f_(std::move(f)) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    f_(s.iteration, s.cost);
-    return ceres::SOLVER_CONTINUE;
+    if (f_) f_(s.iteration, s.cost);
+    return InterruptRequested() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
   }
-  void Attach(ceres::Solver::Options* options) {
-    if (f_) options->callbacks.push_back(this);
-  }
+  void Attach(ceres::Solver::Options* options) { options->callbacks.push_back(this); }
 
  private:
   std::function<void(int, double)> f_;

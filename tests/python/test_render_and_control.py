@@ -1,0 +1,94 @@
+"""Pictures into numpy and files (pipelines/, VTK under X), and controllers from Python."""
+import pathlib
+
+import numpy as np
+import pytest
+
+import wobble
+from conftest import no_ground
+
+needs_display = pytest.mark.skipif(not hasattr(wobble, "render") or not wobble.has_display(),
+                                   reason="rendering needs wobble's VTK pipelines and an X display (xvfb-run)")
+
+
+def dropped(table, seconds=1.0):
+    options = wobble.WorldOptions(dt=0.01)
+    world = wobble.World(options)
+    world.add_body(table)
+    world.set_state(0, [0, 30, 0.1, 0.2, 0, 0, 0])
+    return world, options, wobble.simulate(world, seconds)
+
+
+@needs_display
+def test_render_world_draws_what_it_is_asked(table):
+    world, _, _ = dropped(table)
+    image = wobble.render_world(world, width=320, height=200)
+    assert image.shape == (200, 320, 3) and image.dtype == np.uint8
+    assert image.std() > 5  # not a blank frame
+    bare = wobble.render_world(world, width=320, height=200, lattice=False, points=False, overlay=False)
+    assert (np.abs(image.astype(int) - bare).sum(axis=2) > 0).mean() > 0.005  # the lattice and points show
+    with pytest.raises(wobble.InputError, match="frame"):
+        wobble.render_world(world, frame=(0, 0, -1, 1))
+
+
+@needs_display
+def test_render_writes_frames_filmstrip_and_paraview_series(table, tmp_path):
+    _, options, run = dropped(table, 1.0)
+    files = wobble.render(run, options, str(tmp_path), name="drop", what=["frames", "filmstrip", "vtp"], fps=10,
+                          width=320, height=240)
+    written = sorted(p.name for p in tmp_path.rglob("*") if p.is_file())
+    assert sum(n.endswith(".png") and n.startswith("frame") for n in written) == 11  # 0, 0.1, ..., 1.0 s
+    assert any(n.endswith(".pvd") for n in written) and any("filmstrip" in n for n in written)
+    assert len(files) >= 3
+    with pytest.raises(wobble.InputError, match="what"):
+        wobble.render(run, options, str(tmp_path), what=["gif"])
+
+
+def test_a_pose_graph_controller_drives_the_active_modes(data):
+    interp = wobble.Interpreter()
+    lines = []
+    for line in (data / "bounding_table.wob").read_text().splitlines():
+        if line.startswith("anneal"):
+            break
+        lines.append(line)
+    interp.run("\n".join(lines), dir=str(data))
+    problem, graph = interp.synthesis_problem(), interp.pose_graph
+    world = wobble.World(problem.options)
+    world.add_body(problem.body)
+    world.set_state(0, problem.q0, problem.qd0)
+    masses = problem.body.masses
+
+    def centre_x():  # the direct per-point sum Σ m_k x_k / m, not the mass moments
+        return float(masses @ world.point_positions(0)[:, 0] / masses.sum())
+
+    x0 = centre_x()
+    controller = wobble.PoseGraphController(world, 0, graph)
+    world.add_controller(controller)
+    world.step(problem.steps)
+    # the same trial as the synthesis' own: the same travel of the centre of mass
+    outcome = problem.run(graph)
+    assert outcome.ok
+    assert centre_x() - x0 == pytest.approx(outcome.distance, rel=1e-9, abs=1e-9)
+    assert controller.steps == problem.steps and 0 <= controller.pose < len(graph.durations)
+    with pytest.raises(wobble.InputError, match="pose graph"):
+        wobble.PoseGraphController(world, 0, wobble.PoseGraph(np.zeros((2, 1)), [0.5, 0.5]))
+
+
+def test_keyframes_hold_a_foot_and_hand_over_to_the_simulation(table):
+    world = wobble.World(wobble.WorldOptions(dt=0.01))
+    world.add_body(table)
+    world.set_state(0, [0, 0, 0, 0, 0, 0, 0])
+    foot = world.point_positions(0)[5].copy()  # mass point 5: the left foot, lattice (0, 0)
+    keys = wobble.KeyframeController(world, 0, [0.0, 0.5, 1.0], [[0, 0, 0, 0], [0, 0, 0.4, 0], [0, 0, 0, 0]],
+                                     hold=[0.0, 0.0])
+    world.add_controller(keys)
+    world.step(25)  # halfway up the squash: γ_vsquash = 0.2, the foot where it was
+    assert world.q(0)[5] == pytest.approx(0.2, abs=1e-12)
+    np.testing.assert_allclose(world.point_positions(0)[5], foot, atol=1e-9)
+    world.step(75)
+    assert keys.finished()
+    keys.release(world)
+    world.remove_controller(keys)
+    world.step(10)  # simulated again
+    with pytest.raises(wobble.InputError, match="keyframes"):
+        wobble.KeyframeController(world, 0, [0.0, 0.5], [[0, 0, 0, 0]])
