@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "support/test_bodies.h"
+#include "wobble/core/errors.h"
+#include "wobble/core/interrupt.h"
 #include "wobble/fit/pose_fit.h"
 #include "wobble/formats/parse_error.h"
 #include "wobble/formats/target_file.h"
@@ -73,6 +75,16 @@ std::vector<Correspondence> NoisyTargets(const BodyModel& body, unsigned seed) {
   t[7].position += Eigen::Vector2d(-60, 40);
   t[15].position += Eigen::Vector2d(0, 90);
   return t;
+}
+
+// Ctrl-C (the flag of core/interrupt.h the CLI's SIGINT handler raises) aborts the Ceres solve
+// at its next iteration and the fit ends with Interrupted, not with a half-done result.
+TEST(PoseFit, CtrlCStopsTheSolveWithInterrupted) {
+  const BodyModel body = Table();
+  RequestInterrupt();
+  EXPECT_THROW(fit::FitPose(body, TargetsFrom(body, KnownQ()), PoseFitOptions()), Interrupted);
+  ClearInterrupt();
+  EXPECT_TRUE(fit::FitPose(body, TargetsFrom(body, KnownQ()), PoseFitOptions()).report.usable);
 }
 
 TEST(PoseFit, RobustLossRecoversQDespiteNoiseAndOutliers) {

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "wobble/script/interpreter.h"
+#include "wobble/core/interrupt.h"
 #include "wobble/synth/anneal.h"
 #ifdef WOBBLE_HAVE_PAGMO
 #include "wobble/synth/cmaes.h"
@@ -145,6 +146,20 @@ TEST(Cmaes, ReproducibleFromItsSeedAndImprovesOnTheInitialController) {
   EXPECT_EQ(results[0].trials, 6 + 8 * 6);
   EXPECT_LT(results[0].best_outcome.cost, results[0].initial_outcome.cost);
   for (size_t i = 1; i < results[0].history.size(); ++i) EXPECT_LE(results[0].history[i].best, results[0].history[i - 1].best);
+
+  // Ctrl-C before the first generation: the initial population only, marked interrupted
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  std::istringstream setup("load_obj table.obj\nload_def table_modes.def\npose 0.1 0 0.4\npose 0 -0.1 0.4\n");
+  interp.RunStream(setup, "cmaes.wob", kData);
+  synth::CmaesOptions o;
+  o.generations = 5;
+  o.population = 6;
+  RequestInterrupt();
+  const synth::AnnealResult stopped = synth::Cmaes(interp.SynthesisProblem(), interp.pose_graph(), o);
+  ClearInterrupt();
+  EXPECT_TRUE(stopped.interrupted);
+  EXPECT_EQ(stopped.history.size(), 1u);
 }
 #endif
 

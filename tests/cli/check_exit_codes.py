@@ -248,6 +248,33 @@ def main():
         proc.kill()
         expect(False, "simulate + Ctrl-C: stopped within 30 s")
 
+    # Ctrl-C in an optimiser: anneal and cmaes stop between batches, adopt the best so far, 130
+    setup = []
+    with open(os.path.join(data, "bounding_table.wob")) as f:
+        for line in f:
+            if line.startswith("anneal"):
+                break
+            if line.startswith(("load_obj", "load_def")):
+                line = line.split()[0] + " " + os.path.join(data, line.split()[1]) + "\n"
+            if not line.startswith("set anneal_csv"):
+                setup.append(line)
+    for command, round_name in (("anneal", "iteration"), ("cmaes", "generation")):
+        long_run = script(f"long_{command}.wob", "".join(setup) + f"set max_steps 1e15\n{command} 1000000\n")
+        proc = subprocess.Popen([wobble, "run", long_run], cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        time.sleep(1.5)
+        proc.send_signal(signal.SIGINT)
+        try:
+            _, err = proc.communicate(timeout=60)
+            if "built without pagmo2" in err:
+                print(f"skip {command} + Ctrl-C: built without pagmo2")
+                continue
+            expect(proc.returncode == 130, f"{command} + Ctrl-C: exit {proc.returncode} (130 expected)")
+            expect(f"{command} stopped by Ctrl-C after {round_name}" in err and "best pose graph so far" in err,
+                   f"{command} + Ctrl-C: says how far it got: {err.strip()[-300:]}")
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            expect(False, f"{command} + Ctrl-C: stopped within 60 s")
+
     if failures:
         print(f"{len(failures)} failure(s)")
         sys.exit(1)
