@@ -112,6 +112,16 @@ void BindScript(py::module_& m) {
             return py::cast(std::make_shared<record::Trajectory>(*t));  // a copy: the scene's may grow
           },
           "a copy of the Trajectory of the FFD object's last simul or keyframe (None before one)")
+      .def_property_readonly(
+          "scene_record",
+          [](PyInterpreter& p) -> py::object {
+            auto t = p.interp().scene().recorded();
+            if (!t) return py::none();
+            return py::cast(std::make_shared<record::Trajectory>(*t));
+          },
+          "a copy of the Witkin & Welch scene's frames (`record FPS`; every body, prefixed NAME.), None\n"
+          "before `record`. (A script's `render` needs the command line's renderer: from Python, use\n"
+          "wobble.render on last_run.)")
       .def_property_readonly("last_anneal", [](PyInterpreter& p) { return p.interp().last_anneal(); },
                              "the last anneal's or cmaes' AnnealResult (None before one)")
       .def("replay_script", [](PyInterpreter& p) { return p.interp().ReplayScript(); },

@@ -218,6 +218,7 @@ class Interpreter:
     max_steps: int
     max_record_mb: float
     last_run: Optional[Trajectory]
+    scene_record: Optional[Trajectory]
     last_anneal: Optional[AnnealResult]
     def __init__(self, echo: bool = False) -> None: ...
     def run_file(self, path: str) -> None: ...
