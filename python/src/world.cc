@@ -143,7 +143,8 @@ void BindWorld(py::module_& m) {
   py::class_<World>(m, "World",
                     "THE world: FFD bodies (q = [tx, ty, θ, γ1..γD], Eq. 4.4), the ground, springs, constraints,\n"
                     "one clock and one status. Every accepted state is finite, or the world stops and\n"
-                    "step() raises SimulationStopped.")
+                    "step() raises SimulationStopped. Not thread-safe: one World per thread (steps\n"
+                    "release the GIL).")
       .def(py::init<WorldOptions>(), py::arg("options") = WorldOptions())
       .def("add_body", [](World& w, std::shared_ptr<BodyModel> body) { return w.AddBody(body); }, py::arg("body"),
            "Adds an FFD body at q = 0, at rest; returns its index.")
