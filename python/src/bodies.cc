@@ -2,9 +2,15 @@
 // body is made of, as numpy arrays.
 #include "bindings.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "wobble/analysis/conditioning.h"
 #include "wobble/body/body_model.h"
+#include "wobble/body/linear_body.h"
+#include "wobble/body/linear_shapes.h"
 #include "wobble/core/errors.h"
+#include "wobble/core/limits.h"
 #include "wobble/core/types.h"
 #include "wobble/scene/ffd_object.h"
 
@@ -77,6 +83,26 @@ std::vector<Eigen::MatrixXd> Outline(const BodyModel& body, const py::object& q_
   return out;
 }
 
+LinearOrder ParseOrder(const std::string& order) {
+  if (order == "affine") return LinearOrder::kAffine;
+  if (order == "quadratic") return LinearOrder::kQuadratic;
+  throw InputError("order: '" + order + "' is not affine or quadratic");
+}
+
+int CheckDim(int dim) {
+  if (dim != 2 && dim != 3) throw InputError("dim must be 2 or 3, got " + std::to_string(dim));
+  return dim;
+}
+
+// A grid of per_side^dim points (pyramids: per level), within kMaxLinearPoints.
+int CheckPerSide(int per_side, int dim, double layers) {
+  CheckedCount(std::pow(double(per_side), dim) * layers, 1, kMaxLinearPoints, "the body's mass points");
+  if (per_side < 2) throw InputError("per_side must be at least 2");
+  return per_side;
+}
+
+std::shared_ptr<LinearBodyModel> Linear(LinearBodyDef def) { return std::make_shared<LinearBodyModel>(std::move(def)); }
+
 }  // namespace
 
 py::array_t<double, py::array::c_style> AsMatrix(const py::handle& h, long rows, long cols, const std::string& what) {
@@ -140,6 +166,73 @@ void BindBodies(py::module_& m) {
         return "<BodyModel " + b.name() + ": " + std::to_string(b.num_points()) + " mass points, " +
                std::to_string(b.num_modes()) + " modes>";
       });
+
+  py::class_<LinearBodyModel, std::shared_ptr<LinearBodyModel>>(
+      m, "LinearBodyModel",
+      "A Witkin & Welch body (1990 §3): x = R p(u) with p affine [u, 1] or quadratic, the constant mass\n"
+      "matrix M = Σ m_k p(u_k) p(u_k)ᵀ (Eq. 5) inverted once. Make one with linear_box, linear_pyramid\n"
+      "or linear_body.")
+      .def_property_readonly("name", &LinearBodyModel::name)
+      .def_property_readonly("dim", &LinearBodyModel::dim)
+      .def_property_readonly("order", [](const LinearBodyModel& b) { return b.order() == LinearOrder::kAffine ? "affine" : "quadratic"; })
+      .def_property_readonly("basis_size", &LinearBodyModel::basis_size, "n: the columns of R")
+      .def_property_readonly("num_points", &LinearBodyModel::num_points)
+      .def_property_readonly("total_mass", &LinearBodyModel::total_mass)
+      .def_property_readonly("mass_matrix", &LinearBodyModel::mass_matrix, "M (n x n), Eq. 5")
+      .def_property_readonly("points",
+                             [](const LinearBodyModel& b) {
+                               Eigen::MatrixXd u(b.num_points(), b.dim());
+                               for (int k = 0; k < b.num_points(); ++k) u.row(k) = b.def().points[k].transpose();
+                               return u;
+                             },
+                             "(num_points, dim) undeformed coordinates u_k")
+      .def_property_readonly("masses", [](const LinearBodyModel& b) { return b.def().masses; })
+      .def("rest_state", &LinearBodyModel::RestState, "R of the rest shape: [I | 0 | 0]")
+      .def("__repr__", [](const LinearBodyModel& b) {
+        return "<LinearBodyModel " + b.name() + ": " + std::to_string(b.dim()) + "D, " + std::to_string(b.num_points()) +
+               " mass points>";
+      });
+
+  m.def(
+      "linear_box",
+      [](int dim, const Eigen::VectorXd& half_extents, int per_side, double mass, const std::string& order,
+         const std::string& name) {
+        CheckPerSide(per_side, CheckDim(dim), 1);
+        if (half_extents.size() != dim || !(half_extents.array() > 0).all() || !half_extents.allFinite())
+          throw InputError("half_extents: expected " + std::to_string(dim) + " finite numbers > 0");
+        if (!(mass > 0) || !std::isfinite(mass)) throw InputError("mass must be a finite number > 0");
+        return Linear(MakeBoxBody(name, dim, ParseOrder(order), half_extents, per_side, mass));
+      },
+      py::arg("dim"), py::arg("half_extents"), py::kw_only(), py::arg("per_side") = 2, py::arg("mass") = 1.0,
+      py::arg("order") = "affine", py::arg("name") = "box",
+      "A box [-half, half] filled with per_side points per axis, equal masses summing to `mass`.");
+  m.def(
+      "linear_pyramid",
+      [](int dim, double half_width, double height, int levels, int per_side, double mass, const std::string& order,
+         const std::string& name) {
+        CheckPerSide(per_side, CheckDim(dim), std::max(levels, 1));
+        if (!(mass > 0) || !std::isfinite(mass)) throw InputError("mass must be a finite number > 0");
+        return Linear(MakePyramidBody(name, dim, ParseOrder(order), half_width, height, levels, per_side, mass));
+      },
+      py::arg("dim"), py::arg("half_width"), py::arg("height"), py::kw_only(), py::arg("levels") = 3,
+      py::arg("per_side") = 2, py::arg("mass") = 1.0, py::arg("order") = "affine", py::arg("name") = "pyramid",
+      "A pyramid (2D: a triangle) of `levels` point layers and an apex, as Witkin & Welch's Fig. 3.");
+  m.def(
+      "linear_body",
+      [](const Eigen::MatrixXd& points, const std::vector<double>& masses, const std::string& order, const std::string& name) {
+        LinearBodyDef def;
+        def.name = name;
+        def.dim = CheckDim(int(points.cols()));
+        def.order = ParseOrder(order);
+        if (long(masses.size()) != points.rows())
+          throw InputError("masses: expected " + std::to_string(points.rows()) + " masses, one per point");
+        CheckedCount(double(points.rows()), 1, kMaxLinearPoints, "the body's mass points");
+        for (int k = 0; k < points.rows(); ++k) def.points.push_back(points.row(k).transpose());
+        def.masses = masses;
+        return Linear(std::move(def));
+      },
+      py::arg("points"), py::arg("masses"), py::kw_only(), py::arg("order") = "affine", py::arg("name") = "body",
+      "A linear body from its mass points (K, dim) and masses (K,) (InputError when M is singular).");
 
   m.def("load_body", &LoadBody, py::arg("object"), py::arg("modes") = std::vector<std::string>(),
         py::arg("check") = true,

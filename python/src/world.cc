@@ -17,10 +17,32 @@ Eigen::VectorXd AsVector(const py::handle& h, long n, const std::string& what) {
   return Eigen::Map<const Eigen::VectorXd>(a.data(), n);
 }
 
-void CheckBody(const World& w, int body) {
+void CheckIndex(const World& w, int body) {
   if (body < 0 || body >= w.num_bodies())
     throw InputError("body " + std::to_string(body) + ": the world has " + std::to_string(w.num_bodies()) + " bodies");
+}
+
+void CheckBody(const World& w, int body) {
+  CheckIndex(w, body);
   if (w.kind(body) != BodyKind::kFfd) throw InputError("body " + std::to_string(body) + " is not an FFD body");
+}
+
+void CheckLinear(const World& w, int body) {
+  CheckIndex(w, body);
+  if (w.kind(body) != BodyKind::kLinear) throw InputError("body " + std::to_string(body) + " is not a linear body");
+}
+
+// A material point: mass point k, or u (FFD bodies: lattice (s, t); linear bodies: undeformed
+// coordinates); the world checks both.
+MaterialPoint PointOf(const World& w, int body, const py::object& mass_point, const py::object& u) {
+  CheckIndex(w, body);
+  if (mass_point.is_none() == u.is_none()) throw InputError("give exactly one of mass_point or u");
+  if (!mass_point.is_none()) {
+    const int k = mass_point.cast<int>();
+    if (k < 0) throw InputError("mass_point must be at least 0");
+    return MassPointOf(body, k);
+  }
+  return At(body, u.cast<Eigen::VectorXd>());
 }
 
 py::dict ForcesDict(const ForceBreakdown<double>& f) {
@@ -196,7 +218,8 @@ void BindWorld(py::module_& m) {
           [](World& w, double t_end) { RunWorld(w, t_end, -1); },
           py::arg("t_end"), "Steps until the time reaches t_end (to half a step).")
       .def(
-          "energies", [](const World& w, int body) { return w.ComputeEnergies(body); }, py::arg("body") = 0)
+          "energies", [](const World& w, int body) { CheckIndex(w, body); return w.ComputeEnergies(body); },
+          py::arg("body") = 0)
       .def("total_energy", &World::TotalEnergy, "every body's every term")
       .def(
           "contacts",
@@ -236,15 +259,61 @@ void BindWorld(py::module_& m) {
           py::arg("body") = 0, "free q̈ = M⁻¹ (Q − velocity terms), no constraint forces")
       .def(
           "add_nail",
-          [](World& w, int body, int mass_point, const py::object& where) {
-            CheckBody(w, body);
-            if (mass_point < 0 || mass_point >= w.body(body).num_points())
-              throw InputError("mass_point " + std::to_string(mass_point) + ": the body has " +
-                               std::to_string(w.body(body).num_points()) + " mass points");
-            return w.AddNail(MassPointOf(body, mass_point), where.is_none() ? Eigen::VectorXd() : AsVector(where, 2, "where"));
+          [](World& w, int body, const py::object& mass_point, const py::object& u, const py::object& where) {
+            const MaterialPoint p = PointOf(w, body, mass_point, u);
+            return w.AddNail(p, where.is_none() ? Eigen::VectorXd() : AsVector(where, w.dim(body), "where"));
           },
-          py::arg("body"), py::arg("mass_point"), py::arg("where") = py::none(),
-          "Nails a mass point where it is now (or at `where`); returns the constraint's id.")
+          py::arg("body"), py::arg("mass_point") = py::none(), py::kw_only(), py::arg("u") = py::none(),
+          py::arg("where") = py::none(),
+          "Nails a material point (mass_point k, or u) where it is now, or at `where`; returns the\n"
+          "constraint's id. Constraints are held by Lagrange multipliers (Witkin & Welch Eq. 6-10).")
+      .def(
+          "add_attachment",
+          [](World& w, int a, int b, const py::object& a_mass_point, const py::object& a_u, const py::object& b_mass_point,
+             const py::object& b_u) { return w.AddAttachment(PointOf(w, a, a_mass_point, a_u), PointOf(w, b, b_mass_point, b_u)); },
+          py::arg("a"), py::arg("b"), py::kw_only(), py::arg("a_mass_point") = py::none(), py::arg("a_u") = py::none(),
+          py::arg("b_mass_point") = py::none(), py::arg("b_u") = py::none(),
+          "Joins a point of body a to a point of body b; returns the constraint's id.")
+      .def(
+          "point_position",
+          [](const World& w, int body, const py::object& mass_point, const py::object& u) {
+            return w.PointPosition(PointOf(w, body, mass_point, u));
+          },
+          py::arg("body"), py::arg("mass_point") = py::none(), py::kw_only(), py::arg("u") = py::none(),
+          "World position of a material point of any body")
+      .def(
+          "add_linear_body",
+          [](World& w, std::shared_ptr<LinearBodyModel> model, double rigidity, double volume, double damping,
+             double bending) {
+            for (double v : {rigidity, volume, damping, bending})
+              if (!(v >= 0) || !std::isfinite(v)) throw InputError("material constants must be finite and >= 0");
+            return w.AddLinearBody(model, AffineMaterial{rigidity, volume, damping, bending});
+          },
+          py::arg("model"), py::kw_only(), py::arg("rigidity") = 0.0, py::arg("volume") = 0.0, py::arg("damping") = 0.0,
+          py::arg("bending") = 0.0,
+          "Adds a Witkin & Welch body at its rest state, at rest, with the affine energies k_e, k_c, k_d,\n"
+          "k_q (rigidity, volume, damping, bending); returns its index.")
+      .def(
+          "linear_state",
+          [](const World& w, int body) {
+            CheckLinear(w, body);
+            return py::make_tuple(Eigen::MatrixXd(w.linear_R(body)), Eigen::MatrixXd(w.linear_R_dot(body)));
+          },
+          py::arg("body"), "(R, Ṙ) of a linear body, each d x n: x = R p(u)")
+      .def(
+          "set_linear_state",
+          [](World& w, int body, const Eigen::MatrixXd& R, const py::object& R_dot) {
+            CheckLinear(w, body);
+            const Eigen::MatrixXd& now = w.linear_R(body);
+            if (R.rows() != now.rows() || R.cols() != now.cols())
+              throw InputError("R: expected shape (" + std::to_string(now.rows()) + ", " + std::to_string(now.cols()) + ")");
+            Eigen::MatrixXd Rd = R_dot.is_none() ? Eigen::MatrixXd::Zero(R.rows(), R.cols()) : R_dot.cast<Eigen::MatrixXd>();
+            if (Rd.rows() != R.rows() || Rd.cols() != R.cols()) throw InputError("R_dot: expected the shape of R");
+            w.SetLinearState(body, R, Rd);
+          },
+          py::arg("body"), py::arg("R"), py::arg("R_dot") = py::none(), "Sets R and Ṙ (zero when not given).")
+      .def("kind", [](const World& w, int body) { CheckIndex(w, body); return w.kind(body) == BodyKind::kFfd ? "ffd" : "linear"; },
+           py::arg("body"), "'ffd' or 'linear'")
       .def("add_controller", &World::AddController, py::arg("controller"), py::keep_alive<1, 2>(),
            "Calls the controller around every step from now on.")
       .def(
