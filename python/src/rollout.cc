@@ -26,8 +26,10 @@ struct RolloutResult {
 py::array_t<double, py::array::c_style> Rows(const py::handle& h, long n, const std::string& what) {
   auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
   if (!a) throw InputError(what + ": expected an array of numbers");
-  if (a.ndim() == 1) return AsMatrix(a.reshape({py::ssize_t(1), a.shape(0)}), 1, n, what);
-  return AsMatrix(a, a.ndim() == 2 ? a.shape(0) : -1, n, what + " (N, " + std::to_string(n) + ")");
+  if (a.ndim() == 1) return AsMatrix(a.reshape({py::ssize_t(1), a.shape(0)}), 1, n, what + " (one state)");
+  if (a.ndim() != 2)
+    throw InputError(what + ": expected shape (N, " + std::to_string(n) + "), got " + std::to_string(a.ndim()) + " dimensions");
+  return AsMatrix(a, a.shape(0), n, what + " (N, " + std::to_string(n) + ")");
 }
 
 RolloutResult Rollout(std::shared_ptr<BodyModel> body, const py::object& q0_in, const py::object& qd0_in, long steps,
