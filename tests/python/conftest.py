@@ -31,3 +31,16 @@ def no_ground(integrator="thesis", dt=0.01, gravity=True):
     options = wobble.WorldOptions(dt=dt, integrator=integrator, gravity_on=gravity)
     options.ground.enabled = False
     return options
+
+
+def bounding_table(data):
+    """An Interpreter that ran data/bounding_table.wob up to (not including) its anneal: the
+    synthesis problem of §5.2."""
+    interp = wobble.Interpreter()
+    lines = []
+    for line in (data / "bounding_table.wob").read_text().splitlines():
+        if line.startswith("anneal"):
+            break
+        lines.append(line)
+    interp.run("\n".join(lines), name=str(data / "bounding_table.wob"), dir=str(data))
+    return interp

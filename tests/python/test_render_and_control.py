@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import wobble
-from conftest import no_ground
+from conftest import bounding_table, no_ground
 
 needs_display = pytest.mark.skipif(not hasattr(wobble, "render") or not wobble.has_display(),
                                    reason="rendering needs wobble's VTK pipelines and an X display (xvfb-run)")
@@ -45,13 +45,7 @@ def test_render_writes_frames_filmstrip_and_paraview_series(table, tmp_path):
 
 
 def test_a_pose_graph_controller_drives_the_active_modes(data):
-    interp = wobble.Interpreter()
-    lines = []
-    for line in (data / "bounding_table.wob").read_text().splitlines():
-        if line.startswith("anneal"):
-            break
-        lines.append(line)
-    interp.run("\n".join(lines), dir=str(data))
+    interp = bounding_table(data)
     problem, graph = interp.synthesis_problem(), interp.pose_graph
     world = wobble.World(problem.options)
     world.add_body(problem.body)

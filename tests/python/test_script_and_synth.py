@@ -4,18 +4,7 @@ import numpy as np
 import pytest
 
 import wobble
-
-
-def bounding_table(data):
-    """data/bounding_table.wob up to (not including) its anneal: the synthesis problem of §5.2."""
-    interp = wobble.Interpreter()
-    lines = []
-    for line in (data / "bounding_table.wob").read_text().splitlines():
-        if line.startswith("anneal"):
-            break
-        lines.append(line)
-    interp.run("\n".join(lines), name=str(data / "bounding_table.wob"), dir=str(data))
-    return interp
+from conftest import bounding_table
 
 
 def test_a_script_run_equals_the_world_from_python(data, table):
