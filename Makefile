@@ -147,11 +147,13 @@ bench-python: configure
 # with -merge=1), crashes to $(FUZZ_BUILD)/artifacts/. Prints the executions of each target.
 FUZZ_BUILD   ?= build-fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS ?= object deformation targets trajectory_csv script world_step
+FUZZ_TARGETS ?= object deformation object3 deformation3 targets trajectory_csv script world_step
 # the readers take files of any size; scripts and world states are kept short (each input is
 # a simulation), and a script that runs longer than 10 s is reported as a hang
 FUZZ_FLAGS_object         := -max_len=4096
 FUZZ_FLAGS_deformation    := -max_len=4096
+FUZZ_FLAGS_object3        := -max_len=4096
+FUZZ_FLAGS_deformation3   := -max_len=4096
 FUZZ_FLAGS_targets        := -max_len=4096
 FUZZ_FLAGS_trajectory_csv := -max_len=8192
 FUZZ_FLAGS_script         := -max_len=4096 -timeout=10
@@ -171,6 +173,7 @@ fuzz: deps fuzz-deps
 	  log=$(FUZZ_BUILD)/fuzz_$$t.log
 	  case $$t in
 	    object) flags="$(FUZZ_FLAGS_object)" ;; deformation) flags="$(FUZZ_FLAGS_deformation)" ;;
+	    object3) flags="$(FUZZ_FLAGS_object3)" ;; deformation3) flags="$(FUZZ_FLAGS_deformation3)" ;;
 	    targets) flags="$(FUZZ_FLAGS_targets)" ;; trajectory_csv) flags="$(FUZZ_FLAGS_trajectory_csv)" ;;
 	    script) flags="$(FUZZ_FLAGS_script)" ;; world_step) flags="$(FUZZ_FLAGS_world_step)" ;; *) flags="" ;;
 	  esac

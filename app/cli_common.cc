@@ -26,6 +26,19 @@ void AddBodyFlags(CLI::App* cmd, BodyFiles* files) {
       ->type_name("FILE[,FILE...]");
 }
 
+namespace {
+// Refuses a mode set that cannot be simulated, and warns of a poor one.
+template <class Body> void CheckLoadedModes(const Body& body, const std::string& object_file) {
+  const analysis::ModeSetReport report = analysis::CheckModeSet(body);
+  if (report.level == analysis::ModeSetReport::Level::kError) {
+    std::string msg = "the modes of " + object_file + " cannot be simulated:";
+    for (const std::string& m : report.messages) msg += "\n  " + m;
+    throw std::invalid_argument(msg + "\n(wobble condition check explains the mode set)");
+  }
+  for (const std::string& m : report.messages) std::cerr << "wobble: warning: " << m << "\n";
+}
+}  // namespace
+
 std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_modes) {
   BodyDef def = formats::ReadObjectFile(files.object);
   std::vector<DeformationMode> modes;
@@ -35,15 +48,20 @@ std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_mod
     modes.insert(modes.end(), more.begin(), more.end());
   }
   auto body = std::make_shared<const BodyModel>(std::move(def), std::move(modes));
-  if (check_modes) {
-    const analysis::ModeSetReport report = analysis::CheckModeSet(*body);
-    if (report.level == analysis::ModeSetReport::Level::kError) {
-      std::string msg = "the modes of " + files.object + " cannot be simulated:";
-      for (const std::string& m : report.messages) msg += "\n  " + m;
-      throw std::invalid_argument(msg + "\n(wobble condition check explains the mode set)");
-    }
-    for (const std::string& m : report.messages) std::cerr << "wobble: warning: " << m << "\n";
+  if (check_modes) CheckLoadedModes(*body, files.object);
+  return body;
+}
+
+std::shared_ptr<const BodyModel3> LoadBody3(const BodyFiles& files, bool check_modes) {
+  BodyDef3 def = formats::ReadObjectFile3(files.object);
+  std::vector<DeformationMode3> modes;
+  for (const std::string& path : files.modes) {
+    if (path.empty()) throw UsageError("--modes: empty file name in the list");
+    std::vector<DeformationMode3> more = formats::ReadDeformationFile3(path, def.lattice);
+    modes.insert(modes.end(), more.begin(), more.end());
   }
+  auto body = std::make_shared<const BodyModel3>(std::move(def), std::move(modes));
+  if (check_modes) CheckLoadedModes(*body, files.object);
   return body;
 }
 

@@ -45,6 +45,8 @@ void AddBodyFlags(CLI::App* cmd, BodyFiles* files);
 // (nearly dependent modes, modes the mass cannot see) go to stderr, and a dependent set — M
 // singular — is refused with std::invalid_argument.
 std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_modes = true);
+// The same for a 3D object file ('dimension 3') and its 3D deformation files.
+std::shared_ptr<const BodyModel3> LoadBody3(const BodyFiles& files, bool check_modes = true);
 
 // Gravity and ground flags, shared by simulate and inspect.
 struct WorldFlags {

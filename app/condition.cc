@@ -11,6 +11,7 @@
 
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/csv.h"
+#include "wobble/formats/object_file.h"
 #include "wobble/analysis/conditioning.h"
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/object_file.h"
@@ -275,16 +276,28 @@ int RunConditionTime(const ConditionTimeArgs& a) {
 #endif
 }
 
+namespace {
+int PrintModeSetReport(const analysis::ModeSetReport& r, const std::string& body_name, const ConditionCheckArgs& a);
+}  // namespace
+
 int RunConditionCheck(const ConditionCheckArgs& a) {
-  const std::shared_ptr<const BodyModel> body = LoadBody(a.files, /*check_modes=*/false);
   RequirePositive(a.warn_angle_deg, "--warn-angle");
   RequireNonNegative(a.warn_visibility, "--warn-visibility");
   analysis::ModeCheckOptions options;
   options.warn_angle_deg = a.warn_angle_deg;
   options.warn_visibility = a.warn_visibility;
-  const analysis::ModeSetReport r = analysis::CheckModeSet(*body, ParseCoordinates(a.q, "--q", *body), options);
+  if (formats::ObjectFileDimension(a.files.object) == 3) {
+    if (!a.q.empty()) throw UsageError("--q: a 3D body is checked at rest (its orientation is no coordinate)");
+    const std::shared_ptr<const BodyModel3> body = LoadBody3(a.files, /*check_modes=*/false);
+    return PrintModeSetReport(analysis::CheckModeSet(*body, options), body->name(), a);
+  }
+  const std::shared_ptr<const BodyModel> body = LoadBody(a.files, /*check_modes=*/false);
+  return PrintModeSetReport(analysis::CheckModeSet(*body, ParseCoordinates(a.q, "--q", *body), options), body->name(), a);
+}
 
-  std::cout << "mode set of '" << body->name() << "': " << analysis::LevelName(r.level) << "\n";
+namespace {
+int PrintModeSetReport(const analysis::ModeSetReport& r, const std::string& body_name, const ConditionCheckArgs& a) {
+  std::cout << "mode set of '" << body_name << "': " << analysis::LevelName(r.level) << "\n";
   for (const std::string& m : r.messages) std::cout << "  " << m << "\n";
   std::cout << "cond(M) = " << CondText(r.condition) << ", scaled " << r.condition.cond_scaled << "\n";
   std::cout << "mode          visibility  angle to the rest (deg)  closest combination\n";
@@ -323,5 +336,7 @@ int RunConditionCheck(const ConditionCheckArgs& a) {
   }
   return r.level == analysis::ModeSetReport::Level::kError ? kExitBadInput : kExitOk;
 }
+
+}  // namespace
 
 }  // namespace wobble::app

@@ -6,12 +6,15 @@
 // contact), and the moment-based mass matrix against the per-point reference of Eq. 4.10.
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <filesystem>
+#include <numeric>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "support/reference.h"
+#include "wobble/dynamics/step3.h"
 #include "wobble/world/world.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
@@ -211,6 +214,72 @@ void BM_MassMatrixReference(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_MassMatrixReference);
+
+
+// ---- the 3D table (data/table3.obj, data/table3_modes.def3) ----------------------------
+
+// The 3D table with its four modes; `points` > 0 redistributes its mass over that many points:
+// 20 keeps the legs' 12 and 8 of the top's 15; more repeat the file's 27 with small offsets
+// (same total mass, same lattice), to show that a step out of contact does not depend on N.
+std::shared_ptr<const BodyModel3> Table3(int points = 0) {
+  BodyDef3 def = formats::ReadObjectFile3(kDataDir + "/table3.obj");
+  if (points > 0) {
+    const double total = std::accumulate(def.masses.begin(), def.masses.end(), 0.0);
+    const std::vector<Eigen::Vector3d> file = def.mass_positions;  // 15 top, then 12 leg points
+    def.mass_positions.clear();
+    if (points == 20) {
+      for (int k : {0, 2, 4, 5, 9, 10, 12, 14}) def.mass_positions.push_back(file[k]);
+      for (int k = 15; k < 27; ++k) def.mass_positions.push_back(file[k]);
+    } else {
+      for (int k = 0; k < points; ++k) {
+        const Eigen::Vector3d jitter(std::sin(1.3 * k), -std::abs(std::cos(0.7 * k)), std::sin(2.9 * k));
+        Eigen::Vector3d p = file[k % file.size()] + 2.0 * jitter;
+        def.mass_positions.push_back(p.cwiseMax(Eigen::Vector3d::Zero()).cwiseMin(Eigen::Vector3d(300, 100, 200)));
+      }
+    }
+    def.masses.assign(def.mass_positions.size(), total / double(def.mass_positions.size()));
+  }
+  std::vector<DeformationMode3> modes = formats::ReadDeformationFile3(kDataDir + "/table3_modes.def3", def.lattice);
+  return std::make_shared<const BodyModel3>(def, modes);
+}
+
+void TimeSteps3(benchmark::State& state, const BodyModel3& body, const WorldParams3& w, double dt,
+                BodyState3<double>* s) {
+  for (auto _ : state) {
+    const StepStatus st = StepBody3(body, w, Integrator::kThesis, dt, s);
+    if (!st.ok()) {
+      state.SkipWithError(StatusCodeName(st.code).c_str());
+      break;
+    }
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["contacts"] = double(s->contacts.size());
+}
+
+// Resting on its four feet after a drop, as BM_TableRestingOnGround does for the 2D table.
+void BM_Table3RestingOnGround(benchmark::State& state) {
+  const std::shared_ptr<const BodyModel3> body = Table3();
+  WorldParams3 w;
+  w.ground.enabled = true;
+  BodyState3<double> s = RestState3<double>(*body);
+  s.t.y() = 10.0;
+  for (int i = 0; i < 3000; ++i)
+    if (!StepBody3(*body, w, Integrator::kThesis, 0.01, &s).ok()) {
+      state.SkipWithError("the table did not settle");
+      return;
+    }
+  TimeSteps3(state, *body, w, 0.01, &s);
+}
+BENCHMARK(BM_Table3RestingOnGround);
+
+// Falling freely with no ground: 27 points (the file) against 20 and 1,000 resampled points.
+void BM_Table3OutOfContact(benchmark::State& state) {
+  const std::shared_ptr<const BodyModel3> body = Table3(int(state.range(0)));
+  const WorldParams3 w;
+  BodyState3<double> s = RestState3<double>(*body);
+  TimeSteps3(state, *body, w, 0.01, &s);
+}
+BENCHMARK(BM_Table3OutOfContact)->ArgName("points")->Arg(0)->Arg(20)->Arg(1000);
 
 }  // namespace
 }  // namespace wobble

@@ -11,14 +11,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::vector<DeformationMode> modes = formats::ParseDeformations(in, "fuzz.def");
     if (modes.empty()) std::abort();  // the reader promises at least one mode
     for (const DeformationMode& m : modes) {
-      if (m.num_s < 2 || m.num_t < 2) std::abort();
+      if (m.lattice_size[0] < 2 || m.lattice_size[1] < 2) std::abort();
       if (!(m.stiffness >= 0) || !(m.damping >= 0)) std::abort();
-      if (m.displacement.size() != size_t(m.num_s) * size_t(m.num_t)) std::abort();
+      if (m.displacement.size() != size_t(m.lattice_size[0]) * size_t(m.lattice_size[1])) std::abort();
       for (const Eigen::Vector2d& d : m.displacement)
         if (!d.allFinite()) std::abort();
     }
     const BodyModel& table = *fuzz::TableBody();
-    if (modes.front().num_s == table.lattice().num_s() && modes.front().num_t == table.lattice().num_t() &&
+    if (modes.front().lattice_size == table.lattice().sizes() &&
         modes.size() <= 8)
       BodyModel body(table.def(), std::move(modes));
   });

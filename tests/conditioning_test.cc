@@ -12,6 +12,8 @@
 #include "support/test_bodies.h"
 #include "wobble/analysis/conditioning.h"
 #include "support/reference.h"
+#include "wobble/formats/deformation_file.h"
+#include "wobble/formats/object_file.h"
 
 namespace wobble::analysis {
 namespace {
@@ -188,6 +190,40 @@ TEST(ModeCheck, ZeroAndMasslessModesAreErrors) {
   const ModeSetReport r = CheckModeSet(BodyModel(def, {testing::Bend(), zero}));
   EXPECT_EQ(r.level, ModeSetReport::Level::kError);
   EXPECT_NE(r.messages[0].find("'nothing' is zero"), std::string::npos) << r.messages[0];
+}
+
+
+// ---- 3D bodies ----
+
+TEST(conditioning3D, TheTableModesAreIndependent) {
+  const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
+  const BodyModel3 body(def, formats::ReadDeformationFile3(std::string(WOBBLE_DATA_DIR) + "/table3_modes.def3", def.lattice));
+  const ModeSetReport r = CheckModeSet(body);
+  EXPECT_EQ(r.level, ModeSetReport::Level::kOk) << (r.messages.empty() ? "" : r.messages[0]);
+  ASSERT_EQ(r.dofs.size(), 10u);
+  EXPECT_EQ(r.dofs[4], "rotation y");
+  EXPECT_FALSE(r.condition.singular);
+  EXPECT_GT(r.smallest_angle_deg, 20.0);
+}
+
+// A "mode" that is a rigid turn about the vertical: dependent on the rotation dof, and named so.
+TEST(conditioning3D, ARigidTurnAsAModeIsFoundWithTheRotation) {
+  const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
+  std::vector<DeformationMode3> modes =
+      formats::ReadDeformationFile3(std::string(WOBBLE_DATA_DIR) + "/table3_modes.def3", def.lattice);
+  DeformationMode3 turn;
+  turn.name = "turn";
+  turn.lattice_size = def.lattice.sizes();
+  for (const Eigen::Vector3d& p : def.lattice.RestPoints())
+    turn.displacement.push_back(Eigen::Vector3d::UnitY().cross(p - Eigen::Vector3d(150, 50, 100)));
+  modes.push_back(turn);
+  const ModeSetReport r = CheckModeSet(BodyModel3(def, modes));
+  EXPECT_EQ(r.level, ModeSetReport::Level::kError);
+  EXPECT_EQ(r.smallest_angle_deg, 0.0);
+  const ModeFinding& f = r.modes.back();
+  bool names_rotation = false;
+  for (const Participant& p : f.closest_combination) names_rotation |= p.dof == "rotation y";
+  EXPECT_TRUE(names_rotation) << r.messages[0];
 }
 
 }  // namespace

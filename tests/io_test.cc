@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/SVD>
+#include <cmath>
 #include <functional>
 #include <sstream>
 
@@ -130,8 +131,8 @@ TEST(ioDataFiles, BendRowsRunBottomToTopColumnsLeftToRight) {
   ASSERT_EQ(modes.size(), 1u);
   const DeformationMode& bend = modes[0];
   EXPECT_EQ(bend.name, "bend");
-  EXPECT_EQ(bend.num_s, 4);
-  EXPECT_EQ(bend.num_t, 4);
+  EXPECT_EQ(bend.lattice_size[0], 4);
+  EXPECT_EQ(bend.lattice_size[1], 4);
   EXPECT_EQ(bend.stiffness, 0.0);
   EXPECT_EQ(bend.damping, 0.0);
   EXPECT_FALSE(bend.active);
@@ -271,8 +272,8 @@ TEST(ioDeformationFile, SeveralModesHeadersAndDefaults) {
   EXPECT_EQ(modes[1].damping, 3.0);
   EXPECT_FALSE(modes[1].active);
   for (const DeformationMode& m : modes) {
-    EXPECT_EQ(m.num_s, 3);
-    EXPECT_EQ(m.num_t, 2);
+    EXPECT_EQ(m.lattice_size[0], 3);
+    EXPECT_EQ(m.lattice_size[1], 2);
     EXPECT_EQ(m.displacement.size(), 6u);
   }
   // i*num_t + j: column i, row j (bottom row first)
@@ -485,6 +486,131 @@ TEST(ioObjectFileErrors, MissingFile) {
   } catch (const ParseError& e) {
     EXPECT_EQ(std::string(e.what()).rfind(path + ":0: ", 0), 0u) << e.what();
   }
+}
+
+
+// ---------------------------------------------------------------- 3D files
+
+BodyDef3 Object3(const std::string& text) {
+  std::istringstream in(text);
+  return ParseObject3(in, "test.obj");
+}
+void ExpectObject3Error(const std::string& text, int line, const std::string& message_part) {
+  ExpectParseError([&] { Object3(text); }, "test.obj", line, message_part);
+}
+const Lattice3& UnitLattice3() {
+  static const Lattice3 lattice(Eigen::Vector3d(0, 0, 0),
+                                {Eigen::Vector3d(300, 0, 0), Eigen::Vector3d(0, 100, 0), Eigen::Vector3d(0, 0, 200)},
+                                {4, 4, 4}, BasisKind::kBernstein);
+  return lattice;
+}
+std::vector<DeformationMode3> Modes3(const std::string& text) {
+  std::istringstream in(text);
+  return ParseDeformations3(in, "test.def3", UnitLattice3());
+}
+void ExpectModes3Error(const std::string& text, int line, const std::string& message_part) {
+  ExpectParseError([&] { Modes3(text); }, "test.def3", line, message_part);
+}
+
+TEST(io3DFiles, TheTableAndItsModes) {
+  const BodyDef3 def = ReadObjectFile3(kData + "/table3.obj");
+  EXPECT_EQ(def.name, "table3");
+  EXPECT_EQ(def.masses.size(), 27u);
+  EXPECT_EQ(def.shapes.size(), 5u);
+  EXPECT_TRUE(def.shapes[0].closed);
+  EXPECT_EQ(def.lattice.sizes(), (std::array<int, 3>{4, 4, 4}));
+  EXPECT_EQ(def.lattice.axis(2), Eigen::Vector3d(0, 0, 200));
+  EXPECT_EQ(ObjectFileDimension(kData + "/table3.obj"), 3);
+  EXPECT_EQ(ObjectFileDimension(kData + "/table.obj"), 2);
+  const std::vector<DeformationMode3> modes = ReadDeformationFile3(kData + "/table3_modes.def3", def.lattice);
+  ASSERT_EQ(modes.size(), 4u);
+  EXPECT_EQ(modes[0].name, "bend");
+  EXPECT_TRUE(modes[0].active);
+  EXPECT_EQ(modes[3].stiffness, 4000000.0);
+  EXPECT_EQ(modes[2].source, kData + "/table3_modes.def3:8");
+  EXPECT_NO_THROW(BodyModel3 body(def, modes));
+}
+
+// Each generator against what it promises, at the control points of a 300 x 100 x 200 lattice
+// (abscissas 0, 1/3, 2/3, 1 per axis).
+TEST(io3DFiles, GeneratorsMakeTheFieldsTheyDescribe) {
+  const Lattice3& lat = UnitLattice3();
+  const std::vector<Eigen::Vector3d> rest = lat.RestPoints();
+  const Eigen::Vector3d centre(150, 50, 100);
+  auto mode = [&](const std::string& line) { return Modes3("dimension 3\nmode m\n" + line + "\n").front(); };
+  const DeformationMode3 bend = mode("bend x y 90"), twist = mode("twist y 40"), squash = mode("squash y 0.5"),
+                         shear = mode("shear y x 100"), taper = mode("taper z 0.4");
+  for (int c = 0; c < lat.size(); ++c) {
+    const auto cell = lat.CellOf(c);
+    const Eigen::Vector3d r = rest[c] - centre, u(cell[0] / 3.0, cell[1] / 3.0, cell[2] / 3.0);
+    // bend: an arch along x, up; 0 at the ends, 90 · 8/9 at the inner columns
+    EXPECT_NEAR((bend.displacement[c] - Eigen::Vector3d(0, cell[0] == 0 || cell[0] == 3 ? 0.0 : 80.0, 0)).norm(), 0, 1e-9);
+    // twist about the vertical centre line: perpendicular to the axis and to the radius, the
+    // top layer turned by +20°, the bottom by −20° (linearized: |d| = θ |u − ½| |r⊥|)
+    const Eigen::Vector3d r_across(r.x(), 0, r.z()), d = twist.displacement[c];
+    EXPECT_NEAR(d.y(), 0, 1e-12);
+    EXPECT_NEAR(d.dot(r_across), 0, 1e-9);
+    EXPECT_NEAR(d.norm(), 40 * M_PI / 180 * std::abs(u.y() - 0.5) * r_across.norm(), 1e-9);
+    if (u.y() > 0.5 && r_across.norm() > 0) EXPECT_GT(Eigen::Vector3d::UnitY().dot(r_across.cross(d)), 0);
+    // squash: y scaled by 1.5 about the centre, x and z by 0.75
+    EXPECT_NEAR((squash.displacement[c] - Eigen::Vector3d(-0.25 * r.x(), 0.5 * r.y(), -0.25 * r.z())).norm(), 0, 1e-9);
+    // shear: x shift from −50 (feet) to +50 (top)
+    EXPECT_NEAR((shear.displacement[c] - Eigen::Vector3d(100 * (u.y() - 0.5), 0, 0)).norm(), 0, 1e-9);
+    // taper along z: x and y offsets scaled by 1 + 0.4 (u_z − ½)
+    EXPECT_NEAR((taper.displacement[c] - 0.4 * (u.z() - 0.5) * Eigen::Vector3d(r.x(), r.y(), 0)).norm(), 0, 1e-9);
+  }
+  // generators add, and 'point' moves one control point
+  const DeformationMode3 sum = Modes3("dimension 3\nmode m\nshear y x 100\npoint 1 2 3 1 2 3\n").front();
+  const int c = lat.FlatIndex({1, 2, 3});
+  EXPECT_NEAR((sum.displacement[c] - shear.displacement[c] - Eigen::Vector3d(1, 2, 3)).norm(), 0, 1e-12);
+}
+
+// The squash keeps the volume to first order: the deformed lattice's Jacobian determinant at
+// amplitude γ is 1 + O(γ²) (the field is linear, which the Bernstein lattice reproduces).
+TEST(io3DFiles, SquashKeepsVolumeToFirstOrder) {
+  const Lattice3& lat = UnitLattice3();
+  const DeformationMode3 squash = Modes3("dimension 3\nmode m\nsquash x 0.3\n").front();
+  const double gamma = 1e-3;
+  std::vector<Eigen::Vector3d> control = lat.RestPoints();
+  for (int c = 0; c < lat.size(); ++c) control[c] += gamma * squash.displacement[c];
+  const Eigen::Vector3d u(0.3, 0.6, 0.45);
+  Eigen::Matrix3d J;
+  for (int a = 0; a < 3; ++a) {
+    const Eigen::Vector3d du = Eigen::Vector3d::Unit(a) * 1e-5;
+    J.col(a) = (lat.Evaluate(control, u + du) - lat.Evaluate(control, u - du)) / 2e-5;
+  }
+  const double ratio = J.determinant() / (300.0 * 100.0 * 200.0);
+  EXPECT_LT(std::abs(ratio - 1.0), 10 * gamma * gamma);
+}
+
+TEST(io3DFileErrors, ObjectFiles) {
+  const std::string head = "dimension 3\nlattice 0 0 0 300 100 200\n";
+  ExpectObject3Error("lattice 0 0 0 300 100 200\nmass 1 1 1 1\n", 1, "starts with 'dimension 3'");
+  ExpectObject3Error(head + "mass 1 1 1\n", 3, "expected 4 numbers after 'mass', got 3 (mass <x> <y> <z> <m>)");
+  ExpectObject3Error(head + "mass 1 1 300 5\n", 3, "outside the lattice (s = 0.00333333333333, t = 0.01, u = 1.5");
+  ExpectObject3Error(head + "mass 1 1 1 1\npolyline 0 0 0 1 1\n", 4, "not a multiple of 3");
+  ExpectObject3Error("dimension 3\nlattice 0 0 0 300 100\nmass 1 1 1 1\n", 2, "expected 6, 9 or 10 values");
+  ExpectObject3Error("dimension 3\nlattice 0 0 0 300 -1 200\nmass 1 1 1 1\n", 2, "lattice <height> must be > 0");
+  ExpectObject3Error("dimension 3\nlattice 0 0 0 1 1 1 1000 1000 1000\nmass 0 0 0 1\n", 2, "at most 65536");
+  ExpectObject3Error(head + "mass 1 1 1 1\ndimension 3\n", 4, "must be the first statement");
+  // the 2D reader names a 3D file for what it is
+  ExpectObjectError("dimension 3\nlattice 0 0 0 1 1 1\n", 1, "this is a 3D object file");
+}
+
+TEST(io3DFileErrors, DeformationFiles) {
+  ExpectModes3Error("mode m\nbend x y 1\n", 1, "starts with 'dimension 3'");
+  ExpectModes3Error("dimension 3\nbend x y 1\n", 2, "'bend' before the first 'mode");
+  ExpectModes3Error("dimension 3\nmode m\nbulge x 1\n", 3, "unknown keyword 'bulge' (expected mode, bend, twist");
+  ExpectModes3Error("dimension 3\nmode m\nbend x x 1\n", 3, "two different axes");
+  ExpectModes3Error("dimension 3\nmode m\nbend x w 1\n", 3, "expected an axis x, y or z, got 'w'");
+  ExpectModes3Error("dimension 3\nmode m\ntwist y\n", 3, "expected 2 values after 'twist', got 1");
+  ExpectModes3Error("dimension 3\nmode m\ntwist y ten\n", 3, "expected a number, got 'ten'");
+  ExpectModes3Error("dimension 3\nmode m\npoint 4 0 0 1 1 1\n", 3, "index i in 0..3, got '4'");
+  ExpectModes3Error("dimension 3\nmode m stiffness -1\nbend x y 1\n", 2, "stiffness must be >= 0");
+  ExpectModes3Error("dimension 3\nmode m\nmode n\nbend x y 1\n", 2, "mode 'm' has no generator line");
+  ExpectModes3Error("dimension 3\nmode m\nbend x y 1\nmode m\nbend x y 2\n", 4, "already used on line 2");
+  ExpectModes3Error("dimension 3\n", 1, "no modes after 'dimension 3'");
+  ExpectModesError("dimension 3\nmode m\nbend x y 1\n", 1, "this is a 3D deformation file");
 }
 
 }  // namespace

@@ -36,11 +36,11 @@ inline DeformationMode ModeFromRows(const std::string& name, const std::vector<s
                                     double damping = 0) {
   DeformationMode m;
   m.name = name;
-  m.num_t = int(x_rows.size());
-  m.num_s = int(x_rows[0].size());
-  m.displacement.resize(m.num_s * m.num_t);
-  for (int j = 0; j < m.num_t; ++j)
-    for (int i = 0; i < m.num_s; ++i) m.displacement[i * m.num_t + j] = {x_rows[j][i], y_rows[j][i]};
+  m.lattice_size[1] = int(x_rows.size());
+  m.lattice_size[0] = int(x_rows[0].size());
+  m.displacement.resize(m.lattice_size[0] * m.lattice_size[1]);
+  for (int j = 0; j < m.lattice_size[1]; ++j)
+    for (int i = 0; i < m.lattice_size[0]; ++i) m.displacement[i * m.lattice_size[1] + j] = {x_rows[j][i], y_rows[j][i]};
   m.stiffness = stiffness;
   m.damping = damping;
   return m;
@@ -95,8 +95,7 @@ inline BodyModel RandomBody(std::mt19937& rng, int num_s, int num_t, BasisKind b
   std::vector<DeformationMode> modes(num_modes);
   for (int d = 0; d < num_modes; ++d) {
     modes[d].name = "m" + std::to_string(d);
-    modes[d].num_s = num_s;
-    modes[d].num_t = num_t;
+    modes[d].lattice_size = {num_s, num_t};
     for (int c = 0; c < num_s * num_t; ++c) modes[d].displacement.push_back({disp(rng), disp(rng)});
   }
   return BodyModel(def, modes);

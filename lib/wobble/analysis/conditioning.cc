@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "wobble/dynamics/kinematics.h"
+#include "wobble/dynamics/step3.h"
 
 namespace wobble::analysis {
 namespace {
@@ -116,8 +117,7 @@ DeformationMode SquashMode(const Lattice& lattice, double phi, const Squash& squ
       lattice.origin() + squash.anchor_st.x() * lattice.axis_s() + squash.anchor_st.y() * lattice.axis_t();
   DeformationMode mode;
   mode.name = name;
-  mode.num_s = lattice.num_s();
-  mode.num_t = lattice.num_t();
+  mode.lattice_size = lattice.sizes();
   for (const Eigen::Vector2d& p : lattice.RestPoints()) mode.displacement.push_back(A * (p - anchor));
   return mode;
 }
@@ -142,38 +142,42 @@ std::string LevelName(ModeSetReport::Level level) {
   return "?";
 }
 
-ModeSetReport CheckModeSet(const BodyModel& body, const Eigen::VectorXd& q_in, const ModeCheckOptions& options) {
+namespace {
+// The check on a body's mass matrix M at some state: the same in 2D (rigid dofs tx, ty, θ) and
+// 3D (tx, ty, tz and the three body-frame rotations).
+template <int Dim>
+ModeSetReport CheckModes(const BodyModelN<Dim>& body, const Eigen::MatrixXd& M, const ModeCheckOptions& options) {
   const int D = body.num_modes(), nq = body.num_q();
-  const Eigen::VectorXd q = q_in.size() ? q_in : Eigen::VectorXd::Zero(nq);
+  constexpr int kRigid = Dim == 2 ? kRigidDofs : kRigidDofs3;
   ModeSetReport report;
-  report.dofs = {"translation x", "translation y", "rotation"};
-  for (const DeformationMode& m : body.modes()) report.dofs.push_back(m.name);
-  MatQ<double> Mq;
-  MassMatrix(body.moments(), VecQ<double>(q), &Mq);
-  const Eigen::MatrixXd M = Mq;
+  if (Dim == 2)
+    report.dofs = {"translation x", "translation y", "rotation"};
+  else
+    report.dofs = {"translation x", "translation y", "translation z", "rotation x", "rotation y", "rotation z"};
+  for (const auto& m : body.modes()) report.dofs.push_back(m.name);
   report.condition = Condition(M);
 
   std::vector<std::string> errors, warnings;
   // Visibility: what the mass points see of each mode's lattice motion (§4.10.3).
-  const MassMoments& mm = body.moments();
+  const MassMomentsN<Dim>& mm = body.moments();
   std::vector<bool> visible(nq, true);
   report.modes.resize(D);
   for (int d = 0; d < D; ++d) {
     ModeFinding& f = report.modes[d];
     f.mode = body.modes()[d].name;
     double lattice_ms = 0.0;
-    for (const Eigen::Vector2d& u : body.modes()[d].displacement) lattice_ms += u.squaredNorm();
+    for (const auto& u : body.modes()[d].displacement) lattice_ms += u.squaredNorm();
     lattice_ms /= double(body.modes()[d].displacement.size());
     if (!(lattice_ms > 0.0)) {
       errors.push_back("mode '" + f.mode + "' is zero: it moves no lattice point");
-      visible[kRigidDofs + d] = false;
+      visible[kRigid + d] = false;
       continue;
     }
     f.visibility = std::sqrt(std::max(0.0, mm.G(d, d)) / mm.m / lattice_ms);
     if (f.visibility < 1e-9) {
       errors.push_back("mode '" + f.mode + "' moves no mass point: the lattice region it moves holds no mass (" +
                        "§4.10.3), so M is singular");
-      visible[kRigidDofs + d] = false;
+      visible[kRigid + d] = false;
     } else if (f.visibility < options.warn_visibility) {
       std::ostringstream w;
       w << "mode '" << f.mode << "' barely moves the mass points (visibility " << f.visibility
@@ -208,8 +212,8 @@ ModeSetReport CheckModeSet(const BodyModel& body, const Eigen::VectorXd& q_in, c
   if (!dependent) Ninv = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
   for (int a = 0; a < n; ++a) {
     const int dof = idx[a];
-    if (dof < kRigidDofs) continue;
-    ModeFinding& f = report.modes[dof - kRigidDofs];
+    if (dof < kRigid) continue;
+    ModeFinding& f = report.modes[dof - kRigid];
     Eigen::VectorXd combo = Eigen::VectorXd::Zero(n);  // mode ≈ Σ combo_b dof_b (scaled)
     if (dependent) {
       // the null vectors v (N v = 0) this mode takes part in: mode = −Σ_{b≠a} v_b/v_a dof_b
@@ -266,6 +270,30 @@ ModeSetReport CheckModeSet(const BodyModel& body, const Eigen::VectorXd& q_in, c
                  : !warnings.empty() ? ModeSetReport::Level::kWarning
                                      : ModeSetReport::Level::kOk;
   return report;
+}
+
+}  // namespace
+
+ModeSetReport CheckModeSet(const BodyModel& body, const Eigen::VectorXd& q_in, const ModeCheckOptions& options) {
+  const Eigen::VectorXd q = q_in.size() ? q_in : Eigen::VectorXd::Zero(body.num_q());
+  MatQ<double> M;
+  MassMatrix(body.moments(), VecQ<double>(q), &M);
+  return CheckModes(body, Eigen::MatrixXd(M), options);
+}
+
+ModeSetReport CheckModeSet(const BodyModel3& body, const ModeCheckOptions& options) {
+  const BodyState3<double> rest = RestState3<double>(body);
+  const ShapeMoments3<double> sm(body.moments(), rest.gamma);
+  MatQ3<double> M;
+  MassMatrix3(body.moments(), sm, Mat3<double>(Mat3<double>::Identity()), &M);
+  return CheckModes(body, Eigen::MatrixXd(M), options);
+}
+
+ConditionNumber MassMatrixCondition(const BodyModel3& body, const BodyState3<double>& s) {
+  const ShapeMoments3<double> sm(body.moments(), s.gamma);
+  MatQ3<double> M;
+  MassMatrix3(body.moments(), sm, Mat3<double>(s.orientation.toRotationMatrix()), &M);
+  return Condition(Eigen::MatrixXd(M));
 }
 
 }  // namespace wobble::analysis

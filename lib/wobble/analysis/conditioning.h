@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "wobble/body/body_model.h"
+#include "wobble/dynamics/step3.h"
 
 namespace wobble::analysis {
 
@@ -26,6 +27,8 @@ struct ConditionNumber {
 ConditionNumber Condition(const Eigen::MatrixXd& M);
 // M(q) of a body (from its mass moments).
 ConditionNumber MassMatrixCondition(const BodyModel& body, const Eigen::VectorXd& q);
+// M of a 3D body at state s.
+ConditionNumber MassMatrixCondition(const BodyModel3& body, const BodyState3<double>& s);
 
 // Estimate of cond₁(A) = ‖A‖₁ ‖A⁻¹‖₁ by Hager's method (Higham's refinement of the iteration):
 // a few solves with an LU factorization, never A⁻¹ itself. A lower bound of cond₁, usually
@@ -101,6 +104,8 @@ struct ModeSetReport {
 // Checks the body's mode set at state q (rest when q is empty).
 ModeSetReport CheckModeSet(const BodyModel& body, const Eigen::VectorXd& q = Eigen::VectorXd(),
                            const ModeCheckOptions& options = {});
+// The same check for a 3D body at rest (dofs: translations x, y, z, rotations x, y, z, modes).
+ModeSetReport CheckModeSet(const BodyModel3& body, const ModeCheckOptions& options = {});
 std::string LevelName(ModeSetReport::Level level);
 
 }  // namespace wobble::analysis

@@ -2,6 +2,8 @@
 
 #include "wobble/core/cholesky.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <tuple>
@@ -9,17 +11,95 @@
 
 namespace wobble {
 
-BodyModel::BodyModel(BodyDef def, std::vector<DeformationMode> modes) : def_(std::move(def)), modes_(std::move(modes)) {
-  const Lattice& lat = def_.lattice;
+namespace {
+
+template <int Dim> std::string SizeText(const std::array<int, Dim>& sizes) {
+  std::string text;
+  for (int a = 0; a < Dim; ++a) text += (a ? "x" : "") + std::to_string(sizes[a]);
+  return text;
+}
+
+// Sizes the moments for D modes.
+void StartMoments(int D, MassMomentsN<2>* mm) {
+  mm->C.setZero(2, D);
+  mm->e0.setZero(D);
+  mm->h0.setZero(D);
+  mm->G.setZero(D, D);
+  mm->P.setZero(D, D);
+}
+void StartMoments(int D, MassMomentsN<3>* mm) {
+  mm->C.setZero(3, D);
+  mm->H0.setZero(3, D);
+  mm->e0.setZero(D);
+  mm->G.setZero(D, D);
+  mm->E.assign(D, Eigen::Matrix3d::Zero());
+  mm->F.assign(size_t(D) * D, Eigen::Matrix3d::Zero());
+  mm->X.assign(size_t(D) * D, Eigen::Vector3d::Zero());
+}
+
+// Adds mass point (m, b0, B) to the moments (definitions in body_model.h).
+void AddPoint(double m, const Eigen::Vector2d& b0, const Mat2D<double>& B, MassMomentsN<2>* mm) {
+  const int D = int(B.cols());
+  const Eigen::Vector2d Sb0(-b0.y(), b0.x());
+  Mat2D<double> SB(2, D);
+  SB.row(0) = -B.row(1);
+  SB.row(1) = B.row(0);
+  mm->m += m;
+  mm->c0 += m * b0;
+  mm->I0 += m * b0.squaredNorm();
+  mm->C += m * B;
+  mm->e0 += m * B.transpose() * b0;
+  mm->h0 += m * B.transpose() * Sb0;
+  mm->G += m * B.transpose() * B;
+  mm->P += m * B.transpose() * SB;
+}
+void AddPoint(double m, const Eigen::Vector3d& b0, const Mat3D<double>& B, MassMomentsN<3>* mm) {
+  const int D = int(B.cols());
+  mm->m += m;
+  mm->c0 += m * b0;
+  mm->C += m * B;
+  mm->e0 += m * B.transpose() * b0;
+  mm->G += m * B.transpose() * B;
+  mm->S0 += m * b0 * b0.transpose();
+  for (int d = 0; d < D; ++d) {
+    const Eigen::Vector3d Bd = B.col(d);
+    mm->H0.col(d) += m * b0.cross(Bd);
+    mm->E[d] += m * b0 * Bd.transpose();
+    for (int e = 0; e < D; ++e) {
+      mm->F[size_t(d) * D + e] += m * Bd * B.col(e).transpose();
+      mm->X[size_t(d) * D + e] += m * Bd.cross(B.col(e));
+    }
+  }
+}
+
+bool MomentsFinite(const MassMomentsN<2>& mm) {
+  return std::isfinite(mm.m) && std::isfinite(mm.I0) && mm.c0.allFinite() && mm.C.allFinite() && mm.e0.allFinite() &&
+         mm.h0.allFinite() && mm.G.allFinite() && mm.P.allFinite();
+}
+bool MomentsFinite(const MassMomentsN<3>& mm) {
+  bool finite = std::isfinite(mm.m) && mm.c0.allFinite() && mm.C.allFinite() && mm.H0.allFinite() &&
+                mm.e0.allFinite() && mm.G.allFinite() && mm.S0.allFinite();
+  for (const auto& x : mm.E) finite = finite && x.allFinite();
+  for (const auto& x : mm.F) finite = finite && x.allFinite();
+  for (const auto& x : mm.X) finite = finite && x.allFinite();
+  return finite;
+}
+
+}  // namespace
+
+template <int Dim>
+BodyModelN<Dim>::BodyModelN(BodyDefN<Dim> def, std::vector<DeformationModeN<Dim>> modes)
+    : def_(std::move(def)), modes_(std::move(modes)) {
+  const LatticeN<Dim>& lat = def_.lattice;
   const int D = num_modes();
   if (D > kMaxModes)
     throw std::invalid_argument("body '" + def_.name + "' has " + std::to_string(D) + " modes; at most " +
                                 std::to_string(kMaxModes) + " are supported");
-  for (const DeformationMode& mode : modes_) {
-    if (mode.num_s != lat.num_s() || mode.num_t != lat.num_t() || int(mode.displacement.size()) != lat.size())
-      throw std::invalid_argument((mode.source.empty() ? "" : mode.source + ": ") + "mode '" + mode.name + "' is defined on a " + std::to_string(mode.num_s) + "x" +
-                                  std::to_string(mode.num_t) + " lattice but body '" + def_.name + "' has a " +
-                                  std::to_string(lat.num_s()) + "x" + std::to_string(lat.num_t()) + " lattice");
+  for (const DeformationModeN<Dim>& mode : modes_) {
+    if (mode.lattice_size != lat.sizes() || int(mode.displacement.size()) != lat.size())
+      throw std::invalid_argument((mode.source.empty() ? "" : mode.source + ": ") + "mode '" + mode.name +
+                                  "' is defined on a " + SizeText<Dim>(mode.lattice_size) + " lattice but body '" +
+                                  def_.name + "' has a " + SizeText<Dim>(lat.sizes()) + " lattice");
   }
   if (def_.masses.size() != def_.mass_positions.size())
     throw std::invalid_argument("body '" + def_.name + "': mass and position counts differ");
@@ -31,67 +111,55 @@ BodyModel::BodyModel(BodyDef def, std::vector<DeformationMode> modes) : def_(std
   const int N = num_points();
   lattice_coords_.resize(N);
   rest_local_.resize(N);
-  mode_rows_.assign(size_t(2) * D * N, 0.0);
+  mode_rows_.assign(size_t(Dim) * D * N, 0.0);
 
-  MassMoments& mm = moments_;
-  mm.C.setZero(2, D);
-  mm.e0.setZero(D);
-  mm.h0.setZero(D);
-  mm.G.setZero(D, D);
-  mm.P.setZero(D, D);
+  StartMoments(D, &moments_);
   for (int k = 0; k < N; ++k) {
     // b0_k and B_k from the constant Bernstein (or B-spline) weights of the point
     lattice_coords_[k] = lat.LocalCoords(def_.mass_positions[k]);
-    Mat2D<double> B;
+    ModeMatrix B;
     LocalBasis(lattice_coords_[k], &rest_local_[k], &B);
-    Eigen::Map<Eigen::Matrix<double, 2, Eigen::Dynamic>>(mode_rows_.data() + 2 * D * k, 2, D) = B;
-
-    // accumulate the moments
-    const double m = def_.masses[k];
-    const Eigen::Vector2d& b0 = rest_local_[k];
-    const Eigen::Vector2d Sb0(-b0.y(), b0.x());
-    Mat2D<double> SB(2, D);
-    SB.row(0) = -B.row(1);
-    SB.row(1) = B.row(0);
-    mm.m += m;
-    mm.c0 += m * b0;
-    mm.I0 += m * b0.squaredNorm();
-    mm.C += m * B;
-    mm.e0 += m * B.transpose() * b0;
-    mm.h0 += m * B.transpose() * Sb0;
-    mm.G += m * B.transpose() * B;
-    mm.P += m * B.transpose() * SB;
+    Eigen::Map<Eigen::Matrix<double, Dim, Eigen::Dynamic>>(mode_rows_.data() + Dim * D * k, Dim, D) = B;
+    AddPoint(def_.masses[k], rest_local_[k], B, &moments_);
   }
+  MassMomentsN<Dim>& mm = moments_;
+  if (!MomentsFinite(mm))
+    throw std::invalid_argument("body '" + def_.name + "': its masses, positions or mode displacements are so large " +
+                                "that the mass moments overflow");
   mm.G_com_factor = mm.G - mm.C.transpose() * mm.C / mm.m;
   mm.G_com_positive = CholeskyInPlace(&mm.G_com_factor);
   BuildClusters();
 }
 
-void BodyModel::BuildClusters() {
+template <int Dim> void BodyModelN<Dim>::BuildClusters() {
   const int N = num_points(), D = num_modes();
-  // a square grid of cells over the lattice coordinates, about kPointsPerCluster per cell
-  const int cells = std::max(1, int(std::lround(std::sqrt(double(N) / kPointsPerCluster))));
-  std::vector<std::vector<int>> members(size_t(cells) * cells);
+  // a square (cubic) grid of cells over the lattice coordinates, about kPointsPerCluster per cell
+  const int cells = std::max(1, int(std::lround(std::pow(double(N) / kPointsPerCluster, 1.0 / Dim))));
+  size_t num_cells = 1;
+  for (int a = 0; a < Dim; ++a) num_cells *= size_t(cells);
+  std::vector<std::vector<int>> members(num_cells);
   for (int k = 0; k < N; ++k) {
     auto cell = [&](double u) { return std::clamp(int(std::floor(u * cells)), 0, cells - 1); };
-    members[size_t(cell(lattice_coords_[k].x())) * cells + cell(lattice_coords_[k].y())].push_back(k);
+    size_t index = 0;
+    for (int a = 0; a < Dim; ++a) index = index * cells + size_t(cell(lattice_coords_[k][a]));
+    members[index].push_back(k);
   }
   clusters_.clear();
   for (std::vector<int>& pts : members) {
     if (pts.empty()) continue;
     // per coordinate, the interval of b0 and of each column of B over the group's points
     auto interval = [&](auto value) {
-      Eigen::Vector2d lo = value(pts[0]), hi = lo;
+      Point lo = value(pts[0]), hi = lo;
       for (int k : pts) lo = lo.cwiseMin(value(k)), hi = hi.cwiseMax(value(k));
-      return std::make_pair(Eigen::Vector2d(0.5 * (lo + hi)), Eigen::Vector2d(0.5 * (hi - lo)));
+      return std::make_pair(Point(0.5 * (lo + hi)), Point(0.5 * (hi - lo)));
     };
-    PointCluster c;
+    PointClusterN<Dim> c;
     c.points = pts;
     std::tie(c.centre0, c.half0) = interval([&](int k) { return rest_local_[k]; });
-    c.centre_modes.setZero(2, D);
-    c.half_modes.setZero(2, D);
+    c.centre_modes.setZero(Dim, D);
+    c.half_modes.setZero(Dim, D);
     for (int d = 0; d < D; ++d) {
-      const auto [centre, half] = interval([&](int k) { return Eigen::Vector2d(mode_matrix(k).col(d)); });
+      const auto [centre, half] = interval([&](int k) { return Point(mode_matrix(k).col(d)); });
       c.centre_modes.col(d) = centre;
       c.half_modes.col(d) = half;
     }
@@ -99,16 +167,19 @@ void BodyModel::BuildClusters() {
   }
 }
 
-void BodyModel::LocalBasis(const Eigen::Vector2d& st, Eigen::Vector2d* b0, Mat2D<double>* B) const {
-  const Lattice& lat = def_.lattice;
+template <int Dim> void BodyModelN<Dim>::LocalBasis(const Point& st, Point* b0, ModeMatrix* B) const {
+  const LatticeN<Dim>& lat = def_.lattice;
   const std::vector<double> w = lat.Weights(st);
   b0->setZero();
-  B->setZero(2, num_modes());
+  B->setZero(Dim, num_modes());
   for (int c = 0; c < lat.size(); ++c) {
     if (w[c] == 0.0) continue;
     *b0 += w[c] * rest_control_[c];
     for (int d = 0; d < num_modes(); ++d) B->col(d) += w[c] * modes_[d].displacement[c];
   }
 }
+
+template class BodyModelN<2>;
+template class BodyModelN<3>;
 
 }  // namespace wobble

@@ -82,29 +82,31 @@ StepStatus Accelerations(const BodyModel& body, const WorldParams& w, int body_i
 
 // Newton's method with a forward-difference Jacobian and backtracking on |r|, for the implicit
 // integrators. x holds the initial guess and receives the solution.
-template <class T, class Residual> StepStatus SolveNewton(Residual&& residual, VecQ<T>* x) {
+// Vec is VecQ<T> (2D bodies) or VecQ3<T> (3D).
+template <class T, class Residual, class Vec> StepStatus SolveNewton(Residual&& residual, Vec* x) {
   const int n = int(x->size());
-  auto norm = [](const VecQ<T>& r) {
+  auto norm = [](const Vec& r) {
     double m = 0.0;
     for (int i = 0; i < r.size(); ++i) m = std::max(m, std::abs(double(ScalarValue(r[i]))));
     return m;
   };
-  VecQ<T> r, r_probe, trial;
+  using Jacobian = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, 0, Vec::MaxRowsAtCompileTime, Vec::MaxRowsAtCompileTime>;
+  Vec r, r_probe, trial;
   StepStatus st;
   if (!(st = residual(*x, &r)).ok()) return st;
   const double scale = 1.0 + norm(r);
   for (int iter = 0; iter < 30; ++iter) {
     const double r_norm = norm(r);
     if (r_norm <= 1e-12 * scale) return {};
-    MatQ<T> jac(n, n);
+    Jacobian jac(n, n);
     for (int i = 0; i < n; ++i) {
       const double eps = 1e-7 * std::max(1.0, std::abs(double(ScalarValue((*x)[i]))));
-      VecQ<T> xp = *x;
+      Vec xp = *x;
       xp[i] += T(eps);
       if (!(st = residual(xp, &r_probe)).ok()) return st;
       jac.col(i) = (r_probe - r) / T(eps);
     }
-    const VecQ<T> dx = jac.partialPivLu().solve(r);
+    const Vec dx = jac.partialPivLu().solve(r);
     // backtrack until the residual decreases (contact forces are only piecewise smooth)
     double step = 1.0;
     for (int k = 0; k < 12; ++k, step *= 0.5) {

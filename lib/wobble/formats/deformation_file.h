@@ -48,6 +48,7 @@
 #include <string>
 #include <vector>
 
+#include "wobble/body/lattice.h"
 #include "wobble/body/mode.h"
 #include "wobble/formats/parse_error.h"
 
@@ -59,5 +60,30 @@ std::vector<DeformationMode> ReadDeformationFile(const std::string& path);
 // Parses deformation modes from `in`; `name_for_errors` is the file name used in errors and,
 // through its stem, the default mode names.
 std::vector<DeformationMode> ParseDeformations(std::istream& in, const std::string& name_for_errors);
+
+// 3D deformation files: modes made by named generators over the body's lattice, so that the
+// common shapes need no typing of every control point (a 4x4x4 lattice has 64). Format:
+//
+//   dimension 3                                        first line
+//   mode <name> [stiffness <K>] [damping <c>] [active|passive]
+//     <generator>                                      one or more; their displacements add
+//
+// Axes x, y, z are the lattice's s, t, u axes; u_a ∈ [0, 1] is a control point's lattice
+// coordinate along axis a, r its offset from the lattice centre and r⊥ the part of r across
+// the named axis. Generators (displacement d of each control point at γ = 1):
+//   bend <along> <toward> <amount>     d = amount (1 − (2u_along − 1)²) ê_toward: an arch whose
+//                                      middle moves by <amount> (length), ends fixed
+//   twist <axis> <degrees>             d = θ (u − ½) ê × r⊥: the ends turn by ±degrees/2 about
+//                                      the centre line (linearized, as every mode is linear in γ)
+//   squash <axis> <fraction>           d = f ((ê·r) ê − ½ r⊥): longer by f along the axis,
+//                                      thinner by f/2 across (γ < 0 squashes)
+//   shear <axis> <toward> <amount>     d = amount (u − ½) ê_toward (the ends part by <amount>)
+//   taper <axis> <fraction>            d = f (u − ½) r⊥: cross-sections scale by 1 ± f/2 at the ends
+//   point <i> <j> <k> <dx> <dy> <dz>   adds (dx, dy, dz) to control point (i, j, k)
+// Modes from generators fit any lattice size; 'point' lines name indices within it. Every
+// problem is a ParseError naming the file and line (data/table3_modes.def3 is an example).
+std::vector<DeformationMode3> ReadDeformationFile3(const std::string& path, const Lattice3& lattice);
+std::vector<DeformationMode3> ParseDeformations3(std::istream& in, const std::string& name_for_errors,
+                                                 const Lattice3& lattice);
 
 }  // namespace wobble::formats

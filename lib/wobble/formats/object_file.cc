@@ -14,19 +14,44 @@ using detail::Line;
 
 constexpr double kInsideTolerance = 1e-9;
 
-const char* const kLatticeUsage = "lattice <x0> <y0> <width> <height> [<num_s> <num_t> [bernstein|bspline]]";
-const char* const kMassUsage = "mass <x> <y> <m>";
-const char* const kPolylineUsage = "polyline <x1> <y1> <x2> <y2> ... [closed]";
 const char* const kNameUsage = "name <word>";
 
-class ObjectParser {
+// The statements' forms in 2D and in 3D (a 3D file starts with 'dimension 3').
+template <int Dim> struct Usage;
+template <> struct Usage<2> {
+  static constexpr const char* lattice = "lattice <x0> <y0> <width> <height> [<num_s> <num_t> [bernstein|bspline]]";
+  static constexpr const char* mass = "mass <x> <y> <m>";
+  static constexpr const char* polyline = "polyline <x1> <y1> <x2> <y2> ... [closed]";
+};
+template <> struct Usage<3> {
+  static constexpr const char* lattice =
+      "lattice <x0> <y0> <z0> <width> <height> <depth> [<num_s> <num_t> <num_u> [bernstein|bspline]]";
+  static constexpr const char* mass = "mass <x> <y> <z> <m>";
+  static constexpr const char* polyline = "polyline <x1> <y1> <z1> <x2> <y2> <z2> ... [closed]";
+};
+
+constexpr const char* kAxisNames[] = {"x", "y", "z"};
+constexpr const char* kSizeNames[] = {"width", "height", "depth"};
+constexpr const char* kCountNames[] = {"num_s", "num_t", "num_u"};
+constexpr const char* kCoordNames[] = {"s", "t", "u"};
+
+template <int Dim> class ObjectParser {
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  static constexpr const char* kLatticeUsage = Usage<Dim>::lattice;
+  static constexpr const char* kMassUsage = Usage<Dim>::mass;
+  static constexpr const char* kPolylineUsage = Usage<Dim>::polyline;
+
  public:
   explicit ObjectParser(const std::string& file) : file_(file) {}
 
-  BodyDef Parse(std::istream& in) {
+  BodyDefN<Dim> Parse(std::istream& in) {
     const std::vector<Line> lines = detail::ReadLines(in, file_);
     if (lines.empty()) Fail(0, "file is empty: expected a 'lattice' line and at least one 'mass' line");
-    for (const Line& line : lines) Statement(line);
+    const bool declared = lines.front().words[0] == "dimension";
+    if (declared) Dimension(lines.front());
+    if (Dim == 3 && !declared)
+      Fail(lines.front().number, "a 3D object file starts with 'dimension 3' (got '" + lines.front().words[0] + "')");
+    for (size_t i = declared ? 1 : 0; i < lines.size(); ++i) Statement(lines[i]);
 
     if (!lattice_) Fail(0, std::string("missing 'lattice' line (") + kLatticeUsage + ")");
     if (def_.masses.empty()) Fail(0, std::string("no 'mass' lines: a body needs at least one mass point (") + kMassUsage + ")");
@@ -54,9 +79,20 @@ class ObjectParser {
     return value;
   }
 
+  void Dimension(const Line& line) {
+    int dim = 0;
+    if (line.words.size() != 2 || !detail::ParseInt(line.words[1], &dim) || (dim != 2 && dim != 3))
+      Fail(line.number, "expected 'dimension 2' or 'dimension 3'");
+    if (dim != Dim)
+      Fail(line.number, "this is a " + std::to_string(dim) + "D object file; a " + std::to_string(Dim) +
+                            "D body was expected here");
+  }
+
   void Statement(const Line& line) {
     const std::string& keyword = line.words[0];
-    if (keyword == "name") {
+    if (keyword == "dimension") {
+      Fail(line.number, "'dimension' must be the first statement of the file");
+    } else if (keyword == "name") {
       Name(line);
     } else if (keyword == "lattice") {
       LatticeLine(line);
@@ -82,25 +118,30 @@ class ObjectParser {
     if (lattice_line_ != 0)
       Fail(line.number, "lattice given twice (first on line " + std::to_string(lattice_line_) + ")");
     const size_t n = line.words.size() - 1;
-    if (n != 4 && n != 6 && n != 7)
-      Fail(line.number, "expected 4, 6 or 7 values after 'lattice', got " + std::to_string(n) + " (" + kLatticeUsage + ")");
-    const double x0 = Number(line, 1, "<x0>", kLatticeUsage);
-    const double y0 = Number(line, 2, "<y0>", kLatticeUsage);
-    const double width = Number(line, 3, "<width>", kLatticeUsage);
-    const double height = Number(line, 4, "<height>", kLatticeUsage);
-    if (!(width > 0)) Fail(line.number, "lattice <width> must be > 0, got " + line.words[3]);
-    if (!(height > 0)) Fail(line.number, "lattice <height> must be > 0, got " + line.words[4]);
-    int num_s = 4, num_t = 4;
-    BasisKind basis = BasisKind::kBernstein;
-    if (n >= 6) {
-      num_s = Count(line, 5, "<num_s>");
-      num_t = Count(line, 6, "<num_t>");
+    const size_t with_counts = 3 * Dim;  // origin, sizes, counts
+    if (n != 2 * Dim && n != with_counts && n != with_counts + 1)
+      Fail(line.number, "expected " + std::to_string(2 * Dim) + ", " + std::to_string(with_counts) + " or " +
+                            std::to_string(with_counts + 1) + " values after 'lattice', got " + std::to_string(n) +
+                            " (" + kLatticeUsage + ")");
+    Point origin;
+    typename LatticeN<Dim>::Axes axes;
+    for (int a = 0; a < Dim; ++a)
+      origin[a] = Number(line, 1 + a, std::string("<") + kAxisNames[a] + "0>", kLatticeUsage);
+    for (int a = 0; a < Dim; ++a) {
+      const double size = Number(line, 1 + Dim + a, std::string("<") + kSizeNames[a] + ">", kLatticeUsage);
+      if (!(size > 0))
+        Fail(line.number, std::string("lattice <") + kSizeNames[a] + "> must be > 0, got " + line.words[1 + Dim + a]);
+      axes[a] = Point::Unit(a) * size;
     }
-    if (n == 7 && !ParseBasisKind(line.words[7], &basis))
-      Fail(line.number, "unknown lattice basis '" + line.words[7] + "' (expected bernstein or bspline)");
+    typename LatticeN<Dim>::Sizes counts;
+    counts.fill(4);
+    BasisKind basis = BasisKind::kBernstein;
+    if (n >= with_counts)
+      for (int a = 0; a < Dim; ++a) counts[a] = Count(line, 1 + 2 * Dim + a, std::string("<") + kCountNames[a] + ">");
+    if (n == with_counts + 1 && !ParseBasisKind(line.words[n], &basis))
+      Fail(line.number, "unknown lattice basis '" + line.words[n] + "' (expected bernstein or bspline)");
     try {
-      lattice_.emplace(Eigen::Vector2d(x0, y0), Eigen::Vector2d(width, 0), Eigen::Vector2d(0, height), num_s, num_t,
-                       basis);
+      lattice_.emplace(origin, axes, counts, basis);
     } catch (const std::invalid_argument& e) {
       Fail(line.number, std::string("bad lattice: ") + e.what());
     }
@@ -108,20 +149,20 @@ class ObjectParser {
   }
 
   void Mass(const Line& line) {
-    if (line.words.size() != 4)
-      Fail(line.number, "expected 3 numbers after 'mass', got " + std::to_string(line.words.size() - 1) + " (" +
-                            kMassUsage + ")");
-    const double x = Number(line, 1, "<x>", kMassUsage);
-    const double y = Number(line, 2, "<y>", kMassUsage);
-    const double m = Number(line, 3, "<m>", kMassUsage);
-    if (!(m > 0)) Fail(line.number, "mass <m> must be > 0, got " + line.words[3]);
-    def_.mass_positions.emplace_back(x, y);
+    if (line.words.size() != Dim + 2)
+      Fail(line.number, "expected " + std::to_string(Dim + 1) + " numbers after 'mass', got " +
+                            std::to_string(line.words.size() - 1) + " (" + kMassUsage + ")");
+    Point p;
+    for (int a = 0; a < Dim; ++a) p[a] = Number(line, 1 + a, std::string("<") + kAxisNames[a] + ">", kMassUsage);
+    const double m = Number(line, Dim + 1, "<m>", kMassUsage);
+    if (!(m > 0)) Fail(line.number, "mass <m> must be > 0, got " + line.words[Dim + 1]);
+    def_.mass_positions.push_back(p);
     def_.masses.push_back(m);
     mass_lines_.push_back(line.number);
   }
 
   void PolylineLine(const Line& line) {
-    Polyline poly;
+    PolylineN<Dim> poly;
     size_t end = line.words.size();
     if (end > 1 && line.words[end - 1] == "closed") {
       poly.closed = true;
@@ -131,42 +172,49 @@ class ObjectParser {
     for (size_t w = 1; w < end; ++w) {
       double value = 0;
       if (!detail::ParseNumber(line.words[w], &value)) {
-        const std::string what = std::string(w % 2 == 1 ? "<x" : "<y") + std::to_string((w + 1) / 2) + ">";
+        const std::string what = std::string("<") + kAxisNames[(w - 1) % Dim] + std::to_string((w - 1) / Dim + 1) + ">";
         Fail(line.number, "expected a number for " + what + ", got '" + line.words[w] +
                               "' (only the last word may be 'closed'; " + kPolylineUsage + ")");
       }
     }
-    if (n % 2 != 0)
-      Fail(line.number, "polyline has an odd number of coordinates (" + std::to_string(n) + "); expected x y pairs (" +
-                            kPolylineUsage + ")");
-    if (n < 4)
-      Fail(line.number, "polyline needs at least 2 points, got " + std::to_string(n / 2) + " (" + kPolylineUsage + ")");
-    for (size_t w = 1; w < end; w += 2) {
-      double x = 0, y = 0;
-      detail::ParseNumber(line.words[w], &x);
-      detail::ParseNumber(line.words[w + 1], &y);
-      poly.points.emplace_back(x, y);
+    if (n % Dim != 0)
+      Fail(line.number, Dim == 2 ? "polyline has an odd number of coordinates (" + std::to_string(n) +
+                                       "); expected x y pairs (" + kPolylineUsage + ")"
+                                 : "polyline has " + std::to_string(n) +
+                                       " coordinates, not a multiple of 3; expected x y z triples (" +
+                                       kPolylineUsage + ")");
+    if (n < 2 * Dim)
+      Fail(line.number, "polyline needs at least 2 points, got " + std::to_string(n / Dim) + " (" + kPolylineUsage + ")");
+    for (size_t w = 1; w < end; w += Dim) {
+      Point p;
+      for (int a = 0; a < Dim; ++a) detail::ParseNumber(line.words[w + a], &p[a]);
+      poly.points.push_back(p);
     }
     def_.shapes.push_back(std::move(poly));
   }
 
   void CheckInside(size_t k) const {
-    const Eigen::Vector2d& p = def_.mass_positions[k];
-    const Eigen::Vector2d st = lattice_->LocalCoords(p);
-    const bool inside = st.x() >= -kInsideTolerance && st.x() <= 1 + kInsideTolerance &&
-                        st.y() >= -kInsideTolerance && st.y() <= 1 + kInsideTolerance;
+    const Point& p = def_.mass_positions[k];
+    const Point u = lattice_->LocalCoords(p);
+    bool inside = true;
+    for (int a = 0; a < Dim; ++a) inside = inside && u[a] >= -kInsideTolerance && u[a] <= 1 + kInsideTolerance;
     if (inside) return;
-    const Eigen::Vector2d lo = lattice_->origin(), hi = lo + lattice_->axis_s() + lattice_->axis_t();
-    Fail(mass_lines_[k], "mass point (" + FormatNumber(p.x()) + ", " + FormatNumber(p.y()) +
-                             ") lies outside the lattice (s = " + FormatNumber(st.x()) + ", t = " +
-                             FormatNumber(st.y()) + "; the lattice on line " + std::to_string(lattice_line_) +
-                             " spans x in [" + FormatNumber(lo.x()) + ", " + FormatNumber(hi.x()) + "], y in [" +
-                             FormatNumber(lo.y()) + ", " + FormatNumber(hi.y()) + "])");
+    Point hi = lattice_->origin();
+    for (int a = 0; a < Dim; ++a) hi += lattice_->axis(a);
+    std::string where, coords, spans;
+    for (int a = 0; a < Dim; ++a) {
+      where += (a ? ", " : "") + FormatNumber(p[a]);
+      coords += std::string(a ? ", " : "") + kCoordNames[a] + " = " + FormatNumber(u[a]);
+      spans += std::string(a ? ", " : "") + kAxisNames[a] + " in [" + FormatNumber(lattice_->origin()[a]) + ", " +
+               FormatNumber(hi[a]) + "]";
+    }
+    Fail(mass_lines_[k], "mass point (" + where + ") lies outside the lattice (" + coords + "; the lattice on line " +
+                             std::to_string(lattice_line_) + " spans " + spans + ")");
   }
 
   const std::string& file_;
-  BodyDef def_;
-  std::optional<Lattice> lattice_;
+  BodyDefN<Dim> def_;
+  std::optional<LatticeN<Dim>> lattice_;
   int name_line_ = 0, lattice_line_ = 0;
   std::vector<int> mass_lines_;
 };
@@ -174,11 +222,30 @@ class ObjectParser {
 }  // namespace
 
 BodyDef ParseObject(std::istream& in, const std::string& name_for_errors) {
-  return ObjectParser(name_for_errors).Parse(in);
+  return ObjectParser<2>(name_for_errors).Parse(in);
 }
 
 BodyDef ReadObjectFile(const std::string& path) {
   return detail::WithFile(path, [&](std::istream& in) { return ParseObject(in, path); });
+}
+
+BodyDef3 ParseObject3(std::istream& in, const std::string& name_for_errors) {
+  return ObjectParser<3>(name_for_errors).Parse(in);
+}
+
+BodyDef3 ReadObjectFile3(const std::string& path) {
+  return detail::WithFile(path, [&](std::istream& in) { return ParseObject3(in, path); });
+}
+
+int ObjectFileDimension(const std::string& path) {
+  return detail::WithFile(path, [&](std::istream& in) {
+    const std::vector<Line> lines = detail::ReadLines(in, path);
+    int dim = 2;
+    if (!lines.empty() && lines.front().words[0] == "dimension" && lines.front().words.size() == 2 &&
+        detail::ParseInt(lines.front().words[1], &dim) && dim == 3)
+      return 3;
+    return 2;
+  });
 }
 
 }  // namespace wobble::formats

@@ -41,4 +41,19 @@ BodyDef ReadObjectFile(const std::string& path);
 // and, through its stem, the default body name.
 BodyDef ParseObject(std::istream& in, const std::string& name_for_errors);
 
+// 3D object files: the same statements with a third coordinate, after a first line
+// 'dimension 3' (a 2D file may start with 'dimension 2'):
+//
+//   dimension 3
+//   name <word>
+//   lattice <x0> <y0> <z0> <width> <height> <depth> [<num_s> <num_t> <num_u> [bernstein|bspline]]
+//   mass <x> <y> <z> <m>
+//   polyline <x1> <y1> <z1> <x2> <y2> <z2> ... [closed]
+//
+// s runs along x, t along y (up), u along z; the body origin is the lattice corner (x0, y0, z0).
+BodyDef3 ReadObjectFile3(const std::string& path);
+BodyDef3 ParseObject3(std::istream& in, const std::string& name_for_errors);
+// 3 for a file whose first statement is 'dimension 3', else 2 (the readers report the rest).
+int ObjectFileDimension(const std::string& path);
+
 }  // namespace wobble::formats

@@ -1,0 +1,376 @@
+// One 3D FFD body: its state, forces and the integrators that advance it (the 3D Eq. 4.21 of
+// kinematics3.h, M v̇ = Q − w), with the orientation kept on SO(3) as a unit quaternion.
+//
+// Forces: gravity, mode potentials V = K γ² with damping (and PD targets, chapter 5), and the
+// penalty ground of §4.9 (Eq. 4.24/4.25) on a plane of any normal, its friction capped in the
+// whole tangent plane (|f_t| ≤ tan θ f_n: the 2D cap, isotropic in the plane's two directions).
+//
+// Integrators (the 2D set, carried to the group):
+//   thesis            v' = v + Δt a(g, v), then g' = g·exp(Δt v')  (Eq. 4.22/4.23's Störmer form)
+//   symplectic_euler  g' = g·exp(Δt v), then v' = v + Δt a(g', v)  (position first, as in 2D)
+//   rk4               Runge–Kutta–Munthe-Kaas: the classical tableau on (t, Θ, γ, v) with
+//                     R = R0 exp(Θ̂), Θ̇ = dexp⁻¹_{−Θ}(ω), so every stage stays on SO(3)
+//   implicit_euler    v' = v + Δt a(g·exp(Δt v'), v'), by Newton
+//   variational       the discrete Euler–Poincaré equations of L_d = Δt L(g_k, ξ_k) with
+//                     g_{k+1} = g_k·cay(Δt ξ_k) (Kobilarov & Marsden 2011; Bou-Rabee &
+//                     Marsden 2009): symplectic, and it keeps linear and angular momentum
+//                     exactly (to the Newton tolerance) when no external force acts
+// where g·exp(Δt v) moves t by Δt ṫ, γ by Δt γ̇ and turns R by exp(Δt ω̂) on the right.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "wobble/body/body_model.h"
+#include "wobble/dynamics/kinematics3.h"
+#include "wobble/dynamics/step.h"
+
+namespace wobble {
+
+// A plane of any normal with the ground constants of the 2D Ground (forces.h).
+struct GroundPlane {
+  bool enabled = false;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  // unit, pointing out of the ground
+  double stiffness = 4500.0, normal_damping = 550.0, friction_damping = 50.0, friction_cap = 0.1;
+  template <class T> T Height(const Vec3<T>& x) const { return normal.cast<T>().dot(x - point.cast<T>()); }
+};
+
+struct WorldParams3 {
+  bool gravity_on = true;
+  Eigen::Vector3d gravity = Eigen::Vector3d(0.0, -9.81, 0.0);  // y up, as in 2D
+  GroundPlane ground;
+  double max_condition = 1e12;  // runs stop when cond₂(M) is estimated above this
+};
+
+template <class T> struct Contact3 {
+  int point;
+  Vec3<T> anchor;  // where the point entered the ground (slides when friction is capped)
+};
+
+// The mutable half of a 3D body: translation, orientation, mode amplitudes, v = [ṫ, ω, γ̇].
+template <class T> struct BodyState3 {
+  Vec3<T> t = Vec3<T>::Zero();
+  Eigen::Quaternion<T> orientation = Eigen::Quaternion<T>::Identity();
+  VecD<T> gamma;
+  VecQ3<T> v;
+  std::vector<Contact3<T>> contacts;  // sorted by point
+  VecD<T> mode_target;                // PD targets γ0; empty: all zero
+};
+
+// A state at rest in the lattice's own pose.
+template <class T> BodyState3<T> RestState3(const BodyModel3& body) {
+  BodyState3<T> s;
+  s.gamma.setZero(body.num_modes());
+  s.v.setZero(body.num_q());
+  return s;
+}
+
+template <class T> struct ForceBreakdown3 {
+  VecQ3<T> gravity, modes, ground, total;
+};
+
+// Which points the ground acts on during an evaluation (ContactSet of the 2D body).
+template <class T, class F>
+void ForEachPointInContact3(const BodyModel3& body, const GroundPlane& g, const BodyState3<T>& s,
+                            const Frame3<T>& frame, F&& f, ContactSet set) {
+  if (!g.enabled) return;
+  auto visit = [&](int k, const Vec3<T>* anchor) {
+    const auto B = body.mode_matrix(k);
+    const Vec3<T> l = LocalPosition3<T>(body.rest_local(k), B, s.gamma);
+    const Vec3<T> x = frame.t + frame.R * l;
+    const T h = g.Height(x);
+    if (set == ContactSet::kDetect && !(ScalarValue(h) < 0.0)) return;
+    f(k, l, x, PointVelocity3(frame, s.v, l, B), anchor ? *anchor : Vec3<T>(x - h * g.normal.cast<T>()));
+  };
+  if (set == ContactSet::kFrozen) {
+    for (const Contact3<T>& c : s.contacts) visit(c.point, &c.anchor);
+    return;
+  }
+  auto existing = s.contacts.begin();
+  for (int k = 0; k < body.num_points(); ++k) {
+    while (existing != s.contacts.end() && existing->point < k) ++existing;
+    const bool has_anchor = existing != s.contacts.end() && existing->point == k;
+    visit(k, has_anchor ? &existing->anchor : nullptr);
+  }
+}
+
+// Eq. 4.24/4.25 in the plane's frame: f_n = −K Δn − C_dam v_n (never pulling),
+// f_t = −K Δt − FR_dam v_t (tangent-plane vectors), scaled back onto |f_t| ≤ tan θ f_n.
+template <class T>
+Vec3<T> GroundForce3(const GroundPlane& g, const Vec3<T>& x, const Vec3<T>& v, const Vec3<T>& anchor, bool* slipping) {
+  using std::sqrt;
+  const Vec3<T> n = g.normal.cast<T>();
+  const Vec3<T> dl = x - anchor;
+  T fn = -T(g.stiffness) * n.dot(dl) - T(g.normal_damping) * n.dot(v);
+  if (fn < T(0.0)) fn = T(0.0);
+  const Vec3<T> dl_t = dl - n * n.dot(dl), v_t = v - n * n.dot(v);
+  Vec3<T> ft = -T(g.stiffness) * dl_t - T(g.friction_damping) * v_t;
+  const T cap = T(g.friction_cap) * fn;
+  const T ft_norm = sqrt(ft.squaredNorm() + T(1e-300));
+  *slipping = ft_norm > cap;
+  if (*slipping) ft *= cap / ft_norm;
+  return fn * n + ft;
+}
+
+template <class T>
+void EvaluateForces3(const BodyModel3& body, const WorldParams3& w, const BodyState3<T>& s, const Frame3<T>& frame,
+                     const ShapeMoments3<T>& sm, ForceBreakdown3<T>* out, ContactSet set = ContactSet::kDetect) {
+  const int n = body.num_q(), D = body.num_modes();
+  if (w.gravity_on) {
+    GravityForce3(body.moments(), sm, frame.R, w.gravity, &out->gravity);
+  } else {
+    out->gravity.setZero(n);
+  }
+  // V = K γ² → −2K(γ − γ0), damping −c γ̇ (§4.7, chapter 5's PD form)
+  out->modes.setZero(n);
+  const bool targeted = s.mode_target.size() == D;
+  for (int d = 0; d < D; ++d) {
+    const DeformationMode3& m = body.modes()[d];
+    const T offset = targeted ? T(s.gamma[d] - s.mode_target[d]) : s.gamma[d];
+    out->modes[kRigidDofs3 + d] = -T(2.0 * m.stiffness) * offset - T(m.damping) * s.v[kRigidDofs3 + d];
+  }
+  out->ground.setZero(n);
+  ForEachPointInContact3(body, w.ground, s, frame, [&](int k, const Vec3<T>& l, const Vec3<T>& x, const Vec3<T>& v,
+                                                       const Vec3<T>& anchor) {
+    bool slipping;
+    AddGeneralizedForce3(frame, l, body.mode_matrix(k), GroundForce3(w.ground, x, v, anchor, &slipping), &out->ground);
+  }, set);
+  out->total = out->gravity + out->modes + out->ground;
+}
+
+// v̇ of M v̇ = Q − w. Fails with kIllConditioned when the Cholesky pivot ratio (a lower bound
+// of cond₂(M)) exceeds w.max_condition.
+template <class T>
+StepStatus Accelerations3(const BodyModel3& body, const WorldParams3& w, const BodyState3<T>& s, VecQ3<T>* a,
+                          ForceBreakdown3<T>* forces = nullptr, ContactSet set = ContactSet::kDetect) {
+  ForceBreakdown3<T> local;
+  ForceBreakdown3<T>& f = forces ? *forces : local;
+  const Frame3<T> frame(s.t, s.orientation);
+  const ShapeMoments3<T> sm(body.moments(), s.gamma);
+  VecQ3<T> vel;
+  VelocityTerms3(body.moments(), sm, frame.R, s.v, &vel);
+  EvaluateForces3(body, w, s, frame, sm, &f, set);
+  MatQ3<T> M;
+  MassMatrix3(body.moments(), sm, frame.R, &M);
+  if (!CholeskyInPlace(&M)) {
+    for (int i = 0; i < f.total.size(); ++i)
+      if (!std::isfinite(double(ScalarValue(f.total[i])))) return {StatusCode::kOverflowingForce, 0.0};
+    return {StatusCode::kSingularMass, 0.0};
+  }
+  double lo = HUGE_VAL, hi = 0.0;
+  CholeskyPivotRange(M, &lo, &hi);
+  *a = f.total - vel;
+  CholeskySolveInPlace(M, a);
+  if (hi / lo > w.max_condition) return {StatusCode::kIllConditioned, hi / lo};
+  return {};
+}
+
+// After an accepted step: anchors for points that entered the ground, none for those that
+// left, and an anchor whose friction hit the cap moved so the tangential spring holds exactly
+// the capped force (Coulomb slip), as UpdateContacts does in 2D.
+template <class T> void UpdateContacts3(const BodyModel3& body, const GroundPlane& g, BodyState3<T>* s) {
+  std::vector<Contact3<T>> next;
+  const Frame3<T> frame(s->t, s->orientation);
+  ForEachPointInContact3(body, g, *s, frame, [&](int k, const Vec3<T>&, const Vec3<T>& x, const Vec3<T>& v,
+                                                 Vec3<T> anchor) {
+    bool slipping;
+    const Vec3<T> f = GroundForce3(g, x, v, anchor, &slipping);
+    if (slipping && g.stiffness > 0.0) {
+      // −K Δt − FR v_t = f_t  ⇒  Δt = −(f_t + FR v_t)/K, measured from the point's foot
+      const Vec3<T> n = g.normal.cast<T>();
+      const Vec3<T> ft = f - n * n.dot(f), v_t = v - n * n.dot(v);
+      const Vec3<T> dt = -(ft + T(g.friction_damping) * v_t) / T(g.stiffness);
+      anchor = x - g.Height(x) * n - dt;
+    }
+    next.push_back({k, anchor});
+  }, ContactSet::kDetect);
+  s->contacts.swap(next);
+}
+
+// Adds a contact (anchor: its foot on the plane) for every point below the ground that has
+// none; returns how many. The implicit step grows its active set with it.
+template <class T> int AddMissingContacts3(const BodyModel3& body, const GroundPlane& g, BodyState3<T>* s) {
+  std::vector<Contact3<T>> added;
+  const BodyState3<T>& view = *s;
+  ForEachPointInContact3(body, g, view, Frame3<T>(view.t, view.orientation),
+                         [&](int k, const Vec3<T>&, const Vec3<T>&, const Vec3<T>&, const Vec3<T>& anchor) {
+                           for (const Contact3<T>& c : view.contacts)
+                             if (c.point == k) return;
+                           added.push_back({k, anchor});
+                         }, ContactSet::kDetect);
+  if (added.empty()) return 0;
+  s->contacts.insert(s->contacts.end(), added.begin(), added.end());
+  std::sort(s->contacts.begin(), s->contacts.end(),
+            [](const Contact3<T>& a, const Contact3<T>& b) { return a.point < b.point; });
+  return int(added.size());
+}
+
+// g·exp(h v) of the header comment, in place.
+template <class T> void AdvanceConfiguration3(const VecQ3<T>& v, const T& h, BodyState3<T>* s) {
+  const int D = int(s->gamma.size());
+  s->t += h * v.template head<3>();
+  s->orientation = (s->orientation * ExpRotation<T>(Vec3<T>(h * v.template segment<3>(3)))).normalized();
+  s->gamma += h * v.tail(D);
+}
+
+// Kinetic-energy gradient ∂T/∂g at fixed ξ, left-trivialized on SO(3) (δR = R ε̂), for the
+// variational integrator. With a = ω × c + C γ̇ (so that M_tω ω + M_tγ γ̇ = R a):
+//   ∂T/∂t = 0,  ∂T/∂R = a × Rᵀṫ,
+//   ∂T/∂γ_d = ṫ·R(ω × C_d) + e_d|ω|² − ωᵀ L_d ω + ω·Σ_e γ̇_e X_de
+// (∂K/∂γ_d = L_d + L_dᵀ, ∂I/∂γ_d = 2 e_d 1 − L_d − L_dᵀ, ∂N_e/∂γ_d = X_de).
+template <class T>
+void KineticGradient3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const Mat3<T>& R, const VecQ3<T>& xi,
+                      VecQ3<T>* out) {
+  const int D = int(sm.e.size());
+  const Vec3<T> t_dot = xi.template head<3>(), omega = xi.template segment<3>(3);
+  const auto gamma_dot = xi.tail(D);
+  const Vec3<T> a = omega.cross(sm.c) + mm.C.cast<T>() * gamma_dot;
+  const Vec3<T> t_local = R.transpose() * t_dot;
+  out->setZero(kRigidDofs3 + D);
+  out->template segment<3>(3) = a.cross(t_local);
+  const T omega2 = omega.squaredNorm();
+  for (int d = 0; d < D; ++d) {
+    Vec3<T> X_gd = Vec3<T>::Zero();
+    for (int e = 0; e < D; ++e) X_gd += mm.X[size_t(d) * D + e].cast<T>() * gamma_dot[e];
+    (*out)[kRigidDofs3 + d] = t_local.dot(omega.cross(mm.C.col(d).cast<T>())) + sm.e[d] * omega2 -
+                              omega.dot(sm.L[d] * omega) + omega.dot(X_gd);
+  }
+}
+
+// Advances one 3D body by dt, then updates its contacts.
+template <class T>
+StepStatus StepBody3(const BodyModel3& body, const WorldParams3& w, Integrator integrator, double dt,
+                     BodyState3<T>* s) {
+  const T h(dt);
+  const int D = body.num_modes();
+  VecQ3<T> a;
+  StepStatus st;
+  switch (integrator) {
+    case Integrator::kThesis: {
+      if (!(st = Accelerations3(body, w, *s, &a)).ok()) return st;
+      s->v += h * a;
+      AdvanceConfiguration3(s->v, h, s);
+      break;
+    }
+    case Integrator::kSymplecticEuler: {
+      AdvanceConfiguration3(s->v, h, s);
+      if (!(st = Accelerations3(body, w, *s, &a)).ok()) return st;
+      s->v += h * a;
+      break;
+    }
+    case Integrator::kRK4: {
+      // stage y = (t, Θ, γ, v) about the start; R = R0 exp(Θ̂)
+      const BodyState3<T> start = *s;
+      VecQ3<T> rate[4];  // per stage: configuration rate (ṫ, Θ̇, γ̇)
+      auto stage = [&](int i, const VecQ3<T>& dy_config, const VecQ3<T>& dv) {
+        BodyState3<T>& x = *s;
+        x.t = start.t + dy_config.template head<3>();
+        const Vec3<T> theta = dy_config.template segment<3>(3);
+        x.orientation = (start.orientation * ExpRotation<T>(theta)).normalized();
+        x.gamma = start.gamma + dy_config.tail(D);
+        x.v = start.v + dv;
+        rate[i] = x.v;
+        rate[i].template segment<3>(3) = RotationVectorRate<T>(theta, Vec3<T>(x.v.template segment<3>(3)));
+        return Accelerations3(body, w, x, &a);
+      };
+      VecQ3<T> k[4];
+      const VecQ3<T> zero = VecQ3<T>::Zero(body.num_q());
+      if (!(st = stage(0, zero, zero)).ok()) return st;
+      k[0] = a;
+      if (!(st = stage(1, T(0.5) * h * rate[0], T(0.5) * h * k[0])).ok()) return st;
+      k[1] = a;
+      if (!(st = stage(2, T(0.5) * h * rate[1], T(0.5) * h * k[1])).ok()) return st;
+      k[2] = a;
+      if (!(st = stage(3, h * rate[2], h * k[2])).ok()) return st;
+      k[3] = a;
+      const VecQ3<T> dy = h / T(6.0) * (rate[0] + T(2.0) * rate[1] + T(2.0) * rate[2] + rate[3]);
+      const VecQ3<T> dv = h / T(6.0) * (k[0] + T(2.0) * k[1] + T(2.0) * k[2] + k[3]);
+      s->t = start.t + dy.template head<3>();
+      s->orientation = (start.orientation * ExpRotation<T>(Vec3<T>(dy.template segment<3>(3)))).normalized();
+      s->gamma = start.gamma + dy.tail(D);
+      s->v = start.v + dv;
+      break;
+    }
+    case Integrator::kImplicitEuler: {
+      const BodyState3<T> start = *s;
+      if (!(st = Accelerations3(body, w, start, &a)).ok()) return st;
+      VecQ3<T> v = start.v + h * a;
+      for (int pass = 0; pass < 4; ++pass) {  // active set, as in 2D
+        st = SolveNewton<T>(
+            [&](const VecQ3<T>& x, VecQ3<T>* r) {
+              BodyState3<T> trial = start;
+              trial.contacts = s->contacts;
+              AdvanceConfiguration3(x, h, &trial);
+              trial.v = x;
+              VecQ3<T> acc;
+              const StepStatus rs = Accelerations3(body, w, trial, &acc, static_cast<ForceBreakdown3<T>*>(nullptr),
+                                                   ContactSet::kFrozen);
+              if (rs.ok()) *r = x - start.v - h * acc;
+              return rs;
+            },
+            &v);
+        if (!st.ok()) return st;
+        std::vector<Contact3<T>> contacts = s->contacts;
+        *s = start;
+        s->contacts = contacts;
+        AdvanceConfiguration3(v, h, s);
+        s->v = v;
+        if (!AddMissingContacts3(body, w.ground, s)) break;
+      }
+      break;
+    }
+    case Integrator::kVariational: {
+      // p_k = M(g_k) v_k; solve for ξ:  A(Δt ξ)ᵀ M(g_k) ξ − Δt (∂T/∂g + Q)(g_k, ξ) = p_k, with A
+      // the Cayley momentum map on the ω rows and the identity elsewhere (translations and
+      // modes); then g_{k+1} = g_k·cay(Δt ξ) and p_{k+1} = A(−Δt ξ)ᵀ M(g_k) ξ.
+      const BodyState3<T> start = *s;
+      const Frame3<T> frame(start.t, start.orientation);
+      const ShapeMoments3<T> sm(body.moments(), start.gamma);
+      MatQ3<T> M0;
+      MassMatrix3(body.moments(), sm, frame.R, &M0);
+      const VecQ3<T> p0 = M0 * start.v;
+      auto residual = [&](const VecQ3<T>& xi, VecQ3<T>* r) {
+        BodyState3<T> at = start;
+        at.v = xi;
+        ForceBreakdown3<T> f;
+        EvaluateForces3(body, w, at, frame, sm, &f, ContactSet::kDetect);
+        VecQ3<T> dT;
+        KineticGradient3(body.moments(), sm, frame.R, xi, &dT);
+        VecQ3<T> mu = M0 * xi;
+        mu.template segment<3>(3) = CayleyMomentumMap<T>(Vec3<T>(h * xi.template segment<3>(3)),
+                                                         Vec3<T>(mu.template segment<3>(3)));
+        *r = mu - h * (dT + f.total) - p0;
+        return StepStatus{};
+      };
+      VecQ3<T> xi = start.v;
+      if (!(st = SolveNewton<T>(residual, &xi)).ok()) return st;
+      VecQ3<T> p1 = M0 * xi;
+      p1.template segment<3>(3) = CayleyMomentumMap<T>(Vec3<T>(-h * xi.template segment<3>(3)),
+                                                       Vec3<T>(p1.template segment<3>(3)));
+      s->t = start.t + h * xi.template head<3>();
+      s->orientation = (start.orientation * CayleyRotation<T>(Vec3<T>(h * xi.template segment<3>(3)))).normalized();
+      s->gamma = start.gamma + h * xi.tail(D);
+      const Frame3<T> frame1(s->t, s->orientation);
+      const ShapeMoments3<T> sm1(body.moments(), s->gamma);
+      MatQ3<T> M1;
+      MassMatrix3(body.moments(), sm1, frame1.R, &M1);
+      if (!CholeskyInPlace(&M1)) return {StatusCode::kSingularMass, 0.0};
+      CholeskySolveInPlace(M1, &p1);
+      s->v = p1;
+      break;
+    }
+  }
+  auto finite = [](const auto& x) {
+    for (int i = 0; i < x.size(); ++i)
+      if (!std::isfinite(double(ScalarValue(x[i])))) return false;
+    return true;
+  };
+  if (!finite(s->v) || !finite(s->t) || !finite(s->gamma) || !finite(s->orientation.coeffs()))
+    return {StatusCode::kNonFinite, 0.0};
+  UpdateContacts3(body, w.ground, s);
+  return {};
+}
+
+}  // namespace wobble
