@@ -272,14 +272,33 @@ void BM_Table3RestingOnGround(benchmark::State& state) {
 }
 BENCHMARK(BM_Table3RestingOnGround);
 
-// Falling freely with no ground: 27 points (the file) against 20 and 1,000 resampled points.
+// Falling freely, far above a ground (the convex-hull test only) or with none: 27 points (the
+// file) against 20 and 1,000 redistributed points.
 void BM_Table3OutOfContact(benchmark::State& state) {
   const std::shared_ptr<const BodyModel3> body = Table3(int(state.range(0)));
-  const WorldParams3 w;
+  WorldParams3 w;
+  w.ground.enabled = state.range(1) != 0;
+  w.ground.point = Eigen::Vector3d(0.0, -1e12, 0.0);
   BodyState3<double> s = RestState3<double>(*body);
   TimeSteps3(state, *body, w, 0.01, &s);
 }
-BENCHMARK(BM_Table3OutOfContact)->ArgName("points")->Arg(0)->Arg(20)->Arg(1000);
+BENCHMARK(BM_Table3OutOfContact)->ArgNames({"points", "ground"})->ArgsProduct({{0, 20, 1000}, {1, 0}});
+
+// Resting with 1,000 points: the point groups keep the scan near the feet.
+void BM_Table3kRestingOnGround(benchmark::State& state) {
+  const std::shared_ptr<const BodyModel3> body = Table3(1000);
+  WorldParams3 w;
+  w.ground.enabled = true;
+  BodyState3<double> s = RestState3<double>(*body);
+  s.t.y() = 10.0;
+  for (int i = 0; i < 3000; ++i)
+    if (!StepBody3(*body, w, Integrator::kThesis, 0.01, &s).ok()) {
+      state.SkipWithError("the table did not settle");
+      return;
+    }
+  TimeSteps3(state, *body, w, 0.01, &s);
+}
+BENCHMARK(BM_Table3kRestingOnGround);
 
 }  // namespace
 }  // namespace wobble

@@ -4,6 +4,7 @@
 // law on an incline.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -274,6 +275,35 @@ TEST(Body3, PlanarMotionReproducesThe2DBody) {
                      Sci(worst) + " after " + std::to_string(contacts_seen) + " contact-steps");
     }
   }
+}
+
+// The contact scan's shortcuts (the convex-hull test, then point groups for big bodies) visit
+// exactly the points below the plane that a scan of every point finds.
+TEST(Body3, PointGroupsFindExactlyThePointsBelowTheGround) {
+  std::mt19937 rng(23);
+  const BodyModel3 body = RandomBody3(rng, {4, 4, 4}, BasisKind::kBernstein, 3, 3000);
+  ASSERT_GT(body.clusters().size(), 8u);
+  GroundPlane g;
+  g.enabled = true;
+  g.normal = Vector3d(0.2, 1.0, -0.1).normalized();
+  std::normal_distribution<double> n(0.0, 1.0);
+  int found = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    BodyState3<double> s = RandomState3(rng, body);
+    s.t = Vector3d(n(rng), n(rng), n(rng)) * 60.0;
+    const Frame3<double> frame(s.t, s.orientation);
+    std::vector<int> visited, below;
+    ForEachPointInContact3(body, g, s, frame, [&](int k, const Vector3d&, const Vector3d&, const Vector3d&,
+                                                  const Vector3d&) { visited.push_back(k); }, ContactSet::kDetect);
+    for (int k = 0; k < body.num_points(); ++k) {
+      const PointKinematics p = DirectPoint(body, k, s.gamma);
+      if (g.Height(Vector3d(frame.t + frame.R * p.l)) < 0.0) below.push_back(k);
+    }
+    std::sort(visited.begin(), visited.end());
+    EXPECT_EQ(visited, below) << "trial " << trial;
+    found += int(below.size());
+  }
+  EXPECT_GT(found, 1000);  // the states do reach into the ground
 }
 
 // A box of eight corner masses with unequal sides: principal axes along the lattice axes,

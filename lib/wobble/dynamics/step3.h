@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 #include "wobble/body/body_model.h"
@@ -57,7 +58,29 @@ template <class T> struct BodyState3 {
   VecQ3<T> v;
   std::vector<Contact3<T>> contacts;  // sorted by point
   VecD<T> mode_target;                // PD targets γ0; empty: all zero
+  // The ground's generalized force at exactly this state, left by UpdateContacts3 for the next
+  // explicit step (which evaluates forces at the same state): one contact scan per step, not
+  // two. Keyed by value, as BodyState::ground_cache in 2D, so it can miss but never be stale.
+  struct GroundForceCache {
+    bool valid = false;
+    Vec3<T> t;
+    Eigen::Quaternion<T> orientation;
+    VecD<T> gamma;
+    VecQ3<T> v, force;
+  } ground_cache;
 };
+
+// The cached ground force of s, when it was computed at s's current state (doubles only).
+template <class T> const VecQ3<T>* CachedGroundForce3(const BodyState3<T>& s) {
+  if constexpr (!std::is_same_v<T, double>) {
+    return nullptr;
+  } else {
+    const auto& c = s.ground_cache;
+    if (!c.valid || c.t != s.t || c.orientation.coeffs() != s.orientation.coeffs() || c.gamma != s.gamma || c.v != s.v)
+      return nullptr;
+    return &c.force;
+  }
+}
 
 // A state at rest in the lattice's own pose.
 template <class T> BodyState3<T> RestState3(const BodyModel3& body) {
@@ -88,11 +111,46 @@ void ForEachPointInContact3(const BodyModel3& body, const GroundPlane& g, const 
     for (const Contact3<T>& c : s.contacts) visit(c.point, &c.anchor);
     return;
   }
-  auto existing = s.contacts.begin();
-  for (int k = 0; k < body.num_points(); ++k) {
-    while (existing != s.contacts.end() && existing->point < k) ++existing;
-    const bool has_anchor = existing != s.contacts.end() && existing->point == k;
-    visit(k, has_anchor ? &existing->anchor : nullptr);
+  // decisions on plain values: height = n·(t − p) + (Rᵀn)·l
+  const Eigen::Vector3d n_local =
+      Mat3<double>(frame.R.unaryExpr([](const T& x) { return double(ScalarValue(x)); })).transpose() * g.normal;
+  const Eigen::Vector3d t(ScalarValue(s.t.x()), ScalarValue(s.t.y()), ScalarValue(s.t.z()));
+  const double offset = g.normal.dot(t - g.point);
+  const int D = body.num_modes();
+  // convex-hull test: every deformed control point above the plane means every point is
+  bool clear = true;
+  const std::vector<Eigen::Vector3d>& rest = body.rest_control();
+  for (int c = 0; clear && c < int(rest.size()); ++c) {
+    double h = offset + n_local.dot(rest[c]);
+    for (int d = 0; d < D; ++d) h += ScalarValue(s.gamma[d]) * n_local.dot(body.modes()[d].displacement[c]);
+    clear = h > 0.0;
+  }
+  if (clear) return;
+  const std::vector<PointClusterN<3>>& clusters = body.clusters();
+  if (clusters.size() <= 1) {
+    auto existing = s.contacts.begin();
+    for (int k = 0; k < body.num_points(); ++k) {
+      while (existing != s.contacts.end() && existing->point < k) ++existing;
+      const bool has_anchor = existing != s.contacts.end() && existing->point == k;
+      visit(k, has_anchor ? &existing->anchor : nullptr);
+    }
+    return;
+  }
+  // large bodies: only point groups whose bounding box reaches below the plane (as in 2D)
+  for (const PointClusterN<3>& c : clusters) {
+    Eigen::Vector3d centre = c.centre0, half = c.half0;
+    for (int d = 0; d < D; ++d) {
+      const double gamma = ScalarValue(s.gamma[d]);
+      centre += gamma * c.centre_modes.col(d);
+      half += std::abs(gamma) * c.half_modes.col(d);
+    }
+    if (offset + n_local.dot(centre) - n_local.cwiseAbs().dot(half) >= 0.0) continue;
+    for (int k : c.points) {
+      const auto existing = std::lower_bound(s.contacts.begin(), s.contacts.end(), k,
+                                             [](const Contact3<T>& a, int point) { return a.point < point; });
+      const bool has_anchor = existing != s.contacts.end() && existing->point == k;
+      visit(k, has_anchor ? &existing->anchor : nullptr);
+    }
   }
 }
 
@@ -131,12 +189,17 @@ void EvaluateForces3(const BodyModel3& body, const WorldParams3& w, const BodySt
     const T offset = targeted ? T(s.gamma[d] - s.mode_target[d]) : s.gamma[d];
     out->modes[kRigidDofs3 + d] = -T(2.0 * m.stiffness) * offset - T(m.damping) * s.v[kRigidDofs3 + d];
   }
-  out->ground.setZero(n);
-  ForEachPointInContact3(body, w.ground, s, frame, [&](int k, const Vec3<T>& l, const Vec3<T>& x, const Vec3<T>& v,
-                                                       const Vec3<T>& anchor) {
-    bool slipping;
-    AddGeneralizedForce3(frame, l, body.mode_matrix(k), GroundForce3(w.ground, x, v, anchor, &slipping), &out->ground);
-  }, set);
+  const VecQ3<T>* cached = set == ContactSet::kDetect ? CachedGroundForce3(s) : nullptr;
+  if (cached) {
+    out->ground = *cached;
+  } else {
+    out->ground.setZero(n);
+    ForEachPointInContact3(body, w.ground, s, frame, [&](int k, const Vec3<T>& l, const Vec3<T>& x, const Vec3<T>& v,
+                                                         const Vec3<T>& anchor) {
+      bool slipping;
+      AddGeneralizedForce3(frame, l, body.mode_matrix(k), GroundForce3(w.ground, x, v, anchor, &slipping), &out->ground);
+    }, set);
+  }
   out->total = out->gravity + out->modes + out->ground;
 }
 
@@ -171,22 +234,34 @@ StepStatus Accelerations3(const BodyModel3& body, const WorldParams3& w, const B
 // left, and an anchor whose friction hit the cap moved so the tangential spring holds exactly
 // the capped force (Coulomb slip), as UpdateContacts does in 2D.
 template <class T> void UpdateContacts3(const BodyModel3& body, const GroundPlane& g, BodyState3<T>* s) {
-  std::vector<Contact3<T>> next;
+  thread_local std::vector<Contact3<T>> next;  // no heap traffic while a body rests
+  next.clear();
   const Frame3<T> frame(s->t, s->orientation);
-  ForEachPointInContact3(body, g, *s, frame, [&](int k, const Vec3<T>&, const Vec3<T>& x, const Vec3<T>& v,
+  auto& cache = s->ground_cache;
+  cache.force.setZero(body.num_q());
+  ForEachPointInContact3(body, g, *s, frame, [&](int k, const Vec3<T>& l, const Vec3<T>& x, const Vec3<T>& v,
                                                  Vec3<T> anchor) {
     bool slipping;
-    const Vec3<T> f = GroundForce3(g, x, v, anchor, &slipping);
+    Vec3<T> f = GroundForce3(g, x, v, anchor, &slipping);
     if (slipping && g.stiffness > 0.0) {
       // −K Δt − FR v_t = f_t  ⇒  Δt = −(f_t + FR v_t)/K, measured from the point's foot
       const Vec3<T> n = g.normal.cast<T>();
       const Vec3<T> ft = f - n * n.dot(f), v_t = v - n * n.dot(v);
       const Vec3<T> dt = -(ft + T(g.friction_damping) * v_t) / T(g.stiffness);
       anchor = x - g.Height(x) * n - dt;
+      f = GroundForce3(g, x, v, anchor, &slipping);  // what the moved anchor exerts
     }
+    AddGeneralizedForce3(frame, l, body.mode_matrix(k), f, &cache.force);
     next.push_back({k, anchor});
   }, ContactSet::kDetect);
+  if (body.clusters().size() > 1)  // groups are visited in lattice order, not point order
+    std::sort(next.begin(), next.end(), [](const Contact3<T>& a, const Contact3<T>& b) { return a.point < b.point; });
   s->contacts.swap(next);
+  cache.t = s->t;
+  cache.orientation = s->orientation;
+  cache.gamma = s->gamma;
+  cache.v = s->v;
+  cache.valid = true;
 }
 
 // Adds a contact (anchor: its foot on the plane) for every point below the ground that has
