@@ -422,6 +422,61 @@ TEST(Body3, IntermediateAxisFlipPeriodMatchesTheEllipticIntegral) {
   }
 }
 
+// A spring at the centre of mass of a rigid box moves it as a harmonic oscillator,
+// x(t) = A cos(√(k/m) t), without turning it.
+TEST(Body3, SpringAtTheCentreOscillatesWithTheClosedFormPeriod) {
+  const BodyModel3 box = Box(1.0, 2.0, 3.0, 0.5);
+  const double m = box.moments().m, k = 40.0, A = 0.1;
+  const Vector3d centre(0.5, 1.0, 1.5);
+  WorldParams3 w;
+  w.gravity_on = false;
+  w.springs.push_back(MakeSpring3(box, Vector3d::Constant(0.5), centre + Vector3d(A, 0, 0), k));
+  BodyState3<double> s = RestState3<double>(box);  // the centre starts A from the anchor, at rest
+  const double omega = std::sqrt(k / m), dt = 1e-3;
+  double worst = 0.0;
+  for (int step = 1; step <= int(2 * M_PI / omega / dt); ++step) {
+    ASSERT_TRUE(StepBody3(box, w, Integrator::kRK4, dt, &s).ok());
+    const double expected = A - A * std::cos(omega * step * dt);  // the centre's x
+    worst = std::max(worst, std::abs(s.t.x() - expected));
+  }
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_LT(std::abs(s.orientation.w() - 1.0), 1e-12);
+}
+
+// A spring pulls toward its anchor only: angular momentum about the anchor is kept, and with
+// no damping so is the energy (variational integrator), for a point off the centre.
+TEST(Body3, OffCentreSpringKeepsMomentumAboutTheAnchor) {
+  std::mt19937 rng(29);
+  const BodyModel3 body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20, 3000.0);
+  WorldParams3 w;
+  w.gravity_on = false;
+  const Vector3d anchor(40, -30, 20);
+  w.springs.push_back(MakeSpring3(body, Vector3d(0.2, 0.9, 0.4), anchor, 50.0, 0.0, 10.0));
+  BodyState3<double> s = RandomState3(rng, body, 0.3);
+  auto about_anchor = [&](const BodyState3<double>& st) {
+    Vector3d P;
+    const Vector3d L = AngularMomentum(body, st, &P);
+    return Vector3d(L - anchor.cross(P));
+  };
+  auto energy = [&](const BodyState3<double>& st) {
+    const Frame3<double> f(st.t, st.orientation);
+    const Spring3& sp = w.springs[0];
+    const Vector3d x = f.t + f.R * LocalPosition3<double>(sp.rest_local, sp.mode_matrix, st.gamma);
+    const double stretch = (x - anchor).norm() - sp.rest_length;
+    return TotalEnergy(body, st) + 0.5 * sp.stiffness * stretch * stretch;
+  };
+  const Vector3d L0 = about_anchor(s);
+  const double E0 = energy(s);
+  double worst_L = 0.0, worst_E = 0.0;
+  for (int step = 0; step < 5000; ++step) {
+    ASSERT_TRUE(StepBody3(body, w, Integrator::kVariational, 2e-3, &s).ok());
+    worst_L = std::max(worst_L, (about_anchor(s) - L0).norm() / L0.norm());
+    worst_E = std::max(worst_E, std::abs(energy(s) - E0) / E0);
+  }
+  EXPECT_LT(worst_L, 1e-9);
+  EXPECT_LT(worst_E, 1e-2);
+}
+
 TEST(Body3, VibratingBodyTumblingKeepsItsMomenta) {
   std::mt19937 rng(17);
   const BodyModel3 body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 4, 30, 2000.0);

@@ -1,8 +1,8 @@
 // One 3D FFD body: its state, forces and the integrators that advance it (the 3D Eq. 4.21 of
 // kinematics3.h, M v̇ = Q − w), with the orientation kept on SO(3) as a unit quaternion.
 //
-// Forces: gravity, mode potentials V = K γ² with damping (and PD targets, chapter 5), and the
-// penalty ground of §4.9 (Eq. 4.24/4.25) on a plane of any normal, its friction capped in the
+// Forces: gravity, mode potentials V = K γ² with damping (and PD targets, chapter 5), damped
+// springs to world anchors (Fig. 4.4), and the penalty ground of §4.9 (Eq. 4.24/4.25) on a plane of any normal, its friction capped in the
 // whole tangent plane (|f_t| ≤ tan θ f_n: the 2D cap, isotropic in the plane's two directions).
 //
 // Integrators (the 2D set, carried to the group):
@@ -38,10 +38,32 @@ struct GroundPlane {
   template <class T> T Height(const Vec3<T>& x) const { return normal.cast<T>().dot(x - point.cast<T>()); }
 };
 
+// A damped spring from a world anchor to a point of the body given by lattice coordinates
+// (the 2D Spring of forces.h, Fig. 4.4). MakeSpring3 fills in the point's b0 and B.
+struct Spring3 {
+  Eigen::Vector3d lattice_coords = Eigen::Vector3d::Constant(0.5);
+  Eigen::Vector3d anchor = Eigen::Vector3d::Zero();
+  double stiffness = 0.0, damping = 0.0, rest_length = 0.0;
+  Eigen::Vector3d rest_local = Eigen::Vector3d::Zero();
+  Mat3D<double> mode_matrix;
+};
+inline Spring3 MakeSpring3(const BodyModel3& body, const Eigen::Vector3d& lattice_coords, const Eigen::Vector3d& anchor,
+                           double stiffness, double damping = 0.0, double rest_length = 0.0) {
+  Spring3 s;
+  s.lattice_coords = lattice_coords;
+  s.anchor = anchor;
+  s.stiffness = stiffness;
+  s.damping = damping;
+  s.rest_length = rest_length;
+  body.LocalBasis(lattice_coords, &s.rest_local, &s.mode_matrix);
+  return s;
+}
+
 struct WorldParams3 {
   bool gravity_on = true;
   Eigen::Vector3d gravity = Eigen::Vector3d(0.0, -9.81, 0.0);  // y up, as in 2D
   GroundPlane ground;
+  std::vector<Spring3> springs;
   double max_condition = 1e12;  // runs stop when cond₂(M) is estimated above this
 };
 
@@ -91,7 +113,7 @@ template <class T> BodyState3<T> RestState3(const BodyModel3& body) {
 }
 
 template <class T> struct ForceBreakdown3 {
-  VecQ3<T> gravity, modes, ground, total;
+  VecQ3<T> gravity, modes, ground, springs, total;
 };
 
 // Which points the ground acts on during an evaluation (ContactSet of the 2D body).
@@ -200,7 +222,20 @@ void EvaluateForces3(const BodyModel3& body, const WorldParams3& w, const BodySt
       AddGeneralizedForce3(frame, l, body.mode_matrix(k), GroundForce3(w.ground, x, v, anchor, &slipping), &out->ground);
     }, set);
   }
-  out->total = out->gravity + out->modes + out->ground;
+  // springs: f = −(K (|Δ| − L) + C v·Δ̂) Δ̂ along Δ = x − anchor
+  out->springs.setZero(n);
+  for (const Spring3& sp : w.springs) {
+    using std::sqrt;
+    const Vec3<T> l = LocalPosition3<T>(sp.rest_local, sp.mode_matrix, s.gamma);
+    const Vec3<T> x = frame.t + frame.R * l;
+    const Vec3<T> v = PointVelocity3(frame, s.v, l, sp.mode_matrix);
+    const Vec3<T> delta = x - sp.anchor.cast<T>();
+    const T len = sqrt(delta.squaredNorm() + T(1e-300));
+    const Vec3<T> dir = delta / len;
+    const Vec3<T> f = -(T(sp.stiffness) * (len - T(sp.rest_length)) + T(sp.damping) * dir.dot(v)) * dir;
+    AddGeneralizedForce3(frame, l, sp.mode_matrix, f, &out->springs);
+  }
+  out->total = out->gravity + out->modes + out->ground + out->springs;
 }
 
 // v̇ of M v̇ = Q − w. Fails with kIllConditioned when the Cholesky pivot ratio (a lower bound
