@@ -8,6 +8,9 @@
 
 #include "support/test_bodies.h"
 #include "wobble/dynamics/step.h"
+#include "wobble/dynamics/step3.h"
+#include "wobble/formats/deformation_file.h"
+#include "wobble/formats/object_file.h"
 
 namespace wobble {
 namespace {
@@ -76,6 +79,57 @@ TEST(Jet, StepDerivativesMatchFiniteDifferences) {
     // double arithmetic but not Jet arithmetic)
     const VecQ<double> plain = Simulate<double>(body, p, integrator, s0.q, s0.qd, 10);
     for (int i = 0; i < 2 * kNq; ++i) EXPECT_NEAR(out[i].a, plain[i], 1e-13 * (1.0 + std::abs(plain[i])));
+  }
+}
+
+
+// The 3D body with Jets: derivatives of its position, shape and velocity after 10 steps with
+// respect to the start velocity v0 = (ṫ, ω, γ̇), through contacts with a tilted plane.
+using Jet3 = ceres::Jet<double, 10>;  // the 3D table: 6 + 4 velocities
+
+template <class T>
+Eigen::Matrix<T, Eigen::Dynamic, 1> Simulate3(const BodyModel3& body, const WorldParams3& w, Integrator integrator,
+                                              const VecQ3<T>& v0, int steps) {
+  BodyState3<T> s = RestState3<T>(body);
+  s.t = Vec3<T>(T(0.0), T(-0.5), T(0.0));
+  s.orientation = Eigen::Quaternion<T>(T(0.999), T(0.02), T(0.01), T(-0.03)).normalized();
+  for (int d = 0; d < body.num_modes(); ++d) s.gamma[d] = T(0.01 * (d + 1));
+  s.v = v0;
+  UpdateContacts3(body, w.ground, &s);
+  for (int i = 0; i < steps; ++i) EXPECT_TRUE(StepBody3(body, w, integrator, 0.005, &s).ok());
+  Eigen::Matrix<T, Eigen::Dynamic, 1> out(7 + 2 * body.num_modes() + 6);
+  out << s.t, s.orientation.coeffs(), s.gamma, s.v;
+  return out;
+}
+
+TEST(Jet, Step3DerivativesMatchFiniteDifferences) {
+  const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
+  std::vector<DeformationMode3> modes =
+      formats::ReadDeformationFile3(std::string(WOBBLE_DATA_DIR) + "/table3_modes.def3", def.lattice);
+  for (DeformationMode3& m : modes) m.stiffness = 4e5, m.damping = 1e4;
+  const BodyModel3 body(def, modes);
+  WorldParams3 w;
+  w.ground.enabled = true;
+  w.ground.normal = Eigen::Vector3d(0.1, 1.0, 0.05).normalized();
+  VecQ3<double> v0(10);
+  v0 << 0.3, -2, 0.2, 0.05, 0.1, -0.08, 0.05, 0.02, -0.04, 0.03;
+  for (Integrator integrator : {Integrator::kThesis, Integrator::kRK4}) {
+    VecQ3<Jet3> v(10);
+    for (int i = 0; i < 10; ++i) v[i] = Jet3(v0[i], i);
+    const auto out = Simulate3<Jet3>(body, w, integrator, v, 10);
+    const Eigen::VectorXd plain = Simulate3<double>(body, w, integrator, v0, 10);
+    for (int j = 0; j < 10; ++j) {
+      const double h = 1e-6;
+      VecQ3<double> vp = v0, vm = v0;
+      vp[j] += h;
+      vm[j] -= h;
+      const Eigen::VectorXd fd = (Simulate3<double>(body, w, integrator, vp, 10) -
+                                  Simulate3<double>(body, w, integrator, vm, 10)) / (2 * h);
+      for (int i = 0; i < fd.size(); ++i)
+        EXPECT_NEAR(out[i].v[j], fd[i], 1e-5 * (1.0 + std::abs(fd[i])))
+            << IntegratorName(integrator) << ": d out" << i << " / d v" << j;
+    }
+    for (int i = 0; i < plain.size(); ++i) EXPECT_NEAR(out[i].a, plain[i], 1e-12 * (1.0 + std::abs(plain[i])));
   }
 }
 
