@@ -148,20 +148,30 @@ ConditionCommands AddConditionCommand(CLI::App* app, ConditionSweepArgs* s, Cond
 }
 
 int RunConditionSweep(const ConditionSweepArgs& a) {
-  const BodyDef def = formats::ReadObjectFile(a.object);
+  const bool three_d = formats::ObjectFileDimension(a.object) == 3;
   const std::vector<double> phis = Angles(a);
   RequirePositive(a.compress, "--compress");
   RequireFinite(a.expand, "--expand");
   if (a.drop_last < 0) throw UsageError("--drop-last must be >= 0");
+  if (three_d && !a.q.empty()) throw UsageError("--q: a 3D body is swept at rest (its orientation is no coordinate)");
+  if (three_d && a.map_size > 0) throw UsageError("--map: the condition map is 2D only so far");
   CheckOutputFolder(a.out);
   analysis::Squash squash;
   squash.compress = a.compress;
   squash.expand = a.expand;
-  // a two-mode body only to parse --q against
-  const BodyModel probe(def, {analysis::SquashMode(def.lattice, 0.0, squash, "v"),
-                              analysis::SquashMode(def.lattice, 0.0, squash, "h")});
-  const Eigen::VectorXd q = ParseCoordinates(a.q, "--q", probe);
-  const std::vector<analysis::SweepSample> samples = analysis::AngleSweep(def, phis, squash, q);
+  BodyDef def;
+  Eigen::VectorXd q;
+  std::vector<analysis::SweepSample> samples;
+  if (three_d) {
+    samples = analysis::AngleSweep(formats::ReadObjectFile3(a.object), phis, squash);
+  } else {
+    def = formats::ReadObjectFile(a.object);
+    // a two-mode body only to parse --q against
+    const BodyModel probe(def, {analysis::SquashMode(def.lattice, 0.0, squash, "v"),
+                                analysis::SquashMode(def.lattice, 0.0, squash, "h")});
+    q = ParseCoordinates(a.q, "--q", probe);
+    samples = analysis::AngleSweep(def, phis, squash, q);
+  }
 
   const std::filesystem::path out(a.out);
   std::vector<std::vector<double>> rows;

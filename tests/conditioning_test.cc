@@ -226,5 +226,23 @@ TEST(conditioning3D, ARigidTurnAsAModeIsFoundWithTheRotation) {
   EXPECT_TRUE(names_rotation) << r.messages[0];
 }
 
+
+// Fig. 4.7 in 3D: the squash whose axis turns from x to y meets the vertical squash at 90°.
+TEST(conditioning3D, AngleSweepIsSingularOnlyWhereTheSquashesMeet) {
+  const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
+  std::vector<double> phis;
+  for (int deg = 30; deg <= 90; deg += 5) phis.push_back(deg * M_PI / 180.0);
+  const std::vector<SweepSample> sweep = AngleSweep(def, phis, Squash());
+  for (size_t i = 0; i + 1 < sweep.size(); ++i) {
+    EXPECT_FALSE(sweep[i].cond.singular) << sweep[i].phi;
+    EXPECT_GT(sweep[i + 1].cond.cond, sweep[i].cond.cond) << "cond grows toward 90°, at " << sweep[i].phi;
+  }
+  EXPECT_TRUE(sweep.back().cond.singular);
+  // near 90° the two fields differ by an angle δ ∝ (90° − φ), the smallest eigenvalue of the
+  // unit-free (Jacobi-scaled) M goes as δ², so halving δ quadruples cond_scaled
+  const std::vector<SweepSample> close = AngleSweep(def, {89.0 * M_PI / 180.0, 89.5 * M_PI / 180.0}, Squash());
+  EXPECT_NEAR(close[1].cond.cond_scaled / close[0].cond.cond_scaled, 4.0, 0.2);
+}
+
 }  // namespace
 }  // namespace wobble::analysis

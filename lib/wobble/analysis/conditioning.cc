@@ -133,6 +133,30 @@ std::vector<SweepSample> AngleSweep(const BodyDef& def, const std::vector<double
   return out;
 }
 
+DeformationMode3 SquashMode3(const Lattice3& lattice, double phi, const Squash& squash, const std::string& name) {
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d A =
+      R * Eigen::Vector3d(-squash.compress, squash.expand, squash.expand).asDiagonal() * R.transpose();
+  // the anchor at the middle of the bottom face: (s, t, u) = (anchor s, anchor t, ½)
+  const Eigen::Vector3d anchor = lattice.origin() + squash.anchor_st.x() * lattice.axis(0) +
+                                 squash.anchor_st.y() * lattice.axis(1) + 0.5 * lattice.axis(2);
+  DeformationMode3 mode;
+  mode.name = name;
+  mode.lattice_size = lattice.sizes();
+  for (const Eigen::Vector3d& p : lattice.RestPoints()) mode.displacement.push_back(A * (p - anchor));
+  return mode;
+}
+
+std::vector<SweepSample> AngleSweep(const BodyDef3& def, const std::vector<double>& phis, const Squash& squash) {
+  const DeformationMode3 vertical = SquashMode3(def.lattice, kPi / 2, squash, "vsquash");
+  std::vector<SweepSample> out;
+  for (double phi : phis) {
+    const BodyModel3 body(def, {vertical, SquashMode3(def.lattice, phi, squash, "squash(phi)")});
+    out.push_back({phi, MassMatrixCondition(body, RestState3<double>(body))});
+  }
+  return out;
+}
+
 std::string LevelName(ModeSetReport::Level level) {
   switch (level) {
     case ModeSetReport::Level::kOk: return "ok";

@@ -61,6 +61,12 @@ struct SweepSample {
 std::vector<SweepSample> AngleSweep(const BodyDef& def, const std::vector<double>& phis, const Squash& squash,
                                     const Eigen::VectorXd& q);
 
+// The sweep for a 3D body at rest: the squash at angle φ turns about z from x (φ = 0) to y,
+// squeezing along its axis and bulging across it in both other directions,
+// A(φ) = R_z(φ) diag(−compress, expand, expand) R_z(φ)ᵀ about the middle of the bottom face.
+DeformationMode3 SquashMode3(const Lattice3& lattice, double phi, const Squash& squash, const std::string& name);
+std::vector<SweepSample> AngleSweep(const BodyDef3& def, const std::vector<double>& phis, const Squash& squash);
+
 // ---- how close the modes of a set are -----------------------------------------------------------
 
 // One degree of freedom's share in a (near) dependency.
