@@ -13,6 +13,9 @@
 #include "support/test_bodies.h"
 #include "wobble/dynamics/step.h"
 #include "wobble/dynamics/step3.h"
+#include "wobble/formats/deformation_file.h"
+#include "wobble/formats/object_file.h"
+#include "wobble/world/world.h"
 
 namespace wobble {
 namespace {
@@ -582,6 +585,63 @@ TEST(Body3, TableDroppedFlatLandsOnItsFourLegsAndSettles) {
   // each foot carries a quarter of the weight: sinks mg/(4K)
   const double sink = table.moments().m * 9.81 / (4 * w.ground.stiffness);
   EXPECT_NEAR(s.t.y(), -sink, 0.02 * sink);
+}
+
+
+// ---- in the World ----
+
+// One world with a 2D table, a 3D table and a Witkin & Welch box: each steps as it would alone.
+TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
+  const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
+  auto table3 = std::make_shared<const BodyModel3>(
+      def, formats::ReadDeformationFile3(std::string(WOBBLE_DATA_DIR) + "/table3_modes.def3", def.lattice));
+  WorldOptions o;
+  o.ground_3d.enabled = true;
+  o.integrator = Integrator::kSymplecticEuler;
+  o.dt = 0.005;
+  World world(o);
+  world.AddBody(std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(4e6, 1e6)));
+  const int b3 = world.AddBody(table3);
+  EXPECT_EQ(world.kind(b3), BodyKind::kFfd3);
+  EXPECT_EQ(world.dim(b3), 3);
+  EXPECT_EQ(world.body3(b3).num_q(), 10);
+  Eigen::VectorXd gamma(4), v(10);
+  gamma << 0.05, 0.0, -0.02, 0.01;
+  v << 10, -20, 5, 0.1, 0.3, -0.2, 0, 0, 0, 0;
+  world.SetState3(b3, Vector3d(0, 30, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Vector3d::UnitX())), gamma, v);
+  // the same body alone, by StepBody3
+  WorldParams3 p;
+  p.ground = o.ground_3d;
+  BodyState3<double> alone = world.state3(b3);
+  for (int step = 0; step < 2000; ++step) {
+    ASSERT_TRUE(world.Step()) << world.status().message;
+    ASSERT_TRUE(StepBody3(*table3, p, o.integrator, o.dt, &alone).ok());
+  }
+  EXPECT_EQ(world.state3(b3).t, alone.t);
+  EXPECT_EQ(world.state3(b3).v, alone.v);
+  EXPECT_FALSE(world.state3(b3).contacts.empty());  // it landed
+  EXPECT_TRUE(std::isfinite(world.ComputeEnergies(b3).total()));
+}
+
+TEST(Body3InWorld, RefusesWhatItCannotDoYet) {
+  const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
+  World world;
+  const int b = world.AddBody(std::make_shared<const BodyModel3>(def, std::vector<DeformationMode3>{}));
+  EXPECT_THROW(world.body(b), std::invalid_argument);  // not a 2D FFD body
+  try {
+    world.AddNail(MassPointOf(b, 0));
+    ADD_FAILURE() << "a nail on a 3D FFD body was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("3D FFD body"), std::string::npos) << e.what();
+  }
+  Eigen::VectorXd none(0), v = Eigen::VectorXd::Zero(6);
+  EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, Eigen::VectorXd::Zero(5)),
+               std::invalid_argument);
+  v[0] = NAN;
+  EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, v), std::invalid_argument);
+  v[0] = 1e160;  // finite, but its kinetic energy is not
+  EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, v), std::invalid_argument);
+  EXPECT_EQ(world.state3(b).v[0], 0.0);  // the refused states left it as it was
 }
 
 }  // namespace

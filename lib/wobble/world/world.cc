@@ -98,15 +98,36 @@ void World::ThrowBadBody(int body, BodyKind wanted) const {
     throw std::invalid_argument("unknown body " + std::to_string(body) + " (the world has " +
                                 std::to_string(num_bodies()) + " bodies)");
   throw std::invalid_argument("body " + std::to_string(body) + " is not " +
-                              (wanted == BodyKind::kFfd ? "an FFD body" : "a linear body"));
+                              (wanted == BodyKind::kFfd    ? "a 2D FFD body"
+                               : wanted == BodyKind::kFfd3 ? "a 3D FFD body"
+                                                           : "a linear body"));
 }
 
-int World::dim(int body) const { return kind(body) == BodyKind::kLinear ? Linear(body).model->dim() : 2; }
+int World::dim(int body) const {
+  switch (kind(body)) {
+    case BodyKind::kLinear: return Linear(body).model->dim();
+    case BodyKind::kFfd3: return 3;
+    case BodyKind::kFfd: break;
+  }
+  return 2;
+}
 
-int World::num_q(int body) const { return kind(body) == BodyKind::kLinear ? Linear(body).model->num_q() : Ffd(body).model->num_q(); }
+int World::num_q(int body) const {
+  switch (kind(body)) {
+    case BodyKind::kLinear: return Linear(body).model->num_q();
+    case BodyKind::kFfd3: return Ffd3(body).model->num_q();
+    case BodyKind::kFfd: break;
+  }
+  return Ffd(body).model->num_q();
+}
 
 const std::string& World::body_name(int body) const {
-  return kind(body) == BodyKind::kLinear ? Linear(body).model->name() : Ffd(body).model->name();
+  switch (kind(body)) {
+    case BodyKind::kLinear: return Linear(body).model->name();
+    case BodyKind::kFfd3: return Ffd3(body).model->name();
+    case BodyKind::kFfd: break;
+  }
+  return Ffd(body).model->name();
 }
 
 const World::LinearEntry& World::Linear(int body) const {
@@ -267,6 +288,10 @@ bool World::StepEachBody() {
       if (!StepFfdBody(body)) return false;
       continue;
     }
+    if (slots_[body].kind == BodyKind::kFfd3) {
+      if (!StepFfd3Body(body)) return false;
+      continue;
+    }
     LinearEntry& e = linear_[slots_[body].index];
     Eigen::VectorXd& acc = acc_.empty() ? acc_.emplace_back() : acc_[0];
     LinearFreeAcceleration(e, &acc);
@@ -327,6 +352,7 @@ bool World::Fail(StatusCode code, int body, const std::string& detail, double va
 Energies World::ComputeEnergies(int i) const {
   Energies e;
   const WorldParams& p = options_.params;
+  if (kind(i) == BodyKind::kFfd3) return Ffd3Energies(i);
   if (kind(i) == BodyKind::kLinear) {
     const LinearEntry& l = Linear(i);
     e.kinetic = 0.5 * (l.R_dot * l.model->mass_matrix() * l.R_dot.transpose()).trace();  // ½ Ṙ_ij Ṙ_ik M_jk

@@ -40,13 +40,14 @@
 #include "wobble/core/interrupt.h"
 #include "wobble/body/linear_body.h"
 #include "wobble/dynamics/step.h"
+#include "wobble/dynamics/step3.h"
 #include "wobble/world/controller.h"
 #include "wobble/world/multiplier_solver.h"
 #include "wobble/world/point_path.h"
 
 namespace wobble {
 
-enum class BodyKind { kLinear, kFfd };
+enum class BodyKind { kLinear, kFfd, kFfd3 };  // kFfd3: the 3D FFD body (step3.h)
 enum class ConstraintKind { kNail, kAttachment, kTrajectory };
 const char* ConstraintKindName(ConstraintKind kind);
 
@@ -80,6 +81,8 @@ struct WorldOptions {
   // the ground, springs and max_condition of the FFD bodies.
   WorldParams params;
   Eigen::Vector3d gravity_3d = Eigen::Vector3d(0.0, -9.81, 0.0);
+  // The ground plane of the 3D FFD bodies (off by default; springs of 3D bodies: not yet).
+  GroundPlane ground_3d;
   // The FFD bodies' integrator while no constraint is enabled.
   Integrator integrator = Integrator::kThesis;
   double dt = 0.01;
@@ -122,12 +125,22 @@ class World {
   // ---- bodies (one numbering for both kinds) ----
   // An FFD body starts at q = 0 (the body frame), at rest.
   int AddBody(std::shared_ptr<const BodyModel> model);
+  // A 3D FFD body starts in its lattice's pose (t = 0, no turn, γ = 0), at rest. It steps with
+  // options().integrator on options().ground_3d and gravity_3d; constraints on it: not yet.
+  int AddBody(std::shared_ptr<const BodyModel3> model);
   // A linear body starts at its rest state R = [I | 0 | 0], at rest.
   int AddLinearBody(std::shared_ptr<const LinearBodyModel> model, AffineMaterial material = {});
   int num_bodies() const { return int(slots_.size()); }
   BodyKind kind(int body) const;
   int dim(int body) const;  // 2 or 3
   const std::string& body_name(int body) const;
+
+  // 3D FFD bodies (std::invalid_argument for another kind or a wrong size; InputError for a
+  // state that is not finite or whose energy is not).
+  const BodyModel3& body3(int i) const;
+  const BodyState3<double>& state3(int i) const;
+  void SetState3(int body, const Eigen::Vector3d& t, const Eigen::Quaterniond& orientation,
+                 const Eigen::VectorXd& gamma, const Eigen::VectorXd& v);
 
   // FFD bodies (std::invalid_argument for a linear one or a wrong size). Setting a state does
   // not enforce constraints: follow with ProjectVelocities() or let the feedback pull it in.
@@ -277,6 +290,10 @@ class World {
     Eigen::VectorXd applied;  // Σ Jᵀ f of ApplyPointForce for the next step
     double scale = 0.0;       // the largest |number| of the model (ModelScale), for EnergyFinite
   };
+  struct Ffd3Entry {
+    std::shared_ptr<const BodyModel3> model;
+    BodyState3<double> state;
+  };
   struct LinearEntry {
     std::shared_ptr<const LinearBodyModel> model;
     AffineMaterial material;
@@ -310,7 +327,12 @@ class World {
   const FfdEntry& Ffd(int body) const;
   [[noreturn]] void ThrowBadBody(int body, BodyKind wanted) const;
   const LinearEntry& Linear(int body) const;
+  const Ffd3Entry& Ffd3(int body) const;
   bool StepEachBody();
+  // world_ffd3.cc: the 3D FFD bodies
+  WorldParams3 Params3() const;
+  bool StepFfd3Body(int body);
+  Energies Ffd3Energies(int body) const;
   bool StepFfdBody(int body);
   void LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const;
   double PenetrationLimit(const BodyModel& model) const;
@@ -361,6 +383,7 @@ class World {
   bool stepping_ = false;
   bool removed_while_stepping_ = false;  // controllers_ has null entries to erase
   std::vector<FfdEntry> ffd_;
+  std::vector<Ffd3Entry> ffd3_;
   std::vector<LinearEntry> linear_;
   std::vector<Constraint> constraints_;
   int enabled_count_ = 0;

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "wobble/core/errors.h"
 #include "wobble/dynamics/kinematics.h"
 #include "wobble/dynamics/step.h"
 
@@ -31,6 +32,9 @@ const char* ConstraintKindName(ConstraintKind kind) {
 
 World::End World::Resolve(const MaterialPoint& point) const {
   CheckBody(point.body);
+  if (slots_[point.body].kind == BodyKind::kFfd3)
+    throw InputError("body '" + body_name(point.body) +
+                     "' is a 3D FFD body: points, forces and constraints on it are not supported yet");
   End e;
   e.body = point.body;
   if (slots_[point.body].kind == BodyKind::kLinear) {
@@ -449,7 +453,9 @@ bool World::FreeAccelerations(std::vector<Eigen::VectorXd>* acc, int* failed_bod
   for (int body = 0; body < num_bodies(); ++body) {
     const Slot& b = slots_[body];
     Eigen::VectorXd& a = (*acc)[body];
-    if (b.kind == BodyKind::kLinear) {
+    if (b.kind == BodyKind::kFfd3) {
+      a.resize(0);  // never constrained (Resolve refuses its points): it steps on its own below
+    } else if (b.kind == BodyKind::kLinear) {
       LinearFreeAcceleration(linear_[b.index], &a);
     } else {
       VecQ<double> qdd;
@@ -541,7 +547,9 @@ bool World::StepConstrained() {
   for (int body = 0; body < num_bodies(); ++body) {
     const Slot& b = slots_[body];
     if (b.kinematic) continue;
-    if (b.kind == BodyKind::kLinear) {
+    if (b.kind == BodyKind::kFfd3) {
+      if (!StepFfd3Body(body)) return false;
+    } else if (b.kind == BodyKind::kLinear) {
       LinearEntry& e = linear_[b.index];
       const int d = e.model->dim(), n = e.model->basis_size();
       e.R_dot_before.noalias() = e.R_dot + h * AsMatrix(acc[body], d, n);  // swapped in below (O(1))

@@ -1,0 +1,97 @@
+// The 3D FFD bodies of the World (issue 15, first step): added, set and stepped on their own
+// with StepBody3 (dynamics/step3.h) on the world's 3D gravity and ground plane. Points,
+// forces and constraints on them are refused (Resolve) until the multiplier step knows them.
+#include <sstream>
+
+#include "wobble/core/errors.h"
+#include "wobble/world/world.h"
+
+namespace wobble {
+
+int World::AddBody(std::shared_ptr<const BodyModel3> model) {
+  if (!model) throw std::invalid_argument("AddBody: no model");
+  Ffd3Entry e;
+  e.state = RestState3<double>(*model);
+  e.model = std::move(model);
+  ffd3_.push_back(std::move(e));
+  slots_.push_back({BodyKind::kFfd3, int(ffd3_.size()) - 1});
+  UpdateContacts3(*ffd3_.back().model, options_.ground_3d, &ffd3_.back().state);
+  return num_bodies() - 1;
+}
+
+const World::Ffd3Entry& World::Ffd3(int body) const {
+  if (unsigned(body) >= slots_.size() || slots_[size_t(body)].kind != BodyKind::kFfd3) ThrowBadBody(body, BodyKind::kFfd3);
+  return ffd3_[slots_[size_t(body)].index];
+}
+const BodyModel3& World::body3(int i) const { return *Ffd3(i).model; }
+const BodyState3<double>& World::state3(int i) const { return Ffd3(i).state; }
+
+WorldParams3 World::Params3() const {
+  WorldParams3 p;
+  p.gravity_on = options_.params.gravity_on;
+  p.gravity = options_.gravity_3d;
+  p.ground = options_.ground_3d;
+  p.max_condition = options_.params.max_condition;
+  return p;
+}
+
+void World::SetState3(int body, const Eigen::Vector3d& t, const Eigen::Quaterniond& orientation,
+                      const Eigen::VectorXd& gamma, const Eigen::VectorXd& v) {
+  Ffd3(body);  // checks the body and its kind
+  Ffd3Entry& e = ffd3_[slots_[size_t(body)].index];
+  const BodyModel3& m = *e.model;
+  if (gamma.size() != m.num_modes() || v.size() != m.num_q())
+    throw InputError("body '" + m.name() + "' has " + std::to_string(m.num_modes()) + " modes and " +
+                     std::to_string(m.num_q()) + " velocities (t-dot, omega and one per mode), got " +
+                     std::to_string(gamma.size()) + " and " + std::to_string(v.size()));
+  if (!t.allFinite() || !orientation.coeffs().allFinite() || !gamma.allFinite() || !v.allFinite())
+    throw InputError("body '" + m.name() + "': the state must be finite");
+  if (!(orientation.norm() > 1e-12)) throw InputError("body '" + m.name() + "': the orientation quaternion is zero");
+  const BodyState3<double> before = e.state;
+  e.state.t = t;
+  e.state.orientation = orientation.normalized();
+  e.state.gamma = gamma;
+  e.state.v = v;
+  e.state.contacts.clear();
+  UpdateContacts3(m, options_.ground_3d, &e.state);
+  const Energies energies = Ffd3Energies(body);
+  if (std::isfinite(energies.total())) return;
+  e.state = before;
+  throw InputError("body '" + m.name() + "': a state whose energy is not finite (" + EnergyTerms(energies) + ")");
+}
+
+bool World::StepFfd3Body(int body) {
+  Ffd3Entry& e = ffd3_[slots_[body].index];
+  const BodyState3<double> before = e.state;
+  const StepStatus st = StepBody3(*e.model, Params3(), options_.integrator, options_.dt, &e.state);
+  if (st.ok() && std::isfinite(Ffd3Energies(body).total())) return true;
+  const Energies energies = st.ok() ? Ffd3Energies(body) : Energies();
+  e.state = before;  // a refused step leaves the state before it
+  if (!st.ok()) return Fail(st.code, body, "", st.value);
+  return Fail(StatusCode::kNonFiniteEnergy, body, EnergyTerms(energies) + " after the step (refused)");
+}
+
+// Kinetic ½ vᵀMv, gravity −g·(m t + R c), modes K (γ − γ0)², and the ground's penalty ½ K |Δ|²
+// of every contact spring.
+Energies World::Ffd3Energies(int body) const {
+  const Ffd3Entry& e = Ffd3(body);
+  const BodyModel3& m = *e.model;
+  const BodyState3<double>& s = e.state;
+  const ShapeMoments3<double> sm(m.moments(), s.gamma);
+  const Frame3<double> frame(s.t, s.orientation);
+  Energies out;
+  out.kinetic = KineticEnergy3(m.moments(), sm, frame.R, s.v);
+  if (options_.params.gravity_on) out.gravity = GravityEnergy3(m.moments(), sm, frame, options_.gravity_3d);
+  for (int d = 0; d < m.num_modes(); ++d) {
+    const double offset = s.gamma[d] - (s.mode_target.size() == m.num_modes() ? s.mode_target[d] : 0.0);
+    out.per_mode.push_back(m.modes()[d].stiffness * offset * offset);
+    out.modes += out.per_mode.back();
+  }
+  for (const Contact3<double>& c : s.contacts) {
+    const Eigen::Vector3d x = frame.t + frame.R * LocalPosition3<double>(m.rest_local(c.point), m.mode_matrix(c.point), s.gamma);
+    out.ground += 0.5 * options_.ground_3d.stiffness * (x - c.anchor).squaredNorm();
+  }
+  return out;
+}
+
+}  // namespace wobble
