@@ -15,6 +15,8 @@
 #include "wobble/dynamics/step3.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "wobble/body/linear_body.h"
+#include "wobble/body/linear_shapes.h"
 #include "wobble/world/world.h"
 
 namespace wobble {
@@ -623,17 +625,14 @@ TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
   EXPECT_TRUE(std::isfinite(world.ComputeEnergies(b3).total()));
 }
 
-TEST(Body3InWorld, RefusesWhatItCannotDoYet) {
+TEST(Body3InWorld, RefusesBadStatesAndPoints) {
   const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
   World world;
   const int b = world.AddBody(std::make_shared<const BodyModel3>(def, std::vector<DeformationMode3>{}));
   EXPECT_THROW(world.body(b), std::invalid_argument);  // not a 2D FFD body
-  try {
-    world.AddNail(MassPointOf(b, 0));
-    ADD_FAILURE() << "a nail on a 3D FFD body was accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("3D FFD body"), std::string::npos) << e.what();
-  }
+  EXPECT_THROW(world.AddNail(At(b, Eigen::Vector2d(0.5, 0.5))), std::invalid_argument);  // (s, t, u) needed
+  EXPECT_THROW(world.AddNail(At(b, Eigen::Vector3d(0.5, 1.5, 0.5))), std::invalid_argument);
+  EXPECT_THROW(world.ApplyPointForce(MassPointOf(b, 0), Eigen::Vector3d(1, 0, 0)), std::invalid_argument);
   Eigen::VectorXd none(0), v = Eigen::VectorXd::Zero(6);
   EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, Eigen::VectorXd::Zero(5)),
                std::invalid_argument);
@@ -642,6 +641,114 @@ TEST(Body3InWorld, RefusesWhatItCannotDoYet) {
   v[0] = 1e160;  // finite, but its kinetic energy is not
   EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, v), std::invalid_argument);
   EXPECT_EQ(world.state3(b).v[0], 0.0);  // the refused states left it as it was
+}
+
+// A rigid box nailed at the middle of its top face is a physical pendulum: small swings about
+// z have the period 2π √(I_pivot / (m g d)), d the distance from the nail to the centre.
+TEST(Body3InWorld, NailedBoxSwingsWithThePhysicalPendulumPeriod) {
+  const double a = 1.0, b = 2.0, c = 3.0, m = 0.5, g = 9.81;
+  auto box = std::make_shared<const BodyModel3>(Box(a, b, c, m));
+  WorldOptions o;
+  o.dt = 1e-4;
+  World world(o);
+  const int body = world.AddBody(box);
+  const double theta0 = 0.05;
+  // turned by θ0 about the nail (a/2, b, c/2): t = pivot − R pivot
+  const Vector3d pivot(a / 2, b, c / 2);
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(theta0, Vector3d::UnitZ()));
+  world.SetState3(body, pivot - turn * pivot, turn, Eigen::VectorXd(0), Eigen::VectorXd::Zero(6));
+  world.AddNail(At(body, Vector3d(0.5, 1.0, 0.5)));
+  const double M = 8 * m, d = b / 2, I_pivot = 8 * m * (a * a + b * b) / 4 + M * d * d;
+  const double period = 2 * M_PI * std::sqrt(I_pivot / (M * g * d)) * (1 + theta0 * theta0 / 16);
+  std::vector<double> crossings;
+  double previous = world.state3(body).v[5], worst_violation = 0.0;
+  while (world.time() < 2.2 * period) {
+    ASSERT_TRUE(world.Step()) << world.status().message;
+    const double now = world.state3(body).v[5];
+    if (previous > 0 && now <= 0) crossings.push_back(world.time() - o.dt * now / (now - previous));
+    previous = now;
+    worst_violation = std::max(worst_violation, world.MaxViolation());
+  }
+  ASSERT_GE(crossings.size(), 2u);
+  EXPECT_NEAR(crossings[1] - crossings[0], period, 2e-3 * period);
+  EXPECT_LT(worst_violation, 1e-4);
+  RecordProperty("pendulum_period_error", Sci((crossings[1] - crossings[0]) / period - 1.0));
+}
+
+// A soft character of several parts (thesis §6.2): a 3D FFD body attached to a second one and
+// to a Witkin & Welch box, tumbling with no gravity for 1 s. The attachments are internal
+// forces, so total linear and angular momentum are constant in the continuous motion; the
+// world's semi-implicit Euler keeps them to O(Δt) (the momenta depend on the configuration),
+// so the drift must halve with Δt, and the joints must hold.
+struct AttachedRun {
+  double drift_P = 0, drift_L = 0, violation = 0;
+};
+AttachedRun RunAttached(double dt) {
+  std::mt19937 rng(31);
+  auto body_a = std::make_shared<const BodyModel3>(RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20, 3000.0));
+  auto body_b = std::make_shared<const BodyModel3>(RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20, 3000.0));
+  auto slab = std::make_shared<const LinearBodyModel>(
+      MakeBoxBody("slab", 3, LinearOrder::kAffine, Eigen::Vector3d(40, 15, 25), 3, 200.0));
+  WorldOptions o;
+  o.params.gravity_on = false;
+  o.dt = dt;
+  World world(o);
+  const int a = world.AddBody(body_a), b = world.AddBody(body_b), s = world.AddLinearBody(slab);
+  BodyState3<double> sa = RandomState3(rng, *body_a, 0.2), sb = RandomState3(rng, *body_b, 0.2);
+  world.SetState3(a, Vector3d::Zero(), Eigen::Quaterniond::Identity(), sa.gamma, sa.v);
+  // b and the slab placed so that their joint points coincide with a's
+  const Vector3d joint_ab = world.PointPosition(At(a, Vector3d(1, 0.5, 0.5)));
+  world.SetState3(b, Vector3d::Zero(), Eigen::Quaterniond::Identity(), sb.gamma, sb.v);
+  const Vector3d b_local = world.PointPosition(At(b, Vector3d(0, 0.5, 0.5)));
+  world.SetState3(b, joint_ab - b_local, Eigen::Quaterniond::Identity(), sb.gamma, sb.v);
+  const Vector3d joint_as = world.PointPosition(At(a, Vector3d(0.5, 1, 0.5)));
+  Eigen::MatrixXd R = slab->RestState();
+  R.col(3) = joint_as - Vector3d(0, -15, 0);  // x = u + R.col(3): the slab point (0, −15, 0) at the joint
+  world.SetLinearState(s, R, Eigen::MatrixXd::Zero(R.rows(), R.cols()));
+  world.AddAttachment(At(a, Vector3d(1, 0.5, 0.5)), At(b, Vector3d(0, 0.5, 0.5)));
+  world.AddAttachment(At(a, Vector3d(0.5, 1, 0.5)), At(s, Vector3d(0, -15, 0)));
+  EXPECT_TRUE(world.ProjectVelocities());
+  auto momenta = [&](Vector3d* P) {
+    Vector3d L = Vector3d::Zero();
+    P->setZero();
+    for (int i : {a, b}) {
+      Vector3d Pi;
+      L += AngularMomentum(world.body3(i), world.state3(i), &Pi);
+      *P += Pi;
+    }
+    // the linear body, from its mass points: P = Σ m ẋ, L = Σ m x × ẋ
+    const LinearBodyModel& m = world.linear_model(s);
+    for (int k = 0; k < m.num_points(); ++k) {
+      const Eigen::VectorXd p = m.Basis(m.def().points[k]);
+      const Vector3d x = world.linear_R(s) * p, v = world.linear_R_dot(s) * p;
+      *P += m.def().masses[k] * v;
+      L += m.def().masses[k] * x.cross(v);
+    }
+    return L;
+  };
+  Vector3d P0;
+  const Vector3d L0 = momenta(&P0);
+  AttachedRun run;
+  while (world.time() < 1.0 - 1e-9) {
+    EXPECT_TRUE(world.Step()) << world.status().message;
+    Vector3d P;
+    const Vector3d L = momenta(&P);
+    run.drift_P = std::max(run.drift_P, (P - P0).norm() / P0.norm());
+    run.drift_L = std::max(run.drift_L, (L - L0).norm() / L0.norm());
+    run.violation = std::max(run.violation, world.MaxViolation());
+  }
+  return run;
+}
+
+TEST(Body3InWorld, AttachedToEachOtherAndToALinearBodyKeepsMomentum) {
+  const AttachedRun coarse = RunAttached(2e-4), fine = RunAttached(1e-4);
+  EXPECT_LT(coarse.drift_P, 1e-4);
+  EXPECT_LT(coarse.drift_L, 1e-4);
+  EXPECT_NEAR(coarse.drift_P / fine.drift_P, 2.0, 0.2);  // first order in Δt
+  EXPECT_NEAR(coarse.drift_L / fine.drift_L, 2.0, 0.2);
+  EXPECT_LT(coarse.violation, 1e-2);
+  RecordProperty("attached_momentum_drift", Sci(coarse.drift_P) + " / " + Sci(fine.drift_P) + " linear, " +
+                                                Sci(coarse.drift_L) + " / " + Sci(fine.drift_L) + " angular");
 }
 
 }  // namespace

@@ -308,6 +308,8 @@ class World {
     Eigen::VectorXd p, Wp;  // linear
     Eigen::Vector2d b0;     // FFD
     Mat2D<double> B;        // FFD
+    Eigen::Vector3d b0_3 = Eigen::Vector3d::Zero();  // 3D FFD
+    Mat3D<double> B3;                                // 3D FFD
   };
   struct Constraint {
     ConstraintKind kind;
@@ -329,8 +331,18 @@ class World {
   const LinearEntry& Linear(int body) const;
   const Ffd3Entry& Ffd3(int body) const;
   bool StepEachBody();
-  // world_ffd3.cc: the 3D FFD bodies
+  // world_ffd3.cc: the 3D FFD bodies; their ends of constraints (the kFfd3 branches of the
+  // End functions in world_constraints.cc)
   WorldParams3 Params3() const;
+  void Ffd3Resolve(const MaterialPoint& point, End* e) const;
+  PointVec Ffd3EndPosition(const End& e) const;
+  PointVec Ffd3EndVelocity(const End& e) const;
+  PointVec Ffd3EndJdotQdot(const End& e) const;
+  Eigen::MatrixXd Ffd3EndJacobian(const End& e) const;
+  void Ffd3AddEndForce(const End& e, const Eigen::VectorXd& f, Eigen::VectorXd* Q) const;
+  void Ffd3ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const;
+  bool Ffd3FreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st) const;
+  bool Ffd3AcceptConstrainedStep(int body, const Eigen::VectorXd& acc);
   bool StepFfd3Body(int body);
   Energies Ffd3Energies(int body) const;
   bool StepFfdBody(int body);

@@ -32,12 +32,11 @@ const char* ConstraintKindName(ConstraintKind kind) {
 
 World::End World::Resolve(const MaterialPoint& point) const {
   CheckBody(point.body);
-  if (slots_[point.body].kind == BodyKind::kFfd3)
-    throw InputError("body '" + body_name(point.body) +
-                     "' is a 3D FFD body: points, forces and constraints on it are not supported yet");
   End e;
   e.body = point.body;
-  if (slots_[point.body].kind == BodyKind::kLinear) {
+  if (slots_[point.body].kind == BodyKind::kFfd3) {
+    Ffd3Resolve(point, &e);
+  } else if (slots_[point.body].kind == BodyKind::kLinear) {
     const LinearBodyModel& m = *linear_[slots_[point.body].index].model;
     Eigen::VectorXd u = point.u;
     if (point.mass_point >= 0) {
@@ -75,6 +74,7 @@ World::End World::Resolve(const MaterialPoint& point) const {
 
 World::PointVec World::EndPosition(const End& e) const {
   const Slot& b = slots_[e.body];
+  if (b.kind == BodyKind::kFfd3) return Ffd3EndPosition(e);
   if (b.kind == BodyKind::kLinear) {
     PointVec x;
     x.noalias() = linear_[b.index].R * e.p;
@@ -86,6 +86,7 @@ World::PointVec World::EndPosition(const End& e) const {
 
 World::PointVec World::EndVelocity(const End& e) const {
   const Slot& b = slots_[e.body];
+  if (b.kind == BodyKind::kFfd3) return Ffd3EndVelocity(e);
   if (b.kind == BodyKind::kLinear) {
     PointVec v;
     v.noalias() = linear_[b.index].R_dot * e.p;
@@ -102,7 +103,9 @@ Eigen::VectorXd World::PointVelocity(const MaterialPoint& point) const { return 
 void World::AddEndForce(const End& e, const Eigen::VectorXd& f, std::vector<Eigen::VectorXd>* Q) const {
   const Slot& b = slots_[e.body];
   Eigen::VectorXd& out = (*Q)[e.body];
-  if (b.kind == BodyKind::kLinear) {
+  if (b.kind == BodyKind::kFfd3) {
+    Ffd3AddEndForce(e, f, &out);
+  } else if (b.kind == BodyKind::kLinear) {
     const int d = int(f.size()), n = int(e.p.size());
     AsMatrix(out, d, n) += f * e.p.transpose();  // Q = f pᵀ (§2.2)
   } else {
@@ -120,7 +123,9 @@ void World::ApplyPointForce(const MaterialPoint& point, const Eigen::VectorXd& f
     throw std::invalid_argument("a force on body '" + body_name(point.body) + "' needs " +
                                 std::to_string(dim(point.body)) + " finite components");
   const Slot& b = slots_[e.body];
-  if (b.kind == BodyKind::kLinear) {
+  if (b.kind == BodyKind::kFfd3) {
+    throw InputError("body '" + body_name(point.body) + "' is a 3D FFD body: point forces on it are not supported yet");
+  } else if (b.kind == BodyKind::kLinear) {
     linear_[b.index].applied += f * e.p.transpose();
   } else {
     std::vector<Eigen::VectorXd> Q(num_bodies());
@@ -132,6 +137,7 @@ void World::ApplyPointForce(const MaterialPoint& point, const Eigen::VectorXd& f
 
 World::PointVec World::EndJdotQdot(const End& e) const {
   const Slot& b = slots_[e.body];
+  if (b.kind == BodyKind::kFfd3) return Ffd3EndJdotQdot(e);
   if (b.kind == BodyKind::kLinear) return PointVec::Zero(linear_[b.index].model->dim());  // J constant
   // J̇ q̇ = R(−θ̇² l + 2 θ̇ S B γ̇) (ARCHITECTURE.md, from Eq. 4.21's velocity terms)
   const BodyState<double>& s = ffd_[b.index].state;
@@ -145,6 +151,7 @@ World::PointVec World::EndJdotQdot(const End& e) const {
 
 Eigen::MatrixXd World::EndJacobian(const End& e) const {
   const Slot& b = slots_[e.body];
+  if (b.kind == BodyKind::kFfd3) return Ffd3EndJacobian(e);
   if (b.kind == BodyKind::kLinear) {
     const int d = linear_[b.index].model->dim(), n = int(e.p.size());
     Eigen::MatrixXd J = Eigen::MatrixXd::Zero(d, d * n);  // ∂x_i/∂R_rs = δ_ir p_s (§3.3)
@@ -170,8 +177,8 @@ Eigen::MatrixXd World::EndWJt(const End& e) const {
     return WJt;
   }
   const Eigen::MatrixXd Jt = EndJacobian(e).transpose();
-  Eigen::MatrixXd WJt(Jt.rows(), 2);
-  for (int i = 0; i < 2; ++i) {
+  Eigen::MatrixXd WJt(Jt.rows(), Jt.cols());
+  for (int i = 0; i < Jt.cols(); ++i) {
     Eigen::VectorXd col;
     ApplyGeneralized(e.body, Jt.col(i), &(col = Eigen::VectorXd::Zero(Jt.rows())));
     WJt.col(i) = col;
@@ -181,6 +188,7 @@ Eigen::MatrixXd World::EndWJt(const End& e) const {
 
 void World::ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const {
   const Slot& b = slots_[body];
+  if (b.kind == BodyKind::kFfd3) return Ffd3ApplyGeneralized(body, Q, acc);
   if (b.kind == BodyKind::kLinear) {
     const LinearBodyModel& m = *linear_[b.index].model;
     AsMatrix(*acc, m.dim(), m.basis_size()) += AsMatrix(Q, m.dim(), m.basis_size()) * m.inverse_mass_matrix();  // Eq. 5
@@ -354,8 +362,8 @@ double World::FeedbackBeta(const Constraint& c) const {
 bool World::AnyFfdConstrained() const {
   for (const Constraint& c : constraints_) {
     if (!c.enabled) continue;
-    if (slots_[c.a.body].kind == BodyKind::kFfd) return true;
-    if (c.b.body >= 0 && slots_[c.b.body].kind == BodyKind::kFfd) return true;
+    if (slots_[c.a.body].kind != BodyKind::kLinear) return true;  // M(q) changes every step
+    if (c.b.body >= 0 && slots_[c.b.body].kind != BodyKind::kLinear) return true;
   }
   return false;
 }
@@ -454,7 +462,10 @@ bool World::FreeAccelerations(std::vector<Eigen::VectorXd>* acc, int* failed_bod
     const Slot& b = slots_[body];
     Eigen::VectorXd& a = (*acc)[body];
     if (b.kind == BodyKind::kFfd3) {
-      a.resize(0);  // never constrained (Resolve refuses its points): it steps on its own below
+      if (!Ffd3FreeAcceleration(body, &a, st)) {
+        *failed_body = body;
+        return false;
+      }
     } else if (b.kind == BodyKind::kLinear) {
       LinearFreeAcceleration(linear_[b.index], &a);
     } else {
@@ -548,7 +559,7 @@ bool World::StepConstrained() {
     const Slot& b = slots_[body];
     if (b.kinematic) continue;
     if (b.kind == BodyKind::kFfd3) {
-      if (!StepFfd3Body(body)) return false;
+      if (!Ffd3AcceptConstrainedStep(body, acc[body])) return false;
     } else if (b.kind == BodyKind::kLinear) {
       LinearEntry& e = linear_[b.index];
       const int d = e.model->dim(), n = e.model->basis_size();
@@ -657,7 +668,11 @@ bool World::ApplyImpulse(const std::vector<VelocityGoal>& goals, std::string* er
     for (int body = 0; body < num_bodies(); ++body) {
       if (dv[body].size() == 0) continue;
       const Slot& b = slots_[body];
-      if (b.kind == BodyKind::kLinear) {
+      if (b.kind == BodyKind::kFfd3) {
+        Ffd3Entry& e = ffd3_[b.index];
+        e.state.v += dv[body];
+        UpdateContacts3(*e.model, options_.ground_3d, &e.state);
+      } else if (b.kind == BodyKind::kLinear) {
         LinearEntry& e = linear_[b.index];
         e.R_dot += AsMatrix(dv[body], e.model->dim(), e.model->basis_size());
       } else {

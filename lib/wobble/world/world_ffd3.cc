@@ -1,6 +1,8 @@
-// The 3D FFD bodies of the World (issue 15, first step): added, set and stepped on their own
-// with StepBody3 (dynamics/step3.h) on the world's 3D gravity and ground plane. Points,
-// forces and constraints on them are refused (Resolve) until the multiplier step knows them.
+// The 3D FFD bodies of the World: added, set and stepped with StepBody3 (dynamics/step3.h) on
+// the world's 3D gravity and ground plane, and the 3D FFD ends of nails, attachments,
+// trajectories and impulses: x = t + R l, J = [1 | −R[l]× | R B], J̇v = R(ω×(ω×l) + 2ω×Bγ̇)
+// (kinematics3.h). A constrained world steps them by semi-implicit Euler, velocity first, on
+// the group, as it steps every other body.
 #include <sstream>
 
 #include "wobble/core/errors.h"
@@ -92,6 +94,102 @@ Energies World::Ffd3Energies(int body) const {
     out.ground += 0.5 * options_.ground_3d.stiffness * (x - c.anchor).squaredNorm();
   }
   return out;
+}
+
+// ---------------------------------------------------------------- constraint ends
+
+void World::Ffd3Resolve(const MaterialPoint& point, End* e) const {
+  const BodyModel3& m = *Ffd3(point.body).model;
+  Eigen::Vector3d u;
+  if (point.mass_point >= 0) {
+    if (point.mass_point >= m.num_points())
+      throw std::invalid_argument("body '" + m.name() + "' has " + std::to_string(m.num_points()) +
+                                  " mass points, no point " + std::to_string(point.mass_point));
+    u = m.lattice_coords(point.mass_point);
+  } else {
+    if (point.u.size() != 3 || !point.u.allFinite())
+      throw std::invalid_argument("a point of 3D FFD body '" + m.name() + "' needs 3 lattice coordinates (s, t, u)");
+    u = point.u;
+    const double tol = 1e-9;
+    if (u.minCoeff() < -tol || u.maxCoeff() > 1.0 + tol)
+      throw std::invalid_argument("lattice coordinates of 3D FFD body '" + m.name() + "' are outside [0, 1]^3");
+  }
+  m.LocalBasis(u, &e->b0_3, &e->B3);
+}
+
+World::PointVec World::Ffd3EndPosition(const End& e) const {
+  const BodyState3<double>& s = Ffd3(e.body).state;
+  const Frame3<double> frame(s.t, s.orientation);
+  return frame.t + frame.R * LocalPosition3<double>(e.b0_3, e.B3, s.gamma);
+}
+
+World::PointVec World::Ffd3EndVelocity(const End& e) const {
+  const BodyState3<double>& s = Ffd3(e.body).state;
+  const Frame3<double> frame(s.t, s.orientation);
+  return PointVelocity3(frame, s.v, LocalPosition3<double>(e.b0_3, e.B3, s.gamma), e.B3);
+}
+
+World::PointVec World::Ffd3EndJdotQdot(const End& e) const {
+  const BodyState3<double>& s = Ffd3(e.body).state;
+  const Frame3<double> frame(s.t, s.orientation);
+  const Eigen::Vector3d l = LocalPosition3<double>(e.b0_3, e.B3, s.gamma);
+  const Eigen::Vector3d omega = s.v.segment<3>(3);
+  const Eigen::Vector3d Bgd = e.B3 * s.v.tail(e.B3.cols());
+  return frame.R * (omega.cross(omega.cross(l)) + 2.0 * omega.cross(Bgd));
+}
+
+Eigen::MatrixXd World::Ffd3EndJacobian(const End& e) const {
+  const BodyState3<double>& s = Ffd3(e.body).state;
+  const Frame3<double> frame(s.t, s.orientation);
+  const Eigen::Vector3d l = LocalPosition3<double>(e.b0_3, e.B3, s.gamma);
+  Eigen::MatrixXd J(3, s.v.size());
+  J.leftCols(3).setIdentity();
+  J.block<3, 3>(0, 3) = -frame.R * Skew<double>(l);
+  if (e.B3.cols() > 0) J.rightCols(e.B3.cols()) = frame.R * e.B3;
+  return J;
+}
+
+void World::Ffd3AddEndForce(const End& e, const Eigen::VectorXd& f, Eigen::VectorXd* Q) const {
+  const BodyState3<double>& s = Ffd3(e.body).state;
+  const Frame3<double> frame(s.t, s.orientation);
+  VecQ3<double> q = *Q;
+  AddGeneralizedForce3(frame, LocalPosition3<double>(e.b0_3, e.B3, s.gamma), e.B3, Eigen::Vector3d(f), &q);
+  *Q = q;
+}
+
+void World::Ffd3ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const {
+  const Ffd3Entry& e = Ffd3(body);
+  const ShapeMoments3<double> sm(e.model->moments(), e.state.gamma);
+  MatQ3<double> M;
+  MassMatrix3(e.model->moments(), sm, Mat3<double>(e.state.orientation.toRotationMatrix()), &M);
+  if (!CholeskyInPlace(&M)) {
+    *acc = Eigen::VectorXd::Constant(acc->size(), std::nan(""));  // caught by the finite checks
+    return;
+  }
+  VecQ3<double> x = Q;
+  CholeskySolveInPlace(M, &x);
+  *acc += x;
+}
+
+bool World::Ffd3FreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st) const {
+  VecQ3<double> a;
+  *st = Accelerations3(*Ffd3(body).model, Params3(), Ffd3(body).state, &a);
+  if (!st->ok()) return false;
+  *acc = a;
+  return true;
+}
+
+bool World::Ffd3AcceptConstrainedStep(int body, const Eigen::VectorXd& acc) {
+  Ffd3Entry& e = ffd3_[slots_[body].index];
+  const BodyState3<double> before = e.state;
+  e.state.v += options_.dt * acc;
+  AdvanceConfiguration3<double>(e.state.v, options_.dt, &e.state);
+  UpdateContacts3(*e.model, options_.ground_3d, &e.state);
+  if (e.state.v.allFinite() && e.state.t.allFinite() && e.state.gamma.allFinite() &&
+      std::isfinite(Ffd3Energies(body).total()))
+    return true;
+  e.state = before;
+  return Fail(StatusCode::kNonFinite, body, "the constrained step left a non-finite state (refused)");
 }
 
 }  // namespace wobble
