@@ -186,6 +186,12 @@ def main():
         case(f"run: {line.split()[0]} under a regular file",
              [wobble, "run", script("unwritable.wob", f"load_obj {obj}\nload_def {modes}\n{line}\n")], work, 2,
              "unwritable.wob:3:", needle)
+    # a folder's name where a file's is expected (trailing '/', '.'): refused when the line is
+    # read, not at the write (was exit 1 "is a directory" after the run; fuzz_script finding)
+    for line in (f"output {work}/new_folder/", f"save {work}/.", f"set anneal_csv {work}/"):
+        case(f"run: {line.split()[0]} naming a folder",
+             [wobble, "run", script("folder_out.wob", f"load_obj {obj}\nload_def {modes}\n{line}\nsimul 1\n")], work, 2,
+             "folder_out.wob:3:", "names a folder")
 
     # ---- a full disk (a 200 kB tmpfs, when this machine lets us mount one): exit 1 with the
     # system's text, and the files of the earlier run unchanged (was: exit 0, empty EXRs)

@@ -28,6 +28,11 @@ void CreateParentFolder(const std::string& path) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   std::error_code ec;
+  // "out/", "." or "dir/..": a folder's name, never a file's (found by fuzz_script: `output out/`
+  // passed the check, which wrote its probe inside the folder, and failed only at the write)
+  const std::string name = target.filename().string();
+  if (name.empty() || name == "." || name == "..")
+    throw std::runtime_error(path + ": names a folder, not a file");
   const std::string kind = NonRegularKind(path);
   if (kind == "a directory") throw std::runtime_error(path + ": is a directory");
   if (!kind.empty()) throw std::runtime_error(path + ": is " + kind + ", not a regular file; wobble writes only regular files");
