@@ -129,6 +129,15 @@ BodyModelN<Dim>::BodyModelN(BodyDefN<Dim> def, std::vector<DeformationModeN<Dim>
   mm.G_com_factor = mm.G - mm.C.transpose() * mm.C / mm.m;
   mm.G_com_positive = CholeskyInPlace(&mm.G_com_factor);
   BuildClusters();
+
+  const int V = int(def_.mesh.points.size());
+  mesh_rest_local_.resize(V);
+  mesh_mode_rows_.assign(size_t(Dim) * D * V, 0.0);
+  for (int v = 0; v < V; ++v) {
+    ModeMatrix B;
+    LocalBasis(lat.LocalCoords(def_.mesh.points[v]), &mesh_rest_local_[v], &B);
+    Eigen::Map<Eigen::Matrix<double, Dim, Eigen::Dynamic>>(mesh_mode_rows_.data() + Dim * D * v, Dim, D) = B;
+  }
 }
 
 template <int Dim> void BodyModelN<Dim>::BuildClusters() {

@@ -11,6 +11,7 @@
 
 #include "wobble/body/lattice.h"
 #include "wobble/body/mode.h"
+#include "wobble/body/surface_mesh.h"
 #include "wobble/core/types.h"
 
 namespace wobble {
@@ -30,6 +31,7 @@ template <int Dim> struct BodyDefN {
   std::vector<Eigen::Matrix<double, Dim, 1>> mass_positions;  // body frame
   std::vector<double> masses;
   std::vector<PolylineN<Dim>> shapes;
+  TriangleMeshN<Dim> mesh;  // a surface to draw (3D: a user's mesh), moved by the FFD; never simulated
 };
 using BodyDef = BodyDefN<2>;
 using BodyDef3 = BodyDefN<3>;
@@ -124,6 +126,13 @@ template <int Dim> class BodyModelN {
   // b0 and B of an arbitrary point given by its lattice coordinates (springs, drawing).
   void LocalBasis(const Point& st, Point* b0, ModeMatrix* B) const;
 
+  // The same for the vertices of def().mesh, made once: drawing a deformed mesh is then
+  // x_v = t + R (b0_v + B_v γ) per vertex, whatever the lattice's size.
+  const Point& mesh_rest_local(int v) const { return mesh_rest_local_[v]; }
+  Eigen::Map<const Eigen::Matrix<double, Dim, Eigen::Dynamic>> mesh_mode_matrix(int v) const {
+    return {mesh_mode_rows_.data() + Dim * num_modes() * v, Dim, num_modes()};
+  }
+
   // Rest control points (flat index), for the convex-hull ground test and drawing.
   const std::vector<Point>& rest_control() const { return rest_control_; }
 
@@ -136,6 +145,8 @@ template <int Dim> class BodyModelN {
   std::vector<DeformationModeN<Dim>> modes_;
   std::vector<Point> lattice_coords_, rest_local_, rest_control_;
   std::vector<double> mode_rows_;  // per point, column-major Dim x D
+  std::vector<Point> mesh_rest_local_;
+  std::vector<double> mesh_mode_rows_;  // per mesh vertex, as mode_rows_
   MassMomentsN<Dim> moments_;
   std::vector<PointClusterN<Dim>> clusters_;
 

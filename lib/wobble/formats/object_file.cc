@@ -1,8 +1,10 @@
 #include "wobble/formats/object_file.h"
 
+#include <filesystem>
 #include <optional>
 #include <stdexcept>
 
+#include "wobble/core/errors.h"
 #include "wobble/formats/line_reader.h"
 
 namespace wobble::formats {
@@ -15,6 +17,10 @@ using detail::Line;
 constexpr double kInsideTolerance = 1e-9;
 
 const char* const kNameUsage = "name <word>";
+const char* const kMeshUsage = "mesh <file: .obj .stl .ply .vtp>";
+const char* const kFitUsage = "lattice fit [<num_s> <num_t> <num_u> [bernstein|bspline]] [margin <f>]";
+const char* const kSampleUsage = "sample surface|volume <points> <total mass>";
+constexpr double kDefaultFitMargin = 0.05;
 
 // The statements' forms in 2D and in 3D (a 3D file starts with 'dimension 3').
 template <int Dim> struct Usage;
@@ -42,7 +48,7 @@ template <int Dim> class ObjectParser {
   static constexpr const char* kPolylineUsage = Usage<Dim>::polyline;
 
  public:
-  explicit ObjectParser(const std::string& file) : file_(file) {}
+  ObjectParser(const std::string& file, const MeshReader& read_mesh) : file_(file), read_mesh_(read_mesh) {}
 
   BodyDefN<Dim> Parse(std::istream& in) {
     const std::vector<Line> lines = detail::ReadLines(in, file_);
@@ -53,6 +59,7 @@ template <int Dim> class ObjectParser {
       Fail(lines.front().number, "a 3D object file starts with 'dimension 3' (got '" + lines.front().words[0] + "')");
     for (size_t i = declared ? 1 : 0; i < lines.size(); ++i) Statement(lines[i]);
 
+    if constexpr (Dim == 3) FromMesh();
     if (!lattice_) Fail(0, std::string("missing 'lattice' line (") + kLatticeUsage + ")");
     if (def_.masses.empty()) Fail(0, std::string("no 'mass' lines: a body needs at least one mass point (") + kMassUsage + ")");
     def_.lattice = *lattice_;
@@ -94,14 +101,116 @@ template <int Dim> class ObjectParser {
       Fail(line.number, "'dimension' must be the first statement of the file");
     } else if (keyword == "name") {
       Name(line);
+    } else if (keyword == "lattice" && line.words.size() > 1 && line.words[1] == "fit") {
+      if constexpr (Dim == 3) LatticeFit(line);
+      else Fail(line.number, "'lattice fit' is for 3D object files, around their mesh");
     } else if (keyword == "lattice") {
       LatticeLine(line);
     } else if (keyword == "mass") {
       Mass(line);
     } else if (keyword == "polyline") {
       PolylineLine(line);
+    } else if (keyword == "mesh" || keyword == "sample") {
+      if constexpr (Dim == 3) keyword == "mesh" ? MeshLine(line) : Sample(line);
+      else Fail(line.number, "'" + keyword + "' is for 3D object files (start the file with 'dimension 3')");
     } else {
-      Fail(line.number, "unknown keyword '" + keyword + "' (expected name, lattice, mass or polyline)");
+      Fail(line.number, "unknown keyword '" + keyword + "' (expected name, lattice, mass" +
+                            (Dim == 3 ? ", polyline, mesh or sample)" : " or polyline)"));
+    }
+  }
+
+  // ---- 3D: a user's mesh, the lattice fitted around it and mass points sampled from it ----
+  void MeshLine(const Line& line) {
+    if (mesh_line_ != 0) Fail(line.number, "mesh given twice (first on line " + std::to_string(mesh_line_) + ")");
+    if (line.words.size() != 2) Fail(line.number, std::string("expected one file name after 'mesh' (") + kMeshUsage + ")");
+    if (!read_mesh_)
+      Fail(line.number, "mesh: this reader cannot read mesh files (VTK reads them: load the object with the wobble "
+                        "command or pipelines::ReadObject3)");
+    // relative to the object file's folder, as a user expects of a file beside it
+    std::filesystem::path mesh_path(line.words[1]);
+    if (mesh_path.is_relative()) mesh_path = std::filesystem::path(file_).parent_path() / mesh_path;
+    try {
+      def_.mesh = read_mesh_(mesh_path.string());
+      CheckSurfaceMesh(def_.mesh);
+    } catch (const ParseError& e) {
+      Fail(line.number, std::string("mesh: ") + e.what());
+    } catch (const std::exception& e) {
+      Fail(line.number, "mesh " + mesh_path.string() + ": " + e.what());
+    }
+    mesh_line_ = line.number;
+  }
+
+  void LatticeFit(const Line& line) {
+    if (lattice_line_ != 0)
+      Fail(line.number, "lattice given twice (first on line " + std::to_string(lattice_line_) + ")");
+    std::vector<std::string> w(line.words.begin() + 2, line.words.end());
+    if (w.size() >= 2 && w[w.size() - 2] == "margin") {
+      if (!detail::ParseNumber(w.back(), &fit_margin_) || fit_margin_ < 0 || fit_margin_ > 10)
+        Fail(line.number, "expected a margin in [0, 10] (a fraction of the mesh's largest side), got '" + w.back() +
+                              "' (" + kFitUsage + ")");
+      w.resize(w.size() - 2);
+    }
+    if (!w.empty() && w.size() != 3 && w.size() != 4)
+      Fail(line.number, std::string("expected 3 control-point counts (and a basis) after 'lattice fit' (") + kFitUsage + ")");
+    for (size_t a = 0; a < w.size() && a < 3; ++a)
+      if (!detail::ParseInt(w[a], &fit_sizes_[a]) || fit_sizes_[a] < 2)
+        Fail(line.number, std::string("expected a whole number >= 2 for <") + kCountNames[a] + ">, got '" + w[a] + "' (" +
+                              kFitUsage + ")");
+    if (w.size() == 4 && !ParseBasisKind(w[3], &fit_basis_))
+      Fail(line.number, "unknown lattice basis '" + w[3] + "' (expected bernstein or bspline)");
+    lattice_line_ = fit_line_ = line.number;
+  }
+
+  void Sample(const Line& line) {
+    if (line.words.size() != 4 || (line.words[1] != "surface" && line.words[1] != "volume"))
+      Fail(line.number, std::string("expected 'sample surface' or 'sample volume', a point count and a total mass (") +
+                            kSampleUsage + ")");
+    int count = 0;
+    double mass = 0;
+    if (!detail::ParseInt(line.words[2], &count) || count < 1 || count > kMaxSampledPoints)
+      Fail(line.number, "expected a point count 1.." + std::to_string(kMaxSampledPoints) + ", got '" + line.words[2] +
+                            "' (" + kSampleUsage + ")");
+    if (!detail::ParseNumber(line.words[3], &mass) || !(mass > 0) || mass > 1e30)
+      Fail(line.number, "expected a total mass > 0 (and at most 1e30), got '" + line.words[3] + "' (" + kSampleUsage + ")");
+    samples_.push_back({line.number, line.words[1] == "volume", count, mass});
+  }
+
+  // After every line: the fitted lattice and the sampled mass points (they need the mesh).
+  void FromMesh() {
+    if (mesh_line_ == 0) {
+      const int needs = fit_line_ != 0 ? fit_line_ : (samples_.empty() ? 0 : samples_.front().line);
+      if (needs != 0) Fail(needs, "there is no mesh to fit or sample (add a 'mesh' line: " + std::string(kMeshUsage) + ")");
+      return;
+    }
+    if (!lattice_) {  // 'lattice fit', or no lattice line at all: fitted around the mesh
+      try {
+        lattice_ = FitLattice(def_.mesh, fit_sizes_, fit_basis_, fit_margin_);
+      } catch (const std::exception& e) {
+        Fail(fit_line_ != 0 ? fit_line_ : mesh_line_, std::string("cannot fit a lattice around the mesh: ") + e.what());
+      }
+      if (lattice_line_ == 0) lattice_line_ = mesh_line_;
+    } else {
+      for (size_t v = 0; v < def_.mesh.points.size(); ++v) {
+        const Point u = lattice_->LocalCoords(def_.mesh.points[v]);
+        if ((u.array() < -kInsideTolerance).any() || (u.array() > 1 + kInsideTolerance).any())
+          Fail(mesh_line_, "mesh point " + std::to_string(v) + " lies outside the lattice on line " +
+                               std::to_string(lattice_line_) + " (use 'lattice fit' to fit one around the mesh)");
+      }
+    }
+    for (const SampleSpec& spec : samples_) {
+      std::vector<Eigen::Vector3d> points;
+      try {
+        points = spec.volume ? SampleVolume(def_.mesh, spec.count) : SampleSurface(def_.mesh, spec.count);
+      } catch (const std::exception& e) {
+        Fail(spec.line, std::string("sample: ") + e.what());
+      }
+      if (def_.masses.size() + points.size() > size_t(kMaxSampledPoints))
+        Fail(spec.line, "more than " + std::to_string(kMaxSampledPoints) + " mass points in all");
+      for (const Eigen::Vector3d& p : points) {
+        def_.mass_positions.push_back(p);
+        def_.masses.push_back(spec.mass / double(points.size()));
+        mass_lines_.push_back(spec.line);
+      }
     }
   }
 
@@ -212,8 +321,21 @@ template <int Dim> class ObjectParser {
                              std::to_string(lattice_line_) + " spans " + spans + ")");
   }
 
+  struct SampleSpec {
+    int line = 0;
+    bool volume = false;
+    int count = 0;
+    double mass = 0;
+  };
+
   const std::string& file_;
+  const MeshReader& read_mesh_;
   BodyDefN<Dim> def_;
+  int mesh_line_ = 0, fit_line_ = 0;
+  std::array<int, 3> fit_sizes_{4, 4, 4};
+  BasisKind fit_basis_ = BasisKind::kBernstein;
+  double fit_margin_ = kDefaultFitMargin;
+  std::vector<SampleSpec> samples_;
   std::optional<LatticeN<Dim>> lattice_;
   int name_line_ = 0, lattice_line_ = 0;
   std::vector<int> mass_lines_;
@@ -222,19 +344,19 @@ template <int Dim> class ObjectParser {
 }  // namespace
 
 BodyDef ParseObject(std::istream& in, const std::string& name_for_errors) {
-  return ObjectParser<2>(name_for_errors).Parse(in);
+  return ObjectParser<2>(name_for_errors, MeshReader()).Parse(in);
 }
 
 BodyDef ReadObjectFile(const std::string& path) {
   return detail::WithFile(path, [&](std::istream& in) { return ParseObject(in, path); });
 }
 
-BodyDef3 ParseObject3(std::istream& in, const std::string& name_for_errors) {
-  return ObjectParser<3>(name_for_errors).Parse(in);
+BodyDef3 ParseObject3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh) {
+  return ObjectParser<3>(name_for_errors, read_mesh).Parse(in);
 }
 
-BodyDef3 ReadObjectFile3(const std::string& path) {
-  return detail::WithFile(path, [&](std::istream& in) { return ParseObject3(in, path); });
+BodyDef3 ReadObjectFile3(const std::string& path, const MeshReader& read_mesh) {
+  return detail::WithFile(path, [&](std::istream& in) { return ParseObject3(in, path, read_mesh); });
 }
 
 int ObjectFileDimension(const std::string& path) {

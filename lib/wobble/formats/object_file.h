@@ -26,6 +26,7 @@
 // Every problem is a ParseError naming the file and line and what was expected.
 #pragma once
 
+#include <functional>
 #include <istream>
 #include <string>
 
@@ -51,8 +52,39 @@ BodyDef ParseObject(std::istream& in, const std::string& name_for_errors);
 //   polyline <x1> <y1> <z1> <x2> <y2> <z2> ... [closed]
 //
 // s runs along x, t along y (up), u along z; the body origin is the lattice corner (x0, y0, z0).
-BodyDef3 ReadObjectFile3(const std::string& path);
-BodyDef3 ParseObject3(std::istream& in, const std::string& name_for_errors);
+//
+// A 3D character may be a user's triangle mesh (issue 15), in the body frame:
+//
+//   mesh <file>                                   at most once; .obj .stl .ply or .vtp, read by
+//                                                 VTK (a path relative to the object file's
+//                                                 folder). Drawn and exported with every vertex
+//                                                 moved by the FFD; never simulated.
+//   lattice fit [<num_s> <num_t> <num_u> [bernstein|bspline]] [margin <f>]
+//                                                 instead of 'lattice': the mesh's bounding box
+//                                                 grown by f (default 0.05) of its largest side
+//                                                 on every side; 4 x 4 x 4 Bernstein by default.
+//                                                 With a mesh and no lattice line at all, this
+//                                                 default. A lattice given by numbers must hold
+//                                                 every mesh vertex.
+//   sample surface|volume <points> <total mass>   mass points from the mesh, each of mass
+//                                                 total / count: 'surface' spreads exactly
+//                                                 <points> by area; 'volume' fills the enclosed
+//                                                 solid with a cubic grid of about <points>
+//                                                 (generalized winding number ≥ ½: a closed
+//                                                 mesh, overlapping parts allowed). May repeat,
+//                                                 and mix with 'mass' lines.
+//
+// Example (data/pot3.obj):
+//   dimension 3
+//   mesh pot3.vtp
+//   lattice fit 4 4 4
+//   sample volume 400 1000
+//
+// Mesh files are read through `read_mesh` (the app passes VTK's readers,
+// pipelines/mesh_io.h); without one, a 'mesh' line is a ParseError saying so.
+using MeshReader = std::function<SurfaceMesh(const std::string& path)>;
+BodyDef3 ReadObjectFile3(const std::string& path, const MeshReader& read_mesh = nullptr);
+BodyDef3 ParseObject3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh = nullptr);
 // 3 for a file whose first statement is 'dimension 3', else 2 (the readers report the rest).
 int ObjectFileDimension(const std::string& path);
 
