@@ -13,6 +13,9 @@
 #include "wobble/analysis/conditioning.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#ifdef WOBBLE_HAVE_PIPELINES
+#include "pipelines/mesh_io.h"
+#endif
 
 namespace wobble::app {
 
@@ -53,7 +56,11 @@ std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_mod
 }
 
 std::shared_ptr<const BodyModel3> LoadBody3(const BodyFiles& files, bool check_modes) {
+#ifdef WOBBLE_HAVE_PIPELINES
+  BodyDef3 def = pipelines::ReadObject3(files.object);  // a `mesh` line is read by VTK
+#else
   BodyDef3 def = formats::ReadObjectFile3(files.object);
+#endif
   std::vector<DeformationMode3> modes;
   for (const std::string& path : files.modes) {
     if (path.empty()) throw UsageError("--modes: empty file name in the list");
@@ -148,6 +155,22 @@ StartingWorld LoadStartingWorld(const BodyFiles& files, const std::string& q, co
   s.options.params = MakeWorldParams(flags);
   s.options.integrator = integrator;
   s.options.dt = dt;
+  if (formats::ObjectFileDimension(files.object) == 3) {
+    // the 3D ground: the plane through y = height, tilted by the slope about z as the 2D line
+    const Ground& g = s.options.params.ground;
+    s.options.ground_3d.enabled = g.enabled;
+    s.options.ground_3d.point = Eigen::Vector3d(0.0, flags.ground_height, 0.0);
+    s.options.ground_3d.normal = Eigen::Vector3d(-std::sin(g.slope), std::cos(g.slope), 0.0);
+    s.options.ground_3d.stiffness = g.stiffness;
+    s.options.ground_3d.normal_damping = g.normal_damping;
+    s.options.ground_3d.friction_damping = g.friction_damping;
+    s.options.ground_3d.friction_cap = g.friction_cap;
+    s.body3 = LoadBody3(files);
+    const int n = kRigidDofs3 + s.body3->num_modes();
+    s.q0 = ParseNumbers(q, "--q", n, CoordinateNames3(*s.body3), s.body3->name());
+    s.qd0 = ParseNumbers(qdot, "--qdot", n, VelocityNames3(*s.body3), s.body3->name());
+    return s;
+  }
   s.body = LoadBody(files);
   s.q0 = ParseCoordinates(q, "--q", *s.body);
   s.qd0 = ParseCoordinates(qdot, "--qdot", *s.body);
@@ -156,13 +179,39 @@ StartingWorld LoadStartingWorld(const BodyFiles& files, const std::string& q, co
 
 World StartingWorld::MakeWorld() const {
   World world(options);
+  if (body3) {
+    // q = (t, rotation vector r, γ): R = exp([r]×), the turn by |r| radians about r
+    world.AddBody(body3);
+    const Eigen::Vector3d r = q0.segment<3>(3);
+    const double angle = r.norm();
+    const Eigen::Quaterniond turn =
+        angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, r / angle)) : Eigen::Quaterniond::Identity();
+    world.SetState3(0, q0.head<3>(), turn, q0.tail(body3->num_modes()), qd0);
+    return world;
+  }
   world.AddBody(body);
   world.SetState(0, q0, qd0);
   return world;
 }
 
+std::string CoordinateNames3(const BodyModel3& body) {
+  std::string names = "tx ty tz rx ry rz";
+  for (int d = 1; d <= body.num_modes(); ++d) names += " g" + std::to_string(d);
+  return names;
+}
+
+std::string VelocityNames3(const BodyModel3& body) {
+  std::string names = "vx vy vz wx wy wz";
+  for (int d = 1; d <= body.num_modes(); ++d) names += " dg" + std::to_string(d);
+  return names;
+}
+
 Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& what, const BodyModel& body) {
-  const int expected_size = body.num_q();
+  return ParseNumbers(text, what, body.num_q(), CoordinateNames(body), body.name());
+}
+
+Eigen::VectorXd ParseNumbers(const std::string& text, const std::string& what, int expected_size,
+                             const std::string& names, const std::string& body_name) {
   std::vector<double> values;
   std::string token;
   auto flush = [&]() {
@@ -172,7 +221,7 @@ Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& wha
     const double v = std::strtod(token.c_str(), &end);
     if (end != token.c_str() + token.size())
       throw UsageError(what + ": '" + token + "' is not a number (expected " + std::to_string(expected_size) +
-                       " numbers: " + CoordinateNames(body) + ")");
+                       " numbers: " + names + ")");
     if (!std::isfinite(v) || errno == ERANGE)
       throw UsageError(what + ": '" + token + "' is not a finite number");
     values.push_back(v);
@@ -191,7 +240,7 @@ Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& wha
   if (int(values.size()) != expected_size) {
     std::ostringstream msg;
     msg << what << ": got " << values.size() << " number" << (values.size() == 1 ? "" : "s") << " but body '"
-        << body.name() << "' has " << expected_size << " generalized coordinates (" << CoordinateNames(body) << ")";
+        << body_name << "' has " << expected_size << " generalized coordinates (" << names << ")";
     throw UsageError(msg.str());
   }
   return Eigen::Map<const Eigen::VectorXd>(values.data(), Eigen::Index(values.size()));

@@ -79,8 +79,13 @@ Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& wha
 
 // What simulate, render, inspect and condition time start from: the body of the files, its
 // start state (--q, --qdot; empty texts give rest) and the world options of the flags.
+// A 3D object file (`dimension 3`) gives a 3D FFD body instead: --q is "tx ty tz rx ry rz g1 ..
+// gD" (r a rotation vector: the turn by |r| radians about r), --qdot "vx vy vz wx wy wz dg1 ..
+// dgD" (ω in the body frame), and the ground is the plane through y = --ground-height tilted
+// by --ground-slope about z.
 struct StartingWorld {
-  std::shared_ptr<const BodyModel> body;
+  std::shared_ptr<const BodyModel> body;     // a 2D object file's
+  std::shared_ptr<const BodyModel3> body3;   // a 3D object file's
   Eigen::VectorXd q0, qd0;
   WorldOptions options;
   World MakeWorld() const;  // the body alone in a world, at (q0, q̇0)
@@ -91,8 +96,14 @@ StartingWorld LoadStartingWorld(const BodyFiles& files, const std::string& q, co
 // --integrator NAME; a UsageError listing the known names otherwise.
 Integrator ParseIntegratorFlag(const std::string& name);
 
-// "tx ty theta g1 .. gD" for a body.
+// "tx ty theta g1 .. gD" for a body; "tx ty tz rx ry rz g1 .." and "vx vy vz wx wy wz dg1 .."
+// for a 3D body's --q and --qdot.
 std::string CoordinateNames(const BodyModel& body);
+std::string CoordinateNames3(const BodyModel3& body);
+std::string VelocityNames3(const BodyModel3& body);
+// Parses `expected_size` numbers (names: what they are, for messages); empty text gives zeros.
+Eigen::VectorXd ParseNumbers(const std::string& text, const std::string& what, int expected_size,
+                             const std::string& names, const std::string& body_name);
 
 // An output folder that can be written (made if missing): a UsageError (exit 2) before any work
 // otherwise, the same for every subcommand.

@@ -258,6 +258,7 @@ int RunConditionTime(const ConditionTimeArgs& a) {
   if (!(a.duration / a.dt <= 1e7)) throw UsageError("--duration / --dt asks for more than 10^7 steps");
   CheckOutputFolder(a.out);
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, "", a.world, Integrator::kThesis, a.dt);
+  if (setup.body3) throw UsageError("condition time takes 2D objects only so far; for a 3D object use condition check");
   const std::shared_ptr<const BodyModel>& body = setup.body;
   World world = setup.MakeWorld();
 

@@ -12,6 +12,7 @@
 #include "fit.h"
 #include "inspect.h"
 #ifdef WOBBLE_HAVE_PIPELINES
+#include "mesh.h"
 #include "render.h"
 #include "view.h"
 #endif
@@ -59,6 +60,8 @@ int main(int argc, char** argv) {
                                         "displacement images", export_what, &export_args);
   ViewArgs view_args;
   CLI::App* view = AddViewCommand(&app, &view_args);
+  MeshArgs mesh_args;
+  CLI::App* mesh = AddMeshCommand(&app, &mesh_args);
 #endif
   FitPoseArgs fit_pose_args;
   FitTrajectoryArgs fit_trajectory_args;
@@ -84,6 +87,7 @@ int main(int argc, char** argv) {
     if (render->parsed()) return RunRender(render_args, render_what);
     if (exporter->parsed()) return RunRender(export_args, export_what);
     if (view->parsed()) return RunView(view_args);
+    if (mesh->parsed()) return RunMesh(mesh_args);
 #endif
     if (fit.pose->parsed()) return RunFitPose(fit_pose_args);
     if (fit.trajectory->parsed()) return RunFitTrajectory(fit_trajectory_args);

@@ -115,6 +115,12 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
   cmd->add_option("--disp-size", a->disp_size, "Size of the displacement image (default: 256 wide, lattice aspect)")
       ->type_name("WxH");
   cmd->add_option("--chart-size", a->chart_size, "Size of the charts")->capture_default_str()->type_name("WxH");
+  cmd->add_option("--azimuth", a->azimuth, "3D: the camera's angle about +y, degrees from +z towards +x")
+      ->capture_default_str();
+  cmd->add_option("--elevation", a->elevation, "3D: the camera's angle above the ground plane, degrees")
+      ->capture_default_str();
+  cmd->add_option("--orbit", a->orbit, "3D: the camera orbits the motion at this many degrees per simulated second")
+      ->capture_default_str();
   cmd->add_option("--trail", a->trail, "Trace points given by lattice coordinates \"s t s t ..\" in the frames")
       ->type_name("\"S T ..\"");
   return cmd;
@@ -161,6 +167,9 @@ void CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
   ParseSize(a.chart_size, "--chart-size");
   ParseNumbers(a.filmstrip_times, "--filmstrip");
   if (ParseNumbers(a.trail, "--trail").size() % 2) throw UsageError("--trail: lattice coordinates come in pairs s t");
+  RequireFinite(a.azimuth, "--azimuth");
+  RequireFinite(a.orbit, "--orbit");
+  if (!(std::abs(a.elevation) < 90.0)) throw UsageError("--elevation must be between -90 and 90 degrees");
   const bool renders = what.count("frames") || what.count("filmstrip") || what.count("charts") || what.count("exr");
   if (renders && !pl::HasDisplay())
     throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"
@@ -204,6 +213,9 @@ pl::RenderOutputs RenderOutputsOf(const RenderArgs& a, const std::string& defaul
   const std::vector<double> trail = ParseNumbers(a.trail, "--trail");
   for (size_t i = 0; i + 1 < trail.size(); i += 2) out.trail.emplace_back(trail[i], trail[i + 1]);
   out.view.show_trails = !out.trail.empty();
+  out.view.azimuth = a.azimuth;
+  out.view.elevation = a.elevation;
+  out.orbit_deg_per_s = a.orbit;
   return out;
 }
 

@@ -42,6 +42,8 @@ struct RenderArgs {
   std::string disp_size;            // "WxH"; empty: 256 wide, lattice aspect
   std::string chart_size = "800x500";
   std::string trail;                // lattice coords "s t s t ..." of points to trace
+  double azimuth = 30.0, elevation = 20.0;  // 3D camera, degrees
+  double orbit = 0.0;               // 3D camera turn, degrees per simulated second
   Limits limits;
 };
 

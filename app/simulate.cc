@@ -74,7 +74,6 @@ int RunSimulate(const SimulateArgs& a) {
 
   // the body and its world
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, integrator, a.dt);
-  const std::shared_ptr<const BodyModel>& body = setup.body;
   World world = setup.MakeWorld();
   const long expected_steps =
       std::max(1L, CheckRunLimits(a.duration, a.dt, a.every, int(record::Trajectory(world).Columns().size()), a.limits));
@@ -85,13 +84,13 @@ int RunSimulate(const SimulateArgs& a) {
   auto recorder = std::make_shared<record::Recorder>(trajectory, a.every);
   recorder->Start(world);
   world.SetRecorder(recorder);
-  double max_pen = world.state(0).penetration, max_pen_time = 0.0;
+  double max_pen = world.Penetration(0), max_pen_time = 0.0;
   Progress progress(isatty(STDERR_FILENO) == 1);
   const auto start = std::chrono::steady_clock::now();
   bool ok = false;
   try {
     ok = world.RunUntil(a.duration, [&](const World& w) {
-      const double pen = w.state(0).penetration;
+      const double pen = w.Penetration(0);
       if (pen > max_pen) {
         max_pen = pen;
         max_pen_time = w.time();
@@ -116,15 +115,19 @@ int RunSimulate(const SimulateArgs& a) {
   if (!a.out.empty()) record::WriteTrajectoryCsv(a.out, *trajectory);
 
   // the summary: one paragraph, a sentence per line
-  const BodyState<double>& s = final_world.state(0);
   const Energies e = final_world.ComputeEnergies(0);
   const Ground& g = setup.options.params.ground;
+  const bool three = setup.body3 != nullptr;
+  const std::string name = three ? setup.body3->name() : setup.body->name();
+  const int points = three ? setup.body3->num_points() : setup.body->num_points();
+  const int modes = three ? setup.body3->num_modes() : setup.body->num_modes();
   std::ostringstream out;
-  out << body->name() << ": " << body->num_points() << " mass points, " << body->num_modes() << " modes; "
+  out << name << (three ? " (3D)" : "") << ": " << points << " mass points, " << modes << " modes; "
       << IntegratorName(integrator) << " integrator, dt " << Num(a.dt) << "; gravity "
       << (setup.options.params.gravity_on ? "on" : "off") << "; ";
   if (g.enabled) {
-    out << "ground through y = " << Num(g.point.y()) << " at " << Num(a.world.ground_slope_deg) << " deg.\n";
+    out << (three ? "ground plane" : "ground") << " through y = " << Num(g.point.y()) << " at "
+        << Num(a.world.ground_slope_deg) << " deg.\n";
   } else {
     out << "no ground.\n";
   }
@@ -133,12 +136,24 @@ int RunSimulate(const SimulateArgs& a) {
   out << "Simulated " << Num(world.time()) << " s in " << world.steps() << " steps: " << Num(wall)
       << " s wall with recording, " << (wall > 0 ? Num(double(world.steps()) / wall) : std::string("-"))
       << " steps/s.\n";
-  out << "Final state at t = " << Num(world.time()) << ": q = " << VectorText(s.q) << ",\n"
-      << "  qdot = " << VectorText(s.qd) << ".\n";
+  int contacts = 0;
+  if (three) {
+    const BodyState3<double>& s = final_world.state3(0);
+    const Eigen::Quaterniond& o = s.orientation;
+    out << "Final state at t = " << Num(world.time()) << ": t = " << VectorText(s.t) << ", orientation (w x y z) = "
+        << VectorText(Eigen::Vector4d(o.w(), o.x(), o.y(), o.z())) << ", modes = " << VectorText(s.gamma) << ",\n"
+        << "  v (t-dot, body omega, modes-dot) = " << VectorText(s.v) << ".\n";
+    contacts = int(s.contacts.size());
+  } else {
+    const BodyState<double>& s = final_world.state(0);
+    out << "Final state at t = " << Num(world.time()) << ": q = " << VectorText(s.q) << ",\n"
+        << "  qdot = " << VectorText(s.qd) << ".\n";
+    contacts = int(s.contacts.size());
+  }
   out << "Energies at the end: kinetic " << Num(e.kinetic) << ", gravity " << Num(e.gravity) << ", modes "
       << Num(e.modes) << ", ground " << Num(e.ground) << ", springs " << Num(e.springs) << ", total "
       << Num(e.total()) << " (" << Num(e0.total()) << " at the start).\n";
-  out << s.contacts.size() << " point" << (s.contacts.size() == 1 ? "" : "s")
+  out << contacts << " point" << (contacts == 1 ? "" : "s")
       << " in contact at the end; max penetration " << Num(max_pen);
   if (max_pen > 0) out << " at t = " << Num(max_pen_time);
   out << ".\n";

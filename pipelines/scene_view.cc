@@ -66,6 +66,8 @@ Eigen::AlignedBox3d SceneBounds(const World& world, const SceneSpec& spec) {
     if (world.kind(b) == BodyKind::kLinear) {
       const LinearDrawing* d = b < int(spec.drawings.size()) ? &spec.drawings[b] : nullptr;
       box.extend(LinearBodyBounds(world, b, d));
+    } else if (world.kind(b) == BodyKind::kFfd3) {
+      box.extend(BodyBounds3(world, b));
     } else {
       const Eigen::AlignedBox2d flat = BodyBounds(world, b);
       box.extend(Eigen::Vector3d(flat.min().x(), flat.min().y(), 0.0));
@@ -153,9 +155,20 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
     return s;
   };
   // the world's layers, where FFD bodies live: ground, trails, springs
-  int first_ffd = -1;
-  for (int b = world->num_bodies() - 1; b >= 0; --b)
+  int first_ffd = -1, first_ffd3 = -1;
+  for (int b = world->num_bodies() - 1; b >= 0; --b) {
     if (world->kind(b) == BodyKind::kFfd) first_ffd = b;
+    if (world->kind(b) == BodyKind::kFfd3) first_ffd3 = b;
+  }
+  if (first_ffd3 >= 0) {  // the 3D ground plane, lit, several body sizes across
+    m.ground = Ptr<GroundSource>::New();
+    const Eigen::AlignedBox3d box = SceneBounds(*world, spec);
+    m.ground->SetLength(6.0 * box.sizes().maxCoeff());
+    const double plane_rgb[3] = {0.78, 0.74, 0.66};
+    vtkProperty* plane = m.Add(SceneLayer::kGround, on(m.ground, 0), plane_rgb, 1.0, 1.0, 0.0, true)->GetProperty();
+    plane->SetAmbient(0.55);  // the camera's light grazes the plane: mostly ambient, or it goes black
+    plane->SetDiffuse(0.45);
+  }
   if (first_ffd >= 0) {
     m.ground = Ptr<GroundSource>::New();
     m.Add(SceneLayer::kGround, on(m.ground, 0), ground_rgb, 1.0, 1.0, 0.0);
@@ -174,6 +187,15 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
       auto shape = Ptr<ShapeSource>::New();
       shape->SetSamplesPerSegment(options_.shape_samples);
       m.Add(SceneLayer::kShape, on(shape, b), shape_rgb, options_.line_width, 1.0, 2);
+    } else if (world->kind(b) == BodyKind::kFfd3) {
+      // the mesh as a lit surface (flat-shaded facets), and the polylines over it
+      auto surface = Ptr<ShapeSource>::New();
+      surface->SetLines(false);
+      m.Add(SceneLayer::kShape, on(surface, b), surface_rgb, 1.0, 1.0, 0.0, true);
+      auto lines = Ptr<ShapeSource>::New();
+      lines->SetSurface(false);
+      lines->SetSamplesPerSegment(options_.shape_samples);
+      m.Add(SceneLayer::kShape, on(lines, b), shape_rgb, options_.line_width, 1.0, 0.0);
     } else if (b < int(spec.drawings.size()) && spec.drawings[b].dim() != 0) {
       const LinearDrawing& d = spec.drawings[b];
       if (!d.triangles.empty()) {
@@ -188,8 +210,12 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
       lines->SetSurface(false);
       m.Add(SceneLayer::kShape, on(lines, b), shape_rgb, options_.line_width, 1.0, 2);
     }
+    // a mesh's sampled mass (hundreds of points) would cover its surface at the usual size
+    double point_size = options_.point_size;
+    if (world->kind(b) == BodyKind::kFfd3)
+      point_size = std::max(2.0, point_size * std::min(1.0, std::sqrt(27.0 / world->body3(b).num_points())));
     point_mappers.push_back(vtkPolyDataMapper::SafeDownCast(
-        m.Add(SceneLayer::kPoints, on(m.points[b], b), points_rgb, 1.0, options_.point_size, 3)->GetMapper()));
+        m.Add(SceneLayer::kPoints, on(m.points[b], b), points_rgb, 1.0, point_size, 3)->GetMapper()));
   }
   if (!spec.anchors.empty()) {
     auto anchors = Ptr<AnchorSource>::New();

@@ -103,6 +103,12 @@ class SceneView {
   void FrameBox3d(const Eigen::AlignedBox3d& box, double margin = 0.08);
   // FrameBox of the box's x-y extent for a world of 2D bodies, FrameBox3d otherwise.
   void FrameBounds(const Eigen::AlignedBox3d& box, double margin = 0.08);
+  // The 3D camera's angles (degrees) for the next FrameBox3d: an orbiting camera sets them
+  // per frame and frames the same box again.
+  void SetViewAngles(double azimuth, double elevation) {
+    options_.azimuth = azimuth;
+    options_.elevation = elevation;
+  }
   const Eigen::AlignedBox2d& framed_box() const { return framed_; }
 
   // Rebuilds every source from the world's current state and renders.

@@ -122,7 +122,7 @@ std::vector<DispTarget> DispTargets(const World& world, const RenderOutputs& out
   return targets;
 }
 
-bool HasFfdBody(const World& world) {
+bool HasFfdBody(const World& world) {  // 2D: the ground line is framed with the motion
   for (int b = 0; b < world.num_bodies(); ++b)
     if (world.kind(b) == BodyKind::kFfd) return true;
   return false;
@@ -149,6 +149,7 @@ World WorldFor(const record::Trajectory& run, const WorldOptions& options) {
   World world(options);
   for (const record::BodyInfo& b : run.bodies()) {
     if (b.kind == BodyKind::kFfd) world.AddBody(b.ffd);
+    else if (b.kind == BodyKind::kFfd3) world.AddBody(b.ffd3);
     else world.AddLinearBody(b.linear);
   }
   return world;
@@ -179,8 +180,9 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   }
 
   // the camera's pass: the box of every drawn state (and the ground below it), the colour range
+  Eigen::AlignedBox3d motion;
+  const bool orbit = out.orbit_deg_per_s != 0.0 && !IsFlat(world);
   if (view || strip_view) {
-    Eigen::AlignedBox3d motion;
     double lo = 1e300, hi = -1e300;
     const bool fixed_range = out.view.color_range[0] < out.view.color_range[1];
     Replay replay(run, &world);
@@ -229,6 +231,10 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     }
     for (SceneView* sv : {view.get(), strip_view.get()})
       if (sv && !out.trail.empty() && sv->trails()) sv->trails()->Record();
+    if (view && orbit) {  // the frame's angle of the orbit; the box framed is the whole motion's
+      view->SetViewAngles(out.view.azimuth + out.orbit_deg_per_s * (world.time() - run.time(0)), out.view.elevation);
+      view->FrameBox3d(motion);
+    }
     if (view) {
       view->Render();
       if (out.frames) view->WritePng(Numbered(out.folder + "/frames", "frame", v.frame, "png"), &writer);

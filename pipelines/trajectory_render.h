@@ -43,6 +43,9 @@ struct RenderOutputs {
   // The frames' view: size, colour by (a fixed colour_range, or the range over the frames),
   // shape samples, point size, title, 3D camera angles.
   SceneOptions view;
+  // 3D worlds: the camera orbits the motion's box at this many degrees per simulated second
+  // (azimuth view.azimuth + rate (t − t0)), framing the whole motion from every side; 0: fixed.
+  double orbit_deg_per_s = 0.0;
   // Filmstrip panels: the samples nearest these times, in this order (empty: 6 evenly spaced
   // from the first sample to t_end; times the run did not reach have no panel).
   std::vector<double> filmstrip_times;

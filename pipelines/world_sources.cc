@@ -124,7 +124,8 @@ bool WorldSourceBase::Check(Needs needs) {
 int BodyPartSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
   if (!Check(Needs::kAnyBody)) return 0;
   vtkPolyData* out = OutputOf(out_vec);
-  if (!(world_->kind(Body) == BodyKind::kFfd ? DrawFfd(out) : DrawLinear(out))) return 0;
+  const BodyKind kind = world_->kind(Body);
+  if (!(kind == BodyKind::kFfd ? DrawFfd(out) : kind == BodyKind::kFfd3 ? DrawFfd3(out) : DrawLinear(out))) return 0;
   AddTimeValue(out, world_->time());
   return 1;
 }
@@ -422,6 +423,26 @@ int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
   const Ground& g = world_->options().params.ground;
   auto points = DoublePoints();
   AddTimeValue(out, world_->time());
+  // a world of 3D FFD bodies stands on the 3D ground plane
+  Eigen::AlignedBox3d bodies3;
+  for (int b = 0; b < world_->num_bodies(); ++b)
+    if (world_->kind(b) == BodyKind::kFfd3) bodies3.extend(BodyBounds3(*world_, b));
+  if (!bodies3.isEmpty()) {
+    const GroundPlane& plane = world_->options().ground_3d;
+    out->SetPoints(points);
+    if (!plane.enabled) return 1;
+    const Eigen::Vector3d n = plane.normal.normalized();
+    const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+    const Eigen::Vector3d foot = bodies3.center() - n * plane.Height(Eigen::Vector3d(bodies3.center()));
+    const double half = 0.5 * Length;
+    const double corners[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    for (const auto& c : corners) points->InsertNextPoint(Eigen::Vector3d(foot + half * (c[0] * u + c[1] * v)).data());
+    auto polys = Ptr<vtkCellArray>::New();
+    const vtkIdType quad[4] = {0, 1, 2, 3};
+    polys->InsertNextCell(4, quad);
+    out->SetPolys(polys);
+    return 1;
+  }
   if (!g.enabled) {
     out->SetPoints(points);
     return 1;

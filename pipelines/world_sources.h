@@ -25,10 +25,16 @@
 //                    many, §4.10); point array lattice_coords.
 //                    Linear: a LinearDrawing (SetDrawing: polylines and, in 3D, a triangle
 //                    surface) carried by x = R p(u).
+//   3D FFD bodies (world_sources_ffd3.cc): the lattice with lines along its three axes; the
+//                    mass points (mass, velocity, applied_force = gravity, in_contact); the
+//                    shape: the object's mesh as triangles with every vertex moved by the FFD
+//                    (point array displacement = B γ, body frame) and its polylines resampled.
 //   TrailSource      (FFD bodies) trajectories of chosen points (lattice coordinates): call
 //                    Record() after each frame; polylines with a point array time
 // Of the world (Body is not used):
-//   GroundSource     the ground line with its slope, as a filled band of given length and depth
+//   GroundSource     the ground line with its slope, as a filled band of given length and depth;
+//                    with a 3D FFD body, the 3D ground plane: a square of side Length under
+//                    the 3D bodies' centre
 //   SpringSource     the world's springs as lines anchor → held point; cell array stretch
 //   AnchorSource     named points (material points of any body, fixed places) as vertices,
 //                    e.g. the control points of a script
@@ -84,6 +90,7 @@ class BodyPartSource : public WorldSourceBase {
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) final;
   virtual bool DrawFfd(vtkPolyData* out) = 0;
   virtual bool DrawLinear(vtkPolyData* out) = 0;
+  virtual bool DrawFfd3(vtkPolyData* out) = 0;  // world_sources_ffd3.cc
 };
 
 class LatticeSource : public BodyPartSource {
@@ -98,6 +105,7 @@ class LatticeSource : public BodyPartSource {
   LatticeSource() = default;
   bool DrawFfd(vtkPolyData* out) override;
   bool DrawLinear(vtkPolyData* out) override;
+  bool DrawFfd3(vtkPolyData* out) override;
   int Pieces = 12;
 };
 
@@ -110,6 +118,7 @@ class MassPointSource : public BodyPartSource {
   MassPointSource() = default;
   bool DrawFfd(vtkPolyData* out) override;
   bool DrawLinear(vtkPolyData* out) override;
+  bool DrawFfd3(vtkPolyData* out) override;
 };
 
 class ShapeSource : public BodyPartSource {
@@ -137,6 +146,7 @@ class ShapeSource : public BodyPartSource {
   ShapeSource() = default;
   bool DrawFfd(vtkPolyData* out) override;
   bool DrawLinear(vtkPolyData* out) override;
+  bool DrawFfd3(vtkPolyData* out) override;
   int SamplesPerSegment = 16;
   LinearDrawing drawing_;
   bool Lines = true, Surface = true;
@@ -227,6 +237,11 @@ class AnchorSource : public WorldSourceBase {
 // World position of lattice coordinates st of FFD body `body` at the world's current state
 // (Eq. 4.2 through BodyModel::LocalBasis).
 Eigen::Vector2d WorldPositionOf(const World& world, int body, const Eigen::Vector2d& st);
+
+// A 3D FFD body: the world position t + R (b0 + B γ) of a point with this basis, and a box
+// holding its deformed control points (so every point of the body, by the convex hull).
+Eigen::Vector3d WorldPosition3(const World& world, int body, const Eigen::Vector3d& b0, const Mat3D<double>& B);
+Eigen::AlignedBox3d BodyBounds3(const World& world, int body);
 
 // World position of undeformed point u of linear body `body` (x = R p(u)) as 3 numbers (z = 0 in 2D).
 Eigen::Vector3d LinearWorldPoint(const World& world, int body, const Eigen::VectorXd& u);

@@ -43,7 +43,7 @@ int StateColumn(const Trajectory& t, int body, bool velocity) {
     throw InputError("body " + std::to_string(body) + ": the trajectory has " + std::to_string(t.num_bodies()) + " bodies");
   const record::BodyInfo& b = t.bodies()[body];
   const std::string prefix = t.num_bodies() > 1 ? b.name + "." : "";
-  return ColumnOrThrow(t, prefix + (velocity ? "d" : "") + b.coordinate_names.at(0));
+  return ColumnOrThrow(t, prefix + (velocity ? b.velocity_names.at(0) : b.coordinate_names.at(0)));
 }
 
 // Runs `world` for `duration` with a Recorder (every `every`-th step, or `fps` samples per
@@ -104,8 +104,8 @@ void BindRecord(py::module_& m) {
           py::arg("body") = 0, "(samples, num_q) the body's q")
       .def(
           "qd",
-          [](const TrajectoryPtr& t, int body) { return View(t, StateColumn(*t, body, true), t->bodies()[body].num_q, false); },
-          py::arg("body") = 0, "(samples, num_q) the body's q̇")
+          [](const TrajectoryPtr& t, int body) { return View(t, StateColumn(*t, body, true), t->bodies()[body].num_v, false); },
+          py::arg("body") = 0, "(samples, num_v) the body's q̇ (num_q, but 6 + D for a 3D FFD body: ṫ, body ω, γ̇)")
       .def(
           "write_csv", [](const Trajectory& t, const std::string& path) { record::WriteTrajectoryCsv(path, t); },
           py::arg("path"), "Writes the CSV of `wobble simulate` (through a temporary file: never a truncated one).")

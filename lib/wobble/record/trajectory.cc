@@ -2,6 +2,7 @@
 
 #include "wobble/core/errors.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -11,6 +12,7 @@ namespace {
 const char* const kEnergyNames[] = {"kinetic", "gravity", "modes", "ground", "springs", "total"};
 constexpr int kNumEnergies = 6;
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
 }  // namespace
 
 BodyInfo DescribeBody(const World& world, int body) {
@@ -23,13 +25,24 @@ BodyInfo DescribeBody(const World& world, int body) {
     info.ffd = world.shared_body(body);  // drawing after the world is gone
     info.coordinate_names = {"tx", "ty", "theta"};
     for (const DeformationMode& mode : m.modes()) info.coordinate_names.push_back(mode.name);
+  } else if (info.kind == BodyKind::kFfd3) {
+    info.ffd3 = world.shared_body3(body);
+    info.coordinate_names = {"tx", "ty", "tz", "qw", "qx", "qy", "qz"};
+    info.velocity_names = {"dtx", "dty", "dtz", "wx", "wy", "wz"};
+    for (const DeformationMode3& mode : info.ffd3->modes()) {
+      info.coordinate_names.push_back(mode.name);
+      info.velocity_names.push_back("d" + mode.name);
+    }
   } else {
     const LinearBodyModel& m = world.linear_model(body);
     info.linear = world.shared_linear_model(body);
     for (int i = 0; i < m.dim(); ++i)
       for (int s = 0; s < m.basis_size(); ++s) info.coordinate_names.push_back("r" + std::to_string(i) + "_" + std::to_string(s));
   }
+  if (info.velocity_names.empty())
+    for (const std::string& name : info.coordinate_names) info.velocity_names.push_back("d" + name);
   info.num_q = int(info.coordinate_names.size());
+  info.num_v = int(info.velocity_names.size());
   return info;
 }
 
@@ -44,17 +57,22 @@ void Trajectory::Build() {
   columns_ = {"t"};
   layout_.clear();
   const bool prefixed = bodies_.size() > 1;
+  for (BodyInfo& b : bodies_) {  // bodies built by hand may leave the velocities to us
+    if (b.velocity_names.empty())
+      for (const std::string& name : b.coordinate_names) b.velocity_names.push_back("d" + name);
+    b.num_v = int(b.velocity_names.size());
+  }
   for (const BodyInfo& b : bodies_) {
     const std::string p = prefixed ? b.name + "." : "";
     Layout l;
     l.q = int(columns_.size());
     for (const std::string& c : b.coordinate_names) columns_.push_back(p + c);
     l.qd = int(columns_.size());
-    for (const std::string& c : b.coordinate_names) columns_.push_back(p + "d" + c);
+    for (const std::string& c : b.velocity_names) columns_.push_back(p + c);
     l.targets = int(columns_.size());
-    if (b.kind == BodyKind::kFfd) {
-      l.num_targets = b.num_q - kRigidDofs;
-      for (int d = kRigidDofs; d < b.num_q; ++d) columns_.push_back(p + "target_" + b.coordinate_names[d]);
+    if (b.kind != BodyKind::kLinear) {
+      l.num_targets = b.num_modes();
+      for (int d = b.num_q - l.num_targets; d < b.num_q; ++d) columns_.push_back(p + "target_" + b.coordinate_names[d]);
     }
     l.energies = int(columns_.size());
     for (const char* e : kEnergyNames) columns_.push_back(p + e);
@@ -92,6 +110,16 @@ int Trajectory::Append(const World& world, double control_energy, int pose) {
       if (s.mode_target.size() == l.num_targets) Eigen::Map<Eigen::VectorXd>(row + l.targets, l.num_targets) = s.mode_target;
       row[l.contacts] = double(s.contacts.size());
       row[l.contacts + 1] = s.penetration;
+    } else if (bodies_[b].kind == BodyKind::kFfd3) {
+      const BodyState3<double>& s = world.state3(b);
+      Eigen::Map<Eigen::Vector3d>(row + l.q) = s.t;
+      const Eigen::Quaterniond& o = s.orientation;
+      row[l.q + 3] = o.w(), row[l.q + 4] = o.x(), row[l.q + 5] = o.y(), row[l.q + 6] = o.z();
+      Eigen::Map<Eigen::VectorXd>(row + l.q + 7, s.gamma.size()) = s.gamma;
+      Eigen::Map<Eigen::VectorXd>(row + l.qd, bodies_[b].num_v) = s.v;
+      if (s.mode_target.size() == l.num_targets) Eigen::Map<Eigen::VectorXd>(row + l.targets, l.num_targets) = s.mode_target;
+      row[l.contacts] = double(s.contacts.size());
+      row[l.contacts + 1] = world.Penetration(b);
     } else {
       const Eigen::MatrixXd& R = world.linear_R(b);
       const Eigen::MatrixXd& Rd = world.linear_R_dot(b);
@@ -124,7 +152,7 @@ Eigen::Map<const Eigen::VectorXd> Trajectory::q(int k, int body) const {
   return {Row(k) + layout_[body].q, bodies_[body].num_q};
 }
 Eigen::Map<const Eigen::VectorXd> Trajectory::qd(int k, int body) const {
-  return {Row(k) + layout_[body].qd, bodies_[body].num_q};
+  return {Row(k) + layout_[body].qd, bodies_[body].num_v};
 }
 Eigen::Map<const Eigen::VectorXd> Trajectory::targets(int k, int body) const {
   return {Row(k) + layout_[body].targets, layout_[body].num_targets};
@@ -139,11 +167,12 @@ Energies Trajectory::energies(int k, int body) const {
   out.ground = e[3];
   out.springs = e[4];
   const BodyInfo& b = bodies_[body];
-  if (b.kind == BodyKind::kFfd && b.ffd) {  // K (γ − γ0)² per mode, from the recorded q and γ0
+  if ((b.ffd || b.ffd3) && layout_[body].num_targets == b.num_modes()) {  // K (γ − γ0)² per mode
     const Eigen::Map<const Eigen::VectorXd> qk = q(k, body), tk = targets(k, body);
-    for (int d = 0; d < b.ffd->num_modes(); ++d) {
-      const double offset = qk[kRigidDofs + d] - tk[d];
-      out.per_mode.push_back(b.ffd->modes()[d].stiffness * offset * offset);
+    const int first = b.num_q - b.num_modes();
+    for (int d = 0; d < b.num_modes(); ++d) {
+      const double offset = qk[first + d] - tk[d];
+      out.per_mode.push_back((b.ffd ? b.ffd->modes()[d].stiffness : b.ffd3->modes()[d].stiffness) * offset * offset);
     }
   }
   return out;
@@ -157,6 +186,12 @@ void Trajectory::Restore(int k, World& world) const {
   for (int b = 0; b < num_bodies(); ++b) {
     if (bodies_[b].kind == BodyKind::kFfd) {
       world.SetState(b, q(k, b), qd(k, b));
+      const Eigen::VectorXd t = targets(k, b);
+      world.SetModeTargets(b, t.isZero(0.0) ? Eigen::VectorXd() : t);
+    } else if (bodies_[b].kind == BodyKind::kFfd3) {
+      const Eigen::Map<const Eigen::VectorXd> qk = q(k, b);
+      const Eigen::Quaterniond o(qk[3], qk[4], qk[5], qk[6]);  // unit as recorded, to rounding
+      world.SetState3(b, qk.head<3>(), o.normalized(), qk.tail(bodies_[b].num_modes()), qd(k, b));
       const Eigen::VectorXd t = targets(k, b);
       world.SetModeTargets(b, t.isZero(0.0) ? Eigen::VectorXd() : t);
     } else {

@@ -9,6 +9,8 @@
 // Columns (Columns()), for each body b in order, prefixed "NAME." when the world has more than
 // one body:
 //   FFD body:     tx ty theta <mode names> | dtx dty dtheta d<mode names> | target_<mode names>
+//   3D FFD body:  tx ty tz qw qx qy qz <mode names> (orientation as a unit quaternion)
+//                 | dtx dty dtz wx wy wz d<mode names> (ω in the body frame) | target_<mode names>
 //   linear body:  r<i>_<s> (R row i, basis s) | dr<i>_<s>
 //   every body:   kinetic gravity modes ground springs total | contacts penetration
 // then, once: t first, and at the end control_energy pose violation.
@@ -32,9 +34,13 @@ struct BodyInfo {
   BodyKind kind = BodyKind::kFfd;
   int dim = 2;
   int num_q = 0;
+  int num_v = 0;                                  // velocities: num_q, but 6 + D for a 3D FFD body
   std::shared_ptr<const BodyModel> ffd;           // FFD bodies: the model (modes included)
+  std::shared_ptr<const BodyModel3> ffd3;         // 3D FFD bodies
   std::shared_ptr<const LinearBodyModel> linear;  // linear bodies
   std::vector<std::string> coordinate_names;      // one per q entry
+  std::vector<std::string> velocity_names;        // one per q̇ (v) entry
+  int num_modes() const { return ffd ? ffd->num_modes() : ffd3 ? ffd3->num_modes() : 0; }
 };
 
 class Trajectory {
@@ -99,7 +105,9 @@ class Trajectory {
   std::vector<double> data_;
 };
 
-// Names of a body's generalized coordinates: tx ty theta <mode names> (FFD) or r<i>_<s> (linear).
+// Names of a body's generalized coordinates and velocities: tx ty theta <mode names> (FFD),
+// tx ty tz qw qx qy qz <mode names> (3D FFD) or r<i>_<s> (linear); velocities d<name> but
+// wx wy wz for a 3D body's angular velocity.
 BodyInfo DescribeBody(const World& world, int body);
 
 // The recorder: a Controller the world calls after every accepted step (World::SetRecorder),

@@ -78,8 +78,8 @@ ReadTrajectory ParseTrajectoryCsv(std::istream& in, const std::string& file, std
   out.has_velocities = true;
   for (int b = 0; b < traj.num_bodies(); ++b) {
     const std::string prefix = traj.num_bodies() > 1 ? traj.bodies()[b].name + "." : "";
-    for (const std::string& c : traj.bodies()[b].coordinate_names)
-      out.has_velocities = out.has_velocities && traj.Column(prefix + "d" + c) >= 0 && source[traj.Column(prefix + "d" + c)] >= 0;
+    for (const std::string& c : traj.bodies()[b].velocity_names)
+      out.has_velocities = out.has_velocities && traj.Column(prefix + c) >= 0 && source[traj.Column(prefix + c)] >= 0;
   }
 
   int number = 1;

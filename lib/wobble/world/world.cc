@@ -138,12 +138,13 @@ const World::LinearEntry& World::Linear(int body) const {
 const std::shared_ptr<const BodyModel>& World::shared_body(int i) const { return Ffd(i).model; }
 
 void World::SetModeTargets(int i, const Eigen::VectorXd& targets) {
-  FfdEntry& e = Ffd(i);
-  const int D = e.model->num_modes();
+  const bool three = kind(i) == BodyKind::kFfd3;
+  const int D = three ? body3(i).num_modes() : body(i).num_modes();
   if (targets.size() != 0 && targets.size() != D)
-    throw std::invalid_argument("body '" + e.model->name() + "' has " + std::to_string(D) + " modes, got " +
+    throw std::invalid_argument("body '" + body_name(i) + "' has " + std::to_string(D) + " modes, got " +
                                 std::to_string(targets.size()) + " targets");
-  e.state.mode_target = targets;
+  if (three) ffd3_[slots_[size_t(i)].index].state.mode_target = targets;
+  else Ffd(i).state.mode_target = targets;
 }
 
 const LinearBodyModel& World::linear_model(int body) const { return *Linear(body).model; }

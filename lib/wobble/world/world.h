@@ -138,6 +138,10 @@ class World {
   // 3D FFD bodies (std::invalid_argument for another kind or a wrong size; InputError for a
   // state that is not finite or whose energy is not).
   const BodyModel3& body3(int i) const;
+  const std::shared_ptr<const BodyModel3>& shared_body3(int i) const;  // for whoever outlives the world
+  // How deep the body's deepest contact point is below the ground now (0 without contacts or
+  // for a linear body): BodyState::penetration in 2D, computed from the contacts in 3D.
+  double Penetration(int body) const;
   const BodyState3<double>& state3(int i) const;
   void SetState3(int body, const Eigen::Vector3d& t, const Eigen::Quaterniond& orientation,
                  const Eigen::VectorXd& gamma, const Eigen::VectorXd& v);
@@ -148,7 +152,8 @@ class World {
   const std::shared_ptr<const BodyModel>& shared_body(int i) const;  // for whoever outlives the world
   const BodyState<double>& state(int i) const;
   void SetState(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
-  // PD targets γ0 of the body's modes (one per mode; empty: all zero). See wobble/control.
+  // PD targets γ0 of the body's modes (one per mode; empty: all zero), 2D and 3D FFD bodies.
+  // See wobble/control.
   void SetModeTargets(int body, const Eigen::VectorXd& targets);
   ForceBreakdown<double> Forces(int body) const;
   Eigen::VectorXd Accelerations(int body) const;     // free q̈ (no constraint forces)

@@ -3,6 +3,7 @@
 // trajectories and impulses: x = t + R l, J = [1 | −R[l]× | R B], J̇v = R(ω×(ω×l) + 2ω×Bγ̇)
 // (kinematics3.h). A constrained world steps them by semi-implicit Euler, velocity first, on
 // the group, as it steps every other body.
+#include <algorithm>
 #include <sstream>
 
 #include "wobble/core/errors.h"
@@ -26,6 +27,21 @@ const World::Ffd3Entry& World::Ffd3(int body) const {
   return ffd3_[slots_[size_t(body)].index];
 }
 const BodyModel3& World::body3(int i) const { return *Ffd3(i).model; }
+const std::shared_ptr<const BodyModel3>& World::shared_body3(int i) const { return Ffd3(i).model; }
+
+double World::Penetration(int body) const {
+  if (kind(body) == BodyKind::kFfd) return state(body).penetration;
+  if (kind(body) == BodyKind::kLinear) return 0.0;
+  const BodyModel3& m = body3(body);
+  const BodyState3<double>& s = state3(body);
+  const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
+  double deepest = 0.0;
+  for (const Contact3<double>& c : s.contacts) {
+    const Eigen::Vector3d x = s.t + R * (m.rest_local(c.point) + m.mode_matrix(c.point) * s.gamma);
+    deepest = std::max(deepest, -options_.ground_3d.Height(x));
+  }
+  return deepest;
+}
 const BodyState3<double>& World::state3(int i) const { return Ffd3(i).state; }
 
 WorldParams3 World::Params3() const {
