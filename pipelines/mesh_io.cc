@@ -165,12 +165,18 @@ void WriteSurfaceMesh(const std::string& path, const SurfaceMesh& mesh) {
       w->SetInputData(poly);
       ok = w->Write();
     } else {
+      // vtkPLYWriter appends ".ply" to a name that does not end in it: give it one, then move
+      const std::string ply = tmp + ".ply";
       auto w = Ptr<vtkPLYWriter>::New();
-      w->SetFileName(tmp.c_str());
+      w->SetFileName(ply.c_str());
       w->SetInputData(poly);
       ok = w->Write();
+      std::error_code ec;
+      if (ok) std::filesystem::rename(ply, tmp, ec);
+      if (ec) throw std::runtime_error("cannot rename " + ply + " to " + tmp + ": " + ec.message());
     }
-    if (!ok) throw std::runtime_error("VTK could not write " + tmp);
+    std::error_code ec;
+    if (!ok || std::filesystem::file_size(tmp, ec) == 0 || ec) throw std::runtime_error("VTK could not write " + tmp);
   });
 }
 

@@ -30,7 +30,8 @@ BodyDef3 ReadObject3(const std::string& path);
 //   z in [0, 200] (each part a closed box; they overlap where the legs meet the top);
 // - the pot: the 2D pot's outline of data/pot.obj (Figs. 4.10/4.11) revolved about its axis
 //   x = 100 with vtkRotationalExtrusionFilter, 48 steps: a closed solid of revolution (walls
-//   tapering from radius 60 at the bottom to 75 under the rim band, the band 100 wide).
+//   tapering from radius 60 at the bottom to 75 under the rim band, the band 100 wide). The
+//   filter stores single-precision points: the mesh is exact to float rounding.
 SurfaceMesh MakeTableMesh();
 SurfaceMesh MakePotMesh();
 
