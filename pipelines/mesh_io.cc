@@ -211,11 +211,9 @@ SurfaceMesh MakePotMesh() {
   revolve->SetInputData(outline);
   revolve->SetResolution(48);
   revolve->SetAngle(360.0);
-  // z up to y up, the axis to x = z = 100: the body frame of data/pot3.obj
+  // z up to y up, the axis on the body frame's y axis (a spin about body y turns it in place)
   auto to_body = Ptr<vtkTransform>::New();
-  to_body->PostMultiply();
   to_body->RotateX(-90.0);  // (x, y, z) -> (x, z, -y)
-  to_body->Translate(100.0, 0.0, 100.0);
   auto moved = Ptr<vtkTransformPolyDataFilter>::New();
   moved->SetInputConnection(revolve->GetOutputPort());
   moved->SetTransform(to_body);

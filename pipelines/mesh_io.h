@@ -29,7 +29,8 @@ BodyDef3 ReadObject3(const std::string& path);
 //   20 thick, whose upper face is at y = 100, on four 20 x 20 legs down to y = 0, x in [0, 300],
 //   z in [0, 200] (each part a closed box; they overlap where the legs meet the top);
 // - the pot: the 2D pot's outline of data/pot.obj (Figs. 4.10/4.11) revolved about its axis
-//   x = 100 with vtkRotationalExtrusionFilter, 48 steps: a closed solid of revolution (walls
+//   with vtkRotationalExtrusionFilter, 48 steps, the axis put on the body frame's y axis (the
+//   bottom centred at the origin): a closed solid of revolution (walls
 //   tapering from radius 60 at the bottom to 75 under the rim band, the band 100 wide). The
 //   filter stores single-precision points: the mesh is exact to float rounding.
 SurfaceMesh MakeTableMesh();

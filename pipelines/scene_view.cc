@@ -16,6 +16,7 @@
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
+#include <vtkLight.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -159,6 +160,21 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
   for (int b = world->num_bodies() - 1; b >= 0; --b) {
     if (world->kind(b) == BodyKind::kFfd) first_ffd = b;
     if (world->kind(b) == BodyKind::kFfd3) first_ffd3 = b;
+  }
+  if (first_ffd3 >= 0) {
+    // a light from above besides the camera's: the camera's alone leaves every upward face
+    // (a table's top, the ground) dark at a low elevation
+    auto head = Ptr<vtkLight>::New();
+    head->SetLightTypeToHeadlight();
+    head->SetIntensity(0.75);
+    auto sky = Ptr<vtkLight>::New();
+    sky->SetLightTypeToSceneLight();
+    sky->SetPositional(false);
+    sky->SetPosition(0.3, 1.0, 0.5);
+    sky->SetFocalPoint(0.0, 0.0, 0.0);
+    sky->SetIntensity(0.5);
+    m.renderer->AddLight(head);
+    m.renderer->AddLight(sky);
   }
   if (first_ffd3 >= 0) {  // the 3D ground plane, lit, several body sizes across
     m.ground = Ptr<GroundSource>::New();
