@@ -13,6 +13,7 @@
 #include "wobble/analysis/conditioning.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "wobble/scene/ffd_object.h"
 #ifdef WOBBLE_HAVE_PIPELINES
 #include "pipelines/mesh_io.h"
 #endif
@@ -157,14 +158,7 @@ StartingWorld LoadStartingWorld(const BodyFiles& files, const std::string& q, co
   s.options.dt = dt;
   if (formats::ObjectFileDimension(files.object) == 3) {
     // the 3D ground: the plane through y = height, tilted by the slope about z as the 2D line
-    const Ground& g = s.options.params.ground;
-    s.options.ground_3d.enabled = g.enabled;
-    s.options.ground_3d.point = Eigen::Vector3d(0.0, flags.ground_height, 0.0);
-    s.options.ground_3d.normal = Eigen::Vector3d(-std::sin(g.slope), std::cos(g.slope), 0.0);
-    s.options.ground_3d.stiffness = g.stiffness;
-    s.options.ground_3d.normal_damping = g.normal_damping;
-    s.options.ground_3d.friction_damping = g.friction_damping;
-    s.options.ground_3d.friction_cap = g.friction_cap;
+    s.options.ground_3d = GroundPlaneOf(s.options.params.ground);
     s.body3 = LoadBody3(files);
     const int n = kRigidDofs3 + s.body3->num_modes();
     s.q0 = ParseNumbers(q, "--q", n, CoordinateNames3(*s.body3), s.body3->name());
@@ -182,11 +176,7 @@ World StartingWorld::MakeWorld() const {
   if (body3) {
     // q = (t, rotation vector r, γ): R = exp([r]×), the turn by |r| radians about r
     world.AddBody(body3);
-    const Eigen::Vector3d r = q0.segment<3>(3);
-    const double angle = r.norm();
-    const Eigen::Quaterniond turn =
-        angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, r / angle)) : Eigen::Quaterniond::Identity();
-    world.SetState3(0, q0.head<3>(), turn, q0.tail(body3->num_modes()), qd0);
+    scene::SetState3FromQ(&world, 0, q0, qd0);
     return world;
   }
   world.AddBody(body);

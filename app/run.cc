@@ -13,6 +13,7 @@
 #include <filesystem>
 
 #include "pipelines/charts.h"
+#include "pipelines/mesh_io.h"
 #include "pipelines/scene_view.h"
 #include "script_render.h"
 #endif
@@ -95,6 +96,9 @@ int RunScript(const RunArgs& a) {
   interp.scene().limits() = a.limits;
   interp.SetHistoryHook(PlotCostHistory);
   interp.SetRenderHook(RenderRecordedRuns);
+#ifdef WOBBLE_HAVE_PIPELINES
+  interp.SetMeshReader(pipelines::ReadSurfaceMesh);  // a 3D object file's `mesh` line
+#endif
   interp.SetSceneRenderHook(RenderScene);
   Progress progress(isatty(STDERR_FILENO) == 1);
   interp.SetProgress([&](double fraction, double t) {

@@ -221,8 +221,34 @@ BENCHMARK(BM_MassMatrixReference);
 // The 3D table with its four modes; `points` > 0 redistributes its mass over that many points:
 // 20 keeps the legs' 12 and 8 of the top's 15; more repeat the file's 27 with small offsets
 // (same total mass, same lattice), to show that a step out of contact does not depend on N.
-std::shared_ptr<const BodyModel3> Table3(int points = 0) {
+// An ellipsoid of about `vertices` vertices inside the table's box: a user's mesh is drawing
+// geometry, so it must not change what a step costs (issue 15's 10,000-vertex table).
+SurfaceMesh EllipsoidInTable(int vertices) {
+  const int rings = std::max(3, int(std::sqrt(double(vertices)))), segments = rings;
+  SurfaceMesh m;
+  const Eigen::Vector3d c(150, 50, 100), r(140, 45, 95);
+  m.points.push_back(c + Eigen::Vector3d(0, r.y(), 0));
+  for (int i = 1; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const double phi = M_PI * i / rings, th = 2 * M_PI * j / segments;
+      m.points.push_back(c + Eigen::Vector3d(std::sin(phi) * std::cos(th), std::cos(phi), std::sin(phi) * std::sin(th)).cwiseProduct(r));
+    }
+  m.points.push_back(c - Eigen::Vector3d(0, r.y(), 0));
+  auto ring = [&](int i, int j) { return 1 + (i - 1) * segments + j % segments; };
+  for (int j = 0; j < segments; ++j) m.triangles.push_back({0, ring(1, j + 1), ring(1, j)});
+  for (int i = 1; i + 1 < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      m.triangles.push_back({ring(i, j), ring(i, j + 1), ring(i + 1, j)});
+      m.triangles.push_back({ring(i, j + 1), ring(i + 1, j + 1), ring(i + 1, j)});
+    }
+  const int south = int(m.points.size()) - 1;
+  for (int j = 0; j < segments; ++j) m.triangles.push_back({south, ring(rings - 1, j), ring(rings - 1, j + 1)});
+  return m;
+}
+
+std::shared_ptr<const BodyModel3> Table3(int points = 0, int mesh_vertices = 0) {
   BodyDef3 def = formats::ReadObjectFile3(kDataDir + "/table3.obj");
+  if (mesh_vertices > 0) def.mesh = EllipsoidInTable(mesh_vertices);
   if (points > 0) {
     const double total = std::accumulate(def.masses.begin(), def.masses.end(), 0.0);
     const std::vector<Eigen::Vector3d> file = def.mass_positions;  // 15 top, then 12 leg points
@@ -273,16 +299,20 @@ void BM_Table3RestingOnGround(benchmark::State& state) {
 BENCHMARK(BM_Table3RestingOnGround);
 
 // Falling freely, far above a ground (the convex-hull test only) or with none: 27 points (the
-// file) against 20 and 1,000 redistributed points.
+// file) against 20 and 1,000 redistributed points, and 1,000 with a 10,000-vertex mesh.
 void BM_Table3OutOfContact(benchmark::State& state) {
-  const std::shared_ptr<const BodyModel3> body = Table3(int(state.range(0)));
+  const std::shared_ptr<const BodyModel3> body = Table3(int(state.range(0)), int(state.range(2)));
+  state.counters["mesh_vertices"] = double(body->def().mesh.points.size());
   WorldParams3 w;
   w.ground.enabled = state.range(1) != 0;
   w.ground.point = Eigen::Vector3d(0.0, -1e12, 0.0);
   BodyState3<double> s = RestState3<double>(*body);
   TimeSteps3(state, *body, w, 0.01, &s);
 }
-BENCHMARK(BM_Table3OutOfContact)->ArgNames({"points", "ground"})->ArgsProduct({{0, 20, 1000}, {1, 0}});
+BENCHMARK(BM_Table3OutOfContact)
+    ->ArgNames({"points", "ground", "mesh"})
+    ->ArgsProduct({{0, 20, 1000}, {1, 0}, {0}})
+    ->Args({1000, 1, 10000});  // issue 15: a 10,000-vertex mesh and 1,000 points vs 20 points
 
 // Resting with 1,000 points: the point groups keep the scan near the feet.
 void BM_Table3kRestingOnGround(benchmark::State& state) {

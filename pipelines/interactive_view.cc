@@ -126,6 +126,8 @@ InteractiveView::InteractiveView(scene::Scene& scene, ViewerOptions options) : i
     throw std::invalid_argument("the slider range must be positive");
   if (!scene.has_bodies() && !scene.object().loaded())
     throw std::invalid_argument("InteractiveView: the scene has no bodies and no FFD object");
+  if (!scene.has_bodies() && scene.object().dim() == 3)
+    throw std::invalid_argument("wobble view shows 2D characters only so far; render a 3D object with wobble render");
   Impl& m = *impl_;
   m.self = this;
   m.scene = &scene;

@@ -8,20 +8,6 @@
 
 namespace wobble::control {
 
-std::vector<int> ActiveModes(const BodyModel& body) {
-  std::vector<int> active;
-  for (int d = 0; d < body.num_modes(); ++d)
-    if (body.modes()[d].active) active.push_back(d);
-  return active;
-}
-
-Eigen::VectorXd TargetsFromPose(const BodyModel& body, const Eigen::VectorXd& pose) {
-  const std::vector<int> active = ActiveModes(body);
-  Eigen::VectorXd targets = Eigen::VectorXd::Zero(body.num_modes());
-  for (int i = 0; i < int(active.size()) && i < pose.size(); ++i) targets[active[i]] = pose[i];
-  return targets;
-}
-
 Eigen::VectorXd ModeControlForces(const BodyModel& body, const BodyState<double>& s) {
   const int D = body.num_modes();
   Eigen::VectorXd f(D);

@@ -28,10 +28,21 @@
 namespace wobble::control {
 
 // Indices (0-based) of the body's active modes, in order: a pose lists one target per entry.
-std::vector<int> ActiveModes(const BodyModel& body);
+// 2D and 3D bodies alike.
+template <int Dim> std::vector<int> ActiveModes(const BodyModelN<Dim>& body) {
+  std::vector<int> active;
+  for (int d = 0; d < body.num_modes(); ++d)
+    if (body.modes()[size_t(d)].active) active.push_back(d);
+  return active;
+}
 
 // Full target vector γ0 (one per mode): the pose's values on the active modes, 0 elsewhere.
-Eigen::VectorXd TargetsFromPose(const BodyModel& body, const Eigen::VectorXd& pose);
+template <int Dim> Eigen::VectorXd TargetsFromPose(const BodyModelN<Dim>& body, const Eigen::VectorXd& pose) {
+  const std::vector<int> active = ActiveModes(body);
+  Eigen::VectorXd targets = Eigen::VectorXd::Zero(body.num_modes());
+  for (int i = 0; i < int(active.size()) && i < pose.size(); ++i) targets[active[size_t(i)]] = pose[i];
+  return targets;
+}
 
 // Q_r,d = −(2K_d (γ_d − γ0_d) + c_d γ̇_d) of every mode (the modes' block of the generalized
 // forces). `targets` empty means all zero.
@@ -71,7 +82,7 @@ template <class T> struct PoseGraphOf {
   bool cyclic = true;
   std::vector<int> active;     // mode index of each pose entry (ActiveModes)
   bool empty() const { return poses.empty(); }
-  static PoseGraphOf From(const BodyModel& body, const PoseGraph& g) {
+  template <int Dim> static PoseGraphOf From(const BodyModelN<Dim>& body, const PoseGraph& g) {
     PoseGraphOf c;
     c.cyclic = g.cyclic;
     c.active = ActiveModes(body);
@@ -105,7 +116,8 @@ template <class T> VecD<T> SmoothPoseTargets(const PoseGraphOf<T>& c, int num_mo
   for (size_t i = 0; i < c.active.size(); ++i) target[c.active[i]] = active[int(i)];
   return target;
 }
-inline Eigen::VectorXd SmoothPoseTargets(const BodyModel& body, const PoseGraph& g, double t, double width) {
+template <int Dim>
+Eigen::VectorXd SmoothPoseTargets(const BodyModelN<Dim>& body, const PoseGraph& g, double t, double width) {
   return SmoothPoseTargets(PoseGraphOf<double>::From(body, g), body.num_modes(), t, width);
 }
 

@@ -7,9 +7,22 @@
 
 namespace wobble::control {
 
+namespace {
+// The pose graph's targets at t of a 2D or 3D FFD body (the graph drives either the same way).
+Eigen::VectorXd Targets(const World& world, int body, const PoseGraph& graph, double t, double width, int pose) {
+  if (world.kind(body) == BodyKind::kFfd3)
+    return width > 0 ? SmoothPoseTargets(world.body3(body), graph, t, width)
+                     : TargetsFromPose(world.body3(body), graph.poses[size_t(pose)]);
+  return width > 0 ? SmoothPoseTargets(world.body(body), graph, t, width)
+                   : TargetsFromPose(world.body(body), graph.poses[size_t(pose)]);
+}
+}  // namespace
+
 PoseGraphController::PoseGraphController(const World& world, int body, PoseGraph graph, double switch_width)
     : body_(body), graph_(std::move(graph)), width_(switch_width) {
-  const std::string invalid = graph_.Validate(int(ActiveModes(world.body(body)).size()));
+  const int active = int(world.kind(body) == BodyKind::kFfd3 ? ActiveModes(world.body3(body)).size()
+                                                             : ActiveModes(world.body(body)).size());
+  const std::string invalid = graph_.Validate(active);
   if (!invalid.empty()) throw std::invalid_argument("pose graph: " + invalid);
   if (!(width_ >= 0.0)) throw std::invalid_argument("pose graph: the switch width must be 0 or positive");
 }
@@ -18,13 +31,13 @@ void PoseGraphController::BeforeStep(World& world) {
   const double t = double(steps_++) * world.options().dt;
   if (width_ > 0) {
     pose_ = graph_.PoseAt(t);
-    world.SetModeTargets(body_, SmoothPoseTargets(world.body(body_), graph_, t, width_));
+    world.SetModeTargets(body_, Targets(world, body_, graph_, t, width_, pose_));
     return;
   }
   const int now = graph_.PoseAt(t);
   if (now != pose_) {  // hard switches: the targets change only here
     pose_ = now;
-    world.SetModeTargets(body_, TargetsFromPose(world.body(body_), graph_.poses[pose_]));
+    world.SetModeTargets(body_, Targets(world, body_, graph_, t, 0.0, pose_));
   }
 }
 

@@ -36,6 +36,17 @@ template <class T> Eigen::Quaternion<T> ExpRotation(const Vec3<T>& x) {
   return Eigen::Quaternion<T>(real, scale * x.x(), scale * x.y(), scale * x.z());
 }
 
+// log of a unit quaternion: the rotation vector r (|r| ≤ π) with ExpRotation(r) = ±q.
+template <class T> Vec3<T> LogRotation(const Eigen::Quaternion<T>& q_in) {
+  using std::atan2;
+  using std::sqrt;
+  const Eigen::Quaternion<T> q = ScalarValue(q_in.w()) < 0 ? Eigen::Quaternion<T>(-q_in.coeffs()) : q_in;
+  const T s2 = q.vec().squaredNorm();
+  if (ScalarValue(s2) < 1e-16) return T(2.0) * q.vec() / q.w();  // 2 atan(s/w)/s → 2/w near 0
+  const T s = sqrt(s2);
+  return T(2.0) * atan2(s, q.w()) / s * q.vec();
+}
+
 // The Cayley map cay(x) = (1 − x̂/2)⁻¹ (1 + x̂/2) as a unit quaternion: (1, x/2) normalized,
 // a turn by 2 atan(|x|/2). Exactly rational, which is why the variational integrator uses it.
 template <class T> Eigen::Quaternion<T> CayleyRotation(const Vec3<T>& x) {

@@ -46,6 +46,12 @@ BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel> body) {
   return info;
 }
 
+BodyInfo DescribeFfd3Body(std::shared_ptr<const BodyModel3> body) {
+  World w;
+  w.AddBody(body);
+  return DescribeBody(w, 0);
+}
+
 void WriteTrajectoryCsv(const std::string& path, const Trajectory& t) {
   formats::WriteCsvAtomically(path, t.Columns(), t.size(), [&t](int k) { return t.Row(k); });
 }

@@ -28,5 +28,6 @@ ReadTrajectory ParseTrajectoryCsv(std::istream& in, const std::string& name_for_
 
 // The bodies of a file for one FFD body (names of its coordinates from the model).
 BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel> body);
+BodyInfo DescribeFfd3Body(std::shared_ptr<const BodyModel3> body);  // a 3D FFD body's
 
 }  // namespace wobble::record

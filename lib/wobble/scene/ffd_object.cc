@@ -3,104 +3,163 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "wobble/core/rotation3.h"
 #include "wobble/core/types.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "wobble/world/world.h"
 
 namespace wobble::scene {
 
 namespace {
 
-// Rigid placement (x, y, θ) composed with a body-relative q: world = placement ∘ q.
-void Place(const Eigen::Vector3d& placement, Eigen::VectorXd* q, Eigen::VectorXd* qd) {
-  const Eigen::Matrix2d R = Rotation(placement[2]);
-  if (q) {
-    q->head<2>() = placement.head<2>() + R * q->head<2>();
-    (*q)[2] += placement[2];
+// Rigid placement (x, y, θ) composed with a body-relative q: world = placement ∘ q. In 3D the
+// placement is the translation (x, y, 0) and the turn by θ about z.
+void Place(int dim, const Eigen::Vector3d& placement, Eigen::VectorXd* q, Eigen::VectorXd* qd) {
+  if (dim == 2) {
+    const Eigen::Matrix2d R = Rotation(placement[2]);
+    if (q) {
+      q->head<2>() = placement.head<2>() + R * q->head<2>();
+      (*q)[2] += placement[2];
+    }
+    if (qd) qd->head<2>() = R * qd->head<2>();
+    return;
   }
-  if (qd) qd->head<2>() = R * qd->head<2>();
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(placement[2], Eigen::Vector3d::UnitZ()));
+  if (q) {
+    q->head<3>() = Eigen::Vector3d(placement[0], placement[1], 0.0) + turn * q->head<3>();
+    q->segment<3>(3) = LogRotation<double>(turn * ExpRotation<double>(q->segment<3>(3)));
+  }
+  if (qd) qd->head<3>() = turn * qd->head<3>();  // ω is in the body frame: unchanged
 }
 
 }  // namespace
 
-void FfdObject::Load(const std::string& path) {
-  def_ = formats::ReadObjectFile(path);
+void FfdObject::Load(const std::string& path, const formats::MeshReader& read_mesh) {
+  def_.reset();
+  def3_.reset();
+  if (formats::ObjectFileDimension(path) == 3) def3_ = formats::ReadObjectFile3(path, read_mesh);
+  else def_ = formats::ReadObjectFile(path);
   path_ = std::filesystem::absolute(path).string();
   modes_.clear();
+  modes3_.clear();
   mode_paths_.clear();
-  q_.setZero(kRigidDofs);
-  qd_.setZero(kRigidDofs);
-  Place(placement_, &q_, &qd_);  // at rest where `trans` put it
+  const int rigid = def3_ ? kRigidDofs3 : kRigidDofs;
+  q_.setZero(rigid);
+  qd_.setZero(rigid);
+  Place(dim(), placement_, &q_, &qd_);  // at rest where `trans` put it
   body_.reset();
+  body3_.reset();
 }
 
-void FfdObject::LoadModes(const std::vector<std::string>& paths) {
-  std::vector<DeformationMode> modes;
-  std::vector<std::string> absolute;
-  for (const std::string& path : paths) {
-    std::vector<DeformationMode> more = formats::ReadDeformationFile(path);
-    modes.insert(modes.end(), more.begin(), more.end());
-    absolute.push_back(std::filesystem::absolute(path).string());
-  }
-  BodyModel check(*def_, modes);  // throws when the modes do not fit the object
-  // a new mode set (§4.10): amplitudes of modes with the same name carry over, others start at 0
-  const int n = kRigidDofs + int(modes.size());
+// A new mode set (§4.10): amplitudes of modes with the same name carry over, others start at 0.
+template <class Modes> void FfdObject::Remember(Modes modes, std::vector<std::string> paths) {
+  const int rigid = def3_ ? kRigidDofs3 : kRigidDofs, n = rigid + int(modes.size());
   Eigen::VectorXd q = Eigen::VectorXd::Zero(n), qd = Eigen::VectorXd::Zero(n);
-  q.head<kRigidDofs>() = q_.head<kRigidDofs>();
-  qd.head<kRigidDofs>() = qd_.head<kRigidDofs>();
+  q.head(rigid) = q_.head(rigid);
+  qd.head(rigid) = qd_.head(rigid);
   for (size_t d = 0; d < modes.size(); ++d)
-    for (size_t old = 0; old < modes_.size(); ++old)
-      if (modes_[old].name == modes[d].name) {
-        q[kRigidDofs + d] = q_[kRigidDofs + old];
-        qd[kRigidDofs + d] = qd_[kRigidDofs + old];
+    for (int old = 0; old < num_modes(); ++old)
+      if (mode_name(old) == modes[d].name) {
+        q[rigid + int(d)] = q_[rigid + old];
+        qd[rigid + int(d)] = qd_[rigid + old];
       }
-  modes_ = std::move(modes);
-  mode_paths_ = std::move(absolute);
+  if constexpr (std::is_same_v<Modes, std::vector<DeformationMode3>>) modes3_ = std::move(modes);
+  else modes_ = std::move(modes);
+  mode_paths_ = std::move(paths);
   q_ = q;
   qd_ = qd;
   body_.reset();
+  body3_.reset();
+}
+
+void FfdObject::LoadModes(const std::vector<std::string>& paths) {
+  std::vector<std::string> absolute;
+  for (const std::string& path : paths) absolute.push_back(std::filesystem::absolute(path).string());
+  if (def3_) {
+    std::vector<DeformationMode3> modes;
+    for (const std::string& path : paths) {
+      std::vector<DeformationMode3> more = formats::ReadDeformationFile3(path, def3_->lattice);
+      modes.insert(modes.end(), more.begin(), more.end());
+    }
+    BodyModel3 check(*def3_, modes);  // throws when the modes do not fit the object
+    Remember(std::move(modes), std::move(absolute));
+    return;
+  }
+  std::vector<DeformationMode> modes;
+  for (const std::string& path : paths) {
+    std::vector<DeformationMode> more = formats::ReadDeformationFile(path);
+    modes.insert(modes.end(), more.begin(), more.end());
+  }
+  BodyModel check(*def_, modes);  // throws when the modes do not fit the object
+  Remember(std::move(modes), std::move(absolute));
+}
+
+std::vector<std::string> FfdObject::mode_names() const {
+  std::vector<std::string> names;
+  for (int d = 0; d < num_modes(); ++d) names.push_back(mode_name(d));
+  return names;
 }
 
 int FfdObject::ModeIndex(const std::string& name) const {
-  for (int d = 0; d < int(modes_.size()); ++d)
-    if (modes_[d].name == name) return d;
+  for (int d = 0; d < num_modes(); ++d)
+    if (mode_name(d) == name) return d;
   return -1;
 }
 
-void FfdObject::Assign(int mode, double stiffness, double damping) {
-  modes_.at(mode).stiffness = stiffness;
-  modes_[mode].damping = damping;
+template <class F> void FfdObject::ForEachMode(F&& f) {
+  for (DeformationMode& m : modes_) f(m);
+  for (DeformationMode3& m : modes3_) f(m);
   body_.reset();
+  body3_.reset();
+}
+
+void FfdObject::Assign(int mode, double stiffness, double damping) {
+  int d = 0;
+  ForEachMode([&](auto& m) {
+    if (d++ == mode) m.stiffness = stiffness, m.damping = damping;
+  });
 }
 
 void FfdObject::SetActive(int mode, bool active) {
-  modes_.at(mode).active = active;
-  body_.reset();
+  int d = 0;
+  ForEachMode([&](auto& m) {
+    if (d++ == mode) m.active = active;
+  });
 }
 
 void FfdObject::SetCodamActive(double damping) {
   codam_active_ = damping;
   body_.reset();
+  body3_.reset();
 }
 
 void FfdObject::SetPlacement(const Eigen::Vector3d& placement) {
-  if (q_.size() >= kRigidDofs) {  // re-place the state: its body-relative part is kept
-    const Eigen::Matrix2d Rinv = Rotation(-placement_[2]);
-    q_.head<2>() = Rinv * (q_.head<2>() - placement_.head<2>());
-    q_[2] -= placement_[2];
-    qd_.head<2>() = Rinv * qd_.head<2>();
-    Place(placement, &q_, &qd_);
+  if (loaded()) {  // re-place the state: its body-relative part is kept
+    Eigen::VectorXd q = q_, qd = qd_;
+    const Eigen::Vector3d undo(0.0, 0.0, -placement_[2]);
+    // back to the body-relative state: translate back, then turn back
+    if (dim() == 2) {
+      q.head<2>() -= placement_.head<2>();
+    } else {
+      q[0] -= placement_[0];
+      q[1] -= placement_[1];
+    }
+    Place(dim(), undo, &q, &qd);
+    Place(dim(), placement, &q, &qd);
+    q_ = q;
+    qd_ = qd;
   }
   placement_ = placement;
 }
 
 void FfdObject::SetRelativeQ(Eigen::VectorXd q) {
-  Place(placement_, &q, nullptr);
+  Place(dim(), placement_, &q, nullptr);
   q_ = std::move(q);
 }
 
 void FfdObject::SetRelativeQd(Eigen::VectorXd qd) {
-  Place(placement_, nullptr, &qd);
+  Place(dim(), placement_, nullptr, &qd);
   qd_ = std::move(qd);
 }
 
@@ -116,6 +175,29 @@ std::shared_ptr<const BodyModel> FfdObject::Body() const {
     if (m.active) m.damping += codam_active_;
   body_ = std::make_shared<const BodyModel>(*def_, std::move(modes));
   return body_;
+}
+
+std::shared_ptr<const BodyModel3> FfdObject::Body3() const {
+  if (body3_ || !def3_) return body3_;
+  std::vector<DeformationMode3> modes = modes3_;
+  for (DeformationMode3& m : modes)
+    if (m.active) m.damping += codam_active_;
+  body3_ = std::make_shared<const BodyModel3>(*def3_, std::move(modes));
+  return body3_;
+}
+
+void SetState3FromQ(World* world, int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  const int D = int(q.size()) - kRigidDofs3;
+  world->SetState3(body, q.head<3>(), ExpRotation<double>(q.segment<3>(3)), q.tail(D), qd);
+}
+
+void QFromState3(const World& world, int body, Eigen::VectorXd* q, Eigen::VectorXd* qd) {
+  const BodyState3<double>& s = world.state3(body);
+  q->resize(kRigidDofs3 + s.gamma.size());
+  q->head<3>() = s.t;
+  q->segment<3>(3) = LogRotation<double>(s.orientation);
+  q->tail(s.gamma.size()) = s.gamma;
+  *qd = s.v;
 }
 
 }  // namespace wobble::scene

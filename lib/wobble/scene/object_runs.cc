@@ -19,6 +19,10 @@ std::vector<std::pair<int, int>> Samples(const ObjectRuns& runs) {
   return s;
 }
 
+// The rigid part of a body's q and q̇: 3 and 3 in 2D (t, θ), 7 and 6 in 3D (t, quaternion | ṫ, ω).
+int RigidQ(const record::BodyInfo& b) { return b.num_q - b.num_modes(); }
+int RigidV(const record::BodyInfo& b) { return b.num_v - b.num_modes(); }
+
 // The motion's modes by name, first seen first, and each run's column for each of its modes.
 struct ModeColumns {
   std::vector<std::string> names;
@@ -27,7 +31,7 @@ struct ModeColumns {
     for (const auto& run : runs) {
       const std::vector<std::string>& coords = run->bodies().at(0).coordinate_names;
       std::vector<int> columns;
-      for (size_t c = kRigidDofs; c < coords.size(); ++c) {
+      for (size_t c = size_t(RigidQ(run->bodies().at(0))); c < coords.size(); ++c) {
         const auto it = std::find(names.begin(), names.end(), coords[c]);
         columns.push_back(int(it - names.begin()));
         if (it == names.end()) names.push_back(coords[c]);
@@ -40,17 +44,16 @@ struct ModeColumns {
 // t, q and q̇ of sample k of a run on the motion's modes, and its PD targets on them.
 std::vector<double> MappedState(const record::Trajectory& run, int k, const std::vector<int>& columns, int num_modes,
                                 Eigen::VectorXd* targets = nullptr) {
-  const int nq = kRigidDofs + num_modes;
-  std::vector<double> row(1 + 2 * nq, 0.0);
+  const int rq = RigidQ(run.bodies()[0]), rv = RigidV(run.bodies()[0]);
+  const int nq = rq + num_modes, nv = rv + num_modes;
+  std::vector<double> row(1 + nq + nv, 0.0);
   row[0] = run.time(k);
   const auto q = run.q(k, 0), qd = run.qd(k, 0);
-  for (int i = 0; i < kRigidDofs; ++i) {
-    row[1 + i] = q[i];
-    row[1 + nq + i] = qd[i];
-  }
+  for (int i = 0; i < rq; ++i) row[1 + i] = q[i];
+  for (int i = 0; i < rv; ++i) row[1 + nq + i] = qd[i];
   for (size_t d = 0; d < columns.size(); ++d) {
-    row[1 + kRigidDofs + columns[d]] = q[kRigidDofs + int(d)];
-    row[1 + nq + kRigidDofs + columns[d]] = qd[kRigidDofs + int(d)];
+    row[1 + rq + columns[d]] = q[rq + int(d)];
+    row[1 + nq + rv + columns[d]] = qd[rv + int(d)];
   }
   if (targets) {
     targets->setZero(num_modes);
@@ -59,22 +62,34 @@ std::vector<double> MappedState(const record::Trajectory& run, int k, const std:
   return row;
 }
 
+// The body of the whole motion: the object with every mode any run had, in column order.
+template <int Dim>
+std::shared_ptr<const BodyModelN<Dim>> MergedModel(const ObjectRuns& runs, const ModeColumns& columns,
+                                                   std::shared_ptr<const BodyModelN<Dim>> (*model)(const record::BodyInfo&)) {
+  std::vector<DeformationModeN<Dim>> modes(columns.names.size());
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const BodyModelN<Dim>& body = *model(runs[r]->bodies().at(0));
+    for (int d = 0; d < body.num_modes(); ++d) modes[size_t(columns.of_run[r][size_t(d)])] = body.modes()[size_t(d)];
+  }
+  return std::make_shared<const BodyModelN<Dim>>(model(runs[0]->bodies()[0])->def(), std::move(modes));
+}
+
 }  // namespace
 
 record::Trajectory MergeRuns(const ObjectRuns& runs) {
   if (runs.empty()) throw std::invalid_argument("MergeRuns: no runs");
   const ModeColumns columns(runs);
   const int N = int(columns.names.size());
-  std::vector<DeformationMode> modes(N);
-  for (size_t r = 0; r < runs.size(); ++r) {
-    const BodyModel& body = *runs[r]->bodies().at(0).ffd;
-    for (int d = 0; d < body.num_modes(); ++d) modes[columns.of_run[r][d]] = body.modes()[d];
-  }
   record::BodyInfo info = runs[0]->bodies()[0];
-  info.ffd = std::make_shared<const BodyModel>(info.ffd->def(), modes);
-  info.coordinate_names.resize(kRigidDofs);
+  const int rq = RigidQ(info), rv = RigidV(info);
+  if (info.ffd3) info.ffd3 = MergedModel<3>(runs, columns, [](const record::BodyInfo& b) { return b.ffd3; });
+  else info.ffd = MergedModel<2>(runs, columns, [](const record::BodyInfo& b) { return b.ffd; });
+  info.coordinate_names.resize(size_t(rq));
   info.coordinate_names.insert(info.coordinate_names.end(), columns.names.begin(), columns.names.end());
-  info.num_q = kRigidDofs + N;
+  info.velocity_names.resize(size_t(rv));
+  for (const std::string& name : columns.names) info.velocity_names.push_back("d" + name);
+  info.num_q = rq + N;
+  info.num_v = rv + N;
   record::Trajectory merged({info});
   for (const auto& [r, k] : Samples(runs)) {
     const record::Trajectory& run = *runs[r];

@@ -58,6 +58,13 @@ WorldOptions Scene::ObjectWorldOptions(const BodyModel& body) const {
   return o;
 }
 
+WorldOptions Scene::ObjectWorldOptions3() const {
+  WorldOptions o = options_;
+  o.ground_3d = GroundPlaneOf(options_.params.ground);
+  o.gravity_3d = Eigen::Vector3d(options_.params.gravity.x(), options_.params.gravity.y(), 0.0);
+  return o;
+}
+
 SimulationSetup Scene::CurrentSetup() const {
   SimulationSetup setup;
   setup.body = object_.Body();
@@ -101,11 +108,17 @@ int Scene::AddLinearBody(const std::string& name, std::shared_ptr<const LinearBo
 
 int Scene::AddObjectBody(const std::string& name) {
   if (bodies_.count(name)) throw std::invalid_argument("a body named '" + name + "' exists already");
-  const std::shared_ptr<const BodyModel> body = object_.Body();
-  if (!body) throw std::logic_error("AddObjectBody: no FFD object is loaded");
+  if (!object_.loaded()) throw std::logic_error("AddObjectBody: no FFD object is loaded");
   World& w = world();
-  const int b = w.AddBody(body);
-  w.SetState(b, object_.q(), object_.qd());
+  int b = 0;
+  if (object_.dim() == 3) {
+    w.mutable_options().ground_3d = ObjectWorldOptions3().ground_3d;
+    b = w.AddBody(object_.Body3());
+    SetState3FromQ(&w, b, object_.q(), object_.qd());
+  } else {
+    b = w.AddBody(object_.Body());
+    w.SetState(b, object_.q(), object_.qd());
+  }
   bodies_[name] = b;
   drawings_.resize(w.num_bodies());
   return b;
@@ -174,11 +187,22 @@ void Scene::BeginRun(RunKind kind, bool keep_steps) {
 }
 
 void Scene::BeginObjectRun(RunKind kind, bool keep_steps) {
-  const std::shared_ptr<const BodyModel> body = object_.Body();
-  if (!body) throw std::logic_error("BeginRun: no FFD object is loaded");
-  auto w = std::make_unique<World>(ObjectWorldOptions(*body));
-  w->AddBody(body);
-  w->SetState(0, object_.q(), object_.qd());
+  if (!object_.loaded()) throw std::logic_error("BeginRun: no FFD object is loaded");
+  std::unique_ptr<World> w;
+  if (object_.dim() == 3) {
+    // the 3D object stands on the plane of the ground line (GroundPlaneOf), under the same gravity
+    if (springs_.enabled && !springs_.list.empty())
+      throw std::invalid_argument("springs hold 2D objects only so far ('clear springs' first)");
+    if (kind == RunKind::kKeyframes) throw std::invalid_argument("keyframes drive 2D objects only so far");
+    w = std::make_unique<World>(ObjectWorldOptions3());
+    w->AddBody(object_.Body3());
+    SetState3FromQ(w.get(), 0, object_.q(), object_.qd());
+  } else {
+    const std::shared_ptr<const BodyModel> body = object_.Body();
+    w = std::make_unique<World>(ObjectWorldOptions(*body));
+    w->AddBody(body);
+    w->SetState(0, object_.q(), object_.qd());
+  }
   w->SetTime(time_);
   auto run = std::make_unique<Run>();
   run->kind = kind;
@@ -231,7 +255,13 @@ void Scene::Finish(bool act_due_behaviours) {
     return;
   }
   // the hand-over: the object goes on from the run's last state
-  object_.SetState(w.state(0).q, w.state(0).qd);
+  if (w.kind(0) == BodyKind::kFfd3) {
+    Eigen::VectorXd q, qd;
+    QFromState3(w, 0, &q, &qd);
+    object_.SetState(q, qd);
+  } else {
+    object_.SetState(w.state(0).q, w.state(0).qd);
+  }
   time_ = run->kind == RunKind::kKeyframes ? run->start_time + control_.keys.Duration() : w.time();
   if (run->recorder) {
     energy_ = run->recorder->control_energy();
@@ -275,12 +305,11 @@ long Scene::CheckedRun(double duration, bool object_run) const {
   const long steps = RunSteps(duration, options_.dt, limits_, hint);
   // the samples this run adds: every step of an object run, the frames of the scene's record
   double rows = 0.0, width = 0.0;
-  if (object_run) {
-    const std::shared_ptr<const BodyModel> body = object_.Body();
-    if (body) {
-      rows = double(steps) + 1.0;
-      width = double(record::Trajectory({record::DescribeFfdBody(body)}).Columns().size());
-    }
+  if (object_run && object_.loaded()) {
+    rows = double(steps) + 1.0;
+    const record::BodyInfo info =
+        object_.dim() == 3 ? record::DescribeFfd3Body(object_.Body3()) : record::DescribeFfdBody(object_.Body());
+    width = double(record::Trajectory({info}).Columns().size());
   } else if (recorded_ && record_fps_ > 0) {
     rows = std::min(double(steps), duration * record_fps_) + 1.0;
     width = double(recorded_->Columns().size());

@@ -134,6 +134,9 @@ class Scene {
   const control::ControlEnergy& control_energy() const { return energy_; }
   // options() with the springs (when enabled) on `body`: the world of the object's runs.
   WorldOptions ObjectWorldOptions(const BodyModel& body) const;
+  // The world of a 3D object's runs: options() with the ground line's plane (GroundPlaneOf)
+  // and gravity in the x-y plane; no springs (they hold 2D objects only so far).
+  WorldOptions ObjectWorldOptions3() const;
   SimulationSetup CurrentSetup() const;
 
   // ---- the Witkin & Welch scene ----

@@ -138,6 +138,7 @@ void Interpreter::SetProgress(std::function<void(double, double)> progress) { st
 void Interpreter::SetHistoryHook(HistoryHook hook) { state_->history_hook = std::move(hook); }
 void Interpreter::SetRenderHook(RenderHook hook) { state_->render_hook = std::move(hook); }
 void Interpreter::SetSceneRenderHook(SceneRenderHook hook) { state_->scene_render_hook = std::move(hook); }
+void Interpreter::SetMeshReader(formats::MeshReader reader) { state_->mesh_reader = std::move(reader); }
 
 // ---------------------------------------------------------------- state
 

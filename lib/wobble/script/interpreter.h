@@ -95,6 +95,9 @@ class Interpreter {
   using SceneRenderHook = std::function<std::vector<std::string>(const SceneRenderRequest&)>;
   void SetRenderHook(RenderHook hook);
   void SetSceneRenderHook(SceneRenderHook hook);
+  // Reads the mesh a 3D object file names (`mesh FILE`): lib has no VTK, so the CLI installs
+  // pipelines::ReadSurfaceMesh; without it such a file is refused with a message.
+  void SetMeshReader(formats::MeshReader reader);
 
   // The command table's names, usages and one-line helps, and the names `set` accepts.
   static const std::vector<CommandInfo>& Commands();

@@ -16,15 +16,14 @@ using namespace script_detail;
 namespace {
 
 int ModeIndex(const State& s, const std::string& word, const Context& ctx) {
-  const std::vector<DeformationMode>& modes = s.scene.object().modes();
+  const int count = s.scene.object().num_modes();
   int index;
   if (formats::detail::ParseInt(word, &index)) {
-    if (index < 1 || index > int(modes.size()))
-      ctx.Fail("expected a mode number from 1 to " + std::to_string(modes.size()) + ", got " + word);
+    if (index < 1 || index > count)
+      ctx.Fail("expected a mode number from 1 to " + std::to_string(count) + ", got " + word);
     return index - 1;
   }
-  std::vector<std::string> names;
-  for (const DeformationMode& m : modes) names.push_back(m.name);
+  const std::vector<std::string> names = s.scene.object().mode_names();
   const int d = s.scene.object().ModeIndex(word);
   if (d < 0) {
     const std::string near = Interpreter::Nearest(word, names);
@@ -59,12 +58,21 @@ void RequireObject(const State& s, const Context& ctx, const std::string& comman
     ctx.Fail(command + " needs an object: 'load_obj FILE' first (or run with --object FILE)");
 }
 
+void Require2dObject(const State& s, const Context& ctx, const std::string& command) {
+  RequireObject(s, ctx, command);
+  if (s.scene.object().dim() == 3)
+    ctx.Fail(command + " works on 2D objects only so far (this object file is 3D: 'dimension 3')");
+}
+
 scene::StepCallback StepObserver(State& s, bool object) {
   if (!s.progress && !(object && s.debug)) return nullptr;
   return [&s, object](long n, long steps, const World& world) {
     if (object && s.debug) {
+      Eigen::VectorXd q, qd;
+      if (world.kind(0) == BodyKind::kFfd3) scene::QFromState3(world, 0, &q, &qd);
+      else q = world.state(0).q;
       s.out << "t " << Num(world.time()) << " q";
-      for (int i = 0; i < world.state(0).q.size(); ++i) s.out << " " << Num(world.state(0).q[i]);
+      for (int i = 0; i < q.size(); ++i) s.out << " " << Num(q[i]);
       s.out << "\n";
     }
     if (s.progress && ((n - 1) % 64 == 0 || n == steps)) s.progress(double(n) / double(steps), world.time());
@@ -73,7 +81,7 @@ scene::StepCallback StepObserver(State& s, bool object) {
 
 void LoadObj(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 2, 2);
-  s.scene.object().Load(Resolve(w[1], ctx.dir));
+  s.scene.object().Load(Resolve(w[1], ctx.dir), s.mesh_reader);
   s.track.clear();
 }
 
@@ -100,7 +108,7 @@ void Trans(State& s, const Words& w, const Context& ctx) {
 void Assign(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 4, 4);
   RequireObject(s, ctx, "assign");
-  if (s.scene.object().modes().empty()) ctx.Fail("assign needs modes: 'load_def FILE' first");
+  if (s.scene.object().num_modes() == 0) ctx.Fail("assign needs modes: 'load_def FILE' first");
   const int d = ModeIndex(s, w[1], ctx);
   const double k = Number(w[2], "STIFFNESS", ctx), c = Number(w[3], "DAMPING", ctx);
   if (k < 0 || c < 0) ctx.Fail("expected a non-negative stiffness and damping");
@@ -110,20 +118,24 @@ void Assign(State& s, const Words& w, const Context& ctx) {
 void Mode(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 3, 3);
   RequireObject(s, ctx, "mode");
-  if (s.scene.object().modes().empty()) ctx.Fail("mode needs modes: 'load_def FILE' first");
+  if (s.scene.object().num_modes() == 0) ctx.Fail("mode needs modes: 'load_def FILE' first");
   const int d = ModeIndex(s, w[1], ctx);
   if (w[2] != "active" && w[2] != "passive") ctx.Fail("expected 'active' or 'passive', got '" + w[2] + "'");
   const bool active = w[2] == "active";
-  if (s.scene.object().modes()[d].active != active) s.scene.control().graph = {};  // poses list the active modes
+  if (s.scene.object().mode_active(d) != active) s.scene.control().graph = {};  // poses list the active modes
   s.scene.object().SetActive(d, active);
 }
 
 void SetVec(State& s, const Words& w, const Context& ctx) {
   RequireObject(s, ctx, "set_vec");
-  const int n = kRigidDofs + int(s.scene.object().modes().size());
+  const int n = s.scene.object().num_q();
   if (w.size() < 2 || (w[1] != "q" && w[1] != "dq")) ctx.Fail("expected 'set_vec q V1 .. Vn' or 'set_vec dq V1 .. Vn'");
+  const bool three = s.scene.object().dim() == 3;
+  const std::string layout = !three ? "tx ty theta and one per mode"
+                             : w[1] == "q" ? "tx ty tz, a rotation vector rx ry rz and one per mode"
+                                           : "vx vy vz, the body angular velocity wx wy wz and one per mode";
   if (int(w.size()) - 2 != n)
-    ctx.Fail("expected " + std::to_string(n) + " numbers after 'set_vec " + w[1] + "' (tx ty theta and one per mode), got " +
+    ctx.Fail("expected " + std::to_string(n) + " numbers after 'set_vec " + w[1] + "' (" + layout + "), got " +
              std::to_string(w.size() - 2));
   Eigen::VectorXd v(n);
   for (int i = 0; i < n; ++i) v[i] = Number(w[2 + i], "a coordinate", ctx);
@@ -159,7 +171,8 @@ void Simul(State& s, const Words& w, const Context& ctx) {
 
 void Pose(State& s, const Words& w, const Context& ctx) {
   RequireObject(s, ctx, "pose");
-  const int k = int(control::ActiveModes(*s.scene.object().Body()).size());
+  int k = 0;
+  for (int d = 0; d < s.scene.object().num_modes(); ++d) k += s.scene.object().mode_active(d) ? 1 : 0;
   if (k == 0) ctx.Fail("pose needs active modes: 'mode MODE active' first");
   if (int(w.size()) != k + 2) ctx.Fail("expected 'pose' with " + std::to_string(k) + " targets (one per active mode) and a DURATION");
   Eigen::VectorXd pose(k);
@@ -171,7 +184,7 @@ void Pose(State& s, const Words& w, const Context& ctx) {
 }
 
 void Key(State& s, const Words& w, const Context& ctx) {
-  RequireObject(s, ctx, "key");
+  Require2dObject(s, ctx, "key");
   if (w.size() < 2) ctx.Fail("expected '" + ctx.usage + "'");
   control::Keyframes& keys = s.scene.control().keys;
   const double t = Number(w[1], "TIME", ctx);
@@ -203,7 +216,7 @@ void Hold(State& s, const Words& w, const Context& ctx) {
 
 void Keyframe(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 1, 1);
-  RequireObject(s, ctx, "keyframe");
+  Require2dObject(s, ctx, "keyframe");
   scene::RunReport r;
   try {
     r = s.scene.Keyframe(StepObserver(s, true));
@@ -223,7 +236,7 @@ void Keyframe(State& s, const Words& w, const Context& ctx) {
 
 void SpringCommand(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 5, 8);
-  RequireObject(s, ctx, "spring");
+  Require2dObject(s, ctx, "spring");
   Spring sp;
   sp.lattice_coords = {Number(w[1], "S", ctx), Number(w[2], "T", ctx)};
   if (sp.lattice_coords.minCoeff() < 0 || sp.lattice_coords.maxCoeff() > 1)
@@ -288,7 +301,8 @@ void Render(State& s, const Words& w, const Context& ctx) {
   request.dir = w[1];
   request.what = w.size() > 2 ? w[2] : "";
   const auto merged = std::make_shared<const record::Trajectory>(scene::MergeRuns(s.track));
-  request.world = s.scene.ObjectWorldOptions(*merged->bodies()[0].ffd);
+  request.world = merged->bodies()[0].ffd ? s.scene.ObjectWorldOptions(*merged->bodies()[0].ffd)
+                                          : s.scene.ObjectWorldOptions3();
   request.trajectory = merged;
   try {
     s.render_hook(request);

@@ -1,6 +1,7 @@
 // Motion synthesis from a script (thesis §5.1–5.2): `anneal` and `cmaes` refine the scene's
 // pose graph by trials of the FFD object, `gait` measures it, `save` writes the script that
 // replays it.
+#include "wobble/core/errors.h"
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/csv.h"
 #include "wobble/scene/script_writer.h"
@@ -73,6 +74,7 @@ synth::Problem StartOptimising(State& s) {
 }  // namespace
 
 synth::Problem MakeProblem(const State& s, long steps) {
+  if (s.scene.object().dim() == 3) throw InputError("gait synthesis works on 2D objects only so far");
   synth::Problem p;
   p.body = s.scene.object().Body();
   p.world = s.scene.ObjectWorldOptions(*p.body);
@@ -85,7 +87,7 @@ synth::Problem MakeProblem(const State& s, long steps) {
 
 void Anneal(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 2, 2);
-  RequireObject(s, ctx, "anneal");
+  Require2dObject(s, ctx, "anneal");
   const int iterations = Count(w, "ITERATIONS", ctx);
   if (s.scene.control().graph.empty()) ctx.Fail("anneal needs an initial pose graph: 'pose ...' lines first");
   synth::AnnealOptions o = s.anneal_options;
@@ -102,7 +104,7 @@ void Anneal(State& s, const Words& w, const Context& ctx) {
 
 void Cmaes(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 2, 2);
-  RequireObject(s, ctx, "cmaes");
+  Require2dObject(s, ctx, "cmaes");
   const int generations = Count(w, "GENERATIONS", ctx);
   if (s.scene.control().graph.empty()) ctx.Fail("cmaes needs an initial pose graph: 'pose ...' lines first");
 #ifdef WOBBLE_HAVE_PAGMO
@@ -133,7 +135,7 @@ void Cmaes(State& s, const Words& w, const Context& ctx) {
 
 void Gait(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 3, 3);
-  RequireObject(s, ctx, "gait");
+  Require2dObject(s, ctx, "gait");
   int skip, cycles;
   if (!formats::detail::ParseInt(w[1], &skip) || skip < 0 || !formats::detail::ParseInt(w[2], &cycles) || cycles < 1)
     ctx.Fail("expected 'gait SKIP CYCLES' with SKIP >= 0 and CYCLES >= 1 whole numbers");
@@ -160,6 +162,7 @@ synth::Problem SynthesisProblem(const State& s) {
 }
 
 std::string ReplayScript(const State& s) {
+  if (s.scene.object().dim() == 3) throw InputError("replay scripts are written for 2D objects only so far");
   const scene::Scene& sc = s.scene;
   const scene::FfdObject& object = sc.object();
   scene::ScriptSetup setup;
@@ -181,7 +184,7 @@ std::string ReplayScript(const State& s) {
 
 void Save(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 2, 2);
-  RequireObject(s, ctx, "save");
+  Require2dObject(s, ctx, "save");
   try {
     formats::CheckWritable(w[1]);
   } catch (const std::runtime_error& e) {

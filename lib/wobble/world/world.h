@@ -118,6 +118,11 @@ struct VelocityGoal {
   Eigen::VectorXd v;
 };
 
+// The 3D ground of a 2D ground line (the `set` parameters and the CLI's ground flags): the
+// plane through its point with its normal, extended along z, with its stiffness, damping and
+// friction.
+GroundPlane GroundPlaneOf(const Ground& ground);
+
 class World {
  public:
   explicit World(WorldOptions options = {});

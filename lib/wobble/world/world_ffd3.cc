@@ -29,6 +29,18 @@ const World::Ffd3Entry& World::Ffd3(int body) const {
 const BodyModel3& World::body3(int i) const { return *Ffd3(i).model; }
 const std::shared_ptr<const BodyModel3>& World::shared_body3(int i) const { return Ffd3(i).model; }
 
+GroundPlane GroundPlaneOf(const Ground& g) {
+  GroundPlane p;
+  p.enabled = g.enabled;
+  p.point = Eigen::Vector3d(g.point.x(), g.point.y(), 0.0);
+  p.normal = Eigen::Vector3d(g.normal().x(), g.normal().y(), 0.0);
+  p.stiffness = g.stiffness;
+  p.normal_damping = g.normal_damping;
+  p.friction_damping = g.friction_damping;
+  p.friction_cap = g.friction_cap;
+  return p;
+}
+
 double World::Penetration(int body) const {
   if (kind(body) == BodyKind::kFfd) return state(body).penetration;
   if (kind(body) == BodyKind::kLinear) return 0.0;

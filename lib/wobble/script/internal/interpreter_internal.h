@@ -62,6 +62,7 @@ struct State {
   scene::ObjectRuns output_runs, track;
   Interpreter::HistoryHook history_hook;
   Interpreter::RenderHook render_hook;
+  formats::MeshReader mesh_reader;  // a 3D object file's `mesh` line (VTK's readers, from the app)
   Interpreter::SceneRenderHook scene_render_hook;
 };
 
@@ -96,6 +97,8 @@ const std::vector<Parameter>& ParameterTable();
 // ---- handlers ----
 // "COMMAND needs an object" unless the FFD object is loaded.
 void RequireObject(const State& s, const Context& ctx, const std::string& command);
+// The same, for commands that do not know 3D objects yet (a clear refusal, not a wrong answer).
+void Require2dObject(const State& s, const Context& ctx, const std::string& command);
 // What a run reports after its steps: the progress every 64 steps and, for the FFD object's
 // runs with `set debug T`, q after every step. Null when neither is wanted.
 scene::StepCallback StepObserver(State& s, bool object);
