@@ -425,6 +425,7 @@ TEST(Script3d, PlacementTurnsAboutZAndPoseGraphsKeepTheMomentum) {
                 "set integrator rk4\nset dt 1e-4\nsimul 0.4\n");
   q = interp.q();
   EXPECT_GT(q[6], 1e-3);  // the bend moved towards the first pose's 0.2
+  EXPECT_GT(interp.control_energy(), 0.0);  // the PD forces' work is counted in 3D too
   EXPECT_LT((centre(q) - c0).norm(), 1e-9 * c0.norm());
   // 2D-only commands refuse a 3D object by name and line
   for (const char* line : {"key 0", "spring 0.5 0.5 0 0", "keyframe", "anneal 5", "save x.wob"}) {

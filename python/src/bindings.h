@@ -16,6 +16,7 @@ namespace py = pybind11;
 
 void BindErrors(py::module_& m);   // exceptions (errors.cc)
 void BindBodies(py::module_& m);   // BodyModel, modes, loading (bodies.cc)
+void BindBodies3(py::module_& m);  // BodyModel3, load_body3, the World's 3D methods (bodies3.cc)
 void BindWorld(py::module_& m);    // WorldOptions, Ground, World, Energies (world.cc)
 void BindRecord(py::module_& m);   // Trajectory, simulate (record.cc)
 void BindRollout(py::module_& m);  // batched rollouts (rollout.cc)
@@ -28,5 +29,7 @@ void BindRender(py::module_& m);   // pictures and exports through pipelines/ (r
 // A C-contiguous float64 array of `rows` x `cols` (cols < 0: a vector of `rows`), or
 // InputError naming `what` and the shape expected.
 py::array_t<double, py::array::c_style> AsMatrix(const py::handle& a, long rows, long cols, const std::string& what);
+// The same for a vector of n numbers, copied.
+Eigen::VectorXd AsVector(const py::handle& h, long n, const std::string& what);
 
 }  // namespace wobble::python

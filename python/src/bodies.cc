@@ -122,6 +122,11 @@ py::array_t<double, py::array::c_style> AsMatrix(const py::handle& h, long rows,
   return a;
 }
 
+Eigen::VectorXd AsVector(const py::handle& h, long n, const std::string& what) {
+  auto a = AsMatrix(h, n, -1, what);
+  return Eigen::Map<const Eigen::VectorXd>(a.data(), n);
+}
+
 void BindBodies(py::module_& m) {
   py::class_<DeformationMode>(m, "DeformationMode", "One user-drawn deformation mode (thesis §4.3) and its PD constants.")
       .def_readonly("name", &DeformationMode::name)

@@ -9,6 +9,7 @@ PYBIND11_MODULE(_wobble, m) {
   BindErrors(m);
   BindBodies(m);
   BindWorld(m);
+  BindBodies3(m);  // after World: it adds the World's 3D methods
   BindRecord(m);
   BindRollout(m);
   BindScript(m);

@@ -12,11 +12,6 @@
 namespace wobble::python {
 namespace {
 
-Eigen::VectorXd AsVector(const py::handle& h, long n, const std::string& what) {
-  auto a = AsMatrix(h, n, -1, what);
-  return Eigen::Map<const Eigen::VectorXd>(a.data(), n);
-}
-
 void CheckIndex(const World& w, int body) {
   if (body < 0 || body >= w.num_bodies())
     throw InputError("body " + std::to_string(body) + ": the world has " + std::to_string(w.num_bodies()) + " bodies");

@@ -8,21 +8,44 @@
 
 namespace wobble::control {
 
-Eigen::VectorXd ModeControlForces(const BodyModel& body, const BodyState<double>& s) {
-  const int D = body.num_modes();
+namespace {
+// −(2K_d (γ_d − γ0_d) + c_d γ̇_d) of every mode, either dimension.
+template <class Modes, class G, class Gd>
+Eigen::VectorXd PdForces(const Modes& modes, const G& gamma, const Gd& gamma_dot, const VecD<double>& target) {
+  const int D = int(modes.size());
   Eigen::VectorXd f(D);
   for (int d = 0; d < D; ++d) {
-    const DeformationMode& m = body.modes()[d];
-    const double target = s.mode_target.size() == D ? s.mode_target[d] : 0.0;
-    f[d] = -(2.0 * m.stiffness * (s.q[kRigidDofs + d] - target) + m.damping * s.qd[kRigidDofs + d]);
+    const double t = target.size() == D ? target[d] : 0.0;
+    f[d] = -(2.0 * modes[size_t(d)].stiffness * (gamma[d] - t) + modes[size_t(d)].damping * gamma_dot[d]);
   }
   return f;
+}
+}  // namespace
+
+Eigen::VectorXd ModeControlForces(const BodyModel& body, const BodyState<double>& s) {
+  const int D = body.num_modes();
+  return PdForces(body.modes(), s.q.tail(D), s.qd.tail(D), s.mode_target);
+}
+
+Eigen::VectorXd ModeControlForces(const BodyModel3& body, const BodyState3<double>& s) {
+  const int D = body.num_modes();
+  return PdForces(body.modes(), s.gamma, s.v.tail(D), s.mode_target);
 }
 
 void ControlEnergy::Accumulate(const BodyModel& body, const BodyState<double>& s, double dt) {
   const Eigen::VectorXd f = ModeControlForces(body, s);
   for (int d = 0; d < f.size(); ++d) {
     const double power = f[d] * s.qd[kRigidDofs + d];
+    consumed += std::abs(power) * dt;
+    work += power * dt;
+  }
+}
+
+void ControlEnergy::Accumulate(const BodyModel3& body, const BodyState3<double>& s, double dt) {
+  const Eigen::VectorXd f = ModeControlForces(body, s);
+  const int first = kRigidDofs3;
+  for (int d = 0; d < f.size(); ++d) {
+    const double power = f[d] * s.v[first + d];
     consumed += std::abs(power) * dt;
     work += power * dt;
   }

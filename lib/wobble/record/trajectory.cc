@@ -242,8 +242,11 @@ void Recorder::Start(const World& world) {
 
 void Recorder::AfterStep(World& world) {
   const double dt = world.options().dt;
-  for (int b = 0; b < world.num_bodies(); ++b)
-    if (world.kind(b) == BodyKind::kFfd && !world.kinematic(b)) energy_.Accumulate(world.body(b), world.state(b), dt);
+  for (int b = 0; b < world.num_bodies(); ++b) {
+    if (world.kind(b) == BodyKind::kLinear || world.kinematic(b)) continue;
+    if (world.kind(b) == BodyKind::kFfd) energy_.Accumulate(world.body(b), world.state(b), dt);
+    else energy_.Accumulate(world.body3(b), world.state3(b), dt);
+  }
   int bad = -1;
   if (period_ > 0.0) bad = SampleFrame(world);
   else if (++counter_ % every_ == 0) bad = Sample(world);

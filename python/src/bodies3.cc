@@ -1,0 +1,153 @@
+// 3D FFD characters from Python (issue 15): a 3D object file with its modes (a mesh read by
+// VTK's readers when the module has the pipelines), the body's mesh and its FFD, and the 3D
+// body in the World with the CLI's state convention q = (t, rotation vector, γ), q̇ = (ṫ, body
+// ω, γ̇).
+#include "bindings.h"
+
+#include "wobble/analysis/conditioning.h"
+#include "wobble/body/body_model.h"
+#include "wobble/core/errors.h"
+#include "wobble/core/rotation3.h"
+#include "wobble/scene/ffd_object.h"
+#ifdef WOBBLE_PYTHON_RENDER
+#include "pipelines/mesh_io.h"
+#endif
+
+namespace wobble::python {
+namespace {
+
+std::shared_ptr<BodyModel3> LoadBody3(const std::string& object, const std::vector<std::string>& modes, bool check) {
+  scene::FfdObject o;
+#ifdef WOBBLE_PYTHON_RENDER
+  o.Load(object, pipelines::ReadSurfaceMesh);
+#else
+  o.Load(object);  // a `mesh` line is refused: this module was built without VTK
+#endif
+  if (o.dim() != 3) throw InputError(object + ": a 2D object file (use wobble.load_body)");
+  o.LoadModes(modes);
+  std::shared_ptr<const BodyModel3> body = o.Body3();
+  if (check) {
+    const analysis::ModeSetReport report = analysis::CheckModeSet(*body);
+    if (report.level == analysis::ModeSetReport::Level::kError) {
+      std::string msg = "the modes of " + object + " cannot be simulated:";
+      for (const std::string& line : report.messages) msg += "\n  " + line;
+      throw InputError(msg + "\n(wobble condition check explains the mode set)");
+    }
+  }
+  return std::const_pointer_cast<BodyModel3>(body);
+}
+
+void Check3(const World& w, int body) {
+  if (body < 0 || body >= w.num_bodies() || w.kind(body) != BodyKind::kFfd3)
+    throw InputError("body " + std::to_string(body) + " is not a 3D FFD body of the world");
+}
+
+py::array_t<double> Rows3(const std::vector<Eigen::Vector3d>& points) {
+  py::array_t<double> out({py::ssize_t(points.size()), py::ssize_t(3)});
+  auto a = out.mutable_unchecked<2>();
+  for (size_t k = 0; k < points.size(); ++k)
+    for (int c = 0; c < 3; ++c) a(k, c) = points[k][c];
+  return out;
+}
+
+}  // namespace
+
+void BindBodies3(py::module_& m) {
+  py::class_<BodyModel3, std::shared_ptr<BodyModel3>>(
+      m, "BodyModel3",
+      "A 3D FFD character (issue 15): a trivariate lattice, mass points, modes made by generators,\n"
+      "and optionally a user's mesh. Immutable. In a World its q is [tx, ty, tz, rx, ry, rz,\n"
+      "γ1..γD] (r the rotation vector) and q̇ [vx, vy, vz, ωx, ωy, ωz (body frame), γ̇1..γ̇D].\n"
+      "Make one with wobble.load_body3.")
+      .def_property_readonly("name", &BodyModel3::name)
+      .def_property_readonly("num_modes", &BodyModel3::num_modes)
+      .def_property_readonly("num_q", [](const BodyModel3& b) { return kRigidDofs3 + b.num_modes(); },
+                             "6 rigid coordinates + one per mode")
+      .def_property_readonly("num_points", &BodyModel3::num_points, "mass points")
+      .def_property_readonly("mode_names",
+                             [](const BodyModel3& b) {
+                               std::vector<std::string> names;
+                               for (const DeformationMode3& d : b.modes()) names.push_back(d.name);
+                               return names;
+                             })
+      .def_property_readonly("total_mass", [](const BodyModel3& b) { return b.moments().m; })
+      .def_property_readonly("mass_positions", [](const BodyModel3& b) { return Rows3(b.def().mass_positions); },
+                             "(num_points, 3) mass points in the body frame")
+      .def_property_readonly("mesh_points", [](const BodyModel3& b) { return Rows3(b.def().mesh.points); },
+                             "(V, 3) the mesh's vertices in the body frame (V = 0 without a mesh)")
+      .def_property_readonly(
+          "mesh_triangles",
+          [](const BodyModel3& b) {
+            const auto& t = b.def().mesh.triangles;
+            py::array_t<int> out({py::ssize_t(t.size()), py::ssize_t(3)});
+            auto a = out.mutable_unchecked<2>();
+            for (size_t k = 0; k < t.size(); ++k)
+              for (int c = 0; c < 3; ++c) a(k, c) = t[k][size_t(c)];
+            return out;
+          },
+          "(T, 3) vertex indices of each triangle")
+      .def(
+          "mesh_vertices",
+          [](const BodyModel3& b, const py::object& q_in) {
+            const int n = kRigidDofs3 + b.num_modes();
+            const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
+            const Eigen::Quaterniond R = ExpRotation<double>(Eigen::Vector3d(q.segment<3>(3)));
+            const Eigen::VectorXd gamma = q.tail(b.num_modes());
+            std::vector<Eigen::Vector3d> x(b.def().mesh.points.size());
+            for (size_t v = 0; v < x.size(); ++v)
+              x[v] = q.head<3>() + R * (b.mesh_rest_local(int(v)) + b.mesh_mode_matrix(int(v)) * gamma);
+            return Rows3(x);
+          },
+          py::arg("q") = py::none(),
+          "(V, 3) world positions of the mesh's vertices at q: x = t + R (b0 + B γ), every vertex\n"
+          "moved by the FFD of its lattice")
+      .def("__repr__", [](const BodyModel3& b) {
+        return "<BodyModel3 '" + b.name() + "': " + std::to_string(b.num_points()) + " points, " +
+               std::to_string(b.num_modes()) + " modes, " + std::to_string(b.def().mesh.points.size()) + " mesh vertices>";
+      });
+
+  m.def("load_body3", &LoadBody3, py::arg("object"), py::arg("modes") = std::vector<std::string>(),
+        py::arg("check") = true,
+        "Reads a 3D object file ('dimension 3': a lattice or 'lattice fit', mass points or 'sample',\n"
+        "a 'mesh' read by VTK's readers) and its .def3 mode files, as a script's load_obj and\n"
+        "load_def do. Errors name FILE:LINE (wobble.ParseError).");
+
+  // the 3D body in the World: the methods live on World (bound in world.cc)
+  auto world = py::reinterpret_borrow<py::class_<World>>(m.attr("World"));
+  world
+      .def("add_body3", [](World& w, std::shared_ptr<BodyModel3> body) { return w.AddBody(body); }, py::arg("body"),
+           "Adds a 3D FFD body at q = 0 (its lattice's pose), at rest; returns its index.")
+      .def(
+          "q3",
+          [](const World& w, int body) {
+            Check3(w, body);
+            Eigen::VectorXd q, qd;
+            scene::QFromState3(w, body, &q, &qd);
+            return q;
+          },
+          py::arg("body") = 0, "a copy of the 3D body's q = [t, rotation vector, γ]")
+      .def(
+          "qd3",
+          [](const World& w, int body) {
+            Check3(w, body);
+            return Eigen::VectorXd(w.state3(body).v);
+          },
+          py::arg("body") = 0, "a copy of the 3D body's q̇ = [ṫ, body ω, γ̇]")
+      .def(
+          "set_state3",
+          [](World& w, int body, const py::object& q, const py::object& qd) {
+            Check3(w, body);
+            const long n = kRigidDofs3 + w.body3(body).num_modes();
+            scene::SetState3FromQ(&w, body, AsVector(q, n, "q"), qd.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(qd, n, "qd"));
+          },
+          py::arg("body"), py::arg("q"), py::arg("qd") = py::none(),
+          "Sets a 3D body's state (InputError for a state that is not finite)")
+      .def(
+          "body3", [](const World& w, int body) {
+            Check3(w, body);
+            return std::const_pointer_cast<BodyModel3>(w.shared_body3(body));
+          },
+          py::arg("body"));
+}
+
+}  // namespace wobble::python

@@ -1,0 +1,71 @@
+"""3D characters with their own meshes from Python (issue 15): loading a mesh object, the
+state convention q = [t, rotation vector, modes], free fall against the closed form, the
+recorder's 3D columns, and errors that name FILE:LINE."""
+import numpy as np
+import pytest
+
+import wobble
+from conftest import DATA, no_ground
+
+G = 9.81
+
+
+@pytest.fixture(scope="module")
+def pot3():
+    return wobble.load_body3(str(DATA / "pot3.obj"), [str(DATA / "pot3_modes.def3")])
+
+
+def test_the_mesh_pot_loads_with_its_mass_and_mesh(pot3):
+    assert pot3.num_q == 6 + 3
+    assert pot3.mode_names == ["squash", "sway", "twist"]
+    assert pot3.total_mass == pytest.approx(750, rel=1e-12)
+    assert pot3.mesh_triangles.shape == (384, 3)
+    # at q = 0 every vertex is where the mesh puts it (the FFD's linear precision)
+    assert np.abs(pot3.mesh_vertices() - pot3.mesh_points).max() < 1e-9 * 200
+
+
+def test_a_turned_state_reads_back_and_moves_the_mesh_rigidly(pot3):
+    world = wobble.World(no_ground("rk4", 0.001))
+    world.add_body3(pot3)
+    q = np.array([5.0, 100.0, -3.0, 0.1, 0.7, -0.2, 0.0, 0.0, 0.0])
+    world.set_state3(0, q)
+    assert world.q3(0) == pytest.approx(q, abs=1e-14)
+    # the mesh at a rigid q: rotated by the rotation vector's turn (Rodrigues) and moved by t
+    r = q[3:6]
+    angle = np.linalg.norm(r)
+    k = r / angle
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+    expected = pot3.mesh_points @ R.T + q[:3]
+    assert np.abs(pot3.mesh_vertices(q) - expected).max() < 1e-9 * 200
+
+
+def test_free_fall_follows_the_parabola_and_is_recorded(pot3):
+    # uniform gravity neither turns nor deforms a body: t_y(t) = y0 + v t - g t²/2 (RK4 is exact)
+    world = wobble.World(no_ground("rk4", 0.01))
+    world.add_body3(pot3)
+    world.set_state3(0, [0, 500, 0, 0.2, 0, 0.1, 0, 0, 0], [1, 20, 0, 0, 0, 0, 0, 0, 0])
+    run = wobble.simulate(world, 2.0, every=10)
+    t = 2.0
+    q = world.q3(0)
+    assert q[1] == pytest.approx(500 + 20 * t - 0.5 * G * t * t, abs=1e-9 * 500)
+    assert q[0] == pytest.approx(t, abs=1e-9 * 500)
+    assert q[3:6] == pytest.approx([0.2, 0, 0.1], abs=1e-12)
+    assert np.all(np.abs(q[6:]) < 1e-12)
+    # the record: t, quaternion and modes; velocities ṫ, body ω and mode rates
+    assert run.q(0).shape == (21, 7 + 3)
+    assert run.qd(0).shape == (21, 6 + 3)
+    assert run.column("ty")[-1] == pytest.approx(q[1], abs=1e-12)
+    assert np.allclose(np.linalg.norm(run.q(0)[:, 3:7], axis=1), 1.0, atol=1e-14)
+
+
+def test_errors_name_the_file_and_line(tmp_path):
+    with pytest.raises(wobble.InputError, match="2D object file"):
+        wobble.load_body3(str(DATA / "table.obj"))
+    bad = tmp_path / "bad3.obj"
+    bad.write_text("dimension 3\n# a mesh that is not there\nmesh missing.stl\nsample volume 10 1\n")
+    with pytest.raises(wobble.ParseError, match=r"bad3.obj:3: mesh: .*missing.stl"):
+        wobble.load_body3(str(bad))
+    world = wobble.World()
+    with pytest.raises(wobble.InputError, match="not a 3D FFD body"):
+        world.q3(0)
