@@ -15,6 +15,7 @@
 
 #include "pipelines/mesh_io.h"
 #include "pipelines/world_sources.h"
+#include "support/pipelines_test_util.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/parse_error.h"
 #include "wobble/record/trajectory.h"
@@ -22,6 +23,7 @@
 namespace wobble::pipelines {
 namespace {
 
+using testing::Source;
 using Vec3 = Eigen::Vector3d;
 const std::string kData = WOBBLE_DATA_DIR;
 
@@ -123,14 +125,6 @@ World MovingPot() {
   w.SetState3(0, Vec3(10, 40, -5), Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Vec3(1, 2, -1).normalized())),
               Eigen::Vector3d(0.3, -0.2, 0.15), v);
   return w;
-}
-
-template <class S> vtkSmartPointer<S> Source(const World& w) {
-  auto s = vtkSmartPointer<S>::New();
-  s->SetWorld(&w);
-  s->SetBody(0);
-  s->Update();
-  return s;
 }
 
 // Eq. 4.1/4.2 at a body-frame point: the deformed control points L + Σ γ_d d^d weighted at

@@ -20,16 +20,9 @@ namespace wobble::pipelines {
 namespace {
 
 using testing::AirborneWorld;
+using testing::Source;
 using testing::IndependentWorldPoint;
 using testing::TouchingWorld;
-
-template <class S> vtkSmartPointer<S> Source(const World& w) {
-  auto s = vtkSmartPointer<S>::New();
-  s->SetWorld(&w);
-  s->SetBody(0);
-  s->Update();
-  return s;
-}
 
 Eigen::Vector2d Point(vtkPolyData* pd, vtkIdType i) {
   double p[3];

@@ -10,6 +10,9 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "wobble/analysis/conditioning.h"
+#include "wobble/core/errors.h"
+
 namespace wobble::python {
 
 namespace py = pybind11;
@@ -29,6 +32,18 @@ void BindRender(py::module_& m);   // pictures and exports through pipelines/ (r
 // A C-contiguous float64 array of `rows` x `cols` (cols < 0: a vector of `rows`), or
 // InputError naming `what` and the shape expected.
 py::array_t<double, py::array::c_style> AsMatrix(const py::handle& a, long rows, long cols, const std::string& what);
+// What `wobble simulate` does with a loaded mode set, for load_body and load_body3: a set that
+// cannot be simulated is an InputError naming the object file; warnings become Python's.
+template <class Body> void CheckLoadedModeSet(const Body& body, const std::string& object) {
+  const analysis::ModeSetReport report = analysis::CheckModeSet(body);
+  if (report.level == analysis::ModeSetReport::Level::kError) {
+    std::string msg = "the modes of " + object + " cannot be simulated:";
+    for (const std::string& line : report.messages) msg += "\n  " + line;
+    throw InputError(msg + "\n(wobble condition check explains the mode set)");
+  }
+  for (const std::string& line : report.messages) PyErr_WarnEx(PyExc_UserWarning, line.c_str(), 1);
+}
+
 // The same for a vector of n numbers, copied.
 Eigen::VectorXd AsVector(const py::handle& h, long n, const std::string& what);
 

@@ -25,16 +25,7 @@ std::shared_ptr<BodyModel> LoadBody(const std::string& object, const std::vector
   o.Load(object);
   o.LoadModes(modes);
   std::shared_ptr<const BodyModel> body = o.Body();
-  if (check) {
-    const analysis::ModeSetReport report = analysis::CheckModeSet(*body);
-    if (report.level == analysis::ModeSetReport::Level::kError) {
-      std::string msg = "the modes of " + object + " cannot be simulated:";
-      for (const std::string& line : report.messages) msg += "\n  " + line;
-      throw InputError(msg + "\n(wobble condition check explains the mode set)");
-    }
-    for (const std::string& line : report.messages)
-      PyErr_WarnEx(PyExc_UserWarning, line.c_str(), 1);
-  }
+  if (check) CheckLoadedModeSet(*body, object);
   return std::const_pointer_cast<BodyModel>(body);
 }
 

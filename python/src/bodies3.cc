@@ -26,14 +26,7 @@ std::shared_ptr<BodyModel3> LoadBody3(const std::string& object, const std::vect
   if (o.dim() != 3) throw InputError(object + ": a 2D object file (use wobble.load_body)");
   o.LoadModes(modes);
   std::shared_ptr<const BodyModel3> body = o.Body3();
-  if (check) {
-    const analysis::ModeSetReport report = analysis::CheckModeSet(*body);
-    if (report.level == analysis::ModeSetReport::Level::kError) {
-      std::string msg = "the modes of " + object + " cannot be simulated:";
-      for (const std::string& line : report.messages) msg += "\n  " + line;
-      throw InputError(msg + "\n(wobble condition check explains the mode set)");
-    }
-  }
+  if (check) CheckLoadedModeSet(*body, object);
   return std::const_pointer_cast<BodyModel3>(body);
 }
 

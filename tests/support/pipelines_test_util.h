@@ -11,6 +11,8 @@
 #include <memory>
 #include <string>
 
+#include <vtkSmartPointer.h>
+
 #include "wobble/world/world.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
@@ -21,6 +23,15 @@ inline std::shared_ptr<const BodyModel> Table() {
   static auto body = std::make_shared<const BodyModel>(formats::ReadObjectFile(std::string(WOBBLE_DATA_DIR) + "/table.obj"),
                                                        formats::ReadDeformationFile(std::string(WOBBLE_DATA_DIR) + "/table_modes.def"));
   return body;
+}
+
+// A source of body 0 of `w`, updated.
+template <class S> vtkSmartPointer<S> Source(const World& w) {
+  auto s = vtkSmartPointer<S>::New();
+  s->SetWorld(&w);
+  s->SetBody(0);
+  s->Update();
+  return s;
 }
 
 inline Eigen::VectorXd Vec(std::initializer_list<double> v) {
