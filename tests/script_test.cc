@@ -440,5 +440,18 @@ TEST(Script3d, PlacementTurnsAboutZAndPoseGraphsKeepTheMomentum) {
   }
 }
 
+TEST(Script3d, A3dObjectJoinsAWitkinWelchSceneNailedAndAttached) {
+  // the 3D table hung by the centre of its top, a linear box attached to one foot: the nail
+  // holds (the multiplier step with feedback), and both fall only as the constraints allow
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  Run3d(interp, "set dt 1e-3\nffd t\npoint p t 0.5 1 0.5\npoint foot t 0 0 0\nnail n1 p\n"
+                "linear b 3d affine box 20 20 20 at 0 -40 0\npoint bc b 0 0 0\nattach a1 foot bc\nsimul 0.5\n", false);
+  const Eigen::VectorXd p = interp.scene().Point("p");
+  EXPECT_LT((p - Eigen::Vector3d(150, 100, 100)).norm(), 1e-3);
+  EXPECT_LT((interp.scene().Point("foot") - interp.scene().Point("bc")).norm(), 0.5);  // pulled together from 40 apart
+  EXPECT_LT(interp.scene().Point("bc")[1], 0.0);  // the box hangs below the table's foot
+}
+
 }  // namespace
 }  // namespace wobble
