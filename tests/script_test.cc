@@ -428,7 +428,7 @@ TEST(Script3d, PlacementTurnsAboutZAndPoseGraphsKeepTheMomentum) {
   EXPECT_GT(interp.control_energy(), 0.0);  // the PD forces' work is counted in 3D too
   EXPECT_LT((centre(q) - c0).norm(), 1e-9 * c0.norm());
   // 2D-only commands refuse a 3D object by name and line
-  for (const char* line : {"key 0", "spring 0.5 0.5 0 0", "keyframe", "anneal 5", "save x.wob"}) {
+  for (const char* line : {"key 0", "keyframe", "anneal 5", "save x.wob"}) {
     std::istringstream in(line);
     try {
       interp.RunStream(in, "three.wob", kData);
@@ -451,6 +451,29 @@ TEST(Script3d, A3dObjectJoinsAWitkinWelchSceneNailedAndAttached) {
   EXPECT_LT((p - Eigen::Vector3d(150, 100, 100)).norm(), 1e-3);
   EXPECT_LT((interp.scene().Point("foot") - interp.scene().Point("bc")).norm(), 0.5);  // pulled together from 40 apart
   EXPECT_LT(interp.scene().Point("bc")[1], 0.0);  // the box hangs below the table's foot
+}
+
+TEST(Script3d, ASpringAtTheCentreOfMassOscillatesWithItsPeriod) {
+  // no gravity, no ground, no modes: a spring from the centre of mass to the world point where
+  // the centre rests pulls it back as x(t) = A cos(√(k/m) t), and never turns the body
+  const BodyModel3 body(formats::ReadObjectFile3(kData + "/table3.obj"), {});
+  const double m = body.moments().m, k = 5e4, A = 12.0;
+  const Eigen::Vector3d c = body.moments().c0 / m, u = body.lattice().LocalCoords(c);
+  const double omega = std::sqrt(k / m), period = 2 * M_PI / omega, t = 0.75 * period;
+  std::ostringstream lines;
+  lines.precision(17);
+  lines << "set gravity F\nset ground F\nset integrator rk4\nset dt 1e-4\nset_vec q " << A << " 0 0 0 0 0\n"
+        << "spring " << u.x() << " " << u.y() << " " << u.z() << " " << c.x() << " " << c.y() << " " << c.z() << " " << k
+        << "\nsimul " << t << "\n";
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  Run3d(interp, lines.str(), false);
+  const Eigen::VectorXd q = interp.q();
+  EXPECT_NEAR(q[0], A * std::cos(omega * interp.time()), 1e-7 * A);
+  EXPECT_LT(q.segment<3>(1).norm() + q.segment<3>(3).norm(), 1e-9);
+  // the script's 3D spring has the 2D form's errors
+  std::istringstream bad("spring 0.5 0.5 2 0 0 0\n");
+  EXPECT_THROW(interp.RunStream(bad, "three.wob", kData), formats::ParseError);
 }
 
 }  // namespace

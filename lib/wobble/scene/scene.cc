@@ -62,6 +62,11 @@ WorldOptions Scene::ObjectWorldOptions3() const {
   WorldOptions o = options_;
   o.ground_3d = GroundPlaneOf(options_.params.ground);
   o.gravity_3d = Eigen::Vector3d(options_.params.gravity.x(), options_.params.gravity.y(), 0.0);
+  o.springs_3d.clear();
+  if (springs_.enabled && object_.dim() == 3)
+    for (const LatticeSpring3& sp : springs_.list3)
+      o.springs_3d.push_back(MakeSpring3(*object_.Body3(), sp.lattice_coords, sp.anchor, sp.stiffness, sp.damping,
+                                         sp.rest_length));
   return o;
 }
 
@@ -191,8 +196,6 @@ void Scene::BeginObjectRun(RunKind kind, bool keep_steps) {
   std::unique_ptr<World> w;
   if (object_.dim() == 3) {
     // the 3D object stands on the plane of the ground line (GroundPlaneOf), under the same gravity
-    if (springs_.enabled && !springs_.list.empty())
-      throw std::invalid_argument("springs hold 2D objects only so far ('clear springs' first)");
     if (kind == RunKind::kKeyframes) throw std::invalid_argument("keyframes drive 2D objects only so far");
     w = std::make_unique<World>(ObjectWorldOptions3());
     w->AddBody(object_.Body3());

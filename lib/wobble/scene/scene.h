@@ -56,9 +56,17 @@ struct ObjectControl {
   control::HeldPoint hold;     // held in place while keyframing
 };
 
-// The FFD object's springs (Fig. 4.4): each from a lattice point to a world point.
+// A 3D object's spring as a script gives it: the body's b0 and B are filled in for each run.
+struct LatticeSpring3 {
+  Eigen::Vector3d lattice_coords = Eigen::Vector3d::Constant(0.5), anchor = Eigen::Vector3d::Zero();
+  double stiffness = 0.0, damping = 0.0, rest_length = 0.0;
+};
+
+// The FFD object's springs (Fig. 4.4): each from a lattice point to a world point; `list` for a
+// 2D object, `list3` for a 3D one.
 struct ObjectSprings {
   std::vector<Spring> list;
+  std::vector<LatticeSpring3> list3;
   bool enabled = true;
 };
 
@@ -134,8 +142,8 @@ class Scene {
   const control::ControlEnergy& control_energy() const { return energy_; }
   // options() with the springs (when enabled) on `body`: the world of the object's runs.
   WorldOptions ObjectWorldOptions(const BodyModel& body) const;
-  // The world of a 3D object's runs: options() with the ground line's plane (GroundPlaneOf)
-  // and gravity in the x-y plane; no springs (they hold 2D objects only so far).
+  // The world of a 3D object's runs: options() with the ground line's plane (GroundPlaneOf),
+  // gravity in the x-y plane and the object's 3D springs (when enabled).
   WorldOptions ObjectWorldOptions3() const;
   SimulationSetup CurrentSetup() const;
 

@@ -234,9 +234,25 @@ void Keyframe(State& s, const Words& w, const Context& ctx) {
   s.out << "]\n";
 }
 
+// `spring S T U X Y Z [K C REST]` for a 3D object: the same spring with a third coordinate.
+void Spring3Command(State& s, const Words& w, const Context& ctx) {
+  if (w.size() < 7 || w.size() > 10) ctx.Fail("expected 'spring S T U X Y Z [K [C [REST]]]' for a 3D object");
+  scene::LatticeSpring3 sp;
+  sp.lattice_coords = {Number(w[1], "S", ctx), Number(w[2], "T", ctx), Number(w[3], "U", ctx)};
+  if (sp.lattice_coords.minCoeff() < 0 || sp.lattice_coords.maxCoeff() > 1)
+    ctx.Fail("expected lattice coordinates S, T and U in [0, 1]");
+  sp.anchor = {Number(w[4], "X", ctx), Number(w[5], "Y", ctx), Number(w[6], "Z", ctx)};
+  sp.stiffness = w.size() > 7 ? Number(w[7], "K", ctx) : s.spring_stiffness;
+  sp.damping = w.size() > 8 ? Number(w[8], "C", ctx) : s.spring_damping;
+  sp.rest_length = w.size() > 9 ? Number(w[9], "REST", ctx) : 0.0;
+  if (sp.stiffness < 0 || sp.damping < 0 || sp.rest_length < 0) ctx.Fail("expected non-negative K, C and REST");
+  s.scene.springs().list3.push_back(sp);
+}
+
 void SpringCommand(State& s, const Words& w, const Context& ctx) {
+  RequireObject(s, ctx, "spring");
+  if (s.scene.object().dim() == 3) return Spring3Command(s, w, ctx);
   ctx.ExpectWords(w, 5, 8);
-  Require2dObject(s, ctx, "spring");
   Spring sp;
   sp.lattice_coords = {Number(w[1], "S", ctx), Number(w[2], "T", ctx)};
   if (sp.lattice_coords.minCoeff() < 0 || sp.lattice_coords.maxCoeff() > 1)
@@ -253,7 +269,7 @@ void Clear(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 2, 2);
   if (w[1] == "poses") s.scene.control().graph = {};
   else if (w[1] == "keys") s.scene.control().keys = {};
-  else if (w[1] == "springs") s.scene.springs().list.clear();
+  else if (w[1] == "springs") s.scene.springs() = {};
   else if (w[1] == "output") s.output_runs.clear();
   else if (w[1] == "energy") s.scene.control_energy() = {};
   else if (w[1] == "track") s.track.clear();

@@ -81,8 +81,10 @@ struct WorldOptions {
   // the ground, springs and max_condition of the FFD bodies.
   WorldParams params;
   Eigen::Vector3d gravity_3d = Eigen::Vector3d(0.0, -9.81, 0.0);
-  // The ground plane of the 3D FFD bodies (off by default; springs of 3D bodies: not yet).
+  // The ground plane of the 3D FFD bodies (off by default) and their springs to world
+  // anchors (each made for its body by MakeSpring3; they act on every 3D FFD body).
   GroundPlane ground_3d;
+  std::vector<Spring3> springs_3d;
   // The FFD bodies' integrator while no constraint is enabled.
   Integrator integrator = Integrator::kThesis;
   double dt = 0.01;

@@ -61,6 +61,7 @@ WorldParams3 World::Params3() const {
   p.gravity_on = options_.params.gravity_on;
   p.gravity = options_.gravity_3d;
   p.ground = options_.ground_3d;
+  p.springs = options_.springs_3d;
   p.max_condition = options_.params.max_condition;
   return p;
 }
@@ -120,6 +121,12 @@ Energies World::Ffd3Energies(int body) const {
   for (const Contact3<double>& c : s.contacts) {
     const Eigen::Vector3d x = frame.t + frame.R * LocalPosition3<double>(m.rest_local(c.point), m.mode_matrix(c.point), s.gamma);
     out.ground += 0.5 * options_.ground_3d.stiffness * (x - c.anchor).squaredNorm();
+  }
+  // springs: ½ K (|x − anchor| − L)², the potential of step3.h's force
+  for (const Spring3& sp : options_.springs_3d) {
+    const Eigen::Vector3d x = frame.t + frame.R * LocalPosition3<double>(sp.rest_local, sp.mode_matrix, s.gamma);
+    const double stretch = (x - sp.anchor).norm() - sp.rest_length;
+    out.springs += 0.5 * sp.stiffness * stretch * stretch;
   }
   return out;
 }
