@@ -428,7 +428,7 @@ TEST(Script3d, PlacementTurnsAboutZAndPoseGraphsKeepTheMomentum) {
   EXPECT_GT(interp.control_energy(), 0.0);  // the PD forces' work is counted in 3D too
   EXPECT_LT((centre(q) - c0).norm(), 1e-9 * c0.norm());
   // 2D-only commands refuse a 3D object by name and line
-  for (const char* line : {"key 0", "keyframe", "anneal 5", "save x.wob"}) {
+  for (const char* line : {"anneal 5", "cmaes 5", "save x.wob"}) {
     std::istringstream in(line);
     try {
       interp.RunStream(in, "three.wob", kData);
@@ -474,6 +474,36 @@ TEST(Script3d, ASpringAtTheCentreOfMassOscillatesWithItsPeriod) {
   // the script's 3D spring has the 2D form's errors
   std::istringstream bad("spring 0.5 0.5 2 0 0 0\n");
   EXPECT_THROW(interp.RunStream(bad, "three.wob", kData), formats::ParseError);
+}
+
+TEST(Script3d, KeyframesHoldAPointAndHandOverContinuously) {
+  // the 3D table keyframed from rest with its foot (0, 0, 0) held: the foot stays where it was,
+  // the amplitudes reach the last key, and the hand-over carries the last segment's slope
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  Run3d(interp, "set gravity F\nset ground F\nset dt 1e-3\nset_vec q 10 20 30 0.1 0.4 -0.2 0 0 0 0\nhold 0 0 0\n"
+                "key 0\nkey 0.3 bend=0.2 twist=-0.1\nkey 0.5 bend=0.3 twist=0.1\n");
+  const BodyDef3 def = formats::ReadObjectFile3(kData + "/table3.obj");
+  const BodyModel3 body(def, formats::ReadDeformationFile3(kData + "/table3_modes.def3", def.lattice));
+  auto foot = [&](const Eigen::VectorXd& q) {
+    const Eigen::Vector3d r = q.segment<3>(3);
+    const Eigen::Quaterniond R(Eigen::AngleAxisd(r.norm(), r.normalized()));
+    Eigen::Vector3d b0;
+    Mat3D<double> B;
+    body.LocalBasis(Eigen::Vector3d::Zero(), &b0, &B);
+    return Eigen::Vector3d(q.head<3>() + R * (b0 + B * q.tail(4)));
+  };
+  const Eigen::Vector3d foot0 = foot(interp.q());
+  std::istringstream run("keyframe\n");
+  interp.RunStream(run, "three.wob", kData);
+  const Eigen::VectorXd q = interp.q(), qd = interp.qd();
+  EXPECT_NEAR(interp.time(), 0.5, 1e-12);
+  EXPECT_LT((foot(q) - foot0).norm(), 1e-9 * foot0.norm());
+  EXPECT_NEAR(q[6 + 0], 0.3, 1e-12);   // bend
+  EXPECT_NEAR(q[6 + 3], 0.1, 1e-12);   // twist
+  EXPECT_NEAR(qd[6 + 0], 0.1 / 0.2, 1e-12);  // the slopes of the last segment
+  EXPECT_NEAR(qd[6 + 3], 0.2 / 0.2, 1e-12);
+  EXPECT_LT((q.segment<3>(3) - Eigen::Vector3d(0.1, 0.4, -0.2)).norm(), 1e-12);  // the orientation kept
 }
 
 }  // namespace

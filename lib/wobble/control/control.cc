@@ -169,4 +169,23 @@ void KeyframedState(const BodyModel& body, const HeldPoint& hold, const Eigen::V
   qd->head<2>() = -R * (B * gamma_dot);
 }
 
+void KeyframedState3(const BodyModel3& body, const HeldPoint& hold, const Eigen::Vector3d& anchor,
+                     const Eigen::Vector3d& translation, const Eigen::Quaterniond& orientation,
+                     const Eigen::VectorXd& gamma, const Eigen::VectorXd& gamma_dot, Eigen::Vector3d* t,
+                     Eigen::VectorXd* v) {
+  const int D = body.num_modes();
+  v->setZero(kRigidDofs3 + D);
+  v->tail(D) = gamma_dot;
+  if (!hold.enabled) {
+    *t = translation;
+    return;
+  }
+  // x_p = t + R (b0 + B γ) = anchor fixes t; with ω = 0, ṫ = −R B γ̇
+  Eigen::Vector3d b0;
+  Mat3D<double> B;
+  body.LocalBasis(hold.lattice_coords3, &b0, &B);
+  *t = anchor - orientation * (b0 + B * gamma);
+  v->head<3>() = -(orientation * (B * gamma_dot));
+}
+
 }  // namespace wobble::control

@@ -145,7 +145,8 @@ struct Keyframes {
 // the object deforms this point remains in place", e.g. a foot on the ground).
 struct HeldPoint {
   bool enabled = false;
-  Eigen::Vector2d lattice_coords = Eigen::Vector2d(0.0, 0.0);  // (s, t)
+  Eigen::Vector2d lattice_coords = Eigen::Vector2d(0.0, 0.0);    // (s, t) of a 2D body
+  Eigen::Vector3d lattice_coords3 = Eigen::Vector3d(0.0, 0.0, 0.0);  // (s, t, u) of a 3D body
 };
 
 // The full state of a keyframed body at amplitudes γ, γ̇ with θ kept at `theta`: when a point is
@@ -154,6 +155,13 @@ struct HeldPoint {
 void KeyframedState(const BodyModel& body, const HeldPoint& hold, const Eigen::Vector2d& anchor,
                     const Eigen::Vector2d& translation, double theta, const Eigen::VectorXd& gamma,
                     const Eigen::VectorXd& gamma_dot, Eigen::VectorXd* q, Eigen::VectorXd* qd);
+
+// The same for a 3D body, its orientation R kept: t = anchor − R (b0 + B γ), ṫ = −R B γ̇, ω = 0;
+// v = [ṫ, ω, γ̇].
+void KeyframedState3(const BodyModel3& body, const HeldPoint& hold, const Eigen::Vector3d& anchor,
+                     const Eigen::Vector3d& translation, const Eigen::Quaterniond& orientation,
+                     const Eigen::VectorXd& gamma, const Eigen::VectorXd& gamma_dot, Eigen::Vector3d* t,
+                     Eigen::VectorXd* v);
 
 // World position of a point given by lattice coordinates at state q.
 Eigen::Vector2d PointAt(const BodyModel& body, const Eigen::Vector2d& lattice_coords, const Eigen::VectorXd& q);

@@ -43,6 +43,23 @@ void PoseGraphController::BeforeStep(World& world) {
 
 KeyframeController::KeyframeController(World& world, int body, Keyframes keys, HeldPoint hold)
     : body_(body), keys_(std::move(keys)), hold_(hold), dt_(world.options().dt) {
+  if (world.kind(body) == BodyKind::kFfd3) {  // the same on a 3D body: its orientation is kept
+    const BodyModel3& model = world.body3(body);
+    const std::string invalid = keys_.Validate(model.num_modes());
+    if (!invalid.empty()) throw std::invalid_argument("keyframe: " + invalid);
+    const BodyState3<double>& s = world.state3(body);
+    translation3_ = s.t;
+    orientation_ = s.orientation;
+    if (hold_.enabled) {
+      Eigen::Vector3d b0;
+      Mat3D<double> B;
+      model.LocalBasis(hold_.lattice_coords3, &b0, &B);
+      anchor3_ = s.t + s.orientation * (b0 + B * s.gamma);
+    }
+    world.SetKinematic(body, true);
+    Place(world, 0.0);
+    return;
+  }
   const BodyModel& model = world.body(body);
   const std::string invalid = keys_.Validate(model.num_modes());
   if (!invalid.empty()) throw std::invalid_argument("keyframe: " + invalid);
@@ -67,6 +84,12 @@ void KeyframeController::AfterStep(World& world) {
 void KeyframeController::Place(World& world, double t) const {
   Eigen::VectorXd gamma, gamma_dot, q, qd;
   keys_.Evaluate(t, &gamma, &gamma_dot);
+  if (world.kind(body_) == BodyKind::kFfd3) {
+    Eigen::Vector3d translation;
+    KeyframedState3(world.body3(body_), hold_, anchor3_, translation3_, orientation_, gamma, gamma_dot, &translation, &qd);
+    world.SetState3(body_, translation, orientation_, gamma, qd);
+    return;
+  }
   KeyframedState(world.body(body_), hold_, anchor_, translation_, theta_, gamma, gamma_dot, &q, &qd);
   world.SetState(body_, q, qd);
 }

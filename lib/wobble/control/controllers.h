@@ -64,6 +64,9 @@ class KeyframeController : public Controller {
   double dt_;
   Eigen::Vector2d anchor_, translation_;
   double theta_;
+  // a 3D body's: the held point's place, the translation and the orientation kept
+  Eigen::Vector3d anchor3_ = Eigen::Vector3d::Zero(), translation3_ = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation_ = Eigen::Quaterniond::Identity();
   long steps_ = 0;
 };
 

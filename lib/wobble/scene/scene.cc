@@ -196,7 +196,6 @@ void Scene::BeginObjectRun(RunKind kind, bool keep_steps) {
   std::unique_ptr<World> w;
   if (object_.dim() == 3) {
     // the 3D object stands on the plane of the ground line (GroundPlaneOf), under the same gravity
-    if (kind == RunKind::kKeyframes) throw std::invalid_argument("keyframes drive 2D objects only so far");
     w = std::make_unique<World>(ObjectWorldOptions3());
     w->AddBody(object_.Body3());
     SetState3FromQ(w.get(), 0, object_.q(), object_.qd());

@@ -17,7 +17,7 @@ const std::vector<Command>& CommandTable() {
       {"simul", "simul [DURATION]", "simulate from `time` to `end` (or for DURATION)", Simul},
       {"pose", "pose T1 .. Tk DURATION", "append a pose: one target per active mode, held for DURATION", Pose},
       {"key", "key TIME MODE=VALUE ...", "a keyframe at TIME (from the start of the keyframed run)", Key},
-      {"hold", "hold S T | hold off", "hold the point at lattice coordinates (S, T) in place while keyframing", Hold},
+      {"hold", "hold S T | hold off", "hold the point at lattice coordinates (S, T) in place while keyframing (3D: hold S T U)", Hold},
       {"keyframe", "keyframe", "play the keys from the current state, then hand over to simulation", Keyframe},
       {"spring", "spring S T X Y [K [C [REST]]]",
        "a spring from lattice point (S, T) to the world point (X, Y); a 3D object's: spring S T U X Y Z [K [C [REST]]]",

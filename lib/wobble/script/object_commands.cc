@@ -184,14 +184,15 @@ void Pose(State& s, const Words& w, const Context& ctx) {
 }
 
 void Key(State& s, const Words& w, const Context& ctx) {
-  Require2dObject(s, ctx, "key");
+  RequireObject(s, ctx, "key");
   if (w.size() < 2) ctx.Fail("expected '" + ctx.usage + "'");
   control::Keyframes& keys = s.scene.control().keys;
   const double t = Number(w[1], "TIME", ctx);
   if (keys.times.empty() && t != 0.0) ctx.Fail("the first key must be at time 0");
   if (!keys.times.empty() && !(t > keys.times.back())) ctx.Fail("expected a key time after " + Num(keys.times.back()) + ", got " + w[1]);
   const Eigen::VectorXd& q = s.scene.object().q();
-  Eigen::VectorXd a = keys.amplitudes.empty() ? Eigen::VectorXd(q.tail(q.size() - kRigidDofs)) : keys.amplitudes.back();
+  const int D = s.scene.object().num_modes();
+  Eigen::VectorXd a = keys.amplitudes.empty() ? Eigen::VectorXd(q.tail(D)) : keys.amplitudes.back();
   for (size_t i = 2; i < w.size(); ++i) {
     const size_t eq = w[i].find('=');
     if (eq == std::string::npos || eq == 0) ctx.Fail("expected MODE=VALUE, got '" + w[i] + "'");
@@ -207,6 +208,14 @@ void Hold(State& s, const Words& w, const Context& ctx) {
     hold.enabled = false;
     return;
   }
+  if (s.scene.object().dim() == 3) {  // hold S T U
+    if (w.size() != 4) ctx.Fail("expected 'hold S T U' or 'hold off' for a 3D object");
+    const Eigen::Vector3d st(Number(w[1], "S", ctx), Number(w[2], "T", ctx), Number(w[3], "U", ctx));
+    if (st.minCoeff() < 0 || st.maxCoeff() > 1) ctx.Fail("expected lattice coordinates S, T and U in [0, 1]");
+    hold.enabled = true;
+    hold.lattice_coords3 = st;
+    return;
+  }
   ctx.ExpectWords(w, 3, 3);
   const double u = Number(w[1], "S", ctx), v = Number(w[2], "T", ctx);
   if (u < 0 || u > 1 || v < 0 || v > 1) ctx.Fail("expected lattice coordinates S and T in [0, 1]");
@@ -216,7 +225,7 @@ void Hold(State& s, const Words& w, const Context& ctx) {
 
 void Keyframe(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 1, 1);
-  Require2dObject(s, ctx, "keyframe");
+  RequireObject(s, ctx, "keyframe");
   scene::RunReport r;
   try {
     r = s.scene.Keyframe(StepObserver(s, true));
