@@ -24,6 +24,8 @@
 #include "pipelines/charts.h"
 #include "pipelines/energy_charts.h"
 #include "pipelines/exports.h"
+#include "pipelines/mesh_io.h"
+#include "wobble/formats/deformation_file.h"
 #include "pipelines/scene_view.h"
 #include "wobble/body/linear_shapes.h"
 #include "support/pipelines_test_util.h"
@@ -97,6 +99,29 @@ TEST(RenderRegression, FullSceneWithOverlayAndColourBar) {
   view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-50, -150), Eigen::Vector2d(350, 150)));
   view.Render();
   CompareWithBaseline("full_scene", view.Capture());
+}
+
+// A 3D character with its own mesh (issue 15): the pot deformed (squash, sway, twist) and
+// turned above the ground plane, with its lattice and mass points, in perspective.
+TEST(RenderRegression, MeshCharacter3d) {
+  REQUIRE_DISPLAY();
+  BodyDef3 def = ReadObject3(std::string(WOBBLE_DATA_DIR) + "/pot3.obj");
+  std::vector<DeformationMode3> modes = formats::ReadDeformationFile3(std::string(WOBBLE_DATA_DIR) + "/pot3_modes.def3", def.lattice);
+  WorldOptions options;
+  options.ground_3d.enabled = true;
+  World world(options);
+  world.AddBody(std::make_shared<const BodyModel3>(std::move(def), std::move(modes)));
+  world.SetState3(0, Eigen::Vector3d(0, 40, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 0, 0.5).normalized())),
+                  Eigen::Vector3d(-0.3, 0.4, 0.5), Eigen::VectorXd::Zero(9));
+  SceneOptions o;
+  o.width = 240;
+  o.height = 180;
+  o.overlay = false;
+  o.elevation = 25;
+  SceneView view(&world, o);
+  view.FrameBounds(SceneBounds(world));
+  view.Render();
+  CompareWithBaseline("mesh_character_3d", view.Capture());
 }
 
 TEST(RenderRegression, EnergyChart) {
