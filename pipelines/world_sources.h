@@ -26,8 +26,9 @@
 //                    Linear: a LinearDrawing (SetDrawing: polylines and, in 3D, a triangle
 //                    surface) carried by x = R p(u).
 //   3D FFD bodies (world_sources_ffd3.cc): the lattice with lines along its three axes; the
-//                    mass points (mass, velocity, applied_force = gravity, in_contact); the
-//                    shape: the object's mesh as triangles with every vertex moved by the FFD
+//                    mass points (mass, velocity, in_contact,
+//                    applied_force: gravity plus the ground plane's force on points in
+//                    contact); the shape: the object's mesh as triangles with every vertex moved by the FFD
 //                    (point array displacement = B γ, body frame) and its polylines resampled.
 //   TrailSource      (FFD bodies) trajectories of chosen points (lattice coordinates): call
 //                    Record() after each frame; polylines with a point array time

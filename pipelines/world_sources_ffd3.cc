@@ -110,17 +110,28 @@ bool MassPointSource::DrawFfd3(vtkPolyData* out) {
   for (const Contact3<double>& c : s.contacts) contact->SetValue(c.point, 1);
   auto verts = Ptr<vtkCellArray>::New();
   const Eigen::Vector3d v_t = s.v.head<3>(), omega = s.v.segment<3>(3);
-  for (vtkIdType k = 0; k < n; ++k) {
-    const auto B = body.mode_matrix(int(k));
-    const Eigen::Vector3d l = body.rest_local(int(k)) + B * s.gamma;
-    const Eigen::Vector3d x = s.t + R * l;
+  const size_t count = size_t(n);
+  std::vector<Eigen::Vector3d> x(count), v(count), f(count);
+  for (int k = 0; k < n; ++k) {
+    const auto B = body.mode_matrix(k);
+    const Eigen::Vector3d l = body.rest_local(k) + B * s.gamma;
+    x[size_t(k)] = s.t + R * l;
     // ẋ = ṫ + R (ω × l + B γ̇): J v of kinematics3.h, body-frame ω
-    const Eigen::Vector3d v = v_t + R * (omega.cross(l) + B * s.v.tail(D));
-    const Eigen::Vector3d f = o.params.gravity_on ? Eigen::Vector3d(body.mass(int(k)) * o.gravity_3d) : Eigen::Vector3d::Zero();
-    points->SetPoint(k, x.data());
+    v[size_t(k)] = v_t + R * (omega.cross(l) + B * s.v.tail(D));
+    f[size_t(k)] = o.params.gravity_on ? Eigen::Vector3d(body.mass(k) * o.gravity_3d) : Eigen::Vector3d::Zero();
+  }
+  // the ground's penalty and capped friction on every point tied to it (§4.9, step3.h)
+  if (o.ground_3d.enabled)
+    for (const Contact3<double>& c : s.contacts) {
+      bool slipping;
+      const size_t k = size_t(c.point);
+      f[k] += GroundForce3<double>(o.ground_3d, x[k], v[k], c.anchor, &slipping);
+    }
+  for (vtkIdType k = 0; k < n; ++k) {
+    points->SetPoint(k, x[size_t(k)].data());
     mass->SetValue(k, body.mass(int(k)));
-    velocity->SetTuple(k, v.data());
-    force->SetTuple(k, f.data());  // gravity; the 3D ground's force is not drawn yet
+    velocity->SetTuple(k, v[size_t(k)].data());
+    force->SetTuple(k, f[size_t(k)].data());
     verts->InsertNextCell(1, &k);
   }
   out->SetPoints(points);

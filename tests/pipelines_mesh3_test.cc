@@ -16,6 +16,7 @@
 #include "pipelines/mesh_io.h"
 #include "pipelines/world_sources.h"
 #include "support/pipelines_test_util.h"
+#include "wobble/dynamics/step3.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/parse_error.h"
 #include "wobble/record/trajectory.h"
@@ -187,6 +188,38 @@ TEST(Mesh3Sources, LatticeAndMassPointsOfA3dBody) {
     scale = std::max(scale, fd.norm());
   }
   EXPECT_LT(worst, 1e-6 * scale);
+}
+
+TEST(Mesh3Sources, AppliedForcesSumToTheGeneralizedForcesTranslationRows) {
+  // the pot pressed into the ground plane and sliding: Σ_k f_k over the mass points (gravity
+  // plus each contact's penalty and capped friction) is the translation rows of Q, since
+  // J_t = 1 for every point (EvaluateForces3, the step's own forces, frozen at the contacts)
+  BodyDef3 def = ReadObject3(kData + "/pot3.obj");
+  WorldOptions options;
+  options.ground_3d.enabled = true;
+  World w(options);
+  w.AddBody(std::make_shared<const BodyModel3>(std::move(def), std::vector<DeformationMode3>()));
+  w.SetState3(0, Vec3(0, -2, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Vec3::UnitX())), Eigen::VectorXd(),
+              (Eigen::VectorXd(6) << 30, -5, 10, 0, 0.4, 0).finished());
+  ASSERT_TRUE(w.Step());
+  ASSERT_GT(w.state3(0).contacts.size(), 10u);
+  const auto points = Source<MassPointSource>(w);
+  vtkDataArray* applied = points->GetOutput()->GetPointData()->GetArray("applied_force");
+  Vec3 sum = Vec3::Zero();
+  for (vtkIdType k = 0; k < applied->GetNumberOfTuples(); ++k) {
+    Vec3 f;
+    applied->GetTuple(k, f.data());
+    sum += f;
+  }
+  const BodyState3<double>& s = w.state3(0);
+  WorldParams3 params;
+  params.gravity = options.gravity_3d;
+  params.ground = options.ground_3d;
+  ForceBreakdown3<double> Q;
+  EvaluateForces3(w.body3(0), params, s, Frame3<double>(s.t, s.orientation), ShapeMoments3<double>(w.body3(0).moments(), s.gamma),
+                  &Q, ContactSet::kFrozen);
+  const Vec3 expected = (Q.gravity + Q.ground).head<3>();
+  EXPECT_LT((sum - expected).norm(), 1e-9 * expected.norm()) << sum.transpose() << " vs " << expected.transpose();
 }
 
 TEST(Mesh3Record, A3dBodyRecordsAndRestoresExactly) {
