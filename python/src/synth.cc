@@ -35,9 +35,7 @@ Eigen::MatrixXd PosesOf(const PoseGraph& g) {
 }
 
 int NumActive(const Problem& p) {
-  int active = 0;
-  for (const DeformationMode& d : p.body->modes()) active += d.active;
-  return active;
+  return int(p.body3 ? control::ActiveModes(*p.body3).size() : control::ActiveModes(*p.body).size());
 }
 
 struct TrialResults {

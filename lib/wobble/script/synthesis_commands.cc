@@ -74,10 +74,14 @@ synth::Problem StartOptimising(State& s) {
 }  // namespace
 
 synth::Problem MakeProblem(const State& s, long steps) {
-  if (s.scene.object().dim() == 3) throw InputError("gait synthesis works on 2D objects only so far");
   synth::Problem p;
-  p.body = s.scene.object().Body();
-  p.world = s.scene.ObjectWorldOptions(*p.body);
+  if (s.scene.object().dim() == 3) {
+    p.body3 = s.scene.object().Body3();
+    p.world = s.scene.ObjectWorldOptions3();
+  } else {
+    p.body = s.scene.object().Body();
+    p.world = s.scene.ObjectWorldOptions(*p.body);
+  }
   p.q0 = s.scene.object().q();
   p.qd0 = s.scene.object().qd();
   p.steps = steps;
@@ -87,7 +91,7 @@ synth::Problem MakeProblem(const State& s, long steps) {
 
 void Anneal(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 2, 2);
-  Require2dObject(s, ctx, "anneal");
+  RequireObject(s, ctx, "anneal");
   const int iterations = Count(w, "ITERATIONS", ctx);
   if (s.scene.control().graph.empty()) ctx.Fail("anneal needs an initial pose graph: 'pose ...' lines first");
   synth::AnnealOptions o = s.anneal_options;
@@ -104,7 +108,7 @@ void Anneal(State& s, const Words& w, const Context& ctx) {
 
 void Cmaes(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 2, 2);
-  Require2dObject(s, ctx, "cmaes");
+  RequireObject(s, ctx, "cmaes");
   const int generations = Count(w, "GENERATIONS", ctx);
   if (s.scene.control().graph.empty()) ctx.Fail("cmaes needs an initial pose graph: 'pose ...' lines first");
 #ifdef WOBBLE_HAVE_PAGMO
@@ -135,13 +139,15 @@ void Cmaes(State& s, const Words& w, const Context& ctx) {
 
 void Gait(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 3, 3);
-  Require2dObject(s, ctx, "gait");
+  RequireObject(s, ctx, "gait");
   int skip, cycles;
   if (!formats::detail::ParseInt(w[1], &skip) || skip < 0 || !formats::detail::ParseInt(w[2], &cycles) || cycles < 1)
     ctx.Fail("expected 'gait SKIP CYCLES' with SKIP >= 0 and CYCLES >= 1 whole numbers");
   const control::PoseGraph& graph = s.scene.control().graph;
   if (graph.empty() || !graph.cyclic) ctx.Fail("gait needs a cyclic pose graph: 'pose ...' lines first");
-  const std::string invalid = graph.Validate(int(control::ActiveModes(*s.scene.object().Body()).size()));
+  int active = 0;
+  for (int d = 0; d < s.scene.object().num_modes(); ++d) active += s.scene.object().mode_active(d) ? 1 : 0;
+  const std::string invalid = graph.Validate(active);
   if (!invalid.empty()) ctx.Fail("pose graph: " + invalid);
   CheckedCount((double(skip) + double(cycles)) * graph.Period() / s.scene.options().dt, 0, s.scene.limits().max_steps,
                "gait's run (SKIP + CYCLES periods, in steps)", "raise it with `set max_steps N`");

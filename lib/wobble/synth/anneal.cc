@@ -3,6 +3,7 @@
 #include "wobble/control/controllers.h"
 #include "wobble/core/interrupt.h"
 #include "wobble/core/parallel.h"
+#include "wobble/scene/ffd_object.h"
 
 #include <algorithm>
 #include <cmath>
@@ -76,6 +77,17 @@ void CenterOfMassX(const BodyModel& body, const Eigen::VectorXd& q, const Eigen:
   *v = vel.x();
 }
 
+void CenterOfMassX(const World& world, double* x, double* v) {
+  if (world.kind(0) == BodyKind::kFfd) return CenterOfMassX(world.body(0), world.state(0).q, world.state(0).qd, x, v);
+  const MassMoments3& mm = world.body3(0).moments();
+  const BodyState3<double>& s = world.state3(0);
+  const int D = int(s.gamma.size());
+  const Eigen::Vector3d l = (mm.c0 + mm.C * s.gamma) / mm.m;
+  const Eigen::Vector3d vel = s.v.head<3>() + s.orientation * (s.v.segment<3>(3).cross(l) + mm.C * s.v.tail(D) / mm.m);
+  *x = (s.t + s.orientation * l).x();
+  *v = vel.x();
+}
+
 TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
                       const std::function<void(const World&)>& on_step) {
   TrialOutcome out;
@@ -86,8 +98,15 @@ TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
     return out;
   }
   World world(p.world);
-  world.AddBody(p.body);
-  world.SetState(0, p.q0, p.qd0);
+  if (p.body3) {
+    world.AddBody(p.body3);
+    scene::SetState3FromQ(&world, 0, p.q0, p.qd0);
+  } else {
+    world.AddBody(p.body);
+    world.SetState(0, p.q0, p.qd0);
+  }
+  double x0, v0;
+  CenterOfMassX(world, &x0, &v0);
   if (!graph.empty()) {  // the pose graph picks the targets of every step (chapter 5)
     try {
       world.AddController(std::make_shared<control::PoseGraphController>(world, 0, graph));
@@ -105,13 +124,13 @@ TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
       out.cost = p.cost.high;
       return out;
     }
-    energy.Accumulate(*p.body, world.state(0), dt);
+    if (p.body3) energy.Accumulate(*p.body3, world.state3(0), dt);
+    else energy.Accumulate(*p.body, world.state(0), dt);
     if (on_step) on_step(world);
   }
   out.ok = true;
-  double x0, v0, x1, v1;
-  CenterOfMassX(*p.body, p.q0, p.qd0, &x0, &v0);
-  CenterOfMassX(*p.body, world.state(0).q, world.state(0).qd, &x1, &v1);
+  double x1, v1;
+  CenterOfMassX(world, &x1, &v1);
   out.distance = x1 - x0;
   out.speed = v1;
   out.energy = energy.consumed;
@@ -226,7 +245,7 @@ std::vector<double> DistancePerCycle(const Problem& problem, const control::Pose
   RunTrial(p, graph, [&](const World& w) {
     if (next_cycle <= skip + cycles && w.time() + 0.5 * dt >= next_cycle * period) {
       double x, v;
-      CenterOfMassX(*p.body, w.state(0).q, w.state(0).qd, &x, &v);
+      CenterOfMassX(w, &x, &v);
       marks.push_back(x);
       ++next_cycle;
     }

@@ -53,6 +53,9 @@ double EvaluateCost(const CostFunction& cost, const TrialOutcome& outcome);
 // length and the cost.
 struct Problem {
   std::shared_ptr<const BodyModel> body;
+  // A 3D body instead (issue 15): q0 and qd0 then follow the scripts' convention, q = (t,
+  // rotation vector, γ) and q̇ = (ṫ, body ω, γ̇); the travel is measured along world x all the same.
+  std::shared_ptr<const BodyModel3> body3;
   WorldOptions world;
   Eigen::VectorXd q0, qd0;
   long steps = 1200;  // forward simulation per trial (thesis: 1200 steps of 0.01)
@@ -66,6 +69,9 @@ struct Problem {
 // x position and velocity of the body's centre of mass: m x_c = m t + R (c0 + C γ), from the
 // mass moments, so its velocity is ṫ + R S (c0 + Cγ) θ̇ / m + R C γ̇ / m.
 void CenterOfMassX(const BodyModel& body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double* x, double* v);
+// The same for body 0 of a world, 2D or 3D (3D: m x_c = m t + R (c0 + C γ), its velocity
+// ṫ + R (ω × (c0 + Cγ) + C γ̇) / m with ω in the body frame).
+void CenterOfMassX(const World& world, double* x, double* v);
 
 // Simulates one controller from the problem's start state. Calls on_step(world) after every
 // step when given (replays, gait measurements).
