@@ -428,7 +428,7 @@ TEST(Script3d, PlacementTurnsAboutZAndPoseGraphsKeepTheMomentum) {
   EXPECT_GT(interp.control_energy(), 0.0);  // the PD forces' work is counted in 3D too
   EXPECT_LT((centre(q) - c0).norm(), 1e-9 * c0.norm());
   // 2D-only commands refuse a 3D object by name and line
-  for (const char* line : {"anneal 5", "cmaes 5", "save x.wob"}) {
+  for (const char* line : {"save x.wob"}) {
     std::istringstream in(line);
     try {
       interp.RunStream(in, "three.wob", kData);
