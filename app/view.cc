@@ -11,6 +11,7 @@
 #include "pipelines/exports.h"
 #include "wobble/formats/atomic_file.h"
 #include "pipelines/interactive_view.h"
+#include "pipelines/mesh_io.h"
 #include "pipelines/scene_view.h"
 #include "wobble/script/interpreter.h"
 
@@ -171,10 +172,13 @@ int RunView(const ViewArgs& a) {
     // read and checked here (file, line, sizes), then loaded into the scene as a script would
     const StartingWorld start = LoadStartingWorld(files, a.q, a.qdot, a.world, ParseIntegratorFlag(a.integrator), a.dt);
     object_scene.options() = start.options;
-    object_scene.object().Load(files.object);
+    object_scene.object().Load(files.object, pl::ReadSurfaceMesh);
     object_scene.object().LoadModes(files.modes);
     object_scene.object().SetState(start.q0, start.qd0);
   }
+  // a 3D object is viewed as a scene of one body: the camera orbits ([ and ]), a drag pulls a
+  // mass point (the character session's sliders and charts are 2D only so far)
+  if (!scene->has_bodies() && scene->object().dim() == 3) scene->AddObjectBody(scene->object().Body3()->name());
   if (!a.save_session.empty() && scene->has_bodies())
     throw UsageError("--save-session: sessions are saved for FFD objects, not for scenes");
 

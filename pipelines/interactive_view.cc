@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include <vtkActor.h>
+#include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkImageData.h>
 #include <vtkPoints.h>
@@ -31,7 +32,12 @@ namespace {
 constexpr double kPickRadius = 30.0;  // pixels
 
 int NumMassPoints(const World& w, int b) {
-  return w.kind(b) == BodyKind::kLinear ? w.linear_model(b).num_points() : w.body(b).num_points();
+  switch (w.kind(b)) {
+    case BodyKind::kLinear: return w.linear_model(b).num_points();
+    case BodyKind::kFfd3: return w.body3(b).num_points();
+    case BodyKind::kFfd: break;
+  }
+  return w.body(b).num_points();
 }
 
 }  // namespace
@@ -127,7 +133,7 @@ InteractiveView::InteractiveView(scene::Scene& scene, ViewerOptions options) : i
   if (!scene.has_bodies() && !scene.object().loaded())
     throw std::invalid_argument("InteractiveView: the scene has no bodies and no FFD object");
   if (!scene.has_bodies() && scene.object().dim() == 3)
-    throw std::invalid_argument("wobble view shows 2D characters only so far; render a 3D object with wobble render");
+    throw std::invalid_argument("InteractiveView: a 3D object is viewed as a scene body (Scene::AddObjectBody first)");
   Impl& m = *impl_;
   m.self = this;
   m.scene = &scene;
@@ -263,6 +269,10 @@ bool InteractiveView::HandleKey(const std::string& k) {
   else if (k == "p") ToggleLayer(SceneLayer::kSprings);
   else if (k == "a") ToggleLayer(SceneLayer::kAnchors);
   else if (k == "c") m.FrameScene();
+  else if ((k == "[" || k == "]") && !IsFlat(*m.world)) {  // orbit the 3D camera about its focal point
+    m.view->renderer()->GetActiveCamera()->Azimuth(k == "[" ? -15.0 : 15.0);
+    m.view->renderer()->ResetCameraClippingRange();
+  }
   else if (c && k == "r") Restart();
   else if (c && k == "0") {
     for (int d = 0; d < m.slider_targets.size(); ++d) SetModeTarget(d, 0.0);
@@ -282,7 +292,8 @@ bool InteractiveView::HandleKey(const std::string& k) {
     ScrubTo(std::clamp(at + (k == "Left" ? -1L : 1L), 0L, last));
   } else if (k == "h") {
     std::cout << "wobble view keys: space play/pause, n step, +/- speed, s shapes, l lattice (control boxes), "
-                 "m mass points, g ground, p springs and constraints, a named points, c recentre, q quit"
+                 "m mass points, g ground, p springs and constraints, a named points, c recentre, [ ] orbit (3D), "
+                 "q quit"
               << (c ? "; r restart, 0 targets to zero, k record pose, w write session, Left/Right scrub" : "")
               << "; the left mouse button pulls a point\n"
               << std::flush;
