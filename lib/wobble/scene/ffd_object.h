@@ -37,8 +37,10 @@ class FfdObject {
   // rate of a mode whose name was loaded before carry over, the others start at 0. Throws
   // std::invalid_argument when the modes do not fit the object's lattice.
   void LoadModes(const std::vector<std::string>& paths);
-  // The modes of a 2D object (empty for a 3D one: use the accessors below for either).
+  // The modes as loaded and assigned, codamA not added: a 2D object's, a 3D object's (the other
+  // is empty); the accessors below serve either.
   const std::vector<DeformationMode>& modes() const { return modes_; }
+  const std::vector<DeformationMode3>& modes3() const { return modes3_; }
   int num_modes() const { return def3_ ? int(modes3_.size()) : int(modes_.size()); }
   const std::string& mode_name(int mode) const { return def3_ ? modes3_.at(mode).name : modes_.at(mode).name; }
   bool mode_active(int mode) const { return def3_ ? modes3_.at(mode).active : modes_.at(mode).active; }

@@ -26,8 +26,8 @@ ScriptSetup SessionSetup(const SessionRecord& r) {
   ScriptSetup setup;
   setup.object_path = r.object_path;
   setup.mode_paths = r.mode_paths;
-  setup.modes = r.body->modes();
-  for (DeformationMode& m : setup.modes) m.active = true;
+  setup.modes = ModeSettings(r.body->modes());
+  for (ModeSetting& m : setup.modes) m.active = true;
   setup.world = r.world;
   setup.springs = r.world.params.springs;
   setup.q = r.q0;
@@ -63,6 +63,12 @@ void WriteSetup(std::ostream& s, const ScriptSetup& r) {
   for (const Spring& sp : r.springs)
     s << "spring " << Num(sp.lattice_coords.x()) << " " << Num(sp.lattice_coords.y()) << " " << Num(sp.anchor.x()) << " "
       << Num(sp.anchor.y()) << " " << Num(sp.stiffness) << " " << Num(sp.damping) << " " << Num(sp.rest_length) << "\n";
+  for (const LatticeSpring3& sp : r.springs3) {
+    s << "spring";
+    for (int a = 0; a < 3; ++a) s << " " << Num(sp.lattice_coords[a]);
+    for (int a = 0; a < 3; ++a) s << " " << Num(sp.anchor[a]);
+    s << " " << Num(sp.stiffness) << " " << Num(sp.damping) << " " << Num(sp.rest_length) << "\n";
+  }
   s << "trans 0 0 0\n";
   Vector(s, "q", r.q);
   Vector(s, "dq", r.qd);

@@ -17,6 +17,7 @@
 #include "wobble/body/body_model.h"
 #include "wobble/control/control.h"
 #include "wobble/control/controllers.h"
+#include "wobble/scene/scene.h"
 #include "wobble/world/world.h"
 
 namespace wobble::scene {
@@ -24,15 +25,27 @@ namespace wobble::scene {
 // What WriteSetup writes: `load_obj`, `load_def`, `set codamA`, `assign` and `mode` of every
 // mode, the world's parameters, the springs (`set spring`, `clear springs`, `spring`), the
 // state (`trans 0 0 0`, `set_vec`), and `clear poses`.
+// What `assign` and `mode` set of one mode (2D or 3D).
+struct ModeSetting {
+  double stiffness = 0.0, damping = 0.0;
+  bool active = false;
+};
+template <int Dim> std::vector<ModeSetting> ModeSettings(const std::vector<DeformationModeN<Dim>>& modes) {
+  std::vector<ModeSetting> out;
+  for (const DeformationModeN<Dim>& m : modes) out.push_back({m.stiffness, m.damping, m.active});
+  return out;
+}
+
 struct ScriptSetup {
   std::string object_path;              // as load_obj takes it (absolute is safest)
   std::vector<std::string> mode_paths;  // as load_def takes them, in order
-  std::vector<DeformationMode> modes;   // K, c and active flag of each, in load order
+  std::vector<ModeSetting> modes;       // K, c and active flag of each, in load order
   double codam_active = 0.0;
   WorldOptions world;                   // ground, gravity, integrator, dt
   bool springs_on = true;
   std::vector<Spring> springs;
-  Eigen::VectorXd q, qd;                // world coordinates
+  std::vector<LatticeSpring3> springs3;  // a 3D object's
+  Eigen::VectorXd q, qd;                // world coordinates (3D: t, rotation vector, γ | ṫ, ω, γ̇)
 };
 void WriteSetup(std::ostream& s, const ScriptSetup& setup);
 // `set cyclic`, `set switch_width` and one `pose` line per pose.

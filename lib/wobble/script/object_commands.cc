@@ -58,11 +58,6 @@ void RequireObject(const State& s, const Context& ctx, const std::string& comman
     ctx.Fail(command + " needs an object: 'load_obj FILE' first (or run with --object FILE)");
 }
 
-void Require2dObject(const State& s, const Context& ctx, const std::string& command) {
-  RequireObject(s, ctx, command);
-  if (s.scene.object().dim() == 3)
-    ctx.Fail(command + " works on 2D objects only so far (this object file is 3D: 'dimension 3')");
-}
 
 scene::StepCallback StepObserver(State& s, bool object) {
   if (!s.progress && !(object && s.debug)) return nullptr;

@@ -168,17 +168,17 @@ synth::Problem SynthesisProblem(const State& s) {
 }
 
 std::string ReplayScript(const State& s) {
-  if (s.scene.object().dim() == 3) throw InputError("replay scripts are written for 2D objects only so far");
   const scene::Scene& sc = s.scene;
   const scene::FfdObject& object = sc.object();
   scene::ScriptSetup setup;
   setup.object_path = object.path();
   setup.mode_paths = object.mode_paths();
-  setup.modes = object.modes();
+  setup.modes = object.dim() == 3 ? scene::ModeSettings(object.modes3()) : scene::ModeSettings(object.modes());
   setup.codam_active = object.codam_active();
   setup.world = sc.options();
   setup.springs_on = sc.springs().enabled;
   setup.springs = sc.springs().list;
+  setup.springs3 = sc.springs().list3;
   // after an anneal: from the state its trials started from, for one trial's length (the
   // motion the cost judged); otherwise from the current state over the current span
   const bool annealed = s.anneal_start_q.size() > 0;
@@ -190,7 +190,7 @@ std::string ReplayScript(const State& s) {
 
 void Save(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 2, 2);
-  Require2dObject(s, ctx, "save");
+  RequireObject(s, ctx, "save");
   try {
     formats::CheckWritable(w[1]);
   } catch (const std::runtime_error& e) {

@@ -97,8 +97,6 @@ const std::vector<Parameter>& ParameterTable();
 // ---- handlers ----
 // "COMMAND needs an object" unless the FFD object is loaded.
 void RequireObject(const State& s, const Context& ctx, const std::string& command);
-// The same, for commands that do not know 3D objects yet (a clear refusal, not a wrong answer).
-void Require2dObject(const State& s, const Context& ctx, const std::string& command);
 // What a run reports after its steps: the progress every 64 steps and, for the FFD object's
 // runs with `set debug T`, q after every step. Null when neither is wanted.
 scene::StepCallback StepObserver(State& s, bool object);
