@@ -117,7 +117,6 @@ int Scene::AddObjectBody(const std::string& name) {
   World& w = world();
   int b = 0;
   if (object_.dim() == 3) {
-    w.mutable_options().ground_3d = ObjectWorldOptions3().ground_3d;
     b = w.AddBody(object_.Body3());
     SetState3FromQ(&w, b, object_.q(), object_.qd());
   } else {
@@ -184,6 +183,8 @@ void Scene::BeginRun(RunKind kind, bool keep_steps) {
   o.dt = options_.dt;
   o.params.gravity_on = options_.params.gravity_on;
   o.params.ground = options_.params.ground;
+  o.ground_3d = ObjectWorldOptions3().ground_3d;  // 3D bodies stand on the same ground, set now
+  o.gravity_3d = ObjectWorldOptions3().gravity_3d;
   if (record_fps_ > 0 && recorded_->num_bodies() != w.num_bodies()) Record(record_fps_);
   if (recorder_) recorder_->Start(w);
   run_ = std::make_unique<Run>();
