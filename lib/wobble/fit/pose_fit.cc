@@ -31,11 +31,11 @@ bool ParseLoss(const std::string& text, Loss* loss) {
   return false;
 }
 
-std::string ValidateOptions(const PoseFitOptions& o, int num_modes) {
+std::string ValidateOptions(const PoseFitOptions& o, int num_modes, int num_rigid) {
   auto finite = [](double v) { return std::isfinite(v); };
-  if (o.initial_q.size() != 0 && o.initial_q.size() != kRigidDofs + num_modes)
+  if (o.initial_q.size() != 0 && o.initial_q.size() != num_rigid + num_modes)
     return "initial q has " + std::to_string(o.initial_q.size()) + " numbers, the body has " +
-           std::to_string(kRigidDofs + num_modes) + " coordinates";
+           std::to_string(num_rigid + num_modes) + " coordinates";
   for (int i = 0; i < o.initial_q.size(); ++i)
     if (!finite(o.initial_q[i])) return "initial q is not finite";
   if (!o.mode_lower.empty() && int(o.mode_lower.size()) != num_modes) return "mode_lower needs one bound per mode";
@@ -47,6 +47,8 @@ std::string ValidateOptions(const PoseFitOptions& o, int num_modes) {
   if (o.max_iterations < 1) return "max iterations must be >= 1";
   if (o.samples_per_segment < 0) return "samples per segment must be >= 0";
   if (o.max_rounds < 1) return "max rounds must be >= 1";
+  if (o.max_mesh_samples < 0) return "max mesh samples must be >= 0";
+  if (o.max_reverse_points < 1) return "max reverse points must be >= 1";
   return "";
 }
 

@@ -57,13 +57,17 @@ struct PoseFitOptions {
   // Curve fits: find the nearest segments inside every residual evaluation (one solve per
   // start) instead of alternating closest-point rounds and solves.
   bool joint_closest_points = true;
+  // 3D surface fits: at most this many of the body mesh's vertices join the mass points as
+  // body samples (evenly spread over the vertex list).
+  int max_mesh_samples = 400;
   // Compute PoseFitResult::conditioning (an SVD of the data Jacobian at the solution).
   bool analyze_conditioning = true;
   // Called after every Ceres iteration with its number and cost (progress display).
   std::function<void(int iteration, double cost)> on_iteration;
 };
-// Empty when valid, otherwise what is wrong (for a body with `num_modes` modes).
-std::string ValidateOptions(const PoseFitOptions& options, int num_modes);
+// Empty when valid, otherwise what is wrong (for a body with `num_modes` modes and
+// `num_rigid` rigid coordinates: 3 in 2D, 6 in 3D).
+std::string ValidateOptions(const PoseFitOptions& options, int num_modes, int num_rigid = kRigidDofs);
 
 // How well the data terms (not the prior, not the bounds) determine q at the solution, from
 // the SVD of their Jacobian J. Coordinates have different units (length, radians,

@@ -113,9 +113,6 @@ void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
 Conditioning ComputeConditioning(const BodyModel& body, const std::vector<SegmentResidual>& data,
                                  const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o,
                                  const Eigen::VectorXd& q_in) {
-  const int n = body.num_q();
-  const std::vector<std::string> names = CoordinateNames(body);
-  Conditioning c;
   // the Jacobian of the data terms alone (the prior would hide what the data cannot see)
   Eigen::VectorXd q = q_in;
   ceres::Problem problem;
@@ -123,12 +120,21 @@ Conditioning ComputeConditioning(const BodyModel& body, const std::vector<Segmen
   data_only.prior_weight = 0;
   ceres::Problem::EvaluateOptions eval;
   eval.residual_blocks = AddPoseTerms(body, data, reverse, data_only, q.data(), &problem);
+  return ConditioningOfJacobian(DataJacobian(&problem, eval), CoordinateNames(body), kRigidDofs);
+}
+
+Eigen::MatrixXd DataJacobian(ceres::Problem* problem, const ceres::Problem::EvaluateOptions& eval) {
   ceres::CRSMatrix crs;
-  problem.Evaluate(eval, nullptr, nullptr, nullptr, &crs);
+  problem->Evaluate(eval, nullptr, nullptr, nullptr, &crs);
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
   for (int r = 0; r < crs.num_rows; ++r)
     for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) J(r, crs.cols[k]) = crs.values[k];
+  return J;
+}
 
+Conditioning ConditioningOfJacobian(Eigen::MatrixXd J, const std::vector<std::string>& names, int num_rigid) {
+  const int n = int(J.cols());
+  Conditioning c;
   if (!J.allFinite()) throw NumericalStop("the fit's Jacobian at its result is not finite: no conditioning to report");
   // J / max|J|: the condition numbers do not change, and the SVD never squares a 1e160 (a
   // target that far overflowed inside JacobiSVD, which then crashed on the NaN)
@@ -189,8 +195,7 @@ Conditioning ComputeConditioning(const BodyModel& body, const std::vector<Segmen
             [](const WeakDirection& a, const WeakDirection& b) { return a.relative_singular_value < b.relative_singular_value; });
   if (scale > 0)
     for (double& norm : c.column_norms) norm *= scale;  // reported as the columns of J itself
-  for (int d = 0; d < body.num_modes(); ++d) {
-    const int i = kRigidDofs + d;
+  for (int i = num_rigid; i < n; ++i) {
     if (undetermined[i]) {
       c.undetermined.push_back(names[i]);
     } else if (poor[i]) {

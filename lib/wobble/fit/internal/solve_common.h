@@ -69,4 +69,11 @@ Conditioning ComputeConditioning(const BodyModel& body, const std::vector<Segmen
                                  const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o,
                                  const Eigen::VectorXd& q);
 
+// The Jacobian of the residual blocks eval names, dense (a pose has a handful of unknowns).
+Eigen::MatrixXd DataJacobian(ceres::Problem* problem, const ceres::Problem::EvaluateOptions& eval);
+
+// The conditioning analysis of a data Jacobian J whose columns are the coordinates `names`,
+// the first `num_rigid` of them rigid (the rest modes), for 2D and 3D fits alike.
+Conditioning ConditioningOfJacobian(Eigen::MatrixXd J, const std::vector<std::string>& names, int num_rigid);
+
 }  // namespace wobble::fit

@@ -1,0 +1,108 @@
+// Fits of a 3D FFD body: q = [tx ty tz, rx ry rz, γ1..γD] with r the rotation vector of the
+// orientation R (the turn by |r| about r, as `--q` of the 3D CLI) and
+//     x(q) = t + R (b0 + B γ)                                   (Eq. 4.2, in 3D)
+// for every body point.
+//
+//   FitPose3                 with correspondences: mass points or lattice points (s, t, u)
+//                            and where each should be.
+//   FitPoseToSurface3        without correspondences: the target is a triangle mesh and/or an
+//                            unordered point cloud (e.g. a scan); every body sample is pulled
+//                            to the nearest target triangle or point.
+//   FitKinematicTrajectory3  frames of correspondences → q(t), one sparse problem with a
+//                            smoothness term (trajectory_fit.h in 3D).
+//
+// The orientation lives on SO(3): every solve writes R = R0 exp(δ̂) with R0 the start and δ
+// a body-frame rotation vector that starts at 0, so there is no Euler-angle singularity and
+// no unit-norm constraint; δ stays small in a local fit, and a solve whose δ grew past
+// kRecentreAngle is restarted from its result (R0 ← R0 exp(δ̂)). The objective, options,
+// report and conditioning are those of the 2D fits (pose_fit.h); the conditioning's
+// coordinates are tx ty tz, rx ry rz (body-frame turns, radians) and the modes.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <string>
+#include <vector>
+
+#include "wobble/body/body_model.h"
+#include "wobble/fit/pose_fit.h"
+#include "wobble/fit/trajectory_fit.h"
+
+namespace wobble::fit {
+
+struct Correspondence3 {
+  int mass_point = -1;                                       // >= 0: this mass point
+  Eigen::Vector3d lattice_coords = Eigen::Vector3d::Zero();  // (s, t, u), used when mass_point < 0
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();        // world
+  double weight = 1.0;                                       // > 0
+};
+
+struct ReferenceFrame3 {
+  double time = 0.0;
+  std::vector<Correspondence3> points;
+};
+
+// A target without correspondences: triangles (a surface) and unordered points.
+struct SurfaceTarget3 {
+  std::vector<Eigen::Vector3d> points;             // the mesh's vertices, then cloud points
+  std::vector<std::array<int, 3>> triangles;       // indices into points
+  std::vector<int> cloud;                          // points that belong to no triangle
+  void AddMesh(const SurfaceMesh& mesh);
+  void AddPoint(const Eigen::Vector3d& p);
+  bool empty() const { return triangles.empty() && cloud.empty(); }
+};
+
+struct PointBasis3 {
+  Eigen::Vector3d b0 = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, 3, Eigen::Dynamic> B;
+};
+// Mass point k, or the body point at lattice coordinates (s, t, u) when k < 0.
+PointBasis3 BasisOf3(const BodyModel3& body, int mass_point, const Eigen::Vector3d& lattice_coords);
+// World position of a body point at q = [t, r, γ] (r a rotation vector), in plain doubles.
+Eigen::Vector3d PointPosition3(const PointBasis3& p, const Eigen::VectorXd& q);
+
+// tx ty tz rx ry rz, then the mode names.
+std::vector<std::string> CoordinateNames3(const BodyModel3& body);
+
+// A local solve turns by at most this much (radians) before it is re-centred.
+constexpr double kRecentreAngle = 1.0;
+
+// With correspondences. Without options.initial_q the start is the best rigid placement of
+// the rest shape onto the targets (weighted Kabsch: SVD, no reflection), γ = 0. Throws
+// std::invalid_argument for invalid options, no targets or a mass point the body lacks.
+PoseFitResult FitPose3(const BodyModel3& body, const std::vector<Correspondence3>& targets,
+                       const PoseFitOptions& options);
+
+// Body samples of a surface fit: the mass points (options.use_mass_points) and up to
+// options.max_mesh_samples of the mesh's vertices, evenly spread over its vertex list.
+std::vector<PointBasis3> SurfaceSamples3(const BodyModel3& body, const PoseFitOptions& options);
+
+// Without correspondences: the residual of every body sample is its distance to the nearest
+// target triangle or cloud point, chosen anew at every evaluation (the distance is continuous
+// in q; inside a face it moves the point along the normal, as point-to-plane ICP). Two-sided
+// (options.two_sided): up to options.max_reverse_points target points (evenly spread) are
+// also pulled to the nearest body sample, weighted so that both directions weigh the same.
+// Starts (without options.initial_q): the samples' centroid onto the target's (area-weighted)
+// centroid with the principal axes aligned, in the four proper rotations the axes' signs
+// allow; the lowest final cost wins. point_residuals are those of the body samples.
+PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& target, const PoseFitOptions& options);
+
+// Length scales of the smoothness term, as SmoothnessScales in 2D: 1 for t, the rms radius
+// of the mass points for the rotation, the rms mass point displacement of each mode.
+VecQ3<double> SmoothnessScales3(const BodyModel3& body);
+
+// q(t) for every frame, as FitKinematicTrajectory in 2D. The smoothness of the orientation
+// is the second difference on the group, c2 log(R_fᵀ R_f+1) − c0 log(R_f−1ᵀ R_f) (body-frame
+// turns), that of t and γ the divided second difference; every frame starts from its Kabsch
+// placement (or options.pose.initial_q), γ = 0.
+TrajectoryFitResult FitKinematicTrajectory3(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
+                                            const TrajectoryFitOptions& options);
+
+// Reference frames from recorded 3D states (q = [t, r, γ] rows): the positions of the listed
+// mass points (all when empty) at every `every`-th state.
+std::vector<ReferenceFrame3> FramesFromStates3(const BodyModel3& body, const std::vector<double>& times,
+                                               const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
+                                               int every = 1);
+
+}  // namespace wobble::fit
