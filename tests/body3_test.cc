@@ -275,7 +275,9 @@ TEST(Body3, PlanarMotionReproducesThe2DBody) {
       }
       const std::string what = IntegratorName(integrator) + (ground ? " on the ground" : " in the air");
       EXPECT_LE(worst, 1e-9 * 250.0) << what;  // relative to the body's size
-      if (ground) EXPECT_GT(contacts_seen, 100) << what;
+      if (ground) {
+        EXPECT_GT(contacts_seen, 100) << what;
+      }
       RecordProperty("deviation_" + IntegratorName(integrator) + (ground ? "_ground" : "_air"),
                      Sci(worst) + " after " + std::to_string(contacts_seen) + " contact-steps");
     }

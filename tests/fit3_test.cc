@@ -11,9 +11,11 @@
 
 #include "wobble/body/body_model.h"
 #include "wobble/core/rotation3.h"
+#include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/pose_fit3.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "wobble/world/world.h"
 
 namespace wobble {
 namespace {
@@ -276,6 +278,103 @@ TEST(TrajectoryFit3, SmoothnessOnTheGroupFiltersNoise) {
   const double raw = error(0.0), smoothed = error(100.0), oversmoothed = error(1e4);
   EXPECT_LT(smoothed, 0.6 * raw) << "raw " << raw << ", smoothed " << smoothed;
   EXPECT_GT(oversmoothed, smoothed);  // the term is real: too much of it bends the motion
+}
+
+// ---- dynamic fits: through the simulation (StepBody3 with Jets) ----
+
+// The chair with stiff, lightly damped modes, as the World steps it: vibrating and tumbling
+// in the air. K_d from a mode frequency f_d (γ̈ G_dd = −2K γ: ω² = 2K/G_dd), c_d = 2ζ sqrt(2K G_dd).
+struct Vibrating {
+  Character chair = MakeChair();
+  std::shared_ptr<const BodyModel3> body;
+  Eigen::VectorXd K, c;
+  Vibrating() {
+    const double f[] = {2.0, 3.0, 2.5}, zeta[] = {0.05, 0.1, 0.02};
+    std::vector<DeformationMode3> modes = chair.modes;
+    K.resize(3);
+    c.resize(3);
+    for (int d = 0; d < 3; ++d) {
+      const double G = chair.body.moments().G(d, d), w = 2 * M_PI * f[d];
+      K[d] = 0.5 * G * w * w;
+      c[d] = 2 * zeta[d] * std::sqrt(2 * K[d] * G);
+      modes[size_t(d)].stiffness = K[d];
+      modes[size_t(d)].damping = c[d];
+    }
+    body = std::make_shared<const BodyModel3>(chair.def, modes);
+  }
+};
+
+// Frames of a World run (the world's own mode forces, not the fit's), every `every` steps.
+std::vector<fit::ReferenceFrame3> WorldFrames(const std::shared_ptr<const BodyModel3>& body, const Eigen::VectorXd& q0,
+                                              const Eigen::VectorXd& v0, double dt, int steps, int every) {
+  WorldOptions o;
+  o.dt = dt;
+  o.integrator = Integrator::kThesis;
+  World world(o);
+  const int b = world.AddBody(body);
+  world.SetState3(b, q0.head<3>(), ExpRotation<double>(q0.segment<3>(3)), q0.tail(3), v0);
+  std::vector<fit::ReferenceFrame3> frames;
+  for (int k = 0; k <= steps; ++k) {
+    if (k % every == 0) {
+      const BodyState3<double>& s = world.state3(b);
+      Eigen::VectorXd q(9);
+      q << s.t, LogRotation<double>(s.orientation), s.gamma;
+      fit::ReferenceFrame3 f;
+      f.time = k * dt;
+      for (int i = 0; i < body->num_points(); i += 4) {
+        fit::Correspondence3 p;
+        p.mass_point = i;
+        p.position = fit::PointPosition3(fit::BasisOf3(*body, i, {}), q);
+        f.points.push_back(p);
+      }
+      frames.push_back(f);
+    }
+    if (k < steps && !world.Step()) throw std::runtime_error("the world stopped at step " + std::to_string(k));
+  }
+  return frames;
+}
+
+TEST(DynamicFit3, RecoversStiffnessDampingAndTheStartOfATumblingVibratingBody) {
+  const Vibrating v;
+  Eigen::VectorXd q0(9), v0(9);
+  q0 << 10, 50, -5, 0.3, -0.2, 0.5, 0.2, -0.15, 0.1;
+  v0 << 20, 40, -10, 1.5, -2.0, 3.0, 0, 1.0, -0.5;  // body ω of a few rad/s
+  const double dt = 0.004;
+  const std::vector<fit::ReferenceFrame3> frames = WorldFrames(v.body, q0, v0, dt, 150, 5);
+  fit::DynamicFitOptions o;
+  o.dt = dt;
+  o.world3.gravity_on = true;
+  fit::DynamicParameters start;  // q0 and q̇0 from pose fits of the first two frames
+  start.stiffness = v.K * 1.4;
+  start.damping = v.c * 0.5;
+  const fit::DynamicFitResult r = fit::FitDynamicTrajectory(*v.body, frames, start, o);
+  EXPECT_TRUE(r.report.usable) << r.report.brief_report;
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_NEAR(r.params.stiffness[d] / v.K[d], 1.0, 1e-6) << "mode " << d;
+    EXPECT_NEAR(r.params.damping[d] / v.c[d], 1.0, 1e-5) << "mode " << d;
+  }
+  EXPECT_LT(Compare(r.params.q0, q0).angle, 1e-8);
+  EXPECT_LT(Compare(r.params.q0, q0).translation, 1e-6);
+  EXPECT_LT((r.params.qd0 - v0).cwiseAbs().maxCoeff(), 1e-5);
+  EXPECT_LT(r.rms_residual, 1e-6);
+  // the fitted parameters replay the reference through the fit's own simulation
+  EXPECT_LT(fit::DynamicCost(*v.body, frames, r.params, o), 1e-9);
+}
+
+TEST(DynamicFit3, CostIsTheWorldsRunAtTheTrueParameters) {
+  // the fit's simulation (passive body + Jet-ready mode force) against the World's (the body's
+  // own mode forces): the same motion, so the cost at the truth is zero to rounding
+  const Vibrating v;
+  Eigen::VectorXd q0(9), v0(9);
+  q0 << 0, 0, 0, 2.0, 1.0, -0.5, 0.3, 0.2, -0.1;
+  v0 << 1, 2, 3, -4, 2, 1, 0.5, 0, 0;
+  const std::vector<fit::ReferenceFrame3> frames = WorldFrames(v.body, q0, v0, 0.005, 200, 10);
+  fit::DynamicFitOptions o;
+  o.dt = 0.005;
+  fit::DynamicParameters truth{q0, v0, v.K, v.c, {}};
+  EXPECT_LT(fit::DynamicCost(*v.body, frames, truth, o), 1e-16);
+  truth.stiffness[1] *= 1.01;
+  EXPECT_GT(fit::DynamicCost(*v.body, frames, truth, o), 1e-6);
 }
 
 }  // namespace

@@ -226,7 +226,6 @@ TEST(Mesh3Record, A3dBodyRecordsAndRestoresExactly) {
   World w = MovingPot();
   w.SetModeTargets(0, Eigen::Vector3d(0.1, 0.0, -0.2));
   record::Trajectory run(w);
-  const std::vector<std::string>& cols = run.Columns();
   for (const char* name : {"tx", "tz", "qw", "qz", "squash", "sway", "twist", "dtx", "wx", "wz", "dtwist",
                            "target_twist", "kinetic", "penetration"})
     EXPECT_GE(run.Column(name), 0) << name;

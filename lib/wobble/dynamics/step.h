@@ -51,8 +51,9 @@ struct StepStatus {
 // state being evaluated (every stage of a multi-stage integrator). The World adds none; the
 // dynamic fit (lib/wobble/fit) adds mode and PD-control forces whose gains and targets are
 // Ceres Jets, so that it steps with exactly this code. The default costs nothing (inlined away).
+// The same hook serves the 3D body (step3.h: extra(BodyState3, &Q)).
 struct NoExtraForce {
-  template <class T> void operator()(const BodyState<T>&, VecQ<T>*) const {}
+  template <class State, class Force> void operator()(const State&, Force*) const {}
 };
 
 // q̈ of Eq. 4.21, M q̈ = Q − w, solved about the centre of mass (SolveMassSystem). Fails with

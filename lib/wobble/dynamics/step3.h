@@ -240,9 +240,11 @@ void EvaluateForces3(const BodyModel3& body, const WorldParams3& w, const BodySt
 
 // v̇ of M v̇ = Q − w. Fails with kIllConditioned when the Cholesky pivot ratio (a lower bound
 // of cond₂(M)) exceeds w.max_condition.
-template <class T>
+// `extra` is added to Q (and to forces->total), as in 2D (step.h: NoExtraForce).
+template <class T, class Extra = NoExtraForce>
 StepStatus Accelerations3(const BodyModel3& body, const WorldParams3& w, const BodyState3<T>& s, VecQ3<T>* a,
-                          ForceBreakdown3<T>* forces = nullptr, ContactSet set = ContactSet::kDetect) {
+                          ForceBreakdown3<T>* forces = nullptr, ContactSet set = ContactSet::kDetect,
+                          const Extra& extra = Extra()) {
   ForceBreakdown3<T> local;
   ForceBreakdown3<T>& f = forces ? *forces : local;
   const Frame3<T> frame(s.t, s.orientation);
@@ -250,6 +252,7 @@ StepStatus Accelerations3(const BodyModel3& body, const WorldParams3& w, const B
   VecQ3<T> vel;
   VelocityTerms3(body.moments(), sm, frame.R, s.v, &vel);
   EvaluateForces3(body, w, s, frame, sm, &f, set);
+  extra(s, &f.total);
   MatQ3<T> M;
   MassMatrix3(body.moments(), sm, frame.R, &M);
   if (!CholeskyInPlace(&M)) {
@@ -349,24 +352,28 @@ void KineticGradient3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const 
   }
 }
 
-// Advances one 3D body by dt, then updates its contacts.
-template <class T>
+// Advances one 3D body by dt, then updates its contacts. `extra`: a generalized force added at
+// every force evaluation (NoExtraForce; the dynamic fit's mode forces with Jet gains).
+template <class T, class Extra = NoExtraForce>
 StepStatus StepBody3(const BodyModel3& body, const WorldParams3& w, Integrator integrator, double dt,
-                     BodyState3<T>* s) {
+                     BodyState3<T>* s, const Extra& extra = Extra()) {
   const T h(dt);
   const int D = body.num_modes();
   VecQ3<T> a;
   StepStatus st;
+  auto accelerations = [&](const BodyState3<T>& x, VecQ3<T>* out) {
+    return Accelerations3(body, w, x, out, static_cast<ForceBreakdown3<T>*>(nullptr), ContactSet::kDetect, extra);
+  };
   switch (integrator) {
     case Integrator::kThesis: {
-      if (!(st = Accelerations3(body, w, *s, &a)).ok()) return st;
+      if (!(st = accelerations(*s, &a)).ok()) return st;
       s->v += h * a;
       AdvanceConfiguration3(s->v, h, s);
       break;
     }
     case Integrator::kSymplecticEuler: {
       AdvanceConfiguration3(s->v, h, s);
-      if (!(st = Accelerations3(body, w, *s, &a)).ok()) return st;
+      if (!(st = accelerations(*s, &a)).ok()) return st;
       s->v += h * a;
       break;
     }
@@ -383,7 +390,7 @@ StepStatus StepBody3(const BodyModel3& body, const WorldParams3& w, Integrator i
         x.v = start.v + dv;
         rate[i] = x.v;
         rate[i].template segment<3>(3) = RotationVectorRate<T>(theta, Vec3<T>(x.v.template segment<3>(3)));
-        return Accelerations3(body, w, x, &a);
+        return accelerations(x, &a);
       };
       VecQ3<T> k[4];
       const VecQ3<T> zero = VecQ3<T>::Zero(body.num_q());
@@ -405,7 +412,7 @@ StepStatus StepBody3(const BodyModel3& body, const WorldParams3& w, Integrator i
     }
     case Integrator::kImplicitEuler: {
       const BodyState3<T> start = *s;
-      if (!(st = Accelerations3(body, w, start, &a)).ok()) return st;
+      if (!(st = accelerations(start, &a)).ok()) return st;
       VecQ3<T> v = start.v + h * a;
       for (int pass = 0; pass < 4; ++pass) {  // active set, as in 2D
         st = SolveNewton<T>(
@@ -416,7 +423,7 @@ StepStatus StepBody3(const BodyModel3& body, const WorldParams3& w, Integrator i
               trial.v = x;
               VecQ3<T> acc;
               const StepStatus rs = Accelerations3(body, w, trial, &acc, static_cast<ForceBreakdown3<T>*>(nullptr),
-                                                   ContactSet::kFrozen);
+                                                   ContactSet::kFrozen, extra);
               if (rs.ok()) *r = x - start.v - h * acc;
               return rs;
             },
@@ -446,6 +453,7 @@ StepStatus StepBody3(const BodyModel3& body, const WorldParams3& w, Integrator i
         at.v = xi;
         ForceBreakdown3<T> f;
         EvaluateForces3(body, w, at, frame, sm, &f, ContactSet::kDetect);
+        extra(at, &f.total);
         VecQ3<T> dT;
         KineticGradient3(body.moments(), sm, frame.R, xi, &dT);
         VecQ3<T> mu = M0 * xi;

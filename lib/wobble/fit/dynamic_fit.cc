@@ -10,6 +10,8 @@
 
 #include "wobble/fit/internal/solve_common.h"
 #include "wobble/synth/anneal.h"
+#include "wobble/core/rotation3.h"
+#include "wobble/fit/pose_fit3.h"
 #include "wobble/fit/trajectory_fit.h"
 
 namespace wobble::fit {
@@ -22,10 +24,10 @@ constexpr int kStride = 32;
 
 // The body with its mode potentials switched off: K and c come from the parameters instead
 // (lib/wobble/dynamics reads them from the model as doubles; see ThesisStep).
-BodyModel PassiveCopy(const BodyModel& body) {
-  std::vector<DeformationMode> modes = body.modes();
-  for (DeformationMode& m : modes) m.stiffness = m.damping = 0.0;
-  return BodyModel(body.def(), modes);
+template <int Dim> BodyModelN<Dim> PassiveCopy(const BodyModelN<Dim>& body) {
+  std::vector<DeformationModeN<Dim>> modes = body.modes();
+  for (DeformationModeN<Dim>& m : modes) m.stiffness = m.damping = 0.0;
+  return BodyModelN<Dim>(body.def(), modes);
 }
 
 template <class T> struct ModeParams {
@@ -41,54 +43,162 @@ template <class T> struct ModeForce {
     for (int d = 0; d < p->K.size(); ++d)
       (*Q)[kRigidDofs + d] += -T(2.0) * p->K[d] * (s.q[kRigidDofs + d] - (*target)[d]) - p->c[d] * s.qd[kRigidDofs + d];
   }
+  void operator()(const BodyState3<T>& s, VecQ3<T>* Q) const {
+    for (int d = 0; d < p->K.size(); ++d)
+      (*Q)[kRigidDofs3 + d] += -T(2.0) * p->K[d] * (s.gamma[d] - (*target)[d]) - p->c[d] * s.v[kRigidDofs3 + d];
+  }
 };
 
-// The thesis integrator (Eq. 4.22/4.23), exactly as World runs it: StepBody with the mode forces
-// from `p` and the controller's targets at the start of every step (as the World's pose graph
-// sets them). Calls on_frame(f, q) at every frame step.
-template <class T, class F>
-bool Simulate(const BodyModel& passive, const WorldParams& w, double dt, double width, const VecQ<T>& q0,
-              const VecQ<T>& qd0, const ModeParams<T>& p, const control::PoseGraphOf<T>& control, const std::vector<int>& steps,
-              F&& on_frame) {
-  BodyState<T> s;
-  s.q = q0;
-  s.qd = qd0;
-  UpdateContacts(passive, w.ground, &s);
+// What differs between the dimensions: the state, its step, where a body point is, and how
+// q0 is held as a parameter block. In 3D the block is [t, δ, γ] with the orientation
+// chart · exp(δ̂) (pose_fit3.h), so the solver never meets a rotation-vector singularity.
+template <int Dim> struct Dimension;
+
+template <> struct Dimension<2> {
+  using Body = BodyModel;
+  using Frame = ReferenceFrame;
+  using Target = Correspondence;
+  using Basis = PointBasis;
+  using Vec = Eigen::Vector2d;
+  template <class T> using State = BodyState<T>;
+  static const WorldParams& World(const DynamicFitOptions& o) { return o.world; }
+  static Basis BasisOf(const Body& body, const Target& t) { return SegmentResidual::ToPoint(body, t, "dynamic fit").point; }
+  template <class T> static State<T> Start(const Body& body, const WorldParams& w, const T* q0, const T* qd0,
+                                           const Eigen::Quaterniond&) {
+    State<T> s;
+    s.q = Eigen::Map<const VecQ<T>>(q0, body.num_q());
+    s.qd = Eigen::Map<const VecQ<T>>(qd0, body.num_q());
+    UpdateContacts(body, w.ground, &s);
+    return s;
+  }
+  template <class T, class Extra> static bool Step(const Body& body, const WorldParams& w, double dt, State<T>* s,
+                                                   const Extra& extra) {
+    if (!StepBody(body, w, 0, Integrator::kThesis, dt, s, extra).ok()) return false;
+    for (int i = 0; i < s->q.size(); ++i)
+      if (!std::isfinite(ScalarValue(s->q[i])) || !std::isfinite(ScalarValue(s->qd[i]))) return false;
+    return true;
+  }
+  template <class T> static Vec2<T> Position(const Basis& p, const State<T>& s) {
+    return PointPosition(p, s.q.data(), int(s.q.size()));
+  }
+  static Eigen::VectorXd Q(const State<double>& s) { return s.q; }
+  // q0 as a block, and back
+  static Eigen::Quaterniond Chart(const Eigen::VectorXd&) { return Eigen::Quaterniond::Identity(); }
+  static Eigen::VectorXd ToBlock(const Eigen::VectorXd& q, const Eigen::Quaterniond&) { return q; }
+  static Eigen::VectorXd FromBlock(const Eigen::VectorXd& b, const Eigen::Quaterniond&) { return b; }
+  // a pose fit of one frame, and the velocity between two poses h apart
+  static Eigen::VectorXd FitFrame(const Body& body, const Frame& f, const PoseFitOptions& o) {
+    return FitPose(body, f.points, o).q;
+  }
+  static Eigen::VectorXd Velocity(const Eigen::VectorXd& a, const Eigen::VectorXd& b, double h) { return (b - a) / h; }
+  static VecQ<double> Scales(const Body& body) { return SmoothnessScales(body); }
+};
+
+template <> struct Dimension<3> {
+  using Body = BodyModel3;
+  using Frame = ReferenceFrame3;
+  using Target = Correspondence3;
+  using Basis = PointBasis3;
+  using Vec = Eigen::Vector3d;
+  template <class T> using State = BodyState3<T>;
+  static const WorldParams3& World(const DynamicFitOptions& o) { return o.world3; }
+  static Basis BasisOf(const Body& body, const Target& t) {
+    if (t.mass_point >= body.num_points())
+      throw std::invalid_argument("dynamic fit: mass point " + std::to_string(t.mass_point) + " does not exist");
+    return BasisOf3(body, t.mass_point, t.lattice_coords);
+  }
+  template <class T> static State<T> Start(const Body& body, const WorldParams3& w, const T* q0, const T* qd0,
+                                           const Eigen::Quaterniond& chart) {
+    const int D = body.num_modes();
+    State<T> s = RestState3<T>(body);
+    s.t = Vec3<T>(q0[0], q0[1], q0[2]);
+    s.orientation = (chart.cast<T>() * ExpRotation<T>(Vec3<T>(q0[3], q0[4], q0[5]))).normalized();
+    for (int d = 0; d < D; ++d) s.gamma[d] = q0[kRigidDofs3 + d];
+    s.v = Eigen::Map<const VecQ3<T>>(qd0, body.num_q());
+    UpdateContacts3(body, w.ground, &s);
+    return s;
+  }
+  template <class T, class Extra> static bool Step(const Body& body, const WorldParams3& w, double dt, State<T>* s,
+                                                   const Extra& extra) {
+    return StepBody3(body, w, Integrator::kThesis, dt, s, extra).ok();  // non-finite states fail inside
+  }
+  template <class T> static Vec3<T> Position(const Basis& p, const State<T>& s) {
+    Vec3<T> l = p.b0.cast<T>();
+    for (int d = 0; d < s.gamma.size(); ++d) l += p.B.col(d).cast<T>() * s.gamma[d];
+    return s.t + s.orientation.toRotationMatrix() * l;
+  }
+  static Eigen::VectorXd Q(const State<double>& s) {
+    Eigen::VectorXd q(kRigidDofs3 + s.gamma.size());
+    q << s.t, LogRotation<double>(s.orientation), s.gamma;
+    return q;
+  }
+  static Eigen::Quaterniond Chart(const Eigen::VectorXd& q) { return ExpRotation<double>(q.segment<3>(3)); }
+  static Eigen::VectorXd ToBlock(const Eigen::VectorXd& q, const Eigen::Quaterniond&) {
+    Eigen::VectorXd b = q;
+    b.segment<3>(3).setZero();  // the chart is q's own orientation
+    return b;
+  }
+  static Eigen::VectorXd FromBlock(const Eigen::VectorXd& b, const Eigen::Quaterniond& chart) {
+    Eigen::VectorXd q = b;
+    q.segment<3>(3) = LogRotation<double>(Eigen::Quaterniond(chart * ExpRotation<double>(b.segment<3>(3))));
+    return q;
+  }
+  static Eigen::VectorXd FitFrame(const Body& body, const Frame& f, const PoseFitOptions& o) {
+    return FitPose3(body, f.points, o).q;
+  }
+  // v = [ṫ, body ω, γ̇] with ω = log(R_aᵀ R_b)/h
+  static Eigen::VectorXd Velocity(const Eigen::VectorXd& a, const Eigen::VectorXd& b, double h) {
+    Eigen::VectorXd v = (b - a) / h;
+    v.segment<3>(3) = LogRotation<double>(Eigen::Quaterniond(ExpRotation<double>(a.segment<3>(3)).conjugate() *
+                                                             ExpRotation<double>(b.segment<3>(3)))) / h;
+    return v;
+  }
+  static VecQ3<double> Scales(const Body& body) { return SmoothnessScales3(body); }
+};
+
+// The thesis integrator (Eq. 4.22/4.23), exactly as World runs it: the body's step with the mode
+// forces from `p` and the controller's targets at the start of every step (as the World's pose
+// graph sets them). Calls on_frame(f, state) at every frame step.
+template <int Dim, class T, class F>
+bool Simulate(const BodyModelN<Dim>& passive, const DynamicFitOptions& o, const T* q0, const T* qd0,
+              const Eigen::Quaterniond& chart, const ModeParams<T>& p, const control::PoseGraphOf<T>& control,
+              const std::vector<int>& steps, F&& on_frame) {
+  using Dims = Dimension<Dim>;
+  const auto& w = Dims::World(o);
+  typename Dims::template State<T> s = Dims::template Start<T>(passive, w, q0, qd0, chart);
   VecD<T> target = VecD<T>::Zero(passive.num_modes());
   int step = 0;
   for (size_t f = 0; f < steps.size(); ++f) {
     for (; step < steps[f]; ++step) {
-      if (!control.empty()) target = control::SmoothPoseTargets(control, passive.num_modes(), step * dt, width);
-      if (!StepBody(passive, w, 0, Integrator::kThesis, dt, &s, ModeForce<T>{&p, &target}).ok()) return false;
-      for (int i = 0; i < s.q.size(); ++i)
-        if (!std::isfinite(ScalarValue(s.q[i])) || !std::isfinite(ScalarValue(s.qd[i]))) return false;
+      if (!control.empty()) target = control::SmoothPoseTargets(control, passive.num_modes(), step * o.dt, o.switch_width);
+      if (!Dims::Step(passive, w, o.dt, &s, ModeForce<T>{&p, &target})) return false;
     }
-    on_frame(int(f), s.q);
+    on_frame(int(f), s);
   }
   return true;
 }
 
-control::PoseGraphOf<double> ControllerOf(const BodyModel& body, const control::PoseGraph& g) {
-  return control::PoseGraphOf<double>::From(body, g);
-}
-
 // G_dd, the generalized mass of each mode: the damping scale 2 sqrt(2 K G_dd) is the critical
 // damping of γ̈ G_dd = −2 K γ − c γ̇.
-VecD<double> ModeMasses(const BodyModel& body) {
+template <int Dim> VecD<double> ModeMasses(const BodyModelN<Dim>& body) {
   VecD<double> g(body.num_modes());
   for (int d = 0; d < body.num_modes(); ++d) g[d] = body.moments().G(d, d);
   return g;
 }
 
-// The raw parameter blocks Ceres sees: q0, q̇0, log K, ζ.
-struct Blocks {
+// The raw parameter blocks Ceres sees: q0 (3D: in its chart), q̇0, log K, ζ.
+template <int Dim> struct Blocks {
+  using Dims = Dimension<Dim>;
   std::vector<double> q0, qd0, log_k, zeta;
   std::vector<double> poses, log_times;  // the controller: poses flattened, log transition times
   int pose_size = 0;
   bool cyclic = true;
+  Eigen::Quaterniond chart = Eigen::Quaterniond::Identity();
   static Blocks From(const DynamicParameters& p, const VecD<double>& G) {
     Blocks b;
-    b.q0.assign(p.q0.data(), p.q0.data() + p.q0.size());
+    b.chart = Dims::Chart(p.q0);
+    const Eigen::VectorXd q0 = Dims::ToBlock(p.q0, b.chart);
+    b.q0.assign(q0.data(), q0.data() + q0.size());
     b.qd0.assign(p.qd0.data(), p.qd0.data() + p.qd0.size());
     for (int d = 0; d < p.stiffness.size(); ++d) {
       b.log_k.push_back(std::log(p.stiffness[d]));
@@ -104,7 +214,7 @@ struct Blocks {
   }
   DynamicParameters To(const VecD<double>& G) const {
     DynamicParameters p;
-    p.q0 = Eigen::Map<const Eigen::VectorXd>(q0.data(), q0.size());
+    p.q0 = Dims::FromBlock(Eigen::Map<const Eigen::VectorXd>(q0.data(), q0.size()), chart);
     p.qd0 = Eigen::Map<const Eigen::VectorXd>(qd0.data(), qd0.size());
     p.stiffness.resize(log_k.size());
     p.damping.resize(log_k.size());
@@ -122,19 +232,27 @@ struct Blocks {
 };
 
 // The reference: body points (bases) and their targets, per frame.
-struct Reference {
+template <int Dim> struct Reference {
+  struct Point {
+    typename Dimension<Dim>::Basis basis;
+    Eigen::Matrix<double, Dim, 1> target;
+    double sqrt_weight = 1.0;
+  };
   std::vector<int> steps;
-  std::vector<std::vector<SegmentResidual>> points;
+  std::vector<std::vector<Point>> points;
   int num_residuals = 0;
 };
-Reference MakeReference(const BodyModel& body, const std::vector<ReferenceFrame>& frames, double dt) {
-  Reference r;
+template <int Dim>
+Reference<Dim> MakeReference(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
+                             double dt) {
+  Reference<Dim> r;
   r.steps = FrameSteps(frames, dt);
-  for (const ReferenceFrame& f : frames) {
-    std::vector<SegmentResidual> pts;
-    for (const Correspondence& t : f.points) {
-      pts.push_back(SegmentResidual::ToPoint(body, t, "dynamic fit"));
-      r.num_residuals += 2;
+  for (const auto& f : frames) {
+    std::vector<typename Reference<Dim>::Point> pts;
+    for (const auto& t : f.points) {
+      if (!(t.weight > 0) || !std::isfinite(t.weight)) throw std::invalid_argument("dynamic fit: weights must be > 0");
+      pts.push_back({Dimension<Dim>::BasisOf(body, t), t.position, std::sqrt(t.weight)});
+      r.num_residuals += Dim;
     }
     r.points.push_back(pts);
   }
@@ -142,24 +260,19 @@ Reference MakeReference(const BodyModel& body, const std::vector<ReferenceFrame>
 }
 
 // Residuals sqrt(w)(x_i(q_f) − target) of every frame, from the raw blocks.
-struct DynamicResidual {
-  const BodyModel* passive;
-  const WorldParams* world;
-  double dt, width;
+template <int Dim> struct DynamicResidual {
+  const BodyModelN<Dim>* passive;
+  const DynamicFitOptions* options;
+  Eigen::Quaterniond chart;
   int num_poses, pose_size;  // the controller's blocks follow q0, q̇0, log K, ζ when num_poses > 0
   bool cyclic;
   std::vector<int> active;
-  const Reference* ref;
+  const Reference<Dim>* ref;
   VecD<double> G;
   long* simulations;
 
   template <class T> bool operator()(T const* const* p, T* r) const {
-    const int nq = passive->num_q(), D = passive->num_modes();
-    VecQ<T> q0(nq), qd0(nq);
-    for (int i = 0; i < nq; ++i) {
-      q0[i] = p[0][i];
-      qd0[i] = p[1][i];
-    }
+    const int D = passive->num_modes();
     ModeParams<T> mp;
     mp.K.resize(D);
     mp.c.resize(D);
@@ -184,19 +297,20 @@ struct DynamicResidual {
     }
     ++*simulations;
     int k = 0;
-    return Simulate(*passive, *world, dt, width, q0, qd0, mp, control, ref->steps, [&](int f, const VecQ<T>& q) {
-      for (const SegmentResidual& s : ref->points[f]) {
-        const Vec2<T> x = PointPosition(s.point, q.data(), nq);
-        r[k++] = T(s.sqrt_weight) * (x[0] - T(s.a[0]));
-        r[k++] = T(s.sqrt_weight) * (x[1] - T(s.a[1]));
+    return Simulate(*passive, *options, p[0], p[1], chart, mp, control, ref->steps, [&](int f, const auto& state) {
+      for (const auto& s : ref->points[f]) {
+        const auto x = Dimension<Dim>::Position(s.basis, state);
+        for (int i = 0; i < Dim; ++i) r[k++] = T(s.sqrt_weight) * (x[i] - T(s.target[i]));
       }
     });
   }
 };
 
-void CheckParameters(const BodyModel& body, const DynamicParameters& p) {
+template <int Dim> void CheckParameters(const BodyModelN<Dim>& body, const DynamicParameters& p) {
   const int nq = body.num_q(), D = body.num_modes();
   if (p.q0.size() != nq || p.qd0.size() != nq) throw std::invalid_argument("dynamic fit: q0 and qdot0 need num_q values");
+  for (int i = 0; i < nq; ++i)
+    if (!std::isfinite(p.q0[i]) || !std::isfinite(p.qd0[i])) throw std::invalid_argument("dynamic fit: q0 and qdot0 must be finite");
   if (p.stiffness.size() != D || p.damping.size() != D)
     throw std::invalid_argument("dynamic fit: stiffness and damping need one value per mode");
   for (int d = 0; d < D; ++d) {
@@ -213,7 +327,10 @@ void CheckParameters(const BodyModel& body, const DynamicParameters& p) {
 }
 
 // Fills an empty q0 / q̇0 from pose fits of the first two frames.
-DynamicParameters Completed(const BodyModel& body, const std::vector<ReferenceFrame>& frames, DynamicParameters p) {
+template <int Dim>
+DynamicParameters Completed(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
+                            DynamicParameters p) {
+  using Dims = Dimension<Dim>;
   if (p.stiffness.size() == 0 && p.damping.size() == 0) {
     p.stiffness.resize(body.num_modes());
     p.damping.resize(body.num_modes());
@@ -226,27 +343,26 @@ DynamicParameters Completed(const BodyModel& body, const std::vector<ReferenceFr
   PoseFitOptions o;
   o.gamma_lower = -10;
   o.gamma_upper = 10;
-  const Eigen::VectorXd a = FitPose(body, frames[0].points, o).q;
+  o.analyze_conditioning = false;
+  const Eigen::VectorXd a = Dims::FitFrame(body, frames[0], o);
   if (!p.q0.size()) p.q0 = a;
   if (!p.qd0.size()) {
     if (frames.size() < 2) {
       p.qd0 = Eigen::VectorXd::Zero(body.num_q());
     } else {
       o.initial_q = a;
-      const Eigen::VectorXd b = FitPose(body, frames[1].points, o).q;
-      p.qd0 = (b - a) / (frames[1].time - frames[0].time);
+      const Eigen::VectorXd b = Dims::FitFrame(body, frames[1], o);
+      p.qd0 = Dims::Velocity(a, b, frames[1].time - frames[0].time);
     }
   }
   return p;
 }
 
-}  // namespace
-
-std::vector<int> FrameSteps(const std::vector<ReferenceFrame>& frames, double dt) {
+template <class Frame> std::vector<int> FrameStepsOf(const std::vector<Frame>& frames, double dt) {
   if (!(dt > 0)) throw std::invalid_argument("dynamic fit: dt must be positive");
   if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
   std::vector<int> steps;
-  for (const ReferenceFrame& f : frames) {
+  for (const Frame& f : frames) {
     const double n = (f.time - frames[0].time) / dt;
     const double rounded = std::round(n);
     if (std::abs(n - rounded) > 1e-6 * std::max(1.0, n))
@@ -257,39 +373,53 @@ std::vector<int> FrameSteps(const std::vector<ReferenceFrame>& frames, double dt
   return steps;
 }
 
-bool SimulateWithParameters(const BodyModel& body, const DynamicFitOptions& o, const DynamicParameters& p,
-                            const std::vector<int>& frame_steps,
-                            const std::function<void(int, const Eigen::VectorXd&)>& on_frame) {
+template <int Dim>
+bool SimulateWith(const BodyModelN<Dim>& body, const DynamicFitOptions& o, const DynamicParameters& p,
+                  const std::vector<int>& frame_steps, const std::function<void(int, const Eigen::VectorXd&)>& on_frame) {
+  using Dims = Dimension<Dim>;
   CheckParameters(body, p);
-  const BodyModel passive = PassiveCopy(body);
+  const BodyModelN<Dim> passive = PassiveCopy(body);
   ModeParams<double> mp;
   mp.K = p.stiffness;
   mp.c = p.damping;
-  return Simulate(passive, o.world, o.dt, o.switch_width, VecQ<double>(p.q0), VecQ<double>(p.qd0), mp,
-                  ControllerOf(body, p.graph), frame_steps,
-                  [&](int f, const VecQ<double>& q) { on_frame(f, Eigen::VectorXd(q)); });
+  const Eigen::Quaterniond chart = Dims::Chart(p.q0);
+  const Eigen::VectorXd q0 = Dims::ToBlock(p.q0, chart);
+  return Simulate(passive, o, q0.data(), p.qd0.data(), chart, mp, control::PoseGraphOf<double>::From(body, p.graph),
+                  frame_steps, [&](int f, const auto& state) { on_frame(f, Dims::Q(state)); });
 }
 
-double DynamicCost(const BodyModel& body, const std::vector<ReferenceFrame>& frames, const DynamicParameters& p,
-                   const DynamicFitOptions& o) {
-  const Reference ref = MakeReference(body, frames, o.dt);
+template <int Dim>
+double CostOf(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
+              const DynamicParameters& p, const DynamicFitOptions& o) {
+  using Dims = Dimension<Dim>;
+  const Reference<Dim> ref = MakeReference(body, frames, o.dt);
+  CheckParameters(body, p);
+  const BodyModelN<Dim> passive = PassiveCopy(body);
+  ModeParams<double> mp;
+  mp.K = p.stiffness;
+  mp.c = p.damping;
+  const Eigen::Quaterniond chart = Dims::Chart(p.q0);
+  const Eigen::VectorXd q0 = Dims::ToBlock(p.q0, chart);
   double cost = 0;
-  const bool ok = SimulateWithParameters(body, o, p, ref.steps, [&](int f, const Eigen::VectorXd& q) {
-    for (const SegmentResidual& s : ref.points[f])
-      cost += 0.5 * s.sqrt_weight * s.sqrt_weight * (PointPosition(s.point, q.data(), int(q.size())) - s.a).squaredNorm();
-  });
+  const bool ok = Simulate(passive, o, q0.data(), p.qd0.data(), chart, mp, control::PoseGraphOf<double>::From(body, p.graph),
+                           ref.steps, [&](int f, const auto& state) {
+                             for (const auto& s : ref.points[f])
+                               cost += 0.5 * s.sqrt_weight * s.sqrt_weight *
+                                       (Dims::Position(s.basis, state) - s.target).squaredNorm();
+                           });
   return ok ? cost : std::numeric_limits<double>::infinity();
 }
 
-DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
-                                      const DynamicParameters& initial, const DynamicFitOptions& o) {
+template <int Dim>
+DynamicFitResult FitDynamic(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
+                            const DynamicParameters& initial, const DynamicFitOptions& o) {
   if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
-  const BodyModel passive = PassiveCopy(body);
-  const Reference ref = MakeReference(body, frames, o.dt);
+  const BodyModelN<Dim> passive = PassiveCopy(body);
+  const Reference<Dim> ref = MakeReference(body, frames, o.dt);
   const VecD<double> G = ModeMasses(body);
-  Blocks blocks = Blocks::From(start, G);
+  Blocks<Dim> blocks = Blocks<Dim>::From(start, G);
   const int nq = body.num_q(), D = body.num_modes();
 
   DynamicFitResult result;
@@ -298,9 +428,9 @@ DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<R
   if (o.fit_times && !(o.switch_width > 0))
     throw std::invalid_argument("dynamic fit: fitting transition times needs a switch width > 0 (a hard switch has no gradient)");
   const int num_poses = int(start.graph.poses.size());
-  auto* cost = new ceres::DynamicAutoDiffCostFunction<DynamicResidual, kStride>(
-      new DynamicResidual{&passive, &o.world, o.dt, o.switch_width, num_poses, blocks.pose_size, start.graph.cyclic,
-                          control::ActiveModes(body), &ref, G, &result.simulations});
+  auto* cost = new ceres::DynamicAutoDiffCostFunction<DynamicResidual<Dim>, kStride>(
+      new DynamicResidual<Dim>{&passive, &o, blocks.chart, num_poses, blocks.pose_size, start.graph.cyclic,
+                               control::ActiveModes(body), &ref, G, &result.simulations});
   std::vector<double*> params = {blocks.q0.data(), blocks.qd0.data()};
   cost->AddParameterBlock(nq);
   cost->AddParameterBlock(nq);
@@ -343,24 +473,65 @@ DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<R
   options.parameter_tolerance = 1e-12;
   SolveAndReport(options, &problem, o.on_iteration, o.full_report, &result.report);
   result.params = blocks.To(G);
-  const double c = DynamicCost(body, frames, result.params, o);
-  result.rms_residual = std::sqrt(2.0 * c / (ref.num_residuals / 2));
+  const double c = CostOf(body, frames, result.params, o);
+  result.rms_residual = std::sqrt(2.0 * c / (ref.num_residuals / Dim));
   return result;
 }
 
-AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
-                                const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
-                                std::uint64_t seed) {
+}  // namespace
+
+std::vector<int> FrameSteps(const std::vector<ReferenceFrame>& frames, double dt) { return FrameStepsOf(frames, dt); }
+std::vector<int> FrameSteps(const std::vector<ReferenceFrame3>& frames, double dt) { return FrameStepsOf(frames, dt); }
+
+bool SimulateWithParameters(const BodyModel& body, const DynamicFitOptions& o, const DynamicParameters& p,
+                            const std::vector<int>& frame_steps,
+                            const std::function<void(int, const Eigen::VectorXd&)>& on_frame) {
+  return SimulateWith(body, o, p, frame_steps, on_frame);
+}
+bool SimulateWithParameters(const BodyModel3& body, const DynamicFitOptions& o, const DynamicParameters& p,
+                            const std::vector<int>& frame_steps,
+                            const std::function<void(int, const Eigen::VectorXd&)>& on_frame) {
+  return SimulateWith(body, o, p, frame_steps, on_frame);
+}
+
+double DynamicCost(const BodyModel& body, const std::vector<ReferenceFrame>& frames, const DynamicParameters& p,
+                   const DynamicFitOptions& o) {
+  return CostOf(body, frames, p, o);
+}
+double DynamicCost(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames, const DynamicParameters& p,
+                   const DynamicFitOptions& o) {
+  return CostOf(body, frames, p, o);
+}
+
+DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
+                                      const DynamicParameters& initial, const DynamicFitOptions& o) {
+  return FitDynamic(body, frames, initial, o);
+}
+DynamicFitResult FitDynamicTrajectory(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
+                                      const DynamicParameters& initial, const DynamicFitOptions& o) {
+  return FitDynamic(body, frames, initial, o);
+}
+
+namespace {
+
+template <int Dim>
+AnnealingResult AnnealGraph(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
+                            const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
+                            std::uint64_t seed) {
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
   if (start.graph.empty()) throw std::invalid_argument("anneal: needs a pose graph to start from");
   // the synthesis problem of lib/wobble/synth with this fit's cost in place of Table 5.1's
   synth::Problem problem;
-  problem.body = std::make_shared<BodyModel>(body);
+  if constexpr (Dim == 2) {
+    problem.body = std::make_shared<BodyModel>(body);
+  } else {
+    problem.body3 = std::make_shared<BodyModel3>(body);
+  }
   problem.custom_cost = [&](const control::PoseGraph& g) {
     DynamicParameters p = start;
     p.graph = g;
-    return DynamicCost(body, frames, p, o);
+    return CostOf(body, frames, p, o);
   };
   synth::AnnealOptions a;
   a.seed = seed;
@@ -383,21 +554,21 @@ AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<Referen
   return out;
 }
 
-AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
-                                        const DynamicParameters& initial, const DynamicFitOptions& o,
-                                        long budget, unsigned seed) {
+template <int Dim>
+AnnealingResult AnnealDynamic(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
+                              const DynamicParameters& initial, const DynamicFitOptions& o, long budget, unsigned seed) {
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
   const VecD<double> G = ModeMasses(body);
   const int nq = body.num_q(), D = body.num_modes();
   const double duration = std::max(o.dt, frames.back().time - frames.front().time);
   // step sizes that move the points by about one length unit (SmoothnessScales)
-  const VecQ<double> L = SmoothnessScales(body);
+  const auto L = Dimension<Dim>::Scales(body);
   struct Coordinate {
     double* value;
     double step;
   };
-  Blocks x = Blocks::From(start, G);
+  Blocks<Dim> x = Blocks<Dim>::From(start, G);
   std::vector<Coordinate> coords;
   for (int i = 0; i < nq; ++i) {
     if (o.fit_q0) coords.push_back({&x.q0[i], 1.0 / L[i]});
@@ -408,7 +579,7 @@ AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector
     if (o.fit_damping) coords.push_back({&x.zeta[d], 0.02});
   }
   AnnealingResult best;
-  double current = DynamicCost(body, frames, x.To(G), o);
+  double current = CostOf(body, frames, x.To(G), o);
   best.params = x.To(G);
   best.cost = current;
   best.simulations = 1;
@@ -431,7 +602,7 @@ AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector
     } else {
       *c.value = old + scale * c.step * normal(rng);
     }
-    const double trial = DynamicCost(body, frames, x.To(G), o);
+    const double trial = CostOf(body, frames, x.To(G), o);
     ++best.simulations;
     if (trial < current || uniform(rng) < std::exp(-(trial - current) / temperature)) {
       current = trial;
@@ -449,6 +620,29 @@ AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector
     }
   }
   return best;
+}
+
+}  // namespace
+
+AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
+                                const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
+                                std::uint64_t seed) {
+  return AnnealGraph(body, frames, initial, o, budget, seed);
+}
+AnnealingResult AnnealPoseGraph(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
+                                const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
+                                std::uint64_t seed) {
+  return AnnealGraph(body, frames, initial, o, budget, seed);
+}
+AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
+                                        const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
+                                        unsigned seed) {
+  return AnnealDynamic(body, frames, initial, o, budget, seed);
+}
+AnnealingResult AnnealDynamicTrajectory(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
+                                        const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
+                                        unsigned seed) {
+  return AnnealDynamic(body, frames, initial, o, budget, seed);
 }
 
 }  // namespace wobble::fit

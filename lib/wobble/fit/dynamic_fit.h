@@ -10,6 +10,11 @@
 // forces switched off; the mode and PD forces −2K(γ − γ0(t)) − c γ̇, whose K, c and γ0 are Jets,
 // enter as StepBody's extra generalized force.
 //
+// 3D bodies (issue 15) take the same fits through StepBody3 (every function has a BodyModel3
+// overload): q0 = [t, r, γ] with r a rotation vector and q̇0 = [ṫ, body ω, γ̇], as the 3D CLI;
+// the solver holds q0's orientation as chart · exp(δ̂) (pose_fit3.h), the world is
+// DynamicFitOptions::world3.
+//
 // Transition times are made differentiable by a smoothed pose switch: the targets are
 //     γ0(t) = P_0 + Σ_k (P_{k mod n} − P_{(k−1) mod n}) σ((t − S_k)/w),  S_k = τ_0 + … + τ_{k−1},
 // σ the logistic function and w the switch width (DynamicFitOptions::switch_width). A hard switch
@@ -26,7 +31,9 @@
 
 #include "wobble/control/control.h"
 #include "wobble/dynamics/step.h"
+#include "wobble/dynamics/step3.h"
 #include "wobble/fit/pose_fit.h"
+#include "wobble/fit/pose_fit3.h"
 
 namespace wobble::fit {
 
@@ -39,7 +46,8 @@ struct DynamicParameters {
 };
 
 struct DynamicFitOptions {
-  WorldParams world;  // gravity, ground, springs
+  WorldParams world;    // gravity, ground, springs
+  WorldParams3 world3;  // the same for a 3D body
   double dt = 0.01;   // thesis integrator (Eq. 4.22/4.23), as `wobble simulate --integrator thesis`
   bool fit_q0 = true, fit_qd0 = true, fit_stiffness = true, fit_damping = true;
   bool fit_poses = false, fit_times = false;  // the controller's (needs a non-empty graph)
@@ -60,11 +68,15 @@ struct DynamicFitResult {
 // The reference's frame times as step counts from its first frame; throws
 // std::invalid_argument when a time is not a whole number of steps of dt.
 std::vector<int> FrameSteps(const std::vector<ReferenceFrame>& frames, double dt);
+std::vector<int> FrameSteps(const std::vector<ReferenceFrame3>& frames, double dt);
 
 // Runs the simulation with `p` (the body's own K and c are replaced by p's) and calls
 // on_frame(f, q) at every frame step. Returns false on numerical trouble (singular M,
 // non-finite state).
 bool SimulateWithParameters(const BodyModel& body, const DynamicFitOptions& options, const DynamicParameters& p,
+                            const std::vector<int>& frame_steps,
+                            const std::function<void(int, const Eigen::VectorXd&)>& on_frame);
+bool SimulateWithParameters(const BodyModel3& body, const DynamicFitOptions& options, const DynamicParameters& p,
                             const std::vector<int>& frame_steps,
                             const std::function<void(int, const Eigen::VectorXd&)>& on_frame);
 
@@ -73,6 +85,8 @@ bool SimulateWithParameters(const BodyModel& body, const DynamicFitOptions& opti
 // damping is fitted as the ratio ζ_d = c_d / (2 sqrt(2 K_d G_dd)) (G_dd the mode's
 // generalized mass), bounded below by 0.
 DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
+                                      const DynamicParameters& initial, const DynamicFitOptions& options);
+DynamicFitResult FitDynamicTrajectory(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
                                       const DynamicParameters& initial, const DynamicFitOptions& options);
 
 // Baseline: simulated annealing on the same parameters and the same cost (½ Σ |x − target|²),
@@ -88,12 +102,20 @@ struct AnnealingResult {
 AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
                                 const DynamicParameters& initial, const DynamicFitOptions& options,
                                 long simulation_budget, std::uint64_t seed = 1);
+AnnealingResult AnnealPoseGraph(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
+                                const DynamicParameters& initial, const DynamicFitOptions& options,
+                                long simulation_budget, std::uint64_t seed = 1);
 AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
+                                        const DynamicParameters& initial, const DynamicFitOptions& options,
+                                        long simulation_budget, unsigned seed = 1);
+AnnealingResult AnnealDynamicTrajectory(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
                                         const DynamicParameters& initial, const DynamicFitOptions& options,
                                         long simulation_budget, unsigned seed = 1);
 
 // ½ Σ w |x − target|² of a parameter set (one plain simulation); +inf on numerical trouble.
 double DynamicCost(const BodyModel& body, const std::vector<ReferenceFrame>& frames, const DynamicParameters& p,
+                   const DynamicFitOptions& options);
+double DynamicCost(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames, const DynamicParameters& p,
                    const DynamicFitOptions& options);
 
 }  // namespace wobble::fit

@@ -1,5 +1,7 @@
 #include "wobble/formats/target_file.h"
 
+#include <filesystem>
+
 #include "wobble/formats/line_reader.h"
 
 namespace wobble::formats {
@@ -8,21 +10,55 @@ namespace {
 
 using detail::Line;
 
-const char* const kPointUsage = "point <k> <x> <y> [weight <w>]";
-const char* const kSampleUsage = "sample <s> <t> <x> <y> [weight <w>]";
+// The statements' forms in 2D and 3D.
+template <int Dim> struct Usage;
+template <> struct Usage<2> {
+  static constexpr const char* point = "point <k> <x> <y> [weight <w>]";
+  static constexpr const char* sample = "sample <s> <t> <x> <y> [weight <w>]";
+  static constexpr const char* cloud = "cloud <x> <y>";
+  static constexpr const char* keywords = "point, sample, polyline, cloud or frame";
+  static constexpr const char* curve = "a curve (polyline/cloud)";
+};
+template <> struct Usage<3> {
+  static constexpr const char* point = "point <k> <x> <y> <z> [weight <w>]";
+  static constexpr const char* sample = "sample <s> <t> <u> <x> <y> <z> [weight <w>]";
+  static constexpr const char* cloud = "cloud <x> <y> <z>";
+  static constexpr const char* keywords = "point, sample, cloud, mesh or frame";
+  static constexpr const char* curve = "a surface (mesh/cloud)";
+};
 const char* const kPolylineUsage = "polyline <x1> <y1> <x2> <y2> ... [closed]";
-const char* const kCloudUsage = "cloud <x> <y>";
+const char* const kMeshUsage = "mesh <FILE>";
 const char* const kFrameUsage = "frame <time>";
+const char* const kAxes[] = {"x", "y", "z"};
+const char* const kLatticeAxes[] = {"s", "t", "u"};
 
-class TargetParser {
+template <int Dim> class TargetParser {
  public:
-  explicit TargetParser(const std::string& file) { out_.file = file; }
+  using Vec = Eigen::Matrix<double, Dim, 1>;
+  using Use = Usage<Dim>;
+  TargetParser(const std::string& file, const MeshReader& read_mesh) : read_mesh_(read_mesh) { out_.file = file; }
 
-  TargetFile Parse(std::istream& in) {
-    const std::vector<Line> lines = detail::ReadLines(in, out_.file);
-    if (lines.empty()) Fail(0, "file is empty: expected point, sample, polyline, cloud or frame lines");
+  TargetFileN<Dim> Parse(std::istream& in) {
+    std::vector<Line> lines = detail::ReadLines(in, out_.file);
+    if (lines.empty())
+      Fail(0, std::string("file is empty: expected ") + (Dim == 3 ? "'dimension 3' and " : "") + Use::keywords + " lines");
+    const bool declared = lines.front().words[0] == "dimension";
+    if (Dim == 3 && !declared)
+      Fail(lines.front().number, "the object is 3D: its target file starts with 'dimension 3' (got '" +
+                                     lines.front().words[0] + "')");
+    if (declared) {
+      const Line& first = lines.front();
+      int dim = 0;
+      if (first.words.size() != 2 || !detail::ParseInt(first.words[1], &dim) || (dim != 2 && dim != 3))
+        Fail(first.number, "expected 'dimension 2' or 'dimension 3'");
+      if (dim != Dim)
+        Fail(first.number, std::string("a ") + std::to_string(dim) + "D target file for a " + std::to_string(Dim) +
+                               "D object");
+      lines.erase(lines.begin());
+      if (lines.empty()) Fail(first.number, std::string("expected ") + Use::keywords + " lines after 'dimension'");
+    }
     for (const Line& line : lines) Statement(line);
-    for (const TargetFrame& f : out_.frames)
+    for (const TargetFrameN<Dim>& f : out_.frames)
       if (f.points.empty()) Fail(f.line, "frame has no point or sample lines");
     return std::move(out_);
   }
@@ -52,39 +88,56 @@ class TargetParser {
     const std::string& keyword = line.words[0];
     if (keyword == "point" || keyword == "sample") {
       Correspondence(line, keyword == "point");
-    } else if (keyword == "polyline") {
+    } else if (keyword == "polyline" && Dim == 2) {
       PolylineLine(line);
+    } else if (keyword == "mesh" && Dim == 3) {
+      MeshLine(line);
     } else if (keyword == "cloud") {
       CurveAllowed(line);
-      if (line.words.size() != 3) Fail(line.number, std::string("expected 2 numbers (") + kCloudUsage + ")");
-      out_.cloud.push_back({Number(line, 1, "x", kCloudUsage), Number(line, 2, "y", kCloudUsage)});
+      if (int(line.words.size()) != 1 + Dim)
+        Fail(line.number, "expected " + std::to_string(Dim) + " numbers (" + Use::cloud + ")");
+      out_.cloud.push_back(Numbers(line, 1, kAxes, Use::cloud));
     } else if (keyword == "frame") {
       FrameLine(line);
+    } else if (keyword == "dimension") {
+      Fail(line.number, "'dimension' must be the first statement of the file");
+    } else if (keyword == "polyline" || keyword == "mesh") {
+      Fail(line.number, "'" + keyword + "' is for " + (Dim == 2 ? "3D" : "2D") + " target files (expected " +
+                            Use::keywords + ")");
     } else {
-      Fail(line.number, "unknown keyword '" + keyword + "' (expected point, sample, polyline, cloud or frame)");
+      Fail(line.number, "unknown keyword '" + keyword + "' (expected " + Use::keywords + ")");
     }
+  }
+
+  // Dim numbers at words[first..], named by `names`.
+  Vec Numbers(const Line& line, size_t first, const char* const* names, const char* usage) const {
+    Vec v;
+    for (int i = 0; i < Dim; ++i) v[i] = Number(line, first + i, names[i], usage);
+    return v;
   }
 
   void Correspondence(const Line& line, bool is_point) {
     if (out_.has_curve())
-      Fail(line.number, "a file holds correspondences (point/sample) or a curve (polyline/cloud), not both");
-    PointTarget p;
+      Fail(line.number, std::string("a file holds correspondences (point/sample) or ") + Use::curve + ", not both");
+    PointTargetN<Dim> p;
     p.line = line.number;
     if (is_point) {
-      if (line.words.size() < 4) Fail(line.number, std::string("expected 3 numbers (") + kPointUsage + ")");
+      if (int(line.words.size()) < 2 + Dim)
+        Fail(line.number, "expected " + std::to_string(1 + Dim) + " numbers (" + Use::point + ")");
       if (!detail::ParseInt(line.words[1], &p.mass_point) || p.mass_point < 0)
-        Fail(line.number, "expected a mass point index >= 0, got '" + line.words[1] + "' (" + kPointUsage + ")");
-      p.position = {Number(line, 2, "x", kPointUsage), Number(line, 3, "y", kPointUsage)};
-      p.weight = Weight(line, 4, kPointUsage);
+        Fail(line.number, "expected a mass point index >= 0, got '" + line.words[1] + "' (" + Use::point + ")");
+      p.position = Numbers(line, 2, kAxes, Use::point);
+      p.weight = Weight(line, 2 + Dim, Use::point);
     } else {
-      if (line.words.size() < 5) Fail(line.number, std::string("expected 4 numbers (") + kSampleUsage + ")");
-      p.lattice_coords = {Number(line, 1, "s", kSampleUsage), Number(line, 2, "t", kSampleUsage)};
-      for (int i = 0; i < 2; ++i)
+      if (int(line.words.size()) < 1 + 2 * Dim)
+        Fail(line.number, "expected " + std::to_string(2 * Dim) + " numbers (" + Use::sample + ")");
+      p.lattice_coords = Numbers(line, 1, kLatticeAxes, Use::sample);
+      for (int i = 0; i < Dim; ++i)
         if (p.lattice_coords[i] < -1e-9 || p.lattice_coords[i] > 1 + 1e-9)
-          Fail(line.number, std::string("lattice coordinate ") + (i ? "t" : "s") + " must be in [0, 1], got " +
+          Fail(line.number, std::string("lattice coordinate ") + kLatticeAxes[i] + " must be in [0, 1], got " +
                                 line.words[1 + i]);
-      p.position = {Number(line, 3, "x", kSampleUsage), Number(line, 4, "y", kSampleUsage)};
-      p.weight = Weight(line, 5, kSampleUsage);
+      p.position = Numbers(line, 1 + Dim, kAxes, Use::sample);
+      p.weight = Weight(line, 1 + 2 * Dim, Use::sample);
     }
     if (out_.frames.empty()) {
       out_.points.push_back(p);
@@ -94,9 +147,30 @@ class TargetParser {
   }
 
   void CurveAllowed(const Line& line) const {
-    if (!out_.frames.empty()) Fail(line.number, "polyline/cloud lines are not allowed in a trajectory (frame) file");
+    if (!out_.frames.empty())
+      Fail(line.number, std::string(Dim == 2 ? "polyline/cloud" : "mesh/cloud") +
+                            " lines are not allowed in a trajectory (frame) file");
     if (out_.has_correspondences())
-      Fail(line.number, "a file holds correspondences (point/sample) or a curve (polyline/cloud), not both");
+      Fail(line.number, std::string("a file holds correspondences (point/sample) or ") + Use::curve + ", not both");
+  }
+
+  void MeshLine(const Line& line) {
+    CurveAllowed(line);
+    if (mesh_line_ != 0) Fail(line.number, "mesh given twice (first on line " + std::to_string(mesh_line_) + ")");
+    if (line.words.size() != 2) Fail(line.number, std::string("expected one file name after 'mesh' (") + kMeshUsage + ")");
+    if (!read_mesh_) Fail(line.number, "mesh: this reader cannot read mesh files (the wobble command reads them with VTK)");
+    // relative to the target file's folder, as the object file's mesh
+    std::filesystem::path path(line.words[1]);
+    if (path.is_relative()) path = std::filesystem::path(out_.file).parent_path() / path;
+    try {
+      out_.mesh = read_mesh_(path.string());
+      CheckSurfaceMesh(out_.mesh);
+    } catch (const ParseError& e) {
+      Fail(line.number, std::string("mesh: ") + e.what());
+    } catch (const std::exception& e) {
+      Fail(line.number, "mesh " + path.string() + ": " + e.what());
+    }
+    mesh_line_ = line.number;
   }
 
   void PolylineLine(const Line& line) {
@@ -115,12 +189,12 @@ class TargetParser {
   }
 
   void FrameLine(const Line& line) {
-    if (out_.has_curve()) Fail(line.number, "frame lines are not allowed in a curve (polyline/cloud) file");
+    if (out_.has_curve()) Fail(line.number, std::string("frame lines are not allowed in ") + Use::curve + " file");
     if (out_.has_correspondences())
       Fail(line.number, "point/sample lines before the first frame (" + std::string(kFrameUsage) +
                             " must come first in a trajectory file)");
     if (line.words.size() != 2) Fail(line.number, std::string("expected one number (") + kFrameUsage + ")");
-    TargetFrame f;
+    TargetFrameN<Dim> f;
     f.time = Number(line, 1, "the time", kFrameUsage);
     f.line = line.number;
     if (!out_.frames.empty() && !(f.time > out_.frames.back().time))
@@ -129,29 +203,41 @@ class TargetParser {
     out_.frames.push_back(f);
   }
 
-  TargetFile out_;
+  TargetFileN<Dim> out_;
+  MeshReader read_mesh_;
+  int mesh_line_ = 0;
 };
 
 }  // namespace
 
 TargetFile ParseTargets(std::istream& in, const std::string& name_for_errors) {
-  return TargetParser(name_for_errors).Parse(in);
+  return TargetParser<2>(name_for_errors, nullptr).Parse(in);
 }
 
 TargetFile ReadTargetFile(const std::string& path) {
   return detail::WithFile(path, [&](std::istream& in) { return ParseTargets(in, path); });
 }
 
-void CheckMassPointIndices(const TargetFile& targets, int num_points) {
-  auto check = [&](const PointTarget& p) {
+TargetFile3 ParseTargets3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh) {
+  return TargetParser<3>(name_for_errors, read_mesh).Parse(in);
+}
+
+TargetFile3 ReadTargetFile3(const std::string& path, const MeshReader& read_mesh) {
+  return detail::WithFile(path, [&](std::istream& in) { return ParseTargets3(in, path, read_mesh); });
+}
+
+template <int Dim> void CheckMassPointIndices(const TargetFileN<Dim>& targets, int num_points) {
+  auto check = [&](const PointTargetN<Dim>& p) {
     if (p.mass_point >= num_points)
       throw ParseError(targets.file, p.line,
                        "mass point " + std::to_string(p.mass_point) + " does not exist: the body has " +
                            std::to_string(num_points) + " (numbered from 0)");
   };
-  for (const PointTarget& p : targets.points) check(p);
-  for (const TargetFrame& f : targets.frames)
-    for (const PointTarget& p : f.points) check(p);
+  for (const PointTargetN<Dim>& p : targets.points) check(p);
+  for (const TargetFrameN<Dim>& f : targets.frames)
+    for (const PointTargetN<Dim>& p : f.points) check(p);
 }
+template void CheckMassPointIndices(const TargetFileN<2>&, int);
+template void CheckMassPointIndices(const TargetFileN<3>&, int);
 
 }  // namespace wobble::formats

@@ -1,4 +1,6 @@
 // Target files: what a fit should match (`wobble fit pose`, `wobble fit trajectory`).
+// A 2D file (below) fits a 2D object; a 3D object's file starts with 'dimension 3' (further
+// below).
 //
 // Line based like the object file: '#' starts a comment anywhere on a line; blank lines are
 // ignored; every problem is a ParseError "FILE:LINE: what was expected". Statements:
@@ -18,6 +20,18 @@
 // A file with 'frame' lines is a trajectory: every point/sample line is inside a frame, and
 // polyline/cloud are not allowed. Weights are > 0 (default 1). World frame, y up.
 // Examples: data/table_pose.tgt, data/table_curve.tgt, data/table_keys.tgt.
+//
+// 3D (a 3D object's targets): the first statement is 'dimension 3', then
+//
+//   point <k> <x> <y> <z> [weight <w>]         mass point k should be at (x, y, z)
+//   sample <s> <t> <u> <x> <y> <z> [weight <w>] the body point at lattice coordinates (s, t, u)
+//   cloud <x> <y> <z>                          an unordered target point (e.g. of a scan)
+//   mesh <FILE>                                a target surface (.obj .stl .ply .vtp, read by
+//                                              VTK; relative to the target file's folder)
+//   frame <time>                               as in 2D
+//
+// with the same rules (cloud and mesh form the target without correspondences; there are no
+// polylines). Examples: data/pot3_pose.tgt, data/pot3_squashed.tgt.
 #pragma once
 
 #include <Eigen/Core>
@@ -25,20 +39,24 @@
 #include <string>
 #include <vector>
 
+#include "wobble/body/surface_mesh.h"
+#include "wobble/formats/object_file.h"
+
 namespace wobble::formats {
 
 // One correspondence: a body point (a mass point, or lattice coordinates) and where it should be.
-struct PointTarget {
-  int mass_point = -1;                                       // >= 0: this mass point
-  Eigen::Vector2d lattice_coords = Eigen::Vector2d::Zero();  // used when mass_point < 0
-  Eigen::Vector2d position = Eigen::Vector2d::Zero();        // world
+template <int Dim> struct PointTargetN {
+  using Vec = Eigen::Matrix<double, Dim, 1>;
+  int mass_point = -1;              // >= 0: this mass point
+  Vec lattice_coords = Vec::Zero();  // used when mass_point < 0
+  Vec position = Vec::Zero();        // world
   double weight = 1.0;
   int line = 0;  // source line, for errors found later (a mass point the body does not have)
 };
 
-struct TargetFrame {
+template <int Dim> struct TargetFrameN {
   double time = 0.0;
-  std::vector<PointTarget> points;
+  std::vector<PointTargetN<Dim>> points;
   int line = 0;
 };
 
@@ -47,23 +65,35 @@ struct TargetCurve {
   bool closed = false;
 };
 
-struct TargetFile {
-  std::string file;                    // name used in errors
-  std::vector<PointTarget> points;     // correspondences (no frames)
-  std::vector<TargetCurve> polylines;  // curve target
-  std::vector<Eigen::Vector2d> cloud;  // curve target
-  std::vector<TargetFrame> frames;     // trajectory
+template <int Dim> struct TargetFileN {
+  using Vec = Eigen::Matrix<double, Dim, 1>;
+  std::string file;                           // name used in errors
+  std::vector<PointTargetN<Dim>> points;      // correspondences (no frames)
+  std::vector<TargetCurve> polylines;         // curve target (2D)
+  SurfaceMesh mesh;                           // target surface (3D)
+  std::vector<Vec> cloud;                     // curve / surface target
+  std::vector<TargetFrameN<Dim>> frames;      // trajectory
   bool has_correspondences() const { return !points.empty(); }
-  bool has_curve() const { return !polylines.empty() || !cloud.empty(); }
+  bool has_curve() const { return !polylines.empty() || !cloud.empty() || !mesh.empty(); }
   bool is_trajectory() const { return !frames.empty(); }
 };
+
+using PointTarget = PointTargetN<2>;
+using TargetFrame = TargetFrameN<2>;
+using TargetFile = TargetFileN<2>;
+using PointTarget3 = PointTargetN<3>;
+using TargetFrame3 = TargetFrameN<3>;
+using TargetFile3 = TargetFileN<3>;
 
 // Reads a target file; ParseError (line 0) if it cannot be opened or holds nothing.
 TargetFile ReadTargetFile(const std::string& path);
 TargetFile ParseTargets(std::istream& in, const std::string& name_for_errors);
+// The same for a 3D file; `read_mesh` reads its 'mesh' statements (none: they are refused).
+TargetFile3 ReadTargetFile3(const std::string& path, const MeshReader& read_mesh = nullptr);
+TargetFile3 ParseTargets3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh = nullptr);
 
 // Checks that every mass point index exists in a body with `num_points` points: ParseError at
 // the line of the first one that does not.
-void CheckMassPointIndices(const TargetFile& targets, int num_points);
+template <int Dim> void CheckMassPointIndices(const TargetFileN<Dim>& targets, int num_points);
 
 }  // namespace wobble::formats
