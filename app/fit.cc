@@ -12,8 +12,11 @@
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/csv.h"
 #include "wobble/fit/dynamic_fit.h"
+#include "wobble/core/rotation3.h"
 #include "wobble/fit/pose_fit.h"
+#include "wobble/fit/pose_fit3.h"
 #include "wobble/fit/trajectory_fit.h"
+#include "wobble/formats/object_file.h"
 #include "wobble/record/trajectory_csv.h"
 #include "wobble/formats/parse_error.h"
 #include "wobble/formats/target_file.h"
@@ -22,6 +25,7 @@
 #include <filesystem>
 
 #include "pipelines/charts.h"
+#include "pipelines/mesh_io.h"
 #include "pipelines/scene_view.h"
 #endif
 
@@ -38,6 +42,7 @@ template <class Derived> json Vector(const Eigen::MatrixBase<Derived>& v) {
   return a;
 }
 json Point(const Eigen::Vector2d& p) { return json::array({p.x(), p.y()}); }
+json Point(const Eigen::Vector3d& p) { return json::array({p.x(), p.y(), p.z()}); }
 
 void AddFitFlags(CLI::App* cmd, FitFlags* f) {
   cmd->add_option("--q0", f->q0, "Starting q = \"tx ty theta g1 ..\" (default: see the README)")->type_name("\"NUMS\"");
@@ -52,9 +57,24 @@ void AddFitFlags(CLI::App* cmd, FitFlags* f) {
   cmd->add_option("--costs", f->costs, "Cost per iteration as CSV (written atomically)")->type_name("FILE.csv");
 }
 
-fit::PoseFitOptions PoseOptions(const FitFlags& f, const BodyModel& body) {
+// --q0 (and --qdot0) of a 2D body: "tx ty theta g.."; of a 3D body "tx ty tz rx ry rz g.."
+// (r a rotation vector) and "vx vy vz wx wy wz dg.." (ω in the body frame).
+Eigen::VectorXd StartQ(const std::string& text, const std::string& flag, const BodyModel& body) {
+  return ParseCoordinates(text, flag, body);
+}
+Eigen::VectorXd StartQ(const std::string& text, const std::string& flag, const BodyModel3& body) {
+  return ParseNumbers(text, flag, body.num_q(), CoordinateNames3(body), body.name());
+}
+Eigen::VectorXd StartVelocity(const std::string& text, const std::string& flag, const BodyModel& body) {
+  return ParseCoordinates(text, flag, body);
+}
+Eigen::VectorXd StartVelocity(const std::string& text, const std::string& flag, const BodyModel3& body) {
+  return ParseNumbers(text, flag, body.num_q(), VelocityNames3(body), body.name());
+}
+
+template <int Dim> fit::PoseFitOptions PoseOptions(const FitFlags& f, const BodyModelN<Dim>& body) {
   fit::PoseFitOptions o;
-  if (!f.q0.empty()) o.initial_q = ParseCoordinates(f.q0, "--q0", body);
+  if (!f.q0.empty()) o.initial_q = StartQ(f.q0, "--q0", body);
   RequireFinite(f.gamma_min, "--gamma-min");
   RequireFinite(f.gamma_max, "--gamma-max");
   if (!(f.gamma_min < f.gamma_max)) throw UsageError("--gamma-min must be below --gamma-max");
@@ -128,7 +148,7 @@ void WritePictures(const FitFlags& f, const json& result, const fit::FitReport& 
     spec.series = {s};
     pipelines::WriteChart(spec, std::filesystem::path(f.costs).replace_extension(".png").string(), "");
   }
-  if (!f.out.empty() && result.contains("overlay")) {
+  if (!f.out.empty() && result.contains("overlay") && result.value("dimension", 2) == 2) {
     const json& overlay = result["overlay"];
     pipelines::ChartSpec spec;
     spec.title = "fit (dots) against target";
@@ -197,6 +217,63 @@ std::vector<fit::ReferenceFrame> ReferenceFrames(const std::vector<formats::Targ
   for (const formats::TargetFrame& f : frames) out.push_back({f.time, Correspondences(f.points)});
   return out;
 }
+std::vector<fit::Correspondence3> Correspondences(const std::vector<formats::PointTarget3>& points) {
+  std::vector<fit::Correspondence3> out;
+  for (const formats::PointTarget3& p : points) out.push_back({p.mass_point, p.lattice_coords, p.position, p.weight});
+  return out;
+}
+std::vector<fit::ReferenceFrame3> ReferenceFrames(const std::vector<formats::TargetFrame3>& frames) {
+  std::vector<fit::ReferenceFrame3> out;
+  for (const formats::TargetFrame3& f : frames) out.push_back({f.time, Correspondences(f.points)});
+  return out;
+}
+// What reads a 3D target file's 'mesh' line: VTK's readers, when the pipelines are built.
+formats::MeshReader AppMeshReader() {
+#ifdef WOBBLE_HAVE_PIPELINES
+  return pipelines::ReadSurfaceMesh;
+#else
+  return nullptr;
+#endif
+}
+
+json ConditioningJson(const fit::Conditioning& conditioning) {
+  json c;
+  c["condition_number"] = Number(conditioning.condition_number);
+  c["scaled_condition_number"] = Number(conditioning.scaled_condition_number);
+  c["column_norms"] = conditioning.column_norms;
+  c["undetermined"] = conditioning.undetermined;
+  c["poorly_determined"] = conditioning.poorly_determined;
+  c["weak_directions"] = json::array();
+  for (const fit::WeakDirection& w : conditioning.weak)
+    c["weak_directions"].push_back({{"relative_singular_value", w.relative_singular_value},
+                                    {"coordinates", w.coordinates},
+                                    {"vector", Vector(w.vector)}});
+  return c;
+}
+
+// The summary both pose fits print; returns the exit code.
+int PrintPoseSummary(const std::string& headline, const std::vector<std::string>& names, const fit::PoseFitResult& r,
+                     bool full_report, const std::string& after_iterations = "") {
+  std::ostringstream out;
+  out << headline << r.report.termination << " after " << r.report.iterations << " iterations" << after_iterations
+      << ".\n";
+  out << "q = [";
+  for (int i = 0; i < r.q.size(); ++i) out << (i ? " " : "") << names[i] << " " << Num(r.q[i]);
+  out << "]\n";
+  out << "cost " << Num(r.report.initial_cost) << " -> " << Num(r.report.final_cost) << ", rms residual "
+      << Num(r.rms_residual) << "; at a bound: " << List(r.at_bound) << ".\n";
+  out << "cond(JtJ) " << Num(r.conditioning.condition_number) << " (column-scaled "
+      << Num(r.conditioning.scaled_condition_number) << "); undetermined modes: " << List(r.conditioning.undetermined)
+      << "; poorly determined: " << List(r.conditioning.poorly_determined) << ".";
+  std::cout << out.str() << std::endl;
+  if (full_report) std::cout << r.report.full_report << std::endl;
+  if (!r.report.usable) {  // the solver gave up on the numbers: a numerical stop
+    std::cerr << "wobble: the fit failed: " << r.report.brief_report << std::endl;
+    return kExitSimStopped;
+  }
+  return kExitOk;
+}
+
 fit::CurveTarget CurveTargetOf(const formats::TargetFile& file) {
   fit::CurveTarget c;
   for (const formats::TargetCurve& line : file.polylines) c.AddPolyline(line.points, line.closed);
@@ -221,12 +298,16 @@ FitCommands AddFitCommand(CLI::App* app, FitPoseArgs* pose, FitTrajectoryArgs* t
       ->capture_default_str();
   c.pose->add_option("--max-rounds", pose->max_rounds, "Curve targets with --alternate: closest-point rounds")->capture_default_str();
   c.pose->add_flag("--one-sided", pose->one_sided, "Curve targets: only body-to-target distances");
+  c.pose->add_option("--mesh-samples", pose->mesh_samples, "3D surface targets: body mesh vertices used as samples")
+      ->capture_default_str();
   c.pose->add_flag("--alternate", pose->alternate,
                    "Curve targets: alternate closest-point rounds and solves (ICP) instead of one joint solve");
   c.pose->footer(
-      "Example:\n"
+      "Examples:\n"
       "  wobble fit pose --object data/table.obj --modes data/table_modes.def \\\n"
-      "      --targets data/table_pose.tgt --loss cauchy --loss-scale 5 --out out/pose.json");
+      "      --targets data/table_pose.tgt --loss cauchy --loss-scale 5 --out out/pose.json\n"
+      "  wobble fit pose --object data/pot3.obj --modes data/pot3_modes.def3 \\\n"
+      "      --targets data/pot3_squashed.tgt --out out/pot3_fit.json");
 
   c.trajectory = c.fit->add_subcommand("trajectory", "Fit q(t) per frame (kinematic) or the simulation's parameters (--dynamic)");
   AddBodyFlags(c.trajectory, &traj->files);
@@ -266,8 +347,67 @@ FitCommands AddFitCommand(CLI::App* app, FitPoseArgs* pose, FitTrajectoryArgs* t
   return c;
 }
 
+namespace {
+
+// A 3D object: correspondences, or a surface (mesh and/or cloud) without them.
+int RunFitPose3(const FitPoseArgs& a) {
+  const std::shared_ptr<const BodyModel3> body = LoadBody3(a.files);
+  fit::PoseFitOptions o = PoseOptions(a.fit, *body);
+  if (a.alternate) throw UsageError("--alternate: 3D surface fits find the nearest points jointly (2D curves only)");
+  if (a.mesh_samples < 0) throw UsageError("--mesh-samples must be >= 0");
+  o.max_mesh_samples = a.mesh_samples;
+  o.two_sided = !a.one_sided;
+  o.on_iteration = IterationLine();
+  const formats::TargetFile3 targets = formats::ReadTargetFile3(a.targets, AppMeshReader());
+  formats::CheckMassPointIndices(targets, body->num_points());
+  if (targets.is_trajectory())
+    throw formats::ParseError(a.targets, targets.frames[0].line, "this file has frames: use `wobble fit trajectory`");
+  const bool surface = targets.has_curve();
+  const std::vector<fit::Correspondence3> points = Correspondences(targets.points);
+  fit::SurfaceTarget3 target;
+  if (!targets.mesh.empty()) target.AddMesh(targets.mesh);
+  for (const Eigen::Vector3d& p : targets.cloud) target.AddPoint(p);
+  const fit::PoseFitResult r = surface ? fit::FitPoseToSurface3(*body, target, o) : fit::FitPose3(*body, points, o);
+  EndIterationLine();
+  const std::vector<std::string> names = fit::CoordinateNames3(*body);
+
+  json j;
+  j["kind"] = surface ? "surface" : "correspondences";
+  j["dimension"] = 3;
+  j["body"] = body->name();
+  j["targets"] = a.targets;
+  j["coordinates"] = names;
+  j["q"] = Vector(r.q);
+  j["report"] = ReportJson(r.report);
+  j["rms_residual"] = r.rms_residual;
+  j["point_residuals"] = r.point_residuals;
+  j["at_bound"] = r.at_bound;
+  j["conditioning"] = ConditioningJson(r.conditioning);
+  // fitted body points next to their targets (surface fits: the body samples; the target is
+  // the file's mesh and cloud)
+  json overlay;
+  overlay["fitted"] = json::array();
+  overlay["targets"] = json::array();
+  if (surface) {
+    for (const fit::PointBasis3& p : fit::SurfaceSamples3(*body, o)) overlay["fitted"].push_back(Point(fit::PointPosition3(p, r.q)));
+    for (const Eigen::Vector3d& p : targets.cloud) overlay["targets"].push_back({{"point", Point(p)}});
+  } else {
+    for (const fit::Correspondence3& t : points) {
+      overlay["fitted"].push_back(Point(fit::PointPosition3(fit::BasisOf3(*body, t.mass_point, t.lattice_coords), r.q)));
+      overlay["targets"].push_back({{"point", Point(t.position)}});
+    }
+  }
+  j["overlay"] = overlay;
+  WriteOutputs(a.fit, j, r.report);
+  return PrintPoseSummary(body->name() + ": " + (surface ? "surface" : "correspondence") + " fit to " + a.targets + ": ",
+                          names, r, a.fit.full_report);
+}
+
+}  // namespace
+
 int RunFitPose(const FitPoseArgs& a) {
   CheckOutputs(a.fit);
+  if (formats::ObjectFileDimension(a.files.object) == 3) return RunFitPose3(a);
   const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
   fit::PoseFitOptions o = PoseOptions(a.fit, *body);
   if (a.samples_per_segment < 0) throw UsageError("--samples-per-segment must be >= 0");
@@ -291,6 +431,7 @@ int RunFitPose(const FitPoseArgs& a) {
 
   json j;
   j["kind"] = curve ? "curve" : "correspondences";
+  j["dimension"] = 2;
   j["body"] = body->name();
   j["targets"] = a.targets;
   j["coordinates"] = names;
@@ -300,18 +441,7 @@ int RunFitPose(const FitPoseArgs& a) {
   j["point_residuals"] = r.point_residuals;
   j["at_bound"] = r.at_bound;
   if (curve) j["rounds"] = r.rounds;
-  json c;
-  c["condition_number"] = Number(r.conditioning.condition_number);
-  c["scaled_condition_number"] = Number(r.conditioning.scaled_condition_number);
-  c["column_norms"] = r.conditioning.column_norms;
-  c["undetermined"] = r.conditioning.undetermined;
-  c["poorly_determined"] = r.conditioning.poorly_determined;
-  c["weak_directions"] = json::array();
-  for (const fit::WeakDirection& w : r.conditioning.weak)
-    c["weak_directions"].push_back({{"relative_singular_value", w.relative_singular_value},
-                                    {"coordinates", w.coordinates},
-                                    {"vector", Vector(w.vector)}});
-  j["conditioning"] = c;
+  j["conditioning"] = ConditioningJson(r.conditioning);
   // the overlay hook: fitted body points and their targets, world frame
   json overlay;
   overlay["fitted"] = json::array();
@@ -335,25 +465,10 @@ int RunFitPose(const FitPoseArgs& a) {
   j["overlay"] = overlay;
   WriteOutputs(a.fit, j, r.report);
 
-  std::ostringstream out;
-  out << body->name() << ": " << (curve ? "curve" : "correspondence") << " fit to " << a.targets << ": "
-      << r.report.termination << " after " << r.report.iterations << " iterations"
-      << (curve && a.alternate ? " in " + std::to_string(r.rounds) + " closest-point rounds" : std::string()) << ".\n";
-  out << "q = [";
-  for (int i = 0; i < r.q.size(); ++i) out << (i ? " " : "") << names[i] << " " << Num(r.q[i]);
-  out << "]\n";
-  out << "cost " << Num(r.report.initial_cost) << " -> " << Num(r.report.final_cost) << ", rms residual "
-      << Num(r.rms_residual) << "; at a bound: " << List(r.at_bound) << ".\n";
-  out << "cond(JtJ) " << Num(r.conditioning.condition_number) << " (column-scaled "
-      << Num(r.conditioning.scaled_condition_number) << "); undetermined modes: " << List(r.conditioning.undetermined)
-      << "; poorly determined: " << List(r.conditioning.poorly_determined) << ".";
-  std::cout << out.str() << std::endl;
-  if (a.fit.full_report) std::cout << r.report.full_report << std::endl;
-  if (!r.report.usable) {  // the solver gave up on the numbers: a numerical stop
-    std::cerr << "wobble: the fit failed: " << r.report.brief_report << std::endl;
-    return kExitSimStopped;
-  }
-  return kExitOk;
+  const std::string rounds =
+      curve && a.alternate ? " in " + std::to_string(r.rounds) + " closest-point rounds" : std::string();
+  return PrintPoseSummary(body->name() + ": " + (curve ? "curve" : "correspondence") + " fit to " + a.targets + ": ",
+                          names, r, a.fit.full_report, rounds);
 }
 
 namespace {
@@ -377,17 +492,19 @@ bool EndsWith(const std::string& s, const std::string& tail) {
 }
 
 // --active: a copy of the body with those modes active (the pose graph drives them).
-std::shared_ptr<const BodyModel> WithActiveModes(const std::shared_ptr<const BodyModel>& body, const std::string& names) {
+template <int Dim>
+std::shared_ptr<const BodyModelN<Dim>> WithActiveModes(const std::shared_ptr<const BodyModelN<Dim>>& body,
+                                                       const std::string& names) {
   if (names.empty()) return body;
-  std::vector<DeformationMode> modes = body->modes();
-  for (DeformationMode& m : modes) m.active = false;
+  std::vector<DeformationModeN<Dim>> modes = body->modes();
+  for (DeformationModeN<Dim>& m : modes) m.active = false;
   std::stringstream in(names);
   for (std::string name; std::getline(in, name, ',');) {
-    auto it = std::find_if(modes.begin(), modes.end(), [&](const DeformationMode& m) { return m.name == name; });
+    auto it = std::find_if(modes.begin(), modes.end(), [&](const DeformationModeN<Dim>& m) { return m.name == name; });
     if (it == modes.end()) throw UsageError("--active: the body has no mode '" + name + "'");
     it->active = true;
   }
-  return std::make_shared<const BodyModel>(body->def(), modes);
+  return std::make_shared<const BodyModelN<Dim>>(body->def(), modes);
 }
 
 // --poses "T1 .. Tk D; ...": k targets of the active modes and a transition time per pose.
@@ -416,17 +533,9 @@ control::PoseGraph ParsePoseGraph(const std::string& text, int num_active, bool 
   return g;
 }
 
-}  // namespace
-
-int RunFitTrajectory(const FitTrajectoryArgs& a) {
-  CheckOutputs(a.fit);
-  const std::shared_ptr<const BodyModel> body = WithActiveModes(LoadBody(a.files), a.active);
-  fit::PoseFitOptions po = PoseOptions(a.fit, *body);
-  if (a.every < 1) throw UsageError("--every must be at least 1");
-  RequireNonNegative(a.smoothness, "--smoothness");
-
-  // the reference: a simulation CSV or a target file with frames
-  std::vector<fit::ReferenceFrame> frames;
+// What the trajectory fit does differently in 2D and 3D: the reference's frames, the kinematic
+// fit and the coordinate names.
+std::vector<fit::ReferenceFrame> LoadFrames(const FitTrajectoryArgs& a, const std::shared_ptr<const BodyModel>& body) {
   if (EndsWith(a.reference, ".csv")) {
     const record::Trajectory sim = record::ReadTrajectoryCsv(a.reference, {record::DescribeFfdBody(body)}).trajectory;
     std::vector<double> t;
@@ -435,20 +544,70 @@ int RunFitTrajectory(const FitTrajectoryArgs& a) {
       t.push_back(sim.time(k));
       q.push_back(sim.q(k, 0));
     }
-    frames = fit::FramesFromStates(*body, t, q, ParsePointList(a.points, body->num_points()), a.every);
-  } else {
-    if (!a.points.empty() || a.every != 1) throw UsageError("--points and --every apply to a CSV reference only");
-    const formats::TargetFile t = formats::ReadTargetFile(a.reference);
-    if (!t.is_trajectory())
-      throw formats::ParseError(a.reference, 0, "no 'frame' lines: a trajectory needs frames (for one pose use `wobble fit pose`)");
-    formats::CheckMassPointIndices(t, body->num_points());
-    frames = ReferenceFrames(t.frames);
+    return fit::FramesFromStates(*body, t, q, ParsePointList(a.points, body->num_points()), a.every);
   }
+  const formats::TargetFile t = formats::ReadTargetFile(a.reference);
+  if (!t.is_trajectory())
+    throw formats::ParseError(a.reference, 0, "no 'frame' lines: a trajectory needs frames (for one pose use `wobble fit pose`)");
+  formats::CheckMassPointIndices(t, body->num_points());
+  return ReferenceFrames(t.frames);
+}
+std::vector<fit::ReferenceFrame3> LoadFrames(const FitTrajectoryArgs& a, const std::shared_ptr<const BodyModel3>& body) {
+  if (EndsWith(a.reference, ".csv")) {
+    // a 3D run's rows hold the orientation as a quaternion (tx ty tz qw qx qy qz γ..)
+    const record::Trajectory sim = record::ReadTrajectoryCsv(a.reference, {record::DescribeFfd3Body(body)}).trajectory;
+    std::vector<double> t;
+    std::vector<Eigen::VectorXd> q;
+    for (int k = 0; k < sim.size(); ++k) {
+      const Eigen::VectorXd row = sim.q(k, 0);
+      Eigen::VectorXd qk(body->num_q());
+      const Eigen::Quaterniond orientation(row[3], row[4], row[5], row[6]);
+      qk << row.head<3>(), LogRotation<double>(orientation.normalized()), row.tail(body->num_modes());
+      t.push_back(sim.time(k));
+      q.push_back(qk);
+    }
+    return fit::FramesFromStates3(*body, t, q, ParsePointList(a.points, body->num_points()), a.every);
+  }
+  const formats::TargetFile3 t = formats::ReadTargetFile3(a.reference, AppMeshReader());
+  if (!t.is_trajectory())
+    throw formats::ParseError(a.reference, 0, "no 'frame' lines: a trajectory needs frames (for one pose use `wobble fit pose`)");
+  formats::CheckMassPointIndices(t, body->num_points());
+  return ReferenceFrames(t.frames);
+}
+fit::TrajectoryFitResult FitKinematic(const BodyModel& body, const std::vector<fit::ReferenceFrame>& frames,
+                                      const fit::TrajectoryFitOptions& o) {
+  return fit::FitKinematicTrajectory(body, frames, o);
+}
+fit::TrajectoryFitResult FitKinematic(const BodyModel3& body, const std::vector<fit::ReferenceFrame3>& frames,
+                                      const fit::TrajectoryFitOptions& o) {
+  return fit::FitKinematicTrajectory3(body, frames, o);
+}
+std::vector<std::string> NamesOf(const BodyModel& body) { return fit::CoordinateNames(body); }
+std::vector<std::string> NamesOf(const BodyModel3& body) { return fit::CoordinateNames3(body); }
+void SetWorld(const WorldFlags& flags, fit::DynamicFitOptions* o, const BodyModel&) { o->world = MakeWorldParams(flags); }
+void SetWorld(const WorldFlags& flags, fit::DynamicFitOptions* o, const BodyModel3&) {
+  // the 3D world of the flags, as simulate's (cli_common.h: StartingWorld)
+  const WorldParams w = MakeWorldParams(flags);
+  o->world3.gravity_on = w.gravity_on;
+  o->world3.gravity = Eigen::Vector3d(w.gravity.x(), w.gravity.y(), 0.0);
+  o->world3.ground = GroundPlaneOf(w.ground);
+  o->world3.max_condition = w.max_condition;
+}
+
+template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shared_ptr<const BodyModelN<Dim>>& body) {
+  fit::PoseFitOptions po = PoseOptions(a.fit, *body);
+  if (a.every < 1) throw UsageError("--every must be at least 1");
+  RequireNonNegative(a.smoothness, "--smoothness");
+  // the reference: a simulation CSV or a target file with frames
+  if (!EndsWith(a.reference, ".csv") && (!a.points.empty() || a.every != 1))
+    throw UsageError("--points and --every apply to a CSV reference only");
+  const auto frames = LoadFrames(a, body);
 
   json j;
   j["body"] = body->name();
+  j["dimension"] = Dim;
   j["reference"] = a.reference;
-  j["coordinates"] = fit::CoordinateNames(*body);
+  j["coordinates"] = NamesOf(*body);
   std::ostringstream out;
   fit::FitReport report;
   if (!a.dynamic) {
@@ -456,7 +615,7 @@ int RunFitTrajectory(const FitTrajectoryArgs& a) {
     o.pose = po;
     o.pose.on_iteration = IterationLine();
     o.smoothness = a.smoothness;
-    const fit::TrajectoryFitResult r = fit::FitKinematicTrajectory(*body, frames, o);
+    const fit::TrajectoryFitResult r = FitKinematic(*body, frames, o);
     EndIterationLine();
     report = r.report;
     j["kind"] = "kinematic";
@@ -474,7 +633,7 @@ int RunFitTrajectory(const FitTrajectoryArgs& a) {
         << Num(r.rms_residual) << ".";
   } else {
     fit::DynamicFitOptions o;
-    o.world = MakeWorldParams(a.world);
+    SetWorld(a.world, &o, *body);
     RequirePositive(a.dt, "--dt");
     o.dt = a.dt;
     o.max_iterations = po.max_iterations;
@@ -502,7 +661,7 @@ int RunFitTrajectory(const FitTrajectoryArgs& a) {
     if (o.fit_times && !(o.switch_width > 0))
       throw UsageError("--fit times needs --switch-width > 0: a hard switch gives the times no gradient");
     if (!a.fit.q0.empty()) start.q0 = po.initial_q;
-    if (!a.qdot0.empty()) start.qd0 = ParseCoordinates(a.qdot0, "--qdot0", *body);
+    if (!a.qdot0.empty()) start.qd0 = StartVelocity(a.qdot0, "--qdot0", *body);
     try {
       fit::FrameSteps(frames, o.dt);
     } catch (const std::invalid_argument& e) {
@@ -559,6 +718,14 @@ int RunFitTrajectory(const FitTrajectoryArgs& a) {
     return kExitSimStopped;
   }
   return kExitOk;
+}
+
+}  // namespace
+
+int RunFitTrajectory(const FitTrajectoryArgs& a) {
+  CheckOutputs(a.fit);
+  if (formats::ObjectFileDimension(a.files.object) == 3) return RunTrajectory<3>(a, WithActiveModes(LoadBody3(a.files), a.active));
+  return RunTrajectory<2>(a, WithActiveModes(LoadBody(a.files), a.active));
 }
 
 }  // namespace wobble::app

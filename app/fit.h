@@ -1,10 +1,10 @@
 // `wobble fit pose` and `wobble fit trajectory`: the Ceres fits of lib/wobble/fit on files.
 //
 // Results are one JSON object (written atomically with --out, otherwise nothing is written),
-// the cost per iteration as CSV (--costs), and a short summary on stdout. The JSON's
-// "overlay" member (fitted body points next to their targets) is the hook for the overlay
-// picture and the cost chart, which will be drawn with the pipelines' chart API (issue 3)
-// once it exists: nothing here renders.
+// the cost per iteration as CSV (--costs), and a short summary on stdout. With a display the
+// pictures go beside them: the cost chart (FILE.png beside --costs) and, for 2D bodies, the
+// fitted points over their targets (FILE_overlay.png beside --out). A 3D object (`dimension 3`)
+// takes 3D target files and the fits of lib/wobble/fit/pose_fit3.h and dynamic_fit.h.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -34,6 +34,7 @@ struct FitPoseArgs {
   bool one_sided = false;
   bool alternate = false;
   int max_rounds = 30;
+  int mesh_samples = 400;  // 3D surface targets: body mesh vertices used as samples
 };
 
 struct FitTrajectoryArgs {

@@ -15,6 +15,8 @@
 #include "wobble/fit/pose_fit3.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "wobble/formats/parse_error.h"
+#include "wobble/formats/target_file.h"
 #include "wobble/world/world.h"
 
 namespace wobble {
@@ -191,9 +193,7 @@ TEST(PoseFit3, SurfaceWithoutCorrespondencesFindsThePoseAndTheShape) {
   const SurfaceMesh target_mesh = DeformedMesh(c, truth);
   fit::SurfaceTarget3 target;
   target.AddMesh(target_mesh);
-  fit::PoseFitOptions o;
-  o.use_mass_points = false;  // the mesh's vertices lie on the target surface at the truth
-  const fit::PoseFitResult r = fit::FitPoseToSurface3(c.body, target, o);
+  const fit::PoseFitResult r = fit::FitPoseToSurface3(c.body, target, {});  // samples: the mesh's vertices
   const QError e = Compare(r.q, truth);
   EXPECT_LT(e.translation, 1e-5) << r.report.brief_report;
   EXPECT_LT(e.angle, 1e-7);
@@ -212,7 +212,7 @@ TEST(PoseFit3, PointCloudWithoutCorrespondences) {
   fit::SurfaceTarget3 target;
   for (const Vec3& p : cloud) target.AddPoint(p);
   fit::PoseFitOptions o;
-  o.max_mesh_samples = 0;
+  o.max_mesh_samples = 0;  // the samples are the mass points
   const fit::PoseFitResult r = fit::FitPoseToSurface3(c.body, target, o);
   const QError e = Compare(r.q, truth);
   EXPECT_LT(e.translation, 1e-6) << r.report.brief_report;
@@ -278,6 +278,58 @@ TEST(TrajectoryFit3, SmoothnessOnTheGroupFiltersNoise) {
   const double raw = error(0.0), smoothed = error(100.0), oversmoothed = error(1e4);
   EXPECT_LT(smoothed, 0.6 * raw) << "raw " << raw << ", smoothed " << smoothed;
   EXPECT_GT(oversmoothed, smoothed);  // the term is real: too much of it bends the motion
+}
+
+// ---- 3D target files ----
+
+std::string TargetError(const std::string& text) {
+  std::istringstream in(text);
+  try {
+    formats::ParseTargets3(in, "dir/t.tgt", [](const std::string& path) {
+      if (path != "dir/scan.ply") throw std::runtime_error("cannot read " + path);
+      return Chair();
+    });
+  } catch (const formats::ParseError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(TargetFile3, ParsesEveryStatement) {
+  std::istringstream in("dimension 3\npoint 3 10 20 30\nsample 0.5 1 0.25 1.5 -2 7 weight 4\n");
+  const formats::TargetFile3 f = formats::ParseTargets3(in, "t.tgt");
+  ASSERT_EQ(f.points.size(), 2u);
+  EXPECT_EQ(f.points[0].position, Vec3(10, 20, 30));
+  EXPECT_EQ(f.points[1].lattice_coords, Vec3(0.5, 1, 0.25));
+  EXPECT_EQ(f.points[1].weight, 4.0);
+  std::istringstream surface("dimension 3\nmesh scan.ply   # beside the target file\ncloud 1 2 3\n");
+  const formats::TargetFile3 s = formats::ParseTargets3(surface, "dir/t.tgt", [](const std::string&) { return Chair(); });
+  EXPECT_EQ(s.mesh.triangles.size(), 36u);
+  EXPECT_EQ(s.cloud.size(), 1u);
+  EXPECT_TRUE(s.has_curve());
+  std::istringstream traj("dimension 3\nframe 0\npoint 0 1 2 3\nframe 0.5\npoint 0 1 3 4\n");
+  EXPECT_EQ(formats::ParseTargets3(traj, "k.tgt").frames.size(), 2u);
+}
+
+TEST(TargetFile3, RejectsMalformedInputWithFileAndLine) {
+  EXPECT_EQ(TargetError(""), "dir/t.tgt:0: file is empty: expected 'dimension 3' and point, sample, cloud, mesh or frame lines");
+  EXPECT_EQ(TargetError("point 0 1 2 3\n"),
+            "dir/t.tgt:1: the object is 3D: its target file starts with 'dimension 3' (got 'point')");
+  EXPECT_EQ(TargetError("dimension 2\npoint 0 1 2\n"), "dir/t.tgt:1: a 2D target file for a 3D object");
+  EXPECT_EQ(TargetError("dimension 3\npoint 0 1 2\n"), "dir/t.tgt:2: expected 4 numbers (point <k> <x> <y> <z> [weight <w>])");
+  EXPECT_EQ(TargetError("dimension 3\nsample 0 0 2 1 1 1\n"), "dir/t.tgt:2: lattice coordinate u must be in [0, 1], got 2");
+  EXPECT_EQ(TargetError("dimension 3\ncloud 1 2\n"), "dir/t.tgt:2: expected 3 numbers (cloud <x> <y> <z>)");
+  EXPECT_EQ(TargetError("dimension 3\nmesh other.ply\n"), "dir/t.tgt:2: mesh dir/other.ply: cannot read dir/other.ply");
+  EXPECT_EQ(TargetError("dimension 3\nmesh scan.ply\nmesh scan.ply\n"), "dir/t.tgt:3: mesh given twice (first on line 2)");
+  EXPECT_EQ(TargetError("dimension 3\npoint 0 1 2 3\nmesh scan.ply\n"),
+            "dir/t.tgt:3: a file holds correspondences (point/sample) or a surface (mesh/cloud), not both");
+  EXPECT_EQ(TargetError("dimension 3\nframe 0\npoint 0 1 2 3\ncloud 1 2 3\n"),
+            "dir/t.tgt:4: mesh/cloud lines are not allowed in a trajectory (frame) file");
+  EXPECT_EQ(TargetError("dimension 3\npolyline 0 0 1 1\n"),
+            "dir/t.tgt:2: 'polyline' is for 2D target files (expected point, sample, cloud, mesh or frame)");
+  EXPECT_EQ(TargetError("dimension 3\npoint 0 1 2 3\ndimension 3\n"), "dir/t.tgt:3: 'dimension' must be the first statement of the file");
+  std::istringstream no_reader("dimension 3\nmesh scan.ply\n");
+  EXPECT_THROW(formats::ParseTargets3(no_reader, "t.tgt"), formats::ParseError);
 }
 
 // ---- dynamic fits: through the simulation (StepBody3 with Jets) ----

@@ -8,6 +8,7 @@
 #include "wobble/body/body_model.h"
 #include "wobble/core/errors.h"
 #include "wobble/core/rotation3.h"
+#include "wobble/fit/pose_fit3.h"
 #include "wobble/scene/ffd_object.h"
 #ifdef WOBBLE_PYTHON_RENDER
 #include "pipelines/mesh_io.h"
@@ -94,6 +95,18 @@ void BindBodies3(py::module_& m) {
           py::arg("q") = py::none(),
           "(V, 3) world positions of the mesh's vertices at q: x = t + R (b0 + B γ), every vertex\n"
           "moved by the FFD of its lattice")
+      .def(
+          "mass_points_at",
+          [](const BodyModel3& b, const py::object& q_in) {
+            const int n = kRigidDofs3 + b.num_modes();
+            const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
+            std::vector<Eigen::Vector3d> x;
+            for (int k = 0; k < b.num_points(); ++k) x.push_back(fit::PointPosition3(fit::BasisOf3(b, k, {}), q));
+            return Rows3(x);
+          },
+          py::arg("q") = py::none(),
+          "(N, 3) world positions of the mass points at q = [t, r, γ] (r a rotation vector), as the\n"
+          "fits place them (wobble.fit_pose3's correspondences)")
       .def("__repr__", [](const BodyModel3& b) {
         return "<BodyModel3 '" + b.name() + "': " + std::to_string(b.num_points()) + " points, " +
                std::to_string(b.num_modes()) + " modes, " + std::to_string(b.def().mesh.points.size()) + " mesh vertices>";

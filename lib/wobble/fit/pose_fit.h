@@ -57,8 +57,8 @@ struct PoseFitOptions {
   // Curve fits: find the nearest segments inside every residual evaluation (one solve per
   // start) instead of alternating closest-point rounds and solves.
   bool joint_closest_points = true;
-  // 3D surface fits: at most this many of the body mesh's vertices join the mass points as
-  // body samples (evenly spread over the vertex list).
+  // 3D surface fits: at most this many of the body mesh's vertices are the body samples
+  // (0: the mass points are; see SurfaceSamples3). use_mass_points is for 2D curve fits.
   int max_mesh_samples = 400;
   // Compute PoseFitResult::conditioning (an SVD of the data Jacobian at the solution).
   bool analyze_conditioning = true;

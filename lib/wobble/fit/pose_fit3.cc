@@ -406,9 +406,9 @@ PoseFitResult FitPose3(const BodyModel3& body, const std::vector<Correspondence3
 
 std::vector<PointBasis3> SurfaceSamples3(const BodyModel3& body, const PoseFitOptions& o) {
   std::vector<PointBasis3> samples;
-  if (o.use_mass_points)
-    for (int k = 0; k < body.num_points(); ++k) samples.push_back(BasisOf3(body, k, {}));
   const size_t nv = body.def().mesh.points.size(), keep = std::min(nv, size_t(o.max_mesh_samples));
+  if (keep == 0)  // no mesh to sample: the mass points (a volume grid's lie inside the skin)
+    for (int k = 0; k < body.num_points(); ++k) samples.push_back(BasisOf3(body, k, {}));
   for (size_t i = 0; i < keep; ++i) {
     const int v = int(i * nv / keep);
     PointBasis3 p;
@@ -484,19 +484,38 @@ PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& ta
       if (!(w > 0)) w = point_weight * 1e-6;
     for (int i : target.cloud) tp.push_back(target.points[i]), tw.push_back(point_weight);
     const Shape3 bs = Principal3(rest, ones), ts = Principal3(tp, tw);
-    // axes matched in order, with the four sign choices that keep R a rotation
-    for (int k = 0; k < 4; ++k) {
-      Eigen::Vector3d s(k & 1 ? -1.0 : 1.0, k & 2 ? -1.0 : 1.0, 1.0);
-      Eigen::Matrix3d R = ts.axes * s.asDiagonal() * bs.axes.transpose();
-      if (R.determinant() < 0) {
-        s.z() = -1.0;
-        R = ts.axes * s.asDiagonal() * bs.axes.transpose();
+    // every proper rotation that carries the body's principal axes onto the target's, in any
+    // order (a deformation may change which axis is longest) and with any signs: 24; the
+    // kStartsSolved that fit best as they are (γ = 0) are solved
+    struct Candidate {
+      double cost;
+      Eigen::VectorXd q;
+    };
+    std::vector<Candidate> candidates;
+    const int permutations[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    for (const auto& perm : permutations)
+      for (int k = 0; k < 4; ++k) {
+        Eigen::Matrix3d target_axes;
+        for (int i = 0; i < 3; ++i) target_axes.col(i) = ts.axes.col(perm[i]);
+        Eigen::Vector3d sign(k & 1 ? -1.0 : 1.0, k & 2 ? -1.0 : 1.0, 1.0);
+        Eigen::Matrix3d R = target_axes * sign.asDiagonal() * bs.axes.transpose();
+        if (R.determinant() < 0) {
+          sign.z() = -1.0;
+          R = target_axes * sign.asDiagonal() * bs.axes.transpose();
+        }
+        Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
+        q.head<3>() = ts.centroid - R * bs.centroid;
+        q.segment<3>(3) = LogRotation<double>(Eigen::Quaterniond(R));
+        double cost = 0;
+        for (const PointBasis3& p : samples) {
+          const Eigen::Vector3d x = PointPosition3(p, q);
+          cost += (x - surface.Closest<double>(x)).squaredNorm();
+        }
+        candidates.push_back({cost, q});
       }
-      Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
-      q.head<3>() = ts.centroid - R * bs.centroid;
-      q.segment<3>(3) = LogRotation<double>(Eigen::Quaterniond(R));
-      starts.push_back(q);
-    }
+    constexpr size_t kStartsSolved = 4;
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
+    for (size_t i = 0; i < std::min(kStartsSolved, candidates.size()); ++i) starts.push_back(candidates[i].q);
   }
   PoseFitResult best;
   best.report.final_cost = std::numeric_limits<double>::infinity();

@@ -74,8 +74,10 @@ constexpr double kRecentreAngle = 1.0;
 PoseFitResult FitPose3(const BodyModel3& body, const std::vector<Correspondence3>& targets,
                        const PoseFitOptions& options);
 
-// Body samples of a surface fit: the mass points (options.use_mass_points) and up to
-// options.max_mesh_samples of the mesh's vertices, evenly spread over its vertex list.
+// Body samples of a surface fit: up to options.max_mesh_samples of the body mesh's vertices,
+// evenly spread over its vertex list; the mass points when there are none (no mesh, or
+// max_mesh_samples = 0). Not both: mass points sampled in the volume lie inside the skin,
+// and pulling them onto the target's surface would squeeze the body.
 std::vector<PointBasis3> SurfaceSamples3(const BodyModel3& body, const PoseFitOptions& options);
 
 // Without correspondences: the residual of every body sample is its distance to the nearest
@@ -84,8 +86,8 @@ std::vector<PointBasis3> SurfaceSamples3(const BodyModel3& body, const PoseFitOp
 // (options.two_sided): up to options.max_reverse_points target points (evenly spread) are
 // also pulled to the nearest body sample, weighted so that both directions weigh the same.
 // Starts (without options.initial_q): the samples' centroid onto the target's (area-weighted)
-// centroid with the principal axes aligned, in the four proper rotations the axes' signs
-// allow; the lowest final cost wins. point_residuals are those of the body samples.
+// centroid with the principal axes aligned, in any order and with any signs (24 rotations);
+// the four that fit best before solving are solved, the lowest final cost wins. point_residuals are those of the body samples.
 PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& target, const PoseFitOptions& options);
 
 // Length scales of the smoothness term, as SmoothnessScales in 2D: 1 for t, the rms radius
