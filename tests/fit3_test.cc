@@ -13,6 +13,7 @@
 #include "wobble/core/rotation3.h"
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/pose_fit3.h"
+#include "support/test_bodies.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
 #include "wobble/formats/parse_error.h"
@@ -24,27 +25,6 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-SurfaceMesh Box(const Vec3& lo, const Vec3& hi) {
-  SurfaceMesh m;
-  for (int i = 0; i < 8; ++i) m.points.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
-  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return m;
-}
-
-SurfaceMesh Join(SurfaceMesh a, const SurfaceMesh& b) {
-  const int offset = int(a.points.size());
-  a.points.insert(a.points.end(), b.points.begin(), b.points.end());
-  for (auto t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-  return a;
-}
-
-// A chair without any symmetry: a seat, a back and one arm.
-SurfaceMesh Chair() {
-  return Join(Join(Box(Vec3(0, 0, 0), Vec3(100, 20, 60)), Box(Vec3(0, 20, 0), Vec3(20, 90, 60))),
-              Box(Vec3(70, 20, 0), Vec3(100, 40, 15)));
-}
-
 struct Character {
   BodyDef3 def;
   std::vector<DeformationMode3> modes;
@@ -52,12 +32,8 @@ struct Character {
 };
 
 Character MakeChair() {
-  std::istringstream object("dimension 3\nmesh chair\nlattice fit 4 4 3 margin 0.05\nsample volume 300 100\n");
-  BodyDef3 def = formats::ParseObject3(object, "chair.obj", [](const std::string&) { return Chair(); });
-  std::istringstream text("dimension 3\nmode bend\n  bend x y 20\nmode twist\n  twist y 25\nmode squash\n  squash y 0.3\n");
-  std::vector<DeformationMode3> modes = formats::ParseDeformations3(text, "chair.def3", def.lattice);
-  BodyModel3 body(def, modes);
-  return {def, modes, body};
+  BodyModel3 body = testing::Chair3();
+  return {body.def(), body.modes(), body};
 }
 
 // Eq. 4.1/4.2 directly: the world position of the body point at lattice coordinates u.
@@ -287,7 +263,7 @@ std::string TargetError(const std::string& text) {
   try {
     formats::ParseTargets3(in, "dir/t.tgt", [](const std::string& path) {
       if (path != "dir/scan.ply") throw std::runtime_error("cannot read " + path);
-      return Chair();
+      return testing::ChairMesh();
     });
   } catch (const formats::ParseError& e) {
     return e.what();
@@ -303,7 +279,7 @@ TEST(TargetFile3, ParsesEveryStatement) {
   EXPECT_EQ(f.points[1].lattice_coords, Vec3(0.5, 1, 0.25));
   EXPECT_EQ(f.points[1].weight, 4.0);
   std::istringstream surface("dimension 3\nmesh scan.ply   # beside the target file\ncloud 1 2 3\n");
-  const formats::TargetFile3 s = formats::ParseTargets3(surface, "dir/t.tgt", [](const std::string&) { return Chair(); });
+  const formats::TargetFile3 s = formats::ParseTargets3(surface, "dir/t.tgt", [](const std::string&) { return testing::ChairMesh(); });
   EXPECT_EQ(s.mesh.triangles.size(), 36u);
   EXPECT_EQ(s.cloud.size(), 1u);
   EXPECT_TRUE(s.has_curve());

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "support/test_bodies.h"
 #include "wobble/body/body_model.h"
 #include "wobble/body/surface_mesh.h"
 #include "wobble/core/errors.h"
@@ -19,23 +20,8 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-// An axis-aligned box [lo, hi], 12 triangles, outward (or inward) normals.
-SurfaceMesh Box(const Vec3& lo, const Vec3& hi, bool inward = false) {
-  SurfaceMesh m;
-  for (int i = 0; i < 8; ++i) m.points.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
-  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  if (inward)
-    for (auto& t : m.triangles) std::swap(t[1], t[2]);
-  return m;
-}
-
-SurfaceMesh Join(SurfaceMesh a, const SurfaceMesh& b) {
-  const int offset = int(a.points.size());
-  a.points.insert(a.points.end(), b.points.begin(), b.points.end());
-  for (auto t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-  return a;
-}
+SurfaceMesh Box(const Vec3& lo, const Vec3& hi, bool inward = false) { return testing::BoxMesh(lo, hi, inward); }
+SurfaceMesh Join(SurfaceMesh a, const SurfaceMesh& b) { return testing::JoinMeshes(std::move(a), b); }
 
 // A UV sphere of radius r about c: `rings` latitude bands, `segments` longitudes.
 SurfaceMesh Sphere(const Vec3& c, double r, int rings, int segments) {

@@ -3,9 +3,13 @@
 #pragma once
 
 #include <random>
+#include <sstream>
 #include <vector>
 
 #include "wobble/body/body_model.h"
+#include "wobble/body/surface_mesh.h"
+#include "wobble/formats/deformation_file.h"
+#include "wobble/formats/object_file.h"
 #include "wobble/world/world.h"
 
 namespace wobble::testing {
@@ -99,6 +103,43 @@ inline BodyModel RandomBody(std::mt19937& rng, int num_s, int num_t, BasisKind b
     for (int c = 0; c < num_s * num_t; ++c) modes[d].displacement.push_back({disp(rng), disp(rng)});
   }
   return BodyModel(def, modes);
+}
+
+// ---- 3D meshes made of boxes ----
+
+// An axis-aligned box [lo, hi], 12 triangles, outward (or inward) normals.
+inline SurfaceMesh BoxMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, bool inward = false) {
+  SurfaceMesh m;
+  for (int i = 0; i < 8; ++i) m.points.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  if (inward)
+    for (auto& t : m.triangles) std::swap(t[1], t[2]);
+  return m;
+}
+
+inline SurfaceMesh JoinMeshes(SurfaceMesh a, const SurfaceMesh& b) {
+  const int offset = int(a.points.size());
+  a.points.insert(a.points.end(), b.points.begin(), b.points.end());
+  for (auto t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  return a;
+}
+
+// A chair without any symmetry (a seat, a back and one arm), for fits without correspondences.
+inline SurfaceMesh ChairMesh() {
+  using V = Eigen::Vector3d;
+  return JoinMeshes(JoinMeshes(BoxMesh(V(0, 0, 0), V(100, 20, 60)), BoxMesh(V(0, 20, 0), V(20, 90, 60))),
+                    BoxMesh(V(70, 20, 0), V(100, 40, 15)));
+}
+
+// The chair as a 3D FFD character: its lattice fitted with a 5% margin, 100 kg on a volume grid
+// of about 300 points, and three modes from generators (bend x by y, twist about y, squash y).
+inline BodyModel3 Chair3() {
+  std::istringstream object("dimension 3\nmesh chair\nlattice fit 4 4 3 margin 0.05\nsample volume 300 100\n");
+  BodyDef3 def = formats::ParseObject3(object, "chair.obj", [](const std::string&) { return ChairMesh(); });
+  std::istringstream text("dimension 3\nmode bend\n  bend x y 20\nmode twist\n  twist y 25\nmode squash\n  squash y 0.3\n");
+  std::vector<DeformationMode3> modes = formats::ParseDeformations3(text, "chair.def3", def.lattice);
+  return BodyModel3(def, modes);
 }
 
 }  // namespace wobble::testing

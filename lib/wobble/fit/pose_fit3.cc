@@ -438,6 +438,23 @@ Shape3 Principal3(const std::vector<Eigen::Vector3d>& p, const std::vector<doubl
   return s;
 }
 
+// Points and weights that stand for a shape in its principal axes: triangle centroids weighted
+// by area, and loose points weighted like an average triangle (1 without triangles).
+void ShapePoints(const std::vector<Eigen::Vector3d>& points, const std::vector<std::array<int, 3>>& triangles,
+                 const std::vector<int>& loose, std::vector<Eigen::Vector3d>* p, std::vector<double>* w) {
+  double area_sum = 0;
+  for (const std::array<int, 3>& t : triangles) {
+    const Eigen::Vector3d &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
+    p->push_back((a + b + c) / 3.0);
+    w->push_back(0.5 * (b - a).cross(c - a).norm());
+    area_sum += w->back();
+  }
+  const double point_weight = triangles.empty() || !(area_sum > 0) ? 1.0 : area_sum / double(triangles.size());
+  for (double& x : *w)
+    if (!(x > 0)) x = point_weight * 1e-6;  // a degenerate triangle still counts a little
+  for (int i : loose) p->push_back(points[i]), w->push_back(point_weight);
+}
+
 }  // namespace
 
 PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& target, const PoseFitOptions& o) {
@@ -469,21 +486,20 @@ PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& ta
   if (o.initial_q.size()) {
     starts.push_back(o.initial_q);
   } else {
-    std::vector<Eigen::Vector3d> rest, tp;
-    std::vector<double> ones(ns, 1.0), tw;
-    for (const PointBasis3& s : samples) rest.push_back(s.b0);
-    double area_sum = 0;
-    for (const std::array<int, 3>& t : target.triangles) {
-      const Eigen::Vector3d &a = target.points[t[0]], &b = target.points[t[1]], &c = target.points[t[2]];
-      tp.push_back((a + b + c) / 3.0);
-      tw.push_back(0.5 * (b - a).cross(c - a).norm());
-      area_sum += tw.back();
+    // the same measure on both sides: area on a mesh, count on points
+    std::vector<Eigen::Vector3d> bp, tp;
+    std::vector<double> bw, tw;
+    const SurfaceMesh& mesh = body.def().mesh;
+    if (!mesh.empty() && o.max_mesh_samples > 0) {
+      ShapePoints(mesh.points, mesh.triangles, {}, &bp, &bw);
+    } else {
+      std::vector<Eigen::Vector3d> rest;
+      std::vector<int> all;
+      for (const PointBasis3& p : samples) all.push_back(int(rest.size())), rest.push_back(p.b0);
+      ShapePoints(rest, {}, all, &bp, &bw);
     }
-    const double point_weight = target.triangles.empty() || !(area_sum > 0) ? 1.0 : area_sum / target.triangles.size();
-    for (double& w : tw)
-      if (!(w > 0)) w = point_weight * 1e-6;
-    for (int i : target.cloud) tp.push_back(target.points[i]), tw.push_back(point_weight);
-    const Shape3 bs = Principal3(rest, ones), ts = Principal3(tp, tw);
+    ShapePoints(target.points, target.triangles, target.cloud, &tp, &tw);
+    const Shape3 bs = Principal3(bp, bw), ts = Principal3(tp, tw);
     // every proper rotation that carries the body's principal axes onto the target's, in any
     // order (a deformation may change which axis is longest) and with any signs: 24; the
     // kStartsSolved that fit best as they are (γ = 0) are solved
@@ -526,6 +542,8 @@ PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& ta
     SolvePose3(D, o, add_terms, &run.q, &run.report);
     seconds += run.report.solve_seconds;
     if (!(run.report.final_cost >= best.report.final_cost)) best = run;
+    // a start that met the target exactly (cost down by 1e12) leaves nothing for the others
+    if (run.report.final_cost <= 1e-12 * run.report.initial_cost) break;
   }
   best.report.solve_seconds = seconds;
   best.rounds = 1;

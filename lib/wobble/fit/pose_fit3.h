@@ -86,8 +86,9 @@ std::vector<PointBasis3> SurfaceSamples3(const BodyModel3& body, const PoseFitOp
 // (options.two_sided): up to options.max_reverse_points target points (evenly spread) are
 // also pulled to the nearest body sample, weighted so that both directions weigh the same.
 // Starts (without options.initial_q): the samples' centroid onto the target's (area-weighted)
-// centroid with the principal axes aligned, in any order and with any signs (24 rotations);
-// the four that fit best before solving are solved, the lowest final cost wins. point_residuals are those of the body samples.
+// centroid with the principal axes aligned (area-weighted on meshes, on both sides), in any
+// order and with any signs (24 rotations); the four that fit best before solving are solved,
+// best first, until one meets the target exactly (cost down by 1e12); the lowest cost wins. point_residuals are those of the body samples.
 PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& target, const PoseFitOptions& options);
 
 // Length scales of the smoothness term, as SmoothnessScales in 2D: 1 for t, the rms radius
