@@ -1,5 +1,5 @@
-// What every fuzz target shares: the one list of expected failures, the table body of data/,
-// and a reader of typed values from the fuzzer's bytes.
+// What every fuzz target shares: the one list of expected failures, the table bodies of data/,
+// the stand-in mesh reader, and a reader of typed values from the fuzzer's bytes.
 #pragma once
 
 #include <cmath>
@@ -38,6 +38,34 @@ inline std::shared_ptr<const BodyModel> TableBody() {
   static const std::shared_ptr<const BodyModel> body = std::make_shared<const BodyModel>(
       formats::ReadObjectFile(kDataDir + "/table.obj"), formats::ReadDeformationFile(kDataDir + "/table_modes.def"));
   return body;
+}
+
+// The 3D table (data/table3.obj, mass points only) with its four modes, read once per process.
+inline std::shared_ptr<const BodyModel3> Table3Body() {
+  static const std::shared_ptr<const BodyModel3> body = [] {
+    BodyDef3 def = formats::ReadObjectFile3(kDataDir + "/table3.obj");
+    auto modes = formats::ReadDeformationFile3(kDataDir + "/table3_modes.def3", def.lattice);
+    return std::make_shared<const BodyModel3>(std::move(def), std::move(modes));
+  }();
+  return body;
+}
+
+// The mesh reader of the fuzzers (no VTK here): "box" is a closed 100 x 50 x 80 box, "sheet" a
+// flat square (no volume), anything else fails as a reader would.
+inline SurfaceMesh StandInMesh(const std::string& path) {
+  SurfaceMesh mesh;
+  const std::string name = path.substr(path.find_last_of('/') + 1);
+  if (name == "box") {
+    for (int i = 0; i < 8; ++i) mesh.points.emplace_back(i & 1 ? 100 : 0, i & 2 ? 50 : 0, i & 4 ? 80 : 0);
+    mesh.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                      {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  } else if (name == "sheet") {
+    mesh.points = {{0, 0, 0}, {10, 0, 0}, {0, 0, 10}, {10, 0, 10}};
+    mesh.triangles = {{0, 1, 2}, {1, 3, 2}};
+  } else {
+    throw std::runtime_error("no such mesh");
+  }
+  return mesh;
 }
 
 // Typed values from the front of the input, like LLVM's FuzzedDataProvider but reading plain

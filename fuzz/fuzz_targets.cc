@@ -1,6 +1,8 @@
-// formats::ParseTargets on arbitrary bytes, then what `wobble fit` does with a file before
-// fitting (app/fit.cc): CheckMassPointIndices against the table's mass points, the curve
-// target and the basis of every body point (fit/targets.cc).
+// formats::ParseTargets and ParseTargets3 on arbitrary bytes (each input is read as both: one
+// of them refuses it at its first line unless it is a 'dimension' line), then what `wobble
+// fit` does with a file before fitting (app/fit.cc): CheckMassPointIndices against the 2D or
+// 3D table's mass points, the curve or surface target, and the basis of every body point
+// (fit/targets.cc). 3D 'mesh' lines get the stand-in reader of fuzz_common.h.
 #include <sstream>
 
 #include "fuzz_common.h"
@@ -29,6 +31,31 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (const formats::PointTarget& t : targets.points) basis(t);
     for (const formats::TargetFrame& f : targets.frames)
       for (const formats::PointTarget& t : f.points) basis(t);
+  });
+  fuzz::IgnoringExpectedErrors([&] {
+    std::istringstream in(fuzz::AsText(data, size));
+    const formats::TargetFile3 targets = formats::ParseTargets3(in, "fuzz.tgt", fuzz::StandInMesh);
+    if (targets.has_correspondences() && targets.has_curve()) std::abort();
+    if (targets.is_trajectory() && targets.has_curve()) std::abort();
+    if (!targets.polylines.empty()) std::abort();  // no polylines in 3D
+    for (size_t f = 1; f < targets.frames.size(); ++f)
+      if (!(targets.frames[f].time > targets.frames[f - 1].time)) std::abort();
+    const BodyModel3& table = *fuzz::Table3Body();
+    formats::CheckMassPointIndices(targets, table.num_points());
+    fit::SurfaceTarget3 surface;
+    if (!targets.mesh.empty()) surface.AddMesh(targets.mesh);
+    for (const Eigen::Vector3d& p : targets.cloud) surface.AddPoint(p);
+    for (const auto& t : surface.triangles)
+      for (int i : t)
+        if (i < 0 || i >= int(surface.points.size())) std::abort();
+    const Eigen::VectorXd q = Eigen::VectorXd::Zero(table.num_q());
+    auto basis = [&](const formats::PointTarget3& t) {
+      const fit::PointBasis3 b = fit::BasisOf3(table, t.mass_point, t.lattice_coords);
+      if (!b.b0.allFinite() || !b.B.allFinite() || !fit::PointPosition3(b, q).allFinite()) std::abort();
+    };
+    for (const formats::PointTarget3& t : targets.points) basis(t);
+    for (const formats::TargetFrame3& f : targets.frames)
+      for (const formats::PointTarget3& t : f.points) basis(t);
   });
   return 0;
 }

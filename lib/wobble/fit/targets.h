@@ -3,10 +3,12 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 #include <vector>
 
 #include "wobble/body/body_model.h"
+#include "wobble/body/surface_mesh.h"
 
 namespace wobble::fit {
 
@@ -56,5 +58,38 @@ template <class T> Vec2<T> PointPosition(const PointBasis& p, const T* q, int nu
   const T c = cos(q[2]), s = sin(q[2]);
   return Vec2<T>(q[0] + c * lx - s * ly, q[1] + s * lx + c * ly);
 }
+
+// ---- 3D bodies (pose_fit3.h): q = [t, r, γ], r a rotation vector ----
+
+struct Correspondence3 {
+  int mass_point = -1;                                       // >= 0: this mass point
+  Eigen::Vector3d lattice_coords = Eigen::Vector3d::Zero();  // (s, t, u), used when mass_point < 0
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();        // world
+  double weight = 1.0;                                       // > 0
+};
+
+struct ReferenceFrame3 {
+  double time = 0.0;
+  std::vector<Correspondence3> points;
+};
+
+// A target without correspondences: triangles (a surface) and unordered points.
+struct SurfaceTarget3 {
+  std::vector<Eigen::Vector3d> points;             // the mesh's vertices, then cloud points
+  std::vector<std::array<int, 3>> triangles;       // indices into points
+  std::vector<int> cloud;                          // points that belong to no triangle
+  void AddMesh(const SurfaceMesh& mesh);
+  void AddPoint(const Eigen::Vector3d& p);
+  bool empty() const { return triangles.empty() && cloud.empty(); }
+};
+
+struct PointBasis3 {
+  Eigen::Vector3d b0 = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, 3, Eigen::Dynamic> B;
+};
+// Mass point k, or the body point at lattice coordinates (s, t, u) when k < 0.
+PointBasis3 BasisOf3(const BodyModel3& body, int mass_point, const Eigen::Vector3d& lattice_coords);
+// World position of a body point at q = [t, r, γ] (r a rotation vector), in plain doubles.
+Eigen::Vector3d PointPosition3(const PointBasis3& p, const Eigen::VectorXd& q);
 
 }  // namespace wobble::fit
