@@ -106,7 +106,7 @@ void BindBodies3(py::module_& m) {
           },
           py::arg("q") = py::none(),
           "(N, 3) world positions of the mass points at q = [t, r, γ] (r a rotation vector), as the\n"
-          "fits place them (wobble.fit_pose3's correspondences)")
+          "fits place them (the correspondences of wobble.fit_pose with mass_points)")
       .def("__repr__", [](const BodyModel3& b) {
         return "<BodyModel3 '" + b.name() + "': " + std::to_string(b.num_points()) + " points, " +
                std::to_string(b.num_modes()) + " modes, " + std::to_string(b.def().mesh.points.size()) + " mesh vertices>";

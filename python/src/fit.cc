@@ -1,19 +1,24 @@
 // Fits from Python (fit/pose_fit.h, Ceres): mode amplitudes and placement from target points
 // (mass points or lattice points matched to world positions) or from target curves, with the
-// report and the conditioning of the fit (which modes the data cannot see).
+// report and the conditioning of the fit (which modes the data cannot see). Every fit takes a
+// 3D body too (fit/pose_fit3.h: points (K, 3), q = [t, r, γ]); 3D surfaces without
+// correspondences go to fit_pose_to_surface.
 #include "support.h"
 
 #include <cmath>
 
+#include "wobble/body/surface_mesh.h"
 #include "wobble/core/errors.h"
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/pose_fit.h"
+#include "wobble/fit/pose_fit3.h"
 #include "wobble/fit/trajectory_fit.h"
 
 namespace wobble::python {
 namespace {
 
-fit::PoseFitOptions Options(const BodyModel& body, const py::object& initial_q, const std::string& loss, double loss_scale,
+template <int Dim>
+fit::PoseFitOptions Options(const BodyModelN<Dim>& body, const py::object& initial_q, const std::string& loss, double loss_scale,
                             double prior_weight, std::pair<double, double> bounds, int max_iterations) {
   fit::PoseFitOptions o;
   if (!initial_q.is_none()) {
@@ -27,26 +32,33 @@ fit::PoseFitOptions Options(const BodyModel& body, const py::object& initial_q, 
   o.gamma_lower = bounds.first;
   o.gamma_upper = bounds.second;
   o.max_iterations = max_iterations;
-  const std::string error = fit::ValidateOptions(o, body.num_modes());
+  const std::string error = fit::ValidateOptions(o, body.num_modes(), body.num_q() - body.num_modes());
   if (!error.empty()) throw InputError("pose fit: " + error);
   return o;
 }
 
-// Target points: positions (K, 2), each on a mass point (mass_points, K ints) or at lattice
-// coordinates (lattice_coords, K x 2); weights > 0.
-std::vector<fit::Correspondence> Targets(const BodyModel& body, const py::object& positions_in, const py::object& mass_points,
-                                         const py::object& lattice_coords, const py::object& weights_in) {
+// The correspondence and frame types of a dimension.
+template <int Dim> using CorrespondenceOf = std::conditional_t<Dim == 2, fit::Correspondence, fit::Correspondence3>;
+template <int Dim> using FrameOf = std::conditional_t<Dim == 2, fit::ReferenceFrame, fit::ReferenceFrame3>;
+
+// Target points: positions (K, Dim), each on a mass point (mass_points, K ints) or at lattice
+// coordinates (lattice_coords, K x Dim); weights > 0.
+template <int Dim>
+std::vector<CorrespondenceOf<Dim>> Targets(const BodyModelN<Dim>& body, const py::object& positions_in,
+                                           const py::object& mass_points, const py::object& lattice_coords,
+                                           const py::object& weights_in) {
   auto probe = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(positions_in);
-  if (!probe || probe.ndim() != 2) throw InputError("points: expected an array (K, 2) of world positions");
+  const std::string dim = std::to_string(Dim);
+  if (!probe || probe.ndim() != 2) throw InputError("points: expected an array (K, " + dim + ") of world positions");
   const long K = probe.shape(0);
-  auto positions = AsMatrix(probe, K, 2, "points");
+  auto positions = AsMatrix(probe, K, Dim, "points");
   if (mass_points.is_none() == lattice_coords.is_none())
-    throw InputError("give the body's points as exactly one of mass_points (K,) or lattice_coords (K, 2)");
-  std::vector<fit::Correspondence> out(K);
+    throw InputError("give the body's points as exactly one of mass_points (K,) or lattice_coords (K, " + dim + ")");
+  std::vector<CorrespondenceOf<Dim>> out(K);
   std::vector<long> which;
   if (!mass_points.is_none()) which = mass_points.cast<std::vector<long>>();
   py::array_t<double, py::array::c_style> st;
-  if (!lattice_coords.is_none()) st = AsMatrix(lattice_coords, K, 2, "lattice_coords");
+  if (!lattice_coords.is_none()) st = AsMatrix(lattice_coords, K, Dim, "lattice_coords");
   if (!mass_points.is_none() && long(which.size()) != K)
     throw InputError("mass_points: expected " + std::to_string(K) + " indices, one per point, got " + std::to_string(which.size()));
   std::vector<double> weights(K, 1.0);
@@ -55,8 +67,8 @@ std::vector<fit::Correspondence> Targets(const BodyModel& body, const py::object
     weights.assign(w.data(), w.data() + K);
   }
   for (long k = 0; k < K; ++k) {
-    fit::Correspondence& c = out[k];
-    c.position = Eigen::Vector2d(positions.at(k, 0), positions.at(k, 1));
+    CorrespondenceOf<Dim>& c = out[k];
+    for (int i = 0; i < Dim; ++i) c.position[i] = positions.at(k, i);
     if (!c.position.allFinite()) throw InputError("points[" + std::to_string(k) + "] is not finite");
     if (!(weights[k] > 0) || !std::isfinite(weights[k]))
       throw InputError("weights[" + std::to_string(k) + "] must be a finite number > 0");
@@ -67,7 +79,7 @@ std::vector<fit::Correspondence> Targets(const BodyModel& body, const py::object
                          std::to_string(body.num_points()) + " mass points");
       c.mass_point = int(which[k]);
     } else {
-      c.lattice_coords = Eigen::Vector2d(st.at(k, 0), st.at(k, 1));
+      for (int i = 0; i < Dim; ++i) c.lattice_coords[i] = st.at(k, i);
       if (!c.lattice_coords.allFinite()) throw InputError("lattice_coords[" + std::to_string(k) + "] is not finite");
     }
   }
@@ -82,30 +94,136 @@ Eigen::VectorXd OptionalVector(const py::object& v, long n, const std::string& w
   return out;
 }
 
-// Reference frames: times (F,), world positions (F, K, 2) of the mass points mass_points (K,).
-std::vector<fit::ReferenceFrame> Frames(const BodyModel& body, const py::object& times_in, const py::object& points_in,
-                                        const std::vector<long>& mass_points) {
+// Reference frames: times (F,), world positions (F, K, Dim) of the mass points mass_points (K,).
+template <int Dim>
+std::vector<FrameOf<Dim>> Frames(const BodyModelN<Dim>& body, const py::object& times_in, const py::object& points_in,
+                                 const std::vector<long>& mass_points) {
   auto probe = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(times_in);
   if (!probe || probe.ndim() != 1 || probe.shape(0) < 1) throw InputError("times: expected (F,) frame times, F >= 1");
   const long F = probe.shape(0), K = long(mass_points.size());
   auto points = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(points_in);
-  if (!points || points.ndim() != 3 || points.shape(0) != F || points.shape(1) != K || points.shape(2) != 2)
-    throw InputError("points: expected shape (" + std::to_string(F) + ", " + std::to_string(K) + ", 2): frames x mass_points x (x, y)");
-  std::vector<fit::ReferenceFrame> frames(F);
+  if (!points || points.ndim() != 3 || points.shape(0) != F || points.shape(1) != K || points.shape(2) != Dim)
+    throw InputError("points: expected shape (" + std::to_string(F) + ", " + std::to_string(K) + ", " + std::to_string(Dim) +
+                     "): frames x mass_points x coordinates");
+  std::vector<FrameOf<Dim>> frames(F);
   for (long f = 0; f < F; ++f) {
     frames[f].time = probe.at(f);
     if (!std::isfinite(frames[f].time)) throw InputError("times[" + std::to_string(f) + "] is not finite");
     for (long k = 0; k < K; ++k) {
-      fit::Correspondence c;
+      CorrespondenceOf<Dim> c;
       if (mass_points[k] < 0 || mass_points[k] >= body.num_points())
         throw InputError("mass_points[" + std::to_string(k) + "]: the body has " + std::to_string(body.num_points()) + " mass points");
       c.mass_point = int(mass_points[k]);
-      c.position = Eigen::Vector2d(points.at(f, k, 0), points.at(f, k, 1));
+      for (int i = 0; i < Dim; ++i) c.position[i] = points.at(f, k, i);
       if (!c.position.allFinite()) throw InputError("points[" + std::to_string(f) + ", " + std::to_string(k) + "] is not finite");
       frames[f].points.push_back(c);
     }
   }
   return frames;
+}
+
+// The fits of both dimensions under one name each (pybind11 overloads on the body's type).
+template <int Dim> void BindPoseFit(py::module_& m) {
+  m.def(
+      "fit_pose",
+      [](std::shared_ptr<BodyModelN<Dim>> body, const py::object& points, const py::object& mass_points,
+         const py::object& lattice_coords, const py::object& weights, const py::object& initial_q, const std::string& loss,
+         double loss_scale, double prior_weight, std::pair<double, double> bounds, int max_iterations) {
+        const auto targets = Targets(*body, points, mass_points, lattice_coords, weights);
+        const auto o = Options(*body, initial_q, loss, loss_scale, prior_weight, bounds, max_iterations);
+        return WithCtrlC([&] {
+          if constexpr (Dim == 2) {
+            return fit::FitPose(*body, targets, o);
+          } else {
+            return fit::FitPose3(*body, targets, o);
+          }
+        });
+      },
+      py::arg("body"), py::arg("points"), py::kw_only(), py::arg("mass_points") = py::none(),
+      py::arg("lattice_coords") = py::none(), py::arg("weights") = py::none(), py::arg("initial_q") = py::none(),
+      py::arg("loss") = "squared", py::arg("loss_scale") = 1.0, py::arg("prior_weight") = 0.0,
+      py::arg("mode_bounds") = std::make_pair(-1.0, 1.0), py::arg("max_iterations") = 200,
+      Dim == 2 ? "Fits q = [tx, ty, θ, γ...] so that the body's points land on `points` (K, 2): point k is mass\n"
+                 "point mass_points[k], or the lattice point lattice_coords[k] = (s, t). Like `wobble fit pose`.\n"
+                 "loss: squared, huber or cauchy (robust, scale loss_scale); prior_weight pulls γ to 0."
+               : "A 3D body: points (K, 3), lattice_coords (s, t, u), q = [tx, ty, tz, rx, ry, rz, γ...] with r\n"
+                 "the rotation vector (fit/pose_fit3.h: Kabsch start, the turn solved on SO(3)).");
+}
+
+template <int Dim> void BindTrajectoryFit(py::module_& m) {
+  m.def(
+      "fit_trajectory",
+      [](std::shared_ptr<BodyModelN<Dim>> body, const py::object& times, const py::object& points,
+         const std::vector<long>& mass_points, double smoothness, const std::string& loss, double loss_scale,
+         double prior_weight, std::pair<double, double> bounds, int max_iterations) {
+        const auto frames = Frames(*body, times, points, mass_points);
+        if (!(smoothness >= 0) || !std::isfinite(smoothness)) throw InputError("smoothness must be a finite number >= 0");
+        fit::TrajectoryFitOptions o;
+        o.pose = Options(*body, py::none(), loss, loss_scale, prior_weight, bounds, max_iterations);
+        o.smoothness = smoothness;
+        return WithCtrlC([&] {
+          if constexpr (Dim == 2) {
+            return fit::FitKinematicTrajectory(*body, frames, o);
+          } else {
+            return fit::FitKinematicTrajectory3(*body, frames, o);
+          }
+        });
+      },
+      py::arg("body"), py::arg("times"), py::arg("points"), py::arg("mass_points"), py::kw_only(),
+      py::arg("smoothness") = 1.0, py::arg("loss") = "squared", py::arg("loss_scale") = 1.0,
+      py::arg("prior_weight") = 0.0, py::arg("mode_bounds") = std::make_pair(-1.0, 1.0), py::arg("max_iterations") = 200,
+      Dim == 2 ? "Fits a pose per frame to mass points mass_points (K,) seen at `points` (F, K, 2), all frames\n"
+                 "in one problem with ½ w Σ |L Δ²q|² (w = smoothness) tying neighbours. Like `wobble fit trajectory`."
+               : "A 3D body: points (F, K, 3); q rows [t, r, γ], the orientation's smoothness on SO(3).");
+}
+
+template <int Dim> void BindDynamicFit(py::module_& m) {
+  m.def(
+      "fit_dynamic",
+      [](std::shared_ptr<BodyModelN<Dim>> body, const py::object& times, const py::object& points,
+         const std::vector<long>& mass_points, const py::object& q0, const py::object& qd0, const py::object& stiffness,
+         const py::object& damping, const py::object& graph, const WorldOptions& world, bool fit_q0, bool fit_qd0,
+         bool fit_stiffness, bool fit_damping, bool fit_poses, bool fit_times, double switch_width, int max_iterations) {
+        const auto frames = Frames(*body, times, points, mass_points);
+        fit::DynamicParameters start;
+        start.q0 = OptionalVector(q0, body->num_q(), "q0");
+        start.qd0 = OptionalVector(qd0, body->num_q(), "qd0");
+        start.stiffness = OptionalVector(stiffness, body->num_modes(), "stiffness");
+        start.damping = OptionalVector(damping, body->num_modes(), "damping");
+        if (!graph.is_none()) start.graph = graph.cast<control::PoseGraph>();
+        if (world.integrator != Integrator::kThesis)
+          throw InputError("fit_dynamic simulates with the thesis integrator (options.integrator = 'thesis')");
+        fit::DynamicFitOptions o;
+        o.world = world.params;
+        // a 3D body's world, as World::Params3 makes it
+        o.world3.gravity_on = world.params.gravity_on;
+        o.world3.gravity = world.gravity_3d;
+        o.world3.ground = world.ground_3d;
+        o.world3.springs = world.springs_3d;
+        o.world3.max_condition = world.params.max_condition;
+        o.dt = world.dt;
+        o.fit_q0 = fit_q0;
+        o.fit_qd0 = fit_qd0;
+        o.fit_stiffness = fit_stiffness;
+        o.fit_damping = fit_damping;
+        o.fit_poses = fit_poses;
+        o.fit_times = fit_times;
+        o.switch_width = switch_width;
+        o.max_iterations = max_iterations;
+        return WithCtrlC([&] { return fit::FitDynamicTrajectory(*body, frames, start, o); });
+      },
+      py::arg("body"), py::arg("times"), py::arg("points"), py::arg("mass_points"), py::kw_only(),
+      py::arg("q0") = py::none(), py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(),
+      py::arg("damping") = py::none(), py::arg("graph") = py::none(), py::arg("options") = WorldOptions(),
+      py::arg("fit_q0") = true, py::arg("fit_qd0") = true, py::arg("fit_stiffness") = true, py::arg("fit_damping") = true,
+      py::arg("fit_poses") = false, py::arg("fit_times") = false, py::arg("switch_width") = 0.05,
+      py::arg("max_iterations") = 50,
+      Dim == 2 ? "Fits the start state, mode stiffness and damping (and a pose graph's poses and times) so that\n"
+                 "a simulation puts mass points mass_points (K,) where `points` (F, K, 2) has them at `times`\n"
+                 "(F,, on the step grid). Starts: q0/qd0 None: from pose fits of the first frames; stiffness\n"
+                 "and damping None: the body's. Like `wobble fit trajectory --dynamic`; differentiates with Ceres Jets."
+               : "A 3D body: points (F, K, 3), q0 = [t, r, γ], qd0 = [ṫ, body ω, γ̇]; the world's 3D gravity,\n"
+                 "ground plane and springs (options.gravity_3d, ground_3d, springs_3d).");
 }
 
 }  // namespace
@@ -137,22 +255,8 @@ void BindFit(py::module_& m) {
       .def_readonly("conditioning", &fit::PoseFitResult::conditioning)
       .def_readonly("rounds", &fit::PoseFitResult::rounds, "curve fits: closest-point rounds");
 
-  m.def(
-      "fit_pose",
-      [](std::shared_ptr<BodyModel> body, const py::object& points, const py::object& mass_points,
-         const py::object& lattice_coords, const py::object& weights, const py::object& initial_q, const std::string& loss,
-         double loss_scale, double prior_weight, std::pair<double, double> bounds, int max_iterations) {
-        const auto targets = Targets(*body, points, mass_points, lattice_coords, weights);
-        const auto o = Options(*body, initial_q, loss, loss_scale, prior_weight, bounds, max_iterations);
-        return WithCtrlC([&] { return fit::FitPose(*body, targets, o); });
-      },
-      py::arg("body"), py::arg("points"), py::kw_only(), py::arg("mass_points") = py::none(),
-      py::arg("lattice_coords") = py::none(), py::arg("weights") = py::none(), py::arg("initial_q") = py::none(),
-      py::arg("loss") = "squared", py::arg("loss_scale") = 1.0, py::arg("prior_weight") = 0.0,
-      py::arg("mode_bounds") = std::make_pair(-1.0, 1.0), py::arg("max_iterations") = 200,
-      "Fits q = [tx, ty, θ, γ...] so that the body's points land on `points` (K, 2): point k is mass\n"
-      "point mass_points[k], or the lattice point lattice_coords[k] = (s, t). Like `wobble fit pose`.\n"
-      "loss: squared, huber or cauchy (robust, scale loss_scale); prior_weight pulls γ to 0.");
+  BindPoseFit<2>(m);
+  BindPoseFit<3>(m);
 
   py::class_<fit::TrajectoryFitResult>(m, "TrajectoryFitResult", "One pose per frame, fitted together with a smoothness term.")
       .def_readonly("times", &fit::TrajectoryFitResult::times)
@@ -168,23 +272,8 @@ void BindFit(py::module_& m) {
       .def_readonly("rms_residual", &fit::TrajectoryFitResult::rms_residual)
       .def_readonly("linear_solver", &fit::TrajectoryFitResult::linear_solver);
 
-  m.def(
-      "fit_trajectory",
-      [](std::shared_ptr<BodyModel> body, const py::object& times, const py::object& points,
-         const std::vector<long>& mass_points, double smoothness, const std::string& loss, double loss_scale,
-         double prior_weight, std::pair<double, double> bounds, int max_iterations) {
-        const auto frames = Frames(*body, times, points, mass_points);
-        if (!(smoothness >= 0) || !std::isfinite(smoothness)) throw InputError("smoothness must be a finite number >= 0");
-        fit::TrajectoryFitOptions o;
-        o.pose = Options(*body, py::none(), loss, loss_scale, prior_weight, bounds, max_iterations);
-        o.smoothness = smoothness;
-        return WithCtrlC([&] { return fit::FitKinematicTrajectory(*body, frames, o); });
-      },
-      py::arg("body"), py::arg("times"), py::arg("points"), py::arg("mass_points"), py::kw_only(),
-      py::arg("smoothness") = 1.0, py::arg("loss") = "squared", py::arg("loss_scale") = 1.0,
-      py::arg("prior_weight") = 0.0, py::arg("mode_bounds") = std::make_pair(-1.0, 1.0), py::arg("max_iterations") = 200,
-      "Fits a pose per frame to mass points mass_points (K,) seen at `points` (F, K, 2), all frames\n"
-      "in one problem with ½ w Σ |L Δ²q|² (w = smoothness) tying neighbours. Like `wobble fit trajectory`.");
+  BindTrajectoryFit<2>(m);
+  BindTrajectoryFit<3>(m);
 
   py::class_<fit::DynamicParameters>(m, "DynamicParameters", "What a dynamic fit fits: start state, mode constants, controller.")
       .def_readonly("q0", &fit::DynamicParameters::q0)
@@ -198,44 +287,8 @@ void BindFit(py::module_& m) {
       .def_readonly("rms_residual", &fit::DynamicFitResult::rms_residual, "simulated points to the reference, all frames")
       .def_readonly("simulations", &fit::DynamicFitResult::simulations);
 
-  m.def(
-      "fit_dynamic",
-      [](std::shared_ptr<BodyModel> body, const py::object& times, const py::object& points,
-         const std::vector<long>& mass_points, const py::object& q0, const py::object& qd0, const py::object& stiffness,
-         const py::object& damping, const py::object& graph, const WorldOptions& world, bool fit_q0, bool fit_qd0,
-         bool fit_stiffness, bool fit_damping, bool fit_poses, bool fit_times, double switch_width, int max_iterations) {
-        const auto frames = Frames(*body, times, points, mass_points);
-        fit::DynamicParameters start;
-        start.q0 = OptionalVector(q0, body->num_q(), "q0");
-        start.qd0 = OptionalVector(qd0, body->num_q(), "qd0");
-        start.stiffness = OptionalVector(stiffness, body->num_modes(), "stiffness");
-        start.damping = OptionalVector(damping, body->num_modes(), "damping");
-        if (!graph.is_none()) start.graph = graph.cast<control::PoseGraph>();
-        if (world.integrator != Integrator::kThesis)
-          throw InputError("fit_dynamic simulates with the thesis integrator (options.integrator = 'thesis')");
-        fit::DynamicFitOptions o;
-        o.world = world.params;
-        o.dt = world.dt;
-        o.fit_q0 = fit_q0;
-        o.fit_qd0 = fit_qd0;
-        o.fit_stiffness = fit_stiffness;
-        o.fit_damping = fit_damping;
-        o.fit_poses = fit_poses;
-        o.fit_times = fit_times;
-        o.switch_width = switch_width;
-        o.max_iterations = max_iterations;
-        return WithCtrlC([&] { return fit::FitDynamicTrajectory(*body, frames, start, o); });
-      },
-      py::arg("body"), py::arg("times"), py::arg("points"), py::arg("mass_points"), py::kw_only(),
-      py::arg("q0") = py::none(), py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(),
-      py::arg("damping") = py::none(), py::arg("graph") = py::none(), py::arg("options") = WorldOptions(),
-      py::arg("fit_q0") = true, py::arg("fit_qd0") = true, py::arg("fit_stiffness") = true, py::arg("fit_damping") = true,
-      py::arg("fit_poses") = false, py::arg("fit_times") = false, py::arg("switch_width") = 0.05,
-      py::arg("max_iterations") = 50,
-      "Fits the start state, mode stiffness and damping (and a pose graph's poses and times) so that\n"
-      "a simulation puts mass points mass_points (K,) where `points` (F, K, 2) has them at `times`\n"
-      "(F,, on the step grid). Starts: q0/qd0 None: from pose fits of the first frames; stiffness\n"
-      "and damping None: the body's. Like `wobble fit dynamic`; differentiates with Ceres Jets.");
+  BindDynamicFit<2>(m);
+  BindDynamicFit<3>(m);
 
   m.def(
       "fit_pose_to_curves",
@@ -261,6 +314,44 @@ void BindFit(py::module_& m) {
       py::arg("mode_bounds") = std::make_pair(-1.0, 1.0), py::arg("max_iterations") = 200,
       "Fits the body's outline (its drawing and mass points) to target curves, each (M, 2); a single\n"
       "point is a point target. Like `wobble fit pose --targets` with polylines.");
+
+  m.def(
+      "fit_pose_to_surface",
+      [](std::shared_ptr<BodyModel3> body, const py::object& vertices, const py::object& triangles,
+         const py::object& cloud, const py::object& initial_q, const std::string& loss, double loss_scale,
+         double prior_weight, std::pair<double, double> bounds, int max_iterations, int mesh_samples, bool two_sided) {
+        fit::SurfaceTarget3 target;
+        if (vertices.is_none() != triangles.is_none()) throw InputError("give vertices (V, 3) and triangles (T, 3) together");
+        if (!vertices.is_none()) {
+          const Eigen::MatrixXd v = vertices.cast<Eigen::MatrixXd>();
+          const Eigen::MatrixXi t = triangles.cast<Eigen::MatrixXi>();
+          if (v.cols() != 3 || t.cols() != 3) throw InputError("vertices and triangles: expected (V, 3) and (T, 3)");
+          SurfaceMesh mesh;
+          for (int r = 0; r < v.rows(); ++r) mesh.points.push_back(v.row(r).transpose());
+          for (int r = 0; r < t.rows(); ++r) mesh.triangles.push_back({t(r, 0), t(r, 1), t(r, 2)});
+          CheckSurfaceMesh(mesh);  // finite points, indices in range
+          target.AddMesh(mesh);
+        }
+        if (!cloud.is_none()) {
+          const Eigen::MatrixXd c = cloud.cast<Eigen::MatrixXd>();
+          if (c.cols() != 3) throw InputError("cloud: expected (P, 3) points");
+          if (!c.allFinite()) throw InputError("cloud: the points must be finite");
+          for (int r = 0; r < c.rows(); ++r) target.AddPoint(c.row(r).transpose());
+        }
+        if (target.empty()) throw InputError("fit_pose_to_surface: no triangles and no cloud points");
+        if (mesh_samples < 0) throw InputError("mesh_samples must be >= 0");
+        fit::PoseFitOptions o = Options(*body, initial_q, loss, loss_scale, prior_weight, bounds, max_iterations);
+        o.max_mesh_samples = mesh_samples;
+        o.two_sided = two_sided;
+        return WithCtrlC([&] { return fit::FitPoseToSurface3(*body, target, o); });
+      },
+      py::arg("body"), py::kw_only(), py::arg("vertices") = py::none(), py::arg("triangles") = py::none(),
+      py::arg("cloud") = py::none(), py::arg("initial_q") = py::none(), py::arg("loss") = "squared",
+      py::arg("loss_scale") = 1.0, py::arg("prior_weight") = 0.0, py::arg("mode_bounds") = std::make_pair(-1.0, 1.0),
+      py::arg("max_iterations") = 200, py::arg("mesh_samples") = 400, py::arg("two_sided") = true,
+      "Fits a 3D body to a surface without correspondences: a target mesh (vertices (V, 3), triangles\n"
+      "(T, 3)) and/or a cloud (P, 3), e.g. a scan. The body's samples are its mesh's vertices (at most\n"
+      "mesh_samples; its mass points when it has no mesh). Like `wobble fit pose` with a 3D 'mesh'/'cloud' file.");
 }
 
 }  // namespace wobble::python

@@ -75,6 +75,7 @@ class BodyModel3:
     mesh_points: NDArray
     mesh_triangles: NDArray
     def mesh_vertices(self, q: Optional[ArrayLike] = None) -> NDArray: ...
+    def mass_points_at(self, q: Optional[ArrayLike] = None) -> NDArray: ...
 
 def load_body3(object: str, modes: Sequence[str] = ..., check: bool = True) -> BodyModel3: ...
 
@@ -303,7 +304,8 @@ class PoseFitResult:
     conditioning: FitConditioning
     rounds: int
 
-def fit_pose(body: BodyModel, points: ArrayLike, *, mass_points: Optional[Sequence[int]] = None,
+# Every fit takes a 3D body too (points (K, 3) / (F, K, 3), q = [t, rotation vector, γ]).
+def fit_pose(body: BodyModel | BodyModel3, points: ArrayLike, *, mass_points: Optional[Sequence[int]] = None,
              lattice_coords: Optional[ArrayLike] = None, weights: Optional[ArrayLike] = None,
              initial_q: Optional[ArrayLike] = None, loss: str = "squared", loss_scale: float = 1.0,
              prior_weight: float = 0.0, mode_bounds: tuple[float, float] = (-1.0, 1.0),
@@ -316,7 +318,7 @@ class TrajectoryFitResult:
     rms_residual: float
     linear_solver: str
 
-def fit_trajectory(body: BodyModel, times: ArrayLike, points: ArrayLike, mass_points: Sequence[int], *,
+def fit_trajectory(body: BodyModel | BodyModel3, times: ArrayLike, points: ArrayLike, mass_points: Sequence[int], *,
                    smoothness: float = 1.0, loss: str = "squared", loss_scale: float = 1.0, prior_weight: float = 0.0,
                    mode_bounds: tuple[float, float] = (-1.0, 1.0), max_iterations: int = 200) -> TrajectoryFitResult: ...
 
@@ -333,7 +335,7 @@ class DynamicFitResult:
     rms_residual: float
     simulations: int
 
-def fit_dynamic(body: BodyModel, times: ArrayLike, points: ArrayLike, mass_points: Sequence[int], *,
+def fit_dynamic(body: BodyModel | BodyModel3, times: ArrayLike, points: ArrayLike, mass_points: Sequence[int], *,
                 q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None, stiffness: Optional[ArrayLike] = None,
                 damping: Optional[ArrayLike] = None, graph: Optional[PoseGraph] = None, options: WorldOptions = ...,
                 fit_q0: bool = True, fit_qd0: bool = True, fit_stiffness: bool = True, fit_damping: bool = True,
@@ -343,6 +345,11 @@ def fit_pose_to_curves(body: BodyModel, polylines: Sequence[ArrayLike], *, close
                        initial_q: Optional[ArrayLike] = None, loss: str = "squared", loss_scale: float = 1.0,
                        prior_weight: float = 0.0, mode_bounds: tuple[float, float] = (-1.0, 1.0),
                        max_iterations: int = 200) -> PoseFitResult: ...
+def fit_pose_to_surface(body: BodyModel3, *, vertices: Optional[ArrayLike] = None, triangles: Optional[ArrayLike] = None,
+                        cloud: Optional[ArrayLike] = None, initial_q: Optional[ArrayLike] = None, loss: str = "squared",
+                        loss_scale: float = 1.0, prior_weight: float = 0.0,
+                        mode_bounds: tuple[float, float] = (-1.0, 1.0), max_iterations: int = 200,
+                        mesh_samples: int = 400, two_sided: bool = True) -> PoseFitResult: ...
 
 class ConditionNumber:
     singular: bool
