@@ -140,7 +140,7 @@ ConditionCommands AddConditionCommand(CLI::App* app, ConditionSweepArgs* s, Cond
   time->add_option("--object", t->files.object, "Object file")->capture_default_str();
   time->add_option("--modes", t->files.modes, "Deformation files")->delimiter(',')->capture_default_str();
   AddWorldFlags(time, &t->world);
-  time->add_option("--q", t->q, "Initial state \"tx ty theta g1 ..\"")->capture_default_str();
+  time->add_option("--q", t->q, "Initial state \"tx ty theta g1 ..\" (3D: \"tx ty tz rx ry rz g1 ..\")")->capture_default_str();
   time->add_option("--dt", t->dt, "Time step (thesis integrator)")->capture_default_str();
   time->add_option("--duration", t->duration, "Simulated time")->capture_default_str();
   time->add_option("--out", t->out, "Output folder")->capture_default_str();
@@ -258,8 +258,7 @@ int RunConditionTime(const ConditionTimeArgs& a) {
   if (!(a.duration / a.dt <= 1e7)) throw UsageError("--duration / --dt asks for more than 10^7 steps");
   CheckOutputFolder(a.out);
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, "", a.world, Integrator::kThesis, a.dt);
-  if (setup.body3) throw UsageError("condition time takes 2D objects only so far; for a 3D object use condition check");
-  const std::shared_ptr<const BodyModel>& body = setup.body;
+  const std::string name = setup.body3 ? setup.body3->name() : setup.body->name();
   World world = setup.MakeWorld();
 
   // the run's trajectory: cond₂(M) and the contact events come from it, as for wobble render
@@ -270,7 +269,7 @@ int RunConditionTime(const ConditionTimeArgs& a) {
   const bool ok = world.RunUntil(a.duration);
   const std::filesystem::path out(a.out);
   const pipelines::ChartSpec spec =
-      pipelines::ConditionChart(*run, 0, "cond(M) vs time: " + body->name() + " falling onto the ground (Fig. 4.9)");
+      pipelines::ConditionChart(*run, 0, "cond(M) vs time: " + name + " falling onto the ground (Fig. 4.9)");
   const std::string png = pipelines::HasDisplay() ? (out / "cond_time.png").string() : "";
   pipelines::WriteChart(spec, png, (out / "cond_time.csv").string());
   std::cout << "wrote " << (out / "cond_time.csv").string() << " (" << run->size() << " samples, "

@@ -14,10 +14,10 @@ std::vector<double> Times(const record::Trajectory& run) {
   return t;
 }
 
-const BodyModel& FfdModel(const record::Trajectory& run, int body) {
-  if (body < 0 || body >= run.num_bodies() || run.bodies()[body].kind != BodyKind::kFfd || !run.bodies()[body].ffd)
+const record::BodyInfo& FfdInfo(const record::Trajectory& run, int body) {
+  if (body < 0 || body >= run.num_bodies() || !(run.bodies()[body].ffd || run.bodies()[body].ffd3))
     throw std::invalid_argument("cond(M): body " + std::to_string(body) + " is not an FFD body of the run");
-  return *run.bodies()[body].ffd;
+  return run.bodies()[body];
 }
 
 ChartSpec ConditionChartOf(const record::Trajectory& run, int body, const std::vector<double>& cond, const std::string& title) {
@@ -49,17 +49,28 @@ std::vector<double> ContactEvents(const record::Trajectory& run, int body) {
 }
 
 std::vector<double> ConditionNumbers(const record::Trajectory& run, int body, int first) {
-  const BodyModel& model = FfdModel(run, body);
+  const record::BodyInfo& info = FfdInfo(run, body);
   std::vector<double> cond;
-  for (int k = std::max(0, first); k < run.size(); ++k)
-    cond.push_back(analysis::MassMatrixCondition(model, run.q(k, body)).cond);  // +∞ when M is singular
+  for (int k = std::max(0, first); k < run.size(); ++k) {
+    const Eigen::VectorXd q = run.q(k, body);
+    if (info.ffd) {
+      cond.push_back(analysis::MassMatrixCondition(*info.ffd, q).cond);  // +∞ when M is singular
+    } else {
+      // a 3D row: tx ty tz qw qx qy qz γ..
+      BodyState3<double> s = RestState3<double>(*info.ffd3);
+      s.t = q.head<3>();
+      s.orientation = Eigen::Quaterniond(q[3], q[4], q[5], q[6]).normalized();
+      s.gamma = q.tail(info.ffd3->num_modes());
+      cond.push_back(analysis::MassMatrixCondition(*info.ffd3, s).cond);
+    }
+  }
   return cond;
 }
 
 ChartSpec EnergyChart(const record::Trajectory& run, int body, const std::string& title) {
   if (body < 0 || body >= run.num_bodies()) throw std::invalid_argument("energy chart: no body " + std::to_string(body));
   const record::BodyInfo& info = run.bodies()[body];
-  const int num_modes = info.kind == BodyKind::kFfd && info.ffd ? info.ffd->num_modes() : 0;
+  const int num_modes = info.num_modes();
   std::vector<double> kinetic, gravity, deformation, ground, springs, total;
   std::vector<std::vector<double>> modes(num_modes);  // [mode][sample]
   for (int k = 0; k < run.size(); ++k) {
@@ -88,7 +99,7 @@ ChartSpec EnergyChart(const record::Trajectory& run, int body, const std::string
   add("kinetic", kinetic, true);
   add("gravity", gravity, true);
   for (int d = 0; d < num_modes; ++d) {
-    const std::string& name = info.ffd->modes()[d].name;
+    const std::string& name = info.ffd ? info.ffd->modes()[d].name : info.ffd3->modes()[d].name;
     add("mode " + (name.empty() ? std::to_string(d + 1) : name), modes[d], false);
   }
   if (info.kind == BodyKind::kLinear) add("deformation", deformation, false);

@@ -13,12 +13,14 @@
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 
+#include "pipelines/energy_charts.h"
 #include "pipelines/mesh_io.h"
 #include "pipelines/world_sources.h"
 #include "support/pipelines_test_util.h"
 #include "wobble/dynamics/step3.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/parse_error.h"
+#include "wobble/core/rotation3.h"
 #include "wobble/record/trajectory.h"
 
 namespace wobble::pipelines {
@@ -220,6 +222,43 @@ TEST(Mesh3Sources, AppliedForcesSumToTheGeneralizedForcesTranslationRows) {
                   &Q, ContactSet::kFrozen);
   const Vec3 expected = (Q.gravity + Q.ground).head<3>();
   EXPECT_LT((sum - expected).norm(), 1e-9 * expected.norm()) << sum.transpose() << " vs " << expected.transpose();
+}
+
+// cond(M) over a 3D run (Fig. 4.9 for the 3D pot): against M summed over the mass points,
+// M = Σ m_k J_kᵀ J_k with J_k = ∂x_k/∂(ṫ, ω, γ̇) = [I, −R [l_k]×, R B_k] at each recorded state.
+TEST(Mesh3Record, ConditionNumberOverA3dRunIsThePerPointMassMatrixs) {
+  World w = MovingPot();
+  record::Trajectory run(w);
+  for (int k = 0; k < 40; ++k) {
+    ASSERT_EQ(run.Append(w), -1);
+    ASSERT_TRUE(w.Step());
+  }
+  const std::vector<double> cond = pipelines::ConditionNumbers(run, 0);
+  ASSERT_EQ(int(cond.size()), run.size());
+  const BodyModel3& body = w.body3(0);
+  const int n = body.num_q();
+  double lo = HUGE_VAL, hi = 0;
+  for (int k = 0; k < run.size(); k += 13) {
+    const Eigen::VectorXd q = run.q(k, 0);
+    const Eigen::Matrix3d R = Eigen::Quaterniond(q[3], q[4], q[5], q[6]).normalized().toRotationMatrix();
+    const Eigen::VectorXd gamma = q.tail(body.num_modes());
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
+    for (int i = 0; i < body.num_points(); ++i) {
+      const Vec3 l = body.rest_local(i) + body.mode_matrix(i) * gamma;
+      Eigen::MatrixXd J(3, n);
+      J.leftCols<3>().setIdentity();
+      J.middleCols<3>(3) = -R * Skew<double>(l);
+      J.rightCols(body.num_modes()) = R * body.mode_matrix(i);
+      M += body.mass(i) * J.transpose() * J;
+    }
+    const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(M).singularValues();
+    EXPECT_NEAR(cond[size_t(k)] / (sv[0] / sv[n - 1]), 1.0, 1e-9) << "sample " << k;
+    lo = std::min(lo, cond[size_t(k)]);
+    hi = std::max(hi, cond[size_t(k)]);
+  }
+  EXPECT_GT(hi / lo, 1.0 + 1e-6);  // the modes move: cond(M) changes over the run
+  const pipelines::ChartSpec chart = pipelines::ConditionChart(run, 0, "cond(M)");
+  EXPECT_EQ(chart.series.at(0).y, cond);
 }
 
 TEST(Mesh3Record, A3dBodyRecordsAndRestoresExactly) {
