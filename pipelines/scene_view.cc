@@ -190,8 +190,9 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
     m.Add(SceneLayer::kGround, on(m.ground, 0), ground_rgb, 1.0, 1.0, 0.0);
     m.trails = Ptr<TrailSource>::New();
     m.Add(SceneLayer::kTrails, on(m.trails, first_ffd), trail_rgb, 1.5, 1.0, 0.5);
-    m.Add(SceneLayer::kSprings, on(Ptr<SpringSource>::New(), 0), spring_rgb, 1.5, 1.0, 1.5);
   }
+  if (first_ffd >= 0 || first_ffd3 >= 0)  // springs of either dimension (SpringSource)
+    m.Add(SceneLayer::kSprings, on(Ptr<SpringSource>::New(), 0), spring_rgb, 1.5, 1.0, 1.5);
   // every body: lattice (or control box), shape, mass points
   std::vector<vtkPolyDataMapper*> point_mappers, lattice_mappers;
   for (int b = 0; b < world->num_bodies(); ++b) {

@@ -488,6 +488,17 @@ int SpringSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
     lines->InsertNextCell(2, ids);
     stretch->InsertNextValue((x - sp.anchor).norm() - sp.rest_length);
   }
+  // 3D FFD bodies: every spring of springs_3d acts on every such body (world.h)
+  for (int b = 0; b < world_->num_bodies(); ++b) {
+    if (world_->kind(b) != BodyKind::kFfd3) continue;
+    const BodyState3<double>& s = world_->state3(b);
+    for (const Spring3& sp : world_->options().springs_3d) {
+      const Eigen::Vector3d x = s.t + s.orientation * LocalPosition3<double>(sp.rest_local, sp.mode_matrix, s.gamma);
+      const vtkIdType ids[2] = {points->InsertNextPoint(sp.anchor.data()), points->InsertNextPoint(x.data())};
+      lines->InsertNextCell(2, ids);
+      stretch->InsertNextValue((x - sp.anchor).norm() - sp.rest_length);
+    }
+  }
   out->SetPoints(points);
   out->SetLines(lines);
   out->GetCellData()->AddArray(stretch);

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkDataArray.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
@@ -139,6 +140,29 @@ Vec3 DirectWorldPoint(const World& w, const Vec3& body_point) {
   for (size_t c = 0; c < control.size(); ++c)
     for (int d = 0; d < m.num_modes(); ++d) control[c] += s.gamma[d] * m.modes()[size_t(d)].displacement[c];
   return s.t + s.orientation * m.lattice().Evaluate(control, m.lattice().LocalCoords(body_point));
+}
+
+TEST(Mesh3Sources, SpringsOfA3dBodyRunFromTheAnchorToTheHeldPoint) {
+  BodyDef3 def = ReadObject3(kData + "/pot3.obj");
+  std::vector<DeformationMode3> modes = formats::ReadDeformationFile3(kData + "/pot3_modes.def3", def.lattice);
+  auto body = std::make_shared<const BodyModel3>(std::move(def), std::move(modes));
+  WorldOptions options;
+  const Vec3 coords(0.5, 1.0, 0.25), anchor(0, 300, 20);
+  options.springs_3d.push_back(MakeSpring3(*body, coords, anchor, 100.0, 1.0, 20.0));
+  World w(options);
+  w.AddBody(body);
+  w.SetState3(0, Vec3(10, 40, -5), Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Vec3(1, 2, -1).normalized())),
+              Eigen::Vector3d(0.3, -0.2, 0.15), Eigen::VectorXd::Zero(9));
+  const auto springs = Source<SpringSource>(w);
+  vtkPolyData* out = springs->GetOutput();
+  ASSERT_EQ(out->GetNumberOfLines(), 1);
+  double a[3], x[3];
+  out->GetPoint(0, a);
+  out->GetPoint(1, x);
+  EXPECT_LT((Vec3(a[0], a[1], a[2]) - anchor).norm(), 1e-12);
+  const Vec3 held = DirectWorldPoint(w, body->lattice().Evaluate(body->lattice().RestPoints(), coords));
+  EXPECT_LT((Vec3(x[0], x[1], x[2]) - held).norm(), 1e-9 * 200);
+  EXPECT_NEAR(out->GetCellData()->GetArray("stretch")->GetTuple1(0), (held - anchor).norm() - 20.0, 1e-9);
 }
 
 TEST(Mesh3Sources, TheMeshIsMovedByTheFfdOfItsLattice) {
