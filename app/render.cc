@@ -235,9 +235,9 @@ void RenderRun(const RenderArgs& a, const std::string& default_what, World& worl
             << Num(run.time(run.size() - 1)) << " s, " << Num(wall) << " s wall ("
             << (wall > 0 ? Num(report.frames / wall) : std::string("-")) << " frames/s).\n";
   for (const pl::RenderReport::File& f : report.files) std::cout << "  " << f.Line() << "\n";
-  bool flat_ffd = false;
-  for (const record::BodyInfo& b : run.bodies()) flat_ffd = flat_ffd || b.kind == BodyKind::kFfd;
-  if (out.disp && !flat_ffd) std::cout << "  no displacement images: they are drawn for 2D FFD bodies only\n";
+  bool ffd = false;
+  for (const record::BodyInfo& b : run.bodies()) ffd = ffd || b.kind == BodyKind::kFfd || b.kind == BodyKind::kFfd3;
+  if (out.disp && !ffd) std::cout << "  no displacement images: they are drawn for FFD bodies only\n";
   std::cout << std::flush;
 }
 

@@ -10,6 +10,8 @@
 #include <vtkImageData.h>
 #include <vtkPolyData.h>
 #include <vtkXMLImageDataWriter.h>
+#include <vtkPointData.h>
+#include <vtkDoubleArray.h>
 #include <vtkXMLPolyDataWriter.h>
 
 #include "wobble/dynamics/kinematics.h"
@@ -151,6 +153,50 @@ std::vector<ExrChannel> DisplacementImage(const World& world, int body_index, in
     }
   }
   return channels;
+}
+
+vtkSmartPointer<vtkImageData> DisplacementVolume(const World& world, int body_index, int nx, int ny, int nz) {
+  if (nx <= 0 || ny <= 0 || nz <= 0) throw std::invalid_argument("displacement volume size must be positive");
+  const BodyModel3& body = world.body3(body_index);
+  const Lattice3& lat = body.lattice();
+  const BodyState3<double>& s = world.state3(body_index);
+  // deformed control points in the world, W_c = t + R (L_c + Σ γ_d d^d_c): the weights are a
+  // partition of unity, so x(s, t, u) = Σ_c W_c B_c(s, t, u) is Eq. 4.2 with the rigid motion
+  std::vector<Eigen::Vector3d> W(size_t(lat.size()));
+  for (int c = 0; c < lat.size(); ++c) {
+    Eigen::Vector3d l = body.rest_control()[size_t(c)];
+    for (int m = 0; m < body.num_modes(); ++m) l += body.modes()[size_t(m)].displacement[size_t(c)] * s.gamma[m];
+    W[size_t(c)] = s.t + s.orientation * l;
+  }
+  const std::vector<Eigen::Vector3d> rest = lat.RestPoints();
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(nx, ny, nz);
+  const int n[3] = {nx, ny, nz};
+  double spacing[3], direction[9];
+  for (int a = 0; a < 3; ++a) {
+    const Eigen::Vector3d axis = lat.axes()[size_t(a)];
+    spacing[a] = axis.norm() / n[a];
+    for (int r = 0; r < 3; ++r) direction[3 * r + a] = axis[r] / axis.norm();  // column a: the axis
+  }
+  image->SetSpacing(spacing);
+  image->SetDirectionMatrix(direction);
+  const Eigen::Vector3d first = lat.Evaluate(rest, Eigen::Vector3d(0.5 / nx, 0.5 / ny, 0.5 / nz));
+  image->SetOrigin(first.data());
+  auto disp = vtkSmartPointer<vtkDoubleArray>::New();
+  disp->SetName("disp");
+  disp->SetNumberOfComponents(3);
+  disp->SetNumberOfTuples(vtkIdType(nx) * ny * nz);
+  vtkIdType id = 0;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i, ++id) {
+        const Eigen::Vector3d u((i + 0.5) / nx, (j + 0.5) / ny, (k + 0.5) / nz);
+        const Eigen::Vector3d d = lat.Evaluate(W, u) - lat.Evaluate(rest, u);
+        disp->SetTuple(id, d.data());
+      }
+  image->GetPointData()->AddArray(disp);
+  image->GetPointData()->SetActiveVectors("disp");
+  return image;
 }
 
 void WriteDisplacementExr(const std::string& path, const World& world, int body, int width, int height,

@@ -55,6 +55,12 @@ class PvdCollection {
 // and holds disp = x(s, t) − p: where that point of the rest drawing is now in the world
 // (Eq. 4.2, rigid motion included) minus where it was drawn. Channels disp.X, disp.Y.
 std::vector<ExrChannel> DisplacementImage(const World& world, int body, int width, int height);
+// The same for a 3D FFD body: its rest lattice box as an nx × ny × nz image (vtkImageData
+// with the lattice's origin, spacing and axes as its direction), voxel (i, j, k) standing for
+// lattice coordinates ((i + ½)/nx, (j + ½)/ny, (k + ½)/nz); point array "disp" (3 components)
+// = x(s, t, u) − p, the point's world position (Eq. 4.2 with the rigid motion) minus its rest
+// position. For ParaView (.vti).
+vtkSmartPointer<vtkImageData> DisplacementVolume(const World& world, int body, int nx, int ny, int nz);
 // With a BackgroundWriter the image is computed now and written by its thread.
 void WriteDisplacementExr(const std::string& path, const World& world, int body, int width, int height,
                           BackgroundWriter* writer = nullptr);

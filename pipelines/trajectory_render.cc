@@ -101,23 +101,33 @@ std::vector<Visit> PlanVisits(const record::Trajectory& run, const RenderOutputs
   return visits;
 }
 
-// The displacement image's name and size for each FFD body.
+// The displacement image's (2D) or volume's (3D) name and size for each FFD body.
 struct DispTarget {
   int body;
   std::string stem;
-  int width, height;
+  int width, height, depth;  // depth 0: a 2D body's image
 };
 
 std::vector<DispTarget> DispTargets(const World& world, const RenderOutputs& out) {
   std::vector<int> ffd;
   for (int b = 0; b < world.num_bodies(); ++b)
-    if (world.kind(b) == BodyKind::kFfd) ffd.push_back(b);
+    if (world.kind(b) == BodyKind::kFfd || world.kind(b) == BodyKind::kFfd3) ffd.push_back(b);
   std::vector<DispTarget> targets;
   for (int b : ffd) {
+    const std::string stem = ffd.size() == 1 ? "disp" : "disp_" + world.body_name(b);
+    if (world.kind(b) == BodyKind::kFfd3) {  // disp_volume voxels along the longest axis
+      const Lattice3& lat = world.body3(b).lattice();
+      double longest = 0;
+      for (const auto& axis : lat.axes()) longest = std::max(longest, axis.norm());
+      int n[3];
+      for (int a = 0; a < 3; ++a) n[a] = std::max(1, int(std::lround(out.disp_volume * lat.axes()[size_t(a)].norm() / longest)));
+      targets.push_back({b, stem, n[0], n[1], n[2]});
+      continue;
+    }
     const Lattice& lat = world.body(b).lattice();
     const int h = out.disp_height > 0 ? out.disp_height
                                       : std::max(1, int(std::lround(out.disp_width * lat.axis_t().norm() / lat.axis_s().norm())));
-    targets.push_back({b, ffd.size() == 1 ? "disp" : "disp_" + world.body_name(b), out.disp_width, h});
+    targets.push_back({b, stem, out.disp_width, h, 0});
   }
   return targets;
 }
@@ -214,6 +224,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   std::unique_ptr<VtpSeriesWriter> vtp;
   if (out.vtp) vtp = std::make_unique<VtpSeriesWriter>(&world, out.folder + "/vtp", out.name, spec.drawings, out.view.shape_samples);
   const std::vector<DispTarget> disp = out.disp ? DispTargets(world, out) : std::vector<DispTarget>();
+  PvdCollection volumes;  // 3D bodies' displacement volumes
   std::vector<vtkSmartPointer<vtkImageData>> panels;
   BackgroundWriter writer;  // files are compressed and written while the next frame renders
   Replay replay(run, &world);
@@ -241,8 +252,15 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       if (out.exr) view->WriteExr(Numbered(out.folder + "/exr", "frame", v.frame, "exr"), &writer);
     }
     if (vtp) vtp->WriteFrame(int(v.frame), &writer);
-    for (const DispTarget& d : disp)
-      WriteDisplacementExr(Numbered(out.folder + "/exr", d.stem, v.frame, "exr"), world, d.body, d.width, d.height, &writer);
+    for (const DispTarget& d : disp) {
+      if (d.depth == 0) {
+        WriteDisplacementExr(Numbered(out.folder + "/exr", d.stem, v.frame, "exr"), world, d.body, d.width, d.height, &writer);
+      } else {
+        const std::string file = Numbered(out.folder + "/vti", d.stem, v.frame, "vti");
+        writer.Submit([file, image = DisplacementVolume(world, d.body, d.width, d.height, d.depth)] { WriteVti(file, image); });
+        volumes.Add(world.time(), int(&d - disp.data()), file, d.stem);
+      }
+    }
     ++report.frames;
     if (out.progress) out.progress(double(report.frames) / double(num_frames), world.time());
   }
@@ -256,8 +274,19 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
 
   if (out.frames) report.files.push_back({out.folder + "/frames/frame_NNNN.png", ""});
   if (out.exr) report.files.push_back({out.folder + "/exr/frame_NNNN.exr", "R, G, B, A, depth.Z"});
-  for (const DispTarget& d : disp)
-    report.files.push_back({out.folder + "/exr/" + d.stem + "_NNNN.exr", "disp.X, disp.Y over the rest lattice"});
+  bool any_volume = false;
+  for (const DispTarget& d : disp) {
+    if (d.depth == 0) {
+      report.files.push_back({out.folder + "/exr/" + d.stem + "_NNNN.exr", "disp.X, disp.Y over the rest lattice"});
+    } else {
+      report.files.push_back({out.folder + "/vti/" + d.stem + "_NNNN.vti", "disp (x, y, z) over the rest lattice box"});
+      any_volume = true;
+    }
+  }
+  if (any_volume) {
+    volumes.Write(out.folder + "/vti/disp.pvd");
+    report.files.push_back({out.folder + "/vti/disp.pvd", "ParaView time series of the displacement volumes"});
+  }
   if (vtp) report.files.push_back({vtp->WriteCollection(), "ParaView time series of lattice, points, shape"});
   if (strip_view && !panels.empty()) {
     const std::string path = out.folder + "/filmstrip.png";

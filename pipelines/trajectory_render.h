@@ -14,6 +14,8 @@
 //   exr/frame_NNNN.exr      the frame's R, G, B, A, depth.Z
 //   exr/disp_NNNN.exr       each FFD body's displacement image (disp_<body>_NNNN.exr when
 //                           the world has more than one FFD body)
+//   vti/disp_NNNN.vti       a 3D FFD body's displacement volume instead (DisplacementVolume),
+//   vti/disp.pvd            with their ParaView time series
 //   energy.png/.csv, condition.png/.csv   charts of body chart_body (condition: FFD bodies)
 #pragma once
 
@@ -52,6 +54,7 @@ struct RenderOutputs {
   int filmstrip_width = 320, filmstrip_height = 240, filmstrip_columns = 3;
   double filmstrip_point_size = 0.0;  // 0: the frames' point size
   int disp_width = 256, disp_height = 0;  // height 0: the body's lattice aspect
+  int disp_volume = 32;  // 3D bodies: voxels along the lattice's longest axis (the others by aspect)
   int chart_width = 800, chart_height = 500;
   int chart_body = 0;
   // Points of the first FFD body, by lattice coordinates, traced in the pictures.

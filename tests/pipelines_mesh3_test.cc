@@ -4,17 +4,20 @@
 // evaluated directly and against finite differences, and the 3D body's record round trip.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
+#include <vtkImageData.h>
 #include <vtkDataArray.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 
 #include "pipelines/energy_charts.h"
+#include "pipelines/exports.h"
 #include "pipelines/mesh_io.h"
 #include "pipelines/world_sources.h"
 #include "support/pipelines_test_util.h"
@@ -163,6 +166,38 @@ TEST(Mesh3Sources, SpringsOfA3dBodyRunFromTheAnchorToTheHeldPoint) {
   const Vec3 held = DirectWorldPoint(w, body->lattice().Evaluate(body->lattice().RestPoints(), coords));
   EXPECT_LT((Vec3(x[0], x[1], x[2]) - held).norm(), 1e-9 * 200);
   EXPECT_NEAR(out->GetCellData()->GetArray("stretch")->GetTuple1(0), (held - anchor).norm() - 20.0, 1e-9);
+}
+
+// The 3D displacement volume (render --what disp): every voxel's vector against the body's own
+// basis path, x = t + R (b0 + B γ) at the voxel's lattice coordinates, minus the rest point;
+// the voxel's place from the image's origin, spacing and direction is that rest point.
+TEST(Mesh3Sources, DisplacementVolumeHoldsEachVoxelsMotion) {
+  const World w = MovingPot();
+  const BodyModel3& body = w.body3(0);
+  const BodyState3<double>& s = w.state3(0);
+  const int nx = 8, ny = 6, nz = 5;
+  const vtkSmartPointer<vtkImageData> image = pipelines::DisplacementVolume(w, 0, nx, ny, nz);
+  int dims[3];
+  image->GetDimensions(dims);
+  ASSERT_EQ(dims[0] * dims[1] * dims[2], nx * ny * nz);
+  vtkDataArray* disp = image->GetPointData()->GetArray("disp");
+  ASSERT_NE(disp, nullptr);
+  for (int i : {0, 3, 7})
+    for (int j : {0, 5})
+      for (int k : {0, 2, 4}) {
+        const Vec3 u((i + 0.5) / nx, (j + 0.5) / ny, (k + 0.5) / nz);
+        Vec3 b0;
+        BodyModel3::ModeMatrix B;
+        body.LocalBasis(u, &b0, &B);
+        const Vec3 rest = body.lattice().Evaluate(body.lattice().RestPoints(), u);
+        const Vec3 moved = s.t + s.orientation * (b0 + B * s.gamma);
+        const vtkIdType id = image->ComputePointId(std::array<int, 3>{i, j, k}.data());
+        double d[3], x[3];
+        disp->GetTuple(id, d);
+        EXPECT_LT((Vec3(d[0], d[1], d[2]) - (moved - rest)).norm(), 1e-9 * 200) << i << " " << j << " " << k;
+        image->TransformIndexToPhysicalPoint(i, j, k, x);
+        EXPECT_LT((Vec3(x[0], x[1], x[2]) - rest).norm(), 1e-9 * 200) << i << " " << j << " " << k;
+      }
 }
 
 TEST(Mesh3Sources, TheMeshIsMovedByTheFfdOfItsLattice) {
