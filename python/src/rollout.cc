@@ -12,6 +12,7 @@
 #include "wobble/core/interrupt.h"
 #include "wobble/core/limits.h"
 #include "wobble/core/parallel.h"
+#include "wobble/scene/ffd_object.h"
 
 namespace wobble::python {
 namespace {
@@ -32,7 +33,26 @@ py::array_t<double, py::array::c_style> Rows(const py::handle& h, long n, const 
   return AsMatrix(a, a.shape(0), n, what + " (N, " + std::to_string(n) + ")");
 }
 
-RolloutResult Rollout(std::shared_ptr<BodyModel> body, const py::object& q0_in, const py::object& qd0_in, long steps,
+// A 2D body's state is (q, q̇); a 3D body's q = [t, rotation vector, γ] and q̇ = [ṫ, body ω, γ̇]
+// (World.q3 / set_state3).
+void SetStart(World* w, const BodyModel&, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) { w->SetState(0, q, qd); }
+void SetStart(World* w, const BodyModel3&, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  scene::SetState3FromQ(w, 0, q, qd);
+}
+void ReadState(const World& w, const BodyModel&, double* q, double* qd) {
+  const BodyState<double>& s = w.state(0);
+  std::copy(s.q.data(), s.q.data() + s.q.size(), q);
+  std::copy(s.qd.data(), s.qd.data() + s.qd.size(), qd);
+}
+void ReadState(const World& w, const BodyModel3&, double* q, double* qd) {
+  Eigen::VectorXd q3, qd3;
+  scene::QFromState3(w, 0, &q3, &qd3);
+  std::copy(q3.data(), q3.data() + q3.size(), q);
+  std::copy(qd3.data(), qd3.data() + qd3.size(), qd);
+}
+
+template <int Dim>
+RolloutResult Rollout(std::shared_ptr<BodyModelN<Dim>> body, const py::object& q0_in, const py::object& qd0_in, long steps,
                       const WorldOptions& options, const py::object& targets_in, int every, int threads, bool energies,
                       long max_steps, double max_record_mb) {
   const long n = body->num_q(), D = body->num_modes();
@@ -75,7 +95,7 @@ RolloutResult Rollout(std::shared_ptr<BodyModel> body, const py::object& q0_in, 
   double* e_out = r.energy.mutable_data();
   long* taken = r.steps_taken.mutable_data();
   const double *q0_p = q0.data(), *qd0_p = qd0.data(), *t_p = targets_in.is_none() ? nullptr : targets.data();
-  const std::shared_ptr<const BodyModel> model = body;
+  const std::shared_ptr<const BodyModelN<Dim>> model = body;
   ClearInterrupt();
   struct ClearAtEnd {
     ~ClearAtEnd() { ClearInterrupt(); }
@@ -86,14 +106,13 @@ RolloutResult Rollout(std::shared_ptr<BodyModel> body, const py::object& q0_in, 
       World w(options);
       w.AddBody(model);
       try {
-        w.SetState(0, Eigen::Map<const Eigen::VectorXd>(q0_p + i * n, n), Eigen::Map<const Eigen::VectorXd>(qd0_p + i * n, n));
+        SetStart(&w, *model, Eigen::Map<const Eigen::VectorXd>(q0_p + i * n, n),
+                 Eigen::Map<const Eigen::VectorXd>(qd0_p + i * n, n));
       } catch (const InputError& e) {
         throw InputError("trial " + std::to_string(i) + ": " + e.what());
       }
       auto sample = [&](long k) {
-        const BodyState<double>& s = w.state(0);
-        std::copy(s.q.data(), s.q.data() + n, q_out + (i * S + k) * n);
-        std::copy(s.qd.data(), s.qd.data() + n, qd_out + (i * S + k) * n);
+        ReadState(w, *model, q_out + (i * S + k) * n, qd_out + (i * S + k) * n);
         if (energies) e_out[i * S + k] = w.ComputeEnergies(0).total();
       };
       sample(0);
@@ -136,7 +155,7 @@ void BindRollout(py::module_& m) {
       .def_readonly("status", &RolloutResult::status, "per trial: 'ok' or the cause it stopped for")
       .def_readonly("messages", &RolloutResult::messages, "per trial: the world's status message");
 
-  m.def("rollout", &Rollout, py::arg("body"), py::arg("q0"), py::arg("qd0") = py::none(), py::arg("steps") = 1,
+  m.def("rollout", &Rollout<2>, py::arg("body"), py::arg("q0"), py::arg("qd0") = py::none(), py::arg("steps") = 1,
         py::kw_only(), py::arg("options") = WorldOptions(), py::arg("mode_targets") = py::none(), py::arg("every") = 1,
         py::arg("threads") = 0, py::arg("energies") = false, py::arg("max_steps") = Limits().max_steps,
         py::arg("max_record_mb") = Limits().max_record_mb,
@@ -145,6 +164,13 @@ void BindRollout(py::module_& m) {
         "mode_targets: None, (N, num_modes) PD targets held throughout, or (N, steps, num_modes)\n"
         "one set per step (applied before it). Samples the start and every `every`-th step.\n"
         "Equal, bit for bit, to stepping each trial's World alone, whatever the thread count.");
+  m.def("rollout", &Rollout<3>, py::arg("body"), py::arg("q0"), py::arg("qd0") = py::none(), py::arg("steps") = 1,
+        py::kw_only(), py::arg("options") = WorldOptions(), py::arg("mode_targets") = py::none(), py::arg("every") = 1,
+        py::arg("threads") = 0, py::arg("energies") = false, py::arg("max_steps") = Limits().max_steps,
+        py::arg("max_record_mb") = Limits().max_record_mb,
+        "The same for a 3D FFD body (BodyModel3): q = [t, rotation vector, γ] (|r| <= π as read\n"
+        "back), q̇ = [ṫ, body ω, γ̇], as World.q3/qd3/set_state3; the world's 3D ground and gravity\n"
+        "(options.ground_3d, gravity_3d).");
 }
 
 }  // namespace wobble::python

@@ -197,10 +197,12 @@ void BindWorld(py::module_& m) {
       .def(
           "set_mode_targets",
           [](World& w, int body, const py::object& targets) {
-            CheckBody(w, body);
-            w.SetModeTargets(body, AsVector(targets, w.body(body).num_modes(), "targets"));
+            CheckIndex(w, body);
+            if (w.kind(body) == BodyKind::kLinear) throw InputError("body " + std::to_string(body) + " is not an FFD body");
+            const int D = w.kind(body) == BodyKind::kFfd3 ? w.body3(body).num_modes() : w.body(body).num_modes();
+            w.SetModeTargets(body, AsVector(targets, D, "targets"));
           },
-          py::arg("body"), py::arg("targets"), "PD targets γ0 of the body's modes (chapter 5)")
+          py::arg("body"), py::arg("targets"), "PD targets γ0 of the body's modes (chapter 5), 2D or 3D FFD bodies")
       .def(
           "step",
           [](World& w, long n) {
@@ -234,8 +236,13 @@ void BindWorld(py::module_& m) {
           },
           py::arg("body") = 0, "(points, anchors): the mass points below the ground and their entry points (Fig. 4.5)")
       .def(
-          "penetration", [](const World& w, int body) { CheckBody(w, body); return w.state(body).penetration; },
-          py::arg("body") = 0, "the deepest contact")
+          "penetration",
+          [](const World& w, int body) {
+            CheckIndex(w, body);
+            if (w.kind(body) == BodyKind::kLinear) throw InputError("body " + std::to_string(body) + " is not an FFD body");
+            return w.Penetration(body);
+          },
+          py::arg("body") = 0, "the deepest contact (2D or 3D FFD bodies)")
       .def(
           "point_positions",
           [](const World& w, int body) {

@@ -199,7 +199,7 @@ class RolloutResult:
     status: list[str]
     messages: list[str]
 
-def rollout(body: BodyModel, q0: ArrayLike, qd0: Optional[ArrayLike] = None, steps: int = 1, *,
+def rollout(body: BodyModel | BodyModel3, q0: ArrayLike, qd0: Optional[ArrayLike] = None, steps: int = 1, *,
             options: WorldOptions = ..., mode_targets: Optional[ArrayLike] = None, every: int = 1,
             threads: int = 0, energies: bool = False, max_steps: int = ...,
             max_record_mb: float = ...) -> RolloutResult: ...

@@ -69,3 +69,26 @@ def test_errors_name_the_file_and_line(tmp_path):
     world = wobble.World()
     with pytest.raises(wobble.InputError, match="not a 3D FFD body"):
         world.q3(0)
+
+
+def test_batched_rollout_of_the_3d_pot_equals_worlds_stepped_alone(pot3):
+    # three trials on two threads, with PD targets, equal bit for bit to each World stepped alone
+    options = no_ground("thesis", 0.002)
+    q0 = np.array([[0, 100, 0, 0.2, 0.1, 0.0, 0.1, 0, 0],
+                   [5, 80, -3, 0.0, 1.2, 0.3, 0, 0.2, 0],
+                   [-5, 120, 2, 2.5, 0.0, -1.0, 0, 0, 0.3]])
+    qd0 = np.array([[1, 2, 3, 0.5, -1, 2, 0, 0, 0]] * 3)
+    targets = np.array([[0.3, 0, 0], [0, -0.2, 0.1], [0.1, 0.1, -0.2]])
+    r = wobble.rollout(pot3, q0, qd0, 300, options=options, mode_targets=targets, every=100, threads=2, energies=True)
+    assert r.q.shape == (3, 4, 9) and r.status == ["ok"] * 3
+    for i in range(3):
+        world = wobble.World(options)
+        world.add_body3(pot3)
+        world.set_state3(0, q0[i], qd0[i])
+        world.set_mode_targets(0, targets[i])
+        assert np.array_equal(r.q[i, 0], world.q3(0))
+        for k in range(1, 4):
+            world.step(100)
+            assert np.array_equal(r.q[i, k], world.q3(0)) and np.array_equal(r.qd[i, k], world.qd3(0))
+    # the modes were driven: γ moved toward the targets
+    assert np.abs(r.q[:, -1, 6:] - q0[:, 6:]).max() > 1e-3
