@@ -221,7 +221,8 @@ class TrialOutcome:
     failure: str
 
 class SynthesisProblem:
-    body: BodyModel
+    body: Optional[BodyModel]
+    body3: Optional[BodyModel3]
     options: WorldOptions
     q0: NDArray
     qd0: NDArray

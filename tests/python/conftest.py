@@ -33,14 +33,14 @@ def no_ground(integrator="thesis", dt=0.01, gravity=True):
     return options
 
 
-def bounding_table(data):
-    """An Interpreter that ran data/bounding_table.wob up to (not including) its anneal: the
-    synthesis problem of §5.2."""
+def bounding_table(data, script="bounding_table.wob"):
+    """An Interpreter that ran data/bounding_table.wob (or data/bounding_table3.wob, the 3D
+    table) up to (not including) its anneal: the synthesis problem of §5.2."""
     interp = wobble.Interpreter()
     lines = []
-    for line in (data / "bounding_table.wob").read_text().splitlines():
+    for line in (data / script).read_text().splitlines():
         if line.startswith("anneal"):
             break
         lines.append(line)
-    interp.run("\n".join(lines), name=str(data / "bounding_table.wob"), dir=str(data))
+    interp.run("\n".join(lines), name=str(data / script), dir=str(data))
     return interp

@@ -92,3 +92,26 @@ def test_batched_rollout_of_the_3d_pot_equals_worlds_stepped_alone(pot3):
             assert np.array_equal(r.q[i, k], world.q3(0)) and np.array_equal(r.qd[i, k], world.qd3(0))
     # the modes were driven: γ moved toward the targets
     assert np.abs(r.q[:, -1, 6:] - q0[:, 6:]).max() > 1e-3
+
+
+def test_synthesis_of_the_3d_bounding_table_from_python():
+    # data/bounding_table3.wob up to its anneal: the 3D problem, its trials in a batch on two
+    # threads equal to one at a time, and annealing that lowers the cost
+    from conftest import bounding_table
+    problem = bounding_table(DATA, "bounding_table3.wob").synthesis_problem()
+    assert problem.body is None and problem.body3.num_q == 6 + 4 and problem.num_active == 2
+    problem.steps = 300
+    poses = np.array([[[0.1, 0], [0, -0.1], [-0.1, 0], [0, 0.1]],
+                      [[0.2, 0], [0, -0.2], [-0.2, 0], [0, 0.2]],
+                      [[0.05, 0.05], [0.05, -0.05], [-0.05, -0.05], [-0.05, 0.05]]])
+    durations = [0.4, 0.4, 0.4, 0.4]
+    batch = wobble.run_trials(problem, poses, durations, threads=2)
+    for i in range(3):
+        one = problem.run(wobble.PoseGraph(poses[i], durations))
+        assert one.ok and batch.ok[i]
+        assert batch.cost[i] == one.cost and batch.distance[i] == one.distance
+    assert len(set(batch.distance)) == 3  # the controllers move the table differently
+    start = wobble.PoseGraph(poses[0], durations)
+    result = wobble.anneal(problem, start, seed=3, iterations=4, batch=2, threads=2)
+    assert result.trials == 1 + 4 * 2
+    assert result.best_outcome.cost <= result.initial_outcome.cost
