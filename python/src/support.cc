@@ -13,6 +13,23 @@
 #include "wobble/script/interpreter.h"
 
 namespace wobble::python {
+
+void CheckIndex(const World& w, int body) {
+  if (body < 0 || body >= w.num_bodies())
+    throw InputError("body " + std::to_string(body) + ": the world has " + std::to_string(w.num_bodies()) + " bodies");
+}
+
+MaterialPoint PointOf(const World& w, int body, const py::object& mass_point, const py::object& u) {
+  CheckIndex(w, body);
+  if (mass_point.is_none() == u.is_none()) throw InputError("give exactly one of mass_point or u");
+  if (!mass_point.is_none()) {
+    const int k = mass_point.cast<int>();
+    if (k < 0) throw InputError("mass_point must be at least 0");
+    return MassPointOf(body, k);
+  }
+  return At(body, u.cast<Eigen::VectorXd>());
+}
+
 namespace {
 
 // wobble.SimulationStopped and wobble.InputError; the module holds them, so borrowed handles

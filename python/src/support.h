@@ -11,6 +11,12 @@
 
 namespace wobble::python {
 
+// A body index the world has (InputError otherwise).
+void CheckIndex(const World& w, int body);
+// A material point: mass point k, or u (FFD bodies: lattice (s, t); linear bodies: undeformed
+// coordinates); the world checks both.
+MaterialPoint PointOf(const World& w, int body, const py::object& mass_point, const py::object& u);
+
 // Raises wobble.SimulationStopped for a stopped world, with .cause, .step, .time and .body.
 [[noreturn]] void RaiseStopped(const WorldStatus& status);
 

@@ -12,11 +12,6 @@
 namespace wobble::python {
 namespace {
 
-void CheckIndex(const World& w, int body) {
-  if (body < 0 || body >= w.num_bodies())
-    throw InputError("body " + std::to_string(body) + ": the world has " + std::to_string(w.num_bodies()) + " bodies");
-}
-
 void CheckBody(const World& w, int body) {
   CheckIndex(w, body);
   if (w.kind(body) != BodyKind::kFfd) throw InputError("body " + std::to_string(body) + " is not an FFD body");
@@ -25,19 +20,6 @@ void CheckBody(const World& w, int body) {
 void CheckLinear(const World& w, int body) {
   CheckIndex(w, body);
   if (w.kind(body) != BodyKind::kLinear) throw InputError("body " + std::to_string(body) + " is not a linear body");
-}
-
-// A material point: mass point k, or u (FFD bodies: lattice (s, t); linear bodies: undeformed
-// coordinates); the world checks both.
-MaterialPoint PointOf(const World& w, int body, const py::object& mass_point, const py::object& u) {
-  CheckIndex(w, body);
-  if (mass_point.is_none() == u.is_none()) throw InputError("give exactly one of mass_point or u");
-  if (!mass_point.is_none()) {
-    const int k = mass_point.cast<int>();
-    if (k < 0) throw InputError("mass_point must be at least 0");
-    return MassPointOf(body, k);
-  }
-  return At(body, u.cast<Eigen::VectorXd>());
 }
 
 py::dict ForcesDict(const ForceBreakdown<double>& f) {

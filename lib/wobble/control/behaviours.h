@@ -30,9 +30,11 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
-#include "wobble/world/world.h"
 #include "wobble/control/paths.h"
+#include "wobble/world/controller.h"
+#include "wobble/world/world.h"
 
 namespace wobble::control {
 
@@ -224,6 +226,25 @@ class Sequencer {
  private:
   std::deque<std::unique_ptr<Behaviour>> queue_;
   bool started_ = false;
+};
+
+// The Sequencer as a World controller of its own, for a world without a Scene (a program or
+// Python builds the world): before every step the current behaviour acts; the constraints the
+// behaviours made are in names(), the "t: started ..." lines in log().
+class BehaviourController : public Controller {
+ public:
+  Sequencer& sequencer() { return sequencer_; }
+  const ConstraintNames& names() const { return names_; }
+  const std::vector<std::string>& log() const { return log_; }
+  void BeforeStep(World& world) override {
+    BehaviourContext ctx{&world, &names_};
+    sequencer_.BeforeStep(ctx, [this](const std::string& line) { log_.push_back(line); });
+  }
+
+ private:
+  Sequencer sequencer_;
+  ConstraintNames names_;
+  std::vector<std::string> log_;
 };
 
 }  // namespace wobble::control
