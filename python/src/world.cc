@@ -32,6 +32,21 @@ py::dict ForcesDict(const ForceBreakdown<double>& f) {
   return d;
 }
 
+// A controller written in Python: the world calls its before_step/after_step, with the GIL
+// (steps run without it) and the world by reference.
+class PyController : public Controller {
+ public:
+  void BeforeStep(World& w) override { Call("before_step", w); }
+  void AfterStep(World& w) override { Call("after_step", w); }
+
+ private:
+  void Call(const char* name, World& w) {
+    py::gil_scoped_acquire gil;
+    if (py::function f = py::get_override(static_cast<const Controller*>(this), name))
+      f(py::cast(&w, py::return_value_policy::reference));
+  }
+};
+
 }  // namespace
 
 void BindWorld(py::module_& m) {
@@ -94,11 +109,15 @@ void BindWorld(py::module_& m) {
       .def_readonly("body", &WorldStatus::body)
       .def_readonly("message", &WorldStatus::message);
 
-  py::class_<Controller, std::shared_ptr<Controller>>(
+  py::class_<Controller, PyController, std::shared_ptr<Controller>>(
       m, "Controller",
-      "Something the world calls before and after every step (world/controller.h). Made by the\n"
-      "library (pose graphs); controllers written in Python are not supported: steps run without\n"
-      "the GIL.");
+      "Something the world calls around every step (world/controller.h): subclass it in Python\n"
+      "and define before_step(world) and/or after_step(world), then World.add_controller. Steps run\n"
+      "without the GIL; a Python controller takes it for its calls (so it costs a few µs a step),\n"
+      "and an exception it raises stops the step and comes out of World.step.")
+      .def(py::init<>())
+      .def("before_step", &Controller::BeforeStep, py::arg("world"), "at the step's start time, before any body moves")
+      .def("after_step", &Controller::AfterStep, py::arg("world"), "after the step was accepted");
   py::class_<control::PoseGraphController, Controller, std::shared_ptr<control::PoseGraphController>>(
       m, "PoseGraphController", "Drives a body's active modes through a pose graph (§5.1); add it with World.add_controller.")
       .def(py::init([](const World& w, int body, const control::PoseGraph& graph, double switch_width) {

@@ -86,3 +86,46 @@ def test_keyframes_hold_a_foot_and_hand_over_to_the_simulation(table):
     world.step(10)  # simulated again
     with pytest.raises(wobble.InputError, match="keyframes"):
         wobble.KeyframeController(world, 0, [0.0, 0.5], [[0, 0, 0, 0]])
+
+
+def test_a_controller_written_in_python_runs_around_every_step(table):
+    # a PD target that follows a sine, set before every step by Python: the same run as setting
+    # it by hand between single steps; after_step sees every accepted step's time
+    def target(t):
+        return np.array([0.3 * np.sin(4 * t), 0, 0, 0])
+
+    class Sine(wobble.Controller):
+        def __init__(self):
+            super().__init__()
+            self.times = []
+
+        def before_step(self, world):
+            world.set_mode_targets(0, target(world.time))
+
+        def after_step(self, world):
+            self.times.append(world.time)
+
+    def start():
+        world = wobble.World(no_ground("thesis", 0.005))
+        world.add_body(table)
+        world.set_state(0, [0, 100, 0.1, 0, 0, 0, 0])
+        return world
+
+    driven, by_hand = start(), start()
+    sine = Sine()
+    driven.add_controller(sine)
+    driven.step(200)
+    for _ in range(200):
+        by_hand.set_mode_targets(0, target(by_hand.time))
+        by_hand.step(1)
+    assert np.array_equal(driven.q(0), by_hand.q(0)) and np.array_equal(driven.qd(0), by_hand.qd(0))
+    assert sine.times == pytest.approx([0.005 * (k + 1) for k in range(200)], abs=1e-12)
+    assert abs(driven.q(0)[3]) > 1e-3  # the bend was driven
+
+    class Broken(wobble.Controller):
+        def before_step(self, world):
+            raise KeyError("from Python")
+
+    driven.add_controller(Broken())
+    with pytest.raises(KeyError, match="from Python"):
+        driven.step(1)
