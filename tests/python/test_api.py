@@ -19,6 +19,9 @@ def stub_names():
             top.add(node.name)
             members[node.name] = {n.name for n in node.body if isinstance(n, ast.FunctionDef)} | {
                 n.target.id for n in node.body if isinstance(n, ast.AnnAssign)}
+            for base in node.bases:  # a stub class has what its stub bases declare
+                if isinstance(base, ast.Name) and base.id in members:
+                    members[node.name] |= members[base.id]
         elif isinstance(node, ast.FunctionDef):
             top.add(node.name)
         elif isinstance(node, ast.AnnAssign):
