@@ -20,7 +20,6 @@ namespace {
 
 namespace pl = wobble::pipelines;
 
-const std::set<std::string> kOutputs = {"frames", "filmstrip", "charts", "vtp", "exr", "disp"};
 
 struct Size {
   int w = 0, h = 0;
@@ -60,14 +59,11 @@ std::vector<double> ParseNumbers(const std::string& text, const std::string& fla
 }
 
 std::set<std::string> ParseWhat(const std::string& text) {
-  std::set<std::string> what;
-  for (const std::string& word : ListWords(text)) {
-    if (!kOutputs.count(word))
-      throw UsageError("--what: '" + word + "' is not one of frames, filmstrip, charts, vtp, exr, disp");
-    what.insert(word);
-  }
-  if (what.empty()) throw UsageError("--what: nothing to write");
-  return what;
+  const std::vector<std::string> words = ListWords(text);
+  pl::RenderOutputs probe;
+  const std::string error = pl::SetOutputs(words, &probe);
+  if (!error.empty()) throw UsageError("--what: " + error);
+  return {words.begin(), words.end()};
 }
 
 std::string Num(double v) {
@@ -184,12 +180,7 @@ pl::RenderOutputs RenderOutputsOf(const RenderArgs& a, const std::string& defaul
   pl::RenderOutputs out;
   out.folder = a.out;
   out.name = name;
-  out.frames = what.count("frames") > 0;
-  out.filmstrip = what.count("filmstrip") > 0;
-  out.charts = what.count("charts") > 0;
-  out.vtp = what.count("vtp") > 0;
-  out.exr = what.count("exr") > 0;
-  out.disp = what.count("disp") > 0;
+  pl::SetOutputs(std::vector<std::string>(what.begin(), what.end()), &out);  // checked by ParseWhat
   out.fps = a.fps;
   const Size frame_size = ParseSize(a.size, "--size");
   out.view.width = frame_size.w;

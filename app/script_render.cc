@@ -33,9 +33,7 @@ void RenderScriptRuns(const script::RenderRequest& r) {
 
 std::vector<std::string> RenderScriptScene(const script::SceneRenderRequest& r) {
   const record::Trajectory& run = *r.recorded;
-  pl::RenderOutputs out;
-  out.folder = r.folder;
-  out.name = r.name;
+  pl::RenderOutputs out = pl::SceneRenderOutputs(r.folder, r.name, r.drawing.azimuth, r.drawing.elevation);
   out.frames = r.frames;
   out.filmstrip = r.filmstrip;
   out.vtp = r.vtp;
@@ -45,11 +43,6 @@ std::vector<std::string> RenderScriptScene(const script::SceneRenderRequest& r) 
     out.frames = out.filmstrip = false;
   }
   if (!out.frames && !out.filmstrip && !out.vtp) return {};
-  out.view.point_size = 5.0;  // a scene has many mass points: smaller dots than the FFD view's
-  out.filmstrip_point_size = 3.0;
-  out.view.azimuth = r.drawing.azimuth;
-  out.view.elevation = r.drawing.elevation;
-  out.view.title = r.name;
   World world = pl::WorldFor(run, r.world);
   const pl::RenderReport report = pl::RenderTrajectory(world, run, pl::SceneSpecOf(r.drawing.drawings, r.drawing.anchors), out);
   std::vector<std::string> lines;

@@ -155,6 +155,46 @@ void WriteCharts(const record::Trajectory& run, const RenderOutputs& out, Render
 
 }  // namespace
 
+std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out) {
+  out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = false;
+  for (const std::string& w : what) {
+    bool* flag = w == "frames"      ? &out->frames
+                 : w == "filmstrip" ? &out->filmstrip
+                 : w == "charts"    ? &out->charts
+                 : w == "vtp"       ? &out->vtp
+                 : w == "exr"       ? &out->exr
+                 : w == "disp"      ? &out->disp
+                                    : nullptr;
+    if (!flag) return "'" + w + "' is not one of frames, filmstrip, charts, vtp, exr, disp";
+    *flag = true;
+  }
+  if (what.empty()) return "nothing to write";
+  return "";
+}
+
+std::vector<std::string> KeepWithoutDisplay(RenderOutputs* out) {
+  std::vector<std::string> skipped;
+  for (auto [flag, name] : {std::pair{&out->frames, "frames"}, std::pair{&out->filmstrip, "filmstrip"},
+                            std::pair{&out->charts, "charts"}, std::pair{&out->exr, "exr"}})
+    if (*flag) {
+      skipped.push_back(name);
+      *flag = false;
+    }
+  return skipped;
+}
+
+RenderOutputs SceneRenderOutputs(const std::string& folder, const std::string& name, double azimuth, double elevation) {
+  RenderOutputs out;
+  out.folder = folder;
+  out.name = name;
+  out.view.point_size = 5.0;  // a scene has many mass points: smaller dots than the FFD view's
+  out.filmstrip_point_size = 3.0;
+  out.view.azimuth = azimuth;
+  out.view.elevation = elevation;
+  out.view.title = name;
+  return out;
+}
+
 World WorldFor(const record::Trajectory& run, const WorldOptions& options) {
   World world(options);
   for (const record::BodyInfo& b : run.bodies()) {

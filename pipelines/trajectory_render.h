@@ -86,4 +86,17 @@ RenderReport RenderTrajectory(World& world, const record::Trajectory& run, const
 // material) with these options: somewhere to draw a run whose world is gone.
 World WorldFor(const record::Trajectory& run, const WorldOptions& options);
 
+// The outputs the words of `what` name (frames, filmstrip, charts, vtp, exr, disp) on, the
+// others off: "" when every word is one of them and one at least is given, else what is wrong
+// (`wobble render --what`, a script's `render` and Python's render read it the same way).
+std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out);
+// Of those, the ones drawn without an X display (vtp, disp): the rest are switched off and
+// returned, for the message that says they were skipped.
+std::vector<std::string> KeepWithoutDisplay(RenderOutputs* out);
+
+// A Witkin & Welch scene drawn as a script's `render` draws it: frames, filmstrip and .vtp
+// series with the scene's drawings and named points, smaller dots than a character's, the
+// scene's camera angles (out.view.azimuth/elevation are set from `drawing`).
+RenderOutputs SceneRenderOutputs(const std::string& folder, const std::string& name, double azimuth, double elevation);
+
 }  // namespace wobble::pipelines

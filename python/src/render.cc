@@ -97,16 +97,8 @@ void BindRender(py::module_& m) {
         pl::RenderOutputs out;
         out.folder = folder;
         out.name = name;
-        out.frames = out.filmstrip = out.vtp = out.charts = out.exr = out.disp = false;
-        for (const std::string& w : what) {
-          if (w == "frames") out.frames = true;
-          else if (w == "filmstrip") out.filmstrip = true;
-          else if (w == "vtp") out.vtp = true;
-          else if (w == "charts") out.charts = true;
-          else if (w == "exr") out.exr = true;
-          else if (w == "disp") out.disp = true;
-          else throw InputError("what: '" + w + "' is not one of frames, filmstrip, vtp, charts, exr, disp");
-        }
+        const std::string error = pl::SetOutputs(what, &out);
+        if (!error.empty()) throw InputError("what: " + error);
         if (out.frames || out.filmstrip || out.charts || out.exr) RequireDisplay();
         out.fps = fps;
         out.view = ViewOptions(width, height, true, true, true, true, true, color_by);

@@ -9,6 +9,11 @@
 #include "wobble/core/interrupt.h"
 #include "wobble/core/limits.h"
 #include "wobble/script/interpreter.h"
+#ifdef WOBBLE_PYTHON_RENDER
+#include "pipelines/mesh_io.h"
+#include "pipelines/scene_view.h"
+#include "pipelines/trajectory_render.h"
+#endif
 
 namespace wobble::python {
 namespace {
@@ -25,6 +30,13 @@ class PyInterpreter {
         RequestInterrupt();
       }
     });
+#ifdef WOBBLE_PYTHON_RENDER
+    // what `wobble run` installs: a 3D object's mesh read by VTK, and `render` drawn by the
+    // one render driver (pictures need an X display; vtp and disp are written without one)
+    interp_.SetMeshReader(pipelines::ReadSurfaceMesh);
+    interp_.SetRenderHook([this](const script::RenderRequest& r) { RenderRuns(r); });
+    interp_.SetSceneRenderHook([this](const script::SceneRenderRequest& r) { return RenderScene(r); });
+#endif
   }
   void RunFile(const std::string& path) {
     Guarded([&] { interp_.RunFile(path); });
@@ -44,6 +56,52 @@ class PyInterpreter {
   script::Interpreter& interp() { return interp_; }
 
  private:
+#ifdef WOBBLE_PYTHON_RENDER
+  // `render DIR [WHAT]` of the object's runs (default frames,filmstrip,charts, as wobble run).
+  void RenderRuns(const script::RenderRequest& r) {
+    namespace pl = pipelines;
+    const record::Trajectory& run = *r.trajectory;
+    pl::RenderOutputs out;
+    out.folder = r.dir;
+    out.name = run.bodies().empty() ? "run" : run.bodies()[0].name;
+    out.view.title = out.name;
+    out.fps = 30.0;
+    out.t_end = run.time(run.size() - 1);
+    std::vector<std::string> words;
+    std::istringstream in(r.what.empty() ? "frames,filmstrip,charts" : r.what);
+    for (std::string w; std::getline(in, w, ',');)
+      if (!w.empty()) words.push_back(w);
+    const std::string error = pl::SetOutputs(words, &out);
+    if (!error.empty()) throw InputError(error);
+    if (!pl::HasDisplay()) {
+      std::string skipped;
+      for (const std::string& w : pl::KeepWithoutDisplay(&out)) skipped += (skipped.empty() ? "" : ",") + w;
+      if (!skipped.empty()) out_ << "no X display: " << skipped << " skipped (run under xvfb-run -a)\n";
+      if (!out.vtp && !out.disp) return;
+    }
+    World world = pl::WorldFor(run, r.world);
+    for (const pl::RenderReport::File& f : pl::RenderTrajectory(world, run, pl::SceneSpec{}, out).files)
+      out_ << "  " << f.Line() << "\n";
+  }
+  // `render DIR [WHAT]` of a Witkin & Welch scene.
+  std::vector<std::string> RenderScene(const script::SceneRenderRequest& r) {
+    namespace pl = pipelines;
+    pl::RenderOutputs out = pl::SceneRenderOutputs(r.folder, r.name, r.drawing.azimuth, r.drawing.elevation);
+    out.frames = r.frames;
+    out.filmstrip = r.filmstrip;
+    out.vtp = r.vtp;
+    if (!pl::HasDisplay() && !pl::KeepWithoutDisplay(&out).empty())
+      out_ << "no X display: frames and filmstrip skipped (run under xvfb-run -a)\n";
+    if (!out.frames && !out.filmstrip && !out.vtp) return {};
+    World world = pl::WorldFor(*r.recorded, r.world);
+    std::vector<std::string> lines;
+    for (const pl::RenderReport::File& f :
+         pl::RenderTrajectory(world, *r.recorded, pl::SceneSpecOf(r.drawing.drawings, r.drawing.anchors), out).files)
+      lines.push_back(f.Line());
+    return lines;
+  }
+#endif
+
   template <class F> void Guarded(F&& f) {
     ClearInterrupt();
     try {

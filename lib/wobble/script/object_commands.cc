@@ -316,7 +316,7 @@ void Render(State& s, const Words& w, const Context& ctx) {
   ctx.ExpectWords(w, 2, 3);
   RequireObject(s, ctx, "render");
   if (s.track.empty()) ctx.Fail("render: nothing to draw yet (run 'simul' or 'keyframe' first)");
-  if (!s.render_hook) ctx.Fail("render: this program has no renderer ('wobble run' has one)");
+  if (!s.render_hook) ctx.Fail("render: this program has no renderer ('wobble run' and Python's Interpreter have one, built with VTK)");
   RenderRequest request;
   request.dir = w[1];
   request.what = w.size() > 2 ? w[2] : "";
