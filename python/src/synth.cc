@@ -82,12 +82,20 @@ TrialResults RunTrials(const Problem& problem, const py::object& graphs_or_poses
   }
   std::vector<synth::TrialOutcome> out;
   TrialResults r;
-  {
-    py::gil_scoped_release release;
+  // on a worker while this thread watches for Ctrl-C: the trials not started then are skipped
+  // and KeyboardInterrupt says how many ran
+  out = WithCtrlC([&] {
     const auto start = std::chrono::steady_clock::now();
-    out = synth::RunTrials(problem, graphs, threads);
+    std::vector<synth::TrialOutcome> o = synth::RunTrials(problem, graphs, threads);
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  }
+    if (InterruptRequested()) {
+      long ran = 0;
+      for (const synth::TrialOutcome& t : o) ran += t.failure != synth::kInterruptedTrial;
+      throw Interrupted("run_trials stopped by Ctrl-C after " + std::to_string(ran) + " of " +
+                        std::to_string(o.size()) + " trials");
+    }
+    return o;
+  });
   const py::ssize_t N = py::ssize_t(out.size());
   r.cost = py::array_t<double>(N);
   r.distance = py::array_t<double>(N);

@@ -68,3 +68,25 @@ def test_anneal_returns_the_best_so_far_at_ctrl_c(data):
         """, data)
     assert "interrupted True" in out and "best <= initial True" in out, out + err
     assert after < 10
+
+
+def test_run_trials_stops_at_ctrl_c_and_says_how_many_ran(data):
+    # 20000 trials of the bounding table (~4 ms each on two cores: over a minute): SIGINT after
+    # 1 s skips the trials not started and raises KeyboardInterrupt counting those that ran
+    out, err, after = interrupted("""
+        interp = wobble.Interpreter()
+        lines = []
+        for line in open(d + '/bounding_table.wob').read().splitlines():
+            if line.startswith('anneal'):
+                break
+            lines.append(line)
+        interp.run('\\n'.join(lines), dir=d)
+        graphs = [interp.pose_graph] * 20000
+        try:
+            wobble.run_trials(interp.synthesis_problem(), graphs)
+            print('ran to the end')
+        except KeyboardInterrupt as e:
+            print('stopped:', e)
+        """, data)
+    assert "stopped: run_trials stopped by Ctrl-C after" in out and "of 20000 trials" in out, out + err
+    assert after < 5

@@ -140,7 +140,14 @@ TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
 
 std::vector<TrialOutcome> RunTrials(const Problem& p, const std::vector<control::PoseGraph>& graphs, int threads) {
   std::vector<TrialOutcome> out(graphs.size());
-  ParallelFor(graphs.size(), threads, [&](size_t i) { out[i] = RunTrial(p, graphs[i]); });
+  ParallelFor(graphs.size(), threads, [&](size_t i) {
+    if (InterruptRequested()) {  // Ctrl-C: the trials not yet started are not run
+      out[i].failure = kInterruptedTrial;
+      out[i].cost = p.cost.high;
+      return;
+    }
+    out[i] = RunTrial(p, graphs[i]);
+  });
   return out;
 }
 

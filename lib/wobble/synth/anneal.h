@@ -78,7 +78,10 @@ void CenterOfMassX(const World& world, double* x, double* v);
 TrialOutcome RunTrial(const Problem& problem, const control::PoseGraph& graph,
                       const std::function<void(const World&)>& on_step = nullptr);
 
-// Runs the trials on `threads` threads (0: all cores). Results are in input order.
+// Runs the trials on `threads` threads (0: all cores). Results are in input order. After Ctrl-C
+// (core/interrupt.h) the trials not yet started are not run: their failure is
+// kInterruptedTrial and their cost the cost's `high` (the caller says it stopped).
+inline constexpr const char* kInterruptedTrial = "not run: interrupted (Ctrl-C)";
 std::vector<TrialOutcome> RunTrials(const Problem& problem, const std::vector<control::PoseGraph>& graphs,
                                     int threads = 0);
 
