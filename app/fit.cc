@@ -535,44 +535,41 @@ control::PoseGraph ParsePoseGraph(const std::string& text, int num_active, bool 
 
 // What the trajectory fit does differently in 2D and 3D: the reference's frames, the kinematic
 // fit and the coordinate names.
-std::vector<fit::ReferenceFrame> LoadFrames(const FitTrajectoryArgs& a, const std::shared_ptr<const BodyModel>& body) {
+// The reference's frames: a `wobble simulate` CSV (its q rows; a 3D run's hold the orientation
+// as a quaternion, tx ty tz qw qx qy qz γ.., turned into the fit's rotation vector) or a
+// target file with frames.
+template <int Dim>
+auto LoadFrames(const FitTrajectoryArgs& a, const std::shared_ptr<const BodyModelN<Dim>>& body) {
   if (EndsWith(a.reference, ".csv")) {
-    const record::Trajectory sim = record::ReadTrajectoryCsv(a.reference, {record::DescribeFfdBody(body)}).trajectory;
     std::vector<double> t;
     std::vector<Eigen::VectorXd> q;
+    const record::Trajectory sim = [&] {
+      if constexpr (Dim == 2) return record::ReadTrajectoryCsv(a.reference, {record::DescribeFfdBody(body)}).trajectory;
+      else return record::ReadTrajectoryCsv(a.reference, {record::DescribeFfd3Body(body)}).trajectory;
+    }();
     for (int k = 0; k < sim.size(); ++k) {
+      Eigen::VectorXd row = sim.q(k, 0);
+      if constexpr (Dim == 3) {
+        const Eigen::Quaterniond orientation(row[3], row[4], row[5], row[6]);
+        Eigen::VectorXd qk(body->num_q());
+        qk << row.head<3>(), LogRotation<double>(orientation.normalized()), row.tail(body->num_modes());
+        row = qk;
+      }
       t.push_back(sim.time(k));
-      q.push_back(sim.q(k, 0));
+      q.push_back(row);
     }
-    return fit::FramesFromStates(*body, t, q, ParsePointList(a.points, body->num_points()), a.every);
+    const std::vector<int> points = ParsePointList(a.points, body->num_points());
+    if constexpr (Dim == 2) return fit::FramesFromStates(*body, t, q, points, a.every);
+    else return fit::FramesFromStates3(*body, t, q, points, a.every);
   }
-  const formats::TargetFile t = formats::ReadTargetFile(a.reference);
-  if (!t.is_trajectory())
+  const auto file = [&] {
+    if constexpr (Dim == 2) return formats::ReadTargetFile(a.reference);
+    else return formats::ReadTargetFile3(a.reference, AppMeshReader());
+  }();
+  if (!file.is_trajectory())
     throw formats::ParseError(a.reference, 0, "no 'frame' lines: a trajectory needs frames (for one pose use `wobble fit pose`)");
-  formats::CheckMassPointIndices(t, body->num_points());
-  return ReferenceFrames(t.frames);
-}
-std::vector<fit::ReferenceFrame3> LoadFrames(const FitTrajectoryArgs& a, const std::shared_ptr<const BodyModel3>& body) {
-  if (EndsWith(a.reference, ".csv")) {
-    // a 3D run's rows hold the orientation as a quaternion (tx ty tz qw qx qy qz γ..)
-    const record::Trajectory sim = record::ReadTrajectoryCsv(a.reference, {record::DescribeFfd3Body(body)}).trajectory;
-    std::vector<double> t;
-    std::vector<Eigen::VectorXd> q;
-    for (int k = 0; k < sim.size(); ++k) {
-      const Eigen::VectorXd row = sim.q(k, 0);
-      Eigen::VectorXd qk(body->num_q());
-      const Eigen::Quaterniond orientation(row[3], row[4], row[5], row[6]);
-      qk << row.head<3>(), LogRotation<double>(orientation.normalized()), row.tail(body->num_modes());
-      t.push_back(sim.time(k));
-      q.push_back(qk);
-    }
-    return fit::FramesFromStates3(*body, t, q, ParsePointList(a.points, body->num_points()), a.every);
-  }
-  const formats::TargetFile3 t = formats::ReadTargetFile3(a.reference, AppMeshReader());
-  if (!t.is_trajectory())
-    throw formats::ParseError(a.reference, 0, "no 'frame' lines: a trajectory needs frames (for one pose use `wobble fit pose`)");
-  formats::CheckMassPointIndices(t, body->num_points());
-  return ReferenceFrames(t.frames);
+  formats::CheckMassPointIndices(file, body->num_points());
+  return ReferenceFrames(file.frames);
 }
 fit::TrajectoryFitResult FitKinematic(const BodyModel& body, const std::vector<fit::ReferenceFrame>& frames,
                                       const fit::TrajectoryFitOptions& o) {

@@ -20,6 +20,19 @@ options.ground.enabled = False
 world = wobble.World(options)
 world.add_body(table)
 world.set_state(0, [0, 1e6, 0, 0.1, 0, 0, 0])
+
+
+def bounding_table():  # data/bounding_table.wob up to its anneal: the synthesis problem
+    interp = wobble.Interpreter()
+    lines = []
+    for line in open(d + '/bounding_table.wob').read().splitlines():
+        if line.startswith('anneal'):
+            break
+        lines.append(line)
+    interp.run('\\n'.join(lines), dir=d)
+    return interp
+
+
 print('ready', flush=True)
 start = time.time()
 """
@@ -56,13 +69,7 @@ def test_a_long_loop_stops_at_ctrl_c(data, call):
 
 def test_anneal_returns_the_best_so_far_at_ctrl_c(data):
     out, err, after = interrupted("""
-        interp = wobble.Interpreter()
-        lines = []
-        for line in open(d + '/bounding_table.wob').read().splitlines():
-            if line.startswith('anneal'):
-                break
-            lines.append(line)
-        interp.run('\\n'.join(lines), dir=d)
+        interp = bounding_table()
         r = wobble.anneal(interp.synthesis_problem(), interp.pose_graph, iterations=100000, batch=2, max_steps=10**12)
         print('interrupted', r.interrupted, 'trials', r.trials, 'best <= initial', r.best_outcome.cost <= r.initial_outcome.cost)
         """, data)
@@ -74,13 +81,7 @@ def test_run_trials_stops_at_ctrl_c_and_says_how_many_ran(data):
     # 20000 trials of the bounding table (~4 ms each on two cores: over a minute): SIGINT after
     # 1 s skips the trials not started and raises KeyboardInterrupt counting those that ran
     out, err, after = interrupted("""
-        interp = wobble.Interpreter()
-        lines = []
-        for line in open(d + '/bounding_table.wob').read().splitlines():
-            if line.startswith('anneal'):
-                break
-            lines.append(line)
-        interp.run('\\n'.join(lines), dir=d)
+        interp = bounding_table()
         graphs = [interp.pose_graph] * 20000
         try:
             wobble.run_trials(interp.synthesis_problem(), graphs)

@@ -531,46 +531,6 @@ PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& ta
   return best;
 }
 
-VecQ3<double> SmoothnessScales3(const BodyModel3& body) {
-  const int n = body.num_q(), N = body.num_points();
-  VecQ3<double> L = VecQ3<double>::Ones(n);
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (int k = 0; k < N; ++k) c += body.rest_local(k);
-  c /= N;
-  double r2 = 0;
-  for (int k = 0; k < N; ++k) r2 += (body.rest_local(k) - c).squaredNorm();
-  const double radius = std::sqrt(r2 / N) > 0 ? std::sqrt(r2 / N) : 1.0;
-  for (int i = 3; i < 6; ++i) L[i] = radius;
-  for (int d = 0; d < body.num_modes(); ++d) {
-    double m2 = 0;
-    for (int k = 0; k < N; ++k) m2 += body.mode_matrix(k).col(d).squaredNorm();
-    L[kRigidDofs3 + d] = m2 > 0 ? std::sqrt(m2 / N) : 1.0;
-  }
-  return L;
-}
-
-std::vector<ReferenceFrame3> FramesFromStates3(const BodyModel3& body, const std::vector<double>& times,
-                                               const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
-                                               int every) {
-  std::vector<int> which = points;
-  if (which.empty())
-    for (int k = 0; k < body.num_points(); ++k) which.push_back(k);
-  std::vector<ReferenceFrame3> frames;
-  for (size_t f = 0; f < q.size(); f += size_t(std::max(1, every))) {
-    ReferenceFrame3 frame;
-    frame.time = times[f];
-    for (int k : which) {
-      if (k < 0 || k >= body.num_points()) throw std::invalid_argument("mass point " + std::to_string(k) + " does not exist");
-      Correspondence3 p;
-      p.mass_point = k;
-      p.position = PointPosition3(BasisOf3(body, k, {}), q[f]);
-      frame.points.push_back(p);
-    }
-    frames.push_back(frame);
-  }
-  return frames;
-}
-
 namespace {
 
 // Smoothness between frames f−1, f, f+1 (blocks x0, x1, x2 in their charts): the divided

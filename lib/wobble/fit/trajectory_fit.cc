@@ -1,5 +1,7 @@
 #include "wobble/fit/trajectory_fit.h"
 
+#include "wobble/fit/pose_fit3.h"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -7,44 +9,71 @@
 
 namespace wobble::fit {
 
-VecQ<double> SmoothnessScales(const BodyModel& body) {
-  const int n = body.num_q(), N = body.num_points();
-  VecQ<double> L = VecQ<double>::Ones(n);
-  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+namespace {
+
+// SmoothnessScales of either dimension: 1 for the translation, the rms radius of the mass
+// points about their centroid for every rotation coordinate, each mode's rms displacement of
+// the mass points (1 where there is nothing to measure).
+template <int Dim> Eigen::VectorXd ScalesOf(const BodyModelN<Dim>& body) {
+  const int n = body.num_q(), N = body.num_points(), rigid = n - body.num_modes();
+  Eigen::VectorXd L = Eigen::VectorXd::Ones(n);
+  Eigen::Matrix<double, Dim, 1> c = Eigen::Matrix<double, Dim, 1>::Zero();
   for (int k = 0; k < N; ++k) c += body.rest_local(k);
   c /= N;
   double r2 = 0;
   for (int k = 0; k < N; ++k) r2 += (body.rest_local(k) - c).squaredNorm();
-  L[2] = std::sqrt(r2 / N);
-  if (!(L[2] > 0)) L[2] = 1.0;
+  const double radius = std::sqrt(r2 / N);
+  for (int i = Dim; i < rigid; ++i) L[i] = radius > 0 ? radius : 1.0;
   for (int d = 0; d < body.num_modes(); ++d) {
     double m2 = 0;
     for (int k = 0; k < N; ++k) m2 += body.mode_matrix(k).col(d).squaredNorm();
-    L[kRigidDofs + d] = m2 > 0 ? std::sqrt(m2 / N) : 1.0;
+    L[rigid + d] = m2 > 0 ? std::sqrt(m2 / N) : 1.0;
   }
   return L;
 }
 
-std::vector<ReferenceFrame> FramesFromStates(const BodyModel& body, const std::vector<double>& times,
-                                             const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
-                                             int every) {
+// FramesFromStates of either dimension; place(k, q) is mass point k's world position at q.
+template <class Frame, int Dim, class Place>
+std::vector<Frame> FramesOf(const BodyModelN<Dim>& body, const std::vector<double>& times,
+                            const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points, int every,
+                            const Place& place) {
   std::vector<int> which = points;
   if (which.empty())
     for (int k = 0; k < body.num_points(); ++k) which.push_back(k);
-  std::vector<ReferenceFrame> frames;
+  std::vector<Frame> frames;
   for (size_t f = 0; f < q.size(); f += size_t(std::max(1, every))) {
-    ReferenceFrame frame;
+    Frame frame;
     frame.time = times[f];
     for (int k : which) {
       if (k < 0 || k >= body.num_points()) throw std::invalid_argument("mass point " + std::to_string(k) + " does not exist");
-      Correspondence p;
+      typename decltype(frame.points)::value_type p;
       p.mass_point = k;
-      p.position = PointPosition(BasisOf(body, k, {}), q[f].data(), body.num_q());
+      p.position = place(k, q[f]);
       frame.points.push_back(p);
     }
     frames.push_back(frame);
   }
   return frames;
+}
+
+}  // namespace
+
+VecQ<double> SmoothnessScales(const BodyModel& body) { return ScalesOf(body); }
+VecQ3<double> SmoothnessScales3(const BodyModel3& body) { return ScalesOf(body); }
+
+std::vector<ReferenceFrame> FramesFromStates(const BodyModel& body, const std::vector<double>& times,
+                                             const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
+                                             int every) {
+  return FramesOf<ReferenceFrame>(body, times, q, points, every, [&](int k, const Eigen::VectorXd& qf) {
+    return Eigen::Vector2d(PointPosition(BasisOf(body, k, {}), qf.data(), int(qf.size())));
+  });
+}
+
+std::vector<ReferenceFrame3> FramesFromStates3(const BodyModel3& body, const std::vector<double>& times,
+                                               const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
+                                               int every) {
+  return FramesOf<ReferenceFrame3>(body, times, q, points, every,
+                                   [&](int k, const Eigen::VectorXd& qf) { return PointPosition3(BasisOf3(body, k, {}), qf); });
 }
 
 TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
