@@ -251,6 +251,24 @@ json ConditioningJson(const fit::Conditioning& conditioning) {
   return c;
 }
 
+// The JSON of a pose fit's result (without its overlay).
+json PoseJson(const std::string& kind, int dimension, const std::string& body, const std::string& targets,
+              const std::vector<std::string>& names, const fit::PoseFitResult& r) {
+  json j;
+  j["kind"] = kind;
+  j["dimension"] = dimension;
+  j["body"] = body;
+  j["targets"] = targets;
+  j["coordinates"] = names;
+  j["q"] = Vector(r.q);
+  j["report"] = ReportJson(r.report);
+  j["rms_residual"] = r.rms_residual;
+  j["point_residuals"] = r.point_residuals;
+  j["at_bound"] = r.at_bound;
+  j["conditioning"] = ConditioningJson(r.conditioning);
+  return j;
+}
+
 // The summary both pose fits print; returns the exit code.
 int PrintPoseSummary(const std::string& headline, const std::vector<std::string>& names, const fit::PoseFitResult& r,
                      bool full_report, const std::string& after_iterations = "") {
@@ -371,18 +389,7 @@ int RunFitPose3(const FitPoseArgs& a) {
   EndIterationLine();
   const std::vector<std::string> names = fit::CoordinateNames3(*body);
 
-  json j;
-  j["kind"] = surface ? "surface" : "correspondences";
-  j["dimension"] = 3;
-  j["body"] = body->name();
-  j["targets"] = a.targets;
-  j["coordinates"] = names;
-  j["q"] = Vector(r.q);
-  j["report"] = ReportJson(r.report);
-  j["rms_residual"] = r.rms_residual;
-  j["point_residuals"] = r.point_residuals;
-  j["at_bound"] = r.at_bound;
-  j["conditioning"] = ConditioningJson(r.conditioning);
+  json j = PoseJson(surface ? "surface" : "correspondences", 3, body->name(), a.targets, names, r);
   // fitted body points next to their targets (surface fits: the body samples; the target is
   // the file's mesh and cloud)
   json overlay;
@@ -429,19 +436,8 @@ int RunFitPose(const FitPoseArgs& a) {
   EndIterationLine();
   const std::vector<std::string> names = fit::CoordinateNames(*body);
 
-  json j;
-  j["kind"] = curve ? "curve" : "correspondences";
-  j["dimension"] = 2;
-  j["body"] = body->name();
-  j["targets"] = a.targets;
-  j["coordinates"] = names;
-  j["q"] = Vector(r.q);
-  j["report"] = ReportJson(r.report);
-  j["rms_residual"] = r.rms_residual;
-  j["point_residuals"] = r.point_residuals;
-  j["at_bound"] = r.at_bound;
+  json j = PoseJson(curve ? "curve" : "correspondences", 2, body->name(), a.targets, names, r);
   if (curve) j["rounds"] = r.rounds;
-  j["conditioning"] = ConditioningJson(r.conditioning);
   // the overlay hook: fitted body points and their targets, world frame
   json overlay;
   overlay["fitted"] = json::array();

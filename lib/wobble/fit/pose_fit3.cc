@@ -614,16 +614,7 @@ TrajectoryFitResult FitKinematicTrajectory3(const BodyModel3& body, const std::v
         problem.AddResidualBlock(MakeCost(s, n, 3, n), nullptr, charts[f - 1].x.data(), charts[f].x.data(),
                                  charts[f + 1].x.data());
       }
-    ceres::Solver::Options options;
-    options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    options.sparse_linear_algebra_library_type =
-        ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ? ceres::SUITE_SPARSE : ceres::EIGEN_SPARSE;
-    options.max_num_iterations = po.max_iterations;
-    options.function_tolerance = 1e-12;
-    options.gradient_tolerance = 1e-14;
-    options.parameter_tolerance = 1e-12;
-    result.linear_solver = std::string("SPARSE_NORMAL_CHOLESKY/") +
-                           ceres::SparseLinearAlgebraLibraryTypeToString(options.sparse_linear_algebra_library_type);
+    const ceres::Solver::Options options = TrajectorySolverOptions(po, &result.linear_solver);
     FitReport part;
     SolveAndReport(options, &problem, po.on_iteration, po.full_report, &part);
     AppendReport(part, k == 0, &result.report);

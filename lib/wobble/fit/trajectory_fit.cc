@@ -138,16 +138,7 @@ TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vec
                                result.q[f + 1].data());
     }
   }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  options.sparse_linear_algebra_library_type =
-      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ? ceres::SUITE_SPARSE : ceres::EIGEN_SPARSE;
-  options.max_num_iterations = po.max_iterations;
-  options.function_tolerance = 1e-12;
-  options.gradient_tolerance = 1e-14;
-  options.parameter_tolerance = 1e-12;
-  result.linear_solver = std::string("SPARSE_NORMAL_CHOLESKY/") +
-                         ceres::SparseLinearAlgebraLibraryTypeToString(options.sparse_linear_algebra_library_type);
+  const ceres::Solver::Options options = TrajectorySolverOptions(po, &result.linear_solver);
   SolveAndReport(options, &problem, po.on_iteration, po.full_report, &result.report);
 
   // residuals per frame

@@ -110,6 +110,20 @@ void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
   SolvePoseProblem(o, &problem, report);
 }
 
+ceres::Solver::Options TrajectorySolverOptions(const PoseFitOptions& o, std::string* linear_solver) {
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.sparse_linear_algebra_library_type =
+      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ? ceres::SUITE_SPARSE : ceres::EIGEN_SPARSE;
+  options.max_num_iterations = o.max_iterations;
+  options.function_tolerance = 1e-12;
+  options.gradient_tolerance = 1e-14;
+  options.parameter_tolerance = 1e-12;
+  *linear_solver = std::string("SPARSE_NORMAL_CHOLESKY/") +
+                   ceres::SparseLinearAlgebraLibraryTypeToString(options.sparse_linear_algebra_library_type);
+  return options;
+}
+
 Conditioning ComputeConditioning(const BodyModel& body, const std::vector<SegmentResidual>& data,
                                  const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o,
                                  const Eigen::VectorXd& q_in) {

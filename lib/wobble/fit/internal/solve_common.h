@@ -56,6 +56,10 @@ void FillReport(const ceres::Solver::Summary& summary, bool full, double seconds
 void SolveAndReport(ceres::Solver::Options options, ceres::Problem* problem,
                     const std::function<void(int, double)>& on_iteration, bool full_report, FitReport* report);
 
+// The kinematic trajectory fits' solver (2D and 3D): sparse normal Cholesky (SuiteSparse when
+// Ceres has it), the fit's tight tolerances; `linear_solver` gets its name for the result.
+ceres::Solver::Options TrajectorySolverOptions(const PoseFitOptions& o, std::string* linear_solver);
+
 // Solves a pose problem built by the caller (dense normal equations, the fit's tolerances).
 void SolvePoseProblem(const PoseFitOptions& o, ceres::Problem* problem, FitReport* report);
 
