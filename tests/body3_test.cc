@@ -634,7 +634,7 @@ TEST(Body3InWorld, RefusesBadStatesAndPoints) {
   EXPECT_THROW(world.body(b), std::invalid_argument);  // not a 2D FFD body
   EXPECT_THROW(world.AddNail(At(b, Eigen::Vector2d(0.5, 0.5))), std::invalid_argument);  // (s, t, u) needed
   EXPECT_THROW(world.AddNail(At(b, Eigen::Vector3d(0.5, 1.5, 0.5))), std::invalid_argument);
-  EXPECT_THROW(world.ApplyPointForce(MassPointOf(b, 0), Eigen::Vector3d(1, 0, 0)), std::invalid_argument);
+  EXPECT_THROW(world.ApplyPointForce(MassPointOf(b, 0), Eigen::Vector2d(1, 0)), std::invalid_argument);  // 3 components
   Eigen::VectorXd none(0), v = Eigen::VectorXd::Zero(6);
   EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, Eigen::VectorXd::Zero(5)),
                std::invalid_argument);
@@ -643,6 +643,61 @@ TEST(Body3InWorld, RefusesBadStatesAndPoints) {
   v[0] = 1e160;  // finite, but its kinetic energy is not
   EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, v), std::invalid_argument);
   EXPECT_EQ(world.state3(b).v[0], 0.0);  // the refused states left it as it was
+}
+
+// A point force for one step from rest gives the body exactly its impulse. The explicit step
+// solves M(q0) v1 = dt Q with Q = Jᵀ f, so for every rigid motion u, v1ᵀ M(q0) u = dt fᵀ J u:
+// the linear momentum Σ m_k ẋ_k is f dt and the angular momentum about the origin
+// Σ m_k x_k × ẋ_k is x_p × f dt, with x_k and ẋ_k = ṫ + R (ω × l_k + B_k γ̇) summed over the mass
+// points at the step's start configuration. On the free path and on the constrained one (a
+// nail on another body makes every body step together).
+TEST(Body3InWorld, APointForceGivesTheBodyItsImpulse) {
+  const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
+  auto table3 = std::make_shared<const BodyModel3>(
+      def, formats::ReadDeformationFile3(std::string(WOBBLE_DATA_DIR) + "/table3_modes.def3", def.lattice));
+  for (const bool constrained : {false, true}) {
+    const char* path = constrained ? "constrained" : "free";
+    WorldOptions o;
+    o.params.gravity_on = false;
+    o.integrator = Integrator::kThesis;
+    o.dt = 0.01;
+    World world(o);
+    const int b = world.AddBody(table3);
+    const Vector3d t0(1, 2, 3);
+    const Eigen::Quaterniond R0(Eigen::AngleAxisd(0.7, Vector3d(1, 2, 0.5).normalized()));
+    const Eigen::VectorXd gamma0 = Eigen::VectorXd::Constant(4, 0.05);
+    world.SetState3(b, t0, R0, gamma0, Eigen::VectorXd::Zero(10));
+    if (constrained) world.AddNail(MassPointOf(world.AddBody(table3), 0));
+    const MaterialPoint p = MassPointOf(b, 7);
+    const Vector3d f(30, -50, 20), x_p = world.PointPosition(p);
+    world.ApplyPointForce(p, f);
+    ASSERT_TRUE(world.Step()) << world.status().message;
+    const Eigen::VectorXd v = world.state3(b).v;
+    auto momenta = [&](const Eigen::VectorXd& vel, Vector3d* P, Vector3d* L) {
+      P->setZero();
+      L->setZero();
+      for (int k = 0; k < table3->num_points(); ++k) {
+        const Vector3d l = table3->rest_local(k) + table3->mode_matrix(k) * gamma0;
+        const Vector3d x = t0 + R0 * l;
+        const Vector3d xd = vel.head<3>() + R0 * (Vector3d(vel.segment<3>(3)).cross(l) + table3->mode_matrix(k) * vel.tail(4));
+        *P += table3->mass(k) * xd;
+        *L += table3->mass(k) * x.cross(xd);
+      }
+    };
+    Vector3d P, L;
+    momenta(v, &P, &L);
+    EXPECT_LT((P - f * o.dt).norm(), 1e-12 * f.norm() * o.dt) << path;
+    EXPECT_LT((L - x_p.cross(f) * o.dt).norm(), 1e-12 * (x_p.norm() * f.norm() * o.dt)) << path;
+    // the force acts for one step only: the next step is that of a twin given the same state
+    World twin(o);
+    const int tb = twin.AddBody(table3);
+    if (constrained) twin.AddNail(MassPointOf(twin.AddBody(table3), 0));
+    const BodyState3<double>& s1 = world.state3(b);
+    twin.SetState3(tb, s1.t, s1.orientation, s1.gamma, s1.v);
+    ASSERT_TRUE(world.Step());
+    ASSERT_TRUE(twin.Step());
+    EXPECT_EQ(world.state3(b).v, twin.state3(tb).v) << path;
+  }
 }
 
 // A rigid box nailed at the middle of its top face is a physical pendulum: small swings about

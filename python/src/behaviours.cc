@@ -57,9 +57,9 @@ void BindBehaviours(py::module_& m) {
             return control::PlaceAnchor(name.empty() ? "place" : name, place);
           },
           py::arg("place"), py::kw_only(), py::arg("name") = "", "A fixed place (a sky point: zero velocity).")
-      .def_readonly("name", &Anchor::name)
-      .def("position", &Anchor::Position, py::arg("world"))
-      .def("velocity", &Anchor::Velocity, py::arg("world"));
+      .def_readonly("name", &Anchor::name, "the name behaviours and their log use")
+      .def("position", &Anchor::Position, py::arg("world"), "where it is now in `world`")
+      .def("velocity", &Anchor::Velocity, py::arg("world"), "its velocity now (zero for a place)");
 
   py::class_<BehaviourController, Controller, std::shared_ptr<BehaviourController>>(
       m, "Behaviours",

@@ -65,6 +65,7 @@ void BindBodies3(py::module_& m) {
                                return names;
                              })
       .def_property_readonly("total_mass", [](const BodyModel3& b) { return b.moments().m; })
+      .def_property_readonly("masses", [](const BodyModel3& b) { return b.def().masses; }, "mass of each mass point")
       .def_property_readonly("mass_positions", [](const BodyModel3& b) { return Rows3(b.def().mass_positions); },
                              "(num_points, 3) mass points in the body frame")
       .def_property_readonly("mesh_points", [](const BodyModel3& b) { return Rows3(b.def().mesh.points); },

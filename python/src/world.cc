@@ -65,6 +65,24 @@ void BindWorld(py::module_& m) {
       .def_property_readonly("normal", &Ground::normal)
       .def_property_readonly("tangent", &Ground::tangent);
 
+  py::class_<GroundPlane>(m, "GroundPlane",
+                          "The 3D FFD bodies' ground: a plane of any normal with the penalty contact and capped\n"
+                          "friction of §4.9 in two tangent directions (off by default).")
+      .def(py::init<>())
+      .def_readwrite("enabled", &GroundPlane::enabled)
+      .def_readwrite("point", &GroundPlane::point, "a point of the plane")
+      .def_property(
+          "normal", [](const GroundPlane& g) { return g.normal; },
+          [](GroundPlane& g, const Eigen::Vector3d& n) {
+            if (!(n.norm() > 0) || !n.allFinite()) throw InputError("ground_3d.normal must be a finite, non-zero vector");
+            g.normal = n.normalized();
+          },
+          "unit normal out of the ground (normalized when set)")
+      .def_readwrite("stiffness", &GroundPlane::stiffness)
+      .def_readwrite("normal_damping", &GroundPlane::normal_damping)
+      .def_readwrite("friction_damping", &GroundPlane::friction_damping)
+      .def_readwrite("friction_cap", &GroundPlane::friction_cap);
+
   py::class_<WorldOptions>(m, "WorldOptions", "What a World is made with; every field is also a keyword of the constructor.")
       .def(py::init<>())
       .def_readwrite("dt", &WorldOptions::dt, "time step (s)")
@@ -89,7 +107,12 @@ void BindWorld(py::module_& m) {
           "max_condition", [](const WorldOptions& o) { return o.params.max_condition; },
           [](WorldOptions& o, double c) { o.params.max_condition = c; },
           "runs stop when the estimated condition number of M exceeds this")
-      .def_readwrite("feedback_rate", &WorldOptions::feedback_rate, "constraint drift feedback (Witkin & Welch Eq. 10)");
+      .def_readwrite("feedback_rate", &WorldOptions::feedback_rate, "constraint drift feedback (Witkin & Welch Eq. 10)")
+      .def_property(
+          "ground_3d", [](WorldOptions& o) -> GroundPlane& { return o.ground_3d; },
+          [](WorldOptions& o, const GroundPlane& g) { o.ground_3d = g; }, py::return_value_policy::reference_internal,
+          "the 3D FFD bodies' ground plane (changed in place: options.ground_3d.enabled = True)")
+      .def_readwrite("gravity_3d", &WorldOptions::gravity_3d, "the 3D bodies' gravity (m/s²), on with gravity_on");
 
   py::class_<Energies>(m, "Energies", "Every energy term of one body (J); total() is their sum.")
       .def_readonly("kinetic", &Energies::kinetic, "½ q̇ᵀ M q̇ (Eq. 4.9)")
@@ -222,20 +245,26 @@ void BindWorld(py::module_& m) {
       .def(
           "contacts",
           [](const World& w, int body) {
-            CheckBody(w, body);
-            const auto& contacts = w.state(body).contacts;
-            py::array_t<int> points(contacts.size());
-            py::array_t<double> anchors({py::ssize_t(contacts.size()), py::ssize_t(2)});
-            auto p = points.mutable_unchecked<1>();
-            auto a = anchors.mutable_unchecked<2>();
-            for (size_t k = 0; k < contacts.size(); ++k) {
-              p(k) = contacts[k].point;
-              a(k, 0) = contacts[k].anchor.x();
-              a(k, 1) = contacts[k].anchor.y();
-            }
-            return py::make_tuple(points, anchors);
+            CheckIndex(w, body);
+            if (w.kind(body) == BodyKind::kLinear) throw InputError("body " + std::to_string(body) + " is not an FFD body");
+            // (point, anchor) of either dimension's contacts
+            auto table = [](const auto& contacts, int dim) {
+              py::array_t<int> points(contacts.size());
+              py::array_t<double> anchors({py::ssize_t(contacts.size()), py::ssize_t(dim)});
+              auto p = points.mutable_unchecked<1>();
+              auto a = anchors.mutable_unchecked<2>();
+              for (size_t k = 0; k < contacts.size(); ++k) {
+                p(k) = contacts[k].point;
+                for (int i = 0; i < dim; ++i) a(k, i) = contacts[k].anchor[i];
+              }
+              return py::make_tuple(points, anchors);
+            };
+            if (w.kind(body) == BodyKind::kFfd3) return table(w.state3(body).contacts, 3);
+            return table(w.state(body).contacts, 2);
           },
-          py::arg("body") = 0, "(points, anchors): the mass points below the ground and their entry points (Fig. 4.5)")
+          py::arg("body") = 0,
+          "(points, anchors): the mass points below the ground and their entry points (Fig. 4.5); anchors\n"
+          "(n, 2), or (n, 3) for a 3D FFD body")
       .def(
           "penetration",
           [](const World& w, int body) {
@@ -270,6 +299,15 @@ void BindWorld(py::module_& m) {
           py::arg("where") = py::none(),
           "Nails a material point (mass_point k, or u) where it is now, or at `where`; returns the\n"
           "constraint's id. Constraints are held by Lagrange multipliers (Witkin & Welch Eq. 6-10).")
+      .def(
+          "apply_point_force",
+          [](World& w, int body, const py::object& mass_point, const py::object& u, const Eigen::VectorXd& force) {
+            w.ApplyPointForce(PointOf(w, body, mass_point, u), force);
+          },
+          py::arg("body"), py::arg("mass_point") = py::none(), py::kw_only(), py::arg("u") = py::none(),
+          py::arg("force"),
+          "A world force (2 or 3 components, the body's dimension) at a material point during the next\n"
+          "step only (Jᵀ f for FFD bodies of either dimension, f pᵀ for linear ones).")
       .def(
           "add_attachment",
           [](World& w, int a, int b, const py::object& a_mass_point, const py::object& a_u, const py::object& b_mass_point,

@@ -72,6 +72,7 @@ class BodyModel3:
     num_points: int
     mode_names: list[str]
     total_mass: float
+    masses: list[float]
     mass_positions: NDArray
     mesh_points: NDArray
     mesh_triangles: NDArray
@@ -93,12 +94,25 @@ class Ground:
     tangent: NDArray
     def __init__(self, **fields: Any) -> None: ...
 
+class GroundPlane:
+    """The 3D FFD bodies' ground plane (penalty contact, capped friction); off by default."""
+    enabled: bool
+    point: NDArray
+    normal: NDArray
+    stiffness: float
+    normal_damping: float
+    friction_damping: float
+    friction_cap: float
+    def __init__(self) -> None: ...
+
 class WorldOptions:
     dt: float
     integrator: str
     gravity: NDArray
     gravity_on: bool
     ground: Ground
+    ground_3d: GroundPlane
+    gravity_3d: NDArray
     max_condition: float
     feedback_rate: float
     def __init__(self, **fields: Any) -> None: ...
@@ -198,6 +212,8 @@ class World:
     def accelerations(self, body: int = 0) -> NDArray: ...
     def add_nail(self, body: int, mass_point: Optional[int] = None, *, u: Optional[ArrayLike] = None,
                  where: Optional[ArrayLike] = None) -> int: ...
+    def apply_point_force(self, body: int, mass_point: Optional[int] = None, *, u: Optional[ArrayLike] = None,
+                          force: ArrayLike) -> None: ...
     def add_attachment(self, a: int, b: int, *, a_mass_point: Optional[int] = None, a_u: Optional[ArrayLike] = None,
                        b_mass_point: Optional[int] = None, b_u: Optional[ArrayLike] = None) -> int: ...
     def point_position(self, body: int, mass_point: Optional[int] = None, *, u: Optional[ArrayLike] = None) -> NDArray: ...

@@ -115,3 +115,49 @@ def test_synthesis_of_the_3d_bounding_table_from_python():
     result = wobble.anneal(problem, start, seed=3, iterations=4, batch=2, threads=2)
     assert result.trials == 1 + 4 * 2
     assert result.best_outcome.cost <= result.initial_outcome.cost
+
+
+def test_contacts_and_penetration_of_a_3d_body_on_the_ground(pot3):
+    # the pot dropped onto the ground plane: its contacts are mass points below the plane, each
+    # with a 3D anchor on the plane's side it entered from
+    options = wobble.WorldOptions(dt=0.0005)
+    options.ground_3d.enabled = True
+    options.ground_3d.stiffness = 20000
+    world = wobble.World(options)
+    world.add_body3(pot3)
+    world.set_state3(0, [0, 0.5, 0, 0.1, 0, 0.05, 0, 0, 0])  # its foot 0.5 above the plane, tilted
+    for _ in range(4000):  # until it touches (it bounces: contacts come and go)
+        world.step(1)
+        points, anchors = world.contacts(0)
+        if len(points) > 3:
+            break
+    assert len(points) > 0 and anchors.shape == (len(points), 3)
+    # the contact points are below the plane y = 0; the deepest is the penetration
+    y = pot3.mass_points_at(world.q3(0))[points, 1]
+    assert np.all(y < 0)
+    assert world.penetration(0) == pytest.approx(-y.min(), rel=1e-12)
+
+
+def test_a_point_force_on_a_3d_body_gives_its_impulse(pot3):
+    # one explicit step from rest solves M(q0) v1 = dt Jᵀ f, so the linear momentum Σ m_k ẋ_k,
+    # with ẋ_k = ṫ + (R ω) × (x_k − t) + R B_k γ̇ at the start's configuration, is f dt
+    world = wobble.World(no_ground("thesis", 0.01, gravity=False))
+    world.add_body3(pot3)
+    q0 = np.array([1.0, 2.0, 3.0, 0.3, -0.2, 0.5, 0, 0, 0])
+    world.set_state3(0, q0)
+    x = pot3.mass_points_at(q0)
+    f = np.array([30.0, -50.0, 20.0])
+    world.apply_point_force(0, 7, force=f)
+    world.step(1)
+    v = world.qd3(0)
+    r = q0[3:6]
+    angle = np.linalg.norm(r)
+    k = r / angle
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+    B_gamma_dot = pot3.mass_points_at(np.concatenate([np.zeros(6), v[6:]])) - pot3.mass_points_at(np.zeros(9))
+    xd = v[:3] + np.cross(R @ v[3:6], x - q0[:3]) + B_gamma_dot @ R.T
+    P = (np.array(pot3.masses)[:, None] * xd).sum(axis=0)
+    np.testing.assert_allclose(P, f * 0.01, rtol=0, atol=1e-9 * np.linalg.norm(f) * 0.01)
+    with pytest.raises(wobble.InputError):
+        world.apply_point_force(0, 7, force=[1.0, 2.0])

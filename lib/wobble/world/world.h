@@ -305,6 +305,7 @@ class World {
   struct Ffd3Entry {
     std::shared_ptr<const BodyModel3> model;
     BodyState3<double> state;
+    Eigen::VectorXd applied;  // Σ Jᵀ f of ApplyPointForce for the next step
   };
   struct LinearEntry {
     std::shared_ptr<const LinearBodyModel> model;

@@ -123,16 +123,16 @@ void World::ApplyPointForce(const MaterialPoint& point, const Eigen::VectorXd& f
     throw std::invalid_argument("a force on body '" + body_name(point.body) + "' needs " +
                                 std::to_string(dim(point.body)) + " finite components");
   const Slot& b = slots_[e.body];
-  if (b.kind == BodyKind::kFfd3) {
-    throw InputError("body '" + body_name(point.body) + "' is a 3D FFD body: point forces on it are not supported yet");
-  } else if (b.kind == BodyKind::kLinear) {
+  if (b.kind == BodyKind::kLinear) {
     linear_[b.index].applied += f * e.p.transpose();
-  } else {
-    std::vector<Eigen::VectorXd> Q(num_bodies());
-    Q[e.body] = Eigen::VectorXd::Zero((*ffd_[b.index].model).num_q());
-    AddEndForce(e, f, &Q);
-    ffd_[b.index].applied += Q[e.body];
+    return;
   }
+  // FFD bodies of either dimension: Jᵀ f (Eq. 4.20), as a constraint's force enters
+  Eigen::VectorXd& applied = b.kind == BodyKind::kFfd3 ? ffd3_[b.index].applied : ffd_[b.index].applied;
+  std::vector<Eigen::VectorXd> Q(num_bodies());
+  Q[e.body] = Eigen::VectorXd::Zero(applied.size());
+  AddEndForce(e, f, &Q);
+  applied += Q[e.body];
 }
 
 World::PointVec World::EndJdotQdot(const End& e) const {

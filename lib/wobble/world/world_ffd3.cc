@@ -15,6 +15,7 @@ int World::AddBody(std::shared_ptr<const BodyModel3> model) {
   if (!model) throw std::invalid_argument("AddBody: no model");
   Ffd3Entry e;
   e.state = RestState3<double>(*model);
+  e.applied = Eigen::VectorXd::Zero(model->num_q());
   e.model = std::move(model);
   ffd3_.push_back(std::move(e));
   slots_.push_back({BodyKind::kFfd3, int(ffd3_.size()) - 1});
@@ -91,10 +92,24 @@ void World::SetState3(int body, const Eigen::Vector3d& t, const Eigen::Quaternio
   throw InputError("body '" + m.name() + "': a state whose energy is not finite (" + EnergyTerms(energies) + ")");
 }
 
+namespace {
+// The point forces of ApplyPointForce as StepBody3's extra generalized force; none (null) on
+// almost every step. One functor type for both cases: one instantiation of the step.
+struct AppliedForce3 {
+  const Eigen::VectorXd* force = nullptr;
+  void operator()(const BodyState3<double>&, VecQ3<double>* Q) const {
+    if (force) *Q += *force;
+  }
+};
+}  // namespace
+
 bool World::StepFfd3Body(int body) {
   Ffd3Entry& e = ffd3_[slots_[body].index];
   const BodyState3<double> before = e.state;
-  const StepStatus st = StepBody3(*e.model, Params3(), options_.integrator, options_.dt, &e.state);
+  const bool pushed = !e.applied.isZero(0.0);
+  const StepStatus st = StepBody3(*e.model, Params3(), options_.integrator, options_.dt, &e.state,
+                                  AppliedForce3{pushed ? &e.applied : nullptr});
+  if (pushed) e.applied.setZero();
   if (st.ok() && std::isfinite(Ffd3Energies(body).total())) return true;
   const Energies energies = st.ok() ? Ffd3Energies(body) : Energies();
   e.state = before;  // a refused step leaves the state before it
@@ -211,12 +226,14 @@ bool World::Ffd3FreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st)
   *st = Accelerations3(*Ffd3(body).model, Params3(), Ffd3(body).state, &a);
   if (!st->ok()) return false;
   *acc = a;
+  if (!Ffd3(body).applied.isZero(0.0)) Ffd3ApplyGeneralized(body, Ffd3(body).applied, acc);
   return true;
 }
 
 bool World::Ffd3AcceptConstrainedStep(int body, const Eigen::VectorXd& acc) {
   Ffd3Entry& e = ffd3_[slots_[body].index];
   const BodyState3<double> before = e.state;
+  e.applied.setZero();  // acc holds it
   e.state.v += options_.dt * acc;
   AdvanceConfiguration3<double>(e.state.v, options_.dt, &e.state);
   UpdateContacts3(*e.model, options_.ground_3d, &e.state);
