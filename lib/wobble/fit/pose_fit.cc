@@ -95,14 +95,6 @@ void FillResiduals(const std::vector<SegmentResidual>& data, const Eigen::Vector
   r->rms_residual = data.empty() ? 0.0 : std::sqrt(sum / double(data.size()));
 }
 
-void FillAtBound(const BodyModel& body, const PoseFitOptions& o, PoseFitResult* r) {
-  r->at_bound.clear();
-  for (int d = 0; d < body.num_modes(); ++d) {
-    const double g = r->q[kRigidDofs + d];
-    const double tol = 1e-9 * (ModeUpper(o, d) - ModeLower(o, d));
-    if (g <= ModeLower(o, d) + tol || g >= ModeUpper(o, d) - tol) r->at_bound.push_back(body.modes()[d].name);
-  }
-}
 
 }  // namespace
 

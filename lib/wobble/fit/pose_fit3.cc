@@ -287,14 +287,6 @@ Conditioning Conditioning3(const BodyModel3& body, const AddTerms& add_terms, co
   return ConditioningOfJacobian(DataJacobian(&problem, eval), CoordinateNames3(body), kRigidDofs3);
 }
 
-void FillAtBound3(const BodyModel3& body, const PoseFitOptions& o, PoseFitResult* r) {
-  r->at_bound.clear();
-  for (int d = 0; d < body.num_modes(); ++d) {
-    const double g = r->q[kRigidDofs3 + d];
-    const double tol = 1e-9 * (ModeUpper(o, d) - ModeLower(o, d));
-    if (g <= ModeLower(o, d) + tol || g >= ModeUpper(o, d) - tol) r->at_bound.push_back(body.modes()[d].name);
-  }
-}
 
 // Weighted Kabsch: q (γ = 0) whose rigid motion best carries `rest` onto `target`.
 Eigen::VectorXd RigidStart3(int num_modes, const std::vector<Eigen::Vector3d>& rest,
@@ -370,7 +362,7 @@ PoseFitResult FitPose3(const BodyModel3& body, const std::vector<Correspondence3
     sum += dist * dist;
   }
   result.rms_residual = std::sqrt(sum / double(data.size()));
-  FillAtBound3(body, o, &result);
+  FillAtBound(body, o, &result);
   if (o.analyze_conditioning) result.conditioning = Conditioning3(body, add_terms, result.q);
   return result;
 }
@@ -526,7 +518,7 @@ PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& ta
     sum += dist * dist;
   }
   best.rms_residual = std::sqrt(sum / double(ns));
-  FillAtBound3(body, o, &best);
+  FillAtBound(body, o, &best);
   if (o.analyze_conditioning) best.conditioning = Conditioning3(body, add_terms, best.q);
   return best;
 }

@@ -22,6 +22,18 @@ inline double ModeUpper(const PoseFitOptions& o, int d) { return o.mode_upper.em
 Eigen::VectorXd RigidStart(const BodyModel& body, const std::vector<Eigen::Vector2d>& rest,
                            const std::vector<Eigen::Vector2d>& target, const std::vector<double>& weights);
 
+// Fills r->at_bound: the modes whose fitted amplitude r->q[rigid + d] (rigid: 3 in 2D, 6 in 3D)
+// ended on one of its bounds.
+template <int Dim> void FillAtBound(const BodyModelN<Dim>& body, const PoseFitOptions& o, PoseFitResult* r) {
+  const int rigid = body.num_q() - body.num_modes();
+  r->at_bound.clear();
+  for (int d = 0; d < body.num_modes(); ++d) {
+    const double g = r->q[rigid + d];
+    const double tol = 1e-9 * (ModeUpper(o, d) - ModeLower(o, d));
+    if (g <= ModeLower(o, d) + tol || g >= ModeUpper(o, d) - tol) r->at_bound.push_back(body.modes()[d].name);
+  }
+}
+
 // A new loss function for Problem (which takes ownership); nullptr for squared.
 ceres::LossFunction* MakeLoss(Loss loss, double scale);
 
