@@ -1,5 +1,6 @@
 #include "condition.h"
 
+#include "wobble/core/distribute.h"
 #include "wobble/core/interrupt.h"
 
 #include <cmath>
@@ -212,19 +213,27 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
   if (a.map_size > 0) {
     if (a.map_size < 2 || a.map_size > 2000) throw UsageError("--map must be between 2 and 2000");
     RequirePositive(a.map_gamma, "--map-gamma");
-    std::vector<std::vector<double>> map_rows;
-    for (int j = 0; j < a.map_size; ++j) {
-      if (InterruptRequested())
-        throw Interrupted("the map stopped by Ctrl-C at row " + std::to_string(j) + " of " + std::to_string(a.map_size) +
-                          "; " + (out / "sweep.csv").string() + " is written, the map is not");
+    // the rows on every thread and, under mpirun, on every rank (core/distribute.h): the same
+    // numbers either way; a row Ctrl-C kept from starting comes back empty
+    const std::vector<Bytes> rows = DistributedMap(size_t(a.map_size), MapOptions(), [&](size_t j) -> Bytes {
+      if (InterruptRequested()) return Bytes();
       Eigen::VectorXd qj = q;
-      qj[3] = -a.map_gamma + 2.0 * a.map_gamma * j / (a.map_size - 1);
+      qj[3] = -a.map_gamma + 2.0 * a.map_gamma * double(j) / (a.map_size - 1);
       std::vector<double> map_phis;
       for (int i = 0; i < a.map_size; ++i)
         map_phis.push_back(Rad(a.from_deg + (a.to_deg - a.from_deg) * i / (a.map_size - 1)));
-      for (const analysis::SweepSample& s : analysis::AngleSweep(def, map_phis, squash, qj)) {
-        map_rows.push_back({Deg(s.phi), qj[3], s.cond.cond, s.cond.singular ? INFINITY : std::log10(s.cond.cond)});
-      }
+      std::vector<double> row;
+      for (const analysis::SweepSample& s : analysis::AngleSweep(def, map_phis, squash, qj))
+        row.insert(row.end(), {Deg(s.phi), qj[3], s.cond.cond, s.cond.singular ? INFINITY : std::log10(s.cond.cond)});
+      return ByteWriter().PutDoubles(row).Take();
+    });
+    std::vector<std::vector<double>> map_rows;
+    for (size_t j = 0; j < rows.size(); ++j) {
+      if (rows[j].empty())
+        throw Interrupted("the map stopped by Ctrl-C before row " + std::to_string(j) + " of " +
+                          std::to_string(a.map_size) + "; " + (out / "sweep.csv").string() + " is written, the map is not");
+      const std::vector<double> row = ByteReader(rows[j]).GetDoubles();
+      for (size_t k = 0; k + 4 <= row.size(); k += 4) map_rows.push_back({row[k], row[k + 1], row[k + 2], row[k + 3]});
     }
 #ifdef WOBBLE_HAVE_PIPELINES
     ConditionGrid grid;  // the same numbers as the CSV, on their regular grid

@@ -5,6 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <csignal>
 #include <iostream>
+#include <memory>
+#include <streambuf>
 #include <stdexcept>
 
 #include "cli_common.h"
@@ -18,8 +20,14 @@
 #endif
 #include "run.h"
 #include "simulate.h"
+#include "sweep.h"
+#include "wobble/core/distribute.h"
 #include "wobble/core/interrupt.h"
+#include "wobble/formats/atomic_file.h"
 #include "wobble/formats/object_file.h"
+#ifdef WOBBLE_HAVE_MPI
+#include "wobble/mpi/mpi_distributor.h"
+#endif
 
 namespace {
 // Ctrl-C asks the work to stop at its next step or frame (wobble/core/interrupt.h); the
@@ -32,10 +40,40 @@ void CatchInterrupt() {
   action.sa_flags = SA_RESETHAND;
   sigaction(SIGINT, &action, nullptr);
 }
+
+// Discards what is written to it: the printout of MPI ranks other than 0.
+class NullBuffer : public std::streambuf {
+ protected:
+  int overflow(int c) override { return c; }
+  std::streamsize xsputn(const char*, std::streamsize n) override { return n; }
+};
+
+// Under mpirun every rank runs the command (core/distribute.h); rank 0 alone prints and keeps
+// files, the others compute their share and stay quiet. Errors are printed by rank 0; every
+// rank exits with the same code, since every rank met the same error.
+struct MpiSession {
+#ifdef WOBBLE_HAVE_MPI
+  std::unique_ptr<wobble::mpi::MpiDistributor> mpi;
+#endif
+  NullBuffer null;
+  MpiSession(int* argc, char*** argv) {
+#ifdef WOBBLE_HAVE_MPI
+    if (wobble::mpi::LaunchedByMpirun()) mpi = std::make_unique<wobble::mpi::MpiDistributor>(argc, argv);
+#else
+    (void)argc, (void)argv;
+#endif
+    if (!wobble::IsOutputRank()) {
+      std::cout.rdbuf(&null);
+      std::cerr.rdbuf(&null);
+      wobble::formats::DiscardOutputs();
+    }
+  }
+};
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace wobble::app;
+  MpiSession mpi(&argc, &argv);
   CatchInterrupt();
   CLI::App app("wobble: dynamic free-form deformation characters (Faloutsos 1995)", "wobble");
   app.set_version_flag("--version", "wobble 0.1");
@@ -68,6 +106,8 @@ int main(int argc, char** argv) {
   const FitCommands fit = AddFitCommand(&app, &fit_pose_args, &fit_trajectory_args);
   RunArgs run_args;
   CLI::App* run = AddRunCommand(&app, &run_args);
+  SweepArgs sweep_study_args;
+  CLI::App* sweep_study = AddSweepCommand(&app, &sweep_study_args);
 
   try {
     app.parse(argc, argv);
@@ -92,6 +132,7 @@ int main(int argc, char** argv) {
     if (fit.pose->parsed()) return RunFitPose(fit_pose_args);
     if (fit.trajectory->parsed()) return RunFitTrajectory(fit_trajectory_args);
     if (run->parsed()) return RunScript(run_args);
+    if (sweep_study->parsed()) return RunSweep(sweep_study_args);
   } catch (const wobble::formats::ParseError& e) {
     std::cerr << e.what() << std::endl;  // already "FILE:LINE: message"
     return kExitBadInput;

@@ -2,16 +2,21 @@
 
 #include <unistd.h>
 
+#include <filesystem>
 #include <iostream>
+#include <map>
+#include <set>
+#include <sstream>
 #include <string>
 
 #include "progress.h"
 #include "cli_common.h"
+#include "wobble/core/distribute.h"
+#include "wobble/formats/line_reader.h"
 #include "wobble/script/interpreter.h"
+#include "wobble/script/variables.h"
 
 #ifdef WOBBLE_HAVE_PIPELINES
-#include <filesystem>
-
 #include "pipelines/charts.h"
 #include "pipelines/mesh_io.h"
 #include "pipelines/scene_view.h"
@@ -24,6 +29,8 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* a) {
   CLI::App* cmd = app->add_subcommand("run", "Run a command script (appendix C); no script on a terminal: a prompt");
   cmd->add_option("script", a->script, "Script file (see README: Scripts)")->type_name("SCRIPT");
   AddLimitFlags(cmd, &a->limits);
+  cmd->add_option("--param", a->params, "NAME=VALUE for the script's ${NAME} words (as a sweep case gives them)")
+      ->type_name("NAME=VALUE");
   cmd->add_option("--object", a->object, "Object file loaded before the script (appendix C's script loads none)")
       ->type_name("FILE");
   cmd->footer(
@@ -40,6 +47,7 @@ namespace {
 void PlotCostHistory(const std::string& csv_path, const std::string& optimiser,
                      const std::vector<synth::IterationRecord>& history) {
 #ifdef WOBBLE_HAVE_PIPELINES
+  if (!IsOutputRank()) return;  // under mpirun rank 0 draws
   if (!pipelines::HasDisplay()) {
     std::cout << "no X display: cost chart skipped (run under xvfb-run -a)\n";
     return;
@@ -71,6 +79,7 @@ void PlotCostHistory(const std::string& csv_path, const std::string& optimiser,
 // states replayed instead of simulated. Without a display only vtp and disp can be written.
 void RenderRecordedRuns(const script::RenderRequest& r) {
 #ifdef WOBBLE_HAVE_PIPELINES
+  if (!IsOutputRank()) return;
   RenderScriptRuns(r);
 #else
   (void)r;
@@ -81,11 +90,32 @@ void RenderRecordedRuns(const script::RenderRequest& r) {
 // `render DIR` in a script: the recorded Witkin & Welch scene as frames, filmstrip and .pvd.
 std::vector<std::string> RenderScene(const script::SceneRenderRequest& r) {
 #ifdef WOBBLE_HAVE_PIPELINES
+  if (!IsOutputRank()) return {};
   return RenderScriptScene(r);
 #else
   (void)r;
   throw std::runtime_error("this wobble was built without pipelines/ (VTK): nothing can be drawn");
 #endif
+}
+
+// The script with its ${NAME} words filled (script/variables.h), input paths relative to it.
+void RunScriptFile(script::Interpreter& interp, const std::string& path, const std::vector<std::string>& params) {
+  std::map<std::string, std::string> values;
+  for (const std::string& spec : params) {
+    const size_t eq = spec.find('=');
+    if (eq == std::string::npos || eq == 0) throw UsageError("--param: expected NAME=VALUE, got '" + spec + "'");
+    values[spec.substr(0, eq)] = spec.substr(eq + 1);
+  }
+  const std::string text = formats::detail::WithFile(path, [](std::istream& in) {
+    std::ostringstream all;
+    all << in.rdbuf();
+    return all.str();
+  });
+  const std::set<std::string> used = script::VariablesUsed(text, path);
+  for (const auto& [name, value] : values)
+    if (!used.count(name)) throw UsageError("--param " + name + ": " + path + " has no ${" + name + "}");
+  std::istringstream in(script::ExpandVariables(text, values, path));
+  interp.RunStream(in, path, std::filesystem::path(path).parent_path().string());
 }
 
 }  // namespace
@@ -111,7 +141,7 @@ int RunScript(const RunArgs& a) {
   if (!a.object.empty()) interp.LoadObject(a.object);
   if (!a.script.empty()) {
     try {
-      interp.RunFile(a.script);
+      RunScriptFile(interp, a.script, a.params);
     } catch (const script::SimulationStopped& e) {
       progress.Finish();
       std::cerr << e.what() << std::endl;

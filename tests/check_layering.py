@@ -18,6 +18,7 @@ import sys
 # only folders listed before it (checked below too, so the table itself cannot grow a cycle).
 LAYERS = [
     ("core", []),
+    ("mpi", ["core"]),
     ("body", ["core"]),
     ("formats", ["core", "body"]),
     ("dynamics", ["core", "body"]),

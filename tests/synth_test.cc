@@ -151,6 +151,39 @@ TEST(Cmaes, ReproducibleFromItsSeedAndImprovesOnTheInitialController) {
   EXPECT_LT(results[0].best_outcome.cost, results[0].initial_outcome.cost);
   for (size_t i = 1; i < results[0].history.size(); ++i) EXPECT_LE(results[0].history[i].best, results[0].history[i - 1].best);
 
+  // Each generation simulated together (the rehearsal of cmaes.cc) is the same run as pagmo
+  // asking for one trial after the other, bit for bit, on one thread or two.
+  {
+    std::ostringstream out;
+    script::Interpreter interp(out);
+    std::istringstream setup("load_obj table.obj\nload_def table_modes.def\nassign bend 4e7 4e6\nassign shear 4e7 4e6\n"
+                             "set integrator thesis\nset dt 0.01\nset grconst 45000\nset grdam 3000\n"
+                             "set frconst 3000\nset frsin 0.5\npose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\n"
+                             "pose 0 0.1 0.4\nset trial_steps 400\n");
+    interp.RunStream(setup, "cmaes.wob", kData);
+    synth::CmaesOptions o;
+    o.seed = 9;
+    o.generations = 6;
+    o.population = 7;
+    o.batch_generations = false;
+    const synth::AnnealResult serial = synth::Cmaes(interp.SynthesisProblem(), interp.pose_graph(), o);
+    o.batch_generations = true;
+    const synth::AnnealResult batched = synth::Cmaes(interp.SynthesisProblem(), interp.pose_graph(), o);
+    EXPECT_EQ(batched.trials, serial.trials);
+    EXPECT_EQ(batched.trials, 7 + 6 * 7);
+    EXPECT_EQ(batched.best_outcome.cost, serial.best_outcome.cost);
+    ASSERT_EQ(batched.history.size(), serial.history.size());
+    for (size_t g = 0; g < serial.history.size(); ++g) {
+      EXPECT_EQ(batched.history[g].candidate, serial.history[g].candidate) << "generation " << g;
+      EXPECT_EQ(batched.history[g].best, serial.history[g].best) << "generation " << g;
+    }
+    for (size_t p = 0; p < serial.best.poses.size(); ++p) {
+      EXPECT_EQ(batched.best.poses[p], serial.best.poses[p]);
+      EXPECT_EQ(batched.best.durations[p], serial.best.durations[p]);
+    }
+    EXPECT_LT(serial.best_outcome.cost, serial.initial_outcome.cost);  // a run that moved
+  }
+
   // Ctrl-C before the first generation: the initial population only, marked interrupted
   std::ostringstream out;
   script::Interpreter interp(out);

@@ -1,5 +1,7 @@
 #include "wobble/fit/pose_fit3.h"
 
+#include "wobble/core/distribute.h"
+
 #include <ceres/ceres.h>
 #include <ceres/dynamic_autodiff_cost_function.h>
 
@@ -420,6 +422,45 @@ void ShapePoints(const std::vector<Eigen::Vector3d>& points, const std::vector<s
 
 }  // namespace
 
+namespace {
+
+// A solved start as bytes and back (q and the solver's report), for DistributedMap.
+Bytes EncodeSolve(const PoseFitResult& r) {
+  const FitReport& f = r.report;
+  return ByteWriter()
+      .PutDoubles(std::vector<double>(r.q.data(), r.q.data() + r.q.size()))
+      .Put<std::uint8_t>(f.usable)
+      .PutString(f.termination)
+      .PutString(f.brief_report)
+      .PutString(f.full_report)
+      .Put(f.initial_cost)
+      .Put(f.final_cost)
+      .PutDoubles(f.cost_per_iteration)
+      .Put<std::int32_t>(f.iterations)
+      .Put(f.solve_seconds)
+      .Take();
+}
+
+PoseFitResult DecodeSolve(const Bytes& bytes) {
+  ByteReader in(bytes);
+  PoseFitResult r;
+  const std::vector<double> q = in.GetDoubles();
+  r.q = Eigen::Map<const Eigen::VectorXd>(q.data(), Eigen::Index(q.size()));
+  FitReport& f = r.report;
+  f.usable = in.Get<std::uint8_t>() != 0;
+  f.termination = in.GetString();
+  f.brief_report = in.GetString();
+  f.full_report = in.GetString();
+  f.initial_cost = in.Get<double>();
+  f.final_cost = in.Get<double>();
+  f.cost_per_iteration = in.GetDoubles();
+  f.iterations = in.Get<std::int32_t>();
+  f.solve_seconds = in.Get<double>();
+  return r;
+}
+
+}  // namespace
+
 PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& target, const PoseFitOptions& o) {
   CheckOptions3(body, o, "surface fit");
   if (target.empty()) throw std::invalid_argument("surface fit: the target has no triangles or points");
@@ -496,13 +537,19 @@ PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& ta
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
     for (size_t i = 0; i < std::min(kStartsSolved, candidates.size()); ++i) starts.push_back(candidates[i].q);
   }
+  // The starts are solved at once, on threads and, under mpirun, on ranks (core/distribute.h),
+  // then taken in order as one after the other would take them: so the answer is the same.
+  const std::vector<Bytes> solved = DistributedMap(starts.size(), MapOptions(), [&](size_t i) {
+    PoseFitResult run;
+    run.q = starts[i];
+    SolvePose3(D, o, add_terms, &run.q, &run.report);
+    return EncodeSolve(run);
+  });
   PoseFitResult best;
   best.report.final_cost = std::numeric_limits<double>::infinity();
   double seconds = 0;
-  for (const Eigen::VectorXd& start : starts) {
-    PoseFitResult run;
-    run.q = start;
-    SolvePose3(D, o, add_terms, &run.q, &run.report);
+  for (const Bytes& bytes : solved) {
+    const PoseFitResult run = DecodeSolve(bytes);
     seconds += run.report.solve_seconds;
     if (!(run.report.final_cost >= best.report.final_cost)) best = run;
     // a start that met the target exactly (cost down by 1e12) leaves nothing for the others

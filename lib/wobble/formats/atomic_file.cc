@@ -1,5 +1,6 @@
 #include "wobble/formats/atomic_file.h"
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -41,8 +42,16 @@ void CreateParentFolder(const std::string& path) {
   if (ec) throw std::runtime_error(path + ": cannot create its folder: " + ec.message());
 }
 
+namespace {
+std::atomic<bool> outputs_discarded{false};
+}  // namespace
+
+void DiscardOutputs() { outputs_discarded = true; }
+bool OutputsDiscarded() { return outputs_discarded; }
+
 void WriteFileAtomically(const std::string& path, const std::function<void(const std::string& temp_path)>& write) {
   namespace fs = std::filesystem;
+  if (OutputsDiscarded()) return;
   CreateParentFolder(path);
   const std::string tmp = TempPathFor(path);
   // open the temporary file ourselves first: writers report "cannot open" less clearly

@@ -9,6 +9,12 @@
 
 namespace wobble::formats {
 
+// Under MPI every rank runs the same command, and only rank 0 keeps files: the app calls
+// DiscardOutputs() on the others, and every writer and formats::CheckWritable there then does nothing
+// (two ranks writing, or probing, the same FILE.tmp would spoil each other's file).
+void DiscardOutputs();
+bool OutputsDiscarded();
+
 // The temporary name used for `path`: "path.tmp", in the same folder (rename stays atomic).
 std::string TempPathFor(const std::string& path);
 

@@ -2,7 +2,7 @@
 
 #include "wobble/control/controllers.h"
 #include "wobble/core/interrupt.h"
-#include "wobble/core/parallel.h"
+#include "wobble/core/distribute.h"
 #include "wobble/scene/ffd_object.h"
 
 #include <algorithm>
@@ -138,16 +138,45 @@ TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
   return out;
 }
 
+Bytes EncodeTrialOutcome(const TrialOutcome& o) {
+  return ByteWriter()
+      .Put<std::uint8_t>(o.ok)
+      .Put(o.distance)
+      .Put(o.speed)
+      .Put(o.energy)
+      .Put(o.cost)
+      .PutString(o.failure)
+      .Take();
+}
+
+TrialOutcome DecodeTrialOutcome(const Bytes& bytes) {
+  ByteReader in(bytes);
+  TrialOutcome o;
+  o.ok = in.Get<std::uint8_t>() != 0;
+  o.distance = in.Get<double>();
+  o.speed = in.Get<double>();
+  o.energy = in.Get<double>();
+  o.cost = in.Get<double>();
+  o.failure = in.GetString();
+  return o;
+}
+
 std::vector<TrialOutcome> RunTrials(const Problem& p, const std::vector<control::PoseGraph>& graphs, int threads) {
-  std::vector<TrialOutcome> out(graphs.size());
-  ParallelFor(graphs.size(), threads, [&](size_t i) {
+  MapOptions options;
+  options.threads = threads;
+  const std::vector<Bytes> results = DistributedMap(graphs.size(), options, [&](size_t i) {
+    TrialOutcome out;
     if (InterruptRequested()) {  // Ctrl-C: the trials not yet started are not run
-      out[i].failure = kInterruptedTrial;
-      out[i].cost = p.cost.high;
-      return;
+      out.failure = kInterruptedTrial;
+      out.cost = p.cost.high;
+    } else {
+      out = RunTrial(p, graphs[i]);
     }
-    out[i] = RunTrial(p, graphs[i]);
+    return EncodeTrialOutcome(out);
   });
+  std::vector<TrialOutcome> out;
+  out.reserve(results.size());
+  for (const Bytes& b : results) out.push_back(DecodeTrialOutcome(b));
   return out;
 }
 

@@ -78,7 +78,12 @@ void CenterOfMassX(const World& world, double* x, double* v);
 TrialOutcome RunTrial(const Problem& problem, const control::PoseGraph& graph,
                       const std::function<void(const World&)>& on_step = nullptr);
 
-// Runs the trials on `threads` threads (0: all cores). Results are in input order. After Ctrl-C
+// A trial's outcome as bytes and back, exactly: how trials cross threads and MPI ranks
+// (core/distribute.h).
+std::string EncodeTrialOutcome(const TrialOutcome& outcome);
+TrialOutcome DecodeTrialOutcome(const std::string& bytes);
+
+// Runs the trials on `threads` threads (0: all cores) and, under mpirun, on every rank. Results are in input order. After Ctrl-C
 // (core/interrupt.h) the trials not yet started are not run: their failure is
 // kInterruptedTrial and their cost the cost's `high` (the caller says it stopped).
 inline constexpr const char* kInterruptedTrial = "not run: interrupted (Ctrl-C)";

@@ -3,6 +3,7 @@
 #include "wobble/core/interrupt.h"
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <mutex>
 #include <pagmo/algorithms/cmaes.hpp>
@@ -59,7 +60,13 @@ struct Coding {
   }
 };
 
-// The best simulation seen, shared by the copies pagmo makes of the problem.
+// The best simulation seen, shared by the copies pagmo makes of the problem, and the
+// generation's batch: pagmo 2.18's cmaes asks for one fitness at a time, but draws all λ points
+// of a generation before it evaluates any. So a generation runs twice: a copy of the algorithm
+// (its adapted state and random engine included) first only records the points it asks for
+// (kRecord), they are simulated together (RunTrials: threads and MPI ranks), and the algorithm
+// itself then runs the same draws answered from those results (kAnswer). A point not recorded
+// is simulated on the spot, so the answer never depends on the trick working.
 struct Tally {
   std::mutex mutex;
   long trials = 0;
@@ -67,6 +74,9 @@ struct Tally {
   control::PoseGraph best;
   TrialOutcome best_outcome;
   bool any = false;
+  enum class Mode { kRecord, kAnswer } mode = Mode::kAnswer;
+  std::vector<std::vector<double>> asked;
+  std::map<std::vector<double>, TrialOutcome> answers;
 };
 
 // pagmo user-defined problem: one forward simulation per fitness evaluation.
@@ -75,8 +85,26 @@ struct ControllerProblem {
   Coding coding{};
   std::shared_ptr<Tally> tally;
   pagmo::vector_double fitness(const pagmo::vector_double& x) const {
+    {
+      std::lock_guard<std::mutex> lock(tally->mutex);
+      if (tally->mode == Tally::Mode::kRecord) {
+        tally->asked.push_back(x);
+        return {0.0};  // a placeholder for the copy that is thrown away
+      }
+    }
     const control::PoseGraph g = coding.Decode(x);
-    const TrialOutcome out = RunTrial(*problem, g);
+    TrialOutcome out;
+    bool answered = false;
+    {
+      std::lock_guard<std::mutex> lock(tally->mutex);
+      const auto it = tally->answers.find(x);
+      if (it != tally->answers.end()) out = it->second, answered = true;
+    }
+    if (!answered) out = RunTrial(*problem, g);
+    Count(g, out);
+    return {out.cost};
+  }
+  void Count(const control::PoseGraph& g, const TrialOutcome& out) const {
     std::lock_guard<std::mutex> lock(tally->mutex);
     ++tally->trials;
     if (!tally->any || out.cost < tally->best_cost) {
@@ -85,13 +113,22 @@ struct ControllerProblem {
       tally->best = g;
       tally->best_outcome = out;
     }
-    return {out.cost};
   }
   std::pair<pagmo::vector_double, pagmo::vector_double> get_bounds() const {
     const int n = coding.size();
     return {pagmo::vector_double(n, 0.0), pagmo::vector_double(n, 1.0)};
   }
 };
+
+// Simulates the points together and files their outcomes as answers.
+void Answer(const Problem& p, const Coding& coding, const std::vector<std::vector<double>>& points, Tally* tally) {
+  std::vector<control::PoseGraph> graphs;
+  for (const std::vector<double>& x : points) graphs.push_back(coding.Decode(x));
+  const std::vector<TrialOutcome> outcomes = RunTrials(p, graphs);
+  std::lock_guard<std::mutex> lock(tally->mutex);
+  tally->answers.clear();
+  for (size_t i = 0; i < points.size(); ++i) tally->answers.emplace(points[i], outcomes[i]);
+}
 
 }  // namespace
 
@@ -104,15 +141,16 @@ AnnealResult Cmaes(const Problem& p, const control::PoseGraph& initial, const Cm
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> normal(0.0, o.sigma0);
   pagmo::population pop(prob, 0u, static_cast<unsigned>(o.seed));
-  const std::vector<double> x0 = coding.Encode(initial);
-  pop.push_back(x0);
-  AnnealResult r;
-  r.initial_outcome = tally->best_outcome;
+  std::vector<std::vector<double>> start{coding.Encode(initial)};
   for (int i = 1; i < o.population; ++i) {
-    std::vector<double> x = x0;
+    std::vector<double> x = start[0];
     for (double& v : x) v = std::clamp(v + normal(rng), 0.0, 1.0);
-    pop.push_back(x);
+    start.push_back(x);
   }
+  Answer(p, coding, start, tally.get());
+  for (const std::vector<double>& x : start) pop.push_back(x);  // answered, in order
+  AnnealResult r;
+  r.initial_outcome = tally->answers.at(start[0]);
   auto record = [&](int g, double generation_best) {
     const IterationRecord rec{g, tally->trials, generation_best, tally->best_cost, tally->best_cost, 0.0, true};
     r.history.push_back(rec);
@@ -127,6 +165,14 @@ AnnealResult Cmaes(const Problem& p, const control::PoseGraph& initial, const Cm
       break;
     }
     const long before = tally->trials;
+    if (o.batch_generations) {
+      pagmo::cmaes rehearsal = algo;  // same state, same random engine: the same draws
+      tally->mode = Tally::Mode::kRecord;
+      tally->asked.clear();
+      rehearsal.evolve(pop);
+      tally->mode = Tally::Mode::kAnswer;
+      Answer(p, coding, tally->asked, tally.get());
+    }
     pop = algo.evolve(pop);
     if (tally->trials == before) break;  // cmaes stopped (converged)
     double generation_best = p.cost.high;

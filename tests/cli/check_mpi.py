@@ -1,0 +1,156 @@
+#!/usr/bin/env python3
+"""Studies and synthesis on MPI ranks (issue 17), at the CLI.
+
+usage: check_mpi.py WOBBLE MPIRUN DATA_DIR WORK_DIR
+
+- the same sweep table, byte for byte, on 1 process with 1 and 2 threads and under
+  `mpirun -np 2` and `-np 3`; a case with a bad value is a row, not a dead run;
+- `wobble run` of a synthesis script (annealing batches, CMA-ES generations, the saved
+  replays) writes the same files on 1 process and under mpirun, and only rank 0 writes;
+- a rank killed during a sweep ends the run non-zero with a message naming the rank, and
+  the rows finished before are on disk (sweep.csv.partial), equal to the 1-process rows.
+CI runs as root: Open MPI's allow-run-as-root variables are set, with --oversubscribe.
+"""
+import csv
+import filecmp
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+failures = []
+
+
+def expect(cond, what):
+    print(("ok   " if cond else "FAIL ") + what, flush=True)
+    if not cond:
+        failures.append(what)
+
+
+wobble, mpirun, data, work = sys.argv[1:5]
+env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+           OMPI_MCA_rmaps_base_oversubscribe="1")
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+here = os.path.dirname(os.path.abspath(__file__))
+
+
+def mpi(n):
+    return [mpirun, "-np", str(n), "--oversubscribe"]
+
+
+def run(cmd, timeout=600):
+    r = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True, timeout=timeout)
+    if r.returncode != 0:
+        print(" ".join(cmd), "\n", r.stdout, r.stderr)
+    return r
+
+
+# --- one sweep table everywhere ----------------------------------------------------------
+study = [wobble, "sweep", os.path.join(data, "sweep_bounding.wob"), "--param", "seed=1:3:3",
+         "--param", "frsin=0.3,-1,0.8", "--param", "iterations=2", "--param", "trial_steps=300",
+         "--measure", "cost,trials,distance,state"]
+tables = {}
+for name, prefix, extra in [("1 thread", [], ["--threads", "1"]), ("2 threads", [], ["--threads", "2"]),
+                            ("mpirun -np 2", mpi(2), []), ("mpirun -np 3", mpi(3), [])]:
+    out = os.path.join(work, name.replace(" ", "_"))
+    r = run(prefix + study + extra + ["--out", out])
+    expect(r.returncode == 0, f"sweep on {name}: exit 0 (got {r.returncode})")
+    path = os.path.join(out, "sweep.csv")
+    expect(os.path.exists(path) and not os.path.exists(path + ".partial"),
+           f"sweep on {name}: sweep.csv written, the partial file gone")
+    if os.path.exists(path):
+        tables[name] = open(path, "rb").read()
+    if prefix:
+        expect(f"on {prefix[2]} ranks" in r.stdout, f"sweep on {name}: says it ran on {prefix[2]} ranks")
+        expect(r.stdout.count("table:") == 1, f"sweep on {name}: only rank 0 prints")
+reference = tables.get("1 thread")
+rows = list(csv.DictReader(open(os.path.join(work, "1_thread", "sweep.csv")))) if reference else []
+expect(len(rows) == 9, f"9 cases, 9 rows (got {len(rows)})")
+expect(sum(r["status"] == "ok" for r in rows) == 6 and sum(r["status"] == "bad input" for r in rows) == 3,
+       "the 3 cases with frsin -1 are rows with status 'bad input', the other 6 ran")
+expect(all(r["cost"] != "" and r["trials"] == "17" for r in rows if r["status"] == "ok"),
+       "every case that ran has its cost and 17 trials")
+for name, table in tables.items():
+    expect(table == reference, f"sweep table on {name} is byte-identical to 1 process, 1 thread")
+
+# --- synthesis of one script on ranks -----------------------------------------------------
+script = os.path.join(here, "mpi_synthesis.wob")
+outputs = ["anneal.csv", "annealed.wob", "cmaes.csv", "cmaes.wob"]
+single = os.path.join(work, "run_1")
+r = run([wobble, "run", script, "--param", f"out={single}"])
+expect(r.returncode == 0, "wobble run of the synthesis script: exit 0")
+for n in (2, 3):
+    ranked = os.path.join(work, f"run_np{n}")
+    r = run(mpi(n) + [wobble, "run", script, "--param", f"out={ranked}"])
+    expect(r.returncode == 0, f"mpirun -np {n} wobble run: exit 0")
+    expect(r.stdout.count("anneal: ") == 1, f"mpirun -np {n} wobble run: rank 0 alone prints")
+    for f in outputs:
+        a, b = os.path.join(single, f), os.path.join(ranked, f)
+        expect(os.path.exists(b) and filecmp.cmp(a, b, shallow=False),
+               f"mpirun -np {n}: {f} is the same file as on one process")
+    expect(not any(n.endswith(".tmp") for n in os.listdir(ranked)), f"mpirun -np {n}: no temporary file left")
+
+# --- a killed rank ----------------------------------------------------------------------
+out = os.path.join(work, "killed")
+long_study = [wobble, "sweep", os.path.join(data, "sweep_bounding.wob"), "--param", "seed=1:200:200",
+              "--param", "iterations=2", "--param", "trial_steps=1200", "--measure", "cost", "--out", out]
+ref_out = os.path.join(work, "killed_reference")
+r = run(long_study[:-1] + [ref_out, "--threads", "2"])
+expect(r.returncode == 0, "the longer study on one process: exit 0")
+reference_rows = {row["case"]: row for row in csv.DictReader(open(os.path.join(ref_out, "sweep.csv")))}
+proc = subprocess.Popen(mpi(3) + long_study, cwd=work, env=env, stdout=subprocess.PIPE,
+                        stderr=subprocess.STDOUT, text=True, start_new_session=True)
+partial = os.path.join(out, "sweep.csv.partial")
+
+
+def rows_in(path):
+    try:
+        return list(csv.DictReader(open(path)))
+    except (OSError, csv.Error):
+        return []
+
+
+def rank_pid(rank):
+    """The pid of the wobble process of this rank (its environment says its rank)."""
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            environ = open(f"/proc/{pid}/environ", "rb").read().split(b"\0")
+            cmdline = open(f"/proc/{pid}/cmdline", "rb").read()
+        except OSError:
+            continue
+        if f"OMPI_COMM_WORLD_RANK={rank}".encode() in environ and b"sweep" in cmdline and b"mpirun" not in cmdline:
+            return int(pid)
+    return None
+
+
+deadline = time.time() + 120
+while time.time() < deadline and len(rows_in(partial)) < 4 and proc.poll() is None:
+    time.sleep(0.05)
+victim = rank_pid(2)
+expect(victim is not None and len(rows_in(partial)) >= 4, "rank 2 found while the study runs, rows reaching disk")
+if victim:
+    os.kill(victim, signal.SIGKILL)
+try:
+    text, _ = proc.communicate(timeout=120)
+except subprocess.TimeoutExpired:
+    os.killpg(proc.pid, signal.SIGKILL)
+    text, _ = proc.communicate()
+    expect(False, "mpirun ends within 120 s of a killed rank")
+print(text[-1500:])
+expect(proc.returncode != 0, f"a killed rank ends the run non-zero (got {proc.returncode})")
+expect("rank 2" in text, "the message names the killed rank")
+kept = rows_in(partial)
+expect(len(kept) >= 4, f"the rows finished before are on disk ({len(kept)} in sweep.csv.partial)")
+expect(all(row == reference_rows.get(row["case"]) for row in kept),
+       "every kept row equals the same case's row on one process")
+expect(not os.path.exists(os.path.join(out, "sweep.csv")) or len(kept) == 200, "no complete table is claimed")
+
+if failures:
+    print(f"{len(failures)} check(s) failed")
+    sys.exit(1)
+print("all MPI checks passed")
