@@ -55,8 +55,8 @@ struct MpiSession {
 #ifdef WOBBLE_HAVE_MPI
   std::unique_ptr<wobble::mpi::MpiDistributor> mpi;
 #endif
-  NullBuffer null;
   MpiSession(int* argc, char*** argv) {
+    static NullBuffer null;  // static: std::cout flushes it at exit, after main returned
 #ifdef WOBBLE_HAVE_MPI
     if (wobble::mpi::LaunchedByMpirun()) mpi = std::make_unique<wobble::mpi::MpiDistributor>(argc, argv);
 #else

@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <csignal>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -89,6 +91,28 @@ class PartialRows {
   std::string path_;
   std::FILE* file_ = nullptr;
 };
+
+// mpirun ends every rank with SIGTERM when one of them dies (so does a batch system at its time
+// limit): rank 0 then says how many rows are on disk, and where, before it goes. The text is
+// prepared after every row, so the handler only writes it (async-signal-safe).
+char stop_note[1024];
+std::atomic<size_t> stop_note_length{0};
+
+void OnTerminate(int) {
+  const size_t n = stop_note_length.load();
+  if (n > 0 && write(STDERR_FILENO, stop_note, n) < 0) _exit(143);
+  _exit(143);  // 128 + SIGTERM
+}
+
+void PrepareStopNote(size_t finished, size_t total, const std::string& partial) {
+  const std::string text = "\nwobble sweep: stopped by SIGTERM (under mpirun: another rank ended, mpirun names it); " +
+                           std::to_string(finished) + " of " + std::to_string(total) + " finished rows are in " +
+                           partial + "\n";
+  stop_note_length = 0;
+  const size_t n = std::min(text.size(), sizeof stop_note);
+  std::memcpy(stop_note, text.data(), n);
+  stop_note_length = n;
+}
 
 bool AsNumber(const std::string& s, double* v) { return formats::detail::ParseNumber(s, v); }
 
@@ -188,12 +212,19 @@ int RunSweep(const SweepArgs& a) {
   const Distributor& where = CurrentDistributor();
   std::cout << "sweep: " << n << " cases of " << a.script << " on " << where.ranks() << " rank"
             << (where.ranks() > 1 ? "s" : "") << "\n";
-  PartialRows partial(table_path + ".partial", script::SweepHeader(o));
+  PartialRows partial(table_path + ".partial", script::SweepHeader(o));  // (only on rank 0)
   Progress progress(isatty(STDERR_FILENO) == 1 && IsOutputRank(), "cases");
   size_t finished = 0;
+  const std::string partial_path = table_path + ".partial";
+  if (IsOutputRank()) {
+    PrepareStopNote(0, n, partial_path);
+    std::signal(SIGTERM, OnTerminate);
+  }
   o.on_row = [&](size_t, const std::vector<std::string>& row) {
     partial.Write(row);
-    progress.Update(double(++finished) / double(n), double(finished));
+    ++finished;
+    progress.Update(double(finished) / double(n), double(finished));
+    PrepareStopNote(finished, n, partial_path);
   };
   const auto start = std::chrono::steady_clock::now();
   const script::SweepTable table = script::RunSweep(o);
@@ -208,6 +239,7 @@ int RunSweep(const SweepArgs& a) {
     ++statuses[row[status]];
   }
   formats::WriteTextAtomically(table_path, text);
+  std::signal(SIGTERM, SIG_DFL);
   partial.Remove();
   std::cout << "sweep: " << n << " cases in " << seconds << " s:";
   for (const auto& [word, count] : statuses) std::cout << " " << count << " " << word;

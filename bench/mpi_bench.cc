@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<wobble::mpi::MpiDistributor> mpi;
   if (wobble::mpi::LaunchedByMpirun()) mpi = std::make_unique<wobble::mpi::MpiDistributor>(&argc, &argv);
 #endif
-  wobble::NullBuffer null;
+  static wobble::NullBuffer null;  // static: std::cout flushes it at exit, after main returned
   std::vector<char*> args(argv, argv + argc);
   std::string quiet = "--benchmark_out=/dev/null";
   if (!wobble::IsOutputRank()) {  // the other ranks compute their share and print nothing

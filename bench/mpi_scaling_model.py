@@ -18,7 +18,8 @@ The model is a simulation of what lib/wobble/mpi/mpi_distributor.cc does:
 - every rank, rank 0 included, computes its chunk one trial after the other; trials cost
   trial_ms times a log-normal factor of coefficient of variation C (default 0.3: synthesis
   trials that stop early or run long), so chunks end at different times;
-- rank 0's dealing takes time from its own computing (one core does both);
+- rank 0's dealing takes time from its own computing (one core does both), or, the other
+  row of each rank count, rank 0 only deals (what MpiDistributor does from kDealerOnlyRanks);
 - at the end every result goes to every rank: a pipelined broadcast of trials x (result + 9)
   bytes, 2 x size / bandwidth + log2(ranks) x latency.
 Efficiency = trials x trial time / (ranks x wall time).
@@ -44,7 +45,7 @@ def measured(path):
     return values
 
 
-def simulate(ranks, trials, trial_s, case_s, result_bytes, latency_s, bandwidth, cv, seed=1):
+def simulate(ranks, trials, trial_s, case_s, result_bytes, latency_s, bandwidth, cv, dealer_computes, seed=1):
     rng = random.Random(seed)
     sigma = math.sqrt(math.log(1 + cv * cv))
     mu = -0.5 * sigma * sigma  # mean factor 1
@@ -67,7 +68,7 @@ def simulate(ranks, trials, trial_s, case_s, result_bytes, latency_s, bandwidth,
     own_time = 0.0
     while events or left > 0:
         # the next request to reach rank 0: a worker's, or rank 0's own when it is free first
-        if events and (events[0][0] + latency_s <= own_time or left == 0):
+        if events and (events[0][0] + latency_s <= own_time or left == 0 or not dealer_computes):
             sent, rank, carried = heapq.heappop(events)
             arrival = sent + latency_s + carried * (result_bytes + 17) / bandwidth
             start = max(arrival, master_free)
@@ -85,7 +86,7 @@ def simulate(ranks, trials, trial_s, case_s, result_bytes, latency_s, bandwidth,
             count = min(left, max(1, left // (3 * ranks)))
             left -= count
             own_time += chunk_time(count) + count * case_s
-    finish[0] = own_time + master_busy
+    finish[0] = own_time + master_busy if dealer_computes else master_free
     size = trials * (result_bytes + 9)
     broadcast = 2 * size / bandwidth + math.ceil(math.log2(max(ranks, 2))) * latency_s
     wall = max(finish) + broadcast
@@ -114,11 +115,15 @@ def main():
     if m.get("efficiency_2") is not None:
         print(f"measured on this machine: efficiency {m['efficiency_2']:.3f} on {m['ranks_measured']:.0f} ranks "
               f"(10,000 trials)")
-    print(f"{'ranks':>6} {'efficiency':>10} {'wall s':>9} {'rank 0 dealing s':>17} {'broadcast s':>12}")
+    print(f"{'ranks':>6} {'rank 0':>9} {'efficiency':>10} {'wall s':>9} {'rank 0 dealing s':>17} {'broadcast s':>12}")
     for n in [int(x) for x in a.ranks.split(",")]:
-        e, wall, busy, bcast = simulate(n, a.trials, trial_ms * 1e-3, ns_per_case * 1e-9, result_bytes,
-                                        a.latency_us * 1e-6, a.bandwidth_gbs * 1e9, a.cv)
-        print(f"{n:>6} {e:>10.3f} {wall:>9.2f} {busy:>17.3f} {bcast:>12.3f}")
+        for computes in (True, False):
+            if n < 2 and not computes:
+                continue
+            e, wall, busy, bcast = simulate(n, a.trials, trial_ms * 1e-3, ns_per_case * 1e-9, result_bytes,
+                                            a.latency_us * 1e-6, a.bandwidth_gbs * 1e9, a.cv, computes)
+            role = "computes" if computes else "deals"
+            print(f"{n:>6} {role:>9} {e:>10.3f} {wall:>9.2f} {busy:>17.3f} {bcast:>12.3f}")
 
 
 if __name__ == "__main__":

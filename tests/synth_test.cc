@@ -65,6 +65,38 @@ TEST(Annealing, SameSeedSameResultWhateverTheThreadCount) {
   EXPECT_EQ(results[0].trials, 1 + 6 * 4);
 }
 
+TEST(Annealing, RestartsKeepTheBestOfIndependentSeeds) {
+  // `set restarts 3` is the best of three anneals from seeds 11, 12, 13 run one by one
+  const std::string setup =
+      "load_obj table.obj\nload_def table_modes.def\nassign bend 4e7 4e6\nassign shear 4e7 4e6\n"
+      "set integrator thesis\nset dt 0.01\nset grconst 45000\nset grdam 3000\nset frconst 3000\n"
+      "set frsin 0.5\npose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\npose 0 0.1 0.4\nset trial_steps 400\n"
+      "set batch 4\n";
+  std::vector<synth::AnnealResult> alone;
+  for (int seed : {11, 12, 13}) {
+    std::ostringstream out;
+    script::Interpreter interp(out);
+    std::istringstream in(setup + "set seed " + std::to_string(seed) + "\nanneal 5\n");
+    interp.RunStream(in, "alone.wob", kData);
+    alone.push_back(*interp.last_anneal());
+  }
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  std::istringstream in(setup + "set seed 11\nset restarts 3\nanneal 5\n");
+  interp.RunStream(in, "restarts.wob", kData);
+  const synth::AnnealResult& r = *interp.last_anneal();
+  size_t best = 0;
+  for (size_t k = 1; k < alone.size(); ++k)
+    if (alone[k].best_outcome.cost < alone[best].best_outcome.cost) best = k;
+  EXPECT_EQ(r.best_outcome.cost, alone[best].best_outcome.cost);
+  EXPECT_EQ(r.trials, 3 * (1 + 5 * 4));
+  ASSERT_EQ(r.history.size(), alone[best].history.size());
+  for (size_t h = 0; h < r.history.size(); ++h) EXPECT_EQ(r.history[h].current, alone[best].history[h].current);
+  for (size_t p = 0; p < r.best.poses.size(); ++p) EXPECT_EQ(r.best.poses[p], alone[best].best.poses[p]);
+  // the script's pose graph is the best restart's
+  EXPECT_EQ(interp.pose_graph().durations, alone[best].best.durations);
+}
+
 TEST(Annealing, TableCostFunctionsFollowTable51) {
   synth::TrialOutcome o;
   o.ok = true;

@@ -78,7 +78,7 @@ for name, table in tables.items():
 
 # --- synthesis of one script on ranks -----------------------------------------------------
 script = os.path.join(here, "mpi_synthesis.wob")
-outputs = ["anneal.csv", "annealed.wob", "cmaes.csv", "cmaes.wob"]
+outputs = ["anneal.csv", "annealed.wob", "cmaes.csv", "cmaes.wob", "restarts.csv", "restarts.wob"]
 single = os.path.join(work, "run_1")
 r = run([wobble, "run", script, "--param", f"out={single}"])
 expect(r.returncode == 0, "wobble run of the synthesis script: exit 0")
@@ -86,7 +86,7 @@ for n in (2, 3):
     ranked = os.path.join(work, f"run_np{n}")
     r = run(mpi(n) + [wobble, "run", script, "--param", f"out={ranked}"])
     expect(r.returncode == 0, f"mpirun -np {n} wobble run: exit 0")
-    expect(r.stdout.count("anneal: ") == 1, f"mpirun -np {n} wobble run: rank 0 alone prints")
+    expect(r.stdout.count("anneal: ") == 2, f"mpirun -np {n} wobble run: rank 0 alone prints")
     for f in outputs:
         a, b = os.path.join(single, f), os.path.join(ranked, f)
         expect(os.path.exists(b) and filecmp.cmp(a, b, shallow=False),
@@ -144,6 +144,7 @@ except subprocess.TimeoutExpired:
 print(text[-1500:])
 expect(proc.returncode != 0, f"a killed rank ends the run non-zero (got {proc.returncode})")
 expect("rank 2" in text, "the message names the killed rank")
+expect("finished rows are in " + partial in text, "rank 0 says where the finished rows are")
 kept = rows_in(partial)
 expect(len(kept) >= 4, f"the rows finished before are on disk ({len(kept)} in sweep.csv.partial)")
 expect(all(row == reference_rows.get(row["case"]) for row in kept),

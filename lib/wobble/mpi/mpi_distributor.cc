@@ -18,6 +18,11 @@
 namespace wobble::mpi {
 namespace {
 
+// From this many ranks on, rank 0 only deals: bench/mpi_scaling_model.py, fed with
+// bench/mpi_bench's numbers, puts the crossover near 48 (below it rank 0's share of the
+// trials is worth more than the dealing it delays; above it the dealing is the bottleneck).
+constexpr int kDealerOnlyRanks = 48;
+
 constexpr int kResultsTag = 7101;  // worker -> rank 0: finished items, and a request for more
 constexpr int kAssignTag = 7102;   // rank 0 -> worker: [first, count); count 0: no more
 
@@ -153,7 +158,7 @@ std::vector<Bytes> MpiDistributor::Deal(size_t n, const MapOptions& o, const std
   // rank 0's own share: every thread but this one, which answers the others
   std::thread own([&] {
     const int threads = std::max(1, o.threads - 1);
-    for (;;) {
+    while (ranks_ < kDealerOnlyRanks) {
       size_t first, count;
       take(threads, &first, &count);
       if (count == 0) return;

@@ -122,6 +122,10 @@ const std::vector<Parameter>& ParameterTable() {
          Search(s).seed = std::uint64_t(seed);
        }},
       {"batch", [](State& s, const Value& v) { Search(s).batch = v.Whole(1); }},
+      {"restarts",
+       [](State& s, const Value& v) {
+         s.restarts = int(CheckedCount(v.Number(), 1, 100000, "restarts (independent optimisations)"));
+       }},
       {"cooling",
        [](State& s, const Value& v) {
          Search(s).cooling = v.Positive();

@@ -98,11 +98,18 @@ void Anneal(State& s, const Words& w, const Context& ctx) {
   o.iterations = iterations;
   const std::string invalid = o.Validate();
   if (!invalid.empty()) ctx.Fail("anneal: " + invalid);
-  CheckTrialWork(s, double(iterations) * double(o.batch) + 1.0, "anneal's work");
+  CheckTrialWork(s, (double(iterations) * double(o.batch) + 1.0) * s.restarts, "anneal's work");
   const synth::Problem problem = StartOptimising(s);
-  synth::AnnealResult r = synth::Anneal(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
-    if (s.progress) s.progress(iterations ? double(rec.iteration) / iterations : 1.0, rec.best);
-  });
+  synth::AnnealResult r =
+      s.restarts > 1 ? synth::BestOfRestarts(s.restarts,
+                                             [&](int k) {
+                                               synth::AnnealOptions ok = o;
+                                               ok.seed = o.seed + std::uint64_t(k);
+                                               return synth::Anneal(problem, s.scene.control().graph, ok);
+                                             })
+                     : synth::Anneal(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
+                         if (s.progress) s.progress(iterations ? double(rec.iteration) / iterations : 1.0, rec.best);
+                       });
   AdoptOrStop(s, std::move(r), s.anneal_csv, "simulated annealing", "anneal", "iteration", iterations);
 }
 
@@ -125,11 +132,18 @@ void Cmaes(State& s, const Words& w, const Context& ctx) {
   o.max_time = a.max_time;
   const std::string invalid = o.Validate();
   if (!invalid.empty()) ctx.Fail("cmaes: " + invalid + " (the population is `batch`)");
-  CheckTrialWork(s, (double(generations) + 1.0) * double(o.population), "cmaes' work");
+  CheckTrialWork(s, (double(generations) + 1.0) * double(o.population) * s.restarts, "cmaes' work");
   const synth::Problem problem = StartOptimising(s);
-  synth::AnnealResult r = synth::Cmaes(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
-    if (s.progress) s.progress(generations ? double(rec.iteration) / generations : 1.0, rec.best);
-  });
+  synth::AnnealResult r =
+      s.restarts > 1 ? synth::BestOfRestarts(s.restarts,
+                                             [&](int k) {
+                                               synth::CmaesOptions ok = o;
+                                               ok.seed = o.seed + std::uint64_t(k);
+                                               return synth::Cmaes(problem, s.scene.control().graph, ok);
+                                             })
+                     : synth::Cmaes(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
+                         if (s.progress) s.progress(generations ? double(rec.iteration) / generations : 1.0, rec.best);
+                       });
   AdoptOrStop(s, std::move(r), s.cmaes_csv, "CMA-ES", "cmaes", "generation", generations);
 #else
   (void)generations;

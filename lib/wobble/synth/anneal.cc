@@ -291,4 +291,64 @@ std::vector<double> DistancePerCycle(const Problem& problem, const control::Pose
   return out;
 }
 
+std::string EncodeAnnealResult(const AnnealResult& r) {
+  ByteWriter w;
+  w.Put<std::uint8_t>(r.best.cyclic).Put<std::uint64_t>(r.best.poses.size());
+  for (const Eigen::VectorXd& p : r.best.poses) w.PutDoubles(std::vector<double>(p.data(), p.data() + p.size()));
+  w.PutDoubles(r.best.durations);
+  w.PutString(EncodeTrialOutcome(r.best_outcome)).PutString(EncodeTrialOutcome(r.initial_outcome));
+  w.Put<std::uint64_t>(r.history.size());
+  for (const IterationRecord& h : r.history)
+    w.Put<std::int32_t>(h.iteration).Put<std::int64_t>(h.trials).Put(h.candidate).Put(h.current).Put(h.best)
+        .Put(h.temperature).Put<std::uint8_t>(h.accepted);
+  w.Put<std::int64_t>(r.trials).Put<std::uint8_t>(r.interrupted);
+  return w.Take();
+}
+
+AnnealResult DecodeAnnealResult(const std::string& bytes) {
+  ByteReader in(bytes);
+  AnnealResult r;
+  r.best.cyclic = in.Get<std::uint8_t>() != 0;
+  r.best.poses.resize(in.Get<std::uint64_t>());
+  for (Eigen::VectorXd& p : r.best.poses) {
+    const std::vector<double> v = in.GetDoubles();
+    p = Eigen::Map<const Eigen::VectorXd>(v.data(), Eigen::Index(v.size()));
+  }
+  r.best.durations = in.GetDoubles();
+  r.best_outcome = DecodeTrialOutcome(in.GetString());
+  r.initial_outcome = DecodeTrialOutcome(in.GetString());
+  r.history.resize(in.Get<std::uint64_t>());
+  for (IterationRecord& h : r.history) {
+    h.iteration = in.Get<std::int32_t>();
+    h.trials = long(in.Get<std::int64_t>());
+    h.candidate = in.Get<double>();
+    h.current = in.Get<double>();
+    h.best = in.Get<double>();
+    h.temperature = in.Get<double>();
+    h.accepted = in.Get<std::uint8_t>() != 0;
+  }
+  r.trials = long(in.Get<std::int64_t>());
+  r.interrupted = in.Get<std::uint8_t>() != 0;
+  return r;
+}
+
+AnnealResult BestOfRestarts(int restarts, const std::function<AnnealResult(int restart)>& run) {
+  if (restarts < 1) throw std::invalid_argument("restarts must be at least 1");
+  const std::vector<Bytes> results = DistributedMap(size_t(restarts), MapOptions(), [&](size_t k) {
+    return EncodeAnnealResult(run(int(k)));
+  });
+  AnnealResult best = DecodeAnnealResult(results[0]);
+  long trials = best.trials;
+  bool interrupted = best.interrupted;
+  for (size_t k = 1; k < results.size(); ++k) {
+    AnnealResult r = DecodeAnnealResult(results[k]);
+    trials += r.trials;
+    interrupted = interrupted || r.interrupted;
+    if (r.best_outcome.cost < best.best_outcome.cost) best = std::move(r);
+  }
+  best.trials = trials;
+  best.interrupted = interrupted;
+  return best;
+}
+
 }  // namespace wobble::synth

@@ -132,6 +132,15 @@ struct AnnealResult {
 AnnealResult Anneal(const Problem& problem, const control::PoseGraph& initial, const AnnealOptions& options,
                     const std::function<void(const IterationRecord&)>& on_iteration = nullptr);
 
+// Independent restarts: run(k) for k = 0 .. restarts−1 (the same optimisation from seed + k),
+// spread over threads and MPI ranks (core/distribute.h; each restart's own trials then run on
+// the thread it got). The result is the restart whose best cost is lowest (the first of equal
+// ones) with its history; `trials` counts every restart's.
+AnnealResult BestOfRestarts(int restarts, const std::function<AnnealResult(int restart)>& run);
+// A result as bytes and back, exactly.
+std::string EncodeAnnealResult(const AnnealResult& result);
+AnnealResult DecodeAnnealResult(const std::string& bytes);
+
 // The history as CSV rows: iteration,trials,candidate,current,best,temperature,accepted.
 std::vector<std::string> HistoryHeader();
 std::vector<std::vector<double>> HistoryRows(const std::vector<IterationRecord>& history);

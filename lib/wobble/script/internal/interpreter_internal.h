@@ -51,6 +51,7 @@ struct State {
   synth::CostFunction cost;
   long trial_steps = 1200;
   std::string anneal_csv, cmaes_csv;
+  int restarts = 1;     // independent anneals/cmaes from seed, seed + 1, ...; the best is kept
   double sigma0 = 0.1;  // CMA-ES initial step, a fraction of each variable's range
   std::optional<synth::AnnealResult> anneal;
   Eigen::VectorXd anneal_start_q, anneal_start_qd;  // the trials' start state
