@@ -46,7 +46,7 @@ DEMO3D_ARGS   ?= --object data/pot3.obj --modes data/pot3_modes.def3 --q "0 30 0
                  --qdot "0 -60 0 0 1.2 0 0 0 0" --duration 4 --dt 0.001 --orbit 30 --elevation 25 \
                  --filmstrip "0 0.4 0.8 1.5 2.5 4" --what frames,filmstrip,charts,vtp,exr
 
-.PHONY: all deps fuzz-deps configure build demo-build demo test test-release asan bench bench-python fuzz clean
+.PHONY: all deps fuzz-deps configure build demo-build demo test test-release asan bench bench-mpi bench-python fuzz clean
 
 all: build
 
@@ -147,6 +147,14 @@ bench: configure
 	# rendering and export speed; VTK renders through X
 	if [ -n "$${DISPLAY:-}" ]; then $(BUILD)/bench/wobble_pipelines_bench
 	else xvfb-run -a -s "-screen 0 1280x1024x24" $(BUILD)/bench/wobble_pipelines_bench; fi
+
+# Trials over MPI ranks (issue 17): two ranks on this machine, then the model of 100 and 1,000
+bench-mpi: configure
+	cmake --build $(BUILD) -j $(JOBS) --target mpi_bench
+	mkdir -p out
+	OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -np 2 --oversubscribe \
+	  $(BUILD)/bench/mpi_bench --benchmark_out=out/mpi_bench.json
+	python3 bench/mpi_scaling_model.py out/mpi_bench.json
 
 # Python against C++ (issue 16): batched trials and the cost of one step() call
 bench-python: configure

@@ -11,6 +11,9 @@
 
 #include "wobble/script/interpreter.h"
 #include "wobble/synth/anneal.h"
+#ifdef WOBBLE_HAVE_PAGMO
+#include "wobble/synth/cmaes.h"
+#endif
 
 namespace wobble {
 namespace {
@@ -79,6 +82,21 @@ void BM_Trials1000_3d(benchmark::State& state) {
   state.counters["threads"] = threads ? threads : double(std::thread::hardware_concurrency());
 }
 BENCHMARK(BM_Trials1000_3d)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+
+#ifdef WOBBLE_HAVE_PAGMO
+// CMA-ES on the bounding table (population 8, 20 generations: 168 trials), each generation's
+// population simulated together (issue 17) on 1 thread and on every core, wall time.
+void BM_Cmaes20(benchmark::State& state) {
+  synth::CmaesOptions o;
+  o.seed = 4;
+  o.generations = 20;
+  o.population = 8;
+  o.threads = int(state.range(0));
+  for (auto _ : state) benchmark::DoNotOptimize(synth::Cmaes(Scene().problem, Scene().graph, o).trials);
+  state.counters["threads"] = o.threads ? o.threads : double(std::thread::hardware_concurrency());
+}
+BENCHMARK(BM_Cmaes20)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+#endif
 
 }  // namespace
 }  // namespace wobble

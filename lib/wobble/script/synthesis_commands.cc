@@ -125,6 +125,7 @@ void Cmaes(State& s, const Words& w, const Context& ctx) {
   o.generations = generations;
   o.population = a.batch;
   o.sigma0 = s.sigma0;
+  o.threads = a.threads;
   o.optimize = a.optimize;
   o.min_amplitude = a.min_amplitude;
   o.max_amplitude = a.max_amplitude;

@@ -121,10 +121,11 @@ struct ControllerProblem {
 };
 
 // Simulates the points together and files their outcomes as answers.
-void Answer(const Problem& p, const Coding& coding, const std::vector<std::vector<double>>& points, Tally* tally) {
+void Answer(const Problem& p, const Coding& coding, const std::vector<std::vector<double>>& points, int threads,
+            Tally* tally) {
   std::vector<control::PoseGraph> graphs;
   for (const std::vector<double>& x : points) graphs.push_back(coding.Decode(x));
-  const std::vector<TrialOutcome> outcomes = RunTrials(p, graphs);
+  const std::vector<TrialOutcome> outcomes = RunTrials(p, graphs, threads);
   std::lock_guard<std::mutex> lock(tally->mutex);
   tally->answers.clear();
   for (size_t i = 0; i < points.size(); ++i) tally->answers.emplace(points[i], outcomes[i]);
@@ -147,7 +148,7 @@ AnnealResult Cmaes(const Problem& p, const control::PoseGraph& initial, const Cm
     for (double& v : x) v = std::clamp(v + normal(rng), 0.0, 1.0);
     start.push_back(x);
   }
-  Answer(p, coding, start, tally.get());
+  Answer(p, coding, start, o.threads, tally.get());
   for (const std::vector<double>& x : start) pop.push_back(x);  // answered, in order
   AnnealResult r;
   r.initial_outcome = tally->answers.at(start[0]);
@@ -171,7 +172,7 @@ AnnealResult Cmaes(const Problem& p, const control::PoseGraph& initial, const Cm
       tally->asked.clear();
       rehearsal.evolve(pop);
       tally->mode = Tally::Mode::kAnswer;
-      Answer(p, coding, tally->asked, tally.get());
+      Answer(p, coding, tally->asked, o.threads, tally.get());
     }
     pop = algo.evolve(pop);
     if (tally->trials == before) break;  // cmaes stopped (converged)

@@ -21,6 +21,7 @@ struct CmaesOptions {
   int generations = 60;
   int population = 8;
   double sigma0 = 0.1;  // initial step, as a fraction of each variable's range
+  int threads = 0;      // a generation's trials on this many threads (0: all cores)
   Optimize optimize = Optimize::kBoth;
   double min_amplitude = -1.0, max_amplitude = 1.0;
   double min_time = 0.05, max_time = 5.0;
