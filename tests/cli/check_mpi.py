@@ -93,6 +93,30 @@ for n in (2, 3):
                f"mpirun -np {n}: {f} is the same file as on one process")
     expect(not any(n.endswith(".tmp") for n in os.listdir(ranked)), f"mpirun -np {n}: no temporary file left")
 
+# --- the condition map's rows and a 3D surface fit's starts on ranks ------------------------
+import json
+maps = {}
+fits = {}
+for name, prefix in [("1 process", []), ("mpirun -np 2", mpi(2)), ("mpirun -np 3", mpi(3))]:
+    out = os.path.join(work, "map_" + name.replace(" ", "_"))
+    r = run(prefix + [wobble, "condition", "sweep", "--object", os.path.join(data, "table.obj"), "--step", "30",
+                      "--map", "24", "--out", out])
+    expect(r.returncode == 0, f"condition sweep --map on {name}: exit 0")
+    if os.path.exists(os.path.join(out, "map.csv")):
+        maps[name] = open(os.path.join(out, "map.csv"), "rb").read()
+    fit = os.path.join(work, "fit_" + name.replace(" ", "_") + ".json")
+    r = run(prefix + [wobble, "fit", "pose", "--object", os.path.join(data, "pot3.obj"), "--modes",
+                      os.path.join(data, "pot3_modes.def3"), "--targets", os.path.join(data, "pot3_scan.tgt"),
+                      "--out", fit])
+    expect(r.returncode == 0, f"3D surface fit on {name}: exit 0")
+    if os.path.exists(fit):
+        j = json.load(open(fit))
+        fits[name] = (j["q"], j["rms_residual"])
+expect(len(maps) == 3 and len(set(maps.values())) == 1 and maps["1 process"].count(b"\n") == 24 * 24 + 1,
+       "the condition map (24 x 24) is the same file on 1 process and on 2 and 3 ranks")
+expect(len(fits) == 3 and all(f == fits["1 process"] for f in fits.values()),
+       "the 3D surface fit (its starts solved on the ranks) gives the same q and residual everywhere")
+
 # --- a killed rank ----------------------------------------------------------------------
 out = os.path.join(work, "killed")
 long_study = [wobble, "sweep", os.path.join(data, "sweep_bounding.wob"), "--param", "seed=1:200:200",
