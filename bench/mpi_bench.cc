@@ -23,6 +23,7 @@
 #include <sstream>
 #include <streambuf>
 
+#include "bounding_table_scene.h"
 #include "wobble/core/distribute.h"
 #include "wobble/script/interpreter.h"
 #include "wobble/synth/anneal.h"
@@ -33,40 +34,13 @@
 namespace wobble {
 namespace {
 
-// data/bounding_table.wob up to its anneal: the problem and the initial pose graph.
-struct BoundingTable {
-  BoundingTable() : interp(sink) {
-    const std::string path = std::string(WOBBLE_DATA_DIR) + "/bounding_table.wob";
-    std::ifstream f(path);
-    std::string line;
-    for (int n = 1; std::getline(f, line); ++n) {
-      if (line.rfind("anneal", 0) == 0) break;
-      interp.RunLine(line, path, n, WOBBLE_DATA_DIR);
-    }
-    problem = interp.SynthesisProblem();
-  }
-  std::ostringstream sink;
-  script::Interpreter interp;
-  synth::Problem problem;
-};
-
-std::vector<control::PoseGraph> Candidates(const script::Interpreter& interp, int n) {
-  std::mt19937_64 rng(1);
-  std::normal_distribution<double> normal(0.0, 0.1);
-  std::vector<control::PoseGraph> out(size_t(n), interp.pose_graph());
-  for (control::PoseGraph& g : out)
-    for (Eigen::VectorXd& p : g.poses)
-      for (int i = 0; i < p.size(); ++i) p[i] += normal(rng);
-  return out;
-}
-
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
 void BM_Sweep(benchmark::State& state) {
-  static const BoundingTable scene;
-  const std::vector<control::PoseGraph> graphs = Candidates(scene.interp, int(state.range(0)));
+  static const bench::BoundingTable scene;
+  const std::vector<control::PoseGraph> graphs = bench::Neighbours(scene.graph, int(state.range(0)));
   Distributor& everywhere = CurrentDistributor();
   const int ranks = everywhere.ranks();
   double alone = 0, all = 0;

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <thread>
 
+#include "bounding_table_scene.h"
 #include "wobble/script/interpreter.h"
 #include "wobble/synth/anneal.h"
 #ifdef WOBBLE_HAVE_PAGMO
@@ -18,25 +19,7 @@
 namespace wobble {
 namespace {
 
-// A bounding-table scene's setup: data/NAME.wob up to (not including) its anneal;
-// bounding_table (2D) or bounding_table3 (the 3D table, issue 15).
-struct BoundingTable {
-  explicit BoundingTable(const std::string& name = "bounding_table") : interp(sink) {
-    const std::string path = std::string(WOBBLE_DATA_DIR) + "/" + name + ".wob";
-    std::ifstream f(path);
-    std::string line;
-    for (int n = 1; std::getline(f, line); ++n) {
-      if (line.rfind("anneal", 0) == 0) break;
-      interp.RunLine(line, path, n, WOBBLE_DATA_DIR);
-    }
-    problem = interp.SynthesisProblem();
-    graph = interp.pose_graph();
-  }
-  std::ostringstream sink;
-  script::Interpreter interp;
-  synth::Problem problem;
-  control::PoseGraph graph;
-};
+using bench::BoundingTable;
 
 const BoundingTable& Scene(bool three = false) {
   static const BoundingTable scene, scene3("bounding_table3");
@@ -44,15 +27,7 @@ const BoundingTable& Scene(bool three = false) {
 }
 
 // 1000 random neighbours of the initial controller (fixed seed: the same work every run).
-std::vector<control::PoseGraph> Candidates(int n, bool three = false) {
-  std::mt19937_64 rng(1);
-  std::normal_distribution<double> normal(0.0, 0.1);
-  std::vector<control::PoseGraph> out(n, Scene(three).graph);
-  for (control::PoseGraph& g : out)
-    for (Eigen::VectorXd& p : g.poses)
-      for (int i = 0; i < p.size(); ++i) p[i] += normal(rng);
-  return out;
-}
+std::vector<control::PoseGraph> Candidates(int n, bool three = false) { return bench::Neighbours(Scene(three).graph, n); }
 
 void BM_BoundingTableTrial(benchmark::State& state) {
   const BoundingTable& s = Scene();

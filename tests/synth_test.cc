@@ -23,6 +23,13 @@ namespace {
 
 const std::string kData = WOBBLE_DATA_DIR;
 
+// data/bounding_table.wob's setup (table, modes, ground, the initial pose graph), without its
+// optimisation: the tests add theirs.
+const std::string kBoundingSetup =
+    "load_obj table.obj\nload_def table_modes.def\nassign bend 4e7 4e6\nassign shear 4e7 4e6\n"
+    "set integrator thesis\nset dt 0.01\nset grconst 45000\nset grdam 3000\nset frconst 3000\n"
+    "set frsin 0.5\npose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\npose 0 0.1 0.4\n";
+
 // Runs the scene file in a scratch folder (its outputs are relative to the working directory).
 struct Scene {
   explicit Scene(const std::string& name) : interp(out) {
@@ -45,10 +52,7 @@ TEST(Annealing, SameSeedSameResultWhateverTheThreadCount) {
   for (int threads : {1, 2, 2}) {
     std::ostringstream out;
     script::Interpreter interp(out);
-    std::istringstream in("load_obj table.obj\nload_def table_modes.def\nassign bend 4e7 4e6\nassign shear 4e7 4e6\n"
-                          "set integrator thesis\nset dt 0.01\nset grconst 45000\nset grdam 3000\nset frconst 3000\n"
-                          "set frsin 0.5\npose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\npose 0 0.1 0.4\n"
-                          "set seed 11\nset batch 4\nset threads " + std::to_string(threads) + "\nanneal 6\n");
+    std::istringstream in(kBoundingSetup + "set seed 11\nset batch 4\nset threads " + std::to_string(threads) + "\nanneal 6\n");
     interp.RunStream(in, "seeded.wob", kData);
     results.push_back(*interp.last_anneal());
   }
@@ -67,11 +71,7 @@ TEST(Annealing, SameSeedSameResultWhateverTheThreadCount) {
 
 TEST(Annealing, RestartsKeepTheBestOfIndependentSeeds) {
   // `set restarts 3` is the best of three anneals from seeds 11, 12, 13 run one by one
-  const std::string setup =
-      "load_obj table.obj\nload_def table_modes.def\nassign bend 4e7 4e6\nassign shear 4e7 4e6\n"
-      "set integrator thesis\nset dt 0.01\nset grconst 45000\nset grdam 3000\nset frconst 3000\n"
-      "set frsin 0.5\npose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\npose 0 0.1 0.4\nset trial_steps 400\n"
-      "set batch 4\n";
+  const std::string setup = kBoundingSetup + "set trial_steps 400\nset batch 4\n";
   std::vector<synth::AnnealResult> alone;
   for (int seed : {11, 12, 13}) {
     std::ostringstream out;
@@ -170,10 +170,7 @@ TEST(Cmaes, ReproducibleFromItsSeedAndImprovesOnTheInitialController) {
   for (int run = 0; run < 2; ++run) {
     std::ostringstream out;
     script::Interpreter interp(out);
-    std::istringstream in("load_obj table.obj\nload_def table_modes.def\nassign bend 4e7 4e6\nassign shear 4e7 4e6\n"
-                          "set integrator thesis\nset dt 0.01\nset grconst 45000\nset grdam 3000\nset frconst 3000\n"
-                          "set frsin 0.5\npose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\npose 0 0.1 0.4\n"
-                          "set seed 5\nset batch 6\ncmaes 8\n");
+    std::istringstream in(kBoundingSetup + "set seed 5\nset batch 6\ncmaes 8\n");
     interp.RunStream(in, "cmaes.wob", kData);
     results.push_back(*interp.last_anneal());
   }
@@ -188,10 +185,7 @@ TEST(Cmaes, ReproducibleFromItsSeedAndImprovesOnTheInitialController) {
   {
     std::ostringstream out;
     script::Interpreter interp(out);
-    std::istringstream setup("load_obj table.obj\nload_def table_modes.def\nassign bend 4e7 4e6\nassign shear 4e7 4e6\n"
-                             "set integrator thesis\nset dt 0.01\nset grconst 45000\nset grdam 3000\n"
-                             "set frconst 3000\nset frsin 0.5\npose 0.1 0 0.4\npose 0 -0.1 0.4\npose -0.1 0 0.4\n"
-                             "pose 0 0.1 0.4\nset trial_steps 400\n");
+    std::istringstream setup(kBoundingSetup + "set trial_steps 400\n");
     interp.RunStream(setup, "cmaes.wob", kData);
     synth::CmaesOptions o;
     o.seed = 9;
