@@ -97,6 +97,7 @@ for n in (2, 3):
 import json
 maps = {}
 fits = {}
+curves = {}
 for name, prefix in [("1 process", []), ("mpirun -np 2", mpi(2)), ("mpirun -np 3", mpi(3))]:
     out = os.path.join(work, "map_" + name.replace(" ", "_"))
     r = run(prefix + [wobble, "condition", "sweep", "--object", os.path.join(data, "table.obj"), "--step", "30",
@@ -112,10 +113,20 @@ for name, prefix in [("1 process", []), ("mpirun -np 2", mpi(2)), ("mpirun -np 3
     if os.path.exists(fit):
         j = json.load(open(fit))
         fits[name] = (j["q"], j["rms_residual"])
+    curve = os.path.join(work, "curve_" + name.replace(" ", "_") + ".json")
+    r = run(prefix + [wobble, "fit", "pose", "--object", os.path.join(data, "table.obj"), "--modes",
+                      os.path.join(data, "table_modes.def"), "--targets", os.path.join(data, "table_curve.tgt"),
+                      "--out", curve])
+    expect(r.returncode == 0, f"2D curve fit on {name}: exit 0")
+    if os.path.exists(curve):
+        j = json.load(open(curve))
+        curves[name] = (j["q"], j["rms_residual"])
 expect(len(maps) == 3 and len(set(maps.values())) == 1 and maps["1 process"].count(b"\n") == 24 * 24 + 1,
        "the condition map (24 x 24) is the same file on 1 process and on 2 and 3 ranks")
 expect(len(fits) == 3 and all(f == fits["1 process"] for f in fits.values()),
        "the 3D surface fit (its starts solved on the ranks) gives the same q and residual everywhere")
+expect(len(curves) == 3 and all(f == curves["1 process"] for f in curves.values()),
+       "the 2D curve fit (its starts solved on the ranks) gives the same q and residual everywhere")
 
 # --- a killed rank ----------------------------------------------------------------------
 out = os.path.join(work, "killed")

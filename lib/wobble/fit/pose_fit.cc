@@ -1,5 +1,7 @@
 #include "wobble/fit/pose_fit.h"
 
+#include "wobble/core/distribute.h"
+
 #include <ceres/ceres.h>
 
 #include <Eigen/Eigenvalues>
@@ -226,6 +228,27 @@ PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, c
     int round = 0;
     bool done = false;
   };
+  // the residuals of the assignments run->assigned and run->reverse_assigned
+  auto residuals = [&](Run* run) {
+    for (int i = 0; i < ns; ++i) {
+      const int seg = run->assigned[i];
+      SegmentResidual& d = run->data[i];
+      d.point = samples.points[i];
+      d.a = target.a[seg];
+      d.b = target.b[seg];
+      d.num_q = body.num_q();
+    }
+    if (!two_sided) return;
+    for (size_t v = 0; v < reverse_points.size(); ++v) {
+      const int seg = run->reverse_assigned[v];
+      ReverseSegmentResidual& d = run->reverse[v];
+      d.pa = samples.points[samples.segments[seg].first];
+      d.pb = samples.points[samples.segments[seg].second];
+      d.y = reverse_points[v];
+      d.sqrt_weight = std::sqrt(reverse_weight);
+      d.num_q = body.num_q();
+    }
+  };
   // closest points at run->q; returns whether any assignment changed
   auto assign = [&](Run* run) {
     const Eigen::VectorXd& q = run->q;
@@ -237,11 +260,6 @@ PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, c
       const int seg = NearestSegment(target.a, target.b, x[i]);
       changed = changed || seg != run->assigned[i];
       run->assigned[i] = seg;
-      SegmentResidual& d = run->data[i];
-      d.point = samples.points[i];
-      d.a = target.a[seg];
-      d.b = target.b[seg];
-      d.num_q = body.num_q();
     }
     // ... and target vertices to the body's drawn segments
     if (two_sided) {
@@ -254,14 +272,9 @@ PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, c
         const int seg = NearestSegment(ba, bb, reverse_points[v]);
         changed = changed || seg != run->reverse_assigned[v];
         run->reverse_assigned[v] = seg;
-        ReverseSegmentResidual& d = run->reverse[v];
-        d.pa = samples.points[samples.segments[seg].first];
-        d.pb = samples.points[samples.segments[seg].second];
-        d.y = reverse_points[v];
-        d.sqrt_weight = std::sqrt(reverse_weight);
-        d.num_q = body.num_q();
       }
     }
+    residuals(run);
     return changed;
   };
   // runs rounds until `last_round` (exclusive) or convergence
@@ -292,8 +305,41 @@ PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, c
     }
   };
 
-  std::vector<Run> runs;
-  for (const Eigen::VectorXd& start : starts) {
+  // The starts are solved at once, on threads and, under mpirun, on ranks (core/distribute.h);
+  // a start's state crosses as bytes and the winner goes on from it exactly as it would have.
+  auto encode = [&](const Run& run) {
+    ByteWriter w;
+    w.PutDoubles(std::vector<double>(run.q.data(), run.q.data() + run.q.size()));
+    w.PutString(EncodeFitReport(run.r.report)).Put<std::int32_t>(run.r.rounds);
+    w.Put<std::uint64_t>(run.assigned.size());
+    for (int a : run.assigned) w.Put<std::int32_t>(a);
+    w.Put<std::uint64_t>(run.reverse_assigned.size());
+    for (int a : run.reverse_assigned) w.Put<std::int32_t>(a);
+    w.Put(run.seconds).Put(run.previous_cost).Put<std::int32_t>(run.round).Put<std::uint8_t>(run.done);
+    return w.Take();
+  };
+  auto decode = [&](const Bytes& bytes) {
+    ByteReader in(bytes);
+    Run run;
+    const std::vector<double> q = in.GetDoubles();
+    run.q = Eigen::Map<const Eigen::VectorXd>(q.data(), Eigen::Index(q.size()));
+    run.r.report = DecodeFitReport(in.GetString());
+    run.r.rounds = in.Get<std::int32_t>();
+    run.assigned.resize(in.Get<std::uint64_t>());
+    for (int& a : run.assigned) a = in.Get<std::int32_t>();
+    run.reverse_assigned.resize(in.Get<std::uint64_t>());
+    for (int& a : run.reverse_assigned) a = in.Get<std::int32_t>();
+    run.seconds = in.Get<double>();
+    run.previous_cost = in.Get<double>();
+    run.round = in.Get<std::int32_t>();
+    run.done = in.Get<std::uint8_t>() != 0;
+    run.data.resize(ns);
+    run.reverse.resize(reverse_points.size());
+    if (!run.assigned.empty() && run.assigned[0] >= 0) residuals(&run);  // assigned: the winner goes on from them
+    return run;
+  };
+  const std::vector<Bytes> solved = DistributedMap(starts.size(), MapOptions(), [&](size_t k) {
+    const Eigen::VectorXd& start = starts[k];
     Run run;
     run.q = start;
     for (int d = 0; d < body.num_modes(); ++d)
@@ -331,8 +377,10 @@ PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, c
     } else {
       advance(&run, std::min(o.start_rounds, o.max_rounds));
     }
-    runs.push_back(std::move(run));
-  }
+    return encode(run);
+  });
+  std::vector<Run> runs;
+  for (const Bytes& bytes : solved) runs.push_back(decode(bytes));
   size_t best_index = 0;
   for (size_t i = 1; i < runs.size(); ++i)
     if (runs[i].r.report.final_cost < runs[best_index].r.report.final_cost) best_index = i;

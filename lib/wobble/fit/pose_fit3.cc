@@ -426,18 +426,9 @@ namespace {
 
 // A solved start as bytes and back (q and the solver's report), for DistributedMap.
 Bytes EncodeSolve(const PoseFitResult& r) {
-  const FitReport& f = r.report;
   return ByteWriter()
       .PutDoubles(std::vector<double>(r.q.data(), r.q.data() + r.q.size()))
-      .Put<std::uint8_t>(f.usable)
-      .PutString(f.termination)
-      .PutString(f.brief_report)
-      .PutString(f.full_report)
-      .Put(f.initial_cost)
-      .Put(f.final_cost)
-      .PutDoubles(f.cost_per_iteration)
-      .Put<std::int32_t>(f.iterations)
-      .Put(f.solve_seconds)
+      .PutString(EncodeFitReport(r.report))
       .Take();
 }
 
@@ -446,16 +437,7 @@ PoseFitResult DecodeSolve(const Bytes& bytes) {
   PoseFitResult r;
   const std::vector<double> q = in.GetDoubles();
   r.q = Eigen::Map<const Eigen::VectorXd>(q.data(), Eigen::Index(q.size()));
-  FitReport& f = r.report;
-  f.usable = in.Get<std::uint8_t>() != 0;
-  f.termination = in.GetString();
-  f.brief_report = in.GetString();
-  f.full_report = in.GetString();
-  f.initial_cost = in.Get<double>();
-  f.final_cost = in.Get<double>();
-  f.cost_per_iteration = in.GetDoubles();
-  f.iterations = in.Get<std::int32_t>();
-  f.solve_seconds = in.Get<double>();
+  r.report = DecodeFitReport(in.GetString());
   return r;
 }
 

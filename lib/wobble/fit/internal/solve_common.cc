@@ -1,5 +1,7 @@
 #include "wobble/fit/internal/solve_common.h"
 
+#include "wobble/core/distribute.h"
+
 #include <cmath>
 
 #include "wobble/core/errors.h"
@@ -217,6 +219,35 @@ Conditioning ConditioningOfJacobian(Eigen::MatrixXd J, const std::vector<std::st
     }
   }
   return c;
+}
+
+std::string EncodeFitReport(const FitReport& f) {
+  return ByteWriter()
+      .Put<std::uint8_t>(f.usable)
+      .PutString(f.termination)
+      .PutString(f.brief_report)
+      .PutString(f.full_report)
+      .Put(f.initial_cost)
+      .Put(f.final_cost)
+      .PutDoubles(f.cost_per_iteration)
+      .Put<std::int32_t>(f.iterations)
+      .Put(f.solve_seconds)
+      .Take();
+}
+
+FitReport DecodeFitReport(const std::string& bytes) {
+  ByteReader in(bytes);
+  FitReport f;
+  f.usable = in.Get<std::uint8_t>() != 0;
+  f.termination = in.GetString();
+  f.brief_report = in.GetString();
+  f.full_report = in.GetString();
+  f.initial_cost = in.Get<double>();
+  f.final_cost = in.Get<double>();
+  f.cost_per_iteration = in.GetDoubles();
+  f.iterations = in.Get<std::int32_t>();
+  f.solve_seconds = in.Get<double>();
+  return f;
 }
 
 }  // namespace wobble::fit

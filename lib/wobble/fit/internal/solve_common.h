@@ -64,6 +64,11 @@ class IterationForwarder : public ceres::IterationCallback {
 // Copies what people need from a Ceres summary.
 void FillReport(const ceres::Solver::Summary& summary, bool full, double seconds, FitReport* report);
 
+// A report as bytes and back, exactly: multi-start fits solve their starts through
+// DistributedMap (core/distribute.h).
+std::string EncodeFitReport(const FitReport& report);
+FitReport DecodeFitReport(const std::string& bytes);
+
 // Every fit's last move: silent logging, on_iteration attached, ceres::Solve timed, the report filled.
 void SolveAndReport(ceres::Solver::Options options, ceres::Problem* problem,
                     const std::function<void(int, double)>& on_iteration, bool full_report, FitReport* report);
