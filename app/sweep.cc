@@ -92,8 +92,8 @@ class PartialRows {
   std::FILE* file_ = nullptr;
 };
 
-// mpirun ends every rank with SIGTERM when one of them dies (so does a batch system at its time
-// limit): rank 0 then says how many rows are on disk, and where, before it goes. The text is
+// mpirun ends every rank with SIGTERM on Ctrl-C and when one of them dies (so does a batch
+// system at its time limit): rank 0 then says how many rows are on disk, and where, before it goes. The text is
 // prepared after every row, so the handler only writes it (async-signal-safe).
 char stop_note[1024];
 std::atomic<size_t> stop_note_length{0};
@@ -105,7 +105,8 @@ void OnTerminate(int) {
 }
 
 void PrepareStopNote(size_t finished, size_t total, const std::string& partial) {
-  const std::string text = "\nwobble sweep: stopped by SIGTERM (under mpirun: another rank ended, mpirun names it); " +
+  const std::string text = "\nwobble sweep: stopped by SIGTERM (mpirun sends it to every rank on Ctrl-C and when a rank "
+                           "dies, which it names); " +
                            std::to_string(finished) + " of " + std::to_string(total) + " finished rows are in " +
                            partial + "\n";
   stop_note_length = 0;

@@ -186,6 +186,27 @@ expect(all(row == reference_rows.get(row["case"]) for row in kept),
        "every kept row equals the same case's row on one process")
 expect(not os.path.exists(os.path.join(out, "sweep.csv")) or len(kept) == 200, "no complete table is claimed")
 
+# --- Ctrl-C: mpirun passes it on as SIGTERM to every rank ---------------------------------
+out = os.path.join(work, "ctrl_c")
+partial = os.path.join(out, "sweep.csv.partial")
+proc = subprocess.Popen(mpi(2) + long_study[:-1] + [out], cwd=work, env=env, stdout=subprocess.PIPE,
+                        stderr=subprocess.STDOUT, text=True, start_new_session=True)
+deadline = time.time() + 120
+while time.time() < deadline and len(rows_in(partial)) < 4 and proc.poll() is None:
+    time.sleep(0.05)
+proc.send_signal(signal.SIGINT)
+try:
+    text, _ = proc.communicate(timeout=120)
+except subprocess.TimeoutExpired:
+    os.killpg(proc.pid, signal.SIGKILL)
+    text, _ = proc.communicate()
+    expect(False, "mpirun ends within 120 s of Ctrl-C")
+kept = rows_in(partial)
+expect(proc.returncode != 0, f"Ctrl-C ends the run non-zero (got {proc.returncode})")
+expect("finished rows are in " + partial in text, "rank 0 says where the finished rows are after Ctrl-C")
+expect(len(kept) >= 4 and all(row == reference_rows.get(row["case"]) for row in kept),
+       f"after Ctrl-C the finished rows ({len(kept)}) are on disk and equal the 1-process rows")
+
 if failures:
     print(f"{len(failures)} check(s) failed")
     sys.exit(1)
