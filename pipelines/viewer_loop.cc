@@ -1,10 +1,16 @@
 #include "pipelines/viewer_loop.h"
 
+#include "wobble/formats/line_reader.h"
+#include "wobble/formats/parse_error.h"
+
 #include <algorithm>
+#include <sstream>
+#include <vector>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
 
+#include <vtkCommand.h>
 #include <vtkImageData.h>
 #include <vtkInteractorEventRecorder.h>
 #include <vtkInteractorStyleImage.h>
@@ -91,10 +97,51 @@ void AttachViewerStyle(vtkRenderWindowInteractor* interactor, ViewerControls* co
   interactor->SetInteractorStyle(style);  // the interactor keeps it
 }
 
+void CheckEventFile(const std::string& path) {
+  formats::detail::WithFile(path, [&](std::istream& in) {
+    double version = 1.0;  // a file without a StreamVersion line is read as 1.0
+    std::string line;
+    for (int number = 1; std::getline(in, line); ++number) {
+      std::istringstream words(line);
+      std::vector<std::string> w;
+      for (std::string word; words >> word;) w.push_back(word);
+      if (w.empty()) continue;
+      if (w[0][0] == '#') {
+        if (w.size() >= 3 && w[1] == "StreamVersion") {
+          if (w[2] != "1" && w[2] != "1.0" && w[2] != "1.1")
+            throw formats::ParseError(path, number, "StreamVersion " + w[2] + ": VTK 9.1 plays 1.0 and 1.1");
+          version = std::stod(w[2]);
+        }
+        continue;
+      }
+      if (vtkCommand::GetEventIdFromString(w[0].c_str()) == vtkCommand::NoEvent)
+        throw formats::ParseError(path, number, "'" + w[0] + "' is not a VTK event (e.g. TimerEvent, MouseMoveEvent, "
+                                                "LeftButtonPressEvent, KeyPressEvent, CharEvent)");
+      const bool v11 = version >= 1.1;
+      const size_t values = v11 ? 6 : 7;
+      if (w.size() != values + 1)
+        throw formats::ParseError(
+            path, number,
+            std::string("StreamVersion ") + (v11 ? "1.1" : "1.0") + " lines are 'EventName X Y " +
+                (v11 ? "modifiers" : "ctrl shift") + " keycode repeatCount keysym' (" + std::to_string(values) +
+                " values after the name), got " + std::to_string(w.size() - 1) +
+                (v11 ? " (1.1 has one modifiers mask: 1 shift, 2 control, 4 alt)" : ""));
+      // all but the key symbol are whole numbers (the key code too: 107 for 'k')
+      for (size_t i = 1; i + 1 < w.size(); ++i) {
+        int v;
+        const bool negative = !w[i].empty() && w[i][0] == '-';
+        if (!formats::detail::ParseInt(negative ? w[i].substr(1) : w[i], &v))
+          throw formats::ParseError(path, number, "expected a whole number, got '" + w[i] + "'");
+      }
+    }
+    return 0;
+  });
+}
+
 void RunViewerLoop(vtkRenderWindowInteractor* interactor, double fps, const FramePacer& pacer,
                    const std::string& events_file, bool keep_open) {
   if (!events_file.empty()) {
-    if (!std::filesystem::exists(events_file)) throw std::invalid_argument(events_file + ": no such events file");
+    CheckEventFile(events_file);  // VTK skips what it cannot read without a word
     auto recorder = Ptr<vtkInteractorEventRecorder>::New();
     recorder->SetInteractor(interactor);
     recorder->SetFileName(events_file.c_str());

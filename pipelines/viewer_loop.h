@@ -60,6 +60,13 @@ class FramePacer {
 
 // Both viewers' event loop: plays the events file (vtkInteractorEventRecorder format) first and
 // returns unless keep_open; otherwise runs the repeating timer at fps until quit or max_frames.
+// Refuses (formats::ParseError, FILE:LINE) an events file VTK 9.1's vtkInteractorEventRecorder
+// would play only in part: it skips unknown event names and reads lines with the wrong number of
+// values silently wrong (a key line in 1.0's layout under `# StreamVersion 1.1` loses its key).
+// 1.0: `EventName X Y ctrl shift keycode repeatCount keysym`; 1.1: `EventName X Y modifiers
+// keycode repeatCount keysym` (modifiers: 1 shift, 2 control, 4 alt).
+void CheckEventFile(const std::string& path);
+
 void RunViewerLoop(vtkRenderWindowInteractor* interactor, double fps, const FramePacer& pacer,
                    const std::string& events_file, bool keep_open);
 
