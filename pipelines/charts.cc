@@ -98,7 +98,9 @@ vtkSmartPointer<vtkImageData> RenderChart(const ChartSpec& spec) {
   auto view = MakeView(spec.width, spec.height);
   auto chart = Ptr<vtkChartXY>::New();
   view->GetScene()->AddItem(chart);
-  FillChart(chart, spec);
+  ChartSpec drawn = spec;
+  drawn.legend_beside = spec.width >= kLegendBesideWidth;
+  FillChart(chart, drawn);
   return Grab(view);
 }
 
@@ -109,6 +111,9 @@ void FillChart(vtkChartXY* chart, const ChartSpec& spec) {
   chart->SetTitle(spec.title);
   chart->GetTitleProperties()->SetFontSize(16);
   chart->SetShowLegend(true);
+  // beside the plot area (not inline), so that it never covers data; inline in small charts
+  // (the viewer's panels, thumbnails), where beside it would leave little room for the plot
+  chart->GetLegend()->SetInline(!spec.legend_beside);
   chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
   chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
   StyleAxis(chart->GetAxis(vtkAxis::BOTTOM), spec.x_title, spec.log_x);

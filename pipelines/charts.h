@@ -30,7 +30,11 @@ struct ChartSpec {
   std::vector<double> markers;
   std::string markers_name = "events";
   int width = 800, height = 500;  // pixels
+  // The legend beside the plot area instead of over it. RenderChart sets it for charts at
+  // least kLegendBesideWidth wide (files); FillChart's callers (the viewer's panels) choose.
+  bool legend_beside = false;
 };
+constexpr int kLegendBesideWidth = 600;
 
 // Renders the chart offscreen (RGB image, bottom row first). Throws std::invalid_argument for
 // a malformed spec, std::runtime_error without a display.

@@ -49,6 +49,8 @@ TEST(SweepPlan, ListsRangesAndGridsInCaseOrder) {
   EXPECT_EQ(ParseSweepParameter("seed=1:4:4").values, (std::vector<std::string>{"1", "2", "3", "4"}));
   EXPECT_EQ(ParseSweepParameter("k=1e3:1e5:3:log").values, (std::vector<std::string>{"1e3", "10000", "1e5"}));
   EXPECT_EQ(ParseSweepParameter("x=2:9:1").values, (std::vector<std::string>{"2"}));
+  const std::vector<std::string> seeds = ParseSweepParameter("seed=1:200:200").values;  // whole steps stay whole
+  for (size_t i = 0; i < seeds.size(); ++i) EXPECT_EQ(seeds[i], std::to_string(i + 1));
   for (const char* bad : {"seed", "=1,2", "seed=", "seed=1:2", "seed=1:2:0", "seed=1:2:x", "k=0:1:3:log",
                           "k=1:2:3:lin", "a-b=1", "seed=1,,2"})
     EXPECT_THROW(ParseSweepParameter(bad), InputError) << bad;

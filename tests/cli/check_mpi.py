@@ -131,10 +131,11 @@ expect(len(curves) == 3 and all(f == curves["1 process"] for f in curves.values(
 # --- a killed rank ----------------------------------------------------------------------
 out = os.path.join(work, "killed")
 long_study = [wobble, "sweep", os.path.join(data, "sweep_bounding.wob"), "--param", "seed=1:200:200",
-              "--param", "iterations=2", "--param", "trial_steps=1200", "--measure", "cost", "--out", out]
+              "--param", "iterations=8", "--param", "trial_steps=1200", "--measure", "cost", "--out", out]
 ref_out = os.path.join(work, "killed_reference")
 r = run(long_study[:-1] + [ref_out, "--threads", "2"])
 expect(r.returncode == 0, "the longer study on one process: exit 0")
+expect("200 ok" in r.stdout, "every case of the longer study ran (whole seeds from seed=1:200:200)")
 reference_rows = {row["case"]: row for row in csv.DictReader(open(os.path.join(ref_out, "sweep.csv")))}
 proc = subprocess.Popen(mpi(3) + long_study, cwd=work, env=env, stdout=subprocess.PIPE,
                         stderr=subprocess.STDOUT, text=True, start_new_session=True)
@@ -202,6 +203,7 @@ except subprocess.TimeoutExpired:
     text, _ = proc.communicate()
     expect(False, "mpirun ends within 120 s of Ctrl-C")
 kept = rows_in(partial)
+print(text[-1500:])
 expect(proc.returncode != 0, f"Ctrl-C ends the run non-zero (got {proc.returncode})")
 expect("finished rows are in " + partial in text, "rank 0 says where the finished rows are after Ctrl-C")
 expect(len(kept) >= 4 and all(row == reference_rows.get(row["case"]) for row in kept),

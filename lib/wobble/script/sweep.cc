@@ -165,7 +165,8 @@ SweepParameter ParseSweepParameter(const std::string& spec) {
     CheckedCount(n, 1, 10'000'000, "--param " + p.name + "'s values");
     for (int i = 0; i < n; ++i) {
       const double f = n == 1 ? 0.0 : double(i) / double(n - 1);
-      const double v = log ? from * std::pow(to / from, f) : from + f * (to - from);
+      // (to − from) i / (n − 1): exact whole numbers for whole steps (seeds 1:200:200)
+      const double v = log ? from * std::pow(to / from, f) : from + (to - from) * double(i) / double(n - 1);
       p.values.push_back(i == 0 ? range[0] : i == n - 1 ? range[1] : Number(v));  // the ends as written
     }
     if (n == 1) p.values = {range[0]};
