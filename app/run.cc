@@ -57,6 +57,7 @@ void PlotCostHistory(const std::string& csv_path, const std::string& optimiser,
   spec.x_title = "iteration";
   spec.y_title = "cost";
   spec.log_y = true;
+  spec.integer_x = true;
   pipelines::ChartSeries current, best;
   current.name = "current controller";
   best.name = "best so far";

@@ -126,10 +126,11 @@ void PlotSweep(const script::SweepOptions& o, const script::SweepTable& t, const
   const std::string& first = o.plan.names[0];
   // x: the first parameter's value when every one is a number, else its index among the values
   std::vector<std::string> distinct;
-  bool numeric = true;
+  bool numeric = true, whole = true;
   for (const auto& values : o.plan.cases) {
     double v;
     numeric = numeric && AsNumber(values[0], &v);
+    whole = whole && numeric && v == std::floor(v);
     if (std::find(distinct.begin(), distinct.end(), values[0]) == distinct.end()) distinct.push_back(values[0]);
   }
   std::map<std::string, pipelines::ChartSeries> lines;
@@ -150,6 +151,7 @@ void PlotSweep(const script::SweepOptions& o, const script::SweepTable& t, const
                std::to_string(t.rows.size()) + " cases)";
   spec.x_title = numeric ? first : first + " (index of its value)";
   spec.y_title = measure;
+  spec.integer_x = whole || !numeric;  // seeds, counts, value indices
   double lo = INFINITY, hi = -INFINITY;
   for (const std::string& key : order) {
     pipelines::ChartSeries s = lines[key];

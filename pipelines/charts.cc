@@ -168,6 +168,25 @@ void FillChart(vtkChartXY* chart, const ChartSpec& spec) {
       chart->GetAxis(vtkAxis::LEFT)->SetRange(lo, hi);
     }
   }
+  // whole-number x (iterations, seeds): ticks on whole numbers only, 1, 2 or 5 times a power
+  // of ten apart, about eight of them
+  vtkAxis* bottom = chart->GetAxis(vtkAxis::BOTTOM);
+  bottom->SetCustomTickPositions(nullptr);
+  if (spec.integer_x && !spec.log_x) {
+    double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo;
+    for (const ChartSeries& s : spec.series)
+      for (double v : s.x)
+        if (std::isfinite(v)) xlo = std::min(xlo, v), xhi = std::max(xhi, v);
+    if (xlo <= xhi) {
+      double step = 1.0;
+      for (double decade = 1.0; (xhi - xlo) / step > 8.0; decade *= 10.0)
+        for (double m : {1.0, 2.0, 5.0})
+          if ((xhi - xlo) / step > 8.0) step = m * decade;
+      auto ticks = Ptr<vtkDoubleArray>::New();
+      for (double t = std::ceil(xlo / step) * step; t <= xhi; t += step) ticks->InsertNextValue(t);
+      bottom->SetCustomTickPositions(ticks);
+    }
+  }
   // vertical markers: one dashed two-point line each, one legend entry for all of them
   if (!spec.markers.empty() && ylo <= yhi) {
     bool first = true;

@@ -25,6 +25,8 @@ struct ChartSpec {
   std::string title, x_title, y_title;
   // Log axes plot log10 of the values (titled "log10 ..."); values <= 0 are skipped.
   bool log_x = false, log_y = false;
+  // x is a whole number (iterations, seeds): ticks on whole numbers only
+  bool integer_x = false;
   std::vector<ChartSeries> series;
   // Vertical dashed lines at these x (e.g. the times of contact events), named in the legend.
   std::vector<double> markers;

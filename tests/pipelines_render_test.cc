@@ -13,6 +13,10 @@
 // baselines after an intended change: WOBBLE_UPDATE_BASELINES=1 xvfb-run -a -s "-screen 0
 // 1280x1024x24" build/tests/pipelines_render_test, then look at every image before committing.
 #include <gtest/gtest.h>
+#include <vtkAxis.h>
+#include <vtkChartLegend.h>
+#include <vtkChartXY.h>
+#include <vtkDoubleArray.h>
 #include <vtkImageData.h>
 #include <vtkPNGReader.h>
 
@@ -59,6 +63,31 @@ vtkSmartPointer<vtkImageData> RenderLayer(const SceneOptions& options) {
   view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-100, 0), Eigen::Vector2d(400, 350)));
   view.Render();
   return view.Capture();
+}
+
+// Iterations and seeds: ticks on whole numbers only (1, 2 or 5 times a power of ten apart);
+// a chart for a file keeps its legend beside the plot, where it cannot cover a curve.
+TEST(Charts, WholeNumberTicksAndALegendBesideThePlot) {
+  ChartSpec spec;
+  ChartSeries s;
+  for (int i = 0; i <= 60; ++i) s.x.push_back(i), s.y.push_back(1.0 / (1 + i));
+  spec.series = {s};
+  spec.integer_x = true;
+  auto chart = vtkSmartPointer<vtkChartXY>::New();
+  FillChart(chart, spec);
+  vtkDoubleArray* ticks = chart->GetAxis(vtkAxis::BOTTOM)->GetTickPositions();
+  ASSERT_NE(ticks, nullptr);
+  ASSERT_EQ(ticks->GetNumberOfTuples(), 7);  // 0, 10, ..., 60
+  for (vtkIdType k = 0; k < ticks->GetNumberOfTuples(); ++k) EXPECT_EQ(ticks->GetValue(k), 10.0 * double(k));
+  EXPECT_TRUE(chart->GetLegend()->GetInline());  // FillChart's default, for the viewer's small panels
+  spec.series[0].x = {1, 2, 3, 4, 5, 6};
+  spec.series[0].y = {1, 2, 3, 4, 5, 6};
+  spec.legend_beside = true;
+  FillChart(chart, spec);
+  ticks = chart->GetAxis(vtkAxis::BOTTOM)->GetTickPositions();
+  ASSERT_EQ(ticks->GetNumberOfTuples(), 6);  // 1 ... 6, no 1.5
+  for (vtkIdType k = 0; k < ticks->GetNumberOfTuples(); ++k) EXPECT_EQ(ticks->GetValue(k), double(k + 1));
+  EXPECT_FALSE(chart->GetLegend()->GetInline());
 }
 
 TEST(RenderRegression, LatticeView) {
