@@ -105,22 +105,15 @@ for name, prefix in [("1 process", []), ("mpirun -np 2", mpi(2)), ("mpirun -np 3
     expect(r.returncode == 0, f"condition sweep --map on {name}: exit 0")
     if os.path.exists(os.path.join(out, "map.csv")):
         maps[name] = open(os.path.join(out, "map.csv"), "rb").read()
-    fit = os.path.join(work, "fit_" + name.replace(" ", "_") + ".json")
-    r = run(prefix + [wobble, "fit", "pose", "--object", os.path.join(data, "pot3.obj"), "--modes",
-                      os.path.join(data, "pot3_modes.def3"), "--targets", os.path.join(data, "pot3_scan.tgt"),
-                      "--out", fit])
-    expect(r.returncode == 0, f"3D surface fit on {name}: exit 0")
-    if os.path.exists(fit):
-        j = json.load(open(fit))
-        fits[name] = (j["q"], j["rms_residual"])
-    curve = os.path.join(work, "curve_" + name.replace(" ", "_") + ".json")
-    r = run(prefix + [wobble, "fit", "pose", "--object", os.path.join(data, "table.obj"), "--modes",
-                      os.path.join(data, "table_modes.def"), "--targets", os.path.join(data, "table_curve.tgt"),
-                      "--out", curve])
-    expect(r.returncode == 0, f"2D curve fit on {name}: exit 0")
-    if os.path.exists(curve):
-        j = json.load(open(curve))
-        curves[name] = (j["q"], j["rms_residual"])
+    for kind, files, results in [("3D surface fit", ("pot3.obj", "pot3_modes.def3", "pot3_scan.tgt"), fits),
+                                 ("2D curve fit", ("table.obj", "table_modes.def", "table_curve.tgt"), curves)]:
+        fit = os.path.join(work, kind.replace(" ", "_") + "_" + name.replace(" ", "_") + ".json")
+        obj, modes, targets = (os.path.join(data, f) for f in files)
+        r = run(prefix + [wobble, "fit", "pose", "--object", obj, "--modes", modes, "--targets", targets, "--out", fit])
+        expect(r.returncode == 0, f"{kind} on {name}: exit 0")
+        if os.path.exists(fit):
+            j = json.load(open(fit))
+            results[name] = (j["q"], j["rms_residual"])
 expect(len(maps) == 3 and len(set(maps.values())) == 1 and maps["1 process"].count(b"\n") == 24 * 24 + 1,
        "the condition map (24 x 24) is the same file on 1 process and on 2 and 3 ranks")
 expect(len(fits) == 3 and all(f == fits["1 process"] for f in fits.values()),
@@ -137,11 +130,6 @@ r = run(long_study[:-1] + [ref_out, "--threads", "2"])
 expect(r.returncode == 0, "the longer study on one process: exit 0")
 expect("200 ok" in r.stdout, "every case of the longer study ran (whole seeds from seed=1:200:200)")
 reference_rows = {row["case"]: row for row in csv.DictReader(open(os.path.join(ref_out, "sweep.csv")))}
-proc = subprocess.Popen(mpi(3) + long_study, cwd=work, env=env, stdout=subprocess.PIPE,
-                        stderr=subprocess.STDOUT, text=True, start_new_session=True)
-partial = os.path.join(out, "sweep.csv.partial")
-
-
 def rows_in(path):
     try:
         return list(csv.DictReader(open(path)))
@@ -164,50 +152,45 @@ def rank_pid(rank):
     return None
 
 
-deadline = time.time() + 120
-while time.time() < deadline and len(rows_in(partial)) < 4 and proc.poll() is None:
-    time.sleep(0.05)
-victim = rank_pid(2)
-expect(victim is not None and len(rows_in(partial)) >= 4, "rank 2 found while the study runs, rows reaching disk")
-if victim:
-    os.kill(victim, signal.SIGKILL)
-try:
-    text, _ = proc.communicate(timeout=120)
-except subprocess.TimeoutExpired:
-    os.killpg(proc.pid, signal.SIGKILL)
-    text, _ = proc.communicate()
-    expect(False, "mpirun ends within 120 s of a killed rank")
-print(text[-1500:])
-expect(proc.returncode != 0, f"a killed rank ends the run non-zero (got {proc.returncode})")
-expect("rank 2" in text, "the message names the killed rank")
-expect("finished rows are in " + partial in text, "rank 0 says where the finished rows are")
-kept = rows_in(partial)
-expect(len(kept) >= 4, f"the rows finished before are on disk ({len(kept)} in sweep.csv.partial)")
-expect(all(row == reference_rows.get(row["case"]) for row in kept),
-       "every kept row equals the same case's row on one process")
-expect(not os.path.exists(os.path.join(out, "sweep.csv")) or len(kept) == 200, "no complete table is claimed")
+def stopped_midway(ranks, out, stop, what):
+    """Runs the long study on `ranks` ranks into `out`, calls stop(proc) once 4 rows are on disk,
+    and checks what a stopped study must leave: a non-zero exit, rank 0 saying where the rows
+    are, and those rows equal to the 1-process run's. Returns mpirun's output."""
+    partial = os.path.join(out, "sweep.csv.partial")
+    proc = subprocess.Popen(mpi(ranks) + long_study[:-1] + [out], cwd=work, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and len(rows_in(partial)) < 4 and proc.poll() is None:
+        time.sleep(0.05)
+    expect(proc.poll() is None and len(rows_in(partial)) >= 4, f"{what}: rows reach disk while the study runs")
+    stop(proc)
+    try:
+        text, _ = proc.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        text, _ = proc.communicate()
+        expect(False, f"{what}: mpirun ends within 120 s")
+    print(text[-1500:])
+    kept = rows_in(partial)
+    expect(proc.returncode != 0, f"{what}: the run ends non-zero (got {proc.returncode})")
+    expect("finished rows are in " + partial in text, f"{what}: rank 0 says where the finished rows are")
+    expect(len(kept) >= 4 and all(row == reference_rows.get(row["case"]) for row in kept),
+           f"{what}: the finished rows ({len(kept)}) are on disk and equal the same cases' rows on one process")
+    expect(not os.path.exists(os.path.join(out, "sweep.csv")), f"{what}: no complete table is claimed")
+    return text
 
-# --- Ctrl-C: mpirun passes it on as SIGTERM to every rank ---------------------------------
-out = os.path.join(work, "ctrl_c")
-partial = os.path.join(out, "sweep.csv.partial")
-proc = subprocess.Popen(mpi(2) + long_study[:-1] + [out], cwd=work, env=env, stdout=subprocess.PIPE,
-                        stderr=subprocess.STDOUT, text=True, start_new_session=True)
-deadline = time.time() + 120
-while time.time() < deadline and len(rows_in(partial)) < 4 and proc.poll() is None:
-    time.sleep(0.05)
-proc.send_signal(signal.SIGINT)
-try:
-    text, _ = proc.communicate(timeout=120)
-except subprocess.TimeoutExpired:
-    os.killpg(proc.pid, signal.SIGKILL)
-    text, _ = proc.communicate()
-    expect(False, "mpirun ends within 120 s of Ctrl-C")
-kept = rows_in(partial)
-print(text[-1500:])
-expect(proc.returncode != 0, f"Ctrl-C ends the run non-zero (got {proc.returncode})")
-expect("finished rows are in " + partial in text, "rank 0 says where the finished rows are after Ctrl-C")
-expect(len(kept) >= 4 and all(row == reference_rows.get(row["case"]) for row in kept),
-       f"after Ctrl-C the finished rows ({len(kept)}) are on disk and equal the 1-process rows")
+
+def kill_rank_2(proc):
+    victim = rank_pid(2)
+    expect(victim is not None, "rank 2's process is found")
+    if victim:
+        os.kill(victim, signal.SIGKILL)
+
+
+text = stopped_midway(3, os.path.join(work, "killed"), kill_rank_2, "a killed rank")
+expect("rank 2" in text, "a killed rank: mpirun's message names it")
+# Ctrl-C: mpirun passes it on as SIGTERM to every rank
+stopped_midway(2, os.path.join(work, "ctrl_c"), lambda proc: proc.send_signal(signal.SIGINT), "Ctrl-C")
 
 if failures:
     print(f"{len(failures)} check(s) failed")

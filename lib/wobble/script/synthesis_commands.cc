@@ -63,6 +63,23 @@ void CheckTrialWork(const State& s, double trials, const std::string& what) {
                what + " (trials x trial_steps, in steps)", "raise it with `set max_steps N`, or lower trial_steps");
 }
 
+using Observer = std::function<void(const synth::IterationRecord&)>;
+
+// One optimisation with the progress bar, or with `set restarts N` the best of N from seeds
+// seed, seed + 1, ... on threads and ranks (synth::BestOfRestarts; no progress from inside).
+template <class Options, class Run>
+synth::AnnealResult Optimise(const State& s, const Options& o, int rounds, Run run) {
+  if (s.restarts > 1)
+    return synth::BestOfRestarts(s.restarts, [&](int k) {
+      Options restart = o;
+      restart.seed = o.seed + std::uint64_t(k);
+      return run(restart, Observer());
+    });
+  return run(o, [&](const synth::IterationRecord& rec) {
+    if (s.progress) s.progress(rounds ? double(rec.iteration) / rounds : 1.0, rec.best);
+  });
+}
+
 synth::Problem StartOptimising(State& s) {
   const synth::Problem problem = MakeProblem(s, s.trial_steps);
   s.scene.control().graph.cyclic = true;
@@ -100,16 +117,9 @@ void Anneal(State& s, const Words& w, const Context& ctx) {
   if (!invalid.empty()) ctx.Fail("anneal: " + invalid);
   CheckTrialWork(s, (double(iterations) * double(o.batch) + 1.0) * s.restarts, "anneal's work");
   const synth::Problem problem = StartOptimising(s);
-  synth::AnnealResult r =
-      s.restarts > 1 ? synth::BestOfRestarts(s.restarts,
-                                             [&](int k) {
-                                               synth::AnnealOptions ok = o;
-                                               ok.seed = o.seed + std::uint64_t(k);
-                                               return synth::Anneal(problem, s.scene.control().graph, ok);
-                                             })
-                     : synth::Anneal(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
-                         if (s.progress) s.progress(iterations ? double(rec.iteration) / iterations : 1.0, rec.best);
-                       });
+  synth::AnnealResult r = Optimise(s, o, iterations, [&](const synth::AnnealOptions& ok, const Observer& observe) {
+    return synth::Anneal(problem, s.scene.control().graph, ok, observe);
+  });
   AdoptOrStop(s, std::move(r), s.anneal_csv, "simulated annealing", "anneal", "iteration", iterations);
 }
 
@@ -135,16 +145,9 @@ void Cmaes(State& s, const Words& w, const Context& ctx) {
   if (!invalid.empty()) ctx.Fail("cmaes: " + invalid + " (the population is `batch`)");
   CheckTrialWork(s, (double(generations) + 1.0) * double(o.population) * s.restarts, "cmaes' work");
   const synth::Problem problem = StartOptimising(s);
-  synth::AnnealResult r =
-      s.restarts > 1 ? synth::BestOfRestarts(s.restarts,
-                                             [&](int k) {
-                                               synth::CmaesOptions ok = o;
-                                               ok.seed = o.seed + std::uint64_t(k);
-                                               return synth::Cmaes(problem, s.scene.control().graph, ok);
-                                             })
-                     : synth::Cmaes(problem, s.scene.control().graph, o, [&](const synth::IterationRecord& rec) {
-                         if (s.progress) s.progress(generations ? double(rec.iteration) / generations : 1.0, rec.best);
-                       });
+  synth::AnnealResult r = Optimise(s, o, generations, [&](const synth::CmaesOptions& ok, const Observer& observe) {
+    return synth::Cmaes(problem, s.scene.control().graph, ok, observe);
+  });
   AdoptOrStop(s, std::move(r), s.cmaes_csv, "CMA-ES", "cmaes", "generation", generations);
 #else
   (void)generations;
