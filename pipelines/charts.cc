@@ -187,6 +187,26 @@ void FillChart(vtkChartXY* chart, const ChartSpec& spec) {
       bottom->SetCustomTickPositions(ticks);
     }
   }
+  // a marker at the end of the data (a sweep's singular last sample) would lie on the plot's
+  // border: the x range then reaches 3 % past it
+  bottom->SetBehavior(vtkAxis::AUTO);
+  if (!spec.markers.empty() && !spec.log_x) {
+    double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo;
+    for (const ChartSeries& s : spec.series)
+      for (double v : s.x)
+        if (std::isfinite(v)) xlo = std::min(xlo, v), xhi = std::max(xhi, v);
+    bool at_an_end = false;
+    for (double m : spec.markers)
+      if (std::isfinite(m) && (m <= xlo || m >= xhi)) {
+        at_an_end = true;
+        xlo = std::min(xlo, m), xhi = std::max(xhi, m);
+      }
+    if (at_an_end && xlo < xhi) {
+      const double pad = 0.03 * (xhi - xlo);
+      bottom->SetBehavior(vtkAxis::FIXED);
+      bottom->SetRange(xlo - pad, xhi + pad);
+    }
+  }
   // vertical markers: one dashed two-point line each, one legend entry for all of them
   if (!spec.markers.empty() && ylo <= yhi) {
     bool first = true;

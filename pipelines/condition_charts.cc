@@ -22,12 +22,17 @@ ChartSpec SweepChart(const std::vector<analysis::SweepSample>& samples) {
   // the closeness itself.
   scaled.name = "cond(S M S), S = diag(M)^-1/2";
   for (const analysis::SweepSample& s : samples) {
-    if (s.cond.singular) continue;
+    // a singular M has no finite cond to plot: a dashed line marks where, named in the legend
+    if (s.cond.singular) {
+      spec.markers.push_back(Deg(s.phi));
+      continue;
+    }
     raw.x.push_back(Deg(s.phi));
     raw.y.push_back(s.cond.cond);
     scaled.x.push_back(Deg(s.phi));
     scaled.y.push_back(s.cond.cond_scaled);
   }
+  spec.markers_name = "M singular: the two modes coincide";
   spec.series = {raw, scaled};
   return spec;
 }
