@@ -3,7 +3,8 @@
 // rank 0 in chunks as ranks ask for work (guided self-scheduling, so cases of very different
 // cost keep every rank busy), run on each rank's threads, and gathered back to every rank.
 //
-// Rank 0 computes too: one thread of it answers the other ranks while the rest run items.
+// Below 48 ranks rank 0 computes too: one thread of it answers the other ranks while the rest
+// run items; from 48 on it only deals (the crossover of bench/mpi_scaling_model.py).
 // Nothing waits in a spinning MPI call: waits poll and sleep, so ranks oversubscribed on a
 // few cores (`--oversubscribe`) leave the CPU to the ranks that compute.
 #pragma once
