@@ -108,7 +108,10 @@ TEST(Sweep, EveryCaseIsARowAndTheTableDoesNotDependOnTheThreads) {
   EXPECT_EQ(one.header, (std::vector<std::string>{"case", "seed", "frsin", "iterations", "trial_steps", "status", "cost",
                                                   "trials", "distance", "q", "qd", "time", "message"}));
   ASSERT_EQ(one.rows.size(), 5u);
-  for (size_t i = 0; i < one.rows.size(); ++i) EXPECT_EQ(one.rows[i][0], std::to_string(i));
+  for (size_t i = 0; i < one.rows.size(); ++i) {
+    EXPECT_EQ(one.rows[i][0], std::to_string(i));
+    EXPECT_EQ(one.rows[i].size(), one.header.size()) << "row " << i;  // failed cases too
+  }
   // frsin -1 is refused by `set`: that case is a row saying so, with the script's line
   EXPECT_EQ(one.rows[1][5], "bad input");
   EXPECT_NE(one.rows[1].back().find("sweep_bounding.wob:"), std::string::npos) << one.rows[1].back();

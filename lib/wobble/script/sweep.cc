@@ -57,15 +57,24 @@ std::string ReadScript(const std::string& path) {
   });
 }
 
+// The status word of a case that threw, by the exit-code classes of core/errors.h.
+std::string CaseStatus(const std::exception& e) {
+  if (dynamic_cast<const Interrupted*>(&e)) return "interrupted";
+  if (dynamic_cast<const NumericalStop*>(&e)) return "numerical stop";
+  if (dynamic_cast<const formats::ParseError*>(&e) || dynamic_cast<const std::invalid_argument*>(&e))
+    return "bad input";
+  return "failed";
+}
+
 // One case: the script with the case's values, then the measures. Never throws: a failure is
 // the row's status and message.
 std::vector<std::string> RunCase(const SweepOptions& o, const std::string& text, size_t index) {
   const std::vector<std::string>& values = o.plan.cases[index];
   std::vector<std::string> row{std::to_string(index)};
   row.insert(row.end(), values.begin(), values.end());
-  std::vector<std::string> cells;
-  for (const std::string& m : o.measures)
-    for (size_t k = 0; k < MeasureColumns(m).size(); ++k) cells.push_back("");
+  size_t width = 0;
+  for (const std::string& m : o.measures) width += MeasureColumns(m).size();
+  std::vector<std::string> cells(width);
   auto finish = [&](const std::string& status, const std::string& message) {
     row.push_back(status);
     row.insert(row.end(), cells.begin(), cells.end());
@@ -110,21 +119,10 @@ std::vector<std::string> RunCase(const SweepOptions& o, const std::string& text,
       }
     }
     return finish(kCaseOk, "");
-  } catch (const formats::ParseError& e) {
-    cells.assign(cells.size(), "");
-    return finish("bad input", e.what());
-  } catch (const Interrupted& e) {
-    cells.assign(cells.size(), "");
-    return finish("interrupted", e.what());
-  } catch (const std::invalid_argument& e) {
-    cells.assign(cells.size(), "");
-    return finish("bad input", e.what());
-  } catch (const NumericalStop& e) {
-    cells.assign(cells.size(), "");
-    return finish("numerical stop", e.what());
   } catch (const std::exception& e) {
-    cells.assign(cells.size(), "");
-    return finish("failed", e.what());
+    // the row's width whatever measure failed: every measure's cells empty
+    cells.assign(width, "");
+    return finish(CaseStatus(e), e.what());
   }
 }
 
