@@ -101,6 +101,29 @@ long CheckRunLimits(double duration, double dt, long every, int columns, const L
   return steps;
 }
 
+// The words of a list separated by commas and/or white space.
+std::vector<std::string> ListWords(const std::string& text) {
+  std::string t = text;
+  for (char& c : t)
+    if (c == ',') c = ' ';
+  std::istringstream in(t);
+  std::vector<std::string> words;
+  for (std::string word; in >> word;) words.push_back(word);
+  return words;
+}
+
+std::vector<double> ParseNumbers(const std::string& text, const std::string& flag) {
+  std::vector<double> out;
+  for (const std::string& word : ListWords(text)) {
+    char* end = nullptr;
+    const double v = std::strtod(word.c_str(), &end);
+    if (end == word.c_str() || *end != '\0' || !std::isfinite(v))
+      throw UsageError(flag + ": '" + word + "' is not a finite number");
+    out.push_back(v);
+  }
+  return out;
+}
+
 void AddWorldFlags(CLI::App* cmd, WorldFlags* f) {
   cmd->add_flag("--no-gravity", f->no_gravity, "Switch gravity off (default: g = 9.81 along -y)");
   cmd->add_flag("--no-ground", f->no_ground, "No ground at all");
@@ -122,6 +145,10 @@ void AddWorldFlags(CLI::App* cmd, WorldFlags* f) {
   cmd->add_option("--friction-cap", f->friction_cap, "Largest |friction / normal force| (frsin)")
       ->type_name("TAN")
       ->capture_default_str();
+  cmd->add_option("--terrain", f->terrain,
+                  "A terrain in place of the ground line: its profile through these points, left to right, solid "
+                  "below (two at the same x: a cliff); the ground flags above are its faces' parameters")
+      ->type_name("\"X1 Y1 X2 Y2 ..\"");
 }
 
 WorldParams MakeWorldParams(const WorldFlags& f) {
@@ -141,6 +168,18 @@ WorldParams MakeWorldParams(const WorldFlags& f) {
   p.ground.normal_damping = f.ground_damping;
   p.ground.friction_damping = f.friction_damping;
   p.ground.friction_cap = f.friction_cap;
+  if (!f.terrain.empty()) {
+    const std::vector<double> xy = ParseNumbers(f.terrain, "--terrain");
+    if (xy.size() < 4 || xy.size() % 2) throw UsageError("--terrain: expected pairs X Y, at least two, got " +
+                                                         std::to_string(xy.size()) + " numbers");
+    std::vector<Eigen::Vector2d> vertices;
+    for (size_t i = 0; i + 1 < xy.size(); i += 2) vertices.emplace_back(xy[i], xy[i + 1]);
+    try {
+      p.ground.terrain = Terrain::Make(std::move(vertices));
+    } catch (const InputError& e) {
+      throw UsageError(std::string("--terrain: ") + e.what());
+    }
+  }
   return p;
 }
 

@@ -58,6 +58,7 @@ struct WorldFlags {
   double ground_damping = Ground().normal_damping;
   double friction_damping = Ground().friction_damping;
   double friction_cap = Ground().friction_cap;
+  std::string terrain;  // "X1 Y1 X2 Y2 ...": a terrain profile in place of the line (2D)
 };
 void AddWorldFlags(CLI::App* cmd, WorldFlags* flags);
 // Validates the flags (finite, non-negative where it matters) and fills the params.
@@ -101,6 +102,10 @@ Integrator ParseIntegratorFlag(const std::string& name);
 std::string CoordinateNames(const BodyModel& body);
 std::string CoordinateNames3(const BodyModel3& body);
 std::string VelocityNames3(const BodyModel3& body);
+// The words of a list separated by commas and/or white space.
+std::vector<std::string> ListWords(const std::string& text);
+// Every word of such a list as a finite number (a UsageError naming `flag` otherwise).
+std::vector<double> ParseNumbers(const std::string& text, const std::string& flag);
 // Parses `expected_size` numbers (names: what they are, for messages); empty text gives zeros.
 Eigen::VectorXd ParseNumbers(const std::string& text, const std::string& what, int expected_size,
                              const std::string& names, const std::string& body_name);

@@ -35,29 +35,6 @@ Size ParseSize(const std::string& text, const std::string& flag) {
   return s;
 }
 
-// The words of a list separated by commas and/or white space.
-std::vector<std::string> ListWords(const std::string& text) {
-  std::string t = text;
-  for (char& c : t)
-    if (c == ',') c = ' ';
-  std::istringstream in(t);
-  std::vector<std::string> words;
-  for (std::string word; in >> word;) words.push_back(word);
-  return words;
-}
-
-std::vector<double> ParseNumbers(const std::string& text, const std::string& flag) {
-  std::vector<double> out;
-  for (const std::string& word : ListWords(text)) {
-    char* end = nullptr;
-    const double v = std::strtod(word.c_str(), &end);
-    if (end == word.c_str() || *end != '\0' || !std::isfinite(v))
-      throw UsageError(flag + ": '" + word + "' is not a finite number");
-    out.push_back(v);
-  }
-  return out;
-}
-
 std::set<std::string> ParseWhat(const std::string& text) {
   const std::vector<std::string> words = ListWords(text);
   pl::RenderOutputs probe;
@@ -117,6 +94,12 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
       ->capture_default_str();
   cmd->add_option("--orbit", a->orbit, "3D: the camera orbits the motion at this many degrees per simulated second")
       ->capture_default_str();
+  cmd->add_option("--camera", a->camera, "2D: whole (frame the whole run, standing still) or follow (the body, smoothed, "
+                                        "the ground under it in view)")
+      ->capture_default_str();
+  cmd->add_option("--style", a->style, "diagnostic (lattice, mass points, shape) or clean (the character: filled, "
+                                      "anti-aliased, no lattice or points)")
+      ->capture_default_str();
   cmd->add_option("--trail", a->trail, "Trace points given by lattice coordinates \"s t s t ..\" in the frames")
       ->type_name("\"S T ..\"");
   return cmd;
@@ -166,6 +149,9 @@ void CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
   RequireFinite(a.azimuth, "--azimuth");
   RequireFinite(a.orbit, "--orbit");
   if (!(std::abs(a.elevation) < 90.0)) throw UsageError("--elevation must be between -90 and 90 degrees");
+  if (a.camera != "whole" && a.camera != "follow") throw UsageError("--camera: expected whole or follow, got '" + a.camera + "'");
+  if (a.style != "diagnostic" && a.style != "clean")
+    throw UsageError("--style: expected diagnostic or clean, got '" + a.style + "'");
   const bool renders = what.count("frames") || what.count("filmstrip") || what.count("charts") || what.count("exr");
   if (renders && !pl::HasDisplay())
     throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"
@@ -207,6 +193,8 @@ pl::RenderOutputs RenderOutputsOf(const RenderArgs& a, const std::string& defaul
   out.view.azimuth = a.azimuth;
   out.view.elevation = a.elevation;
   out.orbit_deg_per_s = a.orbit;
+  out.camera = a.camera == "follow" ? pl::RenderOutputs::Camera::kFollow : pl::RenderOutputs::Camera::kWhole;
+  out.view.style = a.style == "clean" ? pl::RenderStyle::kClean : pl::RenderStyle::kDiagnostic;
   return out;
 }
 

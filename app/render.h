@@ -44,6 +44,8 @@ struct RenderArgs {
   std::string trail;                // lattice coords "s t s t ..." of points to trace
   double azimuth = 30.0, elevation = 20.0;  // 3D camera, degrees
   double orbit = 0.0;               // 3D camera turn, degrees per simulated second
+  std::string camera = "whole";     // 2D: whole (the run framed once) or follow
+  std::string style = "diagnostic"; // diagnostic (lattice, mass points) or clean (the character only)
   Limits limits;
 };
 

@@ -117,6 +117,25 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       world.SetState(body, q, qd);
       world.SetModeTargets(body, targets);
     }
+    // a terrain in place of the line, from the bytes after the state (older inputs have none):
+    // up to six vertices, cliffs (equal x) included, each segment maybe with its own parameters
+    if (in.Byte() & 1) {
+      std::vector<Eigen::Vector2d> vertices;
+      std::vector<SurfaceOverrides> faces;
+      double x = in.Value(-600, 600);
+      const int nv = in.Int(2, 6);
+      for (int i = 0; i < nv; ++i) {
+        vertices.emplace_back(x, in.Value(-100, 400));
+        x += (in.Byte() & 1) ? 0.0 : in.Value(0, 400);
+      }
+      for (int i = 0; i + 1 < nv; ++i) {
+        SurfaceOverrides f;
+        if (in.Byte() & 1) f.stiffness = in.Value(0, 1e5);
+        if (in.Byte() & 1) f.friction_cap = in.Value(0, 2);
+        faces.push_back(f);
+      }
+      world.mutable_options().params.ground.terrain = Terrain::Make(vertices, faces);  // may refuse: InputError
+    }
     for (int n = 0; n < steps; ++n) {
       if (!world.Step()) {
         if (world.status().ok() || StatusCodeName(world.status().code).empty())

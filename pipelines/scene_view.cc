@@ -22,6 +22,7 @@
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
 #include <vtkTextActor.h>
+#include <vtkTriangleFilter.h>
 #include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
@@ -145,7 +146,10 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
   Impl& m = *impl_;
   m.world = world;
   m.z_scale = IsFlat(*world) ? 1.0 : 0.0;
+  const bool clean = options_.style == RenderStyle::kClean;
+  if (clean) options_.show_lattice = options_.show_points = false;
   SetUpWindow();
+  if (clean) m.renderer->UseFXAAOn();  // anti-aliased lines and edges, offscreen too
 
   const double ground_rgb[3] = {0.55, 0.47, 0.38}, lattice_rgb[3] = {0.45, 0.6, 0.85}, shape_rgb[3] = {0.1, 0.1, 0.1},
                surface_rgb[3] = {0.95, 0.75, 0.35}, points_rgb[3] = {0.85, 0.2, 0.15}, spring_rgb[3] = {0.2, 0.6, 0.2},
@@ -201,9 +205,18 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
     lattice_mappers.push_back(vtkPolyDataMapper::SafeDownCast(
         m.Add(SceneLayer::kLattice, on(m.lattices[b], b), lattice_rgb, 1.0, options_.point_size * 0.75, 1)->GetMapper()));
     if (world->kind(b) == BodyKind::kFfd) {
+      if (clean) {  // closed outlines filled under the lines; VTK fans polygons, so triangulated
+        auto fill = Ptr<ShapeSource>::New();
+        fill->SetSamplesPerSegment(options_.shape_samples);
+        fill->SetFillClosed(true);
+        auto triangles = Ptr<vtkTriangleFilter>::New();
+        triangles->SetInputConnection(on(fill, b)->GetOutputPort());
+        m.Add(SceneLayer::kShape, fill, surface_rgb, 1.0, 1.0, 1.5)->GetMapper()->SetInputConnection(
+            triangles->GetOutputPort());
+      }
       auto shape = Ptr<ShapeSource>::New();
       shape->SetSamplesPerSegment(options_.shape_samples);
-      m.Add(SceneLayer::kShape, on(shape, b), shape_rgb, options_.line_width, 1.0, 2);
+      m.Add(SceneLayer::kShape, on(shape, b), shape_rgb, clean ? 2.0 * options_.line_width : options_.line_width, 1.0, 2);
     } else if (world->kind(b) == BodyKind::kFfd3) {
       // the mesh as a lit surface (flat-shaded facets), and the polylines over it
       auto surface = Ptr<ShapeSource>::New();

@@ -30,8 +30,13 @@ namespace wobble::pipelines {
 // render, even offscreen, and aborts the process without it). Checked once per process.
 bool HasDisplay();
 
+// kDiagnostic draws what the simulation works with (lattice, mass points, shape); kClean only
+// the character, as a picture: closed outlines filled, thicker anti-aliased lines (FXAA).
+enum class RenderStyle { kDiagnostic, kClean };
+
 struct SceneOptions {
   int width = 640, height = 480;
+  RenderStyle style = RenderStyle::kDiagnostic;  // kClean hides the lattice and the mass points
   bool show_ground = true, show_lattice = true, show_points = true, show_shape = true, show_springs = true,
        show_trails = false;
   // Colour the mass points by one of their arrays: "mass", "velocity", "applied_force" (vectors

@@ -12,6 +12,7 @@
 #include <vtkSmartPointer.h>
 
 #include "pipelines/background_writer.h"
+#include "pipelines/follow_camera.h"
 #include "pipelines/energy_charts.h"
 #include "pipelines/exports.h"
 
@@ -153,6 +154,18 @@ void WriteCharts(const record::Trajectory& run, const RenderOutputs& out, Render
   }
 }
 
+// The follow camera's view of the world now: its bodies' box and the ground under its centre.
+FollowMoment FollowMomentNow(const World& world, const Eigen::AlignedBox3d& bodies) {
+  FollowMoment m;
+  m.t = world.time();
+  m.body = Eigen::AlignedBox2d(bodies.min().head<2>(), bodies.max().head<2>());
+  const Ground& g = world.options().params.ground;
+  const double x = m.body.center().x();
+  if (g.enabled && g.terrain) m.ground_height = g.terrain->HeightAt(x);
+  else if (g.enabled) m.ground_height = g.point.y() + std::tan(g.slope) * (x - g.point.x());
+  return m;
+}
+
 }  // namespace
 
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out) {
@@ -231,6 +244,9 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
 
   // the camera's pass: the box of every drawn state (and the ground below it), the colour range
   Eigen::AlignedBox3d motion;
+  const bool follow = out.camera == RenderOutputs::Camera::kFollow && IsFlat(world);
+  std::vector<FollowMoment> moments;
+  std::vector<Eigen::AlignedBox2d> follow_boxes;  // per visit
   const bool orbit = out.orbit_deg_per_s != 0.0 && !IsFlat(world);
   if (view || strip_view) {
     double lo = 1e300, hi = -1e300;
@@ -238,12 +254,23 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     Replay replay(run, &world);
     for (const Visit& v : visits) {
       replay.To(v.sample);
-      motion.extend(SceneBounds(world, spec));
+      const Eigen::AlignedBox3d bodies = SceneBounds(world, spec);
+      motion.extend(bodies);
+      if (follow) moments.push_back(FollowMomentNow(world, bodies));
       double r[2];
       if (!fixed_range && (view ? view : strip_view)->ColorRangeNow(r)) {
         lo = std::min(lo, r[0]);
         hi = std::max(hi, r[1]);
       }
+    }
+    const std::shared_ptr<const Terrain>& terrain = world.options().params.ground.terrain;
+    if (terrain && HasFfdBody(world) && out.view.show_ground && !motion.isEmpty()) {
+      // the terrain under the motion in view: the cliff the body leaves, the floor it lands on
+      const double x0 = motion.min().x(), x1 = motion.max().x();
+      motion.extend(Eigen::Vector3d(x0, terrain->HeightAt(x0), 0.0));
+      motion.extend(Eigen::Vector3d(x1, terrain->HeightAt(x1), 0.0));
+      for (const Eigen::Vector2d& v : terrain->vertices())
+        if (v.x() >= x0 && v.x() <= x1) motion.extend(Eigen::Vector3d(v.x(), v.y(), 0.0));
     }
     if (HasFfdBody(world) && out.view.show_ground && !motion.isEmpty()) {
       // the ground seen below the bodies: a band under the lowest point
@@ -256,6 +283,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       v->FrameBounds(motion);
       if (lo < hi) v->SetColorRange(lo, hi);  // one colour scale for the whole run
     }
+    if (follow) follow_boxes = FollowBoxes(moments, {double(out.view.width) / out.view.height});
     world = caller;  // the writing pass replays the run from the start again
   }
   for (SceneView* v : {view.get(), strip_view.get()})
@@ -275,6 +303,11 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       break;
     }
     replay.To(v.sample);
+    if (!follow_boxes.empty()) {
+      const Eigen::AlignedBox2d& box = follow_boxes[size_t(&v - visits.data())];
+      for (SceneView* sv : {view.get(), strip_view.get()})
+        if (sv) sv->FrameBox(box, 0.0);
+    }
     if (v.frame < 0) {
       strip_view->Render();
       panels.push_back(strip_view->Capture());

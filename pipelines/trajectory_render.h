@@ -45,6 +45,9 @@ struct RenderOutputs {
   // The frames' view: size, colour by (a fixed colour_range, or the range over the frames),
   // shape samples, point size, title, 3D camera angles.
   SceneOptions view;
+  // 2D worlds: kWhole frames the whole run's motion once (the camera stands still); kFollow
+  // follows the bodies at one scale, smoothed, the ground under them in view (follow_camera.h).
+  enum class Camera { kWhole, kFollow } camera = Camera::kWhole;
   // 3D worlds: the camera orbits the motion's box at this many degrees per simulated second
   // (azimuth view.azimuth + rate (t − t0)), framing the whole motion from every side; 0: fixed.
   double orbit_deg_per_s = 0.0;

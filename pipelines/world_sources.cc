@@ -233,7 +233,6 @@ bool MassPointSource::DrawFfd(vtkPolyData* out) {
   const BodyState<double>& s = world_->state(Body);
   const WorldParams& params = world_->options().params;
   const Frame<double> frame(s.q);
-  const GroundFrame gf(params.ground);
   const int n = body.num_points();
 
   auto points = DoublePoints();
@@ -257,7 +256,8 @@ bool MassPointSource::DrawFfd(vtkPolyData* out) {
   if (params.ground.enabled) {
     for (const Contact<double>& c : s.contacts) {
       bool slipping;
-      f[c.point] += GroundForce(params.ground, gf, Vec2<double>(x[c.point]), Vec2<double>(v[c.point]), c.anchor, &slipping);
+      f[c.point] += GroundForce(params.ground.Face(c.face), Vec2<double>(x[c.point]), Vec2<double>(v[c.point]), c.anchor,
+                                &slipping);
       contact->SetValue(c.point, 1);
     }
   }
@@ -360,16 +360,22 @@ bool ShapeSource::DrawFfd(vtkPolyData* out) {
     points->SetPoint(k, x.x(), x.y(), 0.0);
     st_array->SetTuple2(k, sample_st_[k].x(), sample_st_[k].y());
   }
-  auto lines = Ptr<vtkCellArray>::New();
+  auto cells = Ptr<vtkCellArray>::New();
   vtkIdType first = 0;
   for (const auto& [count, closed] : polyline_sizes_) {
-    lines->InsertNextCell(count + (closed ? 1 : 0));
-    for (int k = 0; k < count; ++k) lines->InsertCellPoint(first + k);
-    if (closed) lines->InsertCellPoint(first);
+    if (FillClosed && closed) {
+      cells->InsertNextCell(count);
+      for (int k = 0; k < count; ++k) cells->InsertCellPoint(first + k);
+    } else if (!FillClosed) {
+      cells->InsertNextCell(count + (closed ? 1 : 0));
+      for (int k = 0; k < count; ++k) cells->InsertCellPoint(first + k);
+      if (closed) cells->InsertCellPoint(first);
+    }
     first += count;
   }
   out->SetPoints(points);
-  out->SetLines(lines);
+  if (FillClosed) out->SetPolys(cells);
+  else out->SetLines(cells);
   out->GetPointData()->AddArray(st_array);
   return true;
 }
@@ -417,6 +423,44 @@ void GroundSource::PrintSelf(ostream& os, vtkIndent indent) {
      << indent << "Length: " << Length << "\n" << indent << "Depth: " << Depth << "\n";
 }
 
+// A terrain over [Center.x ± Length/2]: its surface as one polyline, and below it one
+// trapezoid per non-vertical segment down to Depth under the lowest surface point (convex
+// cells: VTK fans polygons, so a whole non-convex profile would fill wrongly).
+int GroundSource::DrawTerrain(const Terrain& terrain, vtkPoints* points, vtkPolyData* out) {
+  const double x0 = Center[0] - 0.5 * Length, x1 = Center[0] + 0.5 * Length;
+  std::vector<Eigen::Vector2d> surface = {{x0, terrain.HeightAt(x0)}};
+  for (const Eigen::Vector2d& v : terrain.vertices())
+    if (v.x() > x0 && v.x() < x1) surface.push_back(v);
+  surface.push_back({x1, terrain.HeightAt(x1)});
+  double lowest = surface.front().y();
+  for (const Eigen::Vector2d& p : surface) lowest = std::min(lowest, p.y());
+  const double bottom = lowest - Depth;
+  const vtkIdType n = vtkIdType(surface.size());
+  auto height = Scalars("height", 2 * int(n));  // signed height above the surface
+  for (vtkIdType k = 0; k < n; ++k) {
+    points->InsertNextPoint(surface[k].x(), surface[k].y(), 0.0);
+    height->SetValue(k, 0.0);
+  }
+  for (vtkIdType k = 0; k < n; ++k) {
+    points->InsertNextPoint(surface[k].x(), bottom, 0.0);
+    height->SetValue(n + k, bottom - terrain.HeightAt(surface[k].x()));
+  }
+  auto polys = Ptr<vtkCellArray>::New();
+  for (vtkIdType k = 0; k + 1 < n; ++k) {
+    if (surface[k].x() == surface[k + 1].x()) continue;  // a cliff face: the neighbours fill it
+    const vtkIdType quad[4] = {k, k + 1, n + k + 1, n + k};
+    polys->InsertNextCell(4, quad);
+  }
+  auto lines = Ptr<vtkCellArray>::New();
+  lines->InsertNextCell(n);
+  for (vtkIdType k = 0; k < n; ++k) lines->InsertCellPoint(k);
+  out->SetPoints(points);
+  out->SetPolys(polys);
+  out->SetLines(lines);
+  out->GetPointData()->AddArray(height);
+  return 1;
+}
+
 int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
   if (!Check(Needs::kWorld)) return 0;
   vtkPolyData* out = OutputOf(out_vec);
@@ -447,6 +491,7 @@ int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
     out->SetPoints(points);
     return 1;
   }
+  if (g.terrain) return DrawTerrain(*g.terrain, points, out);
   // the surface segment around the ground point nearest Center, and a band below it
   const Eigen::Vector2d tau = g.tangent(), n = g.normal();
   const Eigen::Vector2d c(Center[0], Center[1]);

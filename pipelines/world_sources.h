@@ -33,7 +33,8 @@
 //   TrailSource      (FFD bodies) trajectories of chosen points (lattice coordinates): call
 //                    Record() after each frame; polylines with a point array time
 // Of the world (Body is not used):
-//   GroundSource     the ground line with its slope, as a filled band of given length and depth;
+//   GroundSource     the ground line with its slope, or the terrain's profile, as a filled band of
+//                    given length and depth;
 //                    with a 3D FFD body, the 3D ground plane: a square of side Length under
 //                    the 3D bodies' centre
 //   SpringSource     the world's springs as lines anchor → held point; cell array stretch
@@ -142,6 +143,9 @@ class ShapeSource : public BodyPartSource {
   }
   vtkSetMacro(Lines, bool);
   vtkSetMacro(Surface, bool);
+  // 2D FFD bodies: the closed polylines of the drawing as polygons (the clean style's fill)
+  // instead of every polyline as lines.
+  vtkSetMacro(FillClosed, bool);
 
  protected:
   ShapeSource() = default;
@@ -150,7 +154,7 @@ class ShapeSource : public BodyPartSource {
   bool DrawFfd3(vtkPolyData* out) override;
   int SamplesPerSegment = 16;
   LinearDrawing drawing_;
-  bool Lines = true, Surface = true;
+  bool Lines = true, Surface = true, FillClosed = false;
 
  private:
   // b0 and B of every sample (BodyModel::LocalBasis), cached per body and sample count:
@@ -180,6 +184,7 @@ class GroundSource : public WorldSourceBase {
  protected:
   GroundSource() = default;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int DrawTerrain(const Terrain& terrain, vtkPoints* points, vtkPolyData* out);
   double Center[2] = {0, 0};
   double Length = 2000.0, Depth = 100.0;
 };

@@ -232,8 +232,9 @@ TEST(Ground, GroupedScanVisitsExactlyThePointsBelowTheGround) {
       std::vector<int> visited, expected;
       const Frame<double> frame(s.q);
       ForEachPointInContact(body, g, s, frame, [&](int k, const Vec2<double>&, const Vec2<double>&,
-                                                   const Vec2<double>&, const Vec2<double>&) { visited.push_back(k); });
-      const GroundFrame gf(g);
+                                                   const Vec2<double>&, const Vec2<double>&, const GroundFace&,
+                                                   int) { visited.push_back(k); });
+      const GroundFace gf = g.Face(0);
       for (int k = 0; k < body.num_points(); ++k) {
         const Vec2<double> x = WorldFromLocal(frame, LocalPosition<double>(body.rest_local(k), body.mode_matrix(k), s.q));
         if (gf.Height(x) < 0.0) expected.push_back(k);

@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 #include <vtkDataArray.h>
+#include <vtkCellArray.h>
+#include <vtkIdList.h>
+#include <vtkNew.h>
 #include <vtkCamera.h>
 #include <vtkFieldData.h>
 #include <vtkImageData.h>
@@ -138,6 +141,50 @@ TEST(VtpExport, SeriesReadsBackThroughThePvdWithEveryPointAndArray) {
   vtkSmartPointer<vtkPolyData> points = ReadVtp(dir + "/table_points_0002.vtp");
   for (const char* name : {"mass", "velocity", "applied_force", "in_contact"})
     EXPECT_NE(points->GetPointData()->GetArray(name), nullptr) << name;
+  fs::remove_all(dir);
+}
+
+// A world with a terrain: the .pvd lists it as the last part at every time, one file (it does
+// not move) whose surface polyline passes through every vertex of the profile.
+TEST(VtpExport, TerrainIsItsOwnPartAtEveryTime) {
+  const std::string dir = TempDir("vtp_terrain");
+  WorldOptions o;
+  o.params.ground.terrain = Terrain::Make({{0, 100}, {0, 0}, {300, 0}, {400, 50}});
+  World world(o);
+  world.AddBody(testing::Table());
+  world.SetState(0, testing::Vec({-250, 140, 0, 0, 0, 0, 0}), testing::Vec({0, 0, 0, 0, 0, 0, 0}));
+  VtpSeriesWriter series(&world, dir, "cliff");
+  for (int frame = 0; frame < 3; ++frame) {
+    for (int k = 0; k < 5; ++k) ASSERT_TRUE(world.Step());
+    series.WriteFrame(frame);
+  }
+  vtkXMLDataElement* root = vtkXMLUtilities::ReadElementFromFile(series.WriteCollection().c_str());
+  ASSERT_NE(root, nullptr);
+  vtkXMLDataElement* collection = root->FindNestedElementWithName("Collection");
+  ASSERT_EQ(collection->GetNumberOfNestedElements(), 3 * 4);  // 3 times x (lattice, points, shape, terrain)
+  for (int e = 3; e < 12; e += 4) {
+    vtkXMLDataElement* ds = collection->GetNestedElement(e);
+    int part = -1;
+    ASSERT_TRUE(ds->GetScalarAttribute("part", part));
+    EXPECT_EQ(part, 3);
+    EXPECT_STREQ(ds->GetAttribute("file"), "terrain.vtp");
+    EXPECT_STREQ(ds->GetAttribute("name"), "terrain");
+  }
+  root->Delete();
+  vtkSmartPointer<vtkPolyData> terrain = ReadVtp(dir + "/terrain.vtp");
+  ASSERT_EQ(terrain->GetLines()->GetNumberOfCells(), 1);
+  vtkNew<vtkIdList> line;
+  terrain->GetLines()->GetCellAtId(0, line);
+  std::vector<Eigen::Vector2d> surface;
+  for (vtkIdType k = 0; k < line->GetNumberOfIds(); ++k) {
+    const double* p = terrain->GetPoint(line->GetId(k));
+    surface.emplace_back(p[0], p[1]);
+  }
+  for (const Eigen::Vector2d& v : o.params.ground.terrain->vertices())
+    EXPECT_NE(std::find(surface.begin(), surface.end(), v), surface.end()) << v.transpose();
+  // filled below: the level left of the cliff, the floor, the slope and the level beyond it
+  EXPECT_EQ(terrain->GetPolys()->GetNumberOfCells(), 4);
+  EXPECT_NE(terrain->GetPointData()->GetArray("height"), nullptr);
   fs::remove_all(dir);
 }
 

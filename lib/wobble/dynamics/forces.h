@@ -1,16 +1,19 @@
 // External and internal forces of a body as generalized forces Q = Σ Jᵀ f (Eq. 4.20):
 // gravity (§4.7), mode potentials V = K γ² with damping (§4.7), springs holding a point
-// (Fig. 4.4), and the penalty ground of §4.9 (Eq. 4.24, 4.25) on a line of any slope.
+// (Fig. 4.4), and the penalty ground of §4.9 (Eq. 4.24, 4.25) on a line of any slope or a
+// terrain of straight faces (terrain.h).
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <type_traits>
 #include <vector>
 
 #include "wobble/body/body_model.h"
 #include "wobble/dynamics/kinematics.h"
+#include "wobble/dynamics/terrain.h"
 
 namespace wobble {
 
@@ -27,22 +30,31 @@ struct Ground {
   // A point deeper than this stops the run (runaway penetration). 0 means automatic: half
   // the shorter lattice side of the body.
   double max_penetration = 0.0;
+  // A terrain of straight faces (terrain.h) in place of the line through `point`; the
+  // parameters above are those of every face that has none of its own.
+  std::shared_ptr<const Terrain> terrain;
 
   Eigen::Vector2d tangent() const { return {std::cos(slope), std::sin(slope)}; }
   Eigen::Vector2d normal() const { return {-std::sin(slope), std::cos(slope)}; }
   bool operator==(const Ground& o) const {
     return enabled == o.enabled && point == o.point && slope == o.slope && stiffness == o.stiffness &&
            normal_damping == o.normal_damping && friction_damping == o.friction_damping &&
-           friction_cap == o.friction_cap && max_penetration == o.max_penetration;
+           friction_cap == o.friction_cap && max_penetration == o.max_penetration &&
+           (terrain == o.terrain || (terrain && o.terrain && *terrain == *o.terrain));
   }
-};
-
-// The ground's unit normal and tangent, computed once per evaluation rather than per point.
-struct GroundFrame {
-  explicit GroundFrame(const Ground& g) : point(g.point), n(g.normal()), tau(g.tangent()) {}
-  // Signed height of x above the ground (negative below).
-  template <class T> T Height(const Vec2<T>& x) const { return n.cast<T>().dot(x - point.cast<T>()); }
-  Eigen::Vector2d point, n, tau;
+  // Face i of the ground (0 for the line) with its parameters resolved.
+  GroundFace Face(int i) const {
+    if (terrain) return terrain->Face(i, stiffness, normal_damping, friction_damping, friction_cap);
+    GroundFace f;
+    f.point = point;
+    f.n = normal();
+    f.tau = tangent();
+    f.stiffness = stiffness;
+    f.normal_damping = normal_damping;
+    f.friction_damping = friction_damping;
+    f.friction_cap = friction_cap;
+    return f;
+  }
 };
 
 // A damped spring from a world anchor to a point of a body given by lattice coordinates.
@@ -65,15 +77,20 @@ struct WorldParams {
   double max_condition = 1e12;
 };
 
-// A point below the ground is tied to its entry point `anchor` by the spring–damper unit of
-// Fig. 4.5(a) until it leaves the ground.
+// A point below the ground is tied to its entry point `anchor` on face `face` (0 for the
+// ground line; terrain.h says which faces of a terrain a point feels) by the spring–damper unit
+// of Fig. 4.5(a) until it leaves the ground. A point in a valley has one contact per face.
 template <class T> struct Contact {
   int point;
   Vec2<T> anchor;
+  int face = 0;
 };
+template <class T> bool ContactBefore(const Contact<T>& a, const Contact<T>& b) {
+  return a.point < b.point || (a.point == b.point && a.face < b.face);
+}
 
 // The mutable half of a body (MuJoCo's mjData): q = [tx, ty, θ, γ...], q̇, and its contacts
-// (sorted by point index).
+// (sorted by point index, then face).
 template <class T> struct BodyState {
   VecQ<T> q, qd;
   std::vector<Contact<T>> contacts;
@@ -109,13 +126,12 @@ template <class T> struct ForceBreakdown {
   VecQ<T> gravity, modes, ground, springs, total;
 };
 
-// Ground force at a point x with velocity v tied to `anchor` (Eq. 4.24, 4.25 in the ground's
+// Ground force at a point x with velocity v tied to `anchor` (Eq. 4.24, 4.25 in the face's
 // frame): f_n = −K_d Δn − C_dam v_n (never pulling), f_t = −K_d Δt − FR_dam v_t with
 // |f_t| ≤ tanθ f_n. Sets *slipping when the friction cap was hit.
 template <class T>
-Vec2<T> GroundForce(const Ground& g, const GroundFrame& gf, const Vec2<T>& x, const Vec2<T>& v, const Vec2<T>& anchor,
-                    bool* slipping) {
-  const Vec2<T> n = gf.n.cast<T>(), tau = gf.tau.cast<T>();
+Vec2<T> GroundForce(const GroundFace& g, const Vec2<T>& x, const Vec2<T>& v, const Vec2<T>& anchor, bool* slipping) {
+  const Vec2<T> n = g.n.cast<T>(), tau = g.tau.cast<T>();
   const Vec2<T> dl = x - anchor;
   T fn = -T(g.stiffness) * n.dot(dl) - T(g.normal_damping) * n.dot(v);
   if (fn < T(0.0)) fn = T(0.0);
@@ -134,16 +150,25 @@ Vec2<T> GroundForce(const Ground& g, const GroundFrame& gf, const Vec2<T>& x, co
 
 // Convex-hull test: true when every deformed control point is strictly above the ground, so no
 // point of the body can be below it (Bernstein and B-spline weights are a partition of unity).
+// On a terrain: the hull's bounding box is above the highest surface point under it.
 template <class T> bool ClearOfGround(const BodyModel& body, const Ground& g, const VecQ<T>& q, const Frame<T>& frame) {
   const int D = body.num_modes();
-  const GroundFrame gf(g);
+  const GroundFace face = g.Face(0);
   const std::vector<Eigen::Vector2d>& rest = body.rest_control();
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (int c = 0; c < int(rest.size()); ++c) {
     Vec2<T> local = rest[c].cast<T>();
     for (int d = 0; d < D; ++d) local += body.modes()[d].displacement[c].cast<T>() * q[kRigidDofs + d];
-    if (!(ScalarValue(gf.Height<T>(WorldFromLocal(frame, local))) > 0.0)) return false;
+    const Vec2<T> x = WorldFromLocal(frame, local);
+    if (!g.terrain) {
+      if (!(ScalarValue(face.Height(x)) > 0.0)) return false;
+      continue;
+    }
+    const Eigen::Vector2d xd(ScalarValue(x[0]), ScalarValue(x[1]));
+    lo = lo.cwiseMin(xd);
+    hi = hi.cwiseMax(xd);
   }
-  return true;
+  return !g.terrain || lo.y() > g.terrain->MaxHeight(lo.x(), hi.x());
 }
 
 // Which points the ground acts on during a force evaluation.
@@ -155,45 +180,80 @@ enum class ContactSet {
             // damping pushes, never a pull (f_n >= 0).
 };
 
-// Visits every mass point below the ground as f(k, l, x, v, anchor): l local, x world,
-// v velocity, anchor its contact's anchor (existing, or the entry point projected on the
-// ground for a new contact). Bodies clear of the ground by the hull test cost nothing.
-// `frame` is Frame(s.q), made once by the caller.
+// Visits every mass point below the ground as f(k, l, x, v, anchor, face, face_index): l local,
+// x world, v velocity, anchor its contact's anchor (existing, or the entry point projected on
+// the face for a new contact), face the ground face it feels (a point in a terrain's valley is
+// visited once per face). Bodies clear of the ground by the hull test cost nothing. `frame` is
+// Frame(s.q), made once by the caller.
 template <class T, class F>
 void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodyState<T>& s, const Frame<T>& frame, F&& f,
                            ContactSet set = ContactSet::kDetect) {
   if (!g.enabled) return;
-  const GroundFrame gf(g);
-  auto visit = [&](int k, const Vec2<T>* anchor) {
-    const auto B = body.mode_matrix(k);
-    const Vec2<T> l = LocalPosition<T>(body.rest_local(k), B, s.q);
-    const Vec2<T> x = WorldFromLocal(frame, l);
-    const T h = gf.Height(x);
-    if (set == ContactSet::kDetect && !(ScalarValue(h) < 0.0)) return;
-    f(k, l, x, PointVelocity(frame, s.qd, l, B), anchor ? *anchor : Vec2<T>(x - h * gf.n.cast<T>()));
+  const GroundFace line = g.Face(0);
+  auto point_at = [&](int k, Vec2<T>* l, Vec2<T>* x) {
+    *l = LocalPosition<T>(body.rest_local(k), body.mode_matrix(k), s.q);
+    *x = WorldFromLocal(frame, *l);
+  };
+  auto visit_face = [&](int k, const Vec2<T>& l, const Vec2<T>& x, const GroundFace& face, int face_index,
+                        const Vec2<T>* anchor) {
+    f(k, l, x, PointVelocity(frame, s.qd, l, body.mode_matrix(k)),
+      anchor ? *anchor : Vec2<T>(x - face.Height(x) * face.n.cast<T>()), face, face_index);
   };
   if (set == ContactSet::kFrozen) {
-    for (const Contact<T>& c : s.contacts) visit(c.point, &c.anchor);
-    return;
-  }
-  if (ClearOfGround(body, g, s.q, frame)) return;
-  const std::vector<PointCluster>& clusters = body.clusters();
-  if (clusters.size() <= 1) {
-    auto existing = s.contacts.begin();
-    for (int k = 0; k < body.num_points(); ++k) {
-      while (existing != s.contacts.end() && existing->point < k) ++existing;
-      const bool has_anchor = existing != s.contacts.end() && existing->point == k;
-      visit(k, has_anchor ? &existing->anchor : nullptr);
+    for (const Contact<T>& c : s.contacts) {
+      Vec2<T> l, x;
+      point_at(c.point, &l, &x);
+      visit_face(c.point, l, x, g.terrain ? g.Face(c.face) : line, c.face, &c.anchor);
     }
     return;
   }
+  // The contacts of point k: [first, last) of the sorted list.
+  auto contacts_of = [&](int k) {
+    const auto first = std::lower_bound(s.contacts.begin(), s.contacts.end(), k,
+                                        [](const Contact<T>& a, int point) { return a.point < point; });
+    auto last = first;
+    while (last != s.contacts.end() && last->point == k) ++last;
+    return std::make_pair(first, last);
+  };
+  // One point: on the line, below it or not; on a terrain, every face it feels.
+  auto visit = [&](int k) {
+    Vec2<T> l, x;
+    point_at(k, &l, &x);
+    if (!g.terrain) {
+      if (!(ScalarValue(line.Height(x)) < 0.0)) return;
+      const auto range = contacts_of(k);
+      visit_face(k, l, x, line, 0, range.first != range.second ? &range.first->anchor : nullptr);
+      return;
+    }
+    const Eigen::Vector2d xd(ScalarValue(x[0]), ScalarValue(x[1]));
+    if (!g.terrain->Inside(xd)) return;
+    const Vec2<T> v = PointVelocity(frame, s.qd, l, body.mode_matrix(k));
+    const Eigen::Vector2d vd(ScalarValue(v[0]), ScalarValue(v[1]));
+    const auto range = contacts_of(k);
+    const auto first = range.first, last = range.second;  // (lambdas cannot capture bindings in C++17)
+    thread_local std::vector<int> faces;
+    faces.clear();
+    g.terrain->FacesFelt(xd, vd, [&](int i) { return std::any_of(first, last, [i](const Contact<T>& c) { return c.face == i; }); },
+                         &faces);
+    for (int i : faces) {
+      const auto existing = std::find_if(first, last, [i](const Contact<T>& c) { return c.face == i; });
+      visit_face(k, l, x, g.Face(i), i, existing != last ? &existing->anchor : nullptr);
+    }
+  };
+  if (ClearOfGround(body, g, s.q, frame)) return;
+  const std::vector<PointCluster>& clusters = body.clusters();
+  if (clusters.size() <= 1) {
+    for (int k = 0; k < body.num_points(); ++k) visit(k);
+    return;
+  }
   // Large bodies: only groups whose bounding box reaches below the ground. The box test is a
-  // decision, so it runs on plain values; height = n·(t − p) + (Rᵀn)·l.
+  // decision, so it runs on plain values: on the line, height = n·(t − p) + (Rᵀn)·l; on a
+  // terrain, the box's world bounds against the highest surface point under them.
   const int D = body.num_modes();
-  const Eigen::Vector2d n_local = Mat2<double>(frame.R.unaryExpr([](const T& v) { return double(ScalarValue(v)); }))
-                                      .transpose() * gf.n;
+  const Eigen::Matrix2d R = frame.R.unaryExpr([](const T& v) { return double(ScalarValue(v)); });
+  const Eigen::Vector2d n_local = R.transpose() * line.n;
   const Eigen::Vector2d t(ScalarValue(s.q[0]), ScalarValue(s.q[1]));
-  const double offset = gf.n.dot(t - gf.point);
+  const double offset = line.n.dot(t - line.point);
   for (const PointCluster& c : clusters) {
     Eigen::Vector2d centre = c.centre0, half = c.half0;
     for (int d = 0; d < D; ++d) {
@@ -201,13 +261,15 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
       centre += gamma * c.centre_modes.col(d);
       half += std::abs(gamma) * c.half_modes.col(d);
     }
-    if (offset + n_local.dot(centre) - n_local.cwiseAbs().dot(half) >= 0.0) continue;
-    for (int k : c.points) {
-      const auto existing = std::lower_bound(s.contacts.begin(), s.contacts.end(), k,
-                                             [](const Contact<T>& a, int point) { return a.point < point; });
-      const bool has_anchor = existing != s.contacts.end() && existing->point == k;
-      visit(k, has_anchor ? &existing->anchor : nullptr);
+    if (!g.terrain) {
+      if (offset + n_local.dot(centre) - n_local.cwiseAbs().dot(half) >= 0.0) continue;
+    } else {
+      const Eigen::Vector2d world_centre = t + R * centre, world_half = R.cwiseAbs() * half;
+      if (world_centre.y() - world_half.y() >
+          g.terrain->MaxHeight(world_centre.x() - world_half.x(), world_centre.x() + world_half.x()))
+        continue;
     }
+    for (int k : c.points) visit(k);
   }
 }
 
@@ -237,13 +299,11 @@ void EvaluateForces(const BodyModel& body, const WorldParams& w, int body_index,
   if (cached) {
     out->ground = *cached;
   } else {
-    const GroundFrame gf(w.ground);  // sin/cos of the slope: only when the points are visited
     out->ground.setZero(nq);
     ForEachPointInContact(body, w.ground, s, frame, [&](int k, const Vec2<T>& l, const Vec2<T>& x, const Vec2<T>& v,
-                                                 const Vec2<T>& anchor) {
+                                                 const Vec2<T>& anchor, const GroundFace& face, int) {
       bool slipping;
-      AddGeneralizedForce(frame, l, body.mode_matrix(k), GroundForce(w.ground, gf, x, v, anchor, &slipping),
-                          &out->ground);
+      AddGeneralizedForce(frame, l, body.mode_matrix(k), GroundForce(face, x, v, anchor, &slipping), &out->ground);
     }, contact_set);
   }
   // springs holding a point
@@ -274,14 +334,14 @@ template <class T> int AddMissingContacts(const BodyModel& body, const Ground& g
   std::vector<Contact<T>> added;
   const BodyState<T>& view = *s;
   ForEachPointInContact(body, g, view, Frame<T>(view.q), [&](int k, const Vec2<T>&, const Vec2<T>&, const Vec2<T>&,
-                                            const Vec2<T>& anchor) {
+                                            const Vec2<T>& anchor, const GroundFace&, int face) {
     for (const Contact<T>& c : view.contacts)
-      if (c.point == k) return;
-    added.push_back({k, anchor});
+      if (c.point == k && c.face == face) return;
+    added.push_back({k, anchor, face});
   });
   if (added.empty()) return 0;
   s->contacts.insert(s->contacts.end(), added.begin(), added.end());
-  std::sort(s->contacts.begin(), s->contacts.end(), [](const Contact<T>& a, const Contact<T>& b) { return a.point < b.point; });
+  std::sort(s->contacts.begin(), s->contacts.end(), ContactBefore<T>);
   return int(added.size());
 }
 
@@ -290,15 +350,15 @@ template <class T> int AddMissingContacts(const BodyModel& body, const Ground& g
 // and with this in the loop GCC stopped inlining the contact scan into UpdateContacts (8 %
 // more instructions per resting-table step under callgrind).
 template <class T>
-[[gnu::noinline, gnu::cold]] void SlipAnchor(const Ground& g, const GroundFrame& gf, const Vec2<T>& x, const Vec2<T>& v,
-                                             Vec2<T>* anchor, Vec2<T>* f) {
-  const Vec2<T> tau = gf.tau.cast<T>(), n = gf.n.cast<T>();
+[[gnu::noinline, gnu::cold]] void SlipAnchor(const GroundFace& g, const Vec2<T>& x, const Vec2<T>& v, Vec2<T>* anchor,
+                                             Vec2<T>* f) {
+  const Vec2<T> tau = g.tau.cast<T>(), n = g.n.cast<T>();
   // no stiffness, no spring to the anchor: it sits on the ground (dividing by K = 0 made it NaN)
   const T dt = g.stiffness > 0.0 ? T(-(f->dot(tau) + T(g.friction_damping) * tau.dot(v)) / T(g.stiffness)) : T(0.0);
-  const Vec2<T> on_ground = x - gf.Height(x) * n;
+  const Vec2<T> on_ground = x - g.Height(x) * n;
   *anchor = on_ground - dt * tau;
   bool slipping;
-  *f = GroundForce(g, gf, x, v, *anchor, &slipping);  // what the moved anchor exerts
+  *f = GroundForce(g, x, v, *anchor, &slipping);  // what the moved anchor exerts
 }
 
 // After a step is accepted: points that went below the ground get an anchor at their entry
@@ -310,21 +370,20 @@ template <class T> void UpdateContacts(const BodyModel& body, const Ground& g, B
   thread_local std::vector<Contact<T>> next;
   next.clear();
   s->penetration = 0.0;
-  const GroundFrame gf(g);
   const Frame<T> frame(s->q);
   auto& cache = s->ground_cache;
   cache.force.setZero(s->q.size());
   ForEachPointInContact(body, g, *s, frame, [&](int k, const Vec2<T>& l, const Vec2<T>& x, const Vec2<T>& v,
-                                         Vec2<T> anchor) {
+                                         Vec2<T> anchor, const GroundFace& face, int face_index) {
     bool slipping;
-    Vec2<T> f = GroundForce(g, gf, x, v, anchor, &slipping);
-    if (slipping) SlipAnchor(g, gf, x, v, &anchor, &f);
+    Vec2<T> f = GroundForce(face, x, v, anchor, &slipping);
+    if (slipping) SlipAnchor(face, x, v, &anchor, &f);
     AddGeneralizedForce(frame, l, body.mode_matrix(k), f, &cache.force);
-    next.push_back({k, anchor});
-    s->penetration = std::max(s->penetration, -double(ScalarValue(gf.Height(x))));
+    next.push_back({k, anchor, face_index});
+    s->penetration = std::max(s->penetration, -double(ScalarValue(face.Height(x))));
   });
   if (body.clusters().size() > 1)  // groups are visited in lattice order, not point order
-    std::sort(next.begin(), next.end(), [](const Contact<T>& a, const Contact<T>& b) { return a.point < b.point; });
+    std::sort(next.begin(), next.end(), ContactBefore<T>);
   s->contacts.swap(next);
   cache.q = s->q;
   cache.qd = s->qd;

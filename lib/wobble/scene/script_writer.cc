@@ -50,7 +50,8 @@ void WriteSetup(std::ostream& s, const ScriptSetup& r) {
     s << "assign " << d + 1 << " " << Num(r.modes[d].stiffness) << " " << Num(r.modes[d].damping) << "\n";
     s << "mode " << d + 1 << (r.modes[d].active ? " active" : " passive") << "\n";
   }
-  s << "set gravity " << (r.world.params.gravity_on ? "T" : "F") << "\n";
+  s << "set gravity " << (r.world.params.gravity_on ? "T" : "F") << "\nset g " << Num(-r.world.params.gravity.y())
+    << "\n";
   s << "set ground " << (g.enabled ? "T" : "F") << "\n";
   s << "set grconst " << Num(g.stiffness) << "\nset grdam " << Num(g.normal_damping) << "\nset frconst "
     << Num(g.friction_damping) << "\nset frsin " << Num(g.friction_cap) << "\n";
@@ -58,6 +59,23 @@ void WriteSetup(std::ostream& s, const ScriptSetup& r) {
   s << "set ground_height " << Num(g.point.y() - std::tan(g.slope) * g.point.x()) << "\n";
   s << "set ground_slope " << Num(g.slope * 180.0 / M_PI) << "\n";
   s << "set max_penetration " << Num(g.max_penetration) << "\n";
+  s << "terrain off\n";
+  if (g.terrain) {
+    s << "terrain";
+    for (const Eigen::Vector2d& v : g.terrain->vertices()) s << " " << Num(v.x()) << " " << Num(v.y());
+    s << "\n";
+    const std::vector<SurfaceOverrides>& faces = g.terrain->segments();
+    for (size_t i = 0; i < faces.size(); ++i) {
+      const std::pair<const char*, double> own[] = {{"grconst", faces[i].stiffness},
+                                                    {"grdam", faces[i].normal_damping},
+                                                    {"frconst", faces[i].friction_damping},
+                                                    {"frsin", faces[i].friction_cap}};
+      std::string line;
+      for (const auto& [name, value] : own)
+        if (!std::isnan(value)) line += std::string(" ") + name + " " + Num(value);
+      if (!line.empty()) s << "terrain_face " << i + 1 << line << "\n";
+    }
+  }
   s << "set integrator " << IntegratorName(r.world.integrator) << "\nset dt " << Num(r.world.dt) << "\n";
   s << "set spring " << (r.springs_on ? "T" : "F") << "\nclear springs\n";
   for (const Spring& sp : r.springs)

@@ -11,6 +11,10 @@ const std::vector<Command>& CommandTable() {
       {"load_def", "load_def FILE [FILE...]", "load deformation files; their modes replace the current set", LoadDef},
       {"trans", "trans X Y THETA", "place the object: set_vec q is relative to this placement", Trans},
       {"set", "set NAME VALUE", "set a parameter (see Parameters)", Set},
+      {"terrain", "terrain X1 Y1 X2 Y2 ... | terrain off",
+       "the ground becomes a profile through these points, left to right, solid below (equal X: a cliff)", TerrainCommand},
+      {"terrain_face", "terrain_face SEGMENT NAME VALUE [NAME VALUE ...]",
+       "a terrain segment's own grconst, grdam, frconst or frsin (1-based, left to right)", TerrainFaceCommand},
       {"assign", "assign MODE STIFFNESS DAMPING", "mode MODE (1-based or name): V = K g^2, force -c g'", Assign},
       {"mode", "mode MODE active|passive", "designate a mode active (PD-controlled) or passive", Mode},
       {"set_vec", "set_vec q|dq V1 .. Vn", "generalized coordinates or velocities, n = 3 + modes", SetVec},
@@ -30,10 +34,11 @@ const std::vector<Command>& CommandTable() {
       {"cmaes", "cmaes GENERATIONS", "CMA-ES (pagmo2) on the same problem as anneal; population = batch (>= 5)", Cmaes},
       {"gait", "gait SKIP CYCLES", "distance travelled per cycle of the pose graph, after SKIP cycles", Gait},
       {"save", "save FILE", "write a script that rebuilds the current setup and replays its controller", Save},
-      {"render", "render DIR [WHAT]",
+      {"render", "render DIR [WHAT] [NAME=VALUE ...]",
        "draw into DIR: with a scene (linear bodies) its recorded frames, WHAT a comma list of frames, filmstrip, vtp "
        "(default all); otherwise every FFD run since load_obj (or clear track), WHAT of frames, filmstrip, charts, vtp, "
-       "exr, disp (default frames,filmstrip,charts)",
+       "exr, disp (default frames,filmstrip,charts) and NAME=VALUE options of wobble render (size=WxH, fps=N, "
+       "filmstrip=T1,T2,.., filmstrip-columns=N, color-by=ARRAY, ...)",
        Render},
       {"echo", "echo TEXT", "print TEXT", Echo},
       // Witkin & Welch scenes (linear bodies, constraints, motion control, goal behaviours)

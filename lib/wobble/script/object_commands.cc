@@ -3,6 +3,7 @@
 // (`output`, `render`), and the few commands every mode shares (print, echo, help, quit).
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <sstream>
 
 #include "wobble/record/trajectory_csv.h"
@@ -311,15 +312,43 @@ void Print(State& s, const Words& w, const Context& ctx) {
   s.out << "]  control energy " << Num(s.scene.control_energy().consumed) << "\n";
 }
 
+namespace {
+
+const std::set<std::string>& RenderOptionNamesList() {
+  static const std::set<std::string> names = {"size",  "fps",         "filmstrip", "filmstrip-size", "filmstrip-columns",
+                                              "color-by", "shape-samples", "chart-size", "disp-size", "trail",
+                                              "azimuth", "elevation", "orbit", "camera", "style"};
+  return names;
+}
+
+}  // namespace
+
+std::string RenderOptionNames() {
+  std::string all;
+  for (const std::string& n : RenderOptionNamesList()) all += (all.empty() ? "" : ", ") + n;
+  return all;
+}
+
 void Render(State& s, const Words& w, const Context& ctx) {
   if (s.scene.has_bodies()) return SceneRender(s, w, ctx);
-  ctx.ExpectWords(w, 2, 3);
+  if (w.size() < 2) ctx.Fail("expected '" + ctx.usage + "'");
   RequireObject(s, ctx, "render");
-  if (s.track.empty()) ctx.Fail("render: nothing to draw yet (run 'simul' or 'keyframe' first)");
-  if (!s.render_hook) ctx.Fail("render: this program has no renderer ('wobble run' and Python's Interpreter have one, built with VTK)");
   RenderRequest request;
   request.dir = w[1];
-  request.what = w.size() > 2 ? w[2] : "";
+  for (size_t i = 2; i < w.size(); ++i) {
+    const size_t eq = w[i].find('=');
+    if (eq == std::string::npos) {
+      if (i != 2) ctx.Fail("expected NAME=VALUE after the outputs, got '" + w[i] + "'");
+      request.what = w[i];
+      continue;
+    }
+    const std::string name = w[i].substr(0, eq);
+    if (RenderOptionNamesList().count(name) == 0)
+      ctx.Fail("unknown render option '" + name + "' (" + RenderOptionNames() + ")");
+    request.options.emplace_back(name, w[i].substr(eq + 1));
+  }
+  if (s.track.empty()) ctx.Fail("render: nothing to draw yet (run 'simul' or 'keyframe' first)");
+  if (!s.render_hook) ctx.Fail("render: this program has no renderer ('wobble run' and Python's Interpreter have one, built with VTK)");
   const auto merged = std::make_shared<const record::Trajectory>(scene::MergeRuns(s.track));
   request.world = merged->bodies()[0].ffd ? s.scene.ObjectWorldOptions(*merged->bodies()[0].ffd)
                                           : s.scene.ObjectWorldOptions3();

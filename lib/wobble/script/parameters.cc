@@ -43,6 +43,10 @@ bool Value::Boolean() const {
 namespace {
 
 Ground& TheGround(State& s) { return s.scene.options().params.ground; }
+// The line's height and slope mean nothing under a terrain: refused rather than ignored.
+void RequireGroundLine(State& s, const Value& v) {
+  if (TheGround(s).terrain) v.ctx.Fail("the ground is a terrain ('terrain off' first for a ground line)");
+}
 synth::AnnealOptions& Search(State& s) { return s.anneal_options; }
 
 // A file a later command writes, checked now: a path that cannot be written is bad input of
@@ -88,15 +92,23 @@ const std::vector<Parameter>& ParameterTable() {
       {"time", [](State& s, const Value& v) { s.scene.set_time(v.Number()); }},
       {"end", [](State& s, const Value& v) { s.scene.set_end(v.Number()); }},
       {"dt", [](State& s, const Value& v) { s.scene.options().dt = v.Positive(); }},
+      // gravity's magnitude along −y (9.81: the thesis' pixels as metres); a scene drawn in
+      // centimetres takes 981 (table_cliff.wob)
+      {"g", [](State& s, const Value& v) { s.scene.options().params.gravity = Eigen::Vector2d(0.0, -v.NonNegative()); }},
       // work and memory limits (core/limits.h)
       {"max_steps",
        [](State& s, const Value& v) {
          s.scene.limits().max_steps = CheckedCount(v.Number(), 1, kMaxStepsLimit, "max_steps");
        }},
       {"max_record_mb", [](State& s, const Value& v) { s.scene.limits().max_record_mb = v.Positive(); }},
-      {"ground_height", [](State& s, const Value& v) { TheGround(s).point = Eigen::Vector2d(0.0, v.Number()); }},
+      {"ground_height",
+       [](State& s, const Value& v) {
+         RequireGroundLine(s, v);
+         TheGround(s).point = Eigen::Vector2d(0.0, v.Number());
+       }},
       {"ground_slope",
        [](State& s, const Value& v) {
+         RequireGroundLine(s, v);
          const double deg = v.Number();
          if (std::abs(deg) >= 90) v.ctx.Fail("expected a ground slope between -90 and 90 degrees, got " + v.text);
          TheGround(s).slope = deg * M_PI / 180.0;

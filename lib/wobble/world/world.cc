@@ -387,9 +387,9 @@ Energies World::FfdEnergies(int i, ContactSet contacts, bool per_mode) const {
     e.modes += term;
   }
   ForEachPointInContact(b, p.ground, s, frame,
-                        [&](int, const Vec2<double>&, const Vec2<double>& x, const Vec2<double>&, const Vec2<double>& anchor) {
-                          e.ground += 0.5 * p.ground.stiffness * (x - anchor).squaredNorm();
-                        }, contacts);
+                        [&](int, const Vec2<double>&, const Vec2<double>& x, const Vec2<double>&, const Vec2<double>& anchor,
+                            const GroundFace& face, int) { e.ground += 0.5 * face.stiffness * (x - anchor).squaredNorm(); },
+                        contacts);
   for (const Spring& sp : p.springs) {
     if (sp.body != i) continue;
     const Vec2<double> x = WorldFromLocal(frame, LocalPosition<double>(sp.rest_local, sp.mode_matrix, s.q));
@@ -441,6 +441,7 @@ bool World::EnergySurelyFinite(const FfdEntry& e) const {
   if (!(e.scale <= kScreen && s.q.cwiseAbs().maxCoeff() <= kScreen && s.qd.cwiseAbs().maxCoeff() <= kScreen))
     return false;
   if (s.mode_target.size() > 0 && !(s.mode_target.cwiseAbs().maxCoeff() <= kScreen)) return false;
+  // a terrain's own stiffnesses are at most 1e30 (Terrain::Make)
   if (!(p.gravity.cwiseAbs().maxCoeff() <= kScreen && std::abs(p.ground.stiffness) <= kScreen)) return false;
   for (const Contact<double>& c : s.contacts)
     if (!(c.anchor.cwiseAbs().maxCoeff() <= kScreen)) return false;

@@ -31,6 +31,8 @@ const BodyModel3& World::body3(int i) const { return *Ffd3(i).model; }
 const std::shared_ptr<const BodyModel3>& World::shared_body3(int i) const { return Ffd3(i).model; }
 
 GroundPlane GroundPlaneOf(const Ground& g) {
+  if (g.terrain)
+    throw InputError("a 3D body stands on a ground plane; a terrain profile is 2D only (turn it off with 'terrain off')");
   GroundPlane p;
   p.enabled = g.enabled;
   p.point = Eigen::Vector3d(g.point.x(), g.point.y(), 0.0);

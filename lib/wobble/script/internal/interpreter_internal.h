@@ -116,6 +116,8 @@ void Hold(State& s, const Words& w, const Context& ctx);
 void Keyframe(State& s, const Words& w, const Context& ctx);
 void SpringCommand(State& s, const Words& w, const Context& ctx);
 void Clear(State& s, const Words& w, const Context& ctx);
+void TerrainCommand(State& s, const Words& w, const Context& ctx);      // ground_commands.cc
+void TerrainFaceCommand(State& s, const Words& w, const Context& ctx);
 void Output(State& s, const Words& w, const Context& ctx);
 void Print(State& s, const Words& w, const Context& ctx);   // the scene's once it has a body
 void Render(State& s, const Words& w, const Context& ctx);  // the scene's once it has a body

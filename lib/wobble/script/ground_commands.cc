@@ -1,0 +1,62 @@
+// The ground as terrain (issue 19): `terrain` sets the profile, `terrain_face` a segment's own
+// penalty parameters (the names `set` gives the ground's: grconst, grdam, frconst, frsin).
+#include "wobble/script/internal/interpreter_internal.h"
+
+namespace wobble::script {
+
+using namespace script_detail;
+
+namespace {
+
+Ground& TheGround(State& s) { return s.scene.options().params.ground; }
+
+// Terrain::Make's refusals are this line's bad input.
+std::shared_ptr<const Terrain> MakeTerrain(std::vector<Eigen::Vector2d> vertices, std::vector<SurfaceOverrides> faces,
+                                           const Context& ctx) {
+  try {
+    return Terrain::Make(std::move(vertices), std::move(faces));
+  } catch (const InputError& e) {
+    ctx.Fail(e.what());
+  }
+}
+
+}  // namespace
+
+void TerrainCommand(State& s, const Words& w, const Context& ctx) {
+  if (w.size() == 2 && w[1] == "off") {
+    TheGround(s).terrain = nullptr;
+    return;
+  }
+  if (w.size() < 5 || w.size() % 2 == 0) ctx.Fail("expected 'terrain X1 Y1 X2 Y2 ...' (pairs, at least two) or 'terrain off'");
+  std::vector<Eigen::Vector2d> vertices;
+  for (size_t i = 1; i + 1 < w.size(); i += 2) {
+    const std::string n = std::to_string((i + 1) / 2);
+    vertices.emplace_back(Number(w[i], "X" + n, ctx), Number(w[i + 1], "Y" + n, ctx));
+  }
+  TheGround(s).terrain = MakeTerrain(std::move(vertices), {}, ctx);
+}
+
+void TerrainFaceCommand(State& s, const Words& w, const Context& ctx) {
+  if (w.size() < 4 || w.size() % 2 != 0) ctx.Fail("expected '" + ctx.usage + "'");
+  const std::shared_ptr<const Terrain>& terrain = TheGround(s).terrain;
+  if (!terrain) ctx.Fail("no terrain yet: 'terrain X1 Y1 X2 Y2 ...' first");
+  const int segments = int(terrain->vertices().size()) - 1;
+  const double index = Number(w[1], "SEGMENT", ctx);
+  if (!(index >= 1 && index <= segments && index == std::floor(index)))
+    ctx.Fail("expected a segment from 1 to " + std::to_string(segments) + ", got " + w[1]);
+  std::vector<SurfaceOverrides> faces = terrain->segments();
+  faces.resize(size_t(segments));
+  SurfaceOverrides& face = faces[size_t(index) - 1];
+  for (size_t i = 2; i + 1 < w.size(); i += 2) {
+    const double v = NonNegative(w[i + 1], w[i], ctx);
+    if (w[i] == "grconst") face.stiffness = v;
+    else if (w[i] == "grdam") face.normal_damping = v;
+    else if (w[i] == "frconst") face.friction_damping = v;
+    else if (w[i] == "frsin") face.friction_cap = v;
+    else ctx.Fail("expected grconst, grdam, frconst or frsin, got '" + w[i] + "'" +
+                  DidYouMean(w[i], {"grconst", "grdam", "frconst", "frsin"}));
+  }
+  TheGround(s).terrain = MakeTerrain(terrain->vertices(), std::move(faces), ctx);
+}
+
+}  // namespace wobble::script
