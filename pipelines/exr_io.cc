@@ -6,8 +6,10 @@
 #include <ImfIO.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfStandardAttributes.h>
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -41,8 +43,54 @@ class StdioStream : public Imf::OStream {
 };
 }  // namespace
 
+namespace {
+
+Imath::M44f ToImath(const std::array<float, 16>& m) {
+  return Imath::M44f(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11], m[12], m[13], m[14], m[15]);
+}
+std::array<float, 16> FromImath(const Imath::M44f& m) {
+  std::array<float, 16> a;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) a[size_t(4 * i + j)] = m[i][j];
+  return a;
+}
+
+// A whole frame rate up to 60 (a timeCode's frame field), or 0.
+int WholeFps(double fps) { return fps >= 1 && fps <= 60 && fps == std::floor(fps) ? int(fps) : 0; }
+
+void AddMetadata(const ExrMetadata& m, Imf::Header* header) {
+  if (m.world_to_camera) Imf::addWorldToCamera(*header, ToImath(*m.world_to_camera));
+  if (m.world_to_ndc) Imf::addWorldToNDC(*header, ToImath(*m.world_to_ndc));
+  if (m.frames_per_second > 0) Imf::addFramesPerSecond(*header, Imf::Rational(m.frames_per_second));
+  const int fps = WholeFps(m.frames_per_second);
+  if (fps > 0 && m.frame >= 0) {
+    const long seconds = m.frame / fps;
+    if (seconds < 24 * 3600)  // a day: the hours field's range
+      Imf::addTimeCode(*header, Imf::TimeCode(int(seconds / 3600), int(seconds / 60 % 60), int(seconds % 60),
+                                              int(m.frame % fps)));
+  }
+}
+
+ExrMetadata ReadMetadata(const Imf::Header& header) {
+  ExrMetadata m;
+  if (Imf::hasWorldToCamera(header)) m.world_to_camera = FromImath(Imf::worldToCamera(header));
+  if (Imf::hasWorldToNDC(header)) m.world_to_ndc = FromImath(Imf::worldToNDC(header));
+  if (Imf::hasFramesPerSecond(header)) {
+    const Imf::Rational r = Imf::framesPerSecond(header);
+    m.frames_per_second = double(r);
+  }
+  const int fps = WholeFps(m.frames_per_second);
+  if (Imf::hasTimeCode(header) && fps > 0) {
+    const Imf::TimeCode& tc = Imf::timeCode(header);
+    m.frame = ((long(tc.hours()) * 60 + tc.minutes()) * 60 + tc.seconds()) * fps + tc.frame();
+  }
+  return m;
+}
+
+}  // namespace
+
 void WriteExrChannels(const std::string& path, int width, int height, const std::vector<ExrChannel>& channels,
-                      ExrCompression compression) {
+                      ExrCompression compression, const ExrMetadata& metadata) {
   if (width <= 0 || height <= 0)
     throw std::invalid_argument(path + ": image size " + std::to_string(width) + "x" + std::to_string(height));
   if (channels.empty()) throw std::invalid_argument(path + ": no channels to write");
@@ -52,6 +100,7 @@ void WriteExrChannels(const std::string& path, int width, int height, const std:
                                   " values, expected " + std::to_string(size_t(width) * height));
   formats::WriteFileAtomically(path, [&](const std::string& tmp) {
     Imf::Header header(width, height);
+    AddMetadata(metadata, &header);
     switch (compression) {
       case ExrCompression::kNone: header.compression() = Imf::NO_COMPRESSION; break;
       case ExrCompression::kRle: header.compression() = Imf::RLE_COMPRESSION; break;
@@ -88,6 +137,7 @@ ExrImage ReadExrChannels(const std::string& path) {
     Imf::InputFile file(path.c_str());
     const Imath::Box2i dw = file.header().dataWindow();
     ExrImage image;
+    image.metadata = ReadMetadata(file.header());
     image.width = dw.max.x - dw.min.x + 1;
     image.height = dw.max.y - dw.min.y + 1;
     Imf::FrameBuffer fb;

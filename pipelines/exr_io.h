@@ -5,7 +5,9 @@
 // the image (the EXR convention; VTK images start at the bottom and are flipped by callers).
 #pragma once
 
+#include <array>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,15 +21,27 @@ struct ExrChannel {
 // kRle is the fastest and suits rendered 2D frames (large flat areas); kZip is smaller for data.
 enum class ExrCompression { kNone, kRle, kZip, kPiz };
 
+// OpenEXR's standard attributes of a rendered frame (ImfStandardAttributes.h), for compositors:
+// the camera (worldToCamera: left-handed, +z the viewing direction; worldToNDC: (0, 0) the top
+// left and (1, 1) the bottom right of the image), and the frame's place in time
+// (framesPerSecond; timeCode hh:mm:ss:ff from the frame number, when fps is whole and at most 60).
+// Matrices are row-major in OpenEXR's row-vector convention: p' = p M.
+struct ExrMetadata {
+  std::optional<std::array<float, 16>> world_to_camera, world_to_ndc;
+  double frames_per_second = 0;  // 0: not written
+  long frame = -1;               // < 0: no timeCode
+};
+
 // Writes a scan-line EXR of 32-bit float channels, atomically (temporary file + rename).
 // Throws std::invalid_argument for a bad size or channel length, std::runtime_error (naming
 // the path and reason) when the file cannot be written; an earlier file is then left intact.
 void WriteExrChannels(const std::string& path, int width, int height, const std::vector<ExrChannel>& channels,
-                      ExrCompression compression = ExrCompression::kZip);
+                      ExrCompression compression = ExrCompression::kZip, const ExrMetadata& metadata = {});
 
 struct ExrImage {
   int width = 0, height = 0;
   std::map<std::string, std::vector<float>> channels;  // row 0 at the top
+  ExrMetadata metadata;  // what of it the file has (frame: the timeCode's frame count at fps)
   // Value of channel `name` at pixel (x, y), y from the top. Throws std::out_of_range.
   float At(const std::string& name, int x, int y) const { return channels.at(name).at(size_t(y) * width + x); }
 };

@@ -13,6 +13,7 @@
 #include <vtkFloatArray.h>
 #include <vtkImageData.h>
 #include <vtkLookupTable.h>
+#include <vtkMatrix4x4.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
@@ -525,11 +526,45 @@ std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
   return ch;
 }
 
-void SceneView::WriteExr(const std::string& path, BackgroundWriter* writer) {
+ExrMetadata SceneView::ExrCameraMetadata() const {
+  vtkCamera* camera = impl_->renderer->GetActiveCamera();
+  auto eigen = [](vtkMatrix4x4* m) {
+    Eigen::Matrix4d e;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) e(i, j) = m->GetElement(i, j);
+    return e;
+  };
+  // VTK's camera space is right-handed looking along −z; OpenEXR's (RenderMan's) is left-handed
+  // looking along +z: z flips
+  const Eigen::Matrix4d to_camera = Eigen::Vector4d(1, 1, -1, 1).asDiagonal() * eigen(camera->GetViewTransformMatrix());
+  // VTK's NDC is [−1, 1]² with y up; OpenEXR's [0, 1]² from the top left
+  Eigen::Matrix4d to_exr_ndc;
+  to_exr_ndc << 0.5, 0, 0, 0.5, 0, -0.5, 0, 0.5, 0, 0, 1, 0, 0, 0, 0, 1;
+  const double aspect = double(options_.width) / double(options_.height);
+  const Eigen::Matrix4d to_ndc = to_exr_ndc * eigen(camera->GetCompositeProjectionTransformMatrix(aspect, -1, 1));
+  // OpenEXR multiplies row vectors (p' = p M): the transposes, row-major
+  auto rows = [](const Eigen::Matrix4d& column_form) {
+    std::array<float, 16> a;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) a[size_t(4 * i + j)] = float(column_form(j, i));
+    return a;
+  };
+  ExrMetadata m;
+  m.world_to_camera = rows(to_camera);
+  m.world_to_ndc = rows(to_ndc);
+  return m;
+}
+
+void SceneView::WriteExr(const std::string& path, BackgroundWriter* writer, double fps, long frame) {
   const int w = options_.width, h = options_.height;
   const ExrCompression compression = options_.exr_compression;
-  if (!writer) return WriteExrChannels(path, w, h, CaptureRgbaDepth(), compression);
-  writer->Submit([path, w, h, compression, ch = CaptureRgbaDepth()] { WriteExrChannels(path, w, h, ch, compression); });
+  ExrMetadata meta = ExrCameraMetadata();
+  meta.frames_per_second = fps;
+  meta.frame = frame;
+  if (!writer) return WriteExrChannels(path, w, h, CaptureRgbaDepth(), compression, meta);
+  writer->Submit([path, w, h, compression, meta, ch = CaptureRgbaDepth()] {
+    WriteExrChannels(path, w, h, ch, compression, meta);
+  });
 }
 
 bool SceneView::ColorRangeNow(double range[2]) {

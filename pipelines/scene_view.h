@@ -129,7 +129,11 @@ class SceneView {
   // rendered 8-bit colours as 0..1 floats premultiplied by A (so the white background is
   // transparent black; the 2D text overlay, which has no depth, is not in the EXR).
   std::vector<ExrChannel> CaptureRgbaDepth();
-  void WriteExr(const std::string& path, BackgroundWriter* writer = nullptr);
+  // With the camera of this view in the header (ExrCameraMetadata), and the frame's place in a
+  // series at `fps` when frame >= 0.
+  void WriteExr(const std::string& path, BackgroundWriter* writer = nullptr, double fps = 0, long frame = -1);
+  // OpenEXR's worldToCamera and worldToNDC of the current camera (exr_io.h's conventions).
+  ExrMetadata ExrCameraMetadata() const;
 
   // The range of options().color_by over every body in the world's state now (magnitudes
   // for vectors); false (and 0..1) when nothing is coloured or no body has the array.

@@ -322,7 +322,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     if (view) {
       view->Render();
       if (out.frames) view->WritePng(Numbered(out.folder + "/frames", "frame", v.frame, "png"), &writer);
-      if (out.exr) view->WriteExr(Numbered(out.folder + "/exr", "frame", v.frame, "exr"), &writer);
+      if (out.exr) view->WriteExr(Numbered(out.folder + "/exr", "frame", v.frame, "exr"), &writer, out.fps, v.frame);
     }
     if (vtp) vtp->WriteFrame(int(v.frame), &writer);
     for (const DispTarget& d : disp) {

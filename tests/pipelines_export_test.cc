@@ -240,6 +240,53 @@ TEST(DisplacementExr, ValuesAtKnownPixelsMatchTheFfdEvaluatedIndependently) {
   fs::remove_all(dir);
 }
 
+// The header carries OpenEXR's standard camera and time attributes: a mass point's world
+// position through worldToNDC lands on the pixel where that point is drawn (red, opaque), its
+// worldToCamera z is its depth.Z, and the frame number comes back from the timeCode at 30 fps.
+TEST(RenderedExr, CameraAndTimeInTheHeaderAtKnownPixels) {
+  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
+  const std::string dir = TempDir("frame_exr_meta");
+  auto world = AirborneWorld();  // deformed and turned: the camera is not the identity on it
+  SceneOptions opt;
+  opt.width = 200;
+  opt.height = 150;
+  opt.overlay = false;
+  SceneView view(world.get(), opt);
+  view.Render();
+  view.WriteExr(dir + "/f.exr", nullptr, 30.0, 3725);  // 2 min 4 s and 5 frames at 30 fps
+  const ExrImage img = ReadExrChannels(dir + "/f.exr");
+  ASSERT_TRUE(img.metadata.world_to_ndc && img.metadata.world_to_camera);
+  EXPECT_EQ(img.metadata.frames_per_second, 30.0);
+  EXPECT_EQ(img.metadata.frame, 3725);
+  auto times = [](const Eigen::Vector3d& p, const std::array<float, 16>& m) {  // p M, row vector
+    Eigen::Vector4d r = Eigen::Vector4d::Zero();
+    for (int j = 0; j < 4; ++j)
+      r[j] = p.x() * m[size_t(j)] + p.y() * m[size_t(4 + j)] + p.z() * m[size_t(8 + j)] + m[size_t(12 + j)];
+    return Eigen::Vector3d(r[0] / r[3], r[1] / r[3], r[2] / r[3]);
+  };
+  const std::vector<Eigen::Vector2d> points = world->PointPositions(0);
+  int checked = 0;
+  for (const Eigen::Vector2d& x : points) {
+    // (drawn 3 above the plane, their layer's z offset: the parallel camera looks down z, so
+    // neither their pixel nor, within 1 %, their depth moves)
+    const Eigen::Vector3d at(x.x(), x.y(), 0.0);
+    const Eigen::Vector3d ndc = times(at, *img.metadata.world_to_ndc);
+    const int px = int(ndc.x() * img.width), py = int(ndc.y() * img.height);
+    if (px < 2 || py < 2 || px >= img.width - 2 || py >= img.height - 2) continue;
+    SCOPED_TRACE(std::to_string(px) + ", " + std::to_string(py));
+    EXPECT_EQ(img.At("A", px, py), 1.0f);
+    EXPECT_NEAR(img.At("R", px, py), 0.85, 1.5 / 255);  // the mass points' red
+    EXPECT_NEAR(img.At("G", px, py), 0.2, 1.5 / 255);
+    // the camera looks along +z of its space: the depth of a point drawn in front of it
+    const double z = times(at, *img.metadata.world_to_camera).z();
+    EXPECT_GT(z, 0.0);
+    EXPECT_NEAR(img.At("depth.Z", px, py), z, 0.01 * z);
+    ++checked;
+  }
+  EXPECT_GE(checked, 8);
+  fs::remove_all(dir);
+}
+
 TEST(RenderedExr, ColourAlphaAndDepthAtKnownPixels) {
   if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
   const std::string dir = TempDir("frame_exr");
