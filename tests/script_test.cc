@@ -12,6 +12,7 @@
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
 #include "wobble/script/interpreter.h"
+#include "wobble/script/variables.h"
 
 namespace wobble {
 namespace {
@@ -356,6 +357,67 @@ TEST(CliffJump, LeavesTheCliffLandsUprightOnTheFloorAndSettles) {
     EXPECT_NEAR(p.y(), 0.0, 1.0);
     EXPECT_GT(p.x(), 340.0);
   }
+}
+
+// Figs. 4.10/4.11: a rigid pot (no modes) thrown onto a level floor. Friction off: the floor
+// pushes only along its normal, so from the moment it lands the centre of mass keeps its
+// horizontal speed (the thesis scheme integrates (t, θ), not the centre of mass, so while the
+// pot rocks it keeps it to O(Δt): halving Δt must shrink the drift at least 1.6-fold). Friction
+// on: the slide stops and the pot rests upright.
+record::Trajectory RunPotScript(const std::map<std::string, std::string>& values, std::string* dir_drawn) {
+  const auto dir = std::filesystem::temp_directory_path() / "wobble_pot_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const auto cwd = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  script::RenderRequest drawn;
+  interp.SetRenderHook([&](const script::RenderRequest& r) { drawn = r; });
+  std::ifstream file(kData + "/fig4_10_11_pot.wob");
+  std::stringstream text;
+  text << file.rdbuf();
+  std::istringstream in(script::ExpandVariables(text.str(), values, "fig4_10_11_pot.wob"));
+  interp.RunStream(in, "fig4_10_11_pot.wob", kData);
+  std::filesystem::current_path(cwd);
+  if (!drawn.trajectory) throw std::runtime_error("the pot script rendered nothing");
+  *dir_drawn = drawn.dir;
+  return *drawn.trajectory;
+}
+
+TEST(PotFriction, FrictionOffKeepsTheHorizontalSpeedOnSlidesStopsUpright) {
+  struct Slide {
+    double drift, end_speed, end_tilt;
+  };
+  auto slide = [](const std::map<std::string, std::string>& values, const std::string& expected_dir) {
+    std::string dir;
+    const record::Trajectory run = RunPotScript(values, &dir);
+    EXPECT_EQ(dir, expected_dir);
+    const BodyModel& pot = *run.bodies()[0].ffd;
+    EXPECT_EQ(pot.num_modes(), 0);
+    const Eigen::Vector2d c = pot.moments().c0 / pot.moments().m;
+    auto com_vx = [&](int k) {  // ṫ + θ̇ R S c̄, its x
+      const Eigen::VectorXd q = run.q(k, 0), qd = run.qd(k, 0);
+      return qd[0] - qd[2] * (std::sin(q[2]) * c.x() + std::cos(q[2]) * c.y());
+    };
+    int landed = -1;
+    for (int k = 0; k < run.size() && landed < 0; ++k)
+      if (run.contacts(k, 0) > 0) landed = k;
+    EXPECT_GT(landed, 0);
+    Slide s{0, 0, 0};
+    for (int k = std::max(landed, 0); k < run.size(); ++k) s.drift = std::max(s.drift, std::abs(com_vx(k) / com_vx(landed) - 1));
+    s.end_speed = com_vx(run.size() - 1);
+    s.end_tilt = run.q(run.size() - 1, 0)[2];
+    return s;
+  };
+  const Slide off = slide({}, "out/fig4_10");
+  const Slide off_fine = slide({{"DT", "0.0005"}}, "out/fig4_10");
+  EXPECT_LT(off.drift, 2e-3);
+  EXPECT_LT(off_fine.drift, off.drift / 1.6);
+  EXPECT_GT(off.end_speed, 100.0);  // still sliding at the end
+  const Slide on = slide({{"FRSIN", "0.8"}, {"FIG", "fig4_11"}}, "out/fig4_11");
+  EXPECT_LT(std::abs(on.end_speed), 0.1);
+  EXPECT_LT(std::abs(on.end_tilt), 1e-3);  // upright
 }
 
 // A script's runs are drawn only through the hook the CLI installs; a script with nothing run,
