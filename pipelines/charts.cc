@@ -104,11 +104,52 @@ vtkSmartPointer<vtkImageData> RenderChart(const ChartSpec& spec) {
   return Grab(view);
 }
 
+RobustRange RobustYRange(const std::vector<ChartSeries>& series) {
+  std::vector<double> v;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const ChartSeries& s : series)
+    for (size_t i = 0; i < s.y.size() && i < s.x.size(); ++i)
+      if (std::isfinite(s.y[i]) && std::isfinite(s.x[i])) {
+        v.push_back(s.y[i]);
+        lo = std::min(lo, s.y[i]);
+        hi = std::max(hi, s.y[i]);
+      }
+  RobustRange r{lo, hi, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+  if (v.size() < 10) return r;
+  auto rank = [&](double fraction) {
+    const size_t k = std::min(v.size() - 1, size_t(fraction * double(v.size() - 1) + 0.5));
+    std::nth_element(v.begin(), v.begin() + long(k), v.end());
+    return v[k];
+  };
+  const double q_lo = rank(0.02), q_hi = rank(0.98), span = q_hi - q_lo;
+  if (!(span > 0)) return r;
+  const bool cut_high = hi > q_hi + span, cut_low = lo < q_lo - span;
+  if (!cut_high && !cut_low) return r;
+  if (cut_high) r.hi = q_hi + 0.25 * span;
+  if (cut_low) r.lo = q_lo - 0.25 * span;
+  // the value farthest off the scale, to name in the title
+  double worst = 0;
+  for (const ChartSeries& s : series)
+    for (size_t i = 0; i < s.y.size() && i < s.x.size(); ++i) {
+      if (!std::isfinite(s.y[i]) || !std::isfinite(s.x[i])) continue;
+      const double off = std::max(s.y[i] - r.hi, r.lo - s.y[i]);
+      if (off > worst) worst = off, r.cut_y = s.y[i], r.cut_x = s.x[i];
+    }
+  return r;
+}
+
 void FillChart(vtkChartXY* chart, const ChartSpec& spec) {
   Validate(spec);
   chart->ClearPlots();
   chart->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::AUTO);
   chart->SetTitle(spec.title);
+  const RobustRange robust = spec.robust_y && !spec.log_y ? RobustYRange(spec.series) : RobustRange{1, 0, NAN, NAN};
+  if (std::isfinite(robust.cut_y)) {
+    char note[96];
+    std::snprintf(note, sizeof note, " (%s %.3g at x = %.3g off the scale)", robust.cut_y > robust.hi ? "peak" : "dip",
+                  robust.cut_y, robust.cut_x);
+    chart->SetTitle(spec.title + note);
+  }
   chart->GetTitleProperties()->SetFontSize(16);
   chart->SetShowLegend(true);
   // beside the plot area (not inline), so that it never covers data; inline in small charts
@@ -153,7 +194,12 @@ void FillChart(vtkChartXY* chart, const ChartSpec& spec) {
   // VTK 9.1 draws no line when a plot's y range is tiny next to its magnitude (e.g. log10
   // cond(M) between 5.38 and 5.42): give such an axis a fixed, wider range: whole decades on
   // a log axis, at least ±5% of the magnitude on a linear one
-  if (ylo <= yhi) {
+  if (std::isfinite(robust.cut_y)) {  // a spike: the bulk's range (clipped lines run off the plot)
+    ylo = robust.lo;
+    yhi = robust.hi;
+    chart->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::FIXED);
+    chart->GetAxis(vtkAxis::LEFT)->SetRange(ylo, yhi);
+  } else if (ylo <= yhi) {
     double lo = ylo, hi = yhi;
     if (spec.log_y) {
       lo = std::floor(ylo);

@@ -35,8 +35,21 @@ struct ChartSpec {
   // The legend beside the plot area instead of over it. RenderChart sets it for charts at
   // least kLegendBesideWidth wide (files); FillChart's callers (the viewer's panels) choose.
   bool legend_beside = false;
+  // A linear y axis ignores a spike: when some values lie more than the bulk's span (the 2nd
+  // to 98th percentile of every value plotted) beyond it, the axis shows the bulk with a
+  // quarter span's margin, and the title says what was cut ("peak 1.3e9 at x = 0.41 off
+  // the scale"). The CSV keeps every value.
+  bool robust_y = true;
 };
 constexpr int kLegendBesideWidth = 600;
+
+// The y range a linear axis shows for these values (robust_y above), and the value farthest
+// outside it (NaN when nothing is cut); lo > hi for no finite value.
+struct RobustRange {
+  double lo, hi;
+  double cut_y, cut_x;
+};
+RobustRange RobustYRange(const std::vector<ChartSeries>& series);
 
 // Renders the chart offscreen (RGB image, bottom row first). Throws std::invalid_argument for
 // a malformed spec, std::runtime_error without a display.

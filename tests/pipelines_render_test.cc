@@ -90,6 +90,35 @@ TEST(Charts, WholeNumberTicksAndALegendBesideThePlot) {
   EXPECT_FALSE(chart->GetLegend()->GetInline());
 }
 
+// One spike does not flatten the rest: the axis shows the bulk, the title names the peak, and
+// without a spike the range is the data's.
+TEST(Charts, OneSpikeLeavesTheBulkReadable) {
+  ChartSeries s;
+  for (int i = 0; i < 200; ++i) s.x.push_back(0.01 * i), s.y.push_back(std::sin(0.1 * i));
+  s.y[41] = 1000;  // one sample, 500 spans above the rest
+  const RobustRange r = RobustYRange({s});
+  EXPECT_EQ(r.cut_y, 1000.0);
+  EXPECT_DOUBLE_EQ(r.cut_x, 0.41);
+  EXPECT_GT(r.hi, 0.99);  // the sine's top is in view ...
+  EXPECT_LT(r.hi, 1.6);   // ... the spike is not
+  EXPECT_EQ(r.lo, -1.0 * std::abs(*std::min_element(s.y.begin(), s.y.end())));  // no dip: the data's low end
+  ChartSpec spec;
+  spec.title = "energy";
+  spec.series = {s};
+  auto chart = vtkSmartPointer<vtkChartXY>::New();
+  FillChart(chart, spec);
+  EXPECT_EQ(chart->GetAxis(vtkAxis::LEFT)->GetMaximum(), r.hi);
+  EXPECT_NE(std::string(chart->GetTitle()).find("peak 1e+03 at x = 0.41 off the scale"), std::string::npos)
+      << chart->GetTitle();
+  s.y[41] = std::sin(4.1);
+  const RobustRange plain = RobustYRange({s});
+  EXPECT_TRUE(std::isnan(plain.cut_y));
+  EXPECT_EQ(plain.hi, *std::max_element(s.y.begin(), s.y.end()));
+  spec.series = {s};
+  FillChart(chart, spec);
+  EXPECT_EQ(std::string(chart->GetTitle()), "energy");
+}
+
 TEST(RenderRegression, LatticeView) {
   REQUIRE_DISPLAY();
   CompareWithBaseline("lattice", RenderLayer(OnlyLayer("lattice")));
