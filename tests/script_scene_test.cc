@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <sstream>
 
 #include "wobble/script/interpreter.h"
+#include "wobble/script/variables.h"
 
 namespace wobble {
 namespace {
@@ -167,6 +170,37 @@ TEST(SceneScript, Fig2PendulumKeepsItsNailJointsAndEnergyAndRendersEveryFrame) {
   EXPECT_LT(std::abs(w.TotalEnergy()), 0.01 * 3 * 9.81 * 1.5);
   // it swung: the tip is well below where it started
   EXPECT_LT(interp.scene().Point("tip")[1], -0.5);
+}
+
+// Witkin & Welch Fig. 4 over a range of the humanoid's starting positions: `wait_for near` fires
+// when the heart comes within 0.8 of the skewer's tip, at t = X0 − 3.5 − √(0.8² − 0.2²) (it walks
+// at 1 along y = 0.5, the tip at (3.5, 0.3)); then the skewer grabs the heart and the heart ends
+// in the jaws, the tip with it.
+TEST(SceneScript, Fig4MonsterWaitsForTheHumanoidWhereverItStarts) {
+  std::ifstream file(kData + "/ww_fig4_monster.wob");
+  std::stringstream text;
+  text << file.rdbuf();
+  for (double x0 : {5.0, 7.0, 9.0, 12.0}) {
+    SCOPED_TRACE(x0);
+    std::ostringstream out;
+    script::Interpreter interp(out);
+    interp.SetSceneRenderHook([](const script::SceneRenderRequest&) { return std::vector<std::string>{}; });
+    char value[32];
+    std::snprintf(value, sizeof value, "%g", x0);
+    std::istringstream in(script::ExpandVariables(text.str(), {{"X0", value}, {"END", "10"}}, "ww_fig4_monster.wob"));
+    interp.RunStream(in, "ww_fig4_monster.wob", kData);
+    // "  t = 2.726: chase tip -> heart in 0.3" in the scene's log
+    const std::string log = out.str();
+    const size_t at = log.find(": chase tip -> heart");
+    ASSERT_NE(at, std::string::npos) << log;
+    const size_t t_at = log.rfind("t = ", at);
+    const double fired = std::stod(log.substr(t_at + 4, at - t_at - 4));
+    EXPECT_NEAR(fired, x0 - 3.5 - std::sqrt(0.8 * 0.8 - 0.2 * 0.2), 2e-3);
+    const scene::Scene& scene = interp.scene();
+    EXPECT_LT((scene.Point("heart") - scene.Point("jaws")).norm(), 1e-6);
+    EXPECT_LT((scene.Point("tip") - scene.Point("heart")).norm(), 1e-6);
+    EXPECT_LT((scene.Point("base_l") - (Eigen::VectorXd(2) << -1.5, -1).finished()).norm(), 1e-6);  // still nailed
+  }
 }
 
 TEST(SceneScript, AThinStiffBodyWarnsAboutTheTimeStep) {
