@@ -281,6 +281,32 @@ TEST(Interpreter, OutputWritesOneRowPerRecordedStep) {
 namespace wobble {
 namespace {
 
+// A data/ script with its ${NAME}s filled, run in a fresh temporary working folder (where its
+// outputs land) with a render hook that keeps what `render` asked for.
+struct DataScriptRun {
+  std::ostringstream out;
+  script::Interpreter interp{out};
+  script::RenderRequest drawn;
+  std::filesystem::path dir;
+};
+std::unique_ptr<DataScriptRun> RunDataScript(const std::string& name, const std::map<std::string, std::string>& values = {}) {
+  auto run = std::make_unique<DataScriptRun>();
+  run->dir = std::filesystem::temp_directory_path() / ("wobble_" + name);
+  std::filesystem::remove_all(run->dir);
+  std::filesystem::create_directories(run->dir);
+  const auto cwd = std::filesystem::current_path();
+  std::filesystem::current_path(run->dir);
+  DataScriptRun* r = run.get();
+  r->interp.SetRenderHook([r](const script::RenderRequest& request) { r->drawn = request; });
+  std::ifstream file(kData + "/" + name);
+  std::stringstream text;
+  text << file.rdbuf();
+  std::istringstream in(script::ExpandVariables(text.str(), values, name));
+  r->interp.RunStream(in, name, kData);
+  std::filesystem::current_path(cwd);
+  return run;
+}
+
 // Fig. 4.12: the keyframed jump hands over to the simulation; the table leaves the cliff top
 // (y = 300 up to x = 340, a terrain face, as is the cliff and the valley floor y = 0: no mass
 // point goes below the top while over it after the hand-over), lands on the valley floor on its
@@ -288,17 +314,10 @@ namespace {
 // and at t = 3: |θ| < 1e-3, |ṫ| < 0.1 cm/s, |θ̇| < 1e-3, kinetic energy below 1e-4 of m g h
 // (h = 300, the cliff; g = 981 cm/s²), both feet on the floor (within 1) past the cliff.
 TEST(CliffJump, LeavesTheCliffLandsUprightOnTheFloorAndSettles) {
-  const auto dir = std::filesystem::temp_directory_path() / "wobble_cliff_test";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  const auto cwd = std::filesystem::current_path();
-  std::filesystem::current_path(dir);
-  std::ostringstream out;
-  script::Interpreter interp(out);
-  script::RenderRequest drawn;
-  interp.SetRenderHook([&](const script::RenderRequest& r) { drawn = r; });
-  interp.RunFile(kData + "/table_cliff.wob");
-  std::filesystem::current_path(cwd);
+  const std::unique_ptr<DataScriptRun> cliff = RunDataScript("table_cliff.wob");
+  script::Interpreter& interp = cliff->interp;
+  const script::RenderRequest& drawn = cliff->drawn;
+  const std::filesystem::path& dir = cliff->dir;
   ASSERT_TRUE(drawn.trajectory);
   const record::Trajectory& states = *drawn.trajectory;
   const BodyModel& table = *states.bodies()[0].ffd;  // bend, shear, vsquash: every mode of the two runs
@@ -364,35 +383,15 @@ TEST(CliffJump, LeavesTheCliffLandsUprightOnTheFloorAndSettles) {
 // horizontal speed (the thesis scheme integrates (t, θ), not the centre of mass, so while the
 // pot rocks it keeps it to O(Δt): halving Δt must shrink the drift at least 1.6-fold). Friction
 // on: the slide stops and the pot rests upright.
-record::Trajectory RunPotScript(const std::map<std::string, std::string>& values, std::string* dir_drawn) {
-  const auto dir = std::filesystem::temp_directory_path() / "wobble_pot_test";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  const auto cwd = std::filesystem::current_path();
-  std::filesystem::current_path(dir);
-  std::ostringstream out;
-  script::Interpreter interp(out);
-  script::RenderRequest drawn;
-  interp.SetRenderHook([&](const script::RenderRequest& r) { drawn = r; });
-  std::ifstream file(kData + "/fig4_10_11_pot.wob");
-  std::stringstream text;
-  text << file.rdbuf();
-  std::istringstream in(script::ExpandVariables(text.str(), values, "fig4_10_11_pot.wob"));
-  interp.RunStream(in, "fig4_10_11_pot.wob", kData);
-  std::filesystem::current_path(cwd);
-  if (!drawn.trajectory) throw std::runtime_error("the pot script rendered nothing");
-  *dir_drawn = drawn.dir;
-  return *drawn.trajectory;
-}
-
 TEST(PotFriction, FrictionOffKeepsTheHorizontalSpeedOnSlidesStopsUpright) {
   struct Slide {
     double drift, end_speed, end_tilt;
   };
   auto slide = [](const std::map<std::string, std::string>& values, const std::string& expected_dir) {
-    std::string dir;
-    const record::Trajectory run = RunPotScript(values, &dir);
-    EXPECT_EQ(dir, expected_dir);
+    const std::unique_ptr<DataScriptRun> script = RunDataScript("fig4_10_11_pot.wob", values);
+    EXPECT_EQ(script->drawn.dir, expected_dir);
+    if (!script->drawn.trajectory) throw std::runtime_error("the pot script rendered nothing");
+    const record::Trajectory& run = *script->drawn.trajectory;
     const BodyModel& pot = *run.bodies()[0].ffd;
     EXPECT_EQ(pot.num_modes(), 0);
     const Eigen::Vector2d c = pot.moments().c0 / pot.moments().m;
