@@ -36,13 +36,12 @@ int FirstAtOrAfter(const record::Trajectory& run, double t) {
   return lo;
 }
 
-// The sample nearest time t (the first of equals), as Trajectory::Nearest but by bisection.
-int NearestSample(const record::Trajectory& run, double t) {
+// The last sample at or before time t (0 when t is before every sample): a frame between two
+// samples is drawn from the state interpolated between them (Trajectory::RestoreAt).
+int SampleAtOrBefore(const record::Trajectory& run, double t) {
   const int after = FirstAtOrAfter(run, t);
-  if (after == 0) return 0;
-  const double before = run.time(after - 1);
-  if (after == run.size() || std::abs(before - t) <= std::abs(run.time(after) - t)) return FirstAtOrAfter(run, before);
-  return after;
+  if (after < run.size() && run.time(after) == t) return after;
+  return std::max(after - 1, 0);
 }
 
 // Puts the run's samples back into a world one after the other up to the one asked for, so
@@ -56,6 +55,12 @@ class Replay {
     for (int i = at_ + 1; i <= k; ++i) run_.Restore(i, *world_);
     at_ = k;
   }
+  // The world at time t, from sample k (the last at or before t) on: between two samples the
+  // state is interpolated, so frames are at their exact times, not snapped to the steps.
+  void At(int k, double t) {
+    To(k);
+    if (t != run_.time(k)) run_.RestoreAt(t, *world_);
+  }
 
  private:
   const record::Trajectory& run_;
@@ -63,12 +68,13 @@ class Replay {
   int at_ = -1;
 };
 
-// What is drawn at one sample: frames first, then filmstrip panels (so a panel's trails hold
-// the frames before it).
+// What is drawn at one time t, from the samples at or before it: frames first, then filmstrip
+// panels (so a panel's trails hold the frames before it).
 struct Visit {
-  int sample;
+  int sample;  // the last at or before t
   long frame;  // -1: a panel
   int panel;   // -1: a frame
+  double t;
   bool operator<(const Visit& o) const {
     if (sample != o.sample) return sample < o.sample;
     if ((frame < 0) != (o.frame < 0)) return frame >= 0;
@@ -84,11 +90,11 @@ std::vector<Visit> PlanVisits(const record::Trajectory& run, const RenderOutputs
   if (out.fps > 0) {
     const long wanted = long(std::floor((t1 - t0) * out.fps + 1e-9)) + 1;
     for (long k = 0; k < wanted && reached(t0 + double(k) / out.fps); ++k)
-      visits.push_back({NearestSample(run, t0 + double(k) / out.fps), k, -1});
+      visits.push_back({SampleAtOrBefore(run, t0 + double(k) / out.fps), k, -1, t0 + double(k) / out.fps});
     *num_frames = long(visits.size());
   } else {
     *num_frames = run.size();
-    for (int k = 0; k < run.size(); ++k) visits.push_back({k, k, -1});
+    for (int k = 0; k < run.size(); ++k) visits.push_back({k, k, -1, run.time(k)});
   }
   if (out.filmstrip) {
     std::vector<double> times = out.filmstrip_times;
@@ -96,7 +102,7 @@ std::vector<Visit> PlanVisits(const record::Trajectory& run, const RenderOutputs
       for (int k = 0; k < 6; ++k) times.push_back(t0 + (t1 - t0) * k / 5.0);
     int panel = 0;
     for (double t : times)
-      if (reached(t)) visits.push_back({NearestSample(run, t), -1, panel++});
+      if (reached(t)) visits.push_back({SampleAtOrBefore(run, t), -1, panel++, t});
   }
   std::stable_sort(visits.begin(), visits.end());
   return visits;
@@ -253,7 +259,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     const bool fixed_range = out.view.color_range[0] < out.view.color_range[1];
     Replay replay(run, &world);
     for (const Visit& v : visits) {
-      replay.To(v.sample);
+      replay.At(v.sample, v.t);
       const Eigen::AlignedBox3d bodies = SceneBounds(world, spec);
       motion.extend(bodies);
       if (follow) moments.push_back(FollowMomentNow(world, bodies));
@@ -302,7 +308,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       interrupted = true;
       break;
     }
-    replay.To(v.sample);
+    replay.At(v.sample, v.t);
     if (!follow_boxes.empty()) {
       const Eigen::AlignedBox2d& box = follow_boxes[size_t(&v - visits.data())];
       for (SceneView* sv : {view.get(), strip_view.get()})

@@ -36,7 +36,8 @@ struct RenderOutputs {
   std::string name = "run";   // stem of the .pvd
   bool frames = true, filmstrip = true, charts = false, vtp = true, exr = false, disp = false;
   // Frames at t0 + k/fps (t0 the first sample's time) up to t_end, those the run reached (up
-  // to half a step after its last sample), each showing the sample nearest its time; fps 0:
+  // to half a step after its last sample), each at its exact time: the state interpolated
+  // between the samples around it (record::Trajectory::RestoreAt); fps 0:
   // every sample is a frame.
   double fps = 0.0;
   // The run's intended end, for the frames and the default filmstrip times; empty: the last

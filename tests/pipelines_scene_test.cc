@@ -313,22 +313,43 @@ TEST(SceneRun, AWorldOfBothKindsExportsEachSamplesTimeValue) {
   fs::remove_all(out.folder);
 }
 
-TEST(SceneRun, FramesAtAnFpsShowTheSampleNearestTheirTime) {
+// Frames at their exact times: between two samples every coordinate is blended linearly, so
+// the table's points in a frame's .vtp are those of the blended state, and its TimeValue is k/7.
+TEST(SceneRun, FramesAtAnFpsAreAtTheirExactTimes) {
   const MixedRun mixed;
   const record::Trajectory& run = *mixed.run;
   RenderOutputs out;
   out.folder = testing::TempDir("scene_mixed_fps");
   out.name = "mixed";
   out.frames = out.filmstrip = false;
-  out.fps = 7;  // frames at k/7 s up to 0.5; samples every 0.05 s: the nearest are 0, 0.15, 0.3, 0.45
+  out.fps = 7;  // frames at k/7 s up to 0.5; samples every 0.05 s
   World world = WorldFor(run, mixed.options);
   const RenderReport report = RenderTrajectory(world, run, mixed.spec, out);
   EXPECT_EQ(report.frames, 4);
-  const double expected[] = {0.0, 0.15, 0.3, 0.45};
+  World blended = WorldFor(run, mixed.options);
   for (int k = 0; k < 4; ++k) {
+    SCOPED_TRACE(k);
     char number[16];
     std::snprintf(number, sizeof(number), "_%04d.vtp", k);
-    EXPECT_NEAR(TimeValueOf(out.folder + "/vtp/table_points" + number), expected[k], 1e-9) << k;
+    const std::string vtp = out.folder + "/vtp/table_points" + number;
+    const double t = k / 7.0;
+    EXPECT_NEAR(TimeValueOf(vtp), t, 1e-12);
+    int a = 0;
+    while (a + 1 < run.size() && run.time(a + 1) <= t) ++a;
+    const double alpha = a + 1 < run.size() ? (t - run.time(a)) / (run.time(a + 1) - run.time(a)) : 0.0;
+    const int b = std::min(a + 1, run.size() - 1);
+    blended.SetState(0, (1 - alpha) * run.q(a, 0) + alpha * run.q(b, 0), (1 - alpha) * run.qd(a, 0) + alpha * run.qd(b, 0));
+    const std::vector<Eigen::Vector2d> expected = blended.PointPositions(0);
+    auto reader = Ptr<vtkXMLPolyDataReader>::New();
+    reader->SetFileName(vtp.c_str());
+    reader->Update();
+    vtkPolyData* points = reader->GetOutput();
+    ASSERT_EQ(points->GetNumberOfPoints(), vtkIdType(expected.size()));
+    for (vtkIdType i = 0; i < points->GetNumberOfPoints(); ++i) {
+      double x[3];
+      points->GetPoint(i, x);
+      EXPECT_LT((Eigen::Vector2d(x[0], x[1]) - expected[size_t(i)]).norm(), 1e-9);
+    }
   }
   EXPECT_FALSE(fs::exists(out.folder + "/vtp/table_points_0004.vtp"));
   fs::remove_all(out.folder);

@@ -106,6 +106,54 @@ TEST(Trajectory, RestoreReplaysTheRun) {
   }
 }
 
+// RestoreAt: at a sample's time it is Restore; between two samples every coordinate is the
+// linear blend (a 3D body's quaternion normalised), the clock at t; past the last sample, the
+// last sample.
+TEST(Trajectory, RestoreAtInterpolatesBetweenSamples) {
+  DroppedTable d(4);
+  for (int n = 0; n < 80; ++n) ASSERT_TRUE(d.world.Step());
+  const record::Trajectory& run = *d.trajectory;
+  World at(WorldOptions{}), exact(WorldOptions{});
+  at.AddBody(d.world.shared_body(0));
+  exact.AddBody(d.world.shared_body(0));
+  run.RestoreAt(run.time(7), at);
+  run.Restore(7, exact);
+  EXPECT_EQ(at.state(0).q, exact.state(0).q);
+  EXPECT_EQ(at.state(0).qd, exact.state(0).qd);
+  const double t = run.time(7) + 0.3 * (run.time(8) - run.time(7));
+  run.RestoreAt(t, at);
+  EXPECT_EQ(at.time(), t);
+  const Eigen::VectorXd q = 0.7 * run.q(7, 0) + 0.3 * run.q(8, 0), qd = 0.7 * run.qd(7, 0) + 0.3 * run.qd(8, 0);
+  EXPECT_LT((at.state(0).q - q).norm(), 1e-12 * (1 + q.norm()));
+  EXPECT_LT((at.state(0).qd - qd).norm(), 1e-12 * (1 + qd.norm()));
+  run.RestoreAt(run.time(run.size() - 1) + 1.0, at);
+  EXPECT_EQ(at.state(0).q, run.q(run.size() - 1, 0));
+
+  // a 3D body turning: the orientation between two samples is the normalised blend
+  World w3(WorldOptions{});
+  w3.mutable_options().ground_3d.enabled = false;
+  const int b = w3.AddBody(std::make_shared<const BodyModel3>(testing::Chair3()));
+  const Eigen::VectorXd g0 = Eigen::VectorXd::Zero(w3.body3(b).num_modes());
+  w3.SetState3(b, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), g0,
+               (Eigen::VectorXd(6 + g0.size()) << Eigen::VectorXd::Zero(3), 0.5, 2.0, -1.0, g0).finished());
+  auto run3 = std::make_shared<record::Trajectory>(w3);
+  auto rec3 = std::make_shared<record::Recorder>(run3, 10);
+  rec3->Start(w3);
+  w3.SetRecorder(rec3);
+  for (int n = 0; n < 40; ++n) ASSERT_TRUE(w3.Step()) << w3.status().message;
+  World at3(WorldOptions{});
+  at3.mutable_options().ground_3d.enabled = false;
+  at3.AddBody(w3.shared_body3(b));
+  const double t3 = 0.5 * (run3->time(2) + run3->time(3));
+  run3->RestoreAt(t3, at3);
+  const Eigen::Map<const Eigen::VectorXd> qa = run3->q(2, b), qb = run3->q(3, b);
+  const Eigen::Vector4d wxyz = 0.5 * (qa.segment<4>(3) + qb.segment<4>(3));  // recorded as qw qx qy qz
+  const Eigen::Quaterniond mid = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).normalized();
+  EXPECT_LT(std::abs(std::abs(at3.state3(b).orientation.dot(mid)) - 1.0), 1e-12);
+  EXPECT_LT((at3.state3(b).t - 0.5 * (qa.head<3>() + qb.head<3>())).norm(), 1e-12);
+  EXPECT_EQ(at3.time(), t3);
+}
+
 // One clock for every body: an FFD body nailed to a linear block in one world moves with the
 // world's time (the old constrained world kept its FFD bodies on a clock that never moved).
 TEST(Trajectory, FfdBodyInAConstraintSceneHasTheWorldsTime) {

@@ -182,25 +182,57 @@ int Trajectory::contacts(int k, int body) const { return int(Row(k)[layout_[body
 double Trajectory::penetration(int k, int body) const { return Row(k)[layout_[body].contacts + 1]; }
 
 void Trajectory::Restore(int k, World& world) const {
+  RestoreRow(Row(k), world);
+  world.SetTime(time(k));
+}
+
+void Trajectory::RestoreRow(const double* row, World& world) const {
   if (world.num_bodies() != num_bodies()) throw std::invalid_argument("Trajectory::Restore: another world's trajectory");
   for (int b = 0; b < num_bodies(); ++b) {
+    const Eigen::Map<const Eigen::VectorXd> qb(row + layout_[b].q, bodies_[b].num_q),
+        qdb(row + layout_[b].qd, bodies_[b].num_v), targets(row + layout_[b].targets, layout_[b].num_targets);
     if (bodies_[b].kind == BodyKind::kFfd) {
-      world.SetState(b, q(k, b), qd(k, b));
-      const Eigen::VectorXd t = targets(k, b);
-      world.SetModeTargets(b, t.isZero(0.0) ? Eigen::VectorXd() : t);
+      world.SetState(b, qb, qdb);
+      world.SetModeTargets(b, targets.isZero(0.0) ? Eigen::VectorXd() : Eigen::VectorXd(targets));
     } else if (bodies_[b].kind == BodyKind::kFfd3) {
-      const Eigen::Map<const Eigen::VectorXd> qk = q(k, b);
-      const Eigen::Quaterniond o(qk[3], qk[4], qk[5], qk[6]);  // unit as recorded, to rounding
-      world.SetState3(b, qk.head<3>(), o.normalized(), qk.tail(bodies_[b].num_modes()), qd(k, b));
-      const Eigen::VectorXd t = targets(k, b);
-      world.SetModeTargets(b, t.isZero(0.0) ? Eigen::VectorXd() : t);
+      const Eigen::Quaterniond o(qb[3], qb[4], qb[5], qb[6]);  // unit as recorded, to rounding
+      world.SetState3(b, qb.head<3>(), o.normalized(), qb.tail(bodies_[b].num_modes()), qdb);
+      world.SetModeTargets(b, targets.isZero(0.0) ? Eigen::VectorXd() : Eigen::VectorXd(targets));
     } else {
       const int d = bodies_[b].dim, n = bodies_[b].num_q / d;
-      world.SetLinearState(b, Eigen::Map<const RowMajor>(q(k, b).data(), d, n),
-                           Eigen::Map<const RowMajor>(qd(k, b).data(), d, n));
+      world.SetLinearState(b, Eigen::Map<const RowMajor>(qb.data(), d, n), Eigen::Map<const RowMajor>(qdb.data(), d, n));
     }
   }
-  world.SetTime(time(k));
+}
+
+void Trajectory::RestoreAt(double t, World& world) const {
+  if (empty()) throw std::invalid_argument("Trajectory::RestoreAt: no samples");
+  // the last sample at or before t (the first when t is before it)
+  int k = 0, above = size();
+  while (above - k > 1) {
+    const int mid = (k + above) / 2;
+    if (time(mid) <= t) k = mid;
+    else above = mid;
+  }
+  if (k + 1 == size() || !(t > time(k))) {
+    Restore(k, world);
+    world.SetTime(t);
+    return;
+  }
+  const double alpha = (t - time(k)) / (time(k + 1) - time(k));
+  const double *a = Row(k), *b = Row(k + 1);
+  std::vector<double> row(static_cast<size_t>(width_));
+  for (int i = 0; i < width_; ++i) row[size_t(i)] = a[i] + alpha * (b[i] - a[i]);
+  for (int body = 0; body < num_bodies(); ++body) {  // a quaternion and its negative are one turn
+    if (bodies_[body].kind != BodyKind::kFfd3) continue;
+    const int o = layout_[body].q + 3;
+    double dot = 0;
+    for (int i = 0; i < 4; ++i) dot += a[o + i] * b[o + i];
+    if (dot < 0)
+      for (int i = 0; i < 4; ++i) row[size_t(o + i)] = a[o + i] + alpha * (-b[o + i] - a[o + i]);
+  }
+  RestoreRow(row.data(), world);
+  world.SetTime(t);
 }
 
 int Trajectory::Nearest(double t) const {

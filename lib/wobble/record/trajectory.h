@@ -88,10 +88,16 @@ class Trajectory {
   // Puts the bodies of sample k back into `world` (same bodies) and its clock at the sample's
   // time; PD targets too. Constraints are not touched.
   void Restore(int k, World& world) const;
+  // The bodies at time t between the samples around it, every number interpolated linearly (a
+  // 3D orientation's quaternion on the shorter arc, then normalised) and the clock at t
+  // exactly; before the first or after the last sample, that sample with the clock at t. For
+  // frames at exact frame times, which the step grid need not hit (the render driver).
+  void RestoreAt(double t, World& world) const;
   // The sample nearest to time t (the first of equals).
   int Nearest(double t) const;
 
  private:
+  void RestoreRow(const double* row, World& world) const;  // Restore's state part
   struct Layout {
     int q = 0, qd = 0, targets = 0, energies = 0, contacts = 0;
     int num_targets = 0;
