@@ -3,6 +3,7 @@
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
+#include <Imath/half.h>
 #include <ImfIO.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
@@ -111,7 +112,16 @@ void WriteExrChannels(const std::string& path, int width, int height, const std:
       case ExrCompression::kPiz: header.compression() = Imf::PIZ_COMPRESSION; break;
     }
     Imf::FrameBuffer fb;
+    std::vector<std::vector<Imath::half>> halves;  // the half channels' values, converted here
+    halves.reserve(channels.size());
     for (const ExrChannel& c : channels) {
+      if (c.half) {
+        halves.emplace_back(c.data.begin(), c.data.end());
+        header.channels().insert(c.name, Imf::Channel(Imf::HALF));
+        fb.insert(c.name, Imf::Slice(Imf::HALF, (char*)halves.back().data(), sizeof(Imath::half),
+                                     sizeof(Imath::half) * size_t(width)));
+        continue;
+      }
       header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
       fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.data.data(), sizeof(float), sizeof(float) * size_t(width)));
     }

@@ -16,6 +16,7 @@ namespace wobble::pipelines {
 struct ExrChannel {
   std::string name;         // e.g. "R", "depth.Z", "disp.X", "cond"
   std::vector<float> data;  // width * height values, row 0 at the top
+  bool half = false;        // stored as 16-bit half floats (colour); read back as float
 };
 
 // kRle is the fastest and suits rendered 2D frames (large flat areas); kZip is smaller for data.

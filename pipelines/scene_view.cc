@@ -1,6 +1,7 @@
 #include "pipelines/scene_view.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -506,8 +507,18 @@ std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
   auto eye_distance = [&](double d) {
     return parallel ? range[0] + d * (range[1] - range[0]) : range[0] * range[1] / (range[1] - d * (range[1] - range[0]));
   };
-  std::vector<ExrChannel> ch = {{"R", {}}, {"G", {}}, {"B", {}}, {"A", {}}, {"depth.Z", {}}};
+  // colour and alpha as half floats, the compositors' usual (and half the bytes to compress);
+  // colour in linear light: the frame buffer holds sRGB-encoded 8-bit values (IEC 61966-2-1)
+  std::vector<ExrChannel> ch = {{"R", {}, true}, {"G", {}, true}, {"B", {}, true}, {"A", {}, true}, {"depth.Z", {}}};
   for (ExrChannel& c : ch) c.data.resize(size_t(w) * h);
+  static const std::array<float, 256> linear = [] {
+    std::array<float, 256> lut;
+    for (int v = 0; v < 256; ++v) {
+      const double c = v / 255.0;
+      lut[size_t(v)] = float(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+    }
+    return lut;
+  }();
   const auto* px = static_cast<const unsigned char*>(rgb->GetScalarPointer());
   const float* zp = z->GetPointer(0);
   const float inf = std::numeric_limits<float>::infinity();
@@ -518,7 +529,7 @@ std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
       const float d = zp[in];
       const bool drawn = d < 1.0f;
       const float a = drawn ? 1.0f : 0.0f;
-      for (int c = 0; c < 3; ++c) ch[c].data[out] = a * (px[3 * in + c] / 255.0f);
+      for (int c = 0; c < 3; ++c) ch[c].data[out] = a * linear[px[3 * in + c]];
       ch[3].data[out] = a;
       ch[4].data[out] = drawn ? float(eye_distance(d)) : inf;
     }

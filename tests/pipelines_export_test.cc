@@ -47,6 +47,10 @@ using testing::AirborneWorld;
 using testing::IndependentWorldPoint;
 using testing::TempDir;
 
+// The sRGB transfer function's inverse (IEC 61966-2-1): what an 8-bit display value c is in
+// linear light.
+double SrgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
+
 std::string ReadAll(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream ss;
@@ -275,8 +279,8 @@ TEST(RenderedExr, CameraAndTimeInTheHeaderAtKnownPixels) {
     if (px < 2 || py < 2 || px >= img.width - 2 || py >= img.height - 2) continue;
     SCOPED_TRACE(std::to_string(px) + ", " + std::to_string(py));
     EXPECT_EQ(img.At("A", px, py), 1.0f);
-    EXPECT_NEAR(img.At("R", px, py), 0.85, 1.5 / 255);  // the mass points' red
-    EXPECT_NEAR(img.At("G", px, py), 0.2, 1.5 / 255);
+    EXPECT_NEAR(img.At("R", px, py), SrgbToLinear(0.85), 5e-3);  // the mass points' red
+    EXPECT_NEAR(img.At("G", px, py), SrgbToLinear(0.2), 2e-3);
     // the camera looks along +z of its space: the depth of a point drawn in front of it
     const double z = times(at, *img.metadata.world_to_camera).z();
     EXPECT_GT(z, 0.0);
@@ -312,10 +316,11 @@ TEST(RenderedExr, ColourAlphaAndDepthAtKnownPixels) {
   renderer->GetActiveCamera()->GetPosition(cam);
   EXPECT_NEAR(img.At("depth.Z", 10, 110), cam[2], 1e-3 * cam[2]);
   EXPECT_EQ(img.At("A", 10, 110), 1.0f);
-  // the ground's colour (0.55, 0.47, 0.38), 8-bit in the frame buffer
-  EXPECT_NEAR(img.At("R", 10, 110), 0.55, 1.0 / 255);
-  EXPECT_NEAR(img.At("G", 10, 110), 0.47, 1.0 / 255);
-  EXPECT_NEAR(img.At("B", 10, 110), 0.38, 1.0 / 255);
+  // the ground's colour (0.55, 0.47, 0.38), 8-bit sRGB in the frame buffer, in linear light
+  // in the EXR (IEC 61966-2-1), stored as half floats (11 significant bits)
+  EXPECT_NEAR(img.At("R", 10, 110), SrgbToLinear(0.55), 2.5e-3);
+  EXPECT_NEAR(img.At("G", 10, 110), SrgbToLinear(0.47), 2.5e-3);
+  EXPECT_NEAR(img.At("B", 10, 110), SrgbToLinear(0.38), 2.5e-3);
   // pixel (80, 10) is at world y = 200 − 10.5·2.5 = 173.75, above the table: nothing drawn
   EXPECT_TRUE(std::isinf(img.At("depth.Z", 80, 10)));
   EXPECT_EQ(img.At("A", 80, 10), 0.0f);
