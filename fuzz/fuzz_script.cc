@@ -24,25 +24,45 @@ namespace fs = std::filesystem;
 // The harness's own stop: a script asked for more steps than one input may take.
 struct WorkBudgetSpent {};
 
-// The scene's limits for one run, and the harness's budget for every run of one input: 4000
-// steps of a body of the table's 11 mass points, fewer for a larger body (a step costs about
-// its points: the pot's took 0.7 ms under ASan, the 3D table's 1.8 ms), so that an input costs
-// tens of milliseconds, not seconds (the limits themselves are fuzzed either way, since
-// scripts that ask for more are refused).
+// The scene's limits for one run, and the harness's budget for every run of one input, in
+// table-steps: 300 steps of a body of the table's 11 mass points with the thesis integrator,
+// fewer for a larger body or a dearer integrator. Under ASan and coverage a table-step costs
+// about 0.14-0.19 ms, so a budget of 300 keeps every input's stepping under about 60 ms: the interpreter's
+// paths are what this target explores (fuzz_world_step covers long and wild stepping). A run
+// the budget cannot afford is refused by the scene's own limit, set before every line to what
+// is left (which fuzzes that check too).
 constexpr long kMaxStepsPerRun = 4000;
 constexpr double kMaxRecordMbPerRun = 64;
-constexpr long kMaxPointStepsPerInput = 4000 * 11;
+constexpr double kMaxTableStepsPerInput = 300;
 
-// The mass points of the script's character (1 without one: scenes of linear bodies step a
-// few points per body).
-long PointsPerStep(const wobble::script::Interpreter& interp) {
+// What one step of the script's character costs, in table-steps: its mass points over the
+// table's 11 (1 point without one: scenes of linear bodies step a few points per body), times
+// the integrator's cost per point relative to the thesis integrator in 2D. Measured in this
+// build, 200 steps of the table (2D) and of table3 (3D, 27 points), best of three, in ms:
+//          thesis  symplectic  RK4  implicit  variational
+//   2D       37        33       69     125        234
+//   3D       65        93      196     444        622
+double StepCost(const wobble::script::Interpreter& interp) {
+  static constexpr double kPerPoint[2][5] = {{1.0, 1.0, 1.9, 3.4, 6.3}, {0.7, 1.0, 2.2, 4.9, 6.9}};
+  int dim = 2;
+  long points = 1;
   const wobble::scene::FfdObject& object = interp.scene().object();
-  if (!object.loaded()) return 1;
-  try {
-    return std::max(1, object.dim() == 3 ? object.Body3()->num_points() : object.Body()->num_points());
-  } catch (const std::exception&) {
-    return 1;
+  if (object.loaded()) {
+    try {
+      dim = object.dim();
+      points = std::max(1, dim == 3 ? object.Body3()->num_points() : object.Body()->num_points());
+    } catch (const std::exception&) {
+    }
   }
+  int column = 0;
+  switch (interp.scene().options().integrator) {
+    case wobble::Integrator::kThesis: column = 0; break;
+    case wobble::Integrator::kSymplecticEuler: column = 1; break;
+    case wobble::Integrator::kRK4: column = 2; break;
+    case wobble::Integrator::kImplicitEuler: column = 3; break;
+    case wobble::Integrator::kVariational: column = 4; break;
+  }
+  return kPerPoint[dim == 3 ? 1 : 0][column] * double(points) / 11.0;
 }
 
 // Discards what the interpreter prints.
@@ -123,7 +143,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const fs::path& folder = PrivateFolder();
   NullBuffer null;
   std::ostream out(&null);
-  long steps = 0;  // point-steps: steps x mass points
+  double spent = 0;  // table-steps (StepCost)
   double last_fraction = 2.0;
   try {
     fuzz::IgnoringExpectedErrors([&] {
@@ -134,13 +154,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       // starts over with a smaller fraction. Synthesis reports per iteration (counted alike).
       interp.SetProgress([&](double fraction, double) {
         if (fraction > 0 && fraction < last_fraction) {
-          steps += std::lround(std::min(1.0 / fraction, 1e9)) * PointsPerStep(interp);
-          if (steps > kMaxPointStepsPerInput) throw WorkBudgetSpent{};
+          spent += std::min(1.0 / fraction, 1e9) * StepCost(interp);
+          if (spent > kMaxTableStepsPerInput) throw WorkBudgetSpent{};
         }
         last_fraction = fraction;
       });
+      // Interpreter::RunStream's loop, with the budget left as each line's step limit: a run,
+      // a gait or a synthesis the budget cannot afford is refused by the scene's own check.
       std::istringstream in(text);
-      interp.RunStream(in, "fuzz.wob", fuzz::kDataDir);
+      int number = 0;
+      for (std::string line; std::getline(in, line);) {
+        const double affordable = (kMaxTableStepsPerInput - spent) / StepCost(interp);
+        interp.scene().limits().max_steps = long(std::clamp(affordable, 1.0, double(kMaxStepsPerRun)));
+        if (!interp.RunLine(line, "fuzz.wob", ++number, fuzz::kDataDir)) break;
+      }
     });
   } catch (const WorkBudgetSpent&) {
   }
