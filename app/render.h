@@ -4,7 +4,8 @@
 // They differ in what they write by default (--what):
 //   render: frames (PNG sequence), filmstrip (one PNG of chosen frames), charts (energy and
 //           cond(M) against time, PNG + CSV)
-//   export: vtp (.vtp per frame + .pvd), exr (R,G,B,A + depth.Z per frame), disp (disp.X,
+//   export: vtp (.vtp per frame + .pvd), exr (per frame the characters' R,G,B,A,
+//           terrain.R,G,B,A, depth.Z, motion forward.u/v), disp (disp.X,
 //           disp.Y over the rest lattice per frame)
 // Rendering needs an X display: without DISPLAY the command stops with exit code 2 and says
 // to use xvfb-run (VTK 9.1 would abort).

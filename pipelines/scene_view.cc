@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <vtkActor.h>
 #include <vtkCamera.h>
+#include <vtkCellArray.h>
 #include <vtkDataArray.h>
 #include <vtkFloatArray.h>
 #include <vtkImageData.h>
@@ -489,7 +490,7 @@ void SceneView::WritePng(const std::string& path, BackgroundWriter* writer) {
   writer->Submit([path, pixels = PixelsOf(Capture()), level] { WritePngPixels(path, pixels, level); });
 }
 
-std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
+ExrFrame SceneView::CaptureExrFrame() {
   const int w = options_.width, h = options_.height;
   vtkImageData* rgb = Capture();
   auto z = Ptr<vtkFloatArray>::New();
@@ -507,10 +508,7 @@ std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
   auto eye_distance = [&](double d) {
     return parallel ? range[0] + d * (range[1] - range[0]) : range[0] * range[1] / (range[1] - d * (range[1] - range[0]));
   };
-  // colour and alpha as half floats, the compositors' usual (and half the bytes to compress);
-  // colour in linear light: the frame buffer holds sRGB-encoded 8-bit values (IEC 61966-2-1)
-  std::vector<ExrChannel> ch = {{"R", {}, true}, {"G", {}, true}, {"B", {}, true}, {"A", {}, true}, {"depth.Z", {}}};
-  for (ExrChannel& c : ch) c.data.resize(size_t(w) * h);
+  // the frame buffer holds sRGB-encoded 8-bit values (IEC 61966-2-1): decoded to linear light
   static const std::array<float, 256> linear = [] {
     std::array<float, 256> lut;
     for (int v = 0; v < 256; ++v) {
@@ -519,6 +517,11 @@ std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
     }
     return lut;
   }();
+  ExrFrame f;
+  f.width = w;
+  f.height = h;
+  f.rgb.resize(3 * size_t(w) * h);
+  f.depth.resize(size_t(w) * h);
   const auto* px = static_cast<const unsigned char*>(rgb->GetScalarPointer());
   const float* zp = z->GetPointer(0);
   const float inf = std::numeric_limits<float>::infinity();
@@ -526,15 +529,63 @@ std::vector<ExrChannel> SceneView::CaptureRgbaDepth() {
     const size_t row_out = size_t(h - 1 - y) * w;  // VTK's rows start at the bottom
     for (int x = 0; x < w; ++x) {
       const size_t in = size_t(y) * w + x, out = row_out + x;
-      const float d = zp[in];
-      const bool drawn = d < 1.0f;
-      const float a = drawn ? 1.0f : 0.0f;
-      for (int c = 0; c < 3; ++c) ch[c].data[out] = a * linear[px[3 * in + c]];
-      ch[3].data[out] = a;
-      ch[4].data[out] = drawn ? float(eye_distance(d)) : inf;
+      for (int c = 0; c < 3; ++c) f.rgb[3 * out + size_t(c)] = linear[px[3 * in + c]];
+      f.depth[out] = zp[in] < 1.0f ? float(eye_distance(zp[in])) : inf;
     }
   }
-  return ch;
+  f.characters = CharacterGeometry();
+  f.metadata = ExrCameraMetadata();
+  return f;
+}
+
+ScreenGeometry SceneView::CharacterGeometry() const {
+  Impl& m = *impl_;
+  const int* size = m.window->GetSize();
+  const double* vp = m.renderer->GetViewport();
+  const double x0 = vp[0] * size[0], y0 = vp[1] * size[1], pw = (vp[2] - vp[0]) * size[0], ph = (vp[3] - vp[1]) * size[1];
+  // world to clip coordinates (VTK's normalised view: x, y, z in [−1, 1] after the divide)
+  vtkCamera* camera = m.renderer->GetActiveCamera();
+  vtkMatrix4x4* projection = camera->GetCompositeProjectionTransformMatrix(pw / ph, -1, 1);
+  Eigen::Matrix4d clip_of_world;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) clip_of_world(i, j) = projection->GetElement(i, j);
+  ScreenGeometry g;
+  for (SceneLayer layer : {SceneLayer::kShape, SceneLayer::kLattice, SceneLayer::kPoints})
+    for (const Ptr<vtkActor>& actor : m.layers[int(layer)]) {
+      if (!actor->GetVisibility()) continue;
+      vtkPolyData* pd = vtkPolyData::SafeDownCast(actor->GetMapper()->GetInput());
+      if (!pd || !pd->GetPoints()) continue;
+      Eigen::Matrix4d model;  // the actor's own offset (2D layers are lifted along z)
+      vtkMatrix4x4* am = actor->GetMatrix();
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) model(i, j) = am->GetElement(i, j);
+      const Eigen::Matrix4d to_clip = clip_of_world * model;
+      const int first = int(g.vertices.size());
+      const vtkIdType n = pd->GetNumberOfPoints();
+      for (vtkIdType i = 0; i < n; ++i) {
+        double p[3];
+        pd->GetPoint(i, p);
+        const Eigen::Vector4d c = to_clip * Eigen::Vector4d(p[0], p[1], p[2], 1.0);
+        g.vertices.emplace_back(x0 + 0.5 * (c.x() / c.w() + 1.0) * pw, y0 + 0.5 * (c.y() / c.w() + 1.0) * ph,
+                                0.5 * (c.z() / c.w() + 1.0));
+        g.w.push_back(c.w());
+      }
+      g.groups.push_back(int(n));
+      const double line_width = actor->GetProperty()->GetLineWidth(), point_size = actor->GetProperty()->GetPointSize();
+      vtkIdType count;
+      const vtkIdType* ids;
+      for (pd->GetVerts()->InitTraversal(); pd->GetVerts()->GetNextCell(count, ids);)
+        for (vtkIdType k = 0; k < count; ++k) g.dots.push_back({first + int(ids[k]), point_size});
+      for (pd->GetLines()->InitTraversal(); pd->GetLines()->GetNextCell(count, ids);)
+        for (vtkIdType k = 0; k + 1 < count; ++k) g.segments.push_back({first + int(ids[k]), first + int(ids[k + 1]), line_width});
+      for (pd->GetPolys()->InitTraversal(); pd->GetPolys()->GetNextCell(count, ids);)  // fans, as VTK draws them
+        for (vtkIdType k = 1; k + 1 < count; ++k)
+          g.triangles.push_back({first + int(ids[0]), first + int(ids[k]), first + int(ids[k + 1])});
+      for (pd->GetStrips()->InitTraversal(); pd->GetStrips()->GetNextCell(count, ids);)
+        for (vtkIdType k = 0; k + 2 < count; ++k)
+          g.triangles.push_back({first + int(ids[k]), first + int(ids[k + 1]), first + int(ids[k + 2])});
+    }
+  return g;
 }
 
 ExrMetadata SceneView::ExrCameraMetadata() const {
@@ -567,15 +618,12 @@ ExrMetadata SceneView::ExrCameraMetadata() const {
 }
 
 void SceneView::WriteExr(const std::string& path, BackgroundWriter* writer, double fps, long frame) {
-  const int w = options_.width, h = options_.height;
   const ExrCompression compression = options_.exr_compression;
-  ExrMetadata meta = ExrCameraMetadata();
-  meta.frames_per_second = fps;
-  meta.frame = frame;
-  if (!writer) return WriteExrChannels(path, w, h, CaptureRgbaDepth(), compression, meta);
-  writer->Submit([path, w, h, compression, meta, ch = CaptureRgbaDepth()] {
-    WriteExrChannels(path, w, h, ch, compression, meta);
-  });
+  ExrFrame f = CaptureExrFrame();
+  f.metadata.frames_per_second = fps;
+  f.metadata.frame = frame;
+  if (!writer) return WriteExrFrame(path, f, nullptr, compression);
+  writer->Submit([path, compression, f = std::move(f)] { WriteExrFrame(path, f, nullptr, compression); });
 }
 
 bool SceneView::ColorRangeNow(double range[2]) {

@@ -16,6 +16,7 @@
 #include <vtkSmartPointer.h>
 
 #include "pipelines/background_writer.h"
+#include "pipelines/exr_frame.h"
 #include "pipelines/exr_io.h"
 #include "pipelines/world_sources.h"
 #include "wobble/control/behaviours.h"
@@ -123,14 +124,17 @@ class SceneView {
   vtkSmartPointer<vtkImageData> Capture();
   // With a BackgroundWriter the pixels are read now and the file is written by its thread.
   void WritePng(const std::string& path, BackgroundWriter* writer = nullptr);
-  // The last render for compositing, row 0 at the top: depth.Z is the distance from the
-  // camera along the view direction (world units) of what was drawn, +inf where nothing was;
-  // A is 1 where the scene drew geometry (depth < far) and 0 elsewhere, and R, G, B are the
-  // rendered 8-bit colours as 0..1 floats premultiplied by A (so the white background is
-  // transparent black; the 2D text overlay, which has no depth, is not in the EXR).
-  std::vector<ExrChannel> CaptureRgbaDepth();
-  // With the camera of this view in the header (ExrCameraMetadata), and the frame's place in a
-  // series at `fps` when frame >= 0.
+  // The bodies as the last Render() drew them, in pixels (exr_frame.h): the visible actors of
+  // the shape, lattice and point layers, one vertex group per actor.
+  ScreenGeometry CharacterGeometry() const;
+  // The last render for compositing (exr_frame.h): the colour in linear light (the frame
+  // buffer's 8-bit sRGB decoded; the 2D text overlay, which has no depth, is left out), the
+  // distance from the camera along the view direction of what was drawn (+inf where nothing
+  // was), the characters' geometry and the camera (ExrCameraMetadata).
+  ExrFrame CaptureExrFrame();
+  // The last render as one EXR frame (ExrFrameChannels, without a next frame: no motion), with
+  // the camera in the header, and the frame's place in a series at `fps` when frame >= 0.
+  // The render driver writes its frames itself, each with the next frame's motion.
   void WriteExr(const std::string& path, BackgroundWriter* writer = nullptr, double fps = 0, long frame = -1);
   // OpenEXR's worldToCamera and worldToNDC of the current camera (exr_io.h's conventions).
   ExrMetadata ExrCameraMetadata() const;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <vtkImageData.h>
 #include <vtkSmartPointer.h>
@@ -14,6 +15,7 @@
 #include "pipelines/background_writer.h"
 #include "pipelines/follow_camera.h"
 #include "pipelines/energy_charts.h"
+#include "pipelines/exr_frame.h"
 #include "pipelines/exports.h"
 
 namespace wobble::pipelines {
@@ -301,6 +303,19 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   PvdCollection volumes;  // 3D bodies' displacement volumes
   std::vector<vtkSmartPointer<vtkImageData>> panels;
   BackgroundWriter writer;  // files are compressed and written while the next frame renders
+  // An EXR frame waits for the next frame's characters: its motion vectors point to them.
+  struct PendingExr {
+    std::string path;
+    ExrFrame frame;
+  };
+  std::optional<PendingExr> pending_exr;
+  const ExrCompression exr_compression = out.view.exr_compression;
+  auto submit_exr = [&](const ScreenGeometry* next) {
+    if (!pending_exr) return;
+    writer.Submit([p = std::move(*pending_exr), next_copy = next ? std::optional<ScreenGeometry>(*next) : std::nullopt,
+                   exr_compression] { WriteExrFrame(p.path, p.frame, next_copy ? &*next_copy : nullptr, exr_compression); });
+    pending_exr.reset();
+  };
   Replay replay(run, &world);
   bool interrupted = false;
   for (const Visit& v : visits) {
@@ -328,7 +343,13 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     if (view) {
       view->Render();
       if (out.frames) view->WritePng(Numbered(out.folder + "/frames", "frame", v.frame, "png"), &writer);
-      if (out.exr) view->WriteExr(Numbered(out.folder + "/exr", "frame", v.frame, "exr"), &writer, out.fps, v.frame);
+      if (out.exr) {
+        ExrFrame frame = view->CaptureExrFrame();
+        frame.metadata.frames_per_second = out.fps;
+        frame.metadata.frame = v.frame;
+        submit_exr(&frame.characters);  // the previous frame's motion ends here
+        pending_exr = PendingExr{Numbered(out.folder + "/exr", "frame", v.frame, "exr"), std::move(frame)};
+      }
     }
     if (vtp) vtp->WriteFrame(int(v.frame), &writer);
     for (const DispTarget& d : disp) {
@@ -343,6 +364,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     ++report.frames;
     if (out.progress) out.progress(double(report.frames) / double(num_frames), world.time());
   }
+  submit_exr(nullptr);  // the last frame drawn has no next frame: no motion
   writer.Wait();
   if (interrupted) {
     std::string where = std::to_string(report.frames) + " of " + std::to_string(num_frames) + " frames";
@@ -352,7 +374,9 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   if (!visits.empty()) run.Restore(visits.back().sample, caller);
 
   if (out.frames) report.files.push_back({out.folder + "/frames/frame_NNNN.png", ""});
-  if (out.exr) report.files.push_back({out.folder + "/exr/frame_NNNN.exr", "R, G, B, A, depth.Z"});
+  if (out.exr)
+    report.files.push_back({out.folder + "/exr/frame_NNNN.exr",
+                            "characters R, G, B, A; terrain.R, G, B, A; depth.Z; motion to the next frame forward.u, forward.v"});
   bool any_volume = false;
   for (const DispTarget& d : disp) {
     if (d.depth == 0) {

@@ -1,5 +1,5 @@
 // The one render driver: a recorded run (record::Trajectory) turned into PNG frames, a
-// filmstrip, a ParaView .vtp/.pvd series, EXR frames (R,G,B,A,depth.Z), displacement images
+// filmstrip, a ParaView .vtp/.pvd series, EXR frames (exr_frame.h), displacement images
 // (disp.X, disp.Y over an FFD body's rest lattice) and charts (energy and cond(M) against
 // time, PNG + CSV), for `wobble render`/`export`, a script's `render` (its FFD runs and its
 // Witkin & Welch scenes) alike. Every sample is put back into a world (Trajectory::Restore)
@@ -11,7 +11,9 @@
 //   filmstrip.png           the panels side by side, filmstrip_columns per row
 //   vtp/NAME.pvd            per frame and body b parts 3b, 3b+1, 3b+2 (lattice or control
 //                           box, mass points, shape), files vtp/<body>_<part>_NNNN.vtp
-//   exr/frame_NNNN.exr      the frame's R, G, B, A, depth.Z
+//   exr/frame_NNNN.exr      the frame for compositing (exr_frame.h): the characters' R, G, B,
+//                           A, the rest as terrain.R/G/B/A, depth.Z, and the characters'
+//                           motion to the next frame (forward.u, forward.v; 0 on the last)
 //   exr/disp_NNNN.exr       each FFD body's displacement image (disp_<body>_NNNN.exr when
 //                           the world has more than one FFD body)
 //   vti/disp_NNNN.vti       a 3D FFD body's displacement volume instead (DisplacementVolume),

@@ -27,6 +27,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "pipelines/charts.h"
@@ -34,7 +35,10 @@
 #include "pipelines/exports.h"
 #include "support/reference.h"
 #include <Eigen/Eigenvalues>
+#include "pipelines/exr_frame.h"
 #include "pipelines/exr_io.h"
+#include "pipelines/trajectory_render.h"
+#include "wobble/record/trajectory.h"
 #include "pipelines/scene_view.h"
 #include "support/pipelines_test_util.h"
 #include "wobble/formats/atomic_file.h"
@@ -308,24 +312,184 @@ TEST(RenderedExr, ColourAlphaAndDepthAtKnownPixels) {
   const ExrImage img = ReadExrChannels(dir + "/f.exr");
   ASSERT_EQ(img.width, 160);
   ASSERT_EQ(img.height, 120);
-  for (const char* c : {"R", "G", "B", "A", "depth.Z"}) ASSERT_TRUE(img.channels.count(c)) << c;
+  for (const char* c : {"R", "G", "B", "A", "terrain.R", "terrain.G", "terrain.B", "terrain.A", "depth.Z", "forward.u",
+                        "forward.v"})
+    ASSERT_TRUE(img.channels.count(c)) << c;
   // pixel (10, 110) is at world (−50 + 10.5·2.5, 200 − 110.5·2.5) = (−23.75, −76.25): the
   // ground band, drawn at z = 0, so its depth is the camera's height above z = 0
   double cam[3];
   vtkRenderer* renderer = view.window()->GetRenderers()->GetFirstRenderer();
   renderer->GetActiveCamera()->GetPosition(cam);
   EXPECT_NEAR(img.At("depth.Z", 10, 110), cam[2], 1e-3 * cam[2]);
-  EXPECT_EQ(img.At("A", 10, 110), 1.0f);
+  // the ground is not a character: it is in the terrain layer, and the characters' alpha is 0
+  EXPECT_EQ(img.At("A", 10, 110), 0.0f);
+  EXPECT_EQ(img.At("R", 10, 110), 0.0f);
+  EXPECT_EQ(img.At("terrain.A", 10, 110), 1.0f);
   // the ground's colour (0.55, 0.47, 0.38), 8-bit sRGB in the frame buffer, in linear light
   // in the EXR (IEC 61966-2-1), stored as half floats (11 significant bits)
-  EXPECT_NEAR(img.At("R", 10, 110), SrgbToLinear(0.55), 2.5e-3);
-  EXPECT_NEAR(img.At("G", 10, 110), SrgbToLinear(0.47), 2.5e-3);
-  EXPECT_NEAR(img.At("B", 10, 110), SrgbToLinear(0.38), 2.5e-3);
+  EXPECT_NEAR(img.At("terrain.R", 10, 110), SrgbToLinear(0.55), 2.5e-3);
+  EXPECT_NEAR(img.At("terrain.G", 10, 110), SrgbToLinear(0.47), 2.5e-3);
+  EXPECT_NEAR(img.At("terrain.B", 10, 110), SrgbToLinear(0.38), 2.5e-3);
   // pixel (80, 10) is at world y = 200 − 10.5·2.5 = 173.75, above the table: nothing drawn
   EXPECT_TRUE(std::isinf(img.At("depth.Z", 80, 10)));
-  EXPECT_EQ(img.At("A", 80, 10), 0.0f);
-  EXPECT_EQ(img.At("R", 80, 10), 0.0f);
+  for (const char* c : {"A", "R", "terrain.A", "terrain.R"}) EXPECT_EQ(img.At(c, 80, 10), 0.0f) << c;
+  // the table's top at world (150, 100) is pixel (80, 40): a character, in front of nothing
+  EXPECT_EQ(img.At("A", 80, 40), 1.0f);
+  EXPECT_EQ(img.At("terrain.A", 80, 40), 0.0f);
+  // a single frame has no next one: nothing moves
+  for (const char* c : {"forward.u", "forward.v"})
+    for (float v : img.channels.at(c)) ASSERT_EQ(v, 0.0f) << c;
   fs::remove_all(dir);
+}
+
+// The characters' alpha and motion vectors of a rendered frame: the pot turned and moved
+// rigidly between two frames (its modes unchanged), so that every point of it goes where
+// x_B = c_B + R(θ_B) R(θ_A)ᵀ (x_A − c_A) takes it (Eq. 4.2: x = c + R(θ) l(γ)). At every pixel
+// the rasteriser says the table covers by a filled surface, forward.u/v is that map applied to
+// the pixel's centre, in pixels (lines and dots: see below); the alpha agrees with what VTK
+// drew away from the edges, in both styles.
+TEST(RenderedExr, CharactersAlphaAndMotionOfARigidMotionAtEveryPixel) {
+  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
+  WorldOptions o;
+  o.params.ground.enabled = false;
+  World world(o);
+  // the pot: its closed outline is filled in the clean style
+  const std::string data = WOBBLE_DATA_DIR;
+  world.AddBody(std::make_shared<const BodyModel>(formats::ReadObjectFile(data + "/pot.obj"),
+                                                  formats::ReadDeformationFile(data + "/def_pot")));
+  const int dofs = world.body(0).num_q();
+  Eigen::VectorXd qa = Eigen::VectorXd::Zero(dofs), qb = qa;
+  qa.head(3) << 12, 140, 0.3;
+  qb.head(3) << 31, 128, 0.42;
+  for (int m = 3; m < dofs; ++m) qa[m] = qb[m] = 0.05 * (m - 1);  // deformed alike in both
+  for (RenderStyle style : {RenderStyle::kDiagnostic, RenderStyle::kClean}) {
+    SCOPED_TRACE(style == RenderStyle::kClean ? "clean" : "diagnostic");
+    SceneOptions opt;
+    opt.width = 240;
+    opt.height = 180;
+    opt.overlay = false;
+    opt.style = style;
+    SceneView view(&world, opt);
+    view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-200, 0), Eigen::Vector2d(400, 450)), 0.0);
+    world.SetState(0, qa, Eigen::VectorXd::Zero(dofs));
+    view.Render();
+    const ExrFrame frame = view.CaptureExrFrame();
+    world.SetState(0, qb, Eigen::VectorXd::Zero(dofs));
+    view.Render();
+    const ScreenGeometry next = view.CharacterGeometry();
+    std::map<std::string, std::vector<float>> ch;
+    for (ExrChannel& c : ExrFrameChannels(frame, &next)) ch[c.name] = std::move(c.data);
+    const Eigen::AlignedBox2d box = view.framed_box();
+    const double scale = opt.width / box.sizes().x();  // pixels per world unit, both axes
+    ASSERT_NEAR(scale, opt.height / box.sizes().y(), 1e-9);
+    const Eigen::Matrix2d rotate = Eigen::Rotation2Dd(qb[2]).toRotationMatrix() * Eigen::Rotation2Dd(qa[2]).toRotationMatrix().transpose();
+    const Eigen::Vector2d ca(qa[0], qa[1]), cb(qb[0], qb[1]);
+    auto at = [&](const char* name, int x, int y_up) { return ch.at(name)[size_t(opt.height - 1 - y_up) * opt.width + x]; };
+    auto drawn = [&](int x, int y_up) { return std::isfinite(frame.depth[size_t(opt.height - 1 - y_up) * opt.width + x]); };
+    int covered = 0, exact = 0, interior_checked = 0;
+    for (int y = 0; y < opt.height; ++y)
+      for (int x = 0; x < opt.width; ++x) {
+        if (at("A", x, y) == 0.0f) {
+          EXPECT_EQ(at("forward.u", x, y), 0.0f);
+          continue;
+        }
+        ++covered;
+        const Eigen::Vector2d pixel(x + 0.5, y + 0.5);
+        const Eigen::Vector2d xa = box.min() + pixel / scale;
+        const Eigen::Vector2d xb = cb + rotate * (xa - ca);
+        const Eigen::Vector2d motion = (xb - xa) * scale;
+        const Eigen::Vector2d got(at("forward.u", x, y), at("forward.v", x, y));
+        // a filled surface's pixel moves as its own point; a line's pixel as the point of the
+        // line's centre beside it, and a dot's as its centre, up to r pixels away: those differ
+        // from the pixel's own motion by at most |R − I| r = 2 sin(Δθ / 2) r
+        double r = 0;
+        for (const ScreenGeometry::Segment& sg : frame.characters.segments) {
+          const Eigen::Vector2d a = frame.characters.vertices[size_t(sg.a)].head<2>(), d = frame.characters.vertices[size_t(sg.b)].head<2>() - a;
+          const double t = std::clamp((pixel - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+          if ((pixel - a - t * d).norm() <= 0.5 * sg.width + 1) r = std::max(r, 0.5 * sg.width);
+        }
+        for (const ScreenGeometry::Dot& dot : frame.characters.dots)
+          if ((pixel - frame.characters.vertices[size_t(dot.v)].head<2>()).cwiseAbs().maxCoeff() <= 0.5 * dot.size + 1)
+            r = std::max(r, std::sqrt(0.5) * dot.size);
+        const double bound = 1e-3 + 2 * std::sin(0.5 * (qb[2] - qa[2])) * r;
+        ASSERT_LE((got - motion).norm(), bound) << x << "," << y;
+        exact += r == 0;
+        EXPECT_EQ(at("terrain.A", x, y), 0.0f);
+      }
+    // where the rasterised characters and VTK's drawing both fill a 3 x 3 neighbourhood they
+    // agree; they may differ only along edges
+    for (int y = 1; y + 1 < opt.height; ++y)
+      for (int x = 1; x + 1 < opt.width; ++x) {
+        bool all_a = true, all_drawn = true;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            all_a = all_a && at("A", x + dx, y + dy) == 1.0f;
+            all_drawn = all_drawn && drawn(x + dx, y + dy);
+          }
+        if (all_a) {
+          EXPECT_TRUE(drawn(x, y)) << x << "," << y;
+        }
+        if (all_drawn) {
+          EXPECT_EQ(at("A", x, y), 1.0f) << x << "," << y;
+        }
+        interior_checked += all_a || all_drawn;
+      }
+    EXPECT_GT(covered, style == RenderStyle::kClean ? 2000 : 400);
+    if (style == RenderStyle::kClean) {
+      EXPECT_GT(exact, 1000);  // the fill inside the outline
+    }
+    EXPECT_GT(interior_checked, 100);
+  }
+}
+
+// The render driver writes each EXR frame once the next is drawn: a table in free flight
+// (no gravity, no ground) translates at constant velocity v, so every character pixel of
+// every frame but the last moves v / fps world units (scaled to pixels), and the last, which
+// has no next frame, does not move.
+TEST(RenderedExr, SeriesMotionPointsToTheNextFrameAndTheLastStandsStill) {
+  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
+  WorldOptions o;
+  o.params.ground.enabled = false;
+  o.params.gravity_on = false;
+  World w(o);
+  w.AddBody(testing::Table());
+  const Eigen::Vector2d v(120.0, -45.0);
+  w.SetState(0, testing::Vec({0, 100, 0.2, 0, 0, 0, 0}), testing::Vec({v.x(), v.y(), 0, 0, 0, 0, 0}));  // modes at rest: no mode forces
+  auto run = std::make_shared<record::Trajectory>(w);
+  auto recorder = std::make_shared<record::Recorder>(run, 5);
+  w.SetRecorder(recorder);
+  recorder->Start(w);
+  ASSERT_TRUE(w.RunUntil(0.3)) << w.status().message;
+  RenderOutputs out;
+  out.folder = TempDir("exr_series");
+  out.frames = out.filmstrip = out.vtp = false;
+  out.exr = true;
+  out.fps = 10;  // frames at 0, 0.1, 0.2, 0.3
+  out.view.width = 160;
+  out.view.height = 120;
+  out.view.overlay = false;
+  World world = WorldFor(*run, o);
+  const RenderReport report = RenderTrajectory(world, *run, SceneSpec(), out);
+  ASSERT_EQ(report.frames, 4);
+  for (int k = 0; k < 4; ++k) {
+    SCOPED_TRACE(k);
+    char name[32];
+    std::snprintf(name, sizeof(name), "/exr/frame_%04d.exr", k);
+    const ExrImage img = ReadExrChannels(out.folder + name);
+    // pixels per world unit from the header's worldToNDC (row vectors: x_ndc = x M00 + ...)
+    const double sx = (*img.metadata.world_to_ndc)[0] * img.width, sy = -(*img.metadata.world_to_ndc)[5] * img.height;
+    const Eigen::Vector2d expected = k < 3 ? Eigen::Vector2d(v.x() / out.fps * sx, v.y() / out.fps * sy) : Eigen::Vector2d::Zero();
+    int covered = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        if (img.At("A", x, y) == 0.0f) continue;
+        ++covered;
+        ASSERT_NEAR(img.At("forward.u", x, y), expected.x(), 1e-3) << x << "," << y;
+        ASSERT_NEAR(img.At("forward.v", x, y), expected.y(), 1e-3) << x << "," << y;
+      }
+    EXPECT_GT(covered, 100);
+  }
+  fs::remove_all(out.folder);
 }
 
 TEST(VtiExport, ImageReadsBackWithItsGeometryAndValues) {
