@@ -446,21 +446,47 @@ void SceneView::Render() {
       std::snprintf(buf, sizeof(buf), "t = %.3f s", m.world->time());
       text += buf;
       if (options_.overlay_energy) {
+        // E and every term of it that is not zero (ground and springs only when they hold
+        // energy), so that E is the sum of the terms listed; two to a line, to stay narrow
         Energies sum;
-        double total = 0.0;
         for (int b = 0; b < m.world->num_bodies(); ++b) {
           const Energies e = m.world->ComputeEnergies(b);
           sum.kinetic += e.kinetic;
           sum.gravity += e.gravity;
           sum.modes += e.modes;
-          total += e.total();
+          sum.ground += e.ground;
+          sum.springs += e.springs;
         }
-        std::snprintf(buf, sizeof(buf), "\nE = %.4g (kin %.3g, grav %.3g, modes %.3g)", total, sum.kinetic, sum.gravity,
-                      sum.modes);
+        std::snprintf(buf, sizeof(buf), "\nE = %.4g =", sum.total());
         text += buf;
+        const std::pair<const char*, double> terms[] = {
+            {"kin", sum.kinetic}, {"grav", sum.gravity}, {"modes", sum.modes}, {"ground", sum.ground}, {"springs", sum.springs}};
+        int listed = 0;
+        for (const auto& [name, value] : terms) {
+          if (value == 0.0 && listed >= 3) continue;  // kin, grav and modes always
+          text += listed % 2 == 0 ? "\n  " : " ";
+          if (listed > 0) text += "+ ";
+          std::snprintf(buf, sizeof(buf), "%s %.3g", name, value);
+          text += buf;
+          ++listed;
+        }
       }
     }
     m.overlay->SetInput(text.c_str());
+  }
+  if (m.bar) {  // the colour bar top right, or bottom right when the text reaches under it
+    const double at_top[2] = {0.62, 0.86}, at_bottom[2] = {0.62, 0.02};
+    const double* where = at_top;
+    if (m.overlay) {
+      double text_box[4];  // xmin, xmax, ymin, ymax in display pixels
+      m.overlay->GetBoundingBox(m.renderer, text_box);
+      const int* size = m.renderer->GetSize();
+      const int* origin = m.renderer->GetOrigin();
+      const double bar_x0 = origin[0] + at_top[0] * size[0], bar_x1 = bar_x0 + m.bar->GetWidth() * size[0];
+      const double bar_y0 = origin[1] + at_top[1] * size[1], bar_y1 = bar_y0 + m.bar->GetHeight() * size[1];
+      if (text_box[0] < bar_x1 && text_box[1] > bar_x0 && text_box[2] < bar_y1 && text_box[3] > bar_y0) where = at_bottom;
+    }
+    m.bar->SetPosition(where[0], where[1]);
   }
   m.window->Render();
   m.last_rgb = nullptr;

@@ -18,9 +18,15 @@
 #include <vtkChartXY.h>
 #include <vtkDoubleArray.h>
 #include <vtkImageData.h>
+#include <vtkActor2DCollection.h>
+#include <vtkCoordinate.h>
 #include <vtkPNGReader.h>
+#include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkTextActor.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 
@@ -157,6 +163,55 @@ TEST(RenderRegression, FullSceneWithOverlayAndColourBar) {
   view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-50, -150), Eigen::Vector2d(350, 150)));
   view.Render();
   CompareWithBaseline("full_scene", view.Capture());
+}
+
+// The overlay lists every term of the energy it shows that is not zero (here the ground's
+// penalty energy too, the table resting in contact), each as the world computes it, and the
+// colour bar never covers the text: both at the baseline's size and at the render's default.
+TEST(RenderOverlay, EnergyIsTheSumOfTheTermsListedAndTheColourBarClearsTheText) {
+  REQUIRE_DISPLAY();
+  auto world = testing::TouchingWorld();
+  const Energies e = world->ComputeEnergies(0);
+  ASSERT_GT(e.ground, 0.0);
+  ASSERT_EQ(e.springs, 0.0);
+  for (const auto& [w, h] : {std::pair{240, 180}, std::pair{640, 480}}) {
+    SCOPED_TRACE(w);
+    SceneOptions o;
+    o.width = w;
+    o.height = h;
+    o.color_by = "applied_force";
+    SceneView view(world.get(), o);
+    view.Render();
+    vtkTextActor* text = nullptr;
+    vtkScalarBarActor* bar = nullptr;
+    vtkActor2DCollection* actors = view.renderer()->GetActors2D();
+    actors->InitTraversal();
+    while (vtkActor2D* a = actors->GetNextActor2D()) {
+      if (auto* t = vtkTextActor::SafeDownCast(a)) text = t;
+      if (auto* b = vtkScalarBarActor::SafeDownCast(a)) bar = b;
+    }
+    ASSERT_TRUE(text && bar);
+    const std::string overlay = text->GetInput();
+    auto value_after = [&](const std::string& label) {
+      const size_t at = overlay.find(label);
+      if (at == std::string::npos) return std::nan("");
+      return std::strtod(overlay.c_str() + at + label.size(), nullptr);
+    };
+    EXPECT_NEAR(value_after("E = "), e.total(), 5e-4 * std::abs(e.total())) << overlay;  // %.4g
+    EXPECT_NEAR(value_after("kin "), e.kinetic, 5e-3 * std::abs(e.kinetic) + 1e-12) << overlay;  // %.3g
+    EXPECT_NEAR(value_after("grav "), e.gravity, 5e-3 * std::abs(e.gravity)) << overlay;
+    EXPECT_NEAR(value_after("modes "), e.modes, 5e-3 * std::abs(e.modes) + 1e-12) << overlay;
+    EXPECT_NEAR(value_after("ground "), e.ground, 5e-3 * e.ground) << overlay;
+    EXPECT_EQ(overlay.find("springs"), std::string::npos) << overlay;  // zero: not listed
+    // the two boxes in display pixels do not meet
+    double t[4];
+    text->GetBoundingBox(view.renderer(), t);
+    double* p = bar->GetPositionCoordinate()->GetComputedDoubleDisplayValue(view.renderer());
+    const double b[4] = {p[0], p[0] + bar->GetWidth() * w, p[1], p[1] + bar->GetHeight() * h};
+    EXPECT_TRUE(t[1] <= b[0] || b[1] <= t[0] || t[3] <= b[2] || b[3] <= t[2])
+        << "text " << t[0] << ".." << t[1] << " x " << t[2] << ".." << t[3] << ", bar " << b[0] << ".." << b[1] << " x "
+        << b[2] << ".." << b[3];
+  }
 }
 
 // A 3D character with its own mesh (issue 15): the pot deformed (squash, sway, twist) and
