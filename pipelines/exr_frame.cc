@@ -159,7 +159,8 @@ CharacterLayers RasterizeCharacters(const ScreenGeometry& g, const std::vector<E
 
 std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeometry* next) {
   const size_t n = size_t(frame.width) * size_t(frame.height);
-  if (frame.rgb.size() != 3 * n || frame.depth.size() != n) throw std::invalid_argument("ExrFrameChannels: an image of another size");
+  if (frame.rgb.size() != 3 * n || frame.depth.size() != n || (!frame.overlay.empty() && frame.overlay.size() != n))
+    throw std::invalid_argument("ExrFrameChannels: an image of another size");
   CharacterLayers c = RasterizeCharacters(frame.characters, NextPixels(frame.characters, next ? *next : ScreenGeometry()),
                                           frame.width, frame.height);
   std::vector<ExrChannel> ch = {{"R", {}, true},         {"G", {}, true},         {"B", {}, true},
@@ -167,13 +168,14 @@ std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeom
                                 {"terrain.B", {}, true}, {"terrain.A", {}, true}, {"depth.Z", frame.depth}};
   for (int k = 0; k < 8; ++k) ch[size_t(k)].data.resize(n);
   for (size_t i = 0; i < n; ++i) {
-    const float a = c.alpha[i];
+    const float a = frame.overlay.empty() || !frame.overlay[i] ? c.alpha[i] : 0.0f;
     const float rest = std::isinf(frame.depth[i]) ? 0.0f : 1.0f - a;  // drawn, and not a character
     for (int k = 0; k < 3; ++k) {
       ch[size_t(k)].data[i] = a * frame.rgb[3 * i + size_t(k)];
       ch[size_t(4 + k)].data[i] = rest * frame.rgb[3 * i + size_t(k)];
     }
     ch[3].data[i] = a;
+    if (a == 0.0f) c.forward_u[i] = c.forward_v[i] = 0.0f;  // under the overlay
     ch[7].data[i] = rest;
   }
   ch.push_back({"forward.u", std::move(c.forward_u)});

@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -71,13 +72,16 @@ struct ExrFrame {
   int width = 0, height = 0;
   std::vector<float> rgb;      // linear-light colour, 3 per pixel (the frame buffer's sRGB decoded)
   std::vector<float> depth;    // distance from the camera along the view direction; +inf: nothing drawn
+  std::vector<uint8_t> overlay;  // 1 where the 2D text overlay or colour bar was drawn (empty: none)
   ScreenGeometry characters;   // the bodies as drawn
   ExrMetadata metadata;        // the camera (and the frame's time, when in a series)
 };
 
 // The frame's channels: R, G, B, A of the characters (colour premultiplied by A, A from the
 // rasterised characters), terrain.R/G/B/A of everything else drawn (the ground or terrain,
-// springs, trails, named points) where no character covers it, depth.Z of whatever is nearest,
+// springs, trails, named points) where no character covers it, depth.Z of whatever is nearest;
+// pixels of the 2D overlay are in no layer (its text hides what is under it, so a character
+// under the text has a hole there: render without the overlay for compositing);
 // and forward.u, forward.v: each character pixel's motion to the next frame in pixels (x
 // right, y up; zero without a next frame). Colour and alpha are half floats, depth and motion
 // 32-bit floats.

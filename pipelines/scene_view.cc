@@ -11,6 +11,7 @@
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
+#include <vtkCoordinate.h>
 #include <vtkDataArray.h>
 #include <vtkFloatArray.h>
 #include <vtkImageData.h>
@@ -478,8 +479,10 @@ void SceneView::Render() {
     const double at_top[2] = {0.62, 0.86}, at_bottom[2] = {0.62, 0.02};
     const double* where = at_top;
     if (m.overlay) {
-      double text_box[4];  // xmin, xmax, ymin, ymax in display pixels
+      double text_box[4];  // xmin, xmax, ymin, ymax relative to the text's position: made absolute
       m.overlay->GetBoundingBox(m.renderer, text_box);
+      const int* at = m.overlay->GetPositionCoordinate()->GetComputedDisplayValue(m.renderer);
+      for (int k = 0; k < 4; ++k) text_box[k] += at[k / 2];
       const int* size = m.renderer->GetSize();
       const int* origin = m.renderer->GetOrigin();
       const double bar_x0 = origin[0] + at_top[0] * size[0], bar_x1 = bar_x0 + m.bar->GetWidth() * size[0];
@@ -548,6 +551,7 @@ ExrFrame SceneView::CaptureExrFrame() {
   f.height = h;
   f.rgb.resize(3 * size_t(w) * h);
   f.depth.resize(size_t(w) * h);
+  f.overlay.resize(size_t(w) * h);
   const auto* px = static_cast<const unsigned char*>(rgb->GetScalarPointer());
   const float* zp = z->GetPointer(0);
   const float inf = std::numeric_limits<float>::infinity();
@@ -556,7 +560,11 @@ ExrFrame SceneView::CaptureExrFrame() {
     for (int x = 0; x < w; ++x) {
       const size_t in = size_t(y) * w + x, out = row_out + x;
       for (int c = 0; c < 3; ++c) f.rgb[3 * out + size_t(c)] = linear[px[3 * in + c]];
-      f.depth[out] = zp[in] < 1.0f ? float(eye_distance(zp[in])) : inf;
+      // VTK draws the 2D overlay (text, colour bar) at window depth 0, the near plane, which
+      // no geometry reaches (the cameras keep the near plane in front of everything framed):
+      // those pixels are the overlay's, in no layer of the EXR
+      f.overlay[out] = zp[in] == 0.0f;
+      f.depth[out] = zp[in] < 1.0f && zp[in] > 0.0f ? float(eye_distance(zp[in])) : inf;
     }
   }
   f.characters = CharacterGeometry();

@@ -22,6 +22,9 @@
 #include <vtkXMLImageDataReader.h>
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLUtilities.h>
+#include <vtkActor2DCollection.h>
+#include <vtkCoordinate.h>
+#include <vtkTextActor.h>
 
 #include <cerrno>
 #include <cstring>
@@ -440,6 +443,52 @@ TEST(RenderedExr, CharactersAlphaAndMotionOfARigidMotionAtEveryPixel) {
     }
     EXPECT_GT(interior_checked, 100);
   }
+}
+
+// The 2D overlay (title, time, energy) is drawn at window depth 0, which no geometry reaches:
+// the EXR frame leaves those pixels out of every layer. Every pixel so marked lies inside the
+// text's box, and the ground band behind the text is in the terrain layer only around it.
+TEST(RenderedExr, TheTextOverlayIsInNoLayer) {
+  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
+  auto world = AirborneWorld();
+  SceneOptions opt;
+  opt.width = 320;
+  opt.height = 240;
+  opt.title = "a title over the ground";
+  SceneView view(world.get(), opt);
+  // the ground band fills the top of the picture, behind the text
+  view.FrameBox(Eigen::AlignedBox2d(Eigen::Vector2d(-100, -300), Eigen::Vector2d(300, 0)), 0.0);
+  view.Render();
+  const ExrFrame frame = view.CaptureExrFrame();
+  vtkTextActor* text = nullptr;
+  vtkActor2DCollection* actors = view.renderer()->GetActors2D();
+  actors->InitTraversal();
+  while (vtkActor2D* a = actors->GetNextActor2D())
+    if (auto* t = vtkTextActor::SafeDownCast(a)) text = t;
+  ASSERT_TRUE(text);
+  double box[4];  // display pixels, y up (VTK gives it relative to the text's position)
+  text->GetBoundingBox(view.renderer(), box);
+  const int* at = text->GetPositionCoordinate()->GetComputedDisplayValue(view.renderer());
+  for (int k = 0; k < 4; ++k) box[k] += at[k / 2];
+  std::map<std::string, std::vector<float>> ch;
+  for (ExrChannel& c : ExrFrameChannels(frame, nullptr)) ch[c.name] = std::move(c.data);
+  int marked = 0, terrain_beside = 0;
+  for (int row = 0; row < opt.height; ++row)
+    for (int x = 0; x < opt.width; ++x) {
+      const size_t i = size_t(row) * opt.width + x;
+      const double y_up = opt.height - 1 - row;
+      if (frame.overlay[i]) {
+        ++marked;
+        EXPECT_TRUE(x >= box[0] - 1 && x <= box[1] + 1 && y_up >= box[2] - 1 && y_up <= box[3] + 1) << x << "," << row;
+        EXPECT_EQ(ch.at("A")[i], 0.0f);
+        EXPECT_EQ(ch.at("terrain.A")[i], 0.0f);
+        EXPECT_TRUE(std::isinf(ch.at("depth.Z")[i]));
+      } else if (x <= box[1] && y_up >= box[2] && ch.at("terrain.A")[i] == 1.0f) {
+        ++terrain_beside;  // the ground between the letters
+      }
+    }
+  EXPECT_GT(marked, 100);
+  EXPECT_GT(terrain_beside, 100);
 }
 
 // The render driver writes each EXR frame once the next is drawn: a table in free flight

@@ -204,8 +204,11 @@ TEST(RenderOverlay, EnergyIsTheSumOfTheTermsListedAndTheColourBarClearsTheText) 
     EXPECT_NEAR(value_after("ground "), e.ground, 5e-3 * e.ground) << overlay;
     EXPECT_EQ(overlay.find("springs"), std::string::npos) << overlay;  // zero: not listed
     // the two boxes in display pixels do not meet
-    double t[4];
+    double t[4];  // VTK gives it relative to the text's position
     text->GetBoundingBox(view.renderer(), t);
+    const int* at = text->GetPositionCoordinate()->GetComputedDisplayValue(view.renderer());
+    for (int k = 0; k < 4; ++k) t[k] += at[k / 2];
+    EXPECT_GT(t[3], 0.8 * h);  // the text is at the top
     double* p = bar->GetPositionCoordinate()->GetComputedDoubleDisplayValue(view.renderer());
     const double b[4] = {p[0], p[0] + bar->GetWidth() * w, p[1], p[1] + bar->GetHeight() * h};
     EXPECT_TRUE(t[1] <= b[0] || b[1] <= t[0] || t[3] <= b[2] || b[3] <= t[2])
