@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -130,7 +131,9 @@ json ReportJson(const fit::FitReport& r) {
 #ifdef WOBBLE_HAVE_PIPELINES
 // Pictures beside the files, when there is a display: the cost per iteration beside --costs
 // (FILE.png), and beside --out the fitted points over their targets (FILE_overlay.png, from
-// the JSON's "overlay": target polylines as lines, target points and fitted points as dots).
+// the JSON's "overlay", at one scale on both axes: the fitted body's drawing, target
+// polylines as lines, target points and fitted points as dots, each fitted point joined to
+// its target).
 void WritePictures(const FitFlags& f, const json& result, const fit::FitReport& r) {
   if (!pipelines::HasDisplay()) {
     if (!f.costs.empty() || !f.out.empty()) std::cout << "no X display: fit pictures skipped (run under xvfb-run -a)\n";
@@ -155,6 +158,20 @@ void WritePictures(const FitFlags& f, const json& result, const fit::FitReport& 
     spec.x_title = "x";
     spec.y_title = "y";
     spec.width = spec.height = 700;
+    spec.equal_aspect = true;  // world units on both axes: the body's true shape
+    // the fitted body's drawing, and a thin grey line from each fitted point to its target
+    auto pairs = [&](const char* key, const char* name, int grey, float width) {
+      pipelines::ChartSeries s;
+      s.name = name;
+      s.segments = true;
+      s.rgb[0] = s.rgb[1] = s.rgb[2] = grey;
+      s.width = width;
+      for (const json& seg : overlay.value(key, json::array()))
+        for (const json& p : seg) s.x.push_back(p[0]), s.y.push_back(p[1]);
+      if (!s.x.empty()) spec.series.push_back(s);
+    };
+    pairs("body", "fitted body", 60, 5.0f);  // wide: seen around the target curves over it
+    pairs("joins", "fitted to target", 150, 1.0f);
     pipelines::ChartSeries target_points, fitted;
     target_points.name = "target points";
     target_points.points = true;
@@ -438,24 +455,47 @@ int RunFitPose(const FitPoseArgs& a) {
 
   json j = PoseJson(curve ? "curve" : "correspondences", 2, body->name(), a.targets, names, r);
   if (curve) j["rounds"] = r.rounds;
-  // the overlay hook: fitted body points and their targets, world frame
+  // the overlay hook, world frame: fitted body points and their targets, the fitted body's
+  // drawing (segments between its samples) and each fitted point joined to its target (a
+  // curve fit: to the nearest point of the target's polylines)
   json overlay;
   overlay["fitted"] = json::array();
   overlay["targets"] = json::array();
+  overlay["body"] = json::array();
+  overlay["joins"] = json::array();
+  const fit::CurveSamples drawing = fit::CurveSamples::Of(*body, o);
+  std::vector<Eigen::Vector2d> drawn;
+  for (const fit::PointBasis& p : drawing.points) drawn.push_back(fit::PointPosition(p, r.q.data(), body->num_q()));
+  for (const auto& [a, b] : drawing.segments) overlay["body"].push_back({Point(drawn[size_t(a)]), Point(drawn[size_t(b)])});
   if (curve) {
-    for (const fit::PointBasis& p : fit::CurveSamples::Of(*body, o).points)
-      overlay["fitted"].push_back(Point(fit::PointPosition(p, r.q.data(), body->num_q())));
+    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> target_segments;
     for (const formats::TargetCurve& line : targets.polylines) {
       json pl = json::array();
       for (const Eigen::Vector2d& p : line.points) pl.push_back(Point(p));
       overlay["targets"].push_back({{"polyline", pl}, {"closed", line.closed}});
+      for (size_t k = 0; k + 1 < line.points.size(); ++k) target_segments.push_back({line.points[k], line.points[k + 1]});
+      if (line.closed && line.points.size() > 2) target_segments.push_back({line.points.back(), line.points.front()});
     }
     for (const Eigen::Vector2d& p : targets.cloud) overlay["targets"].push_back({{"point", Point(p)}});
+    for (const Eigen::Vector2d& x : drawn) {
+      overlay["fitted"].push_back(Point(x));
+      double best = INFINITY;
+      Eigen::Vector2d nearest = x;
+      for (const auto& [a, b] : target_segments) {
+        const Eigen::Vector2d d = b - a;
+        const double t = d.squaredNorm() > 0 ? std::clamp((x - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+        if ((a + t * d - x).norm() < best) best = (a + t * d - x).norm(), nearest = a + t * d;
+      }
+      for (const Eigen::Vector2d& p : targets.cloud)
+        if ((p - x).norm() < best) best = (p - x).norm(), nearest = p;
+      overlay["joins"].push_back({Point(x), Point(nearest)});
+    }
   } else {
     for (const fit::Correspondence& t : points) {
-      overlay["fitted"].push_back(
-          Point(fit::PointPosition(fit::BasisOf(*body, t.mass_point, t.lattice_coords), r.q.data(), body->num_q())));
+      const Eigen::Vector2d x = fit::PointPosition(fit::BasisOf(*body, t.mass_point, t.lattice_coords), r.q.data(), body->num_q());
+      overlay["fitted"].push_back(Point(x));
       overlay["targets"].push_back({{"point", Point(t.position)}});
+      overlay["joins"].push_back({Point(x), Point(t.position)});
     }
   }
   j["overlay"] = overlay;

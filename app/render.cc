@@ -100,6 +100,9 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
   cmd->add_option("--style", a->style, "diagnostic (lattice, mass points, shape) or clean (the character: filled, "
                                       "anti-aliased, no lattice or points)")
       ->capture_default_str();
+  cmd->add_flag("--exr-terrain", a->exr_terrain,
+                "EXR frames: write the rest of the picture (terrain or ground, springs, trails) as its own layer "
+                "terrain.R,G,B,A too (the characters' R,G,B,A are always written)");
   cmd->add_option("--trail", a->trail, "Trace points given by lattice coordinates \"s t s t ..\" in the frames")
       ->type_name("\"S T ..\"");
   return cmd;
@@ -195,6 +198,7 @@ pl::RenderOutputs RenderOutputsOf(const RenderArgs& a, const std::string& defaul
   out.orbit_deg_per_s = a.orbit;
   out.camera = a.camera == "follow" ? pl::RenderOutputs::Camera::kFollow : pl::RenderOutputs::Camera::kWhole;
   out.view.style = a.style == "clean" ? pl::RenderStyle::kClean : pl::RenderStyle::kDiagnostic;
+  out.view.exr_terrain_layer = a.exr_terrain;
   return out;
 }
 

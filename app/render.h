@@ -5,7 +5,7 @@
 //   render: frames (PNG sequence), filmstrip (one PNG of chosen frames), charts (energy and
 //           cond(M) against time, PNG + CSV)
 //   export: vtp (.vtp per frame + .pvd), exr (per frame the characters' R,G,B,A,
-//           terrain.R,G,B,A, depth.Z, motion forward.u/v), disp (disp.X,
+//           depth.Z, motion forward.u/v; with --exr-terrain terrain.R,G,B,A), disp (disp.X,
 //           disp.Y over the rest lattice per frame)
 // Rendering needs an X display: without DISPLAY the command stops with exit code 2 and says
 // to use xvfb-run (VTK 9.1 would abort).
@@ -47,6 +47,7 @@ struct RenderArgs {
   double orbit = 0.0;               // 3D camera turn, degrees per simulated second
   std::string camera = "whole";     // 2D: whole (the run framed once) or follow
   std::string style = "diagnostic"; // diagnostic (lattice, mass points) or clean (the character only)
+  bool exr_terrain = false;         // EXR frames: the terrain as its own layer too
   Limits limits;
 };
 

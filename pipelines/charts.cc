@@ -17,6 +17,7 @@
 #include <vtkImageData.h>
 #include <vtkPen.h>
 #include <vtkPlot.h>
+#include <vtkPlotLine.h>
 #include <vtkPlotPoints.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -93,6 +94,40 @@ std::string CsvField(const std::string& s) {
 
 }  // namespace
 
+namespace {
+
+// One scale on both axes: the plot area's size in pixels is known only once the chart has
+// been laid out, and the labels of new ranges can move it by a few pixels, so it is laid out,
+// the ranges set around the data's centre, and that done once more.
+void EqualAspect(vtkContextView* view, vtkChartXY* chart, const ChartSpec& spec) {
+  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+  for (const ChartSeries& s : spec.series)
+    for (size_t i = 0; i < s.x.size(); ++i)
+      if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) {
+        lo[0] = std::min(lo[0], s.x[i]), hi[0] = std::max(hi[0], s.x[i]);
+        lo[1] = std::min(lo[1], s.y[i]), hi[1] = std::max(hi[1], s.y[i]);
+      }
+  if (!(lo[0] <= hi[0])) return;
+  vtkAxis* axes[2] = {chart->GetAxis(vtkAxis::BOTTOM), chart->GetAxis(vtkAxis::LEFT)};
+  for (int pass = 0; pass < 2; ++pass) {
+    view->GetRenderWindow()->Render();
+    double pixels[2], units = 0;  // the plot area's pixels, and the larger of units per pixel
+    for (int a = 0; a < 2; ++a) {
+      const float* p1 = axes[a]->GetPoint1();
+      const float* p2 = axes[a]->GetPoint2();
+      pixels[a] = std::max(1.0, double(std::abs(p2[a] - p1[a])));
+      units = std::max(units, 1.05 * std::max(hi[a] - lo[a], 1e-12) / pixels[a]);  // 5 % margin
+    }
+    for (int a = 0; a < 2; ++a) {
+      const double centre = 0.5 * (lo[a] + hi[a]), half = 0.5 * units * pixels[a];
+      axes[a]->SetBehavior(vtkAxis::FIXED);
+      axes[a]->SetRange(centre - half, centre + half);
+    }
+  }
+}
+
+}  // namespace
+
 vtkSmartPointer<vtkImageData> RenderChart(const ChartSpec& spec) {
   Validate(spec);
   auto view = MakeView(spec.width, spec.height);
@@ -101,6 +136,7 @@ vtkSmartPointer<vtkImageData> RenderChart(const ChartSpec& spec) {
   ChartSpec drawn = spec;
   drawn.legend_beside = spec.width >= kLegendBesideWidth;
   FillChart(chart, drawn);
+  if (spec.equal_aspect && !spec.log_x && !spec.log_y) EqualAspect(view, chart, spec);
   return Grab(view);
 }
 
@@ -143,7 +179,9 @@ void FillChart(vtkChartXY* chart, const ChartSpec& spec) {
   chart->ClearPlots();
   chart->GetAxis(vtkAxis::LEFT)->SetBehavior(vtkAxis::AUTO);
   chart->SetTitle(spec.title);
-  const RobustRange robust = spec.robust_y && !spec.log_y ? RobustYRange(spec.series) : RobustRange{1, 0, NAN, NAN};
+  // (shapes on equal axes keep every point: no spike is cut)
+  const RobustRange robust =
+      spec.robust_y && !spec.log_y && !spec.equal_aspect ? RobustYRange(spec.series) : RobustRange{1, 0, NAN, NAN};
   if (std::isfinite(robust.cut_y)) {
     char note[96];
     std::snprintf(note, sizeof note, " (%s %.3g at x = %.3g off the scale)", robust.cut_y > robust.hi ? "peak" : "dip",
@@ -190,6 +228,7 @@ void FillChart(vtkChartXY* chart, const ChartSpec& spec) {
     }
     plot->SetWidth(s.width);
     if (s.points) vtkPlotPoints::SafeDownCast(plot)->SetMarkerStyle(vtkPlotPoints::CIRCLE);
+    if (s.segments && !s.points) vtkPlotLine::SafeDownCast(plot)->PolyLineOff();
   }
   // VTK 9.1 draws no line when a plot's y range is tiny next to its magnitude (e.g. log10
   // cond(M) between 5.38 and 5.42): give such an axis a fixed, wider range: whole decades on

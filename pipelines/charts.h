@@ -16,6 +16,7 @@ struct ChartSeries {
   std::string name;
   std::vector<double> x, y;  // same length
   bool points = false;       // markers without lines (like thesis Fig. 4.8) instead of a line
+  bool segments = false;     // a line per pair of points (P1P2, P3P4, ...) instead of one polyline
   // Colour 0..255; a negative red picks the next colour of a fixed palette.
   int rgb[3] = {-1, 0, 0};
   float width = 2.0f;
@@ -40,6 +41,10 @@ struct ChartSpec {
   // quarter span's margin, and the title says what was cut ("peak 1.3e9 at x = 0.41 off
   // the scale"). The CSV keeps every value.
   bool robust_y = true;
+  // x and y in the same units (shapes, positions): RenderChart gives both axes one scale, so
+  // that a circle is drawn round, and shows every point (robust_y does not apply); linear
+  // axes only.
+  bool equal_aspect = false;
 };
 constexpr int kLegendBesideWidth = 600;
 

@@ -166,20 +166,22 @@ std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeom
   std::vector<ExrChannel> ch = {{"R", {}, true},         {"G", {}, true},         {"B", {}, true},
                                 {"A", {}, true},         {"terrain.R", {}, true}, {"terrain.G", {}, true},
                                 {"terrain.B", {}, true}, {"terrain.A", {}, true}, {"depth.Z", frame.depth}};
-  for (int k = 0; k < 8; ++k) ch[size_t(k)].data.resize(n);
+  const int colour_channels = frame.terrain_layer ? 8 : 4;
+  for (int k = 0; k < colour_channels; ++k) ch[size_t(k)].data.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const float a = frame.overlay.empty() || !frame.overlay[i] ? c.alpha[i] : 0.0f;
     const float rest = std::isinf(frame.depth[i]) ? 0.0f : 1.0f - a;  // drawn, and not a character
-    for (int k = 0; k < 3; ++k) {
-      ch[size_t(k)].data[i] = a * frame.rgb[3 * i + size_t(k)];
-      ch[size_t(4 + k)].data[i] = rest * frame.rgb[3 * i + size_t(k)];
-    }
+    for (int k = 0; k < 3; ++k) ch[size_t(k)].data[i] = a * frame.rgb[3 * i + size_t(k)];
     ch[3].data[i] = a;
     if (a == 0.0f) c.forward_u[i] = c.forward_v[i] = 0.0f;  // under the overlay
-    ch[7].data[i] = rest;
+    if (frame.terrain_layer) {
+      for (int k = 0; k < 3; ++k) ch[size_t(4 + k)].data[i] = rest * frame.rgb[3 * i + size_t(k)];
+      ch[7].data[i] = rest;
+    }
   }
-  ch.push_back({"forward.u", std::move(c.forward_u)});
-  ch.push_back({"forward.v", std::move(c.forward_v)});
+  if (!frame.terrain_layer) ch.erase(ch.begin() + 4, ch.begin() + 8);
+  ch.push_back({"forward.u", std::move(c.forward_u), true});
+  ch.push_back({"forward.v", std::move(c.forward_v), true});
   return ch;
 }
 

@@ -75,16 +75,18 @@ struct ExrFrame {
   std::vector<uint8_t> overlay;  // 1 where the 2D text overlay or colour bar was drawn (empty: none)
   ScreenGeometry characters;   // the bodies as drawn
   ExrMetadata metadata;        // the camera (and the frame's time, when in a series)
+  bool terrain_layer = false;  // write the terrain.R/G/B/A layer (it costs a third of the file's time)
 };
 
 // The frame's channels: R, G, B, A of the characters (colour premultiplied by A, A from the
-// rasterised characters), terrain.R/G/B/A of everything else drawn (the ground or terrain,
-// springs, trails, named points) where no character covers it, depth.Z of whatever is nearest;
+// rasterised characters), with frame.terrain_layer terrain.R/G/B/A of everything else drawn
+// (the ground or terrain, springs, trails, named points) where no character covers it,
+// depth.Z of whatever is nearest;
 // pixels of the 2D overlay are in no layer (its text hides what is under it, so a character
 // under the text has a hole there: render without the overlay for compositing);
 // and forward.u, forward.v: each character pixel's motion to the next frame in pixels (x
-// right, y up; zero without a next frame). Colour and alpha are half floats, depth and motion
-// 32-bit floats.
+// right, y up; zero without a next frame). Colour, alpha and motion are half floats (motion to
+// 2^-11 of its size: 0.03 px at 60 px), depth 32-bit floats.
 std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeometry* next);
 
 // ExrFrameChannels written atomically to `path` (WriteExrChannels).

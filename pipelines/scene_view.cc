@@ -569,6 +569,7 @@ ExrFrame SceneView::CaptureExrFrame() {
   }
   f.characters = CharacterGeometry();
   f.metadata = ExrCameraMetadata();
+  f.terrain_layer = options_.exr_terrain_layer;
   return f;
 }
 

@@ -52,6 +52,7 @@ struct SceneOptions {
   int shape_samples = 16;  // ShapeSource::SamplesPerSegment
   double point_size = 8.0, line_width = 3.0;
   ExrCompression exr_compression = ExrCompression::kZip;  // of WriteExr's frames
+  bool exr_terrain_layer = false;  // EXR frames: the rest of the picture as terrain.R/G/B/A too
   int png_compression = 1;                                // zlib level 0-9 of WritePng
   // The interactive viewer (interactive_view.h) draws on screen, in a part of its window:
   // offscreen false opens a visible window; viewport = {xmin, ymin, xmax, ymax} of the window

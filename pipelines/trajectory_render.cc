@@ -376,7 +376,8 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   if (out.frames) report.files.push_back({out.folder + "/frames/frame_NNNN.png", ""});
   if (out.exr)
     report.files.push_back({out.folder + "/exr/frame_NNNN.exr",
-                            "characters R, G, B, A; terrain.R, G, B, A; depth.Z; motion to the next frame forward.u, forward.v"});
+                            std::string("characters R, G, B, A; ") + (out.view.exr_terrain_layer ? "terrain.R, G, B, A; " : "") +
+                                "depth.Z; motion to the next frame forward.u, forward.v"});
   bool any_volume = false;
   for (const DispTarget& d : disp) {
     if (d.depth == 0) {

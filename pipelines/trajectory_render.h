@@ -12,8 +12,9 @@
 //   vtp/NAME.pvd            per frame and body b parts 3b, 3b+1, 3b+2 (lattice or control
 //                           box, mass points, shape), files vtp/<body>_<part>_NNNN.vtp
 //   exr/frame_NNNN.exr      the frame for compositing (exr_frame.h): the characters' R, G, B,
-//                           A, the rest as terrain.R/G/B/A, depth.Z, and the characters'
-//                           motion to the next frame (forward.u, forward.v; 0 on the last)
+//                           A, depth.Z, the characters' motion to the next frame (forward.u,
+//                           forward.v; 0 on the last), and with view.exr_terrain_layer the
+//                           rest as terrain.R/G/B/A
 //   exr/disp_NNNN.exr       each FFD body's displacement image (disp_<body>_NNNN.exr when
 //                           the world has more than one FFD body)
 //   vti/disp_NNNN.vti       a 3D FFD body's displacement volume instead (DisplacementVolume),

@@ -96,6 +96,43 @@ TEST(Charts, WholeNumberTicksAndALegendBesideThePlot) {
   EXPECT_FALSE(chart->GetLegend()->GetInline());
 }
 
+// Shapes on a chart: with equal_aspect a circle is drawn round (its red pixels' box is
+// square to 2 %) although the data span three times as much in y as in x; without it, the
+// same circle is not round (so the check can fail). Segments draw pairs, not a polyline.
+TEST(Charts, EqualAspectDrawsACircleRound) {
+  REQUIRE_DISPLAY();
+  ChartSpec spec;
+  spec.width = 700;
+  spec.height = 500;
+  ChartSeries circle, far;
+  circle.name = "circle";
+  circle.rgb[0] = 255, circle.rgb[1] = 0, circle.rgb[2] = 0;
+  for (int i = 0; i <= 200; ++i) circle.x.push_back(10 * std::cos(i * M_PI / 100)), circle.y.push_back(10 * std::sin(i * M_PI / 100));
+  far.name = "far";
+  far.points = true;
+  far.x = {0.0};
+  far.y = {50.0};
+  far.rgb[0] = 0, far.rgb[1] = 0, far.rgb[2] = 255;
+  spec.series = {circle, far};
+  auto red_box = [](vtkImageData* image) {
+    int dims[3];
+    image->GetDimensions(dims);
+    int x0 = dims[0], x1 = -1, y0 = dims[1], y1 = -1;
+    for (int y = 0; y < dims[1]; ++y)
+      for (int x = 0; x < dims[0] * 7 / 10; ++x) {  // left of the legend (beside the plot, with a red sample)
+        const auto* p = static_cast<unsigned char*>(image->GetScalarPointer(x, y, 0));
+        if (p[0] > 200 && p[1] < 80 && p[2] < 80) x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+    return std::pair<double, double>(x1 - x0, y1 - y0);
+  };
+  const auto [w_plain, h_plain] = red_box(RenderChart(spec));
+  EXPECT_GT(std::abs(w_plain / h_plain - 1.0), 0.1) << w_plain << " x " << h_plain;
+  spec.equal_aspect = true;
+  const auto [w, h] = red_box(RenderChart(spec));
+  EXPECT_GT(w, 50.0);
+  EXPECT_NEAR(w / h, 1.0, 0.02) << w << " x " << h;
+}
+
 // One spike does not flatten the rest: the axis shows the bulk, the title names the peak, and
 // without a spike the range is the data's.
 TEST(Charts, OneSpikeLeavesTheBulkReadable) {
