@@ -4,6 +4,7 @@
 #   make test    install, build, run every test (under Xvfb when available), then the unit
 #                tests again in an AddressSanitizer + UBSan debug build (make asan alone)
 #   make bench   build and run the benchmarks
+#   make bench-mujoco  the Witkin & Welch step against MuJoCo 2.2.2 (installs libmujoco-dev)
 #   make build   configure and build only
 #   make deps    install the Debian packages that are missing (as root)
 #   make fuzz    build the libFuzzer targets of fuzz/ (clang) and run each FUZZ_SECONDS (60)
@@ -29,6 +30,8 @@ PACKAGES := libvtk9-dev libeigen3-dev libceres-dev libopenexr-dev libimath-dev \
             libopenmpi-dev openmpi-bin
 # only `make fuzz` needs these (libFuzzer is clang's)
 FUZZ_PACKAGES := clang libclang-rt-14-dev
+# only `make bench-mujoco` needs this (the peer the Witkin & Welch step is measured against)
+MUJOCO_PACKAGES := libmujoco-dev
 
 
 # The default scene: the table (lattice 300 x 100) dropped from 50 onto the ground sloped by
@@ -46,7 +49,7 @@ DEMO3D_ARGS   ?= --object data/pot3.obj --modes data/pot3_modes.def3 --q "0 30 0
                  --qdot "0 -60 0 0 1.2 0 0 0 0" --duration 4 --dt 0.001 --orbit 30 --elevation 25 \
                  --filmstrip "0 0.4 0.8 1.5 2.5 4" --what frames,filmstrip,charts,vtp,exr
 
-.PHONY: all deps fuzz-deps configure build demo-build demo test test-release asan bench bench-mpi bench-python fuzz clean
+.PHONY: all deps fuzz-deps configure build demo-build demo test test-release asan bench bench-mujoco bench-mpi bench-python fuzz clean
 
 all: build
 
@@ -147,6 +150,15 @@ bench: configure
 	# rendering and export speed; VTK renders through X
 	if [ -n "$${DISPLAY:-}" ]; then $(BUILD)/bench/wobble_pipelines_bench
 	else xvfb-run -a -s "-screen 0 1280x1024x24" $(BUILD)/bench/wobble_pipelines_bench; fi
+
+# Fig. 2's triple pendulum, wobble against MuJoCo in one run (issue 18): interleaved
+# repetitions, since the machines here are noisy; compare the medians
+bench-mujoco: configure
+	$(MAKE) deps PACKAGES="$(MUJOCO_PACKAGES)"
+	cmake -S . -B $(BUILD) > /dev/null  # finds MuJoCo now that it is installed
+	cmake --build $(BUILD) -j $(JOBS) --target mujoco_bench
+	$(BUILD)/bench/mujoco_bench --benchmark_min_time=0.3 --benchmark_repetitions=10 \
+	  --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true
 
 # Trials over MPI ranks (issue 17): two ranks on this machine, then the model of 100 and 1,000
 bench-mpi: configure

@@ -66,7 +66,11 @@ void MultiplierSolver::Solve(const Eigen::VectorXd& b, Eigen::VectorXd* x) const
     return;
   }
   if (method_ == MultiplierMethod::kDense) {
-    x->noalias() = inverse_ * b;
+    // a few rows (Fig. 2: 6): the coefficient-wise product beats Eigen's gemv kernel there
+    if (rows_ <= 32)
+      x->noalias() = inverse_.lazyProduct(b);
+    else
+      x->noalias() = inverse_ * b;
   } else {
     *x = ldlt_.solve(b);
   }

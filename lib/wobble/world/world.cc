@@ -297,35 +297,61 @@ bool World::StepEachBody() {
     Eigen::VectorXd& acc = acc_.empty() ? acc_.emplace_back() : acc_[0];
     LinearFreeAcceleration(e, &acc);
     if (!acc.allFinite()) return Fail(StatusCode::kNonFinite, body, "non-finite acceleration");
-    const int d = e.model->dim(), n = e.model->basis_size();
-    // the new state into the scratch, then swapped in (O(1)): a refused step swaps back
-    e.R_dot_before.noalias() =
-        e.R_dot + h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(acc.data(), d, n);
-    e.R_before.noalias() = e.R + h * e.R_dot_before;
-    e.R.swap(e.R_before);
-    e.R_dot.swap(e.R_dot_before);
-    e.applied.setZero();
-    if (!AcceptLinearStep(body)) return false;
+    if (!StepLinearBody(body, acc)) return false;
   }
   return true;
+}
+
+namespace {
+constexpr double kLinearScreen = 1e30;  // AcceptLinearStep's bound on every factor of an energy term
+}  // namespace
+
+// Semi-implicit Euler, velocity first, of a linear body with R̈ given row by row. The new state
+// goes into the scratch matrices and is swapped in (O(1)), so that a refused step swaps back.
+// Plain loops (d ≤ 3, n ≤ 10), which also apply AcceptLinearStep's screen to R and Ṙ on the way.
+bool World::StepLinearBody(int body, const Eigen::VectorXd& acc) {
+  LinearEntry& e = linear_[slots_[body].index];
+  const double h = options_.dt;
+  const int d = e.model->dim(), n = e.model->basis_size();
+  e.R_before.resize(d, n);
+  e.R_dot_before.resize(d, n);
+  bool screened = true;  // every |R|, |Ṙ| ≤ kLinearScreen (false for NaN and inf too)
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < d; ++i) {
+      const double rd = e.R_dot(i, j) + h * acc[i * n + j];
+      const double r = e.R(i, j) + h * rd;
+      e.R_dot_before(i, j) = rd;
+      e.R_before(i, j) = r;
+      screened &= std::abs(rd) <= kLinearScreen && std::abs(r) <= kLinearScreen;
+    }
+  e.R.swap(e.R_before);
+  e.R_dot.swap(e.R_dot_before);
+  e.applied.setZero();
+  return AcceptLinearStep(body, screened);
 }
 
 void World::LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const {
   const WorldParams& params = options_.params;
   const LinearBodyModel& m = *e.model;
+  const int d = m.dim(), n = m.basis_size();
   Eigen::MatrixXd& Q = e.Q;
   Q = e.applied;
   AddAffineForce(e.material, e.R, e.R_dot, &Q);
   if (params.gravity_on) {  // Σ m_k g p_kᵀ
-    if (m.dim() == 2)
-      Q.noalias() += params.gravity * m.first_moment().transpose();
-    else
-      Q.noalias() += options_.gravity_3d * m.first_moment().transpose();
+    const double* g = d == 2 ? params.gravity.data() : options_.gravity_3d.data();
+    const Eigen::VectorXd& mu = m.first_moment();
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < d; ++i) Q(i, j) += g[i] * mu[j];
   }
+  // R̈ = Q W (Eq. 5), flattened row by row; plain loops, as TimesBasis in world_constraints.cc
   acc->resize(m.num_q());
-  // R̈ = Q W (Eq. 5), flattened row by row
-  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(acc->data(), m.dim(), m.basis_size())
-      .noalias() = Q * m.inverse_mass_matrix();
+  const Eigen::MatrixXd& W = m.inverse_mass_matrix();
+  for (int i = 0; i < d; ++i)
+    for (int k = 0; k < n; ++k) {
+      double sum = 0.0;
+      for (int j = 0; j < n; ++j) sum += Q(i, j) * W(j, k);
+      (*acc)[i * n + k] = sum;
+    }
 }
 
 void World::ThrowInterrupted() const {
@@ -401,16 +427,14 @@ Energies World::FfdEnergies(int i, ContactSet contacts, bool per_mode) const {
 
 // A finite acceleration can still overflow R, Ṙ or the energy: the step is refused then, and
 // the body keeps its state before it (R_before, R_dot_before hold it: the step swapped them).
-bool World::AcceptLinearStep(int body) {
+// `screened`: every entry of R and Ṙ is at most kLinearScreen in size.
+bool World::AcceptLinearStep(int body, bool screened) {
   LinearEntry& e = linear_[slots_[body].index];
   // the screen of EnergySurelyFinite, for ½ tr(Ṙ M Ṙᵀ), −g·R m̄ and the affine energies (at
   // most seven factors deep: k_c (det A − 1)² with a 3×3 A)
-  constexpr double kScreen = 1e30;
   const double g = e.model->dim() == 2 ? options_.params.gravity.cwiseAbs().maxCoeff()
                                        : options_.gravity_3d.cwiseAbs().maxCoeff();
-  if (e.scale <= kScreen && e.R.cwiseAbs().maxCoeff() <= kScreen && e.R_dot.cwiseAbs().maxCoeff() <= kScreen &&
-      g <= kScreen)
-    return true;
+  if (screened && e.scale <= kLinearScreen && g <= kLinearScreen) return true;
   const bool finite = e.R.allFinite() && e.R_dot.allFinite();
   if (finite && EnergyFinite(body)) return true;
   const Energies energies = finite ? ComputeEnergies(body) : Energies();

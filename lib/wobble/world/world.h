@@ -370,7 +370,8 @@ class World {
   // q̇ of 1e160 squares past the largest double), and no accepted step leaves one.
   bool EnergyFinite(int body) const;
   bool EnergySurelyFinite(const FfdEntry& e) const;
-  bool AcceptLinearStep(int body);
+  bool StepLinearBody(int body, const Eigen::VectorXd& acc);
+  bool AcceptLinearStep(int body, bool screened);
   bool ForcesFinite(int body) const;  // an FFD body's generalized forces at its state now
   void FinishStep();
 
@@ -387,14 +388,16 @@ class World {
   // W Jᵀ e_i (nq × d) for an end, and J of another end times that.
   Eigen::MatrixXd EndWJt(const End& e) const;
   Eigen::MatrixXd EndJacobian(const End& e) const;  // d × nq of the body
-  void Targets(const Constraint& c, double t, Eigen::VectorXd* n, Eigen::VectorXd* n_dot, Eigen::VectorXd* n_ddot) const;
+  void Targets(const Constraint& c, double t, PointVec* n, PointVec* n_dot, PointVec* n_ddot) const;
   double FeedbackAlpha(const Constraint& c) const;
   double FeedbackBeta(const Constraint& c) const;
   bool AnyFfdConstrained() const;
   int AssignRows();
   // A = J W Jᵀ over the given rows.
   Eigen::SparseMatrix<double> AssembleA(const std::vector<const Constraint*>& rows) const;
-  bool EnsureFactored(std::string* why);
+  // Factors A when it changed (or always, when an FFD body is constrained: A depends on q);
+  // *factored (if given) is the solver that holds it.
+  bool EnsureFactored(std::string* why, const MultiplierSolver** factored = nullptr);
   // Free accelerations of every body (flattened), or false with the failing body and status.
   bool FreeAccelerations(std::vector<Eigen::VectorXd>* a, int* failed_body, StepStatus* st);
   void ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const;  // += W Q
@@ -413,6 +416,7 @@ class World {
   std::vector<Constraint> constraints_;
   int enabled_count_ = 0;
   std::vector<Eigen::VectorXd> acc_, force_;  // per-step work, kept to reuse their storage
+  Eigen::VectorXd rhs_, lambda_;             // per-step work of the multiplier solve
   MultiplierSolver constant_solver_, dynamic_solver_;
   bool structure_dirty_ = true;
   MultiplierMethod last_method_ = MultiplierMethod::kAuto;

@@ -17,6 +17,23 @@ using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::Ro
 // A linear body's flattened coordinates are R row by row: index i·n + s holds R_is (§3.3).
 Eigen::Map<RowMajor> AsMatrix(Eigen::VectorXd& v, int d, int n) { return {v.data(), d, n}; }
 Eigen::Map<const RowMajor> AsMatrix(const Eigen::VectorXd& v, int d, int n) { return {v.data(), d, n}; }
+
+// y = M p for a linear body's d×n matrix M (R, Ṙ or R̈) and a basis vector p: the position,
+// velocity or acceleration of a material point. Plain loops: at d ≤ 3, n ≤ 10 Eigen's run-time
+// sized products spend more on dispatch and alignment peeling than on the arithmetic (Fig. 2's
+// step, bench/mujoco_bench).
+using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;  // World::PointVec
+template <class Matrix>
+SmallVector TimesBasis(const Matrix& M, const Eigen::VectorXd& p) {
+  const int d = int(M.rows()), n = int(M.cols());
+  SmallVector y(d);
+  for (int i = 0; i < d; ++i) {
+    double sum = 0.0;
+    for (int j = 0; j < n; ++j) sum += M(i, j) * p[j];
+    y[i] = sum;
+  }
+  return y;
+}
 }  // namespace
 
 const char* ConstraintKindName(ConstraintKind kind) {
@@ -76,9 +93,7 @@ World::PointVec World::EndPosition(const End& e) const {
   const Slot& b = slots_[e.body];
   if (b.kind == BodyKind::kFfd3) return Ffd3EndPosition(e);
   if (b.kind == BodyKind::kLinear) {
-    PointVec x;
-    x.noalias() = linear_[b.index].R * e.p;
-    return x;
+    return TimesBasis(linear_[b.index].R, e.p);
   }
   const BodyState<double>& s = ffd_[b.index].state;
   return WorldFromLocal(Frame<double>(s.q), LocalPosition<double>(e.b0, e.B, s.q));
@@ -88,9 +103,7 @@ World::PointVec World::EndVelocity(const End& e) const {
   const Slot& b = slots_[e.body];
   if (b.kind == BodyKind::kFfd3) return Ffd3EndVelocity(e);
   if (b.kind == BodyKind::kLinear) {
-    PointVec v;
-    v.noalias() = linear_[b.index].R_dot * e.p;
-    return v;
+    return TimesBasis(linear_[b.index].R_dot, e.p);
   }
   const BodyState<double>& s = ffd_[b.index].state;
   const Frame<double> frame(s.q);
@@ -303,30 +316,32 @@ bool World::exists(int id) const { return id >= 0 && id < num_constraints() && !
 ConstraintKind World::constraint_kind(int id) const { return Get(id).kind; }
 Eigen::VectorXd World::Multiplier(int id) const { return Get(id).lambda; }
 
-void World::Targets(const Constraint& c, double t, Eigen::VectorXd* n, Eigen::VectorXd* n_dot,
-                               Eigen::VectorXd* n_ddot) const {
-  const int d = dim(c.a.body);
+void World::Targets(const Constraint& c, double t, PointVec* n, PointVec* n_dot, PointVec* n_ddot) const {
+  const int d = int(c.lambda.size());
   if (c.kind == ConstraintKind::kTrajectory) {
-    PathSample s = c.path->Evaluate(t);
+    const PathSample s = c.path->Evaluate(t);
     if (s.n.size() != d || s.n_dot.size() != d || s.n_ddot.size() != d)
       throw std::invalid_argument("the path of a trajectory on body '" + body_name(c.a.body) +
                                   "' returned a sample of the wrong size at t = " + std::to_string(t));
     if (!s.n.allFinite() || !s.n_dot.allFinite() || !s.n_ddot.allFinite())
       throw std::invalid_argument("the path of a trajectory on body '" + body_name(c.a.body) +
                                   "' returned a non-finite sample at t = " + std::to_string(t));
-    *n = std::move(s.n);
-    *n_dot = std::move(s.n_dot);
-    *n_ddot = std::move(s.n_ddot);
+    *n = s.n;
+    *n_dot = s.n_dot;
+    *n_ddot = s.n_ddot;
     return;
   }
-  *n = c.kind == ConstraintKind::kNail ? c.where : Eigen::VectorXd::Zero(d);
-  *n_dot = Eigen::VectorXd::Zero(d);
-  *n_ddot = Eigen::VectorXd::Zero(d);
+  if (c.kind == ConstraintKind::kNail)
+    *n = c.where;
+  else
+    n->setZero(d);
+  n_dot->setZero(d);
+  n_ddot->setZero(d);
 }
 
 Eigen::VectorXd World::ConstraintError(int id) const {
   const Constraint& c = Get(id);
-  Eigen::VectorXd n, nd, ndd;
+  PointVec n, nd, ndd;
   Targets(c, time_, &n, &nd, &ndd);
   PointVec e = EndPosition(c.a) - n;
   if (c.b.body >= 0) e -= EndPosition(c.b);
@@ -335,7 +350,7 @@ Eigen::VectorXd World::ConstraintError(int id) const {
 
 Eigen::VectorXd World::ConstraintVelocityError(int id) const {
   const Constraint& c = Get(id);
-  Eigen::VectorXd n, nd, ndd;
+  PointVec n, nd, ndd;
   Targets(c, time_, &n, &nd, &ndd);
   PointVec e = EndVelocity(c.a) - nd;
   if (c.b.body >= 0) e -= EndVelocity(c.b);
@@ -430,8 +445,9 @@ Eigen::SparseMatrix<double> World::AssembleA(const std::vector<const Constraint*
   return A;
 }
 
-bool World::EnsureFactored(std::string* why) {
+bool World::EnsureFactored(std::string* why, const MultiplierSolver** factored) {
   const bool dynamic = AnyFfdConstrained();
+  if (factored) *factored = dynamic ? &dynamic_solver_ : &constant_solver_;
   if (!dynamic && !structure_dirty_ && constant_solver_.factored()) return true;
   const int m = AssignRows();
   std::vector<const Constraint*> rows;
@@ -493,10 +509,13 @@ bool World::StepConstrained() {
   // the multipliers: J W Jᵀ λ = −(J W Q + J̇ q̇ − n̈ + α c + β ċ)  (Eq. 8/10 with feedback)
   std::string why;
   try {
-    if (!EnsureFactored(&why)) return Fail(StatusCode::kSingularConstraints, -1, why);
-    const MultiplierSolver& solver = AnyFfdConstrained() ? dynamic_solver_ : constant_solver_;
+    const MultiplierSolver* factored = nullptr;
+    if (!EnsureFactored(&why, &factored)) return Fail(StatusCode::kSingularConstraints, -1, why);
+    const MultiplierSolver& solver = *factored;
     if (solver.rows() > 0) {
-      Eigen::VectorXd rhs(solver.rows()), n, nd, ndd;
+      Eigen::VectorXd& rhs = rhs_;  // per-step work, its storage kept
+      rhs.resize(solver.rows());
+      PointVec n, nd, ndd;
       for (const Constraint& c : constraints_) {
         if (!c.enabled) continue;
         Targets(c, time_, &n, &nd, &ndd);
@@ -504,27 +523,48 @@ bool World::StepConstrained() {
         // Velocity-first symplectic Euler staggers velocities: q̇ₙ = (qₙ − qₙ₋₁)/Δt is the velocity
         // of t − Δt/2, so ċ compares it with ṅ(t − Δt/2) ≈ ṅ − ½Δt n̈. Against ṅ(t) the β term
         // would see a false ċ = −½Δt n̈ and hold the point β Δt n̈ / (2α) behind its path.
-        PointVec accel_c = -ndd, pos_c = EndPosition(c.a) - n, vel_c = EndVelocity(c.a) - nd + 0.5 * h * ndd, Ja;
+        // c, ċ and c̈ summed end by end in plain arrays: scalar stores read back by vector loads
+        // (Eigen on d ≤ 3 temporaries) stall store forwarding, a tenth of Fig. 2's step
+        double pos_c[3], vel_c[3], accel_c[3];
+        for (int i = 0; i < d; ++i) {
+          pos_c[i] = -n[i];
+          vel_c[i] = -nd[i] + 0.5 * h * ndd[i];
+          accel_c[i] = -ndd[i];
+        }
         auto add_end = [&](const End& e, double sign) {
           const Slot& b = slots_[e.body];
-          if (b.kind == BodyKind::kLinear) {
-            const LinearBodyModel& m = *linear_[b.index].model;
-            Ja.noalias() = AsMatrix(acc[e.body], d, m.basis_size()) * e.p;  // J a = R̈ p; J̇ = 0
-            accel_c += sign * Ja;
+          if (b.kind == BodyKind::kLinear) {  // x = R p, ẋ = Ṙ p, J a = R̈ p (J̇ = 0)
+            const LinearEntry& l = linear_[b.index];
+            const int n_basis = int(e.p.size());
+            const double* a = acc[e.body].data();  // R̈ row by row
+            for (int i = 0; i < d; ++i) {
+              double x = 0.0, v = 0.0, ja = 0.0;
+              for (int j = 0; j < n_basis; ++j) {
+                x += l.R(i, j) * e.p[j];
+                v += l.R_dot(i, j) * e.p[j];
+                ja += a[i * n_basis + j] * e.p[j];
+              }
+              pos_c[i] += sign * x;
+              vel_c[i] += sign * v;
+              accel_c[i] += sign * ja;
+            }
           } else {
-            accel_c += sign * (EndJacobian(e) * acc[e.body] + EndJdotQdot(e));
+            const PointVec x = EndPosition(e), v = EndVelocity(e);
+            const PointVec ja = EndJacobian(e) * acc[e.body] + EndJdotQdot(e);
+            for (int i = 0; i < d; ++i) {
+              pos_c[i] += sign * x[i];
+              vel_c[i] += sign * v[i];
+              accel_c[i] += sign * ja[i];
+            }
           }
         };
         add_end(c.a, 1.0);
-        if (c.b.body >= 0) {
-          add_end(c.b, -1.0);
-          pos_c -= EndPosition(c.b);
-          vel_c -= EndVelocity(c.b);
-        }
-        rhs.segment(c.row, d) = accel_c + FeedbackAlpha(c) * pos_c + FeedbackBeta(c) * vel_c;
+        if (c.b.body >= 0) add_end(c.b, -1.0);
+        const double alpha = FeedbackAlpha(c), beta = FeedbackBeta(c);
+        for (int i = 0; i < d; ++i) rhs[c.row + i] = -(accel_c[i] + alpha * pos_c[i] + beta * vel_c[i]);
       }
-      Eigen::VectorXd lambda;
-      solver.Solve(-rhs, &lambda);
+      Eigen::VectorXd& lambda = lambda_;
+      solver.Solve(rhs, &lambda);
       // constrained accelerations q̈ = W(Q + Jᵀ λ)
       std::vector<Eigen::VectorXd>& force = force_;
       force.resize(num_bodies());
@@ -539,7 +579,10 @@ bool World::StepConstrained() {
           const Slot& b = slots_[e.body];
           if (b.kind == BodyKind::kLinear) {
             const int n_basis = int(e.p.size());
-            AsMatrix(acc[e.body], d, n_basis).noalias() += (sign * c.lambda) * e.Wp.transpose();  // (λ pᵀ) W
+            // (λ pᵀ) W, by plain loops as TimesBasis
+            double* a = acc[e.body].data();
+            for (int i = 0; i < d; ++i)
+              for (int j = 0; j < n_basis; ++j) a[i * n_basis + j] += sign * c.lambda[i] * e.Wp[j];
           } else {
             if (force[e.body].size() == 0) force[e.body] = Eigen::VectorXd::Zero(acc[e.body].size());
             AddEndForce(e, sign * c.lambda, &force);
@@ -561,14 +604,7 @@ bool World::StepConstrained() {
     if (b.kind == BodyKind::kFfd3) {
       if (!Ffd3AcceptConstrainedStep(body, acc[body])) return false;
     } else if (b.kind == BodyKind::kLinear) {
-      LinearEntry& e = linear_[b.index];
-      const int d = e.model->dim(), n = e.model->basis_size();
-      e.R_dot_before.noalias() = e.R_dot + h * AsMatrix(acc[body], d, n);  // swapped in below (O(1))
-      e.R_before.noalias() = e.R + h * e.R_dot_before;
-      e.R.swap(e.R_before);
-      e.R_dot.swap(e.R_dot_before);
-      e.applied.setZero();
-      if (!AcceptLinearStep(body)) return false;
+      if (!StepLinearBody(body, acc[body])) return false;
     } else {
       FfdEntry& e = ffd_[b.index];
       const VecQ<double> q_before = e.state.q, qd_before = e.state.qd;
@@ -608,7 +644,7 @@ bool World::ApplyImpulse(const std::vector<VelocityGoal>& goals, std::string* er
     // rows: the enabled constraints (wanted ċ = 0), then the goals
     std::vector<const Constraint*> rows;
     std::vector<Eigen::VectorXd> jump;  // wanted minus current velocity, per row block
-    Eigen::VectorXd n, nd, ndd;
+    PointVec n, nd, ndd;
     for (const Constraint& c : constraints_) {
       if (!c.enabled) continue;
       rows.push_back(&c);
