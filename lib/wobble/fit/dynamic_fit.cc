@@ -8,6 +8,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "wobble/fit/internal/mode_force.h"
 #include "wobble/fit/internal/solve_common.h"
 #include "wobble/synth/anneal.h"
 #include "wobble/core/rotation3.h"
@@ -21,33 +22,6 @@ namespace {
 // Jet width of the dynamic cost: 24 covers the table (7 + 7 + 4 + 4 parameters) in one pass;
 // bodies with more parameters take several passes (DynamicAutoDiffCostFunction strides).
 constexpr int kStride = 32;
-
-// The body with its mode potentials switched off: K and c come from the parameters instead
-// (lib/wobble/dynamics reads them from the model as doubles; see ThesisStep).
-template <int Dim> BodyModelN<Dim> PassiveCopy(const BodyModelN<Dim>& body) {
-  std::vector<DeformationModeN<Dim>> modes = body.modes();
-  for (DeformationModeN<Dim>& m : modes) m.stiffness = m.damping = 0.0;
-  return BodyModelN<Dim>(body.def(), modes);
-}
-
-template <class T> struct ModeParams {
-  VecD<T> K, c;
-};
-
-// StepBody's extra generalized force: the mode forces −2K_d (γ_d − γ0_d) − c_d γ̇_d (§4.7, and
-// the PD controller of chapter 5) with K, c and γ0 of scalar T; the body's own are switched off.
-template <class T> struct ModeForce {
-  const ModeParams<T>* p;
-  const VecD<T>* target;
-  void operator()(const BodyState<T>& s, VecQ<T>* Q) const {
-    for (int d = 0; d < p->K.size(); ++d)
-      (*Q)[kRigidDofs + d] += -T(2.0) * p->K[d] * (s.q[kRigidDofs + d] - (*target)[d]) - p->c[d] * s.qd[kRigidDofs + d];
-  }
-  void operator()(const BodyState3<T>& s, VecQ3<T>* Q) const {
-    for (int d = 0; d < p->K.size(); ++d)
-      (*Q)[kRigidDofs3 + d] += -T(2.0) * p->K[d] * (s.gamma[d] - (*target)[d]) - p->c[d] * s.v[kRigidDofs3 + d];
-  }
-};
 
 // What differs between the dimensions: the state, its step, where a body point is, and how
 // q0 is held as a parameter block. In 3D the block is [t, δ, γ] with the orientation

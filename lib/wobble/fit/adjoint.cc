@@ -1,0 +1,259 @@
+#include "wobble/fit/adjoint.h"
+
+#include <ceres/jet.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include "wobble/fit/internal/mode_force.h"
+
+namespace wobble::fit {
+
+namespace {
+
+// Inputs differentiated per Jet pass: the table's step has 2·7 + 3·4 = 26 inputs in the air
+// (two passes) and 22 more with all 11 points on the ground.
+constexpr int kChunk = 16;
+using Jet = ceres::Jet<double, kChunk>;
+
+using ContactKey = std::pair<int, int>;  // (point, face): a contact's identity across steps
+
+// λ of one state: ∂cost/∂q, ∂cost/∂q̇ and ∂cost/∂(each contact's anchor).
+struct Adjoint {
+  Eigen::VectorXd q, qd;
+  std::map<ContactKey, Eigen::Vector2d> anchor;
+};
+
+// Input i as a Jet whose derivative part is the unit vector of i when i is in the chunk that
+// starts at `offset`, and zero otherwise.
+Jet Seed(double value, int i, int offset) {
+  Jet x(value);
+  if (i >= offset && i < offset + kChunk) x.v[i - offset] = 1.0;
+  return x;
+}
+
+// g[offset + k] += λ ∂y/∂(input offset + k) for the inputs of the chunk.
+void Pull(const Jet& y, double lambda, int offset, Eigen::VectorXd* g) {
+  if (lambda == 0.0) return;
+  const int n = std::min(kChunk, int(g->size()) - offset);
+  for (int k = 0; k < n; ++k) (*g)[offset + k] += lambda * y.v[k];
+}
+
+// g += (∂(state)/∂(chunk inputs))ᵀ λ: every output of a step, weighted by its adjoint.
+void PullState(const BodyState<Jet>& s, const Adjoint& lambda, int offset, Eigen::VectorXd* g) {
+  for (int i = 0; i < s.q.size(); ++i) {
+    Pull(s.q[i], lambda.q[i], offset, g);
+    Pull(s.qd[i], lambda.qd[i], offset, g);
+  }
+  for (const Contact<Jet>& c : s.contacts) {
+    const auto it = lambda.anchor.find({c.point, c.face});
+    if (it == lambda.anchor.end()) continue;
+    Pull(c.anchor[0], it->second[0], offset, g);
+    Pull(c.anchor[1], it->second[1], offset, g);
+  }
+}
+
+void CheckRollout(const BodyModel& body, const ControlledRollout& r) {
+  const int nq = body.num_q(), D = body.num_modes();
+  auto fail = [](const std::string& what) { throw std::invalid_argument("rollout: " + what); };
+  if (r.integrator != Integrator::kThesis && r.integrator != Integrator::kSymplecticEuler)
+    fail("the adjoint takes the thesis and symplectic_euler integrators, not " + IntegratorName(r.integrator));
+  if (!(r.dt > 0.0) || !std::isfinite(r.dt)) fail("dt must be positive and finite");
+  if (r.q0.size() != nq || r.qd0.size() != nq)
+    fail("q0 and qdot0 need " + std::to_string(nq) + " values (tx ty theta and one per mode)");
+  if (r.stiffness.size() != D || r.damping.size() != D) fail("stiffness and damping need one value per mode");
+  if (r.targets.rows() != D) fail("targets need one row per mode (" + std::to_string(D) + ")");
+  if (!r.q0.allFinite() || !r.qd0.allFinite() || !r.stiffness.allFinite() || !r.damping.allFinite() ||
+      !r.targets.allFinite())
+    fail("every number must be finite");
+}
+
+// The rollout's step, plain and differentiated, on the body with its own mode forces off.
+class Rollout {
+ public:
+  Rollout(const BodyModel& body, const ControlledRollout& r) : passive_(PassiveCopy(body)), r_(r) {
+    params_.K = r.stiffness;
+    params_.c = r.damping;
+  }
+  int nq() const { return passive_.num_q(); }
+  int modes() const { return passive_.num_modes(); }
+
+  BodyState<double> Start() const {
+    BodyState<double> s;
+    s.q = r_.q0;
+    s.qd = r_.qd0;
+    UpdateContacts(passive_, r_.world.ground, &s);
+    return s;
+  }
+
+  bool Step(int n, BodyState<double>* s, std::string* why) const {
+    const VecD<double> target = r_.targets.col(n);
+    const StepStatus st = StepBody(passive_, r_.world, 0, r_.integrator, r_.dt, s, ModeForce<double>{&params_, &target});
+    if (!st.ok()) return Failed(n, StatusCodeName(st.code), why);
+    if (!s->q.allFinite() || !s->qd.allFinite()) return Failed(n, "non-finite state", why);
+    return true;
+  }
+
+  // λ_n from λ_{n+1} = `out` through step n taken from state s; adds the step's part of the
+  // gains' gradient to *g and sets its targets' column.
+  bool StepVjp(int n, const BodyState<double>& s, const Adjoint& out, Adjoint* in, RolloutGradient* g,
+               std::string* why) const {
+    const int nq = this->nq(), D = modes(), nc = int(s.contacts.size());
+    const int anchors = 2 * nq, controls = anchors + 2 * nc, width = controls + 3 * D;
+    Eigen::VectorXd grad = Eigen::VectorXd::Zero(width);
+    for (int offset = 0; offset < width; offset += kChunk) {
+      BodyState<Jet> sj;
+      sj.q.resize(nq);
+      sj.qd.resize(nq);
+      for (int i = 0; i < nq; ++i) {
+        sj.q[i] = Seed(s.q[i], i, offset);
+        sj.qd[i] = Seed(s.qd[i], nq + i, offset);
+      }
+      sj.contacts.resize(nc);
+      for (int c = 0; c < nc; ++c) {
+        sj.contacts[c].point = s.contacts[c].point;
+        sj.contacts[c].face = s.contacts[c].face;
+        for (int k = 0; k < 2; ++k) sj.contacts[c].anchor[k] = Seed(s.contacts[c].anchor[k], anchors + 2 * c + k, offset);
+      }
+      sj.penetration = s.penetration;
+      ModeParams<Jet> mp;
+      mp.K.resize(D);
+      mp.c.resize(D);
+      VecD<Jet> target(D);
+      for (int d = 0; d < D; ++d) {
+        target[d] = Seed(r_.targets(d, n), controls + d, offset);
+        mp.K[d] = Seed(params_.K[d], controls + D + d, offset);
+        mp.c[d] = Seed(params_.c[d], controls + 2 * D + d, offset);
+      }
+      const StepStatus st = StepBody(passive_, r_.world, 0, r_.integrator, r_.dt, &sj, ModeForce<Jet>{&mp, &target});
+      if (!st.ok()) return Failed(n, StatusCodeName(st.code) + " (differentiated step)", why);
+      PullState(sj, out, offset, &grad);
+    }
+    in->q = grad.head(nq);
+    in->qd = grad.segment(nq, nq);
+    in->anchor.clear();
+    for (int c = 0; c < nc; ++c)
+      in->anchor[{s.contacts[c].point, s.contacts[c].face}] = grad.segment(anchors + 2 * c, 2);
+    g->targets.col(n) = grad.segment(controls, D);
+    g->stiffness += grad.segment(controls + D, D);
+    g->damping += grad.segment(controls + 2 * D, D);
+    return true;
+  }
+
+  // The anchors of the first state come from its contact update (a point below the ground at
+  // the start is anchored where it is): their adjoint passes on to q0 and q̇0.
+  void StartVjp(const Adjoint& start, Eigen::VectorXd* dq0, Eigen::VectorXd* dqd0) const {
+    const int nq = this->nq();
+    if (start.anchor.empty()) return;
+    Adjoint anchors_only{Eigen::VectorXd::Zero(nq), Eigen::VectorXd::Zero(nq), start.anchor};
+    Eigen::VectorXd grad = Eigen::VectorXd::Zero(2 * nq);
+    for (int offset = 0; offset < 2 * nq; offset += kChunk) {
+      BodyState<Jet> sj;
+      sj.q.resize(nq);
+      sj.qd.resize(nq);
+      for (int i = 0; i < nq; ++i) {
+        sj.q[i] = Seed(r_.q0[i], i, offset);
+        sj.qd[i] = Seed(r_.qd0[i], nq + i, offset);
+      }
+      UpdateContacts(passive_, r_.world.ground, &sj);
+      PullState(sj, anchors_only, offset, &grad);
+    }
+    *dq0 += grad.head(nq);
+    *dqd0 += grad.tail(nq);
+  }
+
+ private:
+  static bool Failed(int n, const std::string& what, std::string* why) {
+    *why = "step " + std::to_string(n) + " failed: " + what;
+    return false;
+  }
+
+  const BodyModel passive_;
+  const ControlledRollout& r_;
+  ModeParams<double> params_;
+};
+
+}  // namespace
+
+double RolloutCost(const BodyModel& body, const ControlledRollout& rollout, const StageCost& cost) {
+  CheckRollout(body, rollout);
+  const Rollout r(body, rollout);
+  Eigen::VectorXd dq(r.nq()), dqd(r.nq());
+  BodyState<double> s = r.Start();
+  double total = 0.0;
+  std::string why;
+  for (int n = 0;; ++n) {
+    dq.setZero();
+    dqd.setZero();
+    total += cost(n, s.q, s.qd, &dq, &dqd);
+    if (n == rollout.steps()) break;
+    if (!r.Step(n, &s, &why)) return std::numeric_limits<double>::infinity();
+  }
+  return total;
+}
+
+RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollout& rollout, const StageCost& cost,
+                                    int checkpoint_interval) {
+  CheckRollout(body, rollout);
+  const Rollout r(body, rollout);
+  const int nq = r.nq(), D = r.modes(), N = rollout.steps();
+  const int interval = checkpoint_interval > 0 ? checkpoint_interval : std::max(1, int(std::ceil(std::sqrt(double(N)))));
+  RolloutGradient g;
+  g.stiffness = Eigen::VectorXd::Zero(D);
+  g.damping = Eigen::VectorXd::Zero(D);
+  g.targets = Eigen::MatrixXd::Zero(D, N);
+
+  // the stage cost at state n: its value into the total, its gradient into λ
+  Eigen::VectorXd dq(nq), dqd(nq);
+  auto stage = [&](int n, const BodyState<double>& s, Adjoint* lambda) {
+    dq.setZero();
+    dqd.setZero();
+    g.cost += cost(n, s.q, s.qd, &dq, &dqd);
+    lambda->q += dq;
+    lambda->qd += dqd;
+  };
+
+  // forward: a checkpoint every `interval` steps
+  std::vector<BodyState<double>> checkpoints;
+  BodyState<double> s = r.Start();
+  for (int n = 0; n < N; ++n) {
+    if (n % interval == 0) checkpoints.push_back(s);
+    if (!r.Step(n, &s, &g.message)) return g;
+  }
+  Adjoint lambda{Eigen::VectorXd::Zero(nq), Eigen::VectorXd::Zero(nq), {}};
+  stage(N, s, &lambda);
+
+  // backward, one interval at a time from its checkpoint
+  std::vector<BodyState<double>> segment;
+  Adjoint before;
+  for (int c = int(checkpoints.size()) - 1; c >= 0; --c) {
+    const int begin = c * interval, end = std::min(N, begin + interval);
+    segment.assign(1, checkpoints[c]);
+    for (int n = begin; n + 1 < end; ++n) {
+      segment.push_back(segment.back());
+      if (!r.Step(n, &segment.back(), &g.message)) return g;
+    }
+    g.states_held = std::max(g.states_held, int(checkpoints.size() + segment.size()));
+    for (int n = end - 1; n >= begin; --n) {
+      if (!r.StepVjp(n, segment[n - begin], lambda, &before, &g, &g.message)) return g;
+      stage(n, segment[n - begin], &before);
+      std::swap(lambda, before);
+    }
+  }
+  g.q0 = lambda.q;
+  g.qd0 = lambda.qd;
+  r.StartVjp(lambda, &g.q0, &g.qd0);
+  if (!std::isfinite(g.cost)) {
+    g.message = "the cost is not finite";
+    return g;
+  }
+  g.ok = true;
+  return g;
+}
+
+}  // namespace wobble::fit

@@ -1,0 +1,41 @@
+// The mode forces of the fits and of the adjoint (not public): the body's own mode potentials
+// switched off and replaced by StepBody's extra generalized force, whose gains and PD targets
+// are of the scalar type being differentiated (Ceres Jets, or double).
+#pragma once
+
+#include <vector>
+
+#include "wobble/body/body_model.h"
+#include "wobble/dynamics/forces.h"
+#include "wobble/dynamics/step3.h"
+
+namespace wobble::fit {
+
+// The body with its mode potentials switched off: K and c come from the parameters instead
+// (lib/wobble/dynamics reads them from the model as doubles; see ThesisStep).
+template <int Dim> BodyModelN<Dim> PassiveCopy(const BodyModelN<Dim>& body) {
+  std::vector<DeformationModeN<Dim>> modes = body.modes();
+  for (DeformationModeN<Dim>& m : modes) m.stiffness = m.damping = 0.0;
+  return BodyModelN<Dim>(body.def(), modes);
+}
+
+template <class T> struct ModeParams {
+  VecD<T> K, c;
+};
+
+// StepBody's extra generalized force: the mode forces −2K_d (γ_d − γ0_d) − c_d γ̇_d (§4.7, and
+// the PD controller of chapter 5) with K, c and γ0 of scalar T; the body's own are switched off.
+template <class T> struct ModeForce {
+  const ModeParams<T>* p;
+  const VecD<T>* target;
+  void operator()(const BodyState<T>& s, VecQ<T>* Q) const {
+    for (int d = 0; d < p->K.size(); ++d)
+      (*Q)[kRigidDofs + d] += -T(2.0) * p->K[d] * (s.q[kRigidDofs + d] - (*target)[d]) - p->c[d] * s.qd[kRigidDofs + d];
+  }
+  void operator()(const BodyState3<T>& s, VecQ3<T>* Q) const {
+    for (int d = 0; d < p->K.size(); ++d)
+      (*Q)[kRigidDofs3 + d] += -T(2.0) * p->K[d] * (s.gamma[d] - (*target)[d]) - p->c[d] * s.v[kRigidDofs3 + d];
+  }
+};
+
+}  // namespace wobble::fit
