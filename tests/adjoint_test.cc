@@ -78,7 +78,28 @@ Eigen::VectorXd Flatten(const fit::RolloutGradient& g) {
   return p;
 }
 
-// The cost of the rollout with parameters p + ε v, ε a Jet of one dimension (or double).
+// The cost of the rollout from q0, q̇0, gains K, c and the targets target_of(n) of each step.
+template <class T, class Targets>
+T ReferenceCostOf(const BodyModel& passive, const fit::ControlledRollout& r, const std::vector<T>& start,
+                  const std::vector<T>& K, const std::vector<T>& c, const Targets& target_of) {
+  BodyState<T> s;
+  s.q.resize(kNq);
+  s.qd.resize(kNq);
+  for (int i = 0; i < kNq; ++i) {
+    s.q[i] = start[i];
+    s.qd[i] = start[kNq + i];
+  }
+  UpdateContacts(passive, r.world.ground, &s);
+  T total = Stage(passive, 0, s.q, s.qd);
+  for (int n = 0; n < r.steps(); ++n) {
+    const std::vector<T> target = target_of(n);
+    EXPECT_TRUE(StepBody(passive, r.world, 0, r.integrator, r.dt, &s, PdForce<T>{&K, &c, &target}).ok());
+    total += Stage(passive, n + 1, s.q, s.qd);
+  }
+  return total;
+}
+
+// The cost with parameters p + ε v (in Flatten's order), ε a Jet of one dimension (or double).
 template <class T>
 T ReferenceCost(const BodyModel& passive, const fit::ControlledRollout& r, const Eigen::VectorXd& p, const Eigen::VectorXd& v) {
   auto param = [&](int i) {
@@ -86,26 +107,17 @@ T ReferenceCost(const BodyModel& passive, const fit::ControlledRollout& r, const
     if constexpr (!std::is_same_v<T, double>) x.v[0] = v[i];
     return x;
   };
-  BodyState<T> s;
-  s.q.resize(kNq);
-  s.qd.resize(kNq);
-  for (int i = 0; i < kNq; ++i) {
-    s.q[i] = param(i);
-    s.qd[i] = param(kNq + i);
-  }
-  std::vector<T> K(kModes), c(kModes), target(kModes);
+  std::vector<T> start(2 * kNq), K(kModes), c(kModes);
+  for (int i = 0; i < 2 * kNq; ++i) start[i] = param(i);
   for (int d = 0; d < kModes; ++d) {
     K[d] = param(2 * kNq + d);
     c[d] = param(2 * kNq + kModes + d);
   }
-  UpdateContacts(passive, r.world.ground, &s);
-  T total = Stage(passive, 0, s.q, s.qd);
-  for (int n = 0; n < r.steps(); ++n) {
+  return ReferenceCostOf<T>(passive, r, start, K, c, [&](int n) {
+    std::vector<T> target(kModes);
     for (int d = 0; d < kModes; ++d) target[d] = param(2 * kNq + 2 * kModes + kModes * n + d);
-    EXPECT_TRUE(StepBody(passive, r.world, 0, r.integrator, r.dt, &s, PdForce<T>{&K, &c, &target}).ok());
-    total += Stage(passive, n + 1, s.q, s.qd);
-  }
-  return total;
+    return target;
+  });
 }
 
 struct Case {
@@ -116,10 +128,17 @@ struct Case {
 
 // The table with random gains, random PD targets every step and a random start; `grounded`:
 // falling onto the ground, sliding sideways (friction slips), bouncing; else in the air.
-Case MakeCase(Integrator integrator, bool grounded, int steps, unsigned seed) {
+// `active`: every mode is under the controller (a pose graph's poses have an entry per mode).
+std::vector<DeformationMode> Modes(double stiffness, double damping, bool active) {
+  std::vector<DeformationMode> modes = testing::TableModes(stiffness, damping);
+  for (DeformationMode& m : modes) m.active = active;
+  return modes;
+}
+
+Case MakeCase(Integrator integrator, bool grounded, int steps, unsigned seed, bool active = false) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Case k{BodyModel(testing::TableDef(), testing::TableModes(3e5, 2e3)), BodyModel(testing::TableDef(), testing::TableModes()),
+  Case k{BodyModel(testing::TableDef(), Modes(3e5, 2e3, active)), BodyModel(testing::TableDef(), Modes(0, 0, active)),
          {}};
   fit::ControlledRollout& r = k.rollout;
   r.integrator = integrator;
@@ -255,6 +274,57 @@ TEST(Adjoint, MatchesCentralDifferencesInTheAir) {
   for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler}) {
     SCOPED_TRACE(IntegratorName(integrator));
     ExpectCentralDifferences(MakeCase(integrator, false, 80, 7), 1e-7);
+  }
+}
+
+// A smoothed pose-graph controller (three poses, cyclic) standing on the ground: the gradient
+// with respect to its poses and switch times is the chain rule through its per-step targets,
+// checked against Jets through SmoothPoseTargets and the whole simulation.
+TEST(Adjoint, PoseGraphPosesAndSwitchTimesMatchJets) {
+  Case k = MakeCase(Integrator::kSymplecticEuler, true, 240, 31, true);
+  control::PoseGraph graph;
+  graph.poses = {Eigen::Vector4d(0.0, 0.0, 0.0, 0.0), Eigen::Vector4d(0.15, 0.0, -0.2, 0.1),
+                 Eigen::Vector4d(-0.1, 0.05, 0.2, -0.1)};
+  graph.durations = {0.3, 0.25, 0.4};
+  const double width = 0.05;
+  k.rollout.targets = fit::PoseGraphTargets(k.body, graph, k.rollout.dt, 240, width);
+  const fit::RolloutGradient g = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive));
+  ASSERT_TRUE(g.ok) << g.message;
+  const fit::PoseGraphGradient pg = fit::PoseGraphGradientOf(k.body, graph, k.rollout.dt, width, g.targets);
+  ASSERT_EQ(pg.poses.size(), 3u);
+  ASSERT_EQ(pg.durations.size(), 3u);
+  using J1 = ceres::Jet<double, 1>;
+  std::mt19937 rng(37);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int trial = 0; trial < 3; ++trial) {
+    control::PoseGraphOf<J1> c = control::PoseGraphOf<J1>::From(k.body, graph);
+    double adjoint = 0.0, scale = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      for (int d = 0; d < kModes; ++d) {
+        const double v = 0.1 * normal(rng);
+        c.poses[i][d].v[0] = v;
+        adjoint += pg.poses[i][d] * v;
+        scale += std::abs(pg.poses[i][d] * v);
+      }
+      const double v = 0.05 * normal(rng);
+      c.durations[i].v[0] = v;
+      adjoint += pg.durations[i] * v;
+      scale += std::abs(pg.durations[i] * v);
+    }
+    std::vector<J1> start(2 * kNq), K(kModes), damping(kModes);
+    for (int i = 0; i < kNq; ++i) {
+      start[i] = J1(k.rollout.q0[i]);
+      start[kNq + i] = J1(k.rollout.qd0[i]);
+    }
+    for (int d = 0; d < kModes; ++d) {
+      K[d] = J1(k.rollout.stiffness[d]);
+      damping[d] = J1(k.rollout.damping[d]);
+    }
+    const J1 ref = ReferenceCostOf<J1>(k.passive, k.rollout, start, K, damping, [&](int n) {
+      const VecD<J1> t = control::SmoothPoseTargets(c, kModes, n * k.rollout.dt, width);
+      return std::vector<J1>(t.data(), t.data() + kModes);
+    });
+    EXPECT_NEAR(adjoint, ref.v[0], 1e-9 * scale) << "direction " << trial;
   }
 }
 

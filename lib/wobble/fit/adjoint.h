@@ -28,6 +28,7 @@
 #include <string>
 
 #include "wobble/body/body_model.h"
+#include "wobble/control/control.h"
 #include "wobble/dynamics/step.h"
 
 namespace wobble::fit {
@@ -65,5 +66,19 @@ double RolloutCost(const BodyModel& body, const ControlledRollout& rollout, cons
 // checkpoint_interval ≤ 0 means ⌈√steps⌉.
 RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollout& rollout, const StageCost& cost,
                                     int checkpoint_interval = 0);
+
+// A smoothed pose-graph controller (control::SmoothPoseTargets, switch width w > 0) as
+// per-step targets: column n is γ0(n dt), the dynamic fit's convention.
+Eigen::MatrixXd PoseGraphTargets(const BodyModel& body, const control::PoseGraph& graph, double dt, int steps,
+                                 double width);
+
+// The chain rule through PoseGraphTargets: from ∂cost/∂γ0(n) (RolloutGradient::targets) to
+// ∂cost/∂(each pose's entries) and ∂cost/∂(each duration, i.e. the smoothed switch times).
+struct PoseGraphGradient {
+  std::vector<Eigen::VectorXd> poses;
+  std::vector<double> durations;
+};
+PoseGraphGradient PoseGraphGradientOf(const BodyModel& body, const control::PoseGraph& graph, double dt,
+                                      double width, const Eigen::MatrixXd& target_gradient);
 
 }  // namespace wobble::fit
