@@ -1,0 +1,164 @@
+#include "wobble/fit/spacetime.h"
+
+#include <ceres/gradient_problem.h>
+#include <ceres/gradient_problem_solver.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace wobble::fit {
+
+namespace {
+
+// Step n lies between knots j and j + 1 with weight f on j + 1.
+void KnotWeights(int n, int steps, int knots, int* j, double* f) {
+  const double u = double(n) * (knots - 1) / steps;
+  *j = std::min(int(u), knots - 2);
+  *f = u - *j;
+}
+
+double Logistic(double x) { return 1.0 / (1.0 + std::exp(-x)); }
+
+void CheckProblem(const BodyModel& body, const SpacetimeProblem& p) {
+  const int D = body.num_modes(), steps = p.rollout.steps();
+  auto fail = [](const std::string& what) { throw std::invalid_argument("spacetime fit: " + what); };
+  if (D == 0) fail("the body has no modes to control");
+  if (steps < 1) fail("the rollout needs at least one step (its targets' columns)");
+  if (p.knots < 2 || p.knots > steps + 1) fail("knots must be from 2 to steps + 1 (" + std::to_string(steps + 1) + ")");
+  if (p.lower.size() != D || p.upper.size() != D) fail("lower and upper need one bound per mode");
+  for (int d = 0; d < D; ++d)
+    if (!(p.lower[d] < p.upper[d]) || !std::isfinite(p.lower[d]) || !std::isfinite(p.upper[d]))
+      fail("mode '" + body.modes()[d].name + "': the bounds must be finite with lower < upper");
+  if (!(p.control_weight >= 0.0) || !std::isfinite(p.control_weight)) fail("the control weight must be >= 0");
+  if (!p.task) fail("no task cost");
+}
+
+// The cost as Ceres sees it: x (modes × knots, column-major) → knots → targets → rollout.
+class SpacetimeCost final : public ceres::FirstOrderFunction {
+ public:
+  SpacetimeCost(const BodyModel& body, const SpacetimeProblem& p, long* evaluations)
+      : body_(body), p_(p), rollout_(p.rollout), evaluations_(evaluations) {}
+
+  int NumParameters() const override { return int(p_.lower.size()) * p_.knots; }
+
+  Eigen::MatrixXd Knots(const double* x) const {
+    const int D = int(p_.lower.size());
+    Eigen::MatrixXd k(D, p_.knots);
+    for (int j = 0; j < p_.knots; ++j)
+      for (int d = 0; d < D; ++d) k(d, j) = p_.lower[d] + (p_.upper[d] - p_.lower[d]) * Logistic(x[j * D + d]);
+    return k;
+  }
+
+  double ControlEnergy(const Eigen::MatrixXd& targets) const {
+    return p_.control_weight * rollout_.dt * targets.squaredNorm();
+  }
+
+  bool Evaluate(const double* x, double* cost, double* gradient) const override {
+    const int D = int(p_.lower.size()), steps = rollout_.steps();
+    rollout_.targets = KnotTargets(Knots(x), steps);
+    ++*evaluations_;
+    if (!gradient) {
+      *cost = RolloutCost(body_, rollout_, p_.task) + ControlEnergy(rollout_.targets);
+      return std::isfinite(*cost);
+    }
+    const RolloutGradient g = RolloutCostGradient(body_, rollout_, p_.task);
+    if (!g.ok) return false;  // the line search steps back
+    *cost = g.cost + ControlEnergy(rollout_.targets);
+    const Eigen::MatrixXd g_targets = g.targets + (2.0 * p_.control_weight * rollout_.dt) * rollout_.targets;
+    Eigen::Map<Eigen::MatrixXd> g_x(gradient, D, p_.knots);
+    g_x.setZero();
+    for (int n = 0; n < steps; ++n) {
+      int j;
+      double f;
+      KnotWeights(n, steps, p_.knots, &j, &f);
+      g_x.col(j) += (1.0 - f) * g_targets.col(n);
+      g_x.col(j + 1) += f * g_targets.col(n);
+    }
+    // chain rule through knot = lo + (hi − lo) σ(x)
+    for (int j = 0; j < p_.knots; ++j)
+      for (int d = 0; d < D; ++d) {
+        const double s = Logistic(x[j * D + d]);
+        g_x(d, j) *= (p_.upper[d] - p_.lower[d]) * s * (1.0 - s);
+      }
+    return std::isfinite(*cost);
+  }
+
+ private:
+  const BodyModel& body_;
+  const SpacetimeProblem& p_;
+  mutable ControlledRollout rollout_;  // its targets are each evaluation's
+  long* evaluations_;
+};
+
+class Progress final : public ceres::IterationCallback {
+ public:
+  explicit Progress(const SpacetimeOptions& o) : o_(o) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    if (o_.on_iteration) o_.on_iteration(s.iteration, s.cost);
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const SpacetimeOptions& o_;
+};
+
+}  // namespace
+
+Eigen::MatrixXd KnotTargets(const Eigen::MatrixXd& knots, int steps) {
+  if (knots.cols() < 2 || steps < 1) throw std::invalid_argument("KnotTargets: needs two knots and a step");
+  Eigen::MatrixXd targets(knots.rows(), steps);
+  for (int n = 0; n < steps; ++n) {
+    int j;
+    double f;
+    KnotWeights(n, steps, int(knots.cols()), &j, &f);
+    targets.col(n) = (1.0 - f) * knots.col(j) + f * knots.col(j + 1);
+  }
+  return targets;
+}
+
+SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem, const SpacetimeOptions& options) {
+  CheckProblem(body, problem);
+  const int D = body.num_modes(), steps = problem.rollout.steps();
+  // the first guess: the given targets at the knots, kept inside the bounds
+  Eigen::VectorXd x(D * problem.knots);
+  for (int j = 0; j < problem.knots; ++j) {
+    const int n = std::min(steps - 1, int(std::lround(double(j) * steps / (problem.knots - 1))));
+    for (int d = 0; d < D; ++d) {
+      const double span = problem.upper[d] - problem.lower[d];
+      const double s = std::clamp((problem.rollout.targets(d, n) - problem.lower[d]) / span, 1e-3, 1.0 - 1e-3);
+      x[j * D + d] = std::log(s / (1.0 - s));
+    }
+  }
+  SpacetimeResult r;
+  auto* cost = new SpacetimeCost(body, problem, &r.gradients);
+  ceres::GradientProblem ceres_problem(cost);  // owns cost
+  double first = 0.0;
+  if (!cost->Evaluate(x.data(), &first, nullptr)) {
+    r.message = "the rollout of the first guess failed";
+    return r;
+  }
+  r.initial_cost = first;
+  ceres::GradientProblemSolver::Options o;
+  o.line_search_direction_type = ceres::LBFGS;
+  o.max_num_iterations = options.max_iterations;
+  // the logistic map flattens near a bound: Ceres' default tolerances (1e-6 on the cost's
+  // relative change) stop there long before the optimum
+  o.function_tolerance = 1e-12;
+  o.gradient_tolerance = 1e-14;
+  o.logging_type = ceres::SILENT;
+  Progress progress(options);
+  o.callbacks.push_back(&progress);
+  ceres::GradientProblemSolver::Summary summary;
+  ceres::Solve(o, ceres_problem, x.data(), &summary);
+  r.knots = cost->Knots(x.data());
+  r.targets = KnotTargets(r.knots, steps);
+  r.control_energy = cost->ControlEnergy(r.targets);
+  r.cost = summary.final_cost;
+  r.iterations = int(summary.iterations.size());
+  r.message = summary.BriefReport();
+  r.ok = summary.IsSolutionUsable();
+  return r;
+}
+
+}  // namespace wobble::fit

@@ -1,0 +1,53 @@
+// Spacetime control fits (issue 18; thesis §3.1 after Witkin & Kass): the PD targets of a whole
+// motion solved for at once, minimising control energy plus task terms that say where and when
+// the body must be, with bounds on the targets.
+//
+// The unknowns are targets at `knots` evenly spaced knots over the run, linear between them
+// (every step its own knot when knots == steps + 1 … any count ≥ 2). The cost is
+//     ρ Σ_n |γ0(n)|² Δt  +  Σ_n ℓ_n(q_n, q̇_n)
+// (control energy, then the task as a stage cost: reach a point at a time, land upright, …).
+// Its gradient with respect to every knot comes from one adjoint sweep (adjoint.h), so the
+// solver is Ceres' L-BFGS on the gradient alone; the bounds lo ≤ γ0 ≤ hi are kept by solving
+// for x with knot = lo + (hi − lo) σ(x), σ the logistic function.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+
+#include "wobble/fit/adjoint.h"
+
+namespace wobble::fit {
+
+struct SpacetimeProblem {
+  ControlledRollout rollout;     // world, integrator, dt, start, gains; targets: the first guess
+  int knots = 2;                 // ≥ 2, at most steps + 1
+  Eigen::VectorXd lower, upper;  // per mode bounds of the targets, lower < upper
+  double control_weight = 0.0;   // ρ
+  StageCost task;                // ℓ_n, with its gradient
+};
+
+struct SpacetimeOptions {
+  int max_iterations = 100;
+  std::function<void(int iteration, double cost)> on_iteration;  // progress display
+};
+
+struct SpacetimeResult {
+  bool ok = false;
+  std::string message;     // Ceres' summary line, or why the first rollout failed
+  Eigen::MatrixXd knots;   // modes × knots
+  Eigen::MatrixXd targets; // modes × steps, the rollout's targets
+  double initial_cost = 0.0, cost = 0.0, control_energy = 0.0;
+  int iterations = 0;
+  long gradients = 0;      // cost-and-gradient evaluations (one simulation + one adjoint sweep each)
+};
+
+// The targets of each step from knots (modes × knots): linear between evenly spaced knots,
+// the first at step 0 and the last at step `steps`.
+Eigen::MatrixXd KnotTargets(const Eigen::MatrixXd& knots, int steps);
+
+// Throws std::invalid_argument on inconsistent sizes, bounds or knot counts.
+SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem,
+                             const SpacetimeOptions& options = SpacetimeOptions());
+
+}  // namespace wobble::fit
