@@ -146,6 +146,7 @@ SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& prob
   // relative change) stop there long before the optimum
   o.function_tolerance = 1e-12;
   o.gradient_tolerance = 1e-14;
+  o.parameter_tolerance = 1e-14;  // x starts at 0 (targets mid-range): a relative test stops at once
   o.logging_type = ceres::SILENT;
   Progress progress(options);
   o.callbacks.push_back(&progress);
