@@ -14,10 +14,12 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
 #include <vector>
 
 #include "support/test_bodies.h"
 #include "wobble/dynamics/step.h"
+#include "wobble/dynamics/terrain.h"
 #include "wobble/fit/adjoint.h"
 
 namespace wobble {
@@ -171,7 +173,7 @@ Eigen::VectorXd Direction(const Eigen::VectorXd& p, std::mt19937& rng) {
 
 // Contact onsets, ends and slips (a kept contact whose anchor moved: the friction cap was hit)
 // along the plain run: proof that a grounded case went through the branches it is meant to test.
-void ContactEvents(const Case& k, int* onsets, int* ends, int* slips) {
+void ContactEvents(const Case& k, int* onsets, int* ends, int* slips, std::set<int>* faces = nullptr) {
   BodyState<double> s;
   s.q = k.rollout.q0;
   s.qd = k.rollout.qd0;
@@ -190,6 +192,7 @@ void ContactEvents(const Case& k, int* onsets, int* ends, int* slips) {
       return nullptr;
     };
     for (const auto& x : s.contacts) {
+      if (faces) faces->insert(x.face);
       const Contact<double>* was = find(before, x.point);
       *onsets += !was;
       *slips += was && was->anchor != x.anchor;
@@ -241,6 +244,32 @@ TEST(Adjoint, MatchesJetsThroughContactsThatBeginSlipAndEnd) {
     RecordProperty("contact_onsets_ends_slips", std::to_string(onsets) + " " + std::to_string(ends) + " " + std::to_string(slips));
     ExpectJetDirectionalDerivatives(k, 13);
   }
+}
+
+// A terrain (the table slides onto a rising slope: the hand-derived product with faces, and
+// under the symplectic step the Jet product, whose new contacts' faces depend on velocity),
+// and a spring holding a corner (the Jet product).
+TEST(Adjoint, MatchesJetsOnATerrainAndWithASpring) {
+  for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler}) {
+    SCOPED_TRACE(IntegratorName(integrator));
+    Case k = MakeCase(integrator, true, 200, 41);
+    k.rollout.world.ground.terrain = Terrain::Make({{-500, 0}, {250, 0}, {450, 40}, {900, 40}});
+    int onsets = 0, ends = 0, slips = 0;
+    std::set<int> faces;
+    ContactEvents(k, &onsets, &ends, &slips, &faces);
+    EXPECT_GE(faces.size(), 2u) << "the points must touch the level part and the slope";
+    ExpectJetDirectionalDerivatives(k, 43);
+  }
+  Case k = MakeCase(Integrator::kThesis, true, 150, 47);
+  Spring spring;
+  spring.lattice_coords = Eigen::Vector2d(1.0, 1.0);
+  spring.anchor = Eigen::Vector2d(350.0, 180.0);
+  spring.stiffness = 2e3;
+  spring.damping = 50.0;
+  spring.rest_length = 40.0;
+  k.passive.LocalBasis(spring.lattice_coords, &spring.rest_local, &spring.mode_matrix);
+  k.rollout.world.springs.push_back(spring);
+  ExpectJetDirectionalDerivatives(k, 53);
 }
 
 // Central differences of the plain cost, one parameter at a time: q0 (x, θ, a mode), q̇0,

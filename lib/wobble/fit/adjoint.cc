@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -145,92 +146,71 @@ class Rollout {
     return true;
   }
 
-  // Whether step n can take AirVjp: no contact before or after it (so no ground force acts at
-  // any state the step evaluates) and no spring.
-  bool InTheAir(const BodyState<double>& s, bool next_in_the_air) const {
-    return s.contacts.empty() && next_in_the_air && r_.world.springs.empty();
-  }
+  // Whether step n can take HandVjp: no spring (rare: Jets), and no terrain under the
+  // symplectic step (there a new contact's face depends on the velocity, which differs
+  // between the force evaluation at (q', q̇) and the contact update at (q', q̇')).
+  bool ByHand() const { return r_.world.springs.empty() && (!r_.world.ground.terrain || r_.integrator == Integrator::kThesis); }
 
-  // The same product as StepVjp for a step in the air, by hand: the step is
+  // The same product as StepVjp, by hand: the step is
   //   thesis     q' = q + h q̇ + h² a(q, q̇),  q̇' = q̇ + h a(q, q̇)
   //   symplectic q' = q + h q̇,  q̇' = q̇ + h a(q', q̇)
-  // with a = M⁻¹ r, r = gravity + mode forces − w (Eq. 4.21). With y = M⁻¹ μ (M symmetric),
+  // then the contact update (UpdateContacts) at (q', q̇') gives the new anchors. With
+  // a = M⁻¹ r, r = gravity + mode forces + ground − w (Eq. 4.21) and y = M⁻¹ μ (M symmetric),
   //   μᵀ da = yᵀ dr − yᵀ dM a,
   // where yᵀ (∂M/∂q_j) a = (K_j(y + a) − K_j(y − a)) / 2 with K_j(v) = ½ vᵀ (∂M/∂q_j) v the
   // kinetic gradient (KineticGradient), and yᵀ dr is written out from the moment formulas of
-  // GravityForce and VelocityTerms (kinematics.h). The step's a is read back from the next
-  // state, a = (q̇' − q̇)/h (both integrators), exact up to rounding (~1e-13 relative), instead
-  // of evaluating it again: one mass solve and a few moment products per step, where Jets
-  // over 2 nq + 3 D inputs cost 24 steps.
-  void AirVjp(int n, const BodyState<double>& s, const VecQ<double>& next_qd, const Adjoint& out, Adjoint* in,
-              RolloutGradient* g) const {
-    const int D = modes();
+  // GravityForce and VelocityTerms (kinematics.h). The ground's part of r and the anchors'
+  // update are sums over contact points, each a function of (q, q̇, its anchor) only: each is
+  // differentiated on its own by a Jet over those 2 nq + 2 numbers (one pass for the table).
+  // The step's a is read back from the next state, a = (q̇' − q̇)/h (both integrators), exact
+  // up to rounding (~1e-13 relative).
+  void HandVjp(int n, const BodyState<double>& s, const BodyState<double>& next, const Adjoint& out, Adjoint* in,
+               RolloutGradient* g) const {
+    const int nq = this->nq();
     const double h = r_.dt;
     const bool thesis = r_.integrator == Integrator::kThesis;
+    Adjoint bar = out;  // λ of (q', q̇') once the anchors' update is pulled back
+    std::map<ContactKey, Eigen::Vector2d> anchor_grad;  // of s's anchors
+    auto anchor_slot = [&](const Contact<double>* c) -> Eigen::Vector2d* {  // (Eigen leaves a new one unset)
+      return c ? &anchor_grad.try_emplace({c->point, c->face}, Eigen::Vector2d::Zero()).first->second : nullptr;
+    };
+    for (const Contact<double>& c : next.contacts) {
+      const auto it = out.anchor.find({c.point, c.face});
+      if (it == out.anchor.end() || it->second.isZero(0.0)) continue;
+      const Contact<double>* before = Find(s, c);
+      PointVjp(c, before, next.q, next.qd, [&](const Vec2<Jet>& x, const Vec2<Jet>& v, Vec2<Jet> anchor,
+                                                const GroundFace& face) {
+        bool slipping;
+        Vec2<Jet> f = GroundForce(face, x, v, anchor, &slipping);
+        if (slipping) SlipAnchor(face, x, v, &anchor, &f);
+        return Jet(anchor[0] * it->second[0] + anchor[1] * it->second[1]);
+      }, &bar.q, &bar.qd, anchor_slot(before));
+    }
     // where a is evaluated, and μ, the adjoint of a
-    BodyState<double> at;
-    at.q = thesis ? s.q : VecQ<double>(s.q + h * s.qd);
-    at.qd = s.qd;
-    const VecQ<double> mu = thesis ? VecQ<double>(h * h * out.q + h * out.qd) : VecQ<double>(h * out.qd);
-    const VecD<double> target = r_.targets.col(n);
-    const VecQ<double> a = (next_qd - s.qd) / h;
-    const MassMoments& mm = passive_.moments();
-    const Mat2<double> R = Rotation(at.q[2]);
-    VecQ<double> y;
-    double cond = 0.0;
-    SolveMassSystem(mm, at.q, R, mu, &y, &cond);
-    const int nq = this->nq();
-    VecQ<double> gq = VecQ<double>::Zero(nq), gqd = VecQ<double>::Zero(nq);
-    const double thd = at.qd[2], y_theta = y[2];
-    const Eigen::Vector2d y_t = y.head<2>();
-    Eigen::Matrix2d S;
-    S << 0.0, -1.0, 1.0, 0.0;
-    // gravity: r_θ = (R S c)·g, r_γ = Cᵀ Rᵀ g, c = c0 + C γ
-    const Eigen::Vector2d c = mm.c0 + mm.C * at.q.tail(D);
-    if (r_.world.gravity_on) {
-      const Eigen::Vector2d& gv = r_.world.gravity;
-      gq[2] += -y_theta * gv.dot(R * c);
-      if (D > 0) {
-        gq[2] += gv.dot(R * S * (mm.C * y.tail(D)));
-        gq.tail(D) += y_theta * (mm.C.transpose() * (S.transpose() * (R.transpose() * gv)));
-      }
+    const VecQ<double> Q = thesis ? s.q : VecQ<double>(s.q + h * s.qd), V = s.qd;
+    const VecQ<double> mu = thesis ? VecQ<double>(h * h * bar.q + h * bar.qd) : VecQ<double>(h * bar.qd);
+    const VecQ<double> a = (next.qd - s.qd) / h;
+    VecQ<double> y, gQ = VecQ<double>::Zero(nq), gV = VecQ<double>::Zero(nq);
+    ForceVjp(n, Q, V, a, mu, &y, &gQ, &gV, g);
+    // the ground force's part: y · Σ J_kᵀ f_k = Σ (J_k y) · f_k; at (q', q̇) the symplectic step
+    // feels the contacts of the next state, with the anchors they had before it
+    for (const Contact<double>& c : thesis ? s.contacts : next.contacts) {
+      const Contact<double>* before = thesis ? &c : Find(s, c);
+      PointVjp(c, before, Q, V, [&](const Vec2<Jet>& x, const Vec2<Jet>& v, const Vec2<Jet>& anchor,
+                                     const GroundFace& face, const Frame<Jet>& frame, const Vec2<Jet>& l) {
+        bool slipping;
+        const Vec2<Jet> f = GroundForce(face, x, v, anchor, &slipping);
+        return Jet(f.dot(PointVelocity(frame, y.cast<Jet>().eval(), l, passive_.mode_matrix(c.point))));
+      }, &gQ, &gV, anchor_slot(before));
     }
-    // −w: w_t = R(−θ̇² c + 2θ̇ S C γ̇), w_θ = 2θ̇ e·γ̇, w_γ = −θ̇² e + 2θ̇ P γ̇, e = e0 + G γ
-    if (D > 0) {
-      const auto y_g = y.tail(D), gd = at.qd.tail(D);
-      const Eigen::Vector2d Cgd = mm.C * gd;
-      const VecD<double> e = mm.e0 + mm.G * at.q.tail(D);
-      gq[2] -= y_t.dot(R * S * (-thd * thd * c + 2.0 * thd * S * Cgd));
-      gq.tail(D) -= -thd * thd * (mm.C.transpose() * (R.transpose() * y_t)) + 2.0 * thd * y_theta * (mm.G * gd) -
-                    thd * thd * (mm.G * y_g);
-      gqd[2] -= y_t.dot(R * (-2.0 * thd * c + 2.0 * S * Cgd)) + 2.0 * y_theta * e.dot(gd) +
-                y_g.dot(-2.0 * thd * e + 2.0 * (mm.P * gd));
-      gqd.tail(D) -= 2.0 * thd * (mm.C.transpose() * (S.transpose() * (R.transpose() * y_t))) + 2.0 * thd * y_theta * e +
-                     2.0 * thd * (mm.P.transpose() * y_g);
-      // the mode forces −2K (γ − γ0) − c γ̇
-      for (int d = 0; d < D; ++d) {
-        const double yd = y[kRigidDofs + d];
-        gq[kRigidDofs + d] += -2.0 * params_.K[d] * yd;
-        gqd[kRigidDofs + d] += -params_.c[d] * yd;
-        g->targets(d, n) = 2.0 * params_.K[d] * yd;
-        g->stiffness[d] += -2.0 * (at.q[kRigidDofs + d] - target[d]) * yd;
-        g->damping[d] += -at.qd[kRigidDofs + d] * yd;
-      }
-    }
-    // −yᵀ (∂M/∂q) a
-    VecQ<double> k_plus, k_minus;
-    KineticGradient(mm, at.q, VecQ<double>(y + a), &k_plus);
-    KineticGradient(mm, at.q, VecQ<double>(y - a), &k_minus);
-    gq -= 0.5 * (k_plus - k_minus);
     // through the integrator
-    if (thesis) {
-      in->q = out.q + gq;
-      in->qd = h * out.q + out.qd + gqd;
-    } else {
-      in->q = out.q + gq;
-      in->qd = h * (out.q + gq) + out.qd + gqd;
-    }
+    in->q = bar.q + gQ;
+    in->qd = thesis ? VecQ<double>(h * bar.q + bar.qd + gV) : VecQ<double>(h * (bar.q + gQ) + bar.qd + gV);
     in->anchor.clear();
+    for (const Contact<double>& c : s.contacts) {
+      const auto it = anchor_grad.find({c.point, c.face});
+      in->anchor[{c.point, c.face}] = it == anchor_grad.end() ? Eigen::Vector2d::Zero() : it->second;
+    }
   }
 
   // The anchors of the first state come from its contact update (a point below the ground at
@@ -256,6 +236,105 @@ class Rollout {
   }
 
  private:
+  static const Contact<double>* Find(const BodyState<double>& s, const Contact<double>& c) {
+    for (const Contact<double>& x : s.contacts)
+      if (x.point == c.point && x.face == c.face) return &x;
+    return nullptr;
+  }
+
+  // μᵀ ∂a/∂(q, q̇, gains, targets) at (Q, V) without the ground: sets y = M⁻¹ μ, adds to gQ,
+  // gV and the gains' and targets' gradient.
+  void ForceVjp(int n, const VecQ<double>& Q, const VecQ<double>& V, const VecQ<double>& a, const VecQ<double>& mu,
+                VecQ<double>* y_out, VecQ<double>* gq_out, VecQ<double>* gqd_out, RolloutGradient* g) const {
+    const int D = modes();
+    const MassMoments& mm = passive_.moments();
+    const Mat2<double> R = Rotation(Q[2]);
+    VecQ<double>& y = *y_out;
+    VecQ<double>& gq = *gq_out;
+    VecQ<double>& gqd = *gqd_out;
+    double cond = 0.0;
+    SolveMassSystem(mm, Q, R, mu, &y, &cond);
+    const double thd = V[2], y_theta = y[2];
+    const Eigen::Vector2d y_t = y.head<2>();
+    Eigen::Matrix2d S;
+    S << 0.0, -1.0, 1.0, 0.0;
+    // gravity: r_θ = (R S c)·g, r_γ = Cᵀ Rᵀ g, c = c0 + C γ
+    const Eigen::Vector2d c = mm.c0 + mm.C * Q.tail(D);
+    if (r_.world.gravity_on) {
+      const Eigen::Vector2d& gv = r_.world.gravity;
+      gq[2] += -y_theta * gv.dot(R * c);
+      if (D > 0) {
+        gq[2] += gv.dot(R * S * (mm.C * y.tail(D)));
+        gq.tail(D) += y_theta * (mm.C.transpose() * (S.transpose() * (R.transpose() * gv)));
+      }
+    }
+    // −w: w_t = R(−θ̇² c + 2θ̇ S C γ̇), w_θ = 2θ̇ e·γ̇, w_γ = −θ̇² e + 2θ̇ P γ̇, e = e0 + G γ
+    if (D > 0) {
+      const VecD<double> y_g = y.tail(D), gd = V.tail(D);
+      const Eigen::Vector2d Cgd = mm.C * gd;
+      const VecD<double> e = mm.e0 + mm.G * Q.tail(D);
+      gq[2] -= y_t.dot(R * S * (-thd * thd * c + 2.0 * thd * S * Cgd));
+      gq.tail(D) -= -thd * thd * (mm.C.transpose() * (R.transpose() * y_t)) + 2.0 * thd * y_theta * (mm.G * gd) -
+                    thd * thd * (mm.G * y_g);
+      gqd[2] -= y_t.dot(R * (-2.0 * thd * c + 2.0 * S * Cgd)) + 2.0 * y_theta * e.dot(gd) +
+                y_g.dot(-2.0 * thd * e + 2.0 * (mm.P * gd));
+      gqd.tail(D) -= 2.0 * thd * (mm.C.transpose() * (S.transpose() * (R.transpose() * y_t))) + 2.0 * thd * y_theta * e +
+                     2.0 * thd * (mm.P.transpose() * y_g);
+      // the mode forces −2K (γ − γ0) − c γ̇
+      for (int d = 0; d < D; ++d) {
+        const double yd = y[kRigidDofs + d];
+        gq[kRigidDofs + d] += -2.0 * params_.K[d] * yd;
+        gqd[kRigidDofs + d] += -params_.c[d] * yd;
+        g->targets(d, n) = 2.0 * params_.K[d] * yd;
+        g->stiffness[d] += -2.0 * (Q[kRigidDofs + d] - r_.targets(d, n)) * yd;
+        g->damping[d] += -V[kRigidDofs + d] * yd;
+      }
+    }
+    // −yᵀ (∂M/∂q) a
+    VecQ<double> k_plus, k_minus;
+    KineticGradient(mm, Q, VecQ<double>(y + a), &k_plus);
+    KineticGradient(mm, Q, VecQ<double>(y - a), &k_minus);
+    gq -= 0.5 * (k_plus - k_minus);
+  }
+
+  // The gradient of a scalar φ(x, v, anchor) of contact c's point at (Q, V) with respect to Q,
+  // V and (when `before` holds its anchor) that anchor; a new contact's anchor is its point's
+  // projection on the face, as ForEachPointInContact makes it. φ is called as
+  // phi(x, v, anchor, face) or phi(x, v, anchor, face, frame, l).
+  template <class Phi, class Vec>
+  void PointVjp(const Contact<double>& c, const Contact<double>* before, const VecQ<double>& Q, const VecQ<double>& V,
+                const Phi& phi, Vec* gQ, Vec* gV, Eigen::Vector2d* g_anchor) const {
+    const int nq = this->nq(), width = 2 * nq + 2;
+    const GroundFace face = r_.world.ground.Face(c.face);
+    Eigen::VectorXd grad = Eigen::VectorXd::Zero(width);
+    for (int offset = 0; offset < width; offset += kChunk) {
+      VecQ<Jet> q(nq), qd(nq);
+      for (int i = 0; i < nq; ++i) {
+        q[i] = Seed(Q[i], i, offset);
+        qd[i] = Seed(V[i], nq + i, offset);
+      }
+      const Frame<Jet> frame(q);
+      const Vec2<Jet> l = LocalPosition<Jet>(passive_.rest_local(c.point), passive_.mode_matrix(c.point), q);
+      const Vec2<Jet> x = WorldFromLocal(frame, l);
+      const Vec2<Jet> v = PointVelocity(frame, qd, l, passive_.mode_matrix(c.point));
+      Vec2<Jet> anchor;
+      if (before) {
+        anchor = Vec2<Jet>(Seed(before->anchor[0], 2 * nq, offset), Seed(before->anchor[1], 2 * nq + 1, offset));
+      } else {
+        anchor = x - face.Height(x) * face.n.cast<Jet>();
+      }
+      Jet value;
+      if constexpr (std::is_invocable_v<Phi, Vec2<Jet>, Vec2<Jet>, Vec2<Jet>, GroundFace, Frame<Jet>, Vec2<Jet>>)
+        value = phi(x, v, anchor, face, frame, l);
+      else
+        value = phi(x, v, anchor, face);
+      Pull(value, 1.0, offset, &grad);
+    }
+    *gQ += grad.head(nq);
+    *gV += grad.segment(nq, nq);
+    if (g_anchor) *g_anchor += grad.tail(2);
+  }
+
   static bool Failed(int n, const std::string& what, std::string* why) {
     *why = "step " + std::to_string(n) + " failed: " + what;
     return false;
@@ -319,8 +398,7 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
   // backward, one interval at a time from its checkpoint
   std::vector<BodyState<double>> segment;
   Adjoint before;
-  bool next_in_the_air = s.contacts.empty();  // of state n + 1
-  VecQ<double> next_qd = s.qd;
+  BodyState<double> next = s;  // state n + 1
   for (int c = int(checkpoints.size()) - 1; c >= 0; --c) {
     const int begin = c * interval, end = std::min(N, begin + interval);
     segment.assign(1, checkpoints[c]);
@@ -331,12 +409,11 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
     g.states_held = std::max(g.states_held, int(checkpoints.size() + segment.size()));
     for (int n = end - 1; n >= begin; --n) {
       const BodyState<double>& state = segment[n - begin];
-      if (r.InTheAir(state, next_in_the_air))
-        r.AirVjp(n, state, next_qd, lambda, &before, &g);
+      if (r.ByHand())
+        r.HandVjp(n, state, next, lambda, &before, &g);
       else if (!r.StepVjp(n, state, lambda, &before, &g, &g.message))
         return g;
-      next_in_the_air = state.contacts.empty();
-      next_qd = state.qd;
+      next = state;
       stage(n, state, &before);
       std::swap(lambda, before);
     }
