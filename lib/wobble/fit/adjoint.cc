@@ -38,6 +38,17 @@ Jet Seed(double value, int i, int offset) {
   return x;
 }
 
+// q and q̇ as Jets: inputs 0 … nq − 1 and nq … 2 nq − 1 of the chunk at `offset`.
+void SeedState(const VecQ<double>& q, const VecQ<double>& qd, int offset, VecQ<Jet>* qj, VecQ<Jet>* qdj) {
+  const int nq = int(q.size());
+  qj->resize(nq);
+  qdj->resize(nq);
+  for (int i = 0; i < nq; ++i) {
+    (*qj)[i] = Seed(q[i], i, offset);
+    (*qdj)[i] = Seed(qd[i], nq + i, offset);
+  }
+}
+
 // g[offset + k] += λ ∂y/∂(input offset + k) for the inputs of the chunk.
 void Pull(const Jet& y, double lambda, int offset, Eigen::VectorXd* g) {
   if (lambda == 0.0) return;
@@ -109,12 +120,7 @@ class Rollout {
     Eigen::VectorXd grad = Eigen::VectorXd::Zero(width);
     for (int offset = 0; offset < width; offset += kChunk) {
       BodyState<Jet> sj;
-      sj.q.resize(nq);
-      sj.qd.resize(nq);
-      for (int i = 0; i < nq; ++i) {
-        sj.q[i] = Seed(s.q[i], i, offset);
-        sj.qd[i] = Seed(s.qd[i], nq + i, offset);
-      }
+      SeedState(s.q, s.qd, offset, &sj.q, &sj.qd);
       sj.contacts.resize(nc);
       for (int c = 0; c < nc; ++c) {
         sj.contacts[c].point = s.contacts[c].point;
@@ -222,12 +228,7 @@ class Rollout {
     Eigen::VectorXd grad = Eigen::VectorXd::Zero(2 * nq);
     for (int offset = 0; offset < 2 * nq; offset += kChunk) {
       BodyState<Jet> sj;
-      sj.q.resize(nq);
-      sj.qd.resize(nq);
-      for (int i = 0; i < nq; ++i) {
-        sj.q[i] = Seed(r_.q0[i], i, offset);
-        sj.qd[i] = Seed(r_.qd0[i], nq + i, offset);
-      }
+      SeedState(r_.q0, r_.qd0, offset, &sj.q, &sj.qd);
       UpdateContacts(passive_, r_.world.ground, &sj);
       PullState(sj, anchors_only, offset, &grad);
     }
@@ -308,11 +309,8 @@ class Rollout {
     const GroundFace face = r_.world.ground.Face(c.face);
     Eigen::VectorXd grad = Eigen::VectorXd::Zero(width);
     for (int offset = 0; offset < width; offset += kChunk) {
-      VecQ<Jet> q(nq), qd(nq);
-      for (int i = 0; i < nq; ++i) {
-        q[i] = Seed(Q[i], i, offset);
-        qd[i] = Seed(V[i], nq + i, offset);
-      }
+      VecQ<Jet> q, qd;
+      SeedState(Q, V, offset, &q, &qd);
       const Frame<Jet> frame(q);
       const Vec2<Jet> l = LocalPosition<Jet>(passive_.rest_local(c.point), passive_.mode_matrix(c.point), q);
       const Vec2<Jet> x = WorldFromLocal(frame, l);
