@@ -163,23 +163,23 @@ std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeom
     throw std::invalid_argument("ExrFrameChannels: an image of another size");
   CharacterLayers c = RasterizeCharacters(frame.characters, NextPixels(frame.characters, next ? *next : ScreenGeometry()),
                                           frame.width, frame.height);
-  std::vector<ExrChannel> ch = {{"R", {}, true},         {"G", {}, true},         {"B", {}, true},
-                                {"A", {}, true},         {"terrain.R", {}, true}, {"terrain.G", {}, true},
-                                {"terrain.B", {}, true}, {"terrain.A", {}, true}, {"depth.Z", frame.depth}};
-  const int colour_channels = frame.terrain_layer ? 8 : 4;
-  for (int k = 0; k < colour_channels; ++k) ch[size_t(k)].data.resize(n);
+  // the characters' R, G, B, A, and terrain.R, G, B, A of the rest only when asked for
+  std::vector<ExrChannel> ch = {{"R", {}, true}, {"G", {}, true}, {"B", {}, true}, {"A", {}, true}};
+  if (frame.terrain_layer)
+    for (const char* name : {"terrain.R", "terrain.G", "terrain.B", "terrain.A"}) ch.push_back({name, {}, true});
+  for (ExrChannel& x : ch) x.data.resize(n);
   for (size_t i = 0; i < n; ++i) {
     const float a = frame.overlay.empty() || !frame.overlay[i] ? c.alpha[i] : 0.0f;
-    const float rest = std::isinf(frame.depth[i]) ? 0.0f : 1.0f - a;  // drawn, and not a character
     for (int k = 0; k < 3; ++k) ch[size_t(k)].data[i] = a * frame.rgb[3 * i + size_t(k)];
     ch[3].data[i] = a;
     if (a == 0.0f) c.forward_u[i] = c.forward_v[i] = 0.0f;  // under the overlay
     if (frame.terrain_layer) {
+      const float rest = std::isinf(frame.depth[i]) ? 0.0f : 1.0f - a;  // drawn, and not a character
       for (int k = 0; k < 3; ++k) ch[size_t(4 + k)].data[i] = rest * frame.rgb[3 * i + size_t(k)];
       ch[7].data[i] = rest;
     }
   }
-  if (!frame.terrain_layer) ch.erase(ch.begin() + 4, ch.begin() + 8);
+  ch.push_back({"depth.Z", frame.depth});
   ch.push_back({"forward.u", std::move(c.forward_u), true});
   ch.push_back({"forward.v", std::move(c.forward_v), true});
   return ch;

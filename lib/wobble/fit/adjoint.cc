@@ -200,13 +200,14 @@ class Rollout {
     ForceVjp(n, Q, V, a, mu, &y, &gQ, &gV, g);
     // the ground force's part: y · Σ J_kᵀ f_k = Σ (J_k y) · f_k; at (q', q̇) the symplectic step
     // feels the contacts of the next state, with the anchors they had before it
+    const VecQ<Jet> y_jet = y.cast<Jet>();
     for (const Contact<double>& c : thesis ? s.contacts : next.contacts) {
       const Contact<double>* before = thesis ? &c : Find(s, c);
       PointVjp(c, before, Q, V, [&](const Vec2<Jet>& x, const Vec2<Jet>& v, const Vec2<Jet>& anchor,
                                      const GroundFace& face, const Frame<Jet>& frame, const Vec2<Jet>& l) {
         bool slipping;
         const Vec2<Jet> f = GroundForce(face, x, v, anchor, &slipping);
-        return Jet(f.dot(PointVelocity(frame, y.cast<Jet>().eval(), l, passive_.mode_matrix(c.point))));
+        return Jet(f.dot(PointVelocity(frame, y_jet, l, passive_.mode_matrix(c.point))));
       }, &gQ, &gV, anchor_slot(before));
     }
     // through the integrator
@@ -396,7 +397,6 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
   // backward, one interval at a time from its checkpoint
   std::vector<BodyState<double>> segment;
   Adjoint before;
-  BodyState<double> next = s;  // state n + 1
   for (int c = int(checkpoints.size()) - 1; c >= 0; --c) {
     const int begin = c * interval, end = std::min(N, begin + interval);
     segment.assign(1, checkpoints[c]);
@@ -407,11 +407,14 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
     g.states_held = std::max(g.states_held, int(checkpoints.size() + segment.size()));
     for (int n = end - 1; n >= begin; --n) {
       const BodyState<double>& state = segment[n - begin];
+      // state n + 1: in this interval, or the next interval's checkpoint, or the last state
+      const BodyState<double>& next = n + 1 < end                          ? segment[n + 1 - begin]
+                                      : c + 1 < int(checkpoints.size()) ? checkpoints[c + 1]
+                                                                          : s;
       if (r.ByHand())
         r.HandVjp(n, state, next, lambda, &before, &g);
       else if (!r.StepVjp(n, state, lambda, &before, &g, &g.message))
         return g;
-      next = state;
       stage(n, state, &before);
       std::swap(lambda, before);
     }
