@@ -359,6 +359,11 @@ FitCommands AddFitCommand(CLI::App* app, FitPoseArgs* pose, FitTrajectoryArgs* t
   c.trajectory->add_option("--fit", traj->fit_what, "Dynamic: what to fit, from q0,qdot0,stiffness,damping")
       ->capture_default_str();
   c.trajectory->add_option("--qdot0", traj->qdot0, "Dynamic: starting q-dot (default: from the first two frames)");
+  c.trajectory->add_option("--gradient", traj->gradient,
+                           "Dynamic: jets (Levenberg-Marquardt, Jacobians by forward-mode Jets) or adjoint (BFGS on "
+                           "the adjoint gradient, a few simulations whatever the parameters; 2D)")
+      ->check(CLI::IsMember({"jets", "adjoint"}))
+      ->capture_default_str();
   c.trajectory->add_flag("--anneal", traj->anneal, "Dynamic: also run simulated annealing with the same number of simulations");
   c.trajectory->add_option("--poses", traj->poses,
                            "Dynamic: a pose-graph controller to start from, \"T1 .. Tk DURATION; ...\" (k active modes)")
@@ -671,6 +676,10 @@ template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shar
     o.dt = a.dt;
     o.max_iterations = po.max_iterations;
     o.full_report = po.full_report;
+    if (a.gradient == "adjoint") {
+      if (Dim == 3) throw UsageError("--gradient adjoint: the adjoint takes 2D bodies (3D fits use jets)");
+      o.gradient = fit::FitGradient::kAdjoint;
+    }
     o.fit_q0 = o.fit_qd0 = o.fit_stiffness = o.fit_damping = false;
     std::stringstream what(a.fit_what);
     for (std::string item; std::getline(what, item, ',');) {
@@ -705,6 +714,7 @@ template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shar
     EndIterationLine();
     report = r.report;
     j["kind"] = "dynamic";
+    j["gradient"] = a.gradient;
     j["dt"] = o.dt;
     j["report"] = ReportJson(r.report);
     j["q0"] = Vector(r.params.q0);

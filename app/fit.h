@@ -49,6 +49,7 @@ struct FitTrajectoryArgs {
   double dt = 0.01;
   std::string fit_what = "q0,qdot0,stiffness,damping";
   std::string qdot0;
+  std::string gradient = "jets";  // jets (Levenberg–Marquardt) or adjoint (BFGS), 2D
   bool anneal = false;
   // --dynamic with a pose-graph controller (poses, times in --fit)
   std::string poses;     // "T1 .. Tk DURATION; T1 .. Tk DURATION; ..." (k = active modes)

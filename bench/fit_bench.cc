@@ -148,11 +148,18 @@ void BM_DynamicFit_100Steps(benchmark::State& state) {
   start.damping = Eigen::VectorXd::Constant(4, 2e5 * 0.6);
   fit::DynamicFitOptions o;
   o.world.ground.enabled = false;
-  long sims = 0;
-  for (auto _ : state) sims = fit::FitDynamicTrajectory(*body, frames, start, o).simulations;
-  state.counters["simulations"] = double(sims);
+  if (state.range(0)) {
+    o.gradient = fit::FitGradient::kAdjoint;
+    o.max_iterations = 2000;
+  }
+  fit::DynamicFitResult r;
+  for (auto _ : state) r = fit::FitDynamicTrajectory(*body, frames, start, o);
+  state.counters["simulations"] = double(r.simulations);
+  state.counters["iterations"] = r.report.iterations;
+  state.counters["cost"] = r.report.final_cost;
 }
-BENCHMARK(BM_DynamicFit_100Steps)->Unit(benchmark::kMillisecond);
+// adjoint 0: Jets and Levenberg–Marquardt; 1: the adjoint gradient and BFGS (issue 18)
+BENCHMARK(BM_DynamicFit_100Steps)->Arg(0)->Arg(1)->ArgName("adjoint")->Unit(benchmark::kMillisecond);
 
 // Baseline on the same problem: simulated annealing with a budget of simulations (the
 // argument; Ceres used 24, each a Jet simulation). Counter "cost": the best cost found;
@@ -223,14 +230,20 @@ struct PoseGraphProblem {
 };
 
 void BM_PoseGraphFit_Ground(benchmark::State& state) {
-  const PoseGraphProblem p;
+  PoseGraphProblem p;
+  if (state.range(0)) {
+    p.o.gradient = fit::FitGradient::kAdjoint;
+    p.o.max_iterations = 2000;
+  }
   fit::DynamicFitResult r;
   for (auto _ : state) r = fit::FitDynamicTrajectory(*p.body, p.frames, p.start, p.o);
   state.counters["simulations"] = double(r.simulations);
+  state.counters["iterations"] = r.report.iterations;
   state.counters["cost"] = r.report.final_cost;
   state.counters["start_cost"] = fit::DynamicCost(*p.body, p.frames, p.start, p.o);
 }
-BENCHMARK(BM_PoseGraphFit_Ground)->Unit(benchmark::kMillisecond);
+// adjoint 0: Jets and Levenberg–Marquardt; 1: the adjoint gradient and BFGS (issue 18)
+BENCHMARK(BM_PoseGraphFit_Ground)->Arg(0)->Arg(1)->ArgName("adjoint")->Unit(benchmark::kMillisecond);
 
 // The same problem by lib/wobble/synth's simulated annealing (Fig. 5.2, batch 1) with a budget
 // of simulations (the argument; Ceres used about 24).

@@ -109,6 +109,29 @@ TEST(DynamicFit, RecoversTheParametersThatGeneratedTheReference) {
   EXPECT_GT(sa.cost, 1e3 * r.report.final_cost + 1e-6);
 }
 
+// The same fit with the adjoint gradient (issue 18) and Ceres' L-BFGS: the same parameters to
+// the same tolerances as the Jet fit above.
+TEST(DynamicFit, TheAdjointGradientRecoversTheSameParameters) {
+  Case c(100);
+  const std::vector<fit::ReferenceFrame> frames = fit::FramesFromStates(*c.body, c.t, c.q, {}, 2);
+  const fit::DynamicParameters start = Perturbed(c.truth);
+  fit::DynamicFitOptions o = c.options;
+  o.gradient = fit::FitGradient::kAdjoint;
+  o.max_iterations = 2000;
+  const fit::DynamicFitResult r = fit::FitDynamicTrajectory(*c.body, frames, start, o);
+  ASSERT_TRUE(r.report.usable) << r.report.brief_report;
+  std::cout << r.report.brief_report << "\n" << r.simulations << " simulations, rms " << r.rms_residual << std::endl;
+  for (int d = 0; d < 4; ++d) {
+    EXPECT_NEAR(r.params.stiffness[d] / c.truth.stiffness[d], 1.0, 1e-5) << d;
+    EXPECT_NEAR(r.params.damping[d] / c.truth.damping[d], 1.0, 1e-4) << d;
+  }
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_NEAR(r.params.q0[i], c.truth.q0[i], 1e-6) << i;
+    EXPECT_NEAR(r.params.qd0[i], c.truth.qd0[i], 1e-5) << i;
+  }
+  EXPECT_LT(r.rms_residual, 1e-5);
+}
+
 TEST(DynamicFit, EstimatesTheInitialStateFromTheFirstFrames) {
   Case c(60);
   const std::vector<fit::ReferenceFrame> frames = fit::FramesFromStates(*c.body, c.t, c.q, {});

@@ -166,6 +166,23 @@ TEST(PoseGraphFit, RecoversPosesAndTimesOnTheGround) {
   EXPECT_GT(sa.cost, 1e3 * r.report.final_cost + 1e-6);
 }
 
+// The same two fits with the adjoint gradient (issue 18) and Ceres' BFGS line search: the same
+// poses and times to the same tolerances as the Jet fits above.
+TEST(PoseGraphFit, TheAdjointGradientRecoversPosesAndTimesInTheAirAndOnTheGround) {
+  for (bool ground : {false, true}) {
+    Case c(ground, ground ? 300 : 200);
+    c.options.fit_poses = c.options.fit_times = true;
+    c.options.gradient = fit::FitGradient::kAdjoint;
+    c.options.max_iterations = 2000;
+    const fit::DynamicParameters start = Perturbed(c.truth, true);
+    const fit::DynamicFitResult r = fit::FitDynamicTrajectory(*c.body, c.frames, start, c.options);
+    ASSERT_TRUE(r.report.usable) << r.report.brief_report;
+    std::cout << (ground ? "on the ground: " : "in the air: ") << r.report.brief_report << "\n"
+              << r.simulations << " simulations, rms " << r.rms_residual << std::endl;
+    ExpectRecovered(r.params, c.truth, ground ? 1e-5 : 1e-6, ground ? 1e-5 : 1e-6);
+  }
+}
+
 TEST(PoseGraphFit, RejectsTimesWithAHardSwitchAndMissingGraphs) {
   Case c(false, 10);
   c.options.fit_times = true;

@@ -90,6 +90,20 @@ check(err < 1e-6 and g["active"] == ["bend", "shear"] and g["cyclic"],
 check(j["annealing"]["simulations"] == j["simulations"] and j["annealing"]["cost"] > 1e3 * j["report"]["final_cost"],
       f"annealing with the same {j['simulations']} simulations ends higher: {j['annealing']['cost']} vs "
       f"{j['report']['final_cost']}")
+# the same fit by the adjoint gradient (issue 18): the same graph
+r = run("fit", "trajectory", "--object", f"{data}/table.obj", "--modes", f"{data}/bounding_modes.def",
+        "--reference", f"{work}/out/pose_graph.csv", "--dynamic", "--dt", "0.01", "--every", "2", "--fit", "poses,times",
+        "--q0", "0 0 0 0 0 0 0", "--qdot0", "0 0 0 0 0 0 0", *ground, "--gradient", "adjoint",
+        "--poses", "0.25 -0.05 0.45; -0.05 0.2 0.25; 0.1 0.1 0.55", "--out", f"{work}/graph_adjoint.json")
+check(r.returncode == 0, "fit trajectory --gradient adjoint exits 0: " + r.stderr.strip())
+j = json.load(open(f"{work}/graph_adjoint.json"))
+g = j["pose_graph"]
+err = max(max(abs(a - b) for pa, pb in zip(g["poses"], truth_poses) for a, b in zip(pa, pb)),
+          max(abs(a - b) for a, b in zip(g["durations"], truth_times)))
+check(err < 1e-6 and j["gradient"] == "adjoint", f"the adjoint fit recovers the same pose graph (max error {err:.2g})")
+r = run("fit", "trajectory", "--object", f"{data}/table.obj", "--modes", f"{data}/bounding_modes.def",
+        "--reference", f"{work}/out/pose_graph.csv", "--dynamic", "--gradient", "reverse")
+check(r.returncode == 2 and "--gradient" in r.stderr, "an unknown --gradient: exit 2 " + r.stderr.strip())
 r = run("fit", "trajectory", "--object", f"{data}/table.obj", "--modes", f"{data}/bounding_modes.def",
         "--reference", f"{work}/out/pose_graph.csv", "--dynamic", "--fit", "poses", "--poses", "0.2 0.4; 0.1 0.1 0.3")
 check(r.returncode == 2 and "--poses: a pose needs 2 targets" in r.stderr, "a pose of the wrong size: exit 2 " + r.stderr.strip())

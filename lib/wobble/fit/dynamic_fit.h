@@ -45,6 +45,15 @@ struct DynamicParameters {
   control::PoseGraph graph;
 };
 
+// How a dynamic fit gets its derivatives (issue 18).
+//   kJets:    forward-mode Jets give every residual's Jacobian; Ceres' Levenberg–Marquardt
+//             (bounds exact). A Jacobian costs about one simulation per parameter.
+//   kAdjoint: the adjoint (fit/adjoint.h) gives the cost's gradient for a few simulations
+//             whatever the number of parameters; Ceres' line search (BFGS, L-BFGS past 400
+//             unknowns). ζ ≥ 0 is held by ζ = u² and the transition times' bounds by a
+//             logistic map. 2D bodies.
+enum class FitGradient { kJets, kAdjoint };
+
 struct DynamicFitOptions {
   WorldParams world;    // gravity, ground, springs
   WorldParams3 world3;  // the same for a 3D body
@@ -53,7 +62,8 @@ struct DynamicFitOptions {
   bool fit_poses = false, fit_times = false;  // the controller's (needs a non-empty graph)
   double switch_width = 0.05;  // w of the smoothed pose switch, seconds (> 0 to fit times)
   double min_time = 0.05, max_time = 10.0;  // bounds of the transition times
-  int max_iterations = 50;
+  FitGradient gradient = FitGradient::kJets;
+  int max_iterations = 50;  // solver iterations (L-BFGS takes more, cheaper ones: say 500)
   bool full_report = false;
   std::function<void(int iteration, double cost)> on_iteration;  // progress display
 };

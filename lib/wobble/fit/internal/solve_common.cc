@@ -46,19 +46,6 @@ std::vector<ceres::ResidualBlockId> AddPoseTerms(const BodyModel& body, const st
   return ids;
 }
 
-void FillReport(const ceres::Solver::Summary& summary, bool full, double seconds, FitReport* report) {
-  report->usable = summary.IsSolutionUsable();
-  report->termination = ceres::TerminationTypeToString(summary.termination_type);
-  report->brief_report = summary.BriefReport();
-  if (full) report->full_report = summary.FullReport();
-  report->initial_cost = summary.initial_cost;
-  report->final_cost = summary.final_cost;
-  report->cost_per_iteration.clear();
-  for (const ceres::IterationSummary& it : summary.iterations) report->cost_per_iteration.push_back(it.cost);
-  report->iterations = int(summary.iterations.size()) - 1;
-  report->solve_seconds = seconds;
-}
-
 void SolvePoseProblem(const PoseFitOptions& o, ceres::Problem* problem, FitReport* report) {
   ceres::Solver::Options options;
   // normal equations: J has 2 rows per target but only num_q <= 15 columns; LM's damping keeps

@@ -61,8 +61,19 @@ class IterationForwarder : public ceres::IterationCallback {
   std::function<void(int, double)> f_;
 };
 
-// Copies what people need from a Ceres summary.
-void FillReport(const ceres::Solver::Summary& summary, bool full, double seconds, FitReport* report);
+// Copies what people need from a Ceres summary (least squares or line search).
+template <class Summary> void FillReport(const Summary& summary, bool full, double seconds, FitReport* report) {
+  report->usable = summary.IsSolutionUsable();
+  report->termination = ceres::TerminationTypeToString(summary.termination_type);
+  report->brief_report = summary.BriefReport();
+  if (full) report->full_report = summary.FullReport();
+  report->initial_cost = summary.initial_cost;
+  report->final_cost = summary.final_cost;
+  report->cost_per_iteration.clear();
+  for (const ceres::IterationSummary& it : summary.iterations) report->cost_per_iteration.push_back(it.cost);
+  report->iterations = int(summary.iterations.size()) - 1;
+  report->solve_seconds = seconds;
+}
 
 // A report as bytes and back, exactly: multi-start fits solve their starts through
 // DistributedMap (core/distribute.h).
