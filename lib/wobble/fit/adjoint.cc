@@ -166,8 +166,9 @@ class Rollout {
   // where yᵀ (∂M/∂q_j) a = (K_j(y + a) − K_j(y − a)) / 2 with K_j(v) = ½ vᵀ (∂M/∂q_j) v the
   // kinetic gradient (KineticGradient), and yᵀ dr is written out from the moment formulas of
   // GravityForce and VelocityTerms (kinematics.h). The ground's part of r and the anchors'
-  // update are sums over contact points, each a function of (q, q̇, its anchor) only: each is
-  // differentiated on its own by a Jet over those 2 nq + 2 numbers (one pass for the table).
+  // update are sums over contact points, each a function of (x, v, its anchor) only: each is
+  // differentiated by hand (GroundForcePartials, AnchorUpdatePartials) and pulled back
+  // through x = t + R l and v = J q̇ (PullPoint).
   // The step's a is read back from the next state, a = (q̇' − q̇)/h (both integrators), exact
   // up to rounding (~1e-13 relative).
   void HandVjp(int n, const BodyState<double>& s, const BodyState<double>& next, const Adjoint& out, Adjoint* in,
@@ -184,13 +185,8 @@ class Rollout {
       const auto it = out.anchor.find({c.point, c.face});
       if (it == out.anchor.end() || it->second.isZero(0.0)) continue;
       const Contact<double>* before = Find(s, c);
-      PointVjp(c, before, next.q, next.qd, [&](const Vec2<Jet>& x, const Vec2<Jet>& v, Vec2<Jet> anchor,
-                                                const GroundFace& face) {
-        bool slipping;
-        Vec2<Jet> f = GroundForce(face, x, v, anchor, &slipping);
-        if (slipping) SlipAnchor(face, x, v, &anchor, &f);
-        return Jet(anchor[0] * it->second[0] + anchor[1] * it->second[1]);
-      }, &bar.q, &bar.qd, anchor_slot(before));
+      const ContactPoint p = PointAt(c, before, next.q, next.qd);
+      PullPoint(p, AnchorUpdatePartials(p, it->second), next.qd, &bar.q, &bar.qd, anchor_slot(before));
     }
     // where a is evaluated, and μ, the adjoint of a
     const VecQ<double> Q = thesis ? s.q : VecQ<double>(s.q + h * s.qd), V = s.qd;
@@ -200,15 +196,14 @@ class Rollout {
     ForceVjp(n, Q, V, a, mu, &y, &gQ, &gV, g);
     // the ground force's part: y · Σ J_kᵀ f_k = Σ (J_k y) · f_k; at (q', q̇) the symplectic step
     // feels the contacts of the next state, with the anchors they had before it
-    const VecQ<Jet> y_jet = y.cast<Jet>();
     for (const Contact<double>& c : thesis ? s.contacts : next.contacts) {
       const Contact<double>* before = thesis ? &c : Find(s, c);
-      PointVjp(c, before, Q, V, [&](const Vec2<Jet>& x, const Vec2<Jet>& v, const Vec2<Jet>& anchor,
-                                     const GroundFace& face, const Frame<Jet>& frame, const Vec2<Jet>& l) {
-        bool slipping;
-        const Vec2<Jet> f = GroundForce(face, x, v, anchor, &slipping);
-        return Jet(f.dot(PointVelocity(frame, y_jet, l, passive_.mode_matrix(c.point))));
-      }, &gQ, &gV, anchor_slot(before));
+      const ContactPoint p = PointAt(c, before, Q, V);
+      const Eigen::Vector2d P = PointVelocity(p.frame, y, p.l, passive_.mode_matrix(c.point));  // J_k y
+      bool slipping;
+      const Eigen::Vector2d f = GroundForce(p.face, p.x, p.v, p.anchor, &slipping);
+      PullPoint(p, GroundForcePartials(p, P), V, &gQ, &gV, anchor_slot(before));
+      AddVelocityPartial(p, y, f, &gQ);  // J_k y depends on Q too
     }
     // through the integrator
     in->q = bar.q + gQ;
@@ -299,39 +294,126 @@ class Rollout {
     gq -= 0.5 * (k_plus - k_minus);
   }
 
-  // The gradient of a scalar φ(x, v, anchor) of contact c's point at (Q, V) with respect to Q,
-  // V and (when `before` holds its anchor) that anchor; a new contact's anchor is its point's
-  // projection on the face, as ForEachPointInContact makes it. φ is called as
-  // phi(x, v, anchor, face) or phi(x, v, anchor, face, frame, l).
-  template <class Phi, class Vec>
-  void PointVjp(const Contact<double>& c, const Contact<double>* before, const VecQ<double>& Q, const VecQ<double>& V,
-                const Phi& phi, Vec* gQ, Vec* gV, Eigen::Vector2d* g_anchor) const {
-    const int nq = this->nq(), width = 2 * nq + 2;
+  // A contact point at (Q, V) in plain numbers: its frame, local and world position, velocity
+  // and the anchor its force is tied to (a new contact's is its projection on the face, as
+  // ForEachPointInContact makes it).
+  struct ContactPoint {
+    int point;
+    GroundFace face;
+    Frame<double> frame;
+    Eigen::Vector2d l, x, v, anchor;
+    bool fresh;
+  };
+  ContactPoint PointAt(const Contact<double>& c, const Contact<double>* before, const VecQ<double>& Q,
+                       const VecQ<double>& V) const {
     const GroundFace face = r_.world.ground.Face(c.face);
-    Eigen::VectorXd grad = Eigen::VectorXd::Zero(width);
-    for (int offset = 0; offset < width; offset += kChunk) {
-      VecQ<Jet> q, qd;
-      SeedState(Q, V, offset, &q, &qd);
-      const Frame<Jet> frame(q);
-      const Vec2<Jet> l = LocalPosition<Jet>(passive_.rest_local(c.point), passive_.mode_matrix(c.point), q);
-      const Vec2<Jet> x = WorldFromLocal(frame, l);
-      const Vec2<Jet> v = PointVelocity(frame, qd, l, passive_.mode_matrix(c.point));
-      Vec2<Jet> anchor;
-      if (before) {
-        anchor = Vec2<Jet>(Seed(before->anchor[0], 2 * nq, offset), Seed(before->anchor[1], 2 * nq + 1, offset));
-      } else {
-        anchor = x - face.Height(x) * face.n.cast<Jet>();
-      }
-      Jet value;
-      if constexpr (std::is_invocable_v<Phi, Vec2<Jet>, Vec2<Jet>, Vec2<Jet>, GroundFace, Frame<Jet>, Vec2<Jet>>)
-        value = phi(x, v, anchor, face, frame, l);
-      else
-        value = phi(x, v, anchor, face);
-      Pull(value, 1.0, offset, &grad);
+    const Frame<double> frame(Q);
+    const Eigen::Vector2d l = LocalPosition<double>(passive_.rest_local(c.point), passive_.mode_matrix(c.point), Q);
+    const Eigen::Vector2d x = WorldFromLocal(frame, l);
+    const Eigen::Vector2d v = PointVelocity(frame, V, l, passive_.mode_matrix(c.point));
+    const Eigen::Vector2d anchor = before ? before->anchor : Eigen::Vector2d(x - face.Height(x) * face.n);
+    return {c.point, face, frame, l, x, v, anchor, before == nullptr};
+  }
+
+  // ∂φ/∂(x, v, anchor) of one contact point's scalar φ.
+  struct PointPartials {
+    Eigen::Vector2d x = Eigen::Vector2d::Zero(), v = Eigen::Vector2d::Zero(), anchor = Eigen::Vector2d::Zero();
+  };
+
+  // φ = w · f of GroundForce (Eq. 4.24/4.25) with its branches taken as at the plain values:
+  // f_n = −K n·(x − a) − C n·v while it pushes (≥ 0), f_t = −K τ·(x − a) − F τ·v while it
+  // sticks, ±μ f_n while it slips.
+  static PointPartials GroundForcePartials(const ContactPoint& p, const Eigen::Vector2d& w) {
+    const GroundFace& g = p.face;
+    double w_fn = w.dot(g.n), w_ft = w.dot(g.tau);
+    const int slip = SlipSign(p);
+    if (slip != 0) {  // f_t = slip μ f_n
+      w_fn += slip * g.friction_cap * w_ft;
+      w_ft = 0.0;
     }
-    *gQ += grad.head(nq);
-    *gV += grad.segment(nq, nq);
-    if (g_anchor) *g_anchor += grad.tail(2);
+    PointPartials d;
+    if (Pushing(p)) {
+      d.x -= g.stiffness * w_fn * g.n;
+      d.v -= g.normal_damping * w_fn * g.n;
+      d.anchor += g.stiffness * w_fn * g.n;
+    }
+    d.x -= g.stiffness * w_ft * g.tau;
+    d.v -= g.friction_damping * w_ft * g.tau;
+    d.anchor += g.stiffness * w_ft * g.tau;
+    return d;
+  }
+
+  // φ = w · (the anchor after the contact update): the anchor itself while the point sticks;
+  // when it slips, SlipAnchor's a' = x − h(x) n − δ τ with δ = −(f·τ + F τ·v)/K and
+  // f·τ = ±μ f_n (δ = 0 without stiffness).
+  static PointPartials AnchorUpdatePartials(const ContactPoint& p, const Eigen::Vector2d& w) {
+    const GroundFace& g = p.face;
+    PointPartials d;
+    const int slip = SlipSign(p);
+    if (slip == 0) {
+      d.anchor = w;
+      return d;
+    }
+    d.x = w - g.n * g.n.dot(w);  // x − h(x) n, h(x) = n·(x − point)
+    if (!(g.stiffness > 0.0)) return d;
+    const double alpha = w.dot(g.tau) / g.stiffness;  // −(w·τ) δ = α (±μ f_n + F τ·v)
+    d.v += alpha * g.friction_damping * g.tau;
+    if (Pushing(p)) {
+      const double k = alpha * slip * g.friction_cap;
+      d.x -= k * g.stiffness * g.n;
+      d.v -= k * g.normal_damping * g.n;
+      d.anchor += k * g.stiffness * g.n;
+    }
+    return d;
+  }
+
+  // GroundForce's branches at the plain values: the normal force pushes (it is not clamped to
+  // 0), and the friction slips up (+1), down (−1) or sticks (0).
+  static bool Pushing(const ContactPoint& p) { return NormalForce(p) >= 0.0; }
+  static double NormalForce(const ContactPoint& p) {
+    return -p.face.stiffness * p.face.n.dot(p.x - p.anchor) - p.face.normal_damping * p.face.n.dot(p.v);
+  }
+  static int SlipSign(const ContactPoint& p) {
+    const double ft = -p.face.stiffness * p.face.tau.dot(p.x - p.anchor) - p.face.friction_damping * p.face.tau.dot(p.v);
+    const double cap = p.face.friction_cap * std::max(NormalForce(p), 0.0);
+    return ft > cap ? 1 : ft < -cap ? -1 : 0;
+  }
+
+  // Pulls a point's ∂φ/∂(x, v, anchor) back to Q, V (x = t + R l, v = J V) and its previous
+  // anchor; a new contact's anchor is x − h(x) n, which passes its part on to x.
+  template <class Vec>
+  void PullPoint(const ContactPoint& p, PointPartials d, const VecQ<double>& V, Vec* gQ, Vec* gV,
+                 Eigen::Vector2d* g_anchor) const {
+    if (p.fresh) {
+      d.x += d.anchor - p.face.n * p.face.n.dot(d.anchor);
+    } else if (g_anchor) {
+      *g_anchor += d.anchor;
+    }
+    AddJacobianTranspose(p, d.x, gQ);  // ∂x/∂Q = J
+    AddJacobianTranspose(p, d.v, gV);  // ∂v/∂V = J
+    AddVelocityPartial(p, V, d.v, gQ);
+  }
+
+  // out += Jᵀ w at the point: (w, w·R S l, Bᵀ Rᵀ w), Eq. 4.20.
+  template <class Vec> void AddJacobianTranspose(const ContactPoint& p, const Eigen::Vector2d& w, Vec* out) const {
+    const auto& B = passive_.mode_matrix(p.point);
+    const Eigen::Vector2d w_local = p.frame.R.transpose() * w;
+    (*out)[0] += w[0];
+    (*out)[1] += w[1];
+    (*out)[2] += Perp(p.l).dot(w_local);
+    for (int d = 0; d < B.cols(); ++d) (*out)[kRigidDofs + d] += B.col(d).dot(w_local);
+  }
+
+  // out += (∂(J u)/∂Q)ᵀ w for J u = u_t + R (S l u_θ + B u_γ): by θ, R S (S l u_θ + B u_γ); by
+  // γ_d (through l), u_θ R S b_d.
+  template <class Vec>
+  void AddVelocityPartial(const ContactPoint& p, const VecQ<double>& u, const Eigen::Vector2d& w, Vec* out) const {
+    const auto& B = passive_.mode_matrix(p.point);
+    const Eigen::Vector2d w_local = p.frame.R.transpose() * w;
+    Eigen::Vector2d u_local = Perp(p.l) * u[2];
+    for (int d = 0; d < B.cols(); ++d) u_local += B.col(d) * u[kRigidDofs + d];
+    (*out)[2] += Perp(u_local).dot(w_local);
+    for (int d = 0; d < B.cols(); ++d) (*out)[kRigidDofs + d] += u[2] * Perp(Eigen::Vector2d(B.col(d))).dot(w_local);
   }
 
   static bool Failed(int n, const std::string& what, std::string* why) {

@@ -12,9 +12,9 @@
 //     ∂/∂γ0(n) = (∂z_{n+1}/∂γ0(n))ᵀ λ_{n+1},   ∂/∂(K, c) = Σ_n (∂z_{n+1}/∂(K, c))ᵀ λ_{n+1},
 // with z_n the step's whole state: q, q̇ and the anchor of every ground contact (the friction
 // springs of Eq. 4.24/4.25 remember where a contact began), matched from step to step by
-// (point, face). Each step's vector–Jacobian product is hand-derived (one mass solve and the
-// moment formulas), each contact point's force and anchor update differentiated on its own by
-// a Jet over (q, q̇, its anchor); springs, and a terrain under the symplectic step, take
+// (point, face). Each step's vector–Jacobian product is hand-derived (one mass solve, the
+// moment formulas, and each contact point's force and anchor update through the point's
+// position and velocity); springs, and a terrain under the symplectic step, take
 // forward-mode Jets over the step's whole input (2 nq + 2 × contacts + 3 D numbers, chunks of
 // 16). So the cost of a gradient does not grow with the number of steps' controls, unlike
 // Jets over every parameter. Contact decisions are taken on plain values, as in every Jet
