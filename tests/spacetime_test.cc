@@ -3,9 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
+#include <limits>
 
+#include "support/table_hop.h"
 #include "support/test_bodies.h"
 #include "wobble/fit/spacetime.h"
+#include "wobble/fit/targets.h"
 
 namespace wobble {
 namespace {
@@ -114,6 +118,78 @@ TEST(Spacetime, BoundsHoldWhenTheGoalLiesBeyondThem) {
   double bend = 0, speed = 0;
   EndOf(p, r.targets, &bend, &speed);
   EXPECT_GT(bend, 0.1) << "past the bound of its targets";
+}
+
+// The ready-made task terms' gradients against central differences of their values.
+TEST(Spacetime, TaskTermsHaveTheirExactGradients) {
+  const BodyModel& body = testing::HopTable();
+  fit::Axes only_y;
+  only_y.x = false;
+  const std::vector<fit::StageCost> terms = {
+      fit::CentreOfMassAt(body, 3, {10.0, 80.0}, 2.0), fit::CentreOfMassAt(body, 3, {10.0, 80.0}, 2.0, only_y),
+      fit::UprightAt(3, 5.0, 0.3), fit::StillAt(3, 0.7),
+      fit::SumOf({fit::UprightAt(3, 1.0), fit::CentreOfMassAt(body, 3, {0.0, 50.0}, 1.0)})};
+  Eigen::VectorXd q(7), qd(7);
+  q << 3.0, 70.0, 0.4, 0.1, -0.2, 0.15, 0.05;
+  qd << 1.0, -2.0, 0.5, 0.3, 0.2, -0.1, 0.4;
+  for (size_t t = 0; t < terms.size(); ++t) {
+    Eigen::VectorXd dq = Eigen::VectorXd::Zero(7), dqd = Eigen::VectorXd::Zero(7), scratch = dq, scratch2 = dq;
+    EXPECT_EQ(terms[t](2, q, qd, &scratch, &scratch2), 0.0) << "another step adds nothing";
+    EXPECT_TRUE(scratch.isZero(0.0) && scratch2.isZero(0.0));
+    const double value = terms[t](3, q, qd, &dq, &dqd);
+    EXPECT_GT(value, 0.0);
+    auto at = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+      Eigen::VectorXd g1 = Eigen::VectorXd::Zero(7), g2 = g1;
+      return terms[t](3, a, b, &g1, &g2);
+    };
+    for (int i = 0; i < 7; ++i) {
+      const double h = 1e-6;
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(7);
+      e[i] = h;
+      const double cd_q = (at(q + e, qd) - at(q - e, qd)) / (2 * h), cd_qd = (at(q, qd + e) - at(q, qd - e)) / (2 * h);
+      EXPECT_NEAR(dq[i], cd_q, 1e-6 * (1.0 + std::abs(cd_q))) << "term " << t << " q" << i;
+      EXPECT_NEAR(dqd[i], cd_qd, 1e-6 * (1.0 + std::abs(cd_qd))) << "term " << t << " qdot" << i;
+    }
+  }
+  EXPECT_THROW(fit::UprightAt(-1, 1.0), std::invalid_argument);
+  EXPECT_THROW(fit::StillAt(1, -1.0), std::invalid_argument);
+  EXPECT_THROW(fit::CentreOfMassAt(body, 1, {NAN, 0.0}, 1.0), std::invalid_argument);
+}
+
+// A hop from a standing start (tests/support/table_hop.h): from zero targets the table stands
+// still; the fitted targets make it leave the ground. At 0.7 s its centre of mass is within
+// 0.05 of 2 above its rest height and every mass point is clear of the ground, and it comes
+// down upright.
+TEST(Spacetime, FindsAHopFromAStandingStart) {
+  const fit::SpacetimeProblem p = testing::TableHop(2.0);
+  const BodyModel& body = testing::HopTable();
+  fit::SpacetimeOptions o;
+  o.max_iterations = 300;
+  const fit::SpacetimeResult r = fit::FitSpacetime(body, p, o);
+  ASSERT_TRUE(r.ok) << r.message;
+  std::cout << r.message << ", " << r.gradients << " gradients, cost " << r.initial_cost << " -> " << r.cost
+            << ", control energy " << r.control_energy << "\nknots (bend, shear, vsquash, hsquash):\n"
+            << r.knots << std::endl;
+  const double rest_height = body.moments().c0.y() / body.moments().m;
+  double height = 0, lowest = 0, end_angle = 1;
+  fit::ControlledRollout run = p.rollout;
+  run.targets = r.targets;
+  fit::RolloutCost(body, run, [&](int n, const Eigen::VectorXd& q, const Eigen::VectorXd&, Eigen::VectorXd*,
+                                  Eigen::VectorXd*) {
+    if (n == testing::kHopPeak) {
+      const Eigen::Vector2d c = (body.moments().c0 + body.moments().C * q.tail(4)) / body.moments().m;
+      height = q[1] + (Eigen::Rotation2Dd(q[2]) * c).y();
+      lowest = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < body.num_points(); ++k)
+        lowest = std::min(lowest, fit::PointPosition(fit::BasisOf(body, k, {}), q.data(), 7).y());
+    }
+    if (n == testing::kHopSteps) end_angle = q[2];
+    return 0.0;
+  });
+  EXPECT_NEAR(height - rest_height, 2.0, 0.05);
+  EXPECT_GT(lowest, 0.5) << "every mass point is in the air";
+  EXPECT_LT(std::abs(end_angle), 0.01);
+  EXPECT_GT(r.initial_cost, 1e3 * r.cost);  // zero targets: the table just stands
 }
 
 TEST(Spacetime, RefusesBadProblems) {

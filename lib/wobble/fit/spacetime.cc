@@ -103,7 +103,67 @@ class Progress final : public ceres::IterationCallback {
   const SpacetimeOptions& o_;
 };
 
+void CheckTerm(int step, double weight, const char* what) {
+  if (step < 0) throw std::invalid_argument(std::string(what) + ": the step must be >= 0");
+  if (!(weight >= 0.0) || !std::isfinite(weight)) throw std::invalid_argument(std::string(what) + ": the weight must be >= 0");
+}
+
 }  // namespace
+
+StageCost CentreOfMassAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight, Axes axes) {
+  CheckTerm(step, weight, "CentreOfMassAt");
+  if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassAt: the goal must be finite");
+  const MassMoments mm = body.moments();
+  return [mm, step, goal, weight, axes](int n, const Eigen::VectorXd& q, const Eigen::VectorXd&, Eigen::VectorXd* dq,
+                                        Eigen::VectorXd*) {
+    if (n != step) return 0.0;
+    const int D = int(q.size()) - kRigidDofs;
+    const Eigen::Vector2d c = (mm.c0 + mm.C * q.tail(D)) / mm.m;  // body frame
+    const Eigen::Rotation2Dd R(q[2]);
+    const Eigen::Vector2d Rc = R * c, x = q.head<2>() + Rc;
+    Eigen::Vector2d miss = x - goal;
+    if (!axes.x) miss.x() = 0.0;
+    if (!axes.y) miss.y() = 0.0;
+    const Eigen::Vector2d r = weight * miss;
+    dq->head<2>() += r;                                 // ∂x/∂t = I
+    (*dq)[2] += r.y() * Rc.x() - r.x() * Rc.y();        // ∂x/∂θ = S R c
+    dq->tail(D) += mm.C.transpose() * (R.inverse() * r) / mm.m;  // ∂x/∂γ = R C / m
+    return 0.5 * weight * miss.squaredNorm();
+  };
+}
+
+StageCost UprightAt(int step, double weight, double time_scale) {
+  CheckTerm(step, weight, "UprightAt");
+  if (!(time_scale >= 0.0) || !std::isfinite(time_scale)) throw std::invalid_argument("UprightAt: the time scale must be >= 0");
+  return [step, weight, time_scale](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq,
+                                    Eigen::VectorXd* dqd) {
+    if (n != step) return 0.0;
+    const double s2 = time_scale * time_scale;
+    (*dq)[2] += weight * q[2];
+    (*dqd)[2] += weight * s2 * qd[2];
+    return 0.5 * weight * (q[2] * q[2] + s2 * qd[2] * qd[2]);
+  };
+}
+
+StageCost StillAt(int step, double weight) {
+  CheckTerm(step, weight, "StillAt");
+  return [step, weight](int n, const Eigen::VectorXd&, const Eigen::VectorXd& qd, Eigen::VectorXd*, Eigen::VectorXd* dqd) {
+    if (n != step) return 0.0;
+    *dqd += weight * qd;
+    return 0.5 * weight * qd.squaredNorm();
+  };
+}
+
+StageCost SumOf(std::vector<StageCost> terms) {
+  for (const StageCost& t : terms)
+    if (!t) throw std::invalid_argument("SumOf: an empty term");
+  return [terms = std::move(terms)](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq,
+                                     Eigen::VectorXd* dqd) {
+    double total = 0.0;
+    for (const StageCost& t : terms) total += t(n, q, qd, dq, dqd);
+    return total;
+  };
+}
 
 Eigen::MatrixXd KnotTargets(const Eigen::MatrixXd& knots, int steps) {
   if (knots.cols() < 2 || steps < 1) throw std::invalid_argument("KnotTargets: needs two knots and a step");

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "wobble/fit/adjoint.h"
 
@@ -45,6 +46,20 @@ struct SpacetimeResult {
 // The targets of each step from knots (modes × knots): linear between evenly spaced knots,
 // the first at step 0 and the last at step `steps`.
 Eigen::MatrixXd KnotTargets(const Eigen::MatrixXd& knots, int steps);
+
+// Ready-made task terms (each a StageCost with its exact gradient), and their sum.
+//   CentreOfMassAt: w/2 |x_c(q_n) − goal|² on the axes asked for, x_c = t + R c/m the centre
+//                   of mass (c = c0 + C γ, the mass moments of Eq. 4.9): "be there then".
+//   UprightAt:      w/2 (θ_n² + τ² θ̇_n²): "land upright and without spinning", τ a time scale.
+//   StillAt:        w/2 |q̇_n|² (every coordinate's rate): "be at rest".
+// n is a step index (0 … steps). Throws std::invalid_argument on a negative step or weight.
+struct Axes {
+  bool x = true, y = true;
+};
+StageCost CentreOfMassAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight, Axes axes = {});
+StageCost UprightAt(int step, double weight, double time_scale = 0.0);
+StageCost StillAt(int step, double weight);
+StageCost SumOf(std::vector<StageCost> terms);
 
 // Throws std::invalid_argument on inconsistent sizes, bounds or knot counts.
 SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem,
