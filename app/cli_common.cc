@@ -5,8 +5,10 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
+#include <unistd.h>
 
 #include <iostream>
 
@@ -289,6 +291,18 @@ Integrator ParseIntegratorFlag(const std::string& name) {
   Integrator integrator;
   if (ParseIntegrator(name, &integrator)) return integrator;
   throw UsageError("--integrator: '" + name + "' is not one of " + IntegratorNames());
+}
+
+// A one-line "iteration N, cost C" on stderr when it is a terminal (quiet otherwise).
+std::function<void(int, double)> IterationLine() {
+  if (isatty(STDERR_FILENO) != 1) return {};
+  return [](int iteration, double cost) {
+    std::fprintf(stderr, "\r  iteration %4d  cost %-14.6g", iteration, cost);
+    std::fflush(stderr);
+  };
+}
+void EndIterationLine() {
+  if (isatty(STDERR_FILENO) == 1) std::fprintf(stderr, "\n");
 }
 
 }  // namespace wobble::app

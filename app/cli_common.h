@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -63,6 +64,11 @@ struct WorldFlags {
 void AddWorldFlags(CLI::App* cmd, WorldFlags* flags);
 // Validates the flags (finite, non-negative where it matters) and fills the params.
 WorldParams MakeWorldParams(const WorldFlags& flags);
+
+// A fit's progress: a one-line "iteration N, cost C" on stderr when it is a terminal (an
+// empty function otherwise), and the line's end.
+std::function<void(int, double)> IterationLine();
+void EndIterationLine();
 
 // --max-steps and --max-record-mb (core/limits.h): what one command may simulate and keep.
 void AddLimitFlags(CLI::App* cmd, Limits* limits);

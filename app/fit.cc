@@ -103,18 +103,6 @@ void CheckOutputs(const FitFlags& f) {
   }
 }
 
-// A one-line "iteration N, cost C" on stderr when it is a terminal (quiet otherwise).
-std::function<void(int, double)> IterationLine() {
-  if (isatty(STDERR_FILENO) != 1) return {};
-  return [](int iteration, double cost) {
-    std::fprintf(stderr, "\r  iteration %4d  cost %-14.6g", iteration, cost);
-    std::fflush(stderr);
-  };
-}
-void EndIterationLine() {
-  if (isatty(STDERR_FILENO) == 1) std::fprintf(stderr, "\n");
-}
-
 json ReportJson(const fit::FitReport& r) {
   json j;
   j["usable"] = r.usable;

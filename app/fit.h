@@ -58,6 +58,22 @@ struct FitTrajectoryArgs {
   double switch_width = 0.05;
 };
 
+// `wobble fit spacetime` (fit_spacetime.cc): PD targets for a task, 2D objects.
+struct FitSpacetimeArgs {
+  BodyFiles files;
+  WorldFlags world;
+  std::string q, qdot;
+  double dt = 0.01, duration = 1.0;
+  int knots = 21;
+  std::string rise, reach;  // "DY T", "X Y T"
+  bool upright = false, still = false;
+  double weight = 2000.0, bound = 0.3, effort = 1.0;
+  int max_iterations = 300;
+  std::string targets, out;
+};
+CLI::App* AddFitSpacetimeCommand(CLI::App* fit, FitSpacetimeArgs* args);
+int RunFitSpacetime(const FitSpacetimeArgs& args);
+
 struct FitCommands {
   CLI::App* fit = nullptr;
   CLI::App* pose = nullptr;

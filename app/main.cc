@@ -104,6 +104,8 @@ int main(int argc, char** argv) {
   FitPoseArgs fit_pose_args;
   FitTrajectoryArgs fit_trajectory_args;
   const FitCommands fit = AddFitCommand(&app, &fit_pose_args, &fit_trajectory_args);
+  FitSpacetimeArgs fit_spacetime_args;
+  CLI::App* fit_spacetime = AddFitSpacetimeCommand(fit.fit, &fit_spacetime_args);
   RunArgs run_args;
   CLI::App* run = AddRunCommand(&app, &run_args);
   SweepArgs sweep_study_args;
@@ -131,6 +133,7 @@ int main(int argc, char** argv) {
 #endif
     if (fit.pose->parsed()) return RunFitPose(fit_pose_args);
     if (fit.trajectory->parsed()) return RunFitTrajectory(fit_trajectory_args);
+    if (fit_spacetime->parsed()) return RunFitSpacetime(fit_spacetime_args);
     if (run->parsed()) return RunScript(run_args);
     if (sweep_study->parsed()) return RunSweep(sweep_study_args);
   } catch (const wobble::formats::ParseError& e) {

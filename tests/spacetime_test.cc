@@ -127,7 +127,8 @@ TEST(Spacetime, TaskTermsHaveTheirExactGradients) {
   only_y.x = false;
   const std::vector<fit::StageCost> terms = {
       fit::CentreOfMassAt(body, 3, {10.0, 80.0}, 2.0), fit::CentreOfMassAt(body, 3, {10.0, 80.0}, 2.0, only_y),
-      fit::UprightAt(3, 5.0, 0.3), fit::StillAt(3, 0.7),
+      fit::UprightAt(3, 5.0, 0.3), fit::StillAt(3, 0.7), fit::CentreOfMassVelocityAt(body, 3, {1.0, -2.0}, 3.0),
+      fit::CentreOfMassVelocityAt(body, 3, {0.0, 0.0}, 3.0, only_y),
       fit::SumOf({fit::UprightAt(3, 1.0), fit::CentreOfMassAt(body, 3, {0.0, 50.0}, 1.0)})};
   Eigen::VectorXd q(7), qd(7);
   q << 3.0, 70.0, 0.4, 0.1, -0.2, 0.15, 0.05;

@@ -112,6 +112,43 @@ r = run("fit", "trajectory", "--object", f"{data}/table.obj", "--modes", f"{data
         "--poses", "0.2 0.1 0.4")
 check(r.returncode == 2 and "--switch-width > 0" in r.stderr, "times with a hard switch: exit 2 " + r.stderr.strip())
 
+# a spacetime fit (issue 18): a hop from a standing start, whose targets a script plays with
+# `schedule` (data/hop.wob's setup); the table is off the ground at 0.7 s and back by 1.5 s
+hop = ["--object", f"{data}/table.obj", "--modes", f"{data}/hop_modes.def", "--ground-stiffness", "45000",
+       "--ground-damping", "3000", "--friction-damping", "3000", "--friction-cap", "0.5"]
+r = run("fit", "spacetime", *hop, "--duration", "1", "--knots", "21", "--rise", "2 0.7", "--upright",
+        "--targets", f"{work}/hop_targets.csv", "--out", f"{work}/hop_fit.json")
+check(r.returncode == 0, "fit spacetime exits 0: " + r.stderr.strip())
+j = json.load(open(f"{work}/hop_fit.json"))
+check(j["ok"] and j["cost"] < 1e-2 * j["initial_cost"] and len(j["knots"]) == 21,
+      f"the spacetime fit lowers the cost from {j['initial_cost']} to {j['cost']}")
+rows = list(csv.reader(open(f"{work}/hop_targets.csv")))
+check(rows[0] == ["t", "bend", "shear", "vsquash", "hsquash"] and len(rows) == 101, "the schedule: a row per step")
+with open(f"{work}/hop.wob", "w") as f:
+    f.write(f"load_obj {data}/table.obj\nload_def {data}/hop_modes.def\nset integrator thesis\nset dt 0.01\n"
+            f"set grconst 45000\n"
+            f"set grdam 3000\nset frconst 3000\nset frsin 0.5\nschedule {work}/hop_targets.csv\n"
+            f"output {work}/hop.csv\nsimul 1.5\n")
+r = subprocess.run([wobble, "run", f"{work}/hop.wob"], capture_output=True, text=True, cwd=work)
+check(r.returncode == 0 and "schedule: 100 steps" in r.stdout, "a script plays the schedule: " + r.stderr.strip())
+run_rows = list(csv.DictReader(open(f"{work}/hop.csv")))
+at = {round(float(x["t"]), 2): x for x in run_rows}
+check(int(float(at[0.7]["contacts"])) == 0 and float(at[0.7]["ty"]) > 1.0 and int(float(at[1.5]["contacts"])) > 0,
+      f"in the air at 0.7 s (feet at {at[0.7]['ty']}), down again at 1.5 s")
+with open(f"{work}/bad_schedule.csv", "w") as f:
+    f.write("t,bend,shear\n0,0,0\n")
+with open(f"{work}/bad_schedule.wob", "w") as f:
+    f.write(f"load_obj {data}/table.obj\nload_def {data}/hop_modes.def\nschedule {work}/bad_schedule.csv\n")
+r = subprocess.run([wobble, "run", f"{work}/bad_schedule.wob"], capture_output=True, text=True, cwd=work)
+check(r.returncode == 2 and "bad_schedule.wob:3: schedule: " in r.stderr and "bad_schedule.csv:1: expected the header"
+      in r.stderr, "a schedule without the object's modes: exit 2 with both files and lines: " + r.stderr.strip())
+r = run("fit", "spacetime", *hop, "--duration", "1", "--upright", "--knots", "1")
+check(r.returncode == 2 and "--knots" in r.stderr, "one knot: exit 2 " + r.stderr.strip())
+r = run("fit", "spacetime", *hop, "--duration", "1")
+check(r.returncode == 2 and "no task" in r.stderr, "no task: exit 2 " + r.stderr.strip())
+r = run("fit", "spacetime", *hop, "--duration", "1", "--rise", "2 0.705")
+check(r.returncode == 2 and "--rise" in r.stderr, "a time between steps: exit 2 " + r.stderr.strip())
+
 # bad input: file and line, exit 2, nothing written
 out = f"{work}/never.json"
 r = run("fit", "pose", *body, "--targets", f"{cli}/bad_target.tgt", "--out", out)

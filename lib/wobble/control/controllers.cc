@@ -41,6 +41,18 @@ void PoseGraphController::BeforeStep(World& world) {
   }
 }
 
+TargetScheduleController::TargetScheduleController(const World& world, int body, Eigen::MatrixXd targets)
+    : body_(body), targets_(std::move(targets)) {
+  if (world.kind(body) != BodyKind::kFfd) throw std::invalid_argument("target schedule: a 2D FFD body only");
+  if (targets_.rows() != world.body(body).num_modes() || targets_.cols() < 1)
+    throw std::invalid_argument("target schedule: one row per mode and at least one column needed");
+}
+
+void TargetScheduleController::BeforeStep(World& world) {
+  const long n = std::min<long>(steps_++, long(targets_.cols()) - 1);
+  world.SetModeTargets(body_, targets_.col(n));
+}
+
 KeyframeController::KeyframeController(World& world, int body, Keyframes keys, HeldPoint hold)
     : body_(body), keys_(std::move(keys)), hold_(hold), dt_(world.options().dt) {
   if (world.kind(body) == BodyKind::kFfd3) {  // the same on a 3D body: its orientation is kept

@@ -41,6 +41,20 @@ class PoseGraphController : public Controller, public PoseSource {
   int pose_ = -1;
 };
 
+// Per-step PD targets of every mode of one 2D FFD body, as a spacetime fit finds them
+// (fit/spacetime.h): column n before the run's step n; the last column holds after the end.
+class TargetScheduleController : public Controller {
+ public:
+  // Throws std::invalid_argument when the rows are not the body's modes or there is no column.
+  TargetScheduleController(const World& world, int body, Eigen::MatrixXd targets);
+  void BeforeStep(World& world) override;
+
+ private:
+  int body_;
+  Eigen::MatrixXd targets_;
+  long steps_ = 0;
+};
+
 // Keyframed mode amplitudes (§4.10.1) on one FFD body, which the controller makes kinematic:
 // after step n its state is the keyframed state at min(n Δt, Duration()) with θ kept and, with
 // a held point, the translation solved so that the point stays where it was at the start

@@ -132,6 +132,35 @@ StageCost CentreOfMassAt(const BodyModel& body, int step, const Eigen::Vector2d&
   };
 }
 
+StageCost CentreOfMassVelocityAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight,
+                                 Axes axes) {
+  CheckTerm(step, weight, "CentreOfMassVelocityAt");
+  if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassVelocityAt: the goal must be finite");
+  const MassMoments mm = body.moments();
+  return [mm, step, goal, weight, axes](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                                        Eigen::VectorXd* dq, Eigen::VectorXd* dqd) {
+    if (n != step) return 0.0;
+    const int D = int(q.size()) - kRigidDofs;
+    Eigen::Matrix2d S;
+    S << 0.0, -1.0, 1.0, 0.0;
+    const Eigen::Matrix2d R = Eigen::Rotation2Dd(q[2]).toRotationMatrix();
+    const Eigen::Vector2d c = (mm.c0 + mm.C * q.tail(D)) / mm.m, cd = mm.C * qd.tail(D) / mm.m;
+    const double thd = qd[2];
+    const Eigen::Vector2d v = qd.head<2>() + thd * (S * R * c) + R * cd;
+    Eigen::Vector2d miss = v - goal;
+    if (!axes.x) miss.x() = 0.0;
+    if (!axes.y) miss.y() = 0.0;
+    const Eigen::Vector2d r = weight * miss;
+    // ∂v/∂ṫ = I, ∂v/∂θ̇ = S R c, ∂v/∂γ̇ = R C/m; ∂v/∂θ = θ̇ S S R c + S R ċ, ∂v/∂γ = θ̇ S R C/m
+    dqd->head<2>() += r;
+    (*dqd)[2] += r.dot(S * R * c);
+    dqd->tail(D) += mm.C.transpose() * (R.transpose() * r) / mm.m;
+    (*dq)[2] += r.dot(thd * (S * S * R * c) + S * R * cd);
+    dq->tail(D) += thd * mm.C.transpose() * ((S * R).transpose() * r) / mm.m;
+    return 0.5 * weight * miss.squaredNorm();
+  };
+}
+
 StageCost UprightAt(int step, double weight, double time_scale) {
   CheckTerm(step, weight, "UprightAt");
   if (!(time_scale >= 0.0) || !std::isfinite(time_scale)) throw std::invalid_argument("UprightAt: the time scale must be >= 0");

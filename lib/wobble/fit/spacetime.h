@@ -57,6 +57,10 @@ struct Axes {
   bool x = true, y = true;
 };
 StageCost CentreOfMassAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight, Axes axes = {});
+//   CentreOfMassVelocityAt: w/2 |v_c − goal|² on the axes asked for, v_c the velocity of the
+//                   centre of mass ṫ + θ̇ S R c/m + R C γ̇/m: with goal 0 on y, "at the top of a hop".
+StageCost CentreOfMassVelocityAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight,
+                                 Axes axes = {});
 StageCost UprightAt(int step, double weight, double time_scale = 0.0);
 StageCost StillAt(int step, double weight);
 StageCost SumOf(std::vector<StageCost> terms);

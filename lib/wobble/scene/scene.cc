@@ -217,6 +217,8 @@ void Scene::BeginObjectRun(RunKind kind, bool keep_steps) {
   }
   if (kind == RunKind::kKeyframes) {
     w->AddController(std::make_shared<control::KeyframeController>(*w, 0, control_.keys, control_.hold));
+  } else if (control_.enabled && control_.schedule.cols() > 0) {
+    w->AddController(std::make_shared<control::TargetScheduleController>(*w, 0, control_.schedule));
   } else if (control_.enabled && !control_.graph.empty()) {
     // the pose graph cycles from its first pose at the start of every run (chapter 5)
     run->graph = std::make_shared<control::PoseGraphController>(*w, 0, control_.graph, control_.switch_width);

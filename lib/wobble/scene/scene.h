@@ -52,6 +52,9 @@ struct ObjectControl {
   control::PoseGraph graph;    // drives the active modes while `enabled` (chapter 5)
   bool enabled = true;
   double switch_width = 0.0;   // > 0: smoothed switches (control::SmoothPoseTargets)
+  // A spacetime fit's targets (`spacetime`), modes × steps from the start of every run; while
+  // not empty it drives the modes in place of the pose graph.
+  Eigen::MatrixXd schedule;
   control::Keyframes keys;     // what Keyframe() plays (§4.10.1)
   control::HeldPoint hold;     // held in place while keyframing
 };

@@ -21,6 +21,10 @@ const std::vector<Command>& CommandTable() {
       {"simul", "simul [DURATION]", "simulate from `time` to `end` (or for DURATION)", Simul},
       {"pose", "pose T1 .. Tk DURATION", "append a pose: one target per active mode, held for DURATION", Pose},
       {"key", "key TIME MODE=VALUE ...", "a keyframe at TIME (from the start of the keyframed run)", Key},
+      {"schedule", "schedule FILE.csv | schedule off",
+       "play per-step targets of every mode (`wobble fit spacetime --targets`) in every run from its start, in place "
+       "of the pose graph; FILE as written, from the working directory",
+       Schedule},
       {"hold", "hold S T | hold off", "hold the point at lattice coordinates (S, T) in place while keyframing (3D: hold S T U)", Hold},
       {"keyframe", "keyframe", "play the keys from the current state, then hand over to simulation", Keyframe},
       {"spring", "spring S T X Y [K [C [REST]]]",

@@ -8,6 +8,7 @@
 
 #include "wobble/record/trajectory_csv.h"
 #include "wobble/formats/csv.h"
+#include "wobble/formats/target_schedule.h"
 #include "wobble/script/internal/interpreter_internal.h"
 
 namespace wobble::script {
@@ -279,6 +280,26 @@ void Clear(State& s, const Words& w, const Context& ctx) {
   else if (w[1] == "energy") s.scene.control_energy() = {};
   else if (w[1] == "track") s.track.clear();
   else ctx.Fail("expected poses, keys, springs, output, energy or track after 'clear', got '" + w[1] + "'");
+}
+
+void Schedule(State& s, const Words& w, const Context& ctx) {
+  ctx.ExpectWords(w, 2, 2);
+  RequireObject(s, ctx, "schedule");
+  if (w[1] == "off") {
+    s.scene.control().schedule.resize(0, 0);
+    return;
+  }
+  if (s.scene.object().dim() != 2) ctx.Fail("schedule: 2D objects only");
+  try {
+    s.scene.control().schedule =
+        formats::ReadTargetSchedule(w[1], s.scene.object().mode_names(), s.scene.options().dt);
+  } catch (const formats::ParseError& e) {
+    ctx.Fail(std::string("schedule: ") + e.what());
+  }
+  s.out << "schedule: " << s.scene.control().schedule.cols() << " steps of targets from " << w[1] << "\n";
+  if (s.scene.options().integrator != Integrator::kThesis)  // wobble fit spacetime's
+    s.out << "schedule: note: the targets were fitted with the thesis integrator; this script steps with "
+          << IntegratorName(s.scene.options().integrator) << " ('set integrator thesis' replays the fit)\n";
 }
 
 void Output(State& s, const Words& w, const Context& ctx) {

@@ -1,0 +1,167 @@
+// `wobble fit spacetime`: the PD targets of a whole motion (fit/spacetime.h) for a 2D object
+// from its start, with the task given as flags; the targets go to a schedule file that a
+// script plays with `schedule FILE` (formats/target_schedule.h).
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "fit.h"
+#include "wobble/fit/spacetime.h"
+#include "wobble/formats/atomic_file.h"
+#include "wobble/formats/csv.h"
+#include "wobble/formats/target_schedule.h"
+
+namespace wobble::app {
+
+namespace {
+
+// A time of the run as its step, which must be a whole one.
+int StepAt(double t, double dt, int steps, const std::string& flag) {
+  const double n = t / dt;
+  if (!(t >= 0.0) || std::abs(n - std::round(n)) > 1e-6 * std::max(1.0, n) || std::round(n) > steps)
+    throw UsageError(flag + ": the time must be a whole number of steps of --dt within --duration");
+  return int(std::round(n));
+}
+
+}  // namespace
+
+CLI::App* AddFitSpacetimeCommand(CLI::App* fit, FitSpacetimeArgs* a) {
+  CLI::App* c = fit->add_subcommand("spacetime", "Fit the PD targets of a whole motion to a task (2D; README: Gradients)");
+  AddBodyFlags(c, &a->files);
+  AddWorldFlags(c, &a->world);
+  c->add_option("--q", a->q, "Start q \"tx ty theta g1 ..\" (default: rest at the origin)")->type_name("\"NUMS\"");
+  c->add_option("--qdot", a->qdot, "Start q-dot (default 0)")->type_name("\"NUMS\"");
+  c->add_option("--dt", a->dt, "Time step (thesis integrator)")->capture_default_str();
+  c->add_option("--duration", a->duration, "Length of the motion, seconds")->capture_default_str();
+  c->add_option("--knots", a->knots, "Targets at this many evenly spaced knots, linear between")->capture_default_str();
+  c->add_option("--rise", a->rise, "Task: the centre of mass at the top of a rise of DY above its start at time T")
+      ->type_name("\"DY T\"");
+  c->add_option("--reach", a->reach, "Task: the centre of mass at (X, Y) at time T")->type_name("\"X Y T\"");
+  c->add_flag("--upright", a->upright, "Task: upright and not turning at the end");
+  c->add_flag("--still", a->still, "Task: at rest at the end");
+  c->add_option("--weight", a->weight, "Weight of every task term")->capture_default_str();
+  c->add_option("--bound", a->bound, "Every target within +-BOUND")->capture_default_str();
+  c->add_option("--effort", a->effort, "Weight of the control energy (sum of squared targets x dt)")->capture_default_str();
+  c->add_option("--max-iterations", a->max_iterations, "L-BFGS iterations")->capture_default_str();
+  c->add_option("--targets", a->targets, "The fitted targets of every step, for `schedule` (written atomically)")
+      ->type_name("FILE.csv");
+  c->add_option("--out", a->out, "Result JSON (written atomically)")->type_name("FILE.json");
+  c->footer(
+      "Example (a hop from a standing start; data/hop.wob plays and draws it):\n"
+      "  wobble fit spacetime --object data/table.obj --modes data/hop_modes.def --ground-stiffness 45000 \\\n"
+      "      --ground-damping 3000 --friction-damping 3000 --friction-cap 0.5 --duration 1 --knots 21 \\\n"
+      "      --rise \"2 0.7\" --upright --targets out/hop_targets.csv --out out/hop_fit.json");
+  return c;
+}
+
+int RunFitSpacetime(const FitSpacetimeArgs& a) {
+  RequirePositive(a.dt, "--dt");
+  RequirePositive(a.duration, "--duration");
+  RequirePositive(a.weight, "--weight");
+  RequirePositive(a.bound, "--bound");
+  RequireNonNegative(a.effort, "--effort");
+  if (a.max_iterations < 1) throw UsageError("--max-iterations must be at least 1");
+  if (a.rise.empty() && a.reach.empty() && !a.upright && !a.still)
+    throw UsageError("no task: give --rise, --reach, --upright and/or --still");
+  for (const std::string* path : {&a.targets, &a.out})
+    if (!path->empty()) {
+      try {
+        formats::CheckWritable(*path);
+      } catch (const std::runtime_error& e) {
+        throw UsageError((path == &a.targets ? "--targets: " : "--out: ") + std::string(e.what()));
+      }
+    }
+  const StartingWorld start = LoadStartingWorld(a.files, a.q, a.qdot, a.world, Integrator::kThesis, a.dt);
+  if (!start.body) throw UsageError("fit spacetime takes 2D objects (the adjoint is 2D)");
+  const BodyModel& body = *start.body;
+  const int steps = int(std::lround(a.duration / a.dt)), D = body.num_modes();
+  if (D == 0) throw UsageError("the object has no modes to control (--modes)");
+  if (a.knots < 2 || a.knots > steps + 1)
+    throw UsageError("--knots must be from 2 to " + std::to_string(steps + 1) + " (the steps + 1)");
+
+  fit::SpacetimeProblem p;
+  p.rollout.world = start.options.params;
+  p.rollout.integrator = Integrator::kThesis;
+  p.rollout.dt = a.dt;
+  p.rollout.q0 = start.q0;
+  p.rollout.qd0 = start.qd0;
+  p.rollout.stiffness.resize(D);
+  p.rollout.damping.resize(D);
+  for (int d = 0; d < D; ++d) {
+    p.rollout.stiffness[d] = body.modes()[d].stiffness;
+    p.rollout.damping[d] = body.modes()[d].damping;
+  }
+  p.rollout.targets = Eigen::MatrixXd::Zero(D, steps);
+  p.knots = a.knots;
+  p.lower = Eigen::VectorXd::Constant(D, -a.bound);
+  p.upper = Eigen::VectorXd::Constant(D, a.bound);
+  p.control_weight = a.effort;
+  std::vector<fit::StageCost> terms;
+  nlohmann::json task;
+  const MassMoments& mm = body.moments();
+  const Eigen::Vector2d com0 =
+      start.q0.head<2>() + Eigen::Rotation2Dd(start.q0[2]) * ((mm.c0 + mm.C * start.q0.tail(D)) / mm.m);
+  if (!a.rise.empty()) {
+    const std::vector<double> v = ParseNumbers(a.rise, "--rise");
+    if (v.size() != 2) throw UsageError("--rise takes \"DY T\"");
+    fit::Axes y_only;
+    y_only.x = false;
+    const int top = StepAt(v[1], a.dt, steps, "--rise");
+    terms.push_back(fit::CentreOfMassAt(body, top, {0.0, com0.y() + v[0]}, a.weight, y_only));
+    // at the top: not rising any more (a velocity of 1 weighs as a height of 0.1)
+    terms.push_back(fit::CentreOfMassVelocityAt(body, top, {0.0, 0.0}, 0.01 * a.weight, y_only));
+    task["rise"] = {{"dy", v[0]}, {"t", v[1]}};
+  }
+  if (!a.reach.empty()) {
+    const std::vector<double> v = ParseNumbers(a.reach, "--reach");
+    if (v.size() != 3) throw UsageError("--reach takes \"X Y T\"");
+    terms.push_back(fit::CentreOfMassAt(body, StepAt(v[2], a.dt, steps, "--reach"), {v[0], v[1]}, a.weight));
+    task["reach"] = {{"x", v[0]}, {"y", v[1]}, {"t", v[2]}};
+  }
+  if (a.upright) terms.push_back(fit::UprightAt(steps, a.weight, 0.1)), task["upright"] = true;
+  if (a.still) terms.push_back(fit::StillAt(steps, a.weight)), task["still"] = true;
+  p.task = fit::SumOf(terms);
+
+  fit::SpacetimeOptions o;
+  o.max_iterations = a.max_iterations;
+  o.on_iteration = IterationLine();
+  const fit::SpacetimeResult r = fit::FitSpacetime(body, p, o);
+  EndIterationLine();
+
+  std::vector<std::string> names;
+  for (const DeformationMode& m : body.modes()) names.push_back(m.name);
+  if (!a.targets.empty()) formats::WriteTargetSchedule(a.targets, names, a.dt, r.targets);
+  nlohmann::json j;
+  j["kind"] = "spacetime";
+  j["body"] = body.name();
+  j["modes"] = names;
+  j["dt"] = a.dt;
+  j["steps"] = steps;
+  j["task"] = task;
+  j["ok"] = r.ok;
+  j["message"] = r.message;
+  j["initial_cost"] = r.initial_cost;
+  j["cost"] = r.cost;
+  j["control_energy"] = r.control_energy;
+  j["iterations"] = r.iterations;
+  j["gradients"] = r.gradients;
+  j["knots"] = nlohmann::json::array();
+  for (int k = 0; k < r.knots.cols(); ++k) {
+    nlohmann::json col = nlohmann::json::array();
+    for (int d = 0; d < D; ++d) col.push_back(r.knots(d, k));
+    j["knots"].push_back(col);
+  }
+  if (!a.out.empty()) formats::WriteTextAtomically(a.out, j.dump(2) + "\n");
+  std::cout << body.name() << ": spacetime fit of " << D << " x " << a.knots << " knot targets over " << steps
+            << " steps: " << r.message << "\ncost " << r.initial_cost << " -> " << r.cost << " (control energy "
+            << r.control_energy << ") with " << r.gradients << " gradients.";
+  if (!a.targets.empty()) std::cout << "\ntargets: " << a.targets << " (a script plays them with `schedule`)";
+  std::cout << std::endl;
+  if (!r.ok) {
+    std::cerr << "wobble: the spacetime fit failed: " << r.message << std::endl;
+    return kExitSimStopped;
+  }
+  return kExitOk;
+}
+
+}  // namespace wobble::app
