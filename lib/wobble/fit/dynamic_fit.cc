@@ -90,16 +90,8 @@ template <class Frame> std::vector<int> FrameStepsOf(const std::vector<Frame>& f
 template <int Dim>
 bool SimulateWith(const BodyModelN<Dim>& body, const DynamicFitOptions& o, const DynamicParameters& p,
                   const std::vector<int>& frame_steps, const std::function<void(int, const Eigen::VectorXd&)>& on_frame) {
-  using Dims = Dimension<Dim>;
-  CheckParameters(body, p);
-  const BodyModelN<Dim> passive = PassiveCopy(body);
-  ModeParams<double> mp;
-  mp.K = p.stiffness;
-  mp.c = p.damping;
-  const Eigen::Quaterniond chart = Dims::Chart(p.q0);
-  const Eigen::VectorXd q0 = Dims::ToBlock(p.q0, chart);
-  return Simulate(passive, o, q0.data(), p.qd0.data(), chart, mp, control::PoseGraphOf<double>::From(body, p.graph),
-                  frame_steps, [&](int f, const auto& state) { on_frame(f, Dims::Q(state)); });
+  return SimulatePlain(body, o, p, frame_steps,
+                       [&](int f, const auto& state) { on_frame(f, Dimension<Dim>::Q(state)); });
 }
 
 template <int Dim>

@@ -280,11 +280,11 @@ DynamicParameters Completed(const BodyModelN<Dim>& body, const std::vector<typen
   return p;
 }
 
-template <int Dim>
-double CostOf(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
-              const DynamicParameters& p, const DynamicFitOptions& o) {
+// The plain simulation with parameters p: on_frame(f, state) at every frame step.
+template <int Dim, class F>
+bool SimulatePlain(const BodyModelN<Dim>& body, const DynamicFitOptions& o, const DynamicParameters& p,
+                   const std::vector<int>& frame_steps, F&& on_frame) {
   using Dims = Dimension<Dim>;
-  const Reference<Dim> ref = MakeReference(body, frames, o.dt);
   CheckParameters(body, p);
   const BodyModelN<Dim> passive = PassiveCopy(body);
   ModeParams<double> mp;
@@ -292,13 +292,20 @@ double CostOf(const BodyModelN<Dim>& body, const std::vector<typename Dimension<
   mp.c = p.damping;
   const Eigen::Quaterniond chart = Dims::Chart(p.q0);
   const Eigen::VectorXd q0 = Dims::ToBlock(p.q0, chart);
+  return Simulate(passive, o, q0.data(), p.qd0.data(), chart, mp, control::PoseGraphOf<double>::From(body, p.graph),
+                  frame_steps, on_frame);
+}
+
+template <int Dim>
+double CostOf(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
+              const DynamicParameters& p, const DynamicFitOptions& o) {
+  using Dims = Dimension<Dim>;
+  const Reference<Dim> ref = MakeReference(body, frames, o.dt);
   double cost = 0;
-  const bool ok = Simulate(passive, o, q0.data(), p.qd0.data(), chart, mp, control::PoseGraphOf<double>::From(body, p.graph),
-                           ref.steps, [&](int f, const auto& state) {
-                             for (const auto& s : ref.points[f])
-                               cost += 0.5 * s.sqrt_weight * s.sqrt_weight *
-                                       (Dims::Position(s.basis, state) - s.target).squaredNorm();
-                           });
+  const bool ok = SimulatePlain(body, o, p, ref.steps, [&](int f, const auto& state) {
+    for (const auto& s : ref.points[f])
+      cost += 0.5 * s.sqrt_weight * s.sqrt_weight * (Dims::Position(s.basis, state) - s.target).squaredNorm();
+  });
   return ok ? cost : std::numeric_limits<double>::infinity();
 }
 
