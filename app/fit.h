@@ -69,6 +69,7 @@ struct FitSpacetimeArgs {
   bool upright = false, still = false;
   double weight = 2000.0, bound = 0.3, effort = 1.0;
   int max_iterations = 300;
+  std::string start;  // a schedule file to start from (continuation from an easier task)
   std::string targets, out;
 };
 CLI::App* AddFitSpacetimeCommand(CLI::App* fit, FitSpacetimeArgs* args);

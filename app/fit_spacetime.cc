@@ -43,6 +43,9 @@ CLI::App* AddFitSpacetimeCommand(CLI::App* fit, FitSpacetimeArgs* a) {
   c->add_option("--bound", a->bound, "Every target within +-BOUND")->capture_default_str();
   c->add_option("--effort", a->effort, "Weight of the control energy (sum of squared targets x dt)")->capture_default_str();
   c->add_option("--max-iterations", a->max_iterations, "L-BFGS iterations")->capture_default_str();
+  c->add_option("--start", a->start, "Start from these targets (a --targets file of the same object and --dt; "
+                                     "default zero): continue from an easier task's solution")
+      ->type_name("FILE.csv");
   c->add_option("--targets", a->targets, "The fitted targets of every step, for `schedule` (written atomically)")
       ->type_name("FILE.csv");
   c->add_option("--out", a->out, "Result JSON (written atomically)")->type_name("FILE.json");
@@ -91,7 +94,13 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
     p.rollout.stiffness[d] = body.modes()[d].stiffness;
     p.rollout.damping[d] = body.modes()[d].damping;
   }
+  std::vector<std::string> names;
+  for (const DeformationMode& m : body.modes()) names.push_back(m.name);
   p.rollout.targets = Eigen::MatrixXd::Zero(D, steps);
+  if (!a.start.empty()) {  // its steps, the last one held past its end
+    const Eigen::MatrixXd given = formats::ReadTargetSchedule(a.start, names, a.dt);
+    for (int n = 0; n < steps; ++n) p.rollout.targets.col(n) = given.col(std::min<Eigen::Index>(n, given.cols() - 1));
+  }
   p.knots = a.knots;
   p.lower = Eigen::VectorXd::Constant(D, -a.bound);
   p.upper = Eigen::VectorXd::Constant(D, a.bound);
@@ -128,8 +137,6 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
   const fit::SpacetimeResult r = fit::FitSpacetime(body, p, o);
   EndIterationLine();
 
-  std::vector<std::string> names;
-  for (const DeformationMode& m : body.modes()) names.push_back(m.name);
   if (!a.targets.empty()) formats::WriteTargetSchedule(a.targets, names, a.dt, r.targets);
   nlohmann::json j;
   j["kind"] = "spacetime";

@@ -142,6 +142,14 @@ with open(f"{work}/bad_schedule.wob", "w") as f:
 r = subprocess.run([wobble, "run", f"{work}/bad_schedule.wob"], capture_output=True, text=True, cwd=work)
 check(r.returncode == 2 and "bad_schedule.wob:3: schedule: " in r.stderr and "bad_schedule.csv:1: expected the header"
       in r.stderr, "a schedule without the object's modes: exit 2 with both files and lines: " + r.stderr.strip())
+# --start: a fit from the last one's targets begins near where that one ended
+r = run("fit", "spacetime", *hop, "--duration", "1", "--knots", "21", "--rise", "2 0.7", "--upright",
+        "--start", f"{work}/hop_targets.csv", "--max-iterations", "5", "--out", f"{work}/hop_again.json")
+again = json.load(open(f"{work}/hop_again.json")) if r.returncode == 0 else {"initial_cost": float("inf")}
+check(r.returncode == 0 and again["initial_cost"] < 1e-3 * j["initial_cost"],
+      f"--start: the fit starts at cost {again['initial_cost']} (from zero targets: {j['initial_cost']})")
+r = run("fit", "spacetime", *hop, "--duration", "1", "--upright", "--start", f"{work}/bad_schedule.csv")
+check(r.returncode == 2 and "bad_schedule.csv:1: expected the header" in r.stderr, "a bad --start file: exit 2 " + r.stderr.strip())
 r = run("fit", "spacetime", *hop, "--duration", "1", "--upright", "--knots", "1")
 check(r.returncode == 2 and "--knots" in r.stderr, "one knot: exit 2 " + r.stderr.strip())
 r = run("fit", "spacetime", *hop, "--duration", "1")
