@@ -18,16 +18,13 @@
 namespace wobble {
 namespace {
 
-// The spacetime cost of knots (modes × knots, column-major) by one plain simulation.
+// The spacetime cost of knots (modes × knots, column-major): fit::SpacetimeCostOf.
 struct HopCost {
   const BodyModel* body;
   fit::SpacetimeProblem problem;
   double operator()(const double* x) const {
-    const int D = int(problem.lower.size());
-    const Eigen::MatrixXd knots = Eigen::Map<const Eigen::MatrixXd>(x, D, problem.knots);
-    fit::ControlledRollout r = problem.rollout;
-    r.targets = fit::KnotTargets(knots, r.steps());
-    const double c = fit::RolloutCost(*body, r, problem.task) + problem.control_weight * r.dt * r.targets.squaredNorm();
+    const Eigen::MatrixXd knots = Eigen::Map<const Eigen::MatrixXd>(x, problem.lower.size(), problem.knots);
+    const double c = fit::SpacetimeCostOf(*body, problem, knots);
     return std::isfinite(c) ? c : 1e30;
   }
 };

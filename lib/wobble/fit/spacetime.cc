@@ -56,12 +56,12 @@ class SpacetimeCost final : public ceres::FirstOrderFunction {
 
   bool Evaluate(const double* x, double* cost, double* gradient) const override {
     const int D = int(p_.lower.size()), steps = rollout_.steps();
-    rollout_.targets = KnotTargets(Knots(x), steps);
     ++*evaluations_;
     if (!gradient) {
-      *cost = RolloutCost(body_, rollout_, p_.task) + ControlEnergy(rollout_.targets);
+      *cost = SpacetimeCostOf(body_, p_, Knots(x));
       return std::isfinite(*cost);
     }
+    rollout_.targets = KnotTargets(Knots(x), steps);
     const RolloutGradient g = RolloutCostGradient(body_, rollout_, p_.task);
     if (!g.ok) return false;  // the line search steps back
     *cost = g.cost + ControlEnergy(rollout_.targets);
@@ -204,6 +204,12 @@ Eigen::MatrixXd KnotTargets(const Eigen::MatrixXd& knots, int steps) {
     targets.col(n) = (1.0 - f) * knots.col(j) + f * knots.col(j + 1);
   }
   return targets;
+}
+
+double SpacetimeCostOf(const BodyModel& body, const SpacetimeProblem& problem, const Eigen::MatrixXd& knots) {
+  ControlledRollout r = problem.rollout;
+  r.targets = KnotTargets(knots, r.steps());
+  return RolloutCost(body, r, problem.task) + problem.control_weight * r.dt * r.targets.squaredNorm();
 }
 
 SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem, const SpacetimeOptions& options) {

@@ -65,6 +65,10 @@ StageCost UprightAt(int step, double weight, double time_scale = 0.0);
 StageCost StillAt(int step, double weight);
 StageCost SumOf(std::vector<StageCost> terms);
 
+// The problem's cost at these knots (modes × knots, not bounded here): one plain simulation,
+// +inf when it fails. What FitSpacetime minimises, for other optimisers to compare on.
+double SpacetimeCostOf(const BodyModel& body, const SpacetimeProblem& problem, const Eigen::MatrixXd& knots);
+
 // Throws std::invalid_argument on inconsistent sizes, bounds or knot counts.
 SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem,
                              const SpacetimeOptions& options = SpacetimeOptions());
