@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <memory>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "pipelines/scene_view.h"
 #include "pipelines/trajectory_render.h"
@@ -85,6 +87,10 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
       ->type_name("WxH");
   cmd->add_option("--filmstrip-columns", a->filmstrip_columns, "Panels per filmstrip row (0: one row)")
       ->capture_default_str();
+  cmd->add_option("--filmstrip-cycle", a->filmstrip_cycle,
+                  "Gaits: the panels sample cycle K of the pose graph (0 the first) at PANELS equal steps (6) and "
+                  "its end, each labelled with its active pose (in place of --filmstrip)")
+      ->type_name("\"K [PANELS]\"");
   cmd->add_option("--disp-size", a->disp_size, "Size of the displacement image (default: 256 wide, lattice aspect)")
       ->type_name("WxH");
   cmd->add_option("--chart-size", a->chart_size, "Size of the charts")->capture_default_str()->type_name("WxH");
@@ -140,6 +146,18 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   return kExitOk;
 }
 
+// --filmstrip-cycle "K [PANELS]": (K, PANELS), (-1, 6) when not given.
+std::pair<int, int> FilmstripCycleOf(const RenderArgs& a) {
+  if (a.filmstrip_cycle.empty()) return {-1, 6};
+  const std::vector<double> v = ParseNumbers(a.filmstrip_cycle, "--filmstrip-cycle");
+  const bool whole = std::all_of(v.begin(), v.end(), [](double x) { return x == std::floor(x); });
+  if (v.empty() || v.size() > 2 || !whole || v[0] < 0 || v[0] > 1e6 || (v.size() == 2 && (v[1] < 1 || v[1] > 100)))
+    throw UsageError("--filmstrip-cycle: expected a cycle K >= 0 and optionally 1 to 100 panels, got '" +
+                     a.filmstrip_cycle + "'");
+  if (!a.filmstrip_times.empty()) throw UsageError("--filmstrip-cycle and --filmstrip both place the panels: give one");
+  return {int(v[0]), v.size() == 2 ? int(v[1]) : 6};
+}
+
 void CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
   RequirePositive(a.fps, "--fps");
   if (a.shape_samples < 1 || a.shape_samples > 10000) throw UsageError("--shape-samples must be between 1 and 10000");
@@ -148,6 +166,7 @@ void CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
   ParseSize(a.filmstrip_size, "--filmstrip-size");
   ParseSize(a.chart_size, "--chart-size");
   ParseNumbers(a.filmstrip_times, "--filmstrip");
+  FilmstripCycleOf(a);
   if (ParseNumbers(a.trail, "--trail").size() % 2) throw UsageError("--trail: lattice coordinates come in pairs s t");
   RequireFinite(a.azimuth, "--azimuth");
   RequireFinite(a.orbit, "--orbit");
@@ -182,6 +201,7 @@ pl::RenderOutputs RenderOutputsOf(const RenderArgs& a, const std::string& defaul
   out.filmstrip_width = strip_size.w;
   out.filmstrip_height = strip_size.h;
   out.filmstrip_columns = a.filmstrip_columns;
+  std::tie(out.filmstrip_cycle, out.filmstrip_panels) = FilmstripCycleOf(a);
   if (!a.disp_size.empty()) {
     const Size disp = ParseSize(a.disp_size, "--disp-size");
     out.disp_width = disp.w;

@@ -40,6 +40,7 @@ struct RenderArgs {
   std::string filmstrip_times;      // "0 0.5 1 ..."; empty: 6 evenly spaced
   std::string filmstrip_size = "320x240";
   int filmstrip_columns = 3;
+  std::string filmstrip_cycle;      // "K [PANELS]": the panels sample the pose graph's cycle K
   std::string disp_size;            // "WxH"; empty: 256 wide, lattice aspect
   std::string chart_size = "800x500";
   std::string trail;                // lattice coords "s t s t ..." of points to trace

@@ -34,6 +34,7 @@ void ApplyRenderOption(const std::string& name, const std::string& value, Render
   else if (name == "fps") a->fps = number();
   else if (name == "filmstrip") a->filmstrip_times = spaced();
   else if (name == "filmstrip-size") a->filmstrip_size = value;
+  else if (name == "filmstrip-cycle") a->filmstrip_cycle = spaced();
   else if (name == "filmstrip-columns") {
     const double v = number();
     if (!(v >= 0 && v <= 100 && v == std::floor(v)))

@@ -172,12 +172,13 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
     return s;
   };
   // the world's layers, where FFD bodies live: ground, trails, springs
-  int first_ffd = -1, first_ffd3 = -1;
+  int first_ffd = -1, first_ffd3 = -1, ground_dim = 0;  // ground_dim: GroundDimensionOf the bodies
   for (int b = world->num_bodies() - 1; b >= 0; --b) {
     if (world->kind(b) == BodyKind::kFfd) first_ffd = b;
     if (world->kind(b) == BodyKind::kFfd3) first_ffd3 = b;
+    ground_dim = std::max(ground_dim, GroundDimensionOf(*world, b));
   }
-  if (first_ffd3 >= 0) {
+  if (first_ffd3 >= 0 || ground_dim == 3) {
     // a light from above besides the camera's: the camera's alone leaves every upward face
     // (a table's top, the ground) dark at a low elevation
     auto head = Ptr<vtkLight>::New();
@@ -192,7 +193,7 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
     m.renderer->AddLight(head);
     m.renderer->AddLight(sky);
   }
-  if (first_ffd3 >= 0) {  // the 3D ground plane, lit, several body sizes across
+  if (ground_dim == 3) {  // the 3D ground plane, lit, several body sizes across
     m.ground = Ptr<GroundSource>::New();
     const Eigen::AlignedBox3d box = SceneBounds(*world, spec);
     m.ground->SetLength(6.0 * box.sizes().maxCoeff());
@@ -201,9 +202,11 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
     plane->SetAmbient(0.55);  // the camera's light grazes the plane: mostly ambient, or it goes black
     plane->SetDiffuse(0.45);
   }
-  if (first_ffd >= 0) {
+  if (ground_dim == 2) {
     m.ground = Ptr<GroundSource>::New();
     m.Add(SceneLayer::kGround, on(m.ground, 0), ground_rgb, 1.0, 1.0, 0.0);
+  }
+  if (first_ffd >= 0) {
     m.trails = Ptr<TrailSource>::New();
     m.Add(SceneLayer::kTrails, on(m.trails, first_ffd), trail_rgb, 1.5, 1.0, 0.5);
   }
@@ -454,6 +457,7 @@ void SceneView::Render() {
       char buf[256];
       std::snprintf(buf, sizeof(buf), "t = %.3f s", m.world->time());
       text += buf;
+      if (!caption_.empty()) text += "   " + caption_;
       if (options_.overlay_energy) {
         // E and every term of it that is not zero (ground and springs only when they hold
         // energy), so that E is the sum of the terms listed; two to a line, to stay narrow

@@ -120,6 +120,9 @@ class SceneView {
 
   // Rebuilds every source from the world's current state and renders.
   void Render();
+  // A line after the overlay's time, for what the world does not know (the active pose of a
+  // recorded run); empty: none.
+  void SetCaption(std::string caption) { caption_ = std::move(caption); }
   // The last rendered image (RGB, bottom row first as VTK images are). Read back from the
   // window once per Render() and shared by the PNG and EXR outputs.
   vtkSmartPointer<vtkImageData> Capture();
@@ -164,6 +167,7 @@ class SceneView {
   void SetUpOverlay();
   std::unique_ptr<Impl> impl_;
   SceneOptions options_;
+  std::string caption_;
   Eigen::AlignedBox2d framed_;
 };
 

@@ -84,6 +84,23 @@ struct Visit {
   }
 };
 
+// The times of a gait's filmstrip: `panels` equal steps across cycle k of the recorded pose
+// graph and its end. A cycle begins where the active pose comes back to the run's first one.
+std::vector<double> CycleTimes(const record::Trajectory& run, int k, int panels) {
+  const int first = run.pose(0);
+  if (first < 0) throw std::invalid_argument("filmstrip cycle: the run has no pose graph (no active pose recorded)");
+  std::vector<double> starts = {run.time(0)};
+  for (int i = 1; i < run.size(); ++i)
+    if (run.pose(i) == first && run.pose(i - 1) != first) starts.push_back(run.time(i));
+  if (int(starts.size()) < k + 2)
+    throw std::invalid_argument("filmstrip cycle " + std::to_string(k) + ": the run completes only " +
+                                std::to_string(starts.size() - 1) + " cycles of its pose graph");
+  const double t0 = starts[size_t(k)], period = starts[size_t(k) + 1] - t0;
+  std::vector<double> times;
+  for (int i = 0; i <= panels; ++i) times.push_back(t0 + period * i / panels);
+  return times;
+}
+
 std::vector<Visit> PlanVisits(const record::Trajectory& run, const RenderOutputs& out, double dt, long* num_frames) {
   std::vector<Visit> visits;
   const double t0 = run.time(0), t_last = run.time(run.size() - 1), t1 = out.t_end.value_or(t_last);
@@ -99,7 +116,8 @@ std::vector<Visit> PlanVisits(const record::Trajectory& run, const RenderOutputs
     for (int k = 0; k < run.size(); ++k) visits.push_back({k, k, -1, run.time(k)});
   }
   if (out.filmstrip) {
-    std::vector<double> times = out.filmstrip_times;
+    std::vector<double> times = out.filmstrip_cycle >= 0 ? CycleTimes(run, out.filmstrip_cycle, out.filmstrip_panels)
+                                                         : out.filmstrip_times;
     if (times.empty())
       for (int k = 0; k < 6; ++k) times.push_back(t0 + (t1 - t0) * k / 5.0);
     int panel = 0;
@@ -141,9 +159,9 @@ std::vector<DispTarget> DispTargets(const World& world, const RenderOutputs& out
   return targets;
 }
 
-bool HasFfdBody(const World& world) {  // 2D: the ground line is framed with the motion
+bool StandsOn2DGround(const World& world) {  // the ground line or terrain is framed with the motion
   for (int b = 0; b < world.num_bodies(); ++b)
-    if (world.kind(b) == BodyKind::kFfd) return true;
+    if (GroundDimensionOf(world, b) == 2) return true;
   return false;
 }
 
@@ -221,7 +239,7 @@ World WorldFor(const record::Trajectory& run, const WorldOptions& options) {
   for (const record::BodyInfo& b : run.bodies()) {
     if (b.kind == BodyKind::kFfd) world.AddBody(b.ffd);
     else if (b.kind == BodyKind::kFfd3) world.AddBody(b.ffd3);
-    else world.AddLinearBody(b.linear);
+    else world.SetGroundContact(world.AddLinearBody(b.linear), b.ground_contact);
   }
   return world;
 }
@@ -251,7 +269,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   }
 
   // the camera's pass: the box of every drawn state (and the ground below it), the colour range
-  Eigen::AlignedBox3d motion;
+  Eigen::AlignedBox3d motion, cycle;  // cycle: the panels' states of a gait's filmstrip
   const bool follow = out.camera == RenderOutputs::Camera::kFollow && IsFlat(world);
   std::vector<FollowMoment> moments;
   std::vector<Eigen::AlignedBox2d> follow_boxes;  // per visit
@@ -264,6 +282,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       replay.At(v.sample, v.t);
       const Eigen::AlignedBox3d bodies = SceneBounds(world, spec);
       motion.extend(bodies);
+      if (v.frame < 0 && out.filmstrip_cycle >= 0) cycle.extend(bodies);
       if (follow) moments.push_back(FollowMomentNow(world, bodies));
       double r[2];
       if (!fixed_range && (view ? view : strip_view)->ColorRangeNow(r)) {
@@ -272,23 +291,27 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       }
     }
     const std::shared_ptr<const Terrain>& terrain = world.options().params.ground.terrain;
-    if (terrain && HasFfdBody(world) && out.view.show_ground && !motion.isEmpty()) {
-      // the terrain under the motion in view: the cliff the body leaves, the floor it lands on
-      const double x0 = motion.min().x(), x1 = motion.max().x();
-      motion.extend(Eigen::Vector3d(x0, terrain->HeightAt(x0), 0.0));
-      motion.extend(Eigen::Vector3d(x1, terrain->HeightAt(x1), 0.0));
-      for (const Eigen::Vector2d& v : terrain->vertices())
-        if (v.x() >= x0 && v.x() <= x1) motion.extend(Eigen::Vector3d(v.x(), v.y(), 0.0));
-    }
-    if (HasFfdBody(world) && out.view.show_ground && !motion.isEmpty()) {
-      // the ground seen below the bodies: a band under the lowest point
-      Eigen::Vector3d below = motion.min();
-      below.y() -= 0.1 * motion.sizes().head<2>().maxCoeff();
-      motion.extend(below);
-    }
+    const bool ground_in_view = StandsOn2DGround(world) && out.view.show_ground;
+    auto with_ground = [&](Eigen::AlignedBox3d box) {
+      if (!ground_in_view || box.isEmpty()) return box;
+      if (terrain) {  // the terrain under the motion in view: the cliff the body leaves, the floor it lands on
+        const double x0 = box.min().x(), x1 = box.max().x();
+        box.extend(Eigen::Vector3d(x0, terrain->HeightAt(x0), 0.0));
+        box.extend(Eigen::Vector3d(x1, terrain->HeightAt(x1), 0.0));
+        for (const Eigen::Vector2d& v : terrain->vertices())
+          if (v.x() >= x0 && v.x() <= x1) box.extend(Eigen::Vector3d(v.x(), v.y(), 0.0));
+      }
+      Eigen::Vector3d below = box.min();  // the ground seen below the bodies: a band under the lowest point
+      below.y() -= 0.1 * box.sizes().head<2>().maxCoeff();
+      box.extend(below);
+      return box;
+    };
+    motion = with_ground(motion);
+    cycle = with_ground(cycle);
     for (SceneView* v : {view.get(), strip_view.get()}) {
       if (!v) continue;
-      v->FrameBounds(motion);
+      // a gait's panels are framed on the cycle they show, not on the whole run's travel
+      v->FrameBounds(v == strip_view.get() && !cycle.isEmpty() ? cycle : motion);
       if (lo < hi) v->SetColorRange(lo, hi);  // one colour scale for the whole run
     }
     if (follow) follow_boxes = FollowBoxes(moments, {double(out.view.width) / out.view.height});
@@ -330,6 +353,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
         if (sv) sv->FrameBox(box, 0.0);
     }
     if (v.frame < 0) {
+      if (out.filmstrip_cycle >= 0) strip_view->SetCaption("pose " + std::to_string(run.pose(v.sample)));
       strip_view->Render();
       panels.push_back(strip_view->Capture());
       continue;

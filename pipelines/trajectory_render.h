@@ -59,6 +59,12 @@ struct RenderOutputs {
   // from the first sample to t_end; times the run did not reach have no panel).
   std::vector<double> filmstrip_times;
   int filmstrip_width = 320, filmstrip_height = 240, filmstrip_columns = 3;
+  // Gaits (thesis Figs. 5.3 and 5.6): >= 0 puts the panels on cycle `filmstrip_cycle` of the
+  // recorded pose graph instead (0 the first; a cycle begins where the active pose returns to
+  // the run's first pose): filmstrip_panels equal steps across it and its end, so the last
+  // panel is the first pose again one stride on, each labelled with its active pose. A run
+  // that does not finish that cycle throws std::invalid_argument.
+  int filmstrip_cycle = -1, filmstrip_panels = 6;
   double filmstrip_point_size = 0.0;  // 0: the frames' point size
   int disp_width = 256, disp_height = 0;  // height 0: the body's lattice aspect
   int disp_volume = 32;  // 3D bodies: voxels along the lattice's longest axis (the others by aspect)

@@ -461,16 +461,27 @@ int GroundSource::DrawTerrain(const Terrain& terrain, vtkPoints* points, vtkPoly
   return 1;
 }
 
+int GroundDimensionOf(const World& world, int body) {
+  switch (world.kind(body)) {
+    case BodyKind::kFfd: return 2;
+    case BodyKind::kFfd3: return 3;
+    case BodyKind::kLinear: return world.ground_contact(body) ? world.dim(body) : 0;
+  }
+  return 0;
+}
+
 int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
   if (!Check(Needs::kWorld)) return 0;
   vtkPolyData* out = OutputOf(out_vec);
   const Ground& g = world_->options().params.ground;
   auto points = DoublePoints();
   AddTimeValue(out, world_->time());
-  // a world of 3D FFD bodies stands on the 3D ground plane
+  // a world of 3D bodies stands on the 3D ground plane
   Eigen::AlignedBox3d bodies3;
-  for (int b = 0; b < world_->num_bodies(); ++b)
-    if (world_->kind(b) == BodyKind::kFfd3) bodies3.extend(BodyBounds3(*world_, b));
+  for (int b = 0; b < world_->num_bodies(); ++b) {
+    if (GroundDimensionOf(*world_, b) != 3) continue;
+    bodies3.extend(world_->kind(b) == BodyKind::kFfd3 ? BodyBounds3(*world_, b) : LinearBodyBounds(*world_, b));
+  }
   if (!bodies3.isEmpty()) {
     const GroundPlane& plane = world_->options().ground_3d;
     out->SetPoints(points);

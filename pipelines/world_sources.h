@@ -249,6 +249,11 @@ Eigen::Vector2d WorldPositionOf(const World& world, int body, const Eigen::Vecto
 Eigen::Vector3d WorldPosition3(const World& world, int body, const Eigen::Vector3d& b0, const Mat3D<double>& B);
 Eigen::AlignedBox3d BodyBounds3(const World& world, int body);
 
+// The ground a body stands on, as drawn: 2 for the 2D ground (line or terrain), 3 for the 3D
+// plane, 0 for none. FFD bodies always stand on theirs; a linear body only when it touches it
+// (World::ground_contact), else the ground is not drawn for it (Witkin & Welch's scenes).
+int GroundDimensionOf(const World& world, int body);
+
 // World position of undeformed point u of linear body `body` (x = R p(u)) as 3 numbers (z = 0 in 2D).
 Eigen::Vector3d LinearWorldPoint(const World& world, int body, const Eigen::VectorXd& u);
 

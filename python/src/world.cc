@@ -325,15 +325,29 @@ void BindWorld(py::module_& m) {
       .def(
           "add_linear_body",
           [](World& w, std::shared_ptr<LinearBodyModel> model, double rigidity, double volume, double damping,
-             double bending) {
+             double bending, bool ground) {
             for (double v : {rigidity, volume, damping, bending})
               if (!(v >= 0) || !std::isfinite(v)) throw InputError("material constants must be finite and >= 0");
-            return w.AddLinearBody(model, AffineMaterial{rigidity, volume, damping, bending});
+            const int b = w.AddLinearBody(model, AffineMaterial{rigidity, volume, damping, bending});
+            w.SetGroundContact(b, ground);
+            return b;
           },
           py::arg("model"), py::kw_only(), py::arg("rigidity") = 0.0, py::arg("volume") = 0.0, py::arg("damping") = 0.0,
-          py::arg("bending") = 0.0,
+          py::arg("bending") = 0.0, py::arg("ground") = false,
           "Adds a Witkin & Welch body at its rest state, at rest, with the affine energies k_e, k_c, k_d,\n"
-          "k_q (rigidity, volume, damping, bending); returns its index.")
+          "k_q (rigidity, volume, damping, bending); returns its index. ground=True: its mass points touch\n"
+          "the ground (the 2D ground or terrain; in 3D the ground plane), as an FFD body's do.")
+      .def(
+          "linear_contacts",
+          [](const World& w, int body) {
+            CheckLinear(w, body);
+            const LinearContacts& c = w.linear_contacts(body);
+            py::list out;
+            for (const Contact<double>& k : c.list2) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
+            for (const Contact3<double>& k : c.list3) out.append(py::make_tuple(k.point, 0, Eigen::VectorXd(k.anchor)));
+            return out;
+          },
+          py::arg("body"), "A linear body's ground contacts: (mass point, face, anchor) each")
       .def(
           "linear_state",
           [](const World& w, int body) {

@@ -68,3 +68,27 @@ def test_bad_linear_bodies_are_input_errors():
         wobble.linear_box(3, [1, 1, 1], per_side=1000)
     with pytest.raises(wobble.InputError):  # collinear points: M singular
         wobble.linear_body([[0, 0], [1, 0], [2, 0]], [1, 1, 1])
+
+
+def test_a_linear_body_with_ground_contact_rests_on_its_bottom_row():
+    # frictionless flat ground: by symmetry the three bottom points carry m g / 3 each, sinking
+    # m g / (3 K); without ground=True the same block falls through
+    options = wobble.WorldOptions(dt=0.001)
+    options.ground.friction_cap = 0.0
+    world = wobble.World(options)
+    box = wobble.linear_box(2, [1.0, 0.5], per_side=3, mass=6.0)
+    b = world.add_linear_body(box, rigidity=2e4, volume=2e4, damping=0.02, ground=True)
+    ghost = world.add_linear_body(box, rigidity=2e4, volume=2e4, damping=0.02)
+    for body in (b, ghost):
+        R, _ = world.linear_state(body)
+        R[1, 2] = 0.7
+        world.set_linear_state(body, R)
+    world.run_until(6.0)
+    K = options.ground.stiffness
+    contacts = world.linear_contacts(b)
+    assert sorted(point for point, _, _ in contacts) == [0, 1, 2]  # u_y = -0.5: the bottom row
+    for point, face, _ in contacts:
+        assert face == 0
+        assert world.point_position(b, point)[1] == pytest.approx(-6.0 * G / (3 * K), rel=1e-6)
+    assert world.linear_contacts(ghost) == []
+    assert world.linear_state(ghost)[0][1, 2] < -100  # ½ g t² below where it started

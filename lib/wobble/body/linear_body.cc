@@ -2,10 +2,9 @@
 
 #include <cmath>
 
-#include "wobble/core/limits.h"
-
-#include <cmath>
 #include <stdexcept>
+
+#include "wobble/core/limits.h"
 
 namespace wobble {
 
@@ -64,6 +63,7 @@ LinearBodyModel::LinearBodyModel(LinearBodyDef def) : def_(std::move(def)) {
   n_ = LinearBasisSize(def_.dim, def_.order);
   M_.setZero(n_, n_);
   first_moment_.setZero(n_);
+  point_bases_.resize(n_, num_points());
   for (int k = 0; k < num_points(); ++k) {
     if (def_.points[k].size() != def_.dim || !def_.points[k].allFinite())
       throw std::invalid_argument(who + "point " + std::to_string(k) + " needs " + std::to_string(def_.dim) +
@@ -72,6 +72,7 @@ LinearBodyModel::LinearBodyModel(LinearBodyDef def) : def_(std::move(def)) {
     if (!(m > 0.0) || !std::isfinite(m))
       throw std::invalid_argument(who + "mass " + std::to_string(k) + " must be positive and finite");
     const Eigen::VectorXd p = Basis(def_.points[k]);
+    point_bases_.col(k) = p;
     M_ += m * p * p.transpose();  // M_jk = Σ m p_j p_k (§2.2)
     first_moment_ += m * p;
     total_mass_ += m;
@@ -87,6 +88,10 @@ LinearBodyModel::LinearBodyModel(LinearBodyDef def) : def_(std::move(def)) {
                                 (def_.dim == 2 ? "line" : "plane") + ", a quadratic one more, spread over the body");
   W_ = ldlt.solve(Eigen::MatrixXd::Identity(n_, n_));  // inverted once (Eq. 5)
   W_ = 0.5 * (W_ + W_.transpose());
+  basis_lo_ = point_bases_.rowwise().minCoeff();
+  basis_hi_ = point_bases_.rowwise().maxCoeff();
+  const Eigen::VectorXd sides = basis_hi_.head(def_.dim) - basis_lo_.head(def_.dim);  // p starts with u
+  half_thickness_ = 0.5 * sides.minCoeff();
 }
 
 Eigen::VectorXd LinearBodyModel::centre_of_mass() const { return first_moment_.head(def_.dim) / total_mass_; }

@@ -72,6 +72,16 @@ class LinearBodyModel {
   const Eigen::VectorXd& first_moment() const { return first_moment_; }
   // Σ m_k u_k / Σ m_k in undeformed coordinates.
   Eigen::VectorXd centre_of_mass() const;
+  // p(u_k) of every mass point, one column each (n × points): x_k = R p_k, made once.
+  const Eigen::MatrixXd& point_bases() const { return point_bases_; }
+  // The range of each basis term over the mass points: any point's height above a plane is
+  // at least Σ_j min(c_j lo_j, c_j hi_j) with c = nᵀR, a bound the ground test takes before
+  // visiting points (interval arithmetic: the terms bounded separately, so it is never above).
+  const Eigen::VectorXd& basis_lo() const { return basis_lo_; }
+  const Eigen::VectorXd& basis_hi() const { return basis_hi_; }
+  // Half the shortest side of the mass points' box at rest: how deep a point may go into the
+  // ground before the run stops (runaway penetration), as half a lattice side for FFD bodies.
+  double half_thickness() const { return half_thickness_; }
 
   // R of the rest shape placed by a rotation (d×d) and translation: R = [rot | t | 0].
   Eigen::MatrixXd PlacedState(const Eigen::MatrixXd& rotation, const Eigen::VectorXd& translation) const;
@@ -83,6 +93,9 @@ class LinearBodyModel {
   double total_mass_ = 0;
   Eigen::MatrixXd M_, W_;
   Eigen::VectorXd first_moment_;
+  Eigen::MatrixXd point_bases_;
+  Eigen::VectorXd basis_lo_, basis_hi_;
+  double half_thickness_ = 0;
 };
 
 // Kinematics of a material point with basis vector p (=Basis(u)).

@@ -180,6 +180,35 @@ enum class ContactSet {
             // damping pushes, never a pull (f_n >= 0).
 };
 
+// The faces a point at x below the ground feels, each visited as f(face, face_index, anchor, v):
+// anchor is the point's contact on that face (from [first, last), its contacts sorted by face)
+// or, for a new contact, its foot on the face; v = velocity(), asked once and only for a point
+// below the ground. On the line: face 0 when x is below it. On a terrain: terrain.h's rules.
+// Shared by FFD bodies (ForEachPointInContact) and linear ones (linear_ground.h).
+template <class T, class It, class V, class F>
+void ForEachFaceFelt(const Ground& g, const GroundFace& line, const Vec2<T>& x, V&& velocity, It first, It last,
+                     F&& f) {
+  auto foot = [&x](const GroundFace& face) { return Vec2<T>(x - face.Height(x) * face.n.cast<T>()); };
+  if (!g.terrain) {
+    if (!(ScalarValue(line.Height(x)) < 0.0)) return;
+    f(line, 0, first != last ? Vec2<T>(first->anchor) : foot(line), Vec2<T>(velocity()));
+    return;
+  }
+  const Eigen::Vector2d xd(ScalarValue(x[0]), ScalarValue(x[1]));
+  if (!g.terrain->Inside(xd)) return;
+  const Vec2<T> v = velocity();
+  const Eigen::Vector2d vd(ScalarValue(v[0]), ScalarValue(v[1]));
+  thread_local std::vector<int> faces;
+  faces.clear();
+  g.terrain->FacesFelt(xd, vd, [&](int i) { return std::any_of(first, last, [i](const auto& c) { return c.face == i; }); },
+                       &faces);
+  for (int i : faces) {
+    const auto existing = std::find_if(first, last, [i](const auto& c) { return c.face == i; });
+    const GroundFace face = g.Face(i);
+    f(face, i, existing != last ? Vec2<T>(existing->anchor) : foot(face), v);
+  }
+}
+
 // Visits every mass point below the ground as f(k, l, x, v, anchor, face, face_index): l local,
 // x world, v velocity, anchor its contact's anchor (existing, or the entry point projected on
 // the face for a new contact), face the ground face it feels (a point in a terrain's valley is
@@ -194,16 +223,12 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
     *l = LocalPosition<T>(body.rest_local(k), body.mode_matrix(k), s.q);
     *x = WorldFromLocal(frame, *l);
   };
-  auto visit_face = [&](int k, const Vec2<T>& l, const Vec2<T>& x, const GroundFace& face, int face_index,
-                        const Vec2<T>* anchor) {
-    f(k, l, x, PointVelocity(frame, s.qd, l, body.mode_matrix(k)),
-      anchor ? *anchor : Vec2<T>(x - face.Height(x) * face.n.cast<T>()), face, face_index);
-  };
   if (set == ContactSet::kFrozen) {
     for (const Contact<T>& c : s.contacts) {
       Vec2<T> l, x;
       point_at(c.point, &l, &x);
-      visit_face(c.point, l, x, g.terrain ? g.Face(c.face) : line, c.face, &c.anchor);
+      f(c.point, l, x, PointVelocity(frame, s.qd, l, body.mode_matrix(c.point)), c.anchor,
+        g.terrain ? g.Face(c.face) : line, c.face);
     }
     return;
   }
@@ -219,26 +244,12 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
   auto visit = [&](int k) {
     Vec2<T> l, x;
     point_at(k, &l, &x);
-    if (!g.terrain) {
-      if (!(ScalarValue(line.Height(x)) < 0.0)) return;
-      const auto range = contacts_of(k);
-      visit_face(k, l, x, line, 0, range.first != range.second ? &range.first->anchor : nullptr);
-      return;
-    }
-    const Eigen::Vector2d xd(ScalarValue(x[0]), ScalarValue(x[1]));
-    if (!g.terrain->Inside(xd)) return;
-    const Vec2<T> v = PointVelocity(frame, s.qd, l, body.mode_matrix(k));
-    const Eigen::Vector2d vd(ScalarValue(v[0]), ScalarValue(v[1]));
     const auto range = contacts_of(k);
-    const auto first = range.first, last = range.second;  // (lambdas cannot capture bindings in C++17)
-    thread_local std::vector<int> faces;
-    faces.clear();
-    g.terrain->FacesFelt(xd, vd, [&](int i) { return std::any_of(first, last, [i](const Contact<T>& c) { return c.face == i; }); },
-                         &faces);
-    for (int i : faces) {
-      const auto existing = std::find_if(first, last, [i](const Contact<T>& c) { return c.face == i; });
-      visit_face(k, l, x, g.Face(i), i, existing != last ? &existing->anchor : nullptr);
-    }
+    ForEachFaceFelt(
+        g, line, x, [&] { return PointVelocity(frame, s.qd, l, body.mode_matrix(k)); }, range.first, range.second,
+        [&](const GroundFace& face, int face_index, const Vec2<T>& anchor, const Vec2<T>& v) {
+          f(k, l, x, v, anchor, face, face_index);
+        });
   };
   if (ClearOfGround(body, g, s.q, frame)) return;
   const std::vector<PointCluster>& clusters = body.clusters();

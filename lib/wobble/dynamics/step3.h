@@ -268,6 +268,20 @@ StepStatus Accelerations3(const BodyModel3& body, const WorldParams3& w, const B
   return {};
 }
 
+// The anchor of a point whose friction hit the cap, moved so that the tangential spring holds
+// exactly the capped force f_t, and the force it then exerts (SlipAnchor of forces.h in 3D).
+template <class T>
+void SlipAnchor3(const GroundPlane& g, const Vec3<T>& x, const Vec3<T>& v, Vec3<T>* anchor, Vec3<T>* f) {
+  if (!(g.stiffness > 0.0)) return;  // no spring to the anchor: nothing to move
+  // −K Δt − FR v_t = f_t  ⇒  Δt = −(f_t + FR v_t)/K, measured from the point's foot
+  const Vec3<T> n = g.normal.cast<T>();
+  const Vec3<T> ft = *f - n * n.dot(*f), v_t = v - n * n.dot(v);
+  const Vec3<T> dt = -(ft + T(g.friction_damping) * v_t) / T(g.stiffness);
+  *anchor = x - g.Height(x) * n - dt;
+  bool slipping;
+  *f = GroundForce3(g, x, v, *anchor, &slipping);  // what the moved anchor exerts
+}
+
 // After an accepted step: anchors for points that entered the ground, none for those that
 // left, and an anchor whose friction hit the cap moved so the tangential spring holds exactly
 // the capped force (Coulomb slip), as UpdateContacts does in 2D.
@@ -281,14 +295,7 @@ template <class T> void UpdateContacts3(const BodyModel3& body, const GroundPlan
                                                  Vec3<T> anchor) {
     bool slipping;
     Vec3<T> f = GroundForce3(g, x, v, anchor, &slipping);
-    if (slipping && g.stiffness > 0.0) {
-      // −K Δt − FR v_t = f_t  ⇒  Δt = −(f_t + FR v_t)/K, measured from the point's foot
-      const Vec3<T> n = g.normal.cast<T>();
-      const Vec3<T> ft = f - n * n.dot(f), v_t = v - n * n.dot(v);
-      const Vec3<T> dt = -(ft + T(g.friction_damping) * v_t) / T(g.stiffness);
-      anchor = x - g.Height(x) * n - dt;
-      f = GroundForce3(g, x, v, anchor, &slipping);  // what the moved anchor exerts
-    }
+    if (slipping) SlipAnchor3(g, x, v, &anchor, &f);
     AddGeneralizedForce3(frame, l, body.mode_matrix(k), f, &cache.force);
     next.push_back({k, anchor});
   }, ContactSet::kDetect);

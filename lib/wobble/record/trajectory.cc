@@ -36,6 +36,7 @@ BodyInfo DescribeBody(const World& world, int body) {
   } else {
     const LinearBodyModel& m = world.linear_model(body);
     info.linear = world.shared_linear_model(body);
+    info.ground_contact = world.ground_contact(body);
     for (int i = 0; i < m.dim(); ++i)
       for (int s = 0; s < m.basis_size(); ++s) info.coordinate_names.push_back("r" + std::to_string(i) + "_" + std::to_string(s));
   }
@@ -125,6 +126,9 @@ int Trajectory::Append(const World& world, double control_energy, int pose) {
       const Eigen::MatrixXd& Rd = world.linear_R_dot(b);
       Eigen::Map<RowMajor>(row + l.q, R.rows(), R.cols()) = R;
       Eigen::Map<RowMajor>(row + l.qd, R.rows(), R.cols()) = Rd;
+      const LinearContacts& c = world.linear_contacts(b);
+      row[l.contacts] = double(c.size());
+      row[l.contacts + 1] = c.penetration;
     }
     const Energies e = world.ComputeEnergies(b);
     const double values[kNumEnergies] = {e.kinetic, e.gravity, e.modes, e.ground, e.springs, e.total()};

@@ -38,6 +38,7 @@ struct BodyInfo {
   std::shared_ptr<const BodyModel> ffd;           // FFD bodies: the model (modes included)
   std::shared_ptr<const BodyModel3> ffd3;         // 3D FFD bodies
   std::shared_ptr<const LinearBodyModel> linear;  // linear bodies
+  bool ground_contact = false;                    // a linear body that touches the ground (FFD: always)
   std::vector<std::string> coordinate_names;      // one per q entry
   std::vector<std::string> velocity_names;        // one per q̇ (v) entry
   int num_modes() const { return ffd ? ffd->num_modes() : ffd3 ? ffd3->num_modes() : 0; }

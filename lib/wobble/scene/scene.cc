@@ -183,8 +183,13 @@ void Scene::BeginRun(RunKind kind, bool keep_steps) {
   o.dt = options_.dt;
   o.params.gravity_on = options_.params.gravity_on;
   o.params.ground = options_.params.ground;
-  o.ground_3d = ObjectWorldOptions3().ground_3d;  // 3D bodies stand on the same ground, set now
-  o.gravity_3d = ObjectWorldOptions3().gravity_3d;
+  // 3D bodies stand on the plane of the same ground, set now; a terrain is 2D only, so it is
+  // refused (GroundPlaneOf) only when a 3D body would stand on it
+  bool on_plane = false;
+  for (int b = 0; b < w.num_bodies(); ++b)
+    on_plane = on_plane || (w.dim(b) == 3 && w.ground_contact(b));
+  if (on_plane || !options_.params.ground.terrain) o.ground_3d = GroundPlaneOf(options_.params.ground);
+  o.gravity_3d = Eigen::Vector3d(options_.params.gravity.x(), options_.params.gravity.y(), 0.0);
   if (record_fps_ > 0 && recorded_->num_bodies() != w.num_bodies()) Record(record_fps_);
   if (recorder_) recorder_->Start(w);
   run_ = std::make_unique<Run>();

@@ -48,8 +48,10 @@ const std::vector<Command>& CommandTable() {
       // Witkin & Welch scenes (linear bodies, constraints, motion control, goal behaviours)
       {"linear",
        "linear NAME 2d|3d affine|quadratic box HX HY [HZ] | pyramid W H [grid N] [levels N] [mass M] [at X Y [Z]] [ke K] "
-       "[kc K] [kd K] [kq K]",
-       "a linear-deformation body x = R p(u) (a box or a pyramid of mass points), at rest at X Y Z", Linear},
+       "[kc K] [kd K] [kq K] [ground]",
+       "a linear-deformation body x = R p(u) (a box or a pyramid of mass points), at rest at X Y Z; with 'ground' its "
+       "mass points touch the ground (the set ground line or terrain; in 3D its plane)",
+       Linear},
       {"ffd", "ffd NAME", "the loaded FFD object (its modes and state q, dq) joins the scene as body NAME", Ffd},
       {"point", "point NAME BODY U1 U2 [U3]",
        "name a material point of a body (undeformed coordinates; lattice S T of an FFD body)", PointCommand},

@@ -336,7 +336,7 @@ void Print(State& s, const Words& w, const Context& ctx) {
 namespace {
 
 const std::set<std::string>& RenderOptionNamesList() {
-  static const std::set<std::string> names = {"size",  "fps",         "filmstrip", "filmstrip-size", "filmstrip-columns",
+  static const std::set<std::string> names = {"size",  "fps",         "filmstrip", "filmstrip-size", "filmstrip-columns", "filmstrip-cycle",
                                               "color-by", "shape-samples", "chart-size", "disp-size", "trail",
                                               "azimuth", "elevation", "orbit", "camera", "style"};
   return names;

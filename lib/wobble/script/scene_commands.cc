@@ -123,6 +123,7 @@ void Linear(State& s, const Words& w, const Context& ctx) {
   double mass = 1.0;
   Eigen::VectorXd at = Eigen::VectorXd::Zero(dim);
   AffineMaterial material;
+  bool ground = false;
   auto whole = [&](const std::string& word, const std::string& what, int min) {
     int v;
     if (!formats::detail::ParseInt(word, &v) || v < min)
@@ -142,12 +143,13 @@ void Linear(State& s, const Words& w, const Context& ctx) {
     else if (key == "kc") material.volume = NonNegative(next(), "kc", ctx);
     else if (key == "kd") material.damping = NonNegative(next(), "kd", ctx);
     else if (key == "kq") material.bending = NonNegative(next(), "kq", ctx);
+    else if (key == "ground") ground = true;
     else if (key == "at") {
       at = Vector(w, i + 1, dim, "the position after 'at'", ctx);
       i += dim;
     } else {
       ctx.Fail("unknown option '" + key + "' of linear" +
-               DidYouMean(key, {"grid", "levels", "mass", "at", "ke", "kc", "kd", "kq"}));
+               DidYouMean(key, {"grid", "levels", "mass", "at", "ke", "kc", "kd", "kq", "ground"}));
     }
     ++i;
   }
@@ -159,8 +161,9 @@ void Linear(State& s, const Words& w, const Context& ctx) {
   } catch (const std::invalid_argument& e) {
     ctx.Fail(e.what());
   }
-  s.scene.AddLinearBody(name, model, material, at,
-                        shape == "box" ? MakeBoxDrawing(sizes, 8) : MakePyramidDrawing(dim, sizes[0], sizes[1], 8));
+  const int body = s.scene.AddLinearBody(
+      name, model, material, at, shape == "box" ? MakeBoxDrawing(sizes, 8) : MakePyramidDrawing(dim, sizes[0], sizes[1], 8));
+  if (ground) s.scene.world().SetGroundContact(body, true);
 }
 
 void Ffd(State& s, const Words& w, const Context& ctx) {

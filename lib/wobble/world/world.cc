@@ -161,10 +161,12 @@ void World::SetLinearState(int body, const Eigen::MatrixXd& R, const Eigen::Matr
   e.R_dot_before = e.R_dot;
   e.R = R;
   e.R_dot = R_dot;
+  RefreshLinearContacts(e);
   if (EnergyFinite(body)) return;
   const std::string terms = EnergyTerms(ComputeEnergies(body));
   e.R = e.R_before;
   e.R_dot = e.R_dot_before;
+  RefreshLinearContacts(e);
   throw InputError("linear body '" + m.name() + "': a state whose energy is not finite (" + terms + ")");
 }
 
@@ -179,6 +181,23 @@ void World::SetMaterial(int body, const AffineMaterial& material) {
 }
 
 const AffineMaterial& World::material(int body) const { return Linear(body).material; }
+
+void World::SetGroundContact(int body, bool on) {
+  linear_model(body);
+  LinearEntry& e = linear_[slots_[body].index];
+  e.ground_contact = on;
+  e.contacts.clear();  // found at the next SetLinearState or step, not at a state about to be replaced
+}
+
+bool World::ground_contact(int body) const {
+  return kind(body) != BodyKind::kLinear || Linear(body).ground_contact;
+}
+
+const LinearContacts& World::linear_contacts(int body) const { return Linear(body).contacts; }
+
+void World::RefreshLinearContacts(LinearEntry& e) const {
+  if (e.ground_contact) UpdateLinearContacts(*e.model, linear_ground(), e.R, e.R_dot, &e.contacts);
+}
 
 void World::AddSpring(Spring spring) {
   const BodyModel& b = body(spring.body);
@@ -327,7 +346,24 @@ bool World::StepLinearBody(int body, const Eigen::VectorXd& acc) {
   e.R.swap(e.R_before);
   e.R_dot.swap(e.R_dot_before);
   e.applied.setZero();
-  return AcceptLinearStep(body, screened);
+  if (!AcceptLinearStep(body, screened)) return false;
+  if (!e.ground_contact) return true;
+  // the contacts of the accepted state; a point deeper than half the body's thickness went
+  // through the ground (a step too long for its stiffness): refused, as for FFD bodies
+  e.contacts_before = e.contacts;  // copy-assigned: reuses its storage from step to step
+  RefreshLinearContacts(e);
+  const double limit = options_.params.ground.max_penetration > 0 ? options_.params.ground.max_penetration
+                                                                  : e.model->half_thickness();
+  if (!(e.contacts.penetration > limit)) return true;
+  std::ostringstream detail;
+  detail << "a point is " << e.contacts.penetration << " below the ground (limit " << limit
+         << "); reduce dt, or the ground's stiffness or damping";
+  e.R.swap(e.R_before);
+  e.R_dot.swap(e.R_dot_before);
+  e.contacts.list2.swap(e.contacts_before.list2);
+  e.contacts.list3.swap(e.contacts_before.list3);
+  e.contacts.penetration = e.contacts_before.penetration;
+  return Fail(StatusCode::kPenetration, body, detail.str());
 }
 
 void World::LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const {
@@ -343,6 +379,7 @@ void World::LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const {
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < d; ++i) Q(i, j) += g[i] * mu[j];
   }
+  if (e.ground_contact) AddLinearGroundForce(m, linear_ground(), e.R, e.R_dot, e.contacts, &Q);
   // R̈ = Q W (Eq. 5), flattened row by row; plain loops, as TimesBasis in world_constraints.cc
   acc->resize(m.num_q());
   const Eigen::MatrixXd& W = m.inverse_mass_matrix();
@@ -384,6 +421,7 @@ Energies World::ComputeEnergies(int i) const {
     const LinearEntry& l = Linear(i);
     e.kinetic = 0.5 * (l.R_dot * l.model->mass_matrix() * l.R_dot.transpose()).trace();  // ½ Ṙ_ij Ṙ_ik M_jk
     e.modes = AffineEnergy(l.material, l.R);
+    e.ground = LinearGroundEnergy(*l.model, linear_ground(), l.R, l.contacts);
     if (p.gravity_on) {
       const Eigen::VectorXd g = l.model->dim() == 2 ? Eigen::VectorXd(p.gravity) : Eigen::VectorXd(options_.gravity_3d);
       e.gravity = -g.dot(l.R * l.model->first_moment());

@@ -39,6 +39,7 @@
 #include "wobble/body/affine_energy.h"
 #include "wobble/core/interrupt.h"
 #include "wobble/body/linear_body.h"
+#include "wobble/dynamics/linear_ground.h"
 #include "wobble/dynamics/step.h"
 #include "wobble/dynamics/step3.h"
 #include "wobble/world/controller.h"
@@ -146,8 +147,8 @@ class World {
   // state that is not finite or whose energy is not).
   const BodyModel3& body3(int i) const;
   const std::shared_ptr<const BodyModel3>& shared_body3(int i) const;  // for whoever outlives the world
-  // How deep the body's deepest contact point is below the ground now (0 without contacts or
-  // for a linear body): BodyState::penetration in 2D, computed from the contacts in 3D.
+  // How deep the body's deepest contact point is below the ground now (0 without contacts):
+  // BodyState::penetration in 2D, computed from the contacts in 3D, the linear contacts'.
   double Penetration(int body) const;
   const BodyState3<double>& state3(int i) const;
   void SetState3(int body, const Eigen::Vector3d& t, const Eigen::Quaterniond& orientation,
@@ -174,6 +175,15 @@ class World {
   const Eigen::MatrixXd& linear_R_dot(int body) const;
   void SetMaterial(int body, const AffineMaterial& material);
   const AffineMaterial& material(int body) const;
+  // Whether a linear body feels the ground: a 2D one the 2D ground (line or terrain), a 3D one
+  // ground_3d (linear_ground.h). Off by default, as in Witkin & Welch's scenes, which have no
+  // ground; FFD bodies always feel it. Turning it on or off starts with no contacts.
+  void SetGroundContact(int body, bool on);
+  bool ground_contact(int body) const;
+  // The linear body's contacts with their anchors (empty while ground_contact is off).
+  const LinearContacts& linear_contacts(int body) const;
+  // The ground of a linear body, for the linear_ground.h functions.
+  LinearGround linear_ground() const { return {options_.params.ground, options_.ground_3d}; }
 
   // Springs hold a point of an FFD body given by lattice coordinates (Fig. 4.4).
   void AddSpring(Spring spring);
@@ -314,6 +324,8 @@ class World {
     Eigen::MatrixXd Q;                  // per-step work: the body's generalized force
     Eigen::MatrixXd R_before, R_dot_before;  // per-step work: the state a refused step restores
     double scale = 0.0;  // the largest |number| of the mass matrix, first moment and material
+    bool ground_contact = false;
+    LinearContacts contacts, contacts_before;  // contacts_before: per-step work, as R_before
   };
   // A resolved material point: linear bodies keep p(u) and W p; FFD bodies b0 and B.
   struct End {
@@ -360,6 +372,7 @@ class World {
   Energies Ffd3Energies(int body) const;
   bool StepFfdBody(int body);
   void LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const;
+  void RefreshLinearContacts(LinearEntry& e) const;  // the contacts of its state now
   double PenetrationLimit(const BodyModel& model) const;
   // The ground contacts of an FFD body at its state now (world_step.cc).
   void RefreshContacts(FfdEntry& e) const;

@@ -46,7 +46,7 @@ GroundPlane GroundPlaneOf(const Ground& g) {
 
 double World::Penetration(int body) const {
   if (kind(body) == BodyKind::kFfd) return state(body).penetration;
-  if (kind(body) == BodyKind::kLinear) return 0.0;
+  if (kind(body) == BodyKind::kLinear) return Linear(body).contacts.penetration;
   const BodyModel3& m = body3(body);
   const BodyState3<double>& s = state3(body);
   const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
