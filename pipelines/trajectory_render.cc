@@ -84,22 +84,26 @@ struct Visit {
   }
 };
 
-// The times of a gait's filmstrip: `panels` equal steps across cycle k of the recorded pose
-// graph and its end. A cycle begins where the active pose comes back to the run's first one.
-std::vector<double> CycleTimes(const record::Trajectory& run, int k, int panels) {
-  const int first = run.pose(0);
-  if (first < 0) throw std::invalid_argument("filmstrip cycle: the run has no pose graph (no active pose recorded)");
-  std::vector<double> starts = {run.time(0)};
-  for (int i = 1; i < run.size(); ++i)
+}  // namespace
+
+std::vector<double> FilmstripCycleTimes(const record::Trajectory& run, int k, int panels) {
+  int i = 0;  // the first sample with an active pose (the run's first row may precede the controller)
+  while (i < run.size() && run.pose(i) < 0) ++i;
+  if (i == run.size()) throw std::invalid_argument("filmstrip cycle: the run has no pose graph (no active pose recorded)");
+  const int first = run.pose(i);
+  std::vector<double> starts = {run.time(i)};
+  for (++i; i < run.size(); ++i)
     if (run.pose(i) == first && run.pose(i - 1) != first) starts.push_back(run.time(i));
   if (int(starts.size()) < k + 2)
     throw std::invalid_argument("filmstrip cycle " + std::to_string(k) + ": the run completes only " +
                                 std::to_string(starts.size() - 1) + " cycles of its pose graph");
   const double t0 = starts[size_t(k)], period = starts[size_t(k) + 1] - t0;
   std::vector<double> times;
-  for (int i = 0; i <= panels; ++i) times.push_back(t0 + period * i / panels);
+  for (int p = 0; p <= panels; ++p) times.push_back(t0 + period * p / panels);
   return times;
 }
+
+namespace {
 
 std::vector<Visit> PlanVisits(const record::Trajectory& run, const RenderOutputs& out, double dt, long* num_frames) {
   std::vector<Visit> visits;
@@ -116,7 +120,7 @@ std::vector<Visit> PlanVisits(const record::Trajectory& run, const RenderOutputs
     for (int k = 0; k < run.size(); ++k) visits.push_back({k, k, -1, run.time(k)});
   }
   if (out.filmstrip) {
-    std::vector<double> times = out.filmstrip_cycle >= 0 ? CycleTimes(run, out.filmstrip_cycle, out.filmstrip_panels)
+    std::vector<double> times = out.filmstrip_cycle >= 0 ? FilmstripCycleTimes(run, out.filmstrip_cycle, out.filmstrip_panels)
                                                          : out.filmstrip_times;
     if (times.empty())
       for (int k = 0; k < 6; ++k) times.push_back(t0 + (t1 - t0) * k / 5.0);

@@ -95,6 +95,12 @@ struct RenderReport {
 // empty run or a world of other bodies, std::runtime_error for a failed write (naming the file).
 RenderReport RenderTrajectory(World& world, const record::Trajectory& run, const SceneSpec& spec, const RenderOutputs& out);
 
+// The times of a gait's filmstrip (RenderOutputs::filmstrip_cycle): `panels` equal steps across
+// cycle k of the run's recorded pose graph, and its end. A cycle begins where the active pose
+// comes back to the first one recorded. std::invalid_argument: no pose recorded, or fewer than
+// k + 1 cycles completed.
+std::vector<double> FilmstripCycleTimes(const record::Trajectory& run, int k, int panels);
+
 // A world holding the run's bodies (FFD bodies at their models, linear bodies with the default
 // material) with these options: somewhere to draw a run whose world is gone.
 World WorldFor(const record::Trajectory& run, const WorldOptions& options);

@@ -167,6 +167,33 @@ std::vector<std::string> Paths(const RenderReport& report) {
   return paths;
 }
 
+// A gait's filmstrip samples one cycle of the recorded pose graph: the cycle runs from where
+// the first pose comes back to where it comes back again, the first row before the controller
+// (pose −1) is not a cycle's start, and a run too short for the cycle asked for is refused.
+TEST(SceneRun, GaitFilmstripSamplesOneCycleOfThePoseGraph) {
+  World w;
+  w.AddLinearBody(std::make_shared<LinearBodyModel>(
+      MakeBoxBody("box", 2, LinearOrder::kAffine, Eigen::Vector2d(1, 1), 2, 1.0)));
+  record::Trajectory run(w);
+  // samples every 0.1 s: no pose, then poses 0 0 1 2 2 | 0 1 1 2 | 0 0 1 2 | 0 (cycles of 0.5, 0.4, 0.4 s)
+  const int poses[] = {-1, 0, 0, 1, 2, 2, 0, 1, 1, 2, 0, 0, 1, 2, 0};
+  for (int i = 0; i < 15; ++i) {
+    w.SetTime(0.1 * i);
+    run.Append(w, 0.0, poses[i]);
+  }
+  auto near = [](const std::vector<double>& got, const std::vector<double>& want) {
+    ASSERT_EQ(got.size(), want.size());
+    for (size_t i = 0; i < got.size(); ++i) EXPECT_NEAR(got[i], want[i], 1e-12) << i;
+  };
+  near(FilmstripCycleTimes(run, 0, 5), {0.1, 0.2, 0.3, 0.4, 0.5, 0.6});
+  near(FilmstripCycleTimes(run, 1, 4), {0.6, 0.7, 0.8, 0.9, 1.0});
+  near(FilmstripCycleTimes(run, 2, 2), {1.0, 1.2, 1.4});
+  EXPECT_THROW(FilmstripCycleTimes(run, 3, 2), std::invalid_argument);  // the fourth never ends
+  record::Trajectory no_graph(w);
+  no_graph.Append(w);
+  EXPECT_THROW(FilmstripCycleTimes(no_graph, 0, 2), std::invalid_argument);
+}
+
 TEST(SceneRun, WritesAPvdSeriesThatVtkReadsBack) {
   WorldOptions o = testing::WitkinWelchOptions();
   o.params.gravity_on = false;

@@ -38,12 +38,14 @@ struct Scene {
     std::filesystem::create_directories(dir);
     const auto cwd = std::filesystem::current_path();
     std::filesystem::current_path(dir);
+    interp.SetRenderHook([this](const script::RenderRequest& r) { rendered.push_back(r); });  // no VTK here
     interp.RunFile(kData + "/" + name + ".wob");
     std::filesystem::current_path(cwd);
   }
   std::ostringstream out;
   script::Interpreter interp;
   std::filesystem::path dir;
+  std::vector<script::RenderRequest> rendered;  // what the script's `render` lines asked for
 };
 
 TEST(Annealing, SameSeedSameResultWhateverTheThreadCount) {
@@ -150,6 +152,22 @@ TEST(BoundingTable, AnnealingImprovesAndFindsAStableForwardGaitThatTheSavedScrip
   }
   EXPECT_GT(lo, 0.0);
   EXPECT_LT(hi - lo, 0.25 * sum / late.size()) << "per cycle from " << lo << " to " << hi;
+
+  // Fig. 5.3's filmstrip: cycle 40 of the best controller's pose graph, which the 90 s run
+  // completes (a cycle starts each time the first pose comes back)
+  ASSERT_EQ(scene.rendered.size(), 1u);
+  const script::RenderRequest& strip = scene.rendered[0];
+  EXPECT_EQ(strip.what, "filmstrip");
+  EXPECT_NE(std::find(strip.options.begin(), strip.options.end(), std::make_pair(std::string("filmstrip-cycle"), std::string("40,6"))),
+            strip.options.end());
+  const record::Trajectory& played = *strip.trajectory;
+  int first = -1, cycles = 0;
+  for (int k = 0; k < played.size(); ++k) {
+    if (first < 0) first = played.pose(k);
+    else cycles += played.pose(k) == first && played.pose(k - 1) != first;
+  }
+  EXPECT_NEAR(played.time(played.size() - 1) - played.time(0), 90.0, 1e-9);
+  EXPECT_GE(cycles, 41);
 
   // the saved controller replays the best trial exactly
   std::ostringstream out;

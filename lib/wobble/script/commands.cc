@@ -42,7 +42,7 @@ const std::vector<Command>& CommandTable() {
        "draw into DIR: with a scene (linear bodies) its recorded frames, WHAT a comma list of frames, filmstrip, vtp "
        "(default all); otherwise every FFD run since load_obj (or clear track), WHAT of frames, filmstrip, charts, vtp, "
        "exr, disp (default frames,filmstrip,charts) and NAME=VALUE options of wobble render (size=WxH, fps=N, "
-       "filmstrip=T1,T2,.., filmstrip-columns=N, color-by=ARRAY, ...)",
+       "filmstrip=T1,T2,.., filmstrip-columns=N, filmstrip-cycle=K,PANELS, color-by=ARRAY, ...)",
        Render},
       {"echo", "echo TEXT", "print TEXT", Echo},
       // Witkin & Welch scenes (linear bodies, constraints, motion control, goal behaviours)
