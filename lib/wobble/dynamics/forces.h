@@ -181,21 +181,25 @@ enum class ContactSet {
 };
 
 // The faces a point at x below the ground feels, each visited as f(face, face_index, anchor, v):
-// anchor is the point's contact on that face (from [first, last), its contacts sorted by face)
-// or, for a new contact, its foot on the face; v = velocity(), asked once and only for a point
-// below the ground. On the line: face 0 when x is below it. On a terrain: terrain.h's rules.
+// anchor is the point's contact on that face (contacts() gives [first, last) of the point's
+// contacts, sorted by face) or, for a new contact, its foot on the face; v = velocity(). Both
+// are asked only for a point below the ground: most points visited are above it.
+// On the line: face 0 when x is below it. On a terrain: terrain.h's rules.
 // Shared by FFD bodies (ForEachPointInContact) and linear ones (linear_ground.h).
-template <class T, class It, class V, class F>
-void ForEachFaceFelt(const Ground& g, const GroundFace& line, const Vec2<T>& x, V&& velocity, It first, It last,
-                     F&& f) {
+template <class T, class V, class C, class F>
+[[gnu::always_inline]] inline void ForEachFaceFelt(const Ground& g, const GroundFace& line, const Vec2<T>& x, V&& velocity,
+                                                  C&& contacts, F&& f) {
   auto foot = [&x](const GroundFace& face) { return Vec2<T>(x - face.Height(x) * face.n.cast<T>()); };
   if (!g.terrain) {
     if (!(ScalarValue(line.Height(x)) < 0.0)) return;
-    f(line, 0, first != last ? Vec2<T>(first->anchor) : foot(line), Vec2<T>(velocity()));
+    const auto range = contacts();
+    f(line, 0, range.first != range.second ? Vec2<T>(range.first->anchor) : foot(line), Vec2<T>(velocity()));
     return;
   }
   const Eigen::Vector2d xd(ScalarValue(x[0]), ScalarValue(x[1]));
   if (!g.terrain->Inside(xd)) return;
+  const auto range = contacts();
+  const auto first = range.first, last = range.second;  // (lambdas cannot capture bindings in C++17)
   const Vec2<T> v = velocity();
   const Eigen::Vector2d vd(ScalarValue(v[0]), ScalarValue(v[1]));
   thread_local std::vector<int> faces;
@@ -244,9 +248,8 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
   auto visit = [&](int k) {
     Vec2<T> l, x;
     point_at(k, &l, &x);
-    const auto range = contacts_of(k);
     ForEachFaceFelt(
-        g, line, x, [&] { return PointVelocity(frame, s.qd, l, body.mode_matrix(k)); }, range.first, range.second,
+        g, line, x, [&] { return PointVelocity(frame, s.qd, l, body.mode_matrix(k)); }, [&] { return contacts_of(k); },
         [&](const GroundFace& face, int face_index, const Vec2<T>& anchor, const Vec2<T>& v) {
           f(k, l, x, v, anchor, face, face_index);
         });

@@ -57,10 +57,13 @@ void ForEachContact2(const LinearBodyModel& m, const Ground& g, const Eigen::Mat
   for (int k = 0; k < m.num_points(); ++k) {
     const double* p = P.col(k).data();
     const Vec2<double> x = Times<2>(R, p);
-    while (first != contacts.end() && first->point < k) ++first;
-    auto last = first;
-    while (last != contacts.end() && last->point == k) ++last;
-    ForEachFaceFelt(g, line, x, [&] { return Times<2>(R_dot, p); }, first, last,
+    auto contacts_of_k = [&] {  // points come in order: the cursor only moves forward
+      while (first != contacts.end() && first->point < k) ++first;
+      auto last = first;
+      while (last != contacts.end() && last->point == k) ++last;
+      return std::make_pair(first, last);
+    };
+    ForEachFaceFelt(g, line, x, [&] { return Times<2>(R_dot, p); }, contacts_of_k,
                     [&](const GroundFace& face, int face_index, const Vec2<double>& anchor, const Vec2<double>& v) {
                       f(k, p, x, v, anchor, face, face_index);
                     });
