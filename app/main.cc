@@ -3,6 +3,8 @@
 // every subcommand (wobble/core/errors.h): 0 ok, 2 bad input of any kind (a file, a flag, a
 // script line, a limit), 3 a numerical stop, 130 Ctrl-C, 1 anything else.
 #include <CLI/CLI.hpp>
+#include <malloc.h>
+
 #include <csignal>
 #include <iostream>
 #include <memory>
@@ -71,8 +73,20 @@ struct MpiSession {
 };
 }  // namespace
 
+// Renders allocate and free a few megabytes per frame (colour and depth read back, the EXR's
+// channels and line buffers, the alpha and motion rasters). glibc maps blocks that large
+// afresh and gives freed memory back to the kernel, so every frame faulted its pages in
+// again: a third of a 300-frame render's CPU went to page faults. Keeping blocks up to 32 MB
+// in the heap and never trimming below 1 GB lets each frame reuse the last one's pages
+// (README, Pictures: 11.3-12.9 s wall before, about 5.3-5.8 s after, same run).
+void ReuseFreedMemory() {
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // glibc's largest
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+}
+
 int main(int argc, char** argv) {
   using namespace wobble::app;
+  ReuseFreedMemory();
   MpiSession mpi(&argc, &argv);
   CatchInterrupt();
   CLI::App app("wobble: dynamic free-form deformation characters (Faloutsos 1995)", "wobble");
