@@ -54,7 +54,10 @@ void ApplyRenderOption(const std::string& name, const std::string& value, Render
   else if (name == "orbit") a->orbit = number();
   else if (name == "camera") a->camera = value;
   else if (name == "style") a->style = value;
-  else
+  else if (name == "exr-terrain") {
+    if (value != "on" && value != "off") throw std::invalid_argument("exr-terrain=: expected on or off, got '" + value + "'");
+    a->exr_terrain = value == "on";
+  } else
     throw std::invalid_argument("unknown option '" + name + "' (" + script::RenderOptionNames() + ")");
 }
 

@@ -49,4 +49,10 @@ r = subprocess.run([wobble, "run", path], capture_output=True, text=True, cwd=wo
                    env={k: v for k, v in env.items() if k != "DISPLAY"})
 check(r.returncode == 0 and "no X display: render draws no pictures" in r.stdout and "writing vtp only" in r.stdout,
       "without DISPLAY: the pictures are skipped with a message: " + r.stdout.strip()[-200:])
+# a render option with a bad value: exit 2, the script's file and line, what was expected
+bad = os.path.join(work, "bad_render.wob")
+open(bad, "w").write(script.replace("render pics vtp,frames", "render pics vtp exr-terrain=maybe"))
+r = subprocess.run([wobble, "run", bad], capture_output=True, text=True, cwd=work, env=env)
+check(r.returncode == 2 and "bad_render.wob:10:" in r.stderr and "exr-terrain=: expected on or off" in r.stderr,
+      "exr-terrain=maybe exits 2 naming the line: " + r.stderr.strip()[-200:])
 sys.exit(1 if failures else 0)

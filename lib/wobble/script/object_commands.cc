@@ -338,7 +338,7 @@ namespace {
 const std::set<std::string>& RenderOptionNamesList() {
   static const std::set<std::string> names = {"size",  "fps",         "filmstrip", "filmstrip-size", "filmstrip-columns", "filmstrip-cycle",
                                               "color-by", "shape-samples", "chart-size", "disp-size", "trail",
-                                              "azimuth", "elevation", "orbit", "camera", "style"};
+                                              "azimuth", "elevation", "orbit", "camera", "style", "exr-terrain"};
   return names;
 }
 
