@@ -135,6 +135,21 @@ run_rows = list(csv.DictReader(open(f"{work}/hop.csv")))
 at = {round(float(x["t"]), 2): x for x in run_rows}
 check(int(float(at[0.7]["contacts"])) == 0 and float(at[0.7]["ty"]) > 1.0 and int(float(at[1.5]["contacts"])) > 0,
       f"in the air at 0.7 s (feet at {at[0.7]['ty']}), down again at 1.5 s")
+# `save` writes the schedule beside the script; the saved script replays the same motion
+with open(f"{work}/hop_save.wob", "w") as f:
+    f.write(open(f"{work}/hop.wob").read().replace(f"output {work}/hop.csv\nsimul 1.5\n", "")
+            + f"set end 1.5\nsave {work}/hop_saved.wob\n")
+r = subprocess.run([wobble, "run", f"{work}/hop_save.wob"], capture_output=True, text=True, cwd=work)
+saved = open(f"{work}/hop_saved.wob").read() if os.path.exists(f"{work}/hop_saved.wob") else ""
+check(r.returncode == 0 and f"schedule {work}/hop_saved.schedule.csv" in saved
+      and list(csv.reader(open(f"{work}/hop_saved.schedule.csv"))) == rows,
+      "save writes the schedule beside the script, the same rows: " + r.stderr.strip())
+with open(f"{work}/hop_saved.wob", "w") as f:
+    f.write(saved.replace("simul\nprint\n", f"output {work}/hop_replay.csv\nsimul\nprint\n"))
+r = subprocess.run([wobble, "run", f"{work}/hop_saved.wob"], capture_output=True, text=True, cwd=work)
+replay = {round(float(x["t"]), 2): x for x in csv.DictReader(open(f"{work}/hop_replay.csv"))} if r.returncode == 0 else {}
+check(r.returncode == 0 and replay.get(1.5, {}).get("ty") == at[1.5]["ty"] and replay.get(0.7, {}).get("ty") == at[0.7]["ty"],
+      "the saved script replays the hop digit for digit: " + r.stderr.strip())
 with open(f"{work}/bad_schedule.csv", "w") as f:
     f.write("t,bend,shear\n0,0,0\n")
 with open(f"{work}/bad_schedule.wob", "w") as f:

@@ -104,11 +104,12 @@ void WritePoseGraph(std::ostream& s, const control::PoseGraph& graph, double swi
 }
 
 std::string ReplayScript(const ScriptSetup& setup, const control::PoseGraph& graph, double switch_width, double t0,
-                         double t1) {
+                         double t1, const std::string& schedule) {
   std::ostringstream s;
   s << "# Written by wobble (save): rebuilds the setup and replays its controller with simul.\n";
   WriteSetup(s, setup);
   WritePoseGraph(s, graph, switch_width);
+  if (!schedule.empty()) s << "schedule " << schedule << "\n";
   s << "set time " << Num(t0) << "\nset end " << Num(t1) << "\n";
   s << "# output replay.csv   # uncomment to record the motion\n";
   s << "simul\nprint\n";

@@ -51,9 +51,11 @@ void WriteSetup(std::ostream& s, const ScriptSetup& setup);
 // `set cyclic`, `set switch_width` and one `pose` line per pose.
 void WritePoseGraph(std::ostream& s, const control::PoseGraph& graph, double switch_width);
 
-// `save`: the setup, the pose graph, `set time T0`, `set end T1`, `simul`, `print`.
+// `save`: the setup, the pose graph, `schedule SCHEDULE` when one plays in its place (a
+// spacetime fit's targets, written by the caller to that file), `set time T0`, `set end T1`,
+// `simul`, `print`.
 std::string ReplayScript(const ScriptSetup& setup, const control::PoseGraph& graph, double switch_width, double t0,
-                         double t1);
+                         double t1, const std::string& schedule = "");
 
 // A session stepped outside the interpreter. How the targets are replayed: every mode is made
 // active with `codamA 0` and `assign` gives each its stiffness and damping as the session's body

@@ -1,9 +1,12 @@
 // Motion synthesis from a script (thesis §5.1–5.2): `anneal` and `cmaes` refine the scene's
 // pose graph by trials of the FFD object, `gait` measures it, `save` writes the script that
 // replays it.
+#include <filesystem>
+
 #include "wobble/core/errors.h"
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/csv.h"
+#include "wobble/formats/target_schedule.h"
 #include "wobble/scene/script_writer.h"
 #include "wobble/script/internal/interpreter_internal.h"
 #ifdef WOBBLE_HAVE_PAGMO
@@ -185,7 +188,8 @@ synth::Problem SynthesisProblem(const State& s) {
   return p;
 }
 
-std::string ReplayScript(const State& s) {
+// `schedule_path`: where the scene's target schedule is written, for its `schedule` line.
+std::string ReplayScript(const State& s, const std::string& schedule_path) {
   const scene::Scene& sc = s.scene;
   const scene::FfdObject& object = sc.object();
   scene::ScriptSetup setup;
@@ -203,7 +207,7 @@ std::string ReplayScript(const State& s) {
   setup.q = annealed ? s.anneal_start_q : object.q();
   setup.qd = annealed ? s.anneal_start_qd : object.qd();
   const double t0 = annealed ? 0.0 : sc.time(), t1 = annealed ? double(s.trial_steps) * sc.options().dt : sc.end();
-  return scene::ReplayScript(setup, sc.control().graph, sc.control().switch_width, t0, t1);
+  return scene::ReplayScript(setup, sc.control().graph, sc.control().switch_width, t0, t1, schedule_path);
 }
 
 void Save(State& s, const Words& w, const Context& ctx) {
@@ -214,8 +218,17 @@ void Save(State& s, const Words& w, const Context& ctx) {
   } catch (const std::runtime_error& e) {
     ctx.Fail(std::string("save: ") + e.what());  // a path that cannot be written: bad input
   }
+  // a spacetime fit's schedule plays in place of the pose graph: it goes beside the script
+  // (FILE's stem + .schedule.csv), named by its absolute path, as `schedule` reads from the
+  // working directory
+  const Eigen::MatrixXd& schedule = s.scene.control().schedule;
+  std::string schedule_path;
+  if (schedule.size() > 0)
+    schedule_path = std::filesystem::absolute(std::filesystem::path(w[1]).replace_extension(".schedule.csv")).string();
   try {
-    formats::WriteTextAtomically(w[1], ReplayScript(s));
+    if (!schedule_path.empty())
+      formats::WriteTargetSchedule(schedule_path, s.scene.object().mode_names(), s.scene.options().dt, schedule);
+    formats::WriteTextAtomically(w[1], ReplayScript(s, schedule_path));
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(std::string("save: ") + e.what());  // the disk failed (full, ...): exit 1
   }

@@ -135,7 +135,8 @@ synth::Problem MakeProblem(const State& s, long steps);
 // The problem of the last anneal (or cmaes): its trials' start state, trial_steps long.
 synth::Problem SynthesisProblem(const State& s);
 // The `save` script (scene::ReplayScript of the scene; after an anneal, of its trials).
-std::string ReplayScript(const State& s);
+// `save`'s script; with a schedule_path, the `schedule` line of the target schedule written there
+std::string ReplayScript(const State& s, const std::string& schedule_path = "");
 // scene_commands.cc: Witkin & Welch bodies, points, constraints, paths and behaviours
 void Linear(State& s, const Words& w, const Context& ctx);
 void Ffd(State& s, const Words& w, const Context& ctx);
