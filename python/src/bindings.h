@@ -27,6 +27,7 @@ void BindRollout(py::module_& m);  // batched rollouts (rollout.cc)
 void BindScript(py::module_& m);   // Interpreter, scenes (script.cc)
 void BindSynth(py::module_& m);    // pose graphs, trials, annealing (synth.cc)
 void BindFit(py::module_& m);      // pose fits (fit.cc)
+void BindGradients(py::module_& m);  // rollout gradients, spacetime fits, schedules (gradients.cc)
 void BindAnalysis(py::module_& m); // condition numbers, mode-set checks (analysis.cc)
 void BindRender(py::module_& m);   // pictures and exports through pipelines/ (render.cc; with VTK)
 

@@ -183,7 +183,8 @@ template <int Dim> void BindDynamicFit(py::module_& m) {
       [](std::shared_ptr<BodyModelN<Dim>> body, const py::object& times, const py::object& points,
          const std::vector<long>& mass_points, const py::object& q0, const py::object& qd0, const py::object& stiffness,
          const py::object& damping, const py::object& graph, const WorldOptions& world, bool fit_q0, bool fit_qd0,
-         bool fit_stiffness, bool fit_damping, bool fit_poses, bool fit_times, double switch_width, int max_iterations) {
+         bool fit_stiffness, bool fit_damping, bool fit_poses, bool fit_times, double switch_width, int max_iterations,
+         const std::string& gradient) {
         const auto frames = Frames(*body, times, points, mass_points);
         fit::DynamicParameters start;
         start.q0 = OptionalVector(q0, body->num_q(), "q0");
@@ -210,6 +211,9 @@ template <int Dim> void BindDynamicFit(py::module_& m) {
         o.fit_times = fit_times;
         o.switch_width = switch_width;
         o.max_iterations = max_iterations;
+        if (gradient != "jets" && gradient != "adjoint") throw InputError("gradient: expected 'jets' or 'adjoint', got '" + gradient + "'");
+        if (gradient == "adjoint" && Dim == 3) throw InputError("gradient='adjoint': 2D bodies only (the 3D body has no adjoint yet)");
+        o.gradient = gradient == "adjoint" ? fit::FitGradient::kAdjoint : fit::FitGradient::kJets;
         return WithCtrlC([&] { return fit::FitDynamicTrajectory(*body, frames, start, o); });
       },
       py::arg("body"), py::arg("times"), py::arg("points"), py::arg("mass_points"), py::kw_only(),
@@ -217,11 +221,12 @@ template <int Dim> void BindDynamicFit(py::module_& m) {
       py::arg("damping") = py::none(), py::arg("graph") = py::none(), py::arg("options") = WorldOptions(),
       py::arg("fit_q0") = true, py::arg("fit_qd0") = true, py::arg("fit_stiffness") = true, py::arg("fit_damping") = true,
       py::arg("fit_poses") = false, py::arg("fit_times") = false, py::arg("switch_width") = 0.05,
-      py::arg("max_iterations") = 50,
+      py::arg("max_iterations") = 50, py::arg("gradient") = "jets",
       Dim == 2 ? "Fits the start state, mode stiffness and damping (and a pose graph's poses and times) so that\n"
                  "a simulation puts mass points mass_points (K,) where `points` (F, K, 2) has them at `times`\n"
                  "(F,, on the step grid). Starts: q0/qd0 None: from pose fits of the first frames; stiffness\n"
-                 "and damping None: the body's. Like `wobble fit trajectory --dynamic`; differentiates with Ceres Jets."
+                 "and damping None: the body's. Like `wobble fit trajectory --dynamic`; differentiates with Ceres Jets\n"
+                 "(Levenberg-Marquardt), or with gradient='adjoint' by one adjoint sweep per gradient (BFGS)."
                : "A 3D body: points (F, K, 3), q0 = [t, r, γ], qd0 = [ṫ, body ω, γ̇]; the world's 3D gravity,\n"
                  "ground plane and springs (options.gravity_3d, ground_3d, springs_3d).");
 }

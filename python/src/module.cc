@@ -16,6 +16,7 @@ PYBIND11_MODULE(_wobble, m) {
   BindScript(m);
   BindSynth(m);
   BindFit(m);
+  BindGradients(m);
   BindAnalysis(m);
 #ifdef WOBBLE_PYTHON_RENDER
   BindRender(m);

@@ -395,7 +395,57 @@ def fit_dynamic(body: BodyModel | BodyModel3, times: ArrayLike, points: ArrayLik
                 damping: Optional[ArrayLike] = None, graph: Optional[PoseGraph] = None, options: WorldOptions = ...,
                 fit_q0: bool = True, fit_qd0: bool = True, fit_stiffness: bool = True, fit_damping: bool = True,
                 fit_poses: bool = False, fit_times: bool = False, switch_width: float = 0.05,
-                max_iterations: int = 50) -> DynamicFitResult: ...
+                max_iterations: int = 50, gradient: str = "jets") -> DynamicFitResult: ...
+
+class StageCost:
+    """l_n(q, qd) of one step with its gradient: a task term, a sum (a + b), or StageCost(fn) with
+    fn(n, q, qd) -> (value, dq, dqd)."""
+    def __init__(self, fn: Callable[[int, NDArray, NDArray], tuple[float, Optional[ArrayLike], Optional[ArrayLike]]]) -> None: ...
+    def __call__(self, n: int, q: ArrayLike, qd: ArrayLike) -> tuple[float, NDArray, NDArray]: ...
+    def __add__(self, other: StageCost) -> StageCost: ...
+
+def centre_of_mass_at(body: BodyModel, step: int, goal: ArrayLike, *, weight: float = 1.0, axes: str = "xy") -> StageCost: ...
+def centre_of_mass_velocity_at(body: BodyModel, step: int, goal: ArrayLike, *, weight: float = 1.0,
+                               axes: str = "xy") -> StageCost: ...
+def upright_at(step: int, *, weight: float = 1.0, time_scale: float = 0.0) -> StageCost: ...
+def still_at(step: int, *, weight: float = 1.0) -> StageCost: ...
+
+class RolloutGradient:
+    ok: bool
+    message: str
+    cost: float
+    q0: NDArray
+    qd0: NDArray
+    stiffness: NDArray
+    damping: NDArray
+    targets: NDArray
+    states_held: int
+
+def rollout_gradient(body: BodyModel, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
+                     q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
+                     stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None,
+                     checkpoint_interval: int = 0) -> RolloutGradient: ...
+def rollout_cost(body: BodyModel, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
+                 q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
+                 stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None) -> float: ...
+
+class SpacetimeResult:
+    ok: bool
+    message: str
+    knots: NDArray
+    targets: NDArray
+    initial_cost: float
+    cost: float
+    control_energy: float
+    iterations: int
+    gradients: int
+
+def fit_spacetime(body: BodyModel, task: StageCost, *, targets: ArrayLike, knots: int = 21, bound: float = 0.3,
+                  control_weight: float = 1.0, options: WorldOptions = ..., q0: Optional[ArrayLike] = None,
+                  qd0: Optional[ArrayLike] = None, stiffness: Optional[ArrayLike] = None,
+                  damping: Optional[ArrayLike] = None, max_iterations: int = 100) -> SpacetimeResult: ...
+def write_target_schedule(path: str, modes: Sequence[str], dt: float, targets: ArrayLike) -> None: ...
+def read_target_schedule(path: str, modes: Sequence[str], dt: float) -> NDArray: ...
 def fit_pose_to_curves(body: BodyModel, polylines: Sequence[ArrayLike], *, closed: bool = False,
                        initial_q: Optional[ArrayLike] = None, loss: str = "squared", loss_scale: float = 1.0,
                        prior_weight: float = 0.0, mode_bounds: tuple[float, float] = (-1.0, 1.0),

@@ -83,7 +83,8 @@ def test_fit_inputs_are_checked(table):
         wobble.fit_pose(table, pts, mass_points=[0, 1, 2], weights=[0, 1, 1])
 
 
-def test_a_dynamic_fit_recovers_what_generated_its_reference(table):
+@pytest.mark.parametrize("gradient", ["jets", "adjoint"])
+def test_a_dynamic_fit_recovers_what_generated_its_reference(table, gradient):
     # the reference: the table's own modes (table_modes.def) from a known start, no ground
     options = no_ground("thesis", 0.01)
     q0 = np.array([0, 100, 0.1, 0.2, -0.1, 0.1, 0.05])
@@ -100,7 +101,8 @@ def test_a_dynamic_fit_recovers_what_generated_its_reference(table):
     c = np.array([m.damping for m in table.modes])
     fit = wobble.fit_dynamic(table, times, np.array(points), list(range(table.num_points)), options=options,
                              q0=q0 + [2, -1, 0.01, 0.02, -0.02, 0.01, 0.02], qd0=qd0 + [-3, 2, 0.1, 0.1, 0.1, -0.1, 0.1],
-                             stiffness=1.4 * K, damping=0.6 * c + 1.0)
+                             stiffness=1.4 * K, damping=0.6 * c + 1.0, gradient=gradient,
+                             max_iterations=50 if gradient == "jets" else 500)  # BFGS takes ~20x LM's iterations
     assert fit.report.usable, fit.report.brief_report
     np.testing.assert_allclose(fit.params.q0, q0, atol=1e-6)
     np.testing.assert_allclose(fit.params.qd0, qd0, atol=1e-5)
@@ -109,6 +111,9 @@ def test_a_dynamic_fit_recovers_what_generated_its_reference(table):
     with pytest.raises(wobble.InputError, match="thesis"):
         wobble.fit_dynamic(table, times, np.array(points), list(range(table.num_points)),
                            options=wobble.WorldOptions(integrator="rk4"))
+    with pytest.raises(wobble.InputError, match="jets' or 'adjoint"):
+        wobble.fit_dynamic(table, times, np.array(points), list(range(table.num_points)), options=options,
+                           gradient="finite")
 
 
 def test_a_trajectory_fit_follows_the_frames(table):

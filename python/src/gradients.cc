@@ -1,0 +1,257 @@
+// Gradients through whole rollouts and spacetime control fits from Python (fit/adjoint.h,
+// fit/spacetime.h, issue 18), and the target schedule files that scripts play (`schedule`).
+// A stage cost is a StageCost: one of the task terms, a sum of them (`+`), or a Python callable
+// fn(n, q, qd) -> (value, dq, dqd) called with the GIL taken for each step.
+#include "support.h"
+
+#include <cmath>
+#include <memory>
+
+#include "wobble/core/errors.h"
+#include "wobble/fit/adjoint.h"
+#include "wobble/fit/spacetime.h"
+#include "wobble/formats/target_schedule.h"
+
+namespace wobble::python {
+namespace {
+
+struct StageCostHandle {
+  fit::StageCost cost;
+};
+
+// A Python callable as a stage cost. The function object is shared with a deleter that takes the
+// GIL, because the C++ side copies and drops std::functions on threads that do not hold it.
+fit::StageCost FromPython(py::function fn) {
+  std::shared_ptr<py::function> held(new py::function(std::move(fn)), [](py::function* f) {
+    py::gil_scoped_acquire gil;
+    delete f;
+  });
+  return [held](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq,
+                Eigen::VectorXd* dqd) -> double {
+    py::gil_scoped_acquire gil;
+    const py::object r = (*held)(n, q, qd);
+    if (!py::isinstance<py::tuple>(r) || py::len(r) != 3)
+      throw InputError("a stage cost must return (value, dq, dqd), got " + std::string(py::str(r)));
+    const py::tuple t = r.cast<py::tuple>();
+    const double value = t[0].cast<double>();
+    if (!std::isfinite(value)) throw InputError("a stage cost returned " + std::to_string(value) + " at step " + std::to_string(n));
+    const char* names[2] = {"dq", "dqd"};
+    Eigen::VectorXd* out[2] = {dq, dqd};
+    for (int i = 0; i < 2; ++i) {
+      if (t[i + 1].is_none()) continue;
+      const Eigen::VectorXd g = t[i + 1].cast<Eigen::VectorXd>();
+      if (g.size() != out[i]->size() || !g.allFinite())
+        throw InputError(std::string("a stage cost's ") + names[i] + " must be " + std::to_string(out[i]->size()) +
+                         " finite numbers (num_q)");
+      *out[i] += g;
+    }
+    return value;
+  };
+}
+
+fit::Axes AxesOf(const std::string& axes) {
+  if (axes != "x" && axes != "y" && axes != "xy") throw InputError("axes: expected 'x', 'y' or 'xy', got '" + axes + "'");
+  fit::Axes a;
+  a.x = axes.find('x') != std::string::npos;
+  a.y = axes.find('y') != std::string::npos;
+  return a;
+}
+
+Eigen::VectorXd VectorOr(const py::object& v, long n, const Eigen::VectorXd& otherwise, const std::string& what) {
+  if (v.is_none()) return otherwise;
+  auto a = AsMatrix(v, n, -1, what);
+  Eigen::VectorXd out = Eigen::Map<const Eigen::VectorXd>(a.data(), n);
+  if (!out.allFinite()) throw InputError(what + " must be finite");
+  return out;
+}
+
+// A rollout from the keyword arguments: the options' world, integrator and dt; the start (at
+// rest in the body frame by default); the gains (the body's own by default); the targets
+// (modes, steps).
+fit::ControlledRollout RolloutOf(const BodyModel& body, const WorldOptions& options, const py::object& targets,
+                                 const py::object& q0, const py::object& qd0, const py::object& stiffness,
+                                 const py::object& damping) {
+  const int nq = body.num_q(), D = body.num_modes();
+  fit::ControlledRollout r;
+  r.world = options.params;
+  r.integrator = options.integrator;
+  if (r.integrator != Integrator::kThesis && r.integrator != Integrator::kSymplecticEuler)
+    throw InputError("gradients need the thesis or the symplectic_euler integrator (options.integrator), got " +
+                     IntegratorName(r.integrator));
+  r.dt = options.dt;
+  r.q0 = VectorOr(q0, nq, Eigen::VectorXd::Zero(nq), "q0");
+  r.qd0 = VectorOr(qd0, nq, Eigen::VectorXd::Zero(nq), "qd0");
+  Eigen::VectorXd K(D), c(D);
+  for (int d = 0; d < D; ++d) K[d] = body.modes()[d].stiffness, c[d] = body.modes()[d].damping;
+  r.stiffness = VectorOr(stiffness, D, K, "stiffness");
+  r.damping = VectorOr(damping, D, c, "damping");
+  auto probe = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(targets);
+  if (!probe || probe.ndim() != 2 || probe.shape(0) != D || probe.shape(1) < 1)
+    throw InputError("targets: expected (modes, steps) = (" + std::to_string(D) + ", steps >= 1)");
+  r.targets = probe.cast<Eigen::MatrixXd>();
+  if (!r.targets.allFinite()) throw InputError("targets must be finite");
+  return r;
+}
+
+}  // namespace
+
+void BindGradients(py::module_& m) {
+  py::class_<StageCostHandle>(m, "StageCost",
+                              "A cost l_n(q, qd) of one step of a rollout with its gradient: a task term\n"
+                              "(centre_of_mass_at, upright_at, ...), a sum (a + b), or StageCost(fn) with a\n"
+                              "Python fn(n, q, qd) -> (value, dq, dqd) (dq, dqd: num_q arrays or None).")
+      .def(py::init([](py::function fn) { return StageCostHandle{FromPython(std::move(fn))}; }), py::arg("fn"))
+      .def(
+          "__call__",
+          [](const StageCostHandle& c, int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+            if (q.size() != qd.size()) throw InputError("q and qd must have the same size");
+            Eigen::VectorXd dq = Eigen::VectorXd::Zero(q.size()), dqd = Eigen::VectorXd::Zero(q.size());
+            const double value = c.cost(n, q, qd, &dq, &dqd);
+            return py::make_tuple(value, dq, dqd);
+          },
+          py::arg("n"), py::arg("q"), py::arg("qd"), "(value, dq, dqd) at step n")
+      .def("__add__", [](const StageCostHandle& a, const StageCostHandle& b) {
+        return StageCostHandle{fit::SumOf({a.cost, b.cost})};
+      });
+
+  m.def(
+      "centre_of_mass_at",
+      [](std::shared_ptr<BodyModel> body, int step, const Eigen::Vector2d& goal, double weight, const std::string& axes) {
+        try {
+          return StageCostHandle{fit::CentreOfMassAt(*body, step, goal, weight, AxesOf(axes))};
+        } catch (const std::invalid_argument& e) {
+          throw InputError(e.what());
+        }
+      },
+      py::arg("body"), py::arg("step"), py::arg("goal"), py::kw_only(), py::arg("weight") = 1.0, py::arg("axes") = "xy",
+      "w/2 |centre of mass at step n - goal|^2 on the axes asked for ('x', 'y', 'xy'): be there then");
+  m.def(
+      "centre_of_mass_velocity_at",
+      [](std::shared_ptr<BodyModel> body, int step, const Eigen::Vector2d& goal, double weight, const std::string& axes) {
+        try {
+          return StageCostHandle{fit::CentreOfMassVelocityAt(*body, step, goal, weight, AxesOf(axes))};
+        } catch (const std::invalid_argument& e) {
+          throw InputError(e.what());
+        }
+      },
+      py::arg("body"), py::arg("step"), py::arg("goal"), py::kw_only(), py::arg("weight") = 1.0, py::arg("axes") = "xy",
+      "w/2 |centre-of-mass velocity at step n - goal|^2 (goal 0 on 'y': the top of a hop)");
+  m.def(
+      "upright_at",
+      [](int step, double weight, double time_scale) {
+        try {
+          return StageCostHandle{fit::UprightAt(step, weight, time_scale)};
+        } catch (const std::invalid_argument& e) {
+          throw InputError(e.what());
+        }
+      },
+      py::arg("step"), py::kw_only(), py::arg("weight") = 1.0, py::arg("time_scale") = 0.0,
+      "w/2 (theta^2 + tau^2 thetadot^2) at step n: upright and not spinning");
+  m.def(
+      "still_at",
+      [](int step, double weight) {
+        try {
+          return StageCostHandle{fit::StillAt(step, weight)};
+        } catch (const std::invalid_argument& e) {
+          throw InputError(e.what());
+        }
+      },
+      py::arg("step"), py::kw_only(), py::arg("weight") = 1.0, "w/2 |qd|^2 at step n: at rest");
+
+  py::class_<fit::RolloutGradient>(m, "RolloutGradient", "A rollout's cost and its gradient with respect to every parameter.")
+      .def_readonly("ok", &fit::RolloutGradient::ok)
+      .def_readonly("message", &fit::RolloutGradient::message)
+      .def_readonly("cost", &fit::RolloutGradient::cost)
+      .def_readonly("q0", &fit::RolloutGradient::q0)
+      .def_readonly("qd0", &fit::RolloutGradient::qd0)
+      .def_readonly("stiffness", &fit::RolloutGradient::stiffness)
+      .def_readonly("damping", &fit::RolloutGradient::damping)
+      .def_readonly("targets", &fit::RolloutGradient::targets, "(modes, steps): d cost / d target of each step")
+      .def_readonly("states_held", &fit::RolloutGradient::states_held, "the most states held at once (checkpoints)");
+
+  m.def(
+      "rollout_gradient",
+      [](std::shared_ptr<BodyModel> body, const StageCostHandle& cost, const py::object& targets, const WorldOptions& options,
+         const py::object& q0, const py::object& qd0, const py::object& stiffness, const py::object& damping,
+         int checkpoint_interval) {
+        const fit::ControlledRollout r = RolloutOf(*body, options, targets, q0, qd0, stiffness, damping);
+        py::gil_scoped_release release;  // a Python stage cost takes it back for its own calls
+        return fit::RolloutCostGradient(*body, r, cost.cost, checkpoint_interval);
+      },
+      py::arg("body"), py::arg("cost"), py::kw_only(), py::arg("targets"), py::arg("options") = WorldOptions(),
+      py::arg("q0") = py::none(), py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(),
+      py::arg("damping") = py::none(), py::arg("checkpoint_interval") = 0,
+      "The cost sum_n l_n(q_n, qd_n) of a rollout of the 2D body (PD targets (modes, steps), one per\n"
+      "step; gains K, c per mode; options' world, dt and integrator: thesis or symplectic_euler) and its\n"
+      "gradient with respect to q0, qd0, K, c and every target, by one adjoint sweep (about 2-4\n"
+      "simulations whatever the number of parameters).");
+  m.def(
+      "rollout_cost",
+      [](std::shared_ptr<BodyModel> body, const StageCostHandle& cost, const py::object& targets, const WorldOptions& options,
+         const py::object& q0, const py::object& qd0, const py::object& stiffness, const py::object& damping) {
+        const fit::ControlledRollout r = RolloutOf(*body, options, targets, q0, qd0, stiffness, damping);
+        py::gil_scoped_release release;
+        return fit::RolloutCost(*body, r, cost.cost);
+      },
+      py::arg("body"), py::arg("cost"), py::kw_only(), py::arg("targets"), py::arg("options") = WorldOptions(),
+      py::arg("q0") = py::none(), py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(),
+      py::arg("damping") = py::none(), "The same rollout's cost alone (one plain simulation; inf when a step fails).");
+
+  py::class_<fit::SpacetimeResult>(m, "SpacetimeResult", "A spacetime fit's targets and costs.")
+      .def_readonly("ok", &fit::SpacetimeResult::ok)
+      .def_readonly("message", &fit::SpacetimeResult::message)
+      .def_readonly("knots", &fit::SpacetimeResult::knots, "(modes, knots)")
+      .def_readonly("targets", &fit::SpacetimeResult::targets, "(modes, steps): what a script's schedule plays")
+      .def_readonly("initial_cost", &fit::SpacetimeResult::initial_cost)
+      .def_readonly("cost", &fit::SpacetimeResult::cost)
+      .def_readonly("control_energy", &fit::SpacetimeResult::control_energy)
+      .def_readonly("iterations", &fit::SpacetimeResult::iterations)
+      .def_readonly("gradients", &fit::SpacetimeResult::gradients, "cost-and-gradient evaluations");
+
+  m.def(
+      "fit_spacetime",
+      [](std::shared_ptr<BodyModel> body, const StageCostHandle& task, const py::object& targets, int knots, double bound,
+         double control_weight, const WorldOptions& options, const py::object& q0, const py::object& qd0,
+         const py::object& stiffness, const py::object& damping, int max_iterations) {
+        fit::SpacetimeProblem p;
+        p.rollout = RolloutOf(*body, options, targets, q0, qd0, stiffness, damping);
+        p.knots = knots;
+        if (!(bound > 0) || !std::isfinite(bound)) throw InputError("bound must be a finite number > 0");
+        p.lower = Eigen::VectorXd::Constant(body->num_modes(), -bound);
+        p.upper = Eigen::VectorXd::Constant(body->num_modes(), bound);
+        if (!(control_weight >= 0) || !std::isfinite(control_weight)) throw InputError("control_weight must be >= 0");
+        p.control_weight = control_weight;
+        p.task = task.cost;
+        fit::SpacetimeOptions o;
+        o.max_iterations = max_iterations;
+        try {
+          return WithCtrlC([&] { return fit::FitSpacetime(*body, p, o); });
+        } catch (const std::invalid_argument& e) {
+          throw InputError(std::string("fit_spacetime: ") + e.what());
+        }
+      },
+      py::arg("body"), py::arg("task"), py::kw_only(), py::arg("targets"), py::arg("knots") = 21, py::arg("bound") = 0.3,
+      py::arg("control_weight") = 1.0, py::arg("options") = WorldOptions(), py::arg("q0") = py::none(),
+      py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(), py::arg("damping") = py::none(),
+      py::arg("max_iterations") = 100,
+      "Spacetime control (thesis 3.1 after Witkin & Kass): every mode's PD targets over the whole run,\n"
+      "at `knots` evenly spaced knots within +-bound, minimising control_weight * sum |target|^2 dt plus\n"
+      "the task, by L-BFGS on the adjoint gradient. targets (modes, steps): the first guess and the run's\n"
+      "length. Like `wobble fit spacetime`; write_target_schedule(result.targets) for a script's schedule.");
+
+  m.def(
+      "write_target_schedule",
+      [](const std::string& path, const std::vector<std::string>& modes, double dt, const Eigen::MatrixXd& targets) {
+        if (targets.rows() != long(modes.size()))
+          throw InputError("targets: expected one row per mode (" + std::to_string(modes.size()) + "), got " +
+                           std::to_string(targets.rows()));
+        if (!(dt > 0) || !targets.allFinite()) throw InputError("write_target_schedule: dt > 0 and finite targets");
+        formats::WriteTargetSchedule(path, modes, dt, targets);
+      },
+      py::arg("path"), py::arg("modes"), py::arg("dt"), py::arg("targets"),
+      "Writes targets (modes, steps) as the schedule file a script plays with `schedule FILE`.");
+  m.def("read_target_schedule", &formats::ReadTargetSchedule, py::arg("path"), py::arg("modes"), py::arg("dt"),
+        "Reads a schedule file (modes, steps); ParseError naming the file and line.");
+}
+
+}  // namespace wobble::python
