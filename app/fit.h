@@ -69,6 +69,9 @@ struct FitSpacetimeArgs {
   bool upright = false, still = false;
   double weight = 2000.0, bound = 0.3, effort = 1.0;
   int max_iterations = 300;
+  int starts = 1, threads = 0;  // multi-start (fit/spacetime.h: SpacetimeOptions)
+  double start_spread = 1.0;
+  unsigned seed = 1;
   std::string start;  // a schedule file to start from (continuation from an easier task)
   std::string targets, out;
 };

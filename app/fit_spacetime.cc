@@ -1,11 +1,14 @@
 // `wobble fit spacetime`: the PD targets of a whole motion (fit/spacetime.h) for a 2D object
 // from its start, with the task given as flags; the targets go to a schedule file that a
 // script plays with `schedule FILE` (formats/target_schedule.h).
+#include <unistd.h>
+
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "fit.h"
+#include "progress.h"
 #include "wobble/fit/spacetime.h"
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/csv.h"
@@ -42,7 +45,17 @@ CLI::App* AddFitSpacetimeCommand(CLI::App* fit, FitSpacetimeArgs* a) {
   c->add_option("--weight", a->weight, "Weight of every task term")->capture_default_str();
   c->add_option("--bound", a->bound, "Every target within +-BOUND")->capture_default_str();
   c->add_option("--effort", a->effort, "Weight of the control energy (sum of squared targets x dt)")->capture_default_str();
-  c->add_option("--max-iterations", a->max_iterations, "L-BFGS iterations")->capture_default_str();
+  c->add_option("--max-iterations", a->max_iterations, "L-BFGS iterations (of each start)")->capture_default_str();
+  c->add_option("--starts", a->starts,
+                "Multi-start: descend from this many first guesses, the given one and the rest perturbed at random; "
+                "the lowest cost wins")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  c->add_option("--start-spread", a->start_spread,
+                "Perturbation of the further starts (standard deviation on each knot's logistic coordinate: 1 moves "
+                "a mid-range target by about a quarter of the bounds' span)")
+      ->capture_default_str()->check(CLI::NonNegativeNumber);
+  c->add_option("--seed", a->seed, "Seed of the perturbations (a fit repeats exactly)")->capture_default_str();
+  c->add_option("--threads", a->threads, "Threads sharing the starts (0: every core)")->capture_default_str();
   c->add_option("--start", a->start, "Start from these targets (a --targets file of the same object and --dt; "
                                      "default zero): continue from an easier task's solution")
       ->type_name("FILE.csv");
@@ -133,9 +146,19 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
 
   fit::SpacetimeOptions o;
   o.max_iterations = a.max_iterations;
-  o.on_iteration = IterationLine();
+  o.starts = a.starts;
+  o.start_spread = a.start_spread;
+  o.seed = a.seed;
+  o.threads = a.threads;
+  Progress bar(isatty(STDERR_FILENO) == 1, "best cost");
+  if (a.starts == 1) {
+    o.on_iteration = IterationLine();
+  } else {
+    o.on_start = [&bar](int done, int starts, double best) { bar.Update(double(done) / starts, best); };
+  }
   const fit::SpacetimeResult r = fit::FitSpacetime(body, p, o);
-  EndIterationLine();
+  if (a.starts == 1) EndIterationLine();
+  bar.Finish();
 
   if (!a.targets.empty()) formats::WriteTargetSchedule(a.targets, names, a.dt, r.targets);
   nlohmann::json j;
@@ -152,6 +175,10 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
   j["control_energy"] = r.control_energy;
   j["iterations"] = r.iterations;
   j["gradients"] = r.gradients;
+  if (a.starts > 1) {
+    j["starts"] = {{"count", a.starts}, {"spread", a.start_spread}, {"seed", a.seed}, {"best", r.best_start},
+                   {"costs", r.start_costs}};
+  }
   j["knots"] = nlohmann::json::array();
   for (int k = 0; k < r.knots.cols(); ++k) {
     nlohmann::json col = nlohmann::json::array();
@@ -162,6 +189,7 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
   std::cout << body.name() << ": spacetime fit of " << D << " x " << a.knots << " knot targets over " << steps
             << " steps: " << r.message << "\ncost " << r.initial_cost << " -> " << r.cost << " (control energy "
             << r.control_energy << ") with " << r.gradients << " gradients.";
+  if (a.starts > 1) std::cout << "\nbest of " << a.starts << " starts: start " << r.best_start;
   if (!a.targets.empty()) std::cout << "\ntargets: " << a.targets << " (a script plays them with `schedule`)";
   std::cout << std::endl;
   if (!r.ok) {

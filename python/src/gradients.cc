@@ -206,13 +206,16 @@ void BindGradients(py::module_& m) {
       .def_readonly("cost", &fit::SpacetimeResult::cost)
       .def_readonly("control_energy", &fit::SpacetimeResult::control_energy)
       .def_readonly("iterations", &fit::SpacetimeResult::iterations)
-      .def_readonly("gradients", &fit::SpacetimeResult::gradients, "cost-and-gradient evaluations");
+      .def_readonly("gradients", &fit::SpacetimeResult::gradients, "cost-and-gradient evaluations, all starts")
+      .def_readonly("best_start", &fit::SpacetimeResult::best_start)
+      .def_readonly("start_costs", &fit::SpacetimeResult::start_costs, "every start's final cost (NaN: failed)");
 
   m.def(
       "fit_spacetime",
       [](std::shared_ptr<BodyModel> body, const StageCostHandle& task, const py::object& targets, int knots, double bound,
          double control_weight, const WorldOptions& options, const py::object& q0, const py::object& qd0,
-         const py::object& stiffness, const py::object& damping, int max_iterations) {
+         const py::object& stiffness, const py::object& damping, int max_iterations, int starts, double start_spread,
+         unsigned seed, int threads) {
         fit::SpacetimeProblem p;
         p.rollout = RolloutOf(*body, options, targets, q0, qd0, stiffness, damping);
         p.knots = knots;
@@ -224,6 +227,10 @@ void BindGradients(py::module_& m) {
         p.task = task.cost;
         fit::SpacetimeOptions o;
         o.max_iterations = max_iterations;
+        o.starts = starts;
+        o.start_spread = start_spread;
+        o.seed = seed;
+        o.threads = threads;
         try {
           return WithCtrlC([&] { return fit::FitSpacetime(*body, p, o); });
         } catch (const std::invalid_argument& e) {
@@ -233,11 +240,14 @@ void BindGradients(py::module_& m) {
       py::arg("body"), py::arg("task"), py::kw_only(), py::arg("targets"), py::arg("knots") = 21, py::arg("bound") = 0.3,
       py::arg("control_weight") = 1.0, py::arg("options") = WorldOptions(), py::arg("q0") = py::none(),
       py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(), py::arg("damping") = py::none(),
-      py::arg("max_iterations") = 100,
+      py::arg("max_iterations") = 100, py::arg("starts") = 1, py::arg("start_spread") = 1.0, py::arg("seed") = 1u,
+      py::arg("threads") = 0,
       "Spacetime control (thesis 3.1 after Witkin & Kass): every mode's PD targets over the whole run,\n"
       "at `knots` evenly spaced knots within +-bound, minimising control_weight * sum |target|^2 dt plus\n"
       "the task, by L-BFGS on the adjoint gradient. targets (modes, steps): the first guess and the run's\n"
-      "length. Like `wobble fit spacetime`; write_target_schedule(result.targets) for a script's schedule.");
+      "length. starts > 1: multi-start, the further starts perturbed by a seeded Gaussian of start_spread on\n"
+      "each knot's logistic coordinate, run on `threads` (0: every core), the lowest cost wins (best_start,\n"
+      "start_costs). Like `wobble fit spacetime`; write_target_schedule(result.targets) for a script's schedule.");
 
   m.def(
       "write_target_schedule",

@@ -439,11 +439,14 @@ class SpacetimeResult:
     control_energy: float
     iterations: int
     gradients: int
+    best_start: int
+    start_costs: list[float]
 
 def fit_spacetime(body: BodyModel, task: StageCost, *, targets: ArrayLike, knots: int = 21, bound: float = 0.3,
                   control_weight: float = 1.0, options: WorldOptions = ..., q0: Optional[ArrayLike] = None,
                   qd0: Optional[ArrayLike] = None, stiffness: Optional[ArrayLike] = None,
-                  damping: Optional[ArrayLike] = None, max_iterations: int = 100) -> SpacetimeResult: ...
+                  damping: Optional[ArrayLike] = None, max_iterations: int = 100, starts: int = 1,
+                  start_spread: float = 1.0, seed: int = 1, threads: int = 0) -> SpacetimeResult: ...
 def write_target_schedule(path: str, modes: Sequence[str], dt: float, targets: ArrayLike) -> None: ...
 def read_target_schedule(path: str, modes: Sequence[str], dt: float) -> NDArray: ...
 def fit_pose_to_curves(body: BodyModel, polylines: Sequence[ArrayLike], *, closed: bool = False,

@@ -87,3 +87,26 @@ def test_a_spacetime_hop_played_by_a_script(tmp_path):
     miss = np.sqrt(wobble.centre_of_mass_at(body, 70, [0, rest + 2], weight=2.0, axes="y")(70, q, np.zeros(7))[0])
     assert contacts[at(0.7)] == 0 and miss < 0.05  # in the air, the centre of mass where the task wants it
     assert contacts[at(2.5)] > 0                    # and down again (the task ends at 1 s; it lands at 2.45 s)
+
+
+def test_multi_start_with_a_python_stage_cost_on_two_threads(table):
+    # the starts run on two threads, each taking the GIL for the Python term's calls; the fit is
+    # the one the built-in term gives on one thread
+    kw, cost = air_problem(table)
+    w = 2e-3
+
+    def still_at_15(n, q, qd):
+        if n != 15:
+            return 0.0, None, None
+        return 0.5 * w * qd @ qd, None, w * qd
+
+    common = dict(knots=6, bound=0.3, max_iterations=15, starts=3, seed=7, **kw)
+    mine = wobble.fit_spacetime(table, cost + wobble.StageCost(still_at_15), threads=2, **common)
+    built_in = wobble.fit_spacetime(table, cost + wobble.still_at(15, weight=w), threads=1, **common)
+    assert mine.ok and built_in.ok
+    assert len(mine.start_costs) == 3 and mine.cost == min(mine.start_costs) == mine.start_costs[mine.best_start]
+    assert mine.best_start == built_in.best_start
+    np.testing.assert_allclose(mine.start_costs, built_in.start_costs, rtol=1e-8)
+    np.testing.assert_allclose(mine.knots, built_in.knots, rtol=1e-6, atol=1e-9)
+    with pytest.raises(wobble.InputError, match="starts"):
+        wobble.fit_spacetime(table, cost, starts=0, **{k: v for k, v in common.items() if k != "starts"})

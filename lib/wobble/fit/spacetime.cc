@@ -5,7 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <mutex>
+#include <random>
 #include <stdexcept>
+
+#include "wobble/core/parallel.h"
 
 namespace wobble::fit {
 
@@ -212,19 +218,11 @@ double SpacetimeCostOf(const BodyModel& body, const SpacetimeProblem& problem, c
   return RolloutCost(body, r, problem.task) + problem.control_weight * r.dt * r.targets.squaredNorm();
 }
 
-SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem, const SpacetimeOptions& options) {
-  CheckProblem(body, problem);
-  const int D = body.num_modes(), steps = problem.rollout.steps();
-  // the first guess: the given targets at the knots, kept inside the bounds
-  Eigen::VectorXd x(D * problem.knots);
-  for (int j = 0; j < problem.knots; ++j) {
-    const int n = std::min(steps - 1, int(std::lround(double(j) * steps / (problem.knots - 1))));
-    for (int d = 0; d < D; ++d) {
-      const double span = problem.upper[d] - problem.lower[d];
-      const double s = std::clamp((problem.rollout.targets(d, n) - problem.lower[d]) / span, 1e-3, 1.0 - 1e-3);
-      x[j * D + d] = std::log(s / (1.0 - s));
-    }
-  }
+namespace {
+
+// One L-BFGS descent from x (the logistic coordinates of the knots); `progress` may be null.
+SpacetimeResult DescendFrom(const BodyModel& body, const SpacetimeProblem& problem, int max_iterations,
+                            Eigen::VectorXd x, ceres::IterationCallback* progress) {
   SpacetimeResult r;
   auto* cost = new SpacetimeCost(body, problem, &r.gradients);
   ceres::GradientProblem ceres_problem(cost);  // owns cost
@@ -236,24 +234,81 @@ SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& prob
   r.initial_cost = first;
   ceres::GradientProblemSolver::Options o;
   o.line_search_direction_type = ceres::LBFGS;
-  o.max_num_iterations = options.max_iterations;
+  o.max_num_iterations = max_iterations;
   // the logistic map flattens near a bound: Ceres' default tolerances (1e-6 on the cost's
   // relative change) stop there long before the optimum
   o.function_tolerance = 1e-12;
   o.gradient_tolerance = 1e-14;
   o.parameter_tolerance = 1e-14;  // x starts at 0 (targets mid-range): a relative test stops at once
   o.logging_type = ceres::SILENT;
-  Progress progress(options);
-  o.callbacks.push_back(&progress);
+  if (progress) o.callbacks.push_back(progress);
   ceres::GradientProblemSolver::Summary summary;
   ceres::Solve(o, ceres_problem, x.data(), &summary);
   r.knots = cost->Knots(x.data());
-  r.targets = KnotTargets(r.knots, steps);
+  r.targets = KnotTargets(r.knots, problem.rollout.steps());
   r.control_energy = cost->ControlEnergy(r.targets);
   r.cost = summary.final_cost;
   r.iterations = int(summary.iterations.size());
   r.message = summary.BriefReport();
   r.ok = summary.IsSolutionUsable();
+  return r;
+}
+
+}  // namespace
+
+SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem, const SpacetimeOptions& options) {
+  CheckProblem(body, problem);
+  if (options.starts < 1) throw std::invalid_argument("spacetime fit: starts must be >= 1");
+  if (!(options.start_spread >= 0.0) || !std::isfinite(options.start_spread))
+    throw std::invalid_argument("spacetime fit: the start spread must be >= 0");
+  const int D = body.num_modes(), steps = problem.rollout.steps();
+  // the first guess: the given targets at the knots, kept inside the bounds
+  Eigen::VectorXd x0(D * problem.knots);
+  for (int j = 0; j < problem.knots; ++j) {
+    const int n = std::min(steps - 1, int(std::lround(double(j) * steps / (problem.knots - 1))));
+    for (int d = 0; d < D; ++d) {
+      const double span = problem.upper[d] - problem.lower[d];
+      const double s = std::clamp((problem.rollout.targets(d, n) - problem.lower[d]) / span, 1e-3, 1.0 - 1e-3);
+      x0[j * D + d] = std::log(s / (1.0 - s));
+    }
+  }
+  if (options.starts == 1) {
+    Progress progress(options);
+    return DescendFrom(body, problem, options.max_iterations, x0, &progress);
+  }
+  // Multi-start: start k perturbs the first guess by its own seeded generator, so the result
+  // does not depend on which thread ran which start.
+  std::vector<SpacetimeResult> runs(size_t(options.starts));
+  std::mutex done_mutex;
+  int done = 0;
+  double best = std::numeric_limits<double>::infinity();
+  ParallelFor(runs.size(), options.threads, [&](size_t k) {
+    Eigen::VectorXd x = x0;
+    if (k > 0) {
+      std::seed_seq seq{uint64_t(options.seed), uint64_t(k)};
+      std::mt19937_64 generator(seq);
+      std::normal_distribution<double> normal(0.0, options.start_spread);
+      for (Eigen::Index i = 0; i < x.size(); ++i) x[i] += normal(generator);
+    }
+    runs[k] = DescendFrom(body, problem, options.max_iterations, x, nullptr);
+    std::lock_guard<std::mutex> lock(done_mutex);
+    ++done;
+    if (runs[k].ok) best = std::min(best, runs[k].cost);
+    if (options.on_start) options.on_start(done, options.starts, best);
+  });
+  // the lowest usable cost wins; ties go to the lower start index
+  size_t winner = 0;
+  for (size_t k = 1; k < runs.size(); ++k)
+    if (runs[k].ok && (!runs[winner].ok || runs[k].cost < runs[winner].cost)) winner = k;
+  SpacetimeResult r = runs[winner];
+  r.best_start = int(winner);
+  r.initial_cost = runs[0].initial_cost;  // the given first guess's
+  r.gradients = 0;
+  r.start_costs.clear();
+  for (const SpacetimeResult& run : runs) {
+    r.gradients += run.gradients;
+    r.start_costs.push_back(run.ok ? run.cost : std::numeric_limits<double>::quiet_NaN());
+  }
   return r;
 }
 

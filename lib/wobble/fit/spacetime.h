@@ -29,8 +29,18 @@ struct SpacetimeProblem {
 };
 
 struct SpacetimeOptions {
-  int max_iterations = 100;
-  std::function<void(int iteration, double cost)> on_iteration;  // progress display
+  int max_iterations = 100;  // per start
+  // Multi-start, against local minima: start 0 is the problem's first guess, start k > 0 the
+  // same plus N(0, start_spread²) on each knot's logistic coordinate x (±1 moves a mid-range
+  // target by about a quarter of its span), from a generator seeded by (seed, k), so a fit
+  // repeats bit for bit on any number of threads. The starts share `threads` (0: every core);
+  // the lowest final cost wins.
+  int starts = 1;
+  double start_spread = 1.0;
+  unsigned seed = 1;
+  int threads = 0;
+  std::function<void(int iteration, double cost)> on_iteration;  // progress of a single start
+  std::function<void(int done, int starts, double best)> on_start;  // progress of a multi-start
 };
 
 struct SpacetimeResult {
@@ -40,7 +50,9 @@ struct SpacetimeResult {
   Eigen::MatrixXd targets; // modes × steps, the rollout's targets
   double initial_cost = 0.0, cost = 0.0, control_energy = 0.0;
   int iterations = 0;
-  long gradients = 0;      // cost-and-gradient evaluations (one simulation + one adjoint sweep each)
+  long gradients = 0;      // cost-and-gradient evaluations (one simulation + one adjoint sweep each), all starts
+  int best_start = 0;               // which start won (message, iterations are its)
+  std::vector<double> start_costs;  // every start's final cost (NaN: it failed); empty for one start
 };
 
 // The targets of each step from knots (modes × knots): linear between evenly spaced knots,
