@@ -22,6 +22,8 @@
 namespace wobble {
 namespace {
 
+using testing::Box;
+
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
@@ -300,8 +302,9 @@ TEST(Body3, PointGroupsFindExactlyThePointsBelowTheGround) {
     s.t = Vector3d(n(rng), n(rng), n(rng)) * 60.0;
     const Frame3<double> frame(s.t, s.orientation);
     std::vector<int> visited, below;
-    ForEachPointInContact3(body, g, s, frame, [&](int k, const Vector3d&, const Vector3d&, const Vector3d&,
-                                                  const Vector3d&) { visited.push_back(k); }, ContactSet::kDetect);
+    ForEachPointInContact3(body, g, s, frame, [&](int k, int, const GroundPlane&, const Vector3d&, const Vector3d&,
+                                                  const Vector3d&, const Vector3d&) { visited.push_back(k); },
+                           ContactSet::kDetect);
     for (int k = 0; k < body.num_points(); ++k) {
       const PointKinematics p = DirectPoint(body, k, s.gamma);
       if (g.Height(Vector3d(frame.t + frame.R * p.l)) < 0.0) below.push_back(k);
@@ -311,18 +314,6 @@ TEST(Body3, PointGroupsFindExactlyThePointsBelowTheGround) {
     found += int(below.size());
   }
   EXPECT_GT(found, 1000);  // the states do reach into the ground
-}
-
-// A box of eight corner masses with unequal sides: principal axes along the lattice axes,
-// centre of mass away from the body origin (the lattice corner).
-BodyModel3 Box(double a, double b, double c, double mass = 1.0) {
-  BodyDef3 def;
-  def.name = "box";
-  def.lattice = Lattice3(Vector3d::Zero(), {Vector3d(a, 0, 0), Vector3d(0, b, 0), Vector3d(0, 0, c)}, {2, 2, 2},
-                         BasisKind::kBernstein);
-  for (int i = 0; i < 8; ++i) def.mass_positions.push_back(Vector3d(a * (i & 1), b * ((i >> 1) & 1), c * ((i >> 2) & 1)));
-  def.masses.assign(8, mass);
-  return BodyModel3(def, {});
 }
 
 // Spinning about its centre of mass (ṫ chosen so the centre stays put), no gravity.

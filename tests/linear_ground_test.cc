@@ -119,8 +119,9 @@ TEST(LinearGround, BlockAtRestOnEachFaceOfAValley) {
     EXPECT_LT(std::abs(f.tau.dot(CentreOfMass(w, b)) - s1), 1e-6);  // a slide would go metres
     const std::vector<Eigen::Vector2d> per_face = ForcePerFace(w, b);
     const double weight = 6.0 * kG;
-    for (int i = 0; i < int(per_face.size()); ++i)
+    for (int i = 0; i < int(per_face.size()); ++i) {
       if (i != face) EXPECT_EQ(per_face[i], Eigen::Vector2d::Zero()) << "face " << i;
+    }
     EXPECT_NEAR(per_face[face].dot(f.n), weight * std::cos(alpha), 1e-6 * weight);
     EXPECT_NEAR(per_face[face].dot(f.tau), side * weight * std::sin(alpha), 1e-6 * weight);  // up the face
   }
@@ -178,29 +179,40 @@ TEST(LinearGround, SlidesDownASlopeFaceAboveItsFrictionCap) {
   EXPECT_NEAR((v2 - v1) / 2.0, a, 1e-3 * a);
 }
 
-// The same in 3D on a plane tilted 30° about z, with the plane's cap tan 20° (damping as below).
+// The same in 3D on a plane tilted 30° about z, with the plane's cap tan 20° (damping as below);
+// and on that plane given as a heightfield of triangles 0.25 wide (the block crosses dozens).
 TEST(LinearGround, SlidesDownATiltedPlaneIn3D) {
   const double alpha = 30 * kPi / 180, mu = std::tan(20 * kPi / 180);
-  WorldOptions o;
-  o.dt = 0.0005;
-  o.ground_3d.enabled = true;
-  o.ground_3d.normal = Eigen::Vector3d(std::sin(alpha), std::cos(alpha), 0);
-  o.ground_3d.friction_cap = mu;
-  o.ground_3d.normal_damping = 100;
-  o.ground_3d.friction_damping = 500;
-  World w(o);
-  const int b = w.AddLinearBody(Block(1, 0.5, 3), Stiff());
-  w.SetGroundContact(b, true);
-  const Eigen::Matrix3d turn = Eigen::AngleAxisd(-alpha, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  w.SetLinearState(b, w.linear_model(b).PlacedState(turn, 0.5 * o.ground_3d.normal), Eigen::MatrixXd::Zero(3, 4));
-  const Eigen::Vector3d down_slope(std::cos(alpha), -std::sin(alpha), 0);
-  ASSERT_TRUE(w.RunUntil(2.0)) << w.status().message;
-  const double v1 = down_slope.dot(CentreOfMassVelocity(w, b));
-  ASSERT_TRUE(w.RunUntil(4.0)) << w.status().message;
-  const double v2 = down_slope.dot(CentreOfMassVelocity(w, b));
-  const double a = kG * (std::sin(alpha) - mu * std::cos(alpha));
-  EXPECT_NEAR((v2 - v1) / 2.0, a, 1e-3 * a);
-  EXPECT_EQ(w.linear_contacts(b).list3.size(), 9u);  // the bottom face's 3 × 3 points
+  for (bool heightfield : {false, true}) {
+    WorldOptions o;
+    o.dt = 0.0005;
+    o.ground_3d.enabled = true;
+    o.ground_3d.normal = Eigen::Vector3d(std::sin(alpha), std::cos(alpha), 0);
+    o.ground_3d.friction_cap = mu;
+    o.ground_3d.normal_damping = 100;
+    o.ground_3d.friction_damping = 500;
+    if (heightfield) {
+      const int nx = 161, nz = 25;
+      std::vector<double> h;
+      for (int j = 0; j < nz; ++j)
+        for (int i = 0; i < nx; ++i) h.push_back(-std::tan(alpha) * (-10.0 + 0.25 * i));
+      o.ground_3d.heightfield = Heightfield::Make({-10.0, -3.0}, {0.25, 0.25}, nx, nz, h);
+    }
+    World w(o);
+    const int b = w.AddLinearBody(Block(1, 0.5, 3), Stiff());
+    w.SetGroundContact(b, true);
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(-alpha, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    w.SetLinearState(b, w.linear_model(b).PlacedState(turn, 0.5 * o.ground_3d.normal), Eigen::MatrixXd::Zero(3, 4));
+    const Eigen::Vector3d down_slope(std::cos(alpha), -std::sin(alpha), 0);
+    ASSERT_TRUE(w.RunUntil(2.0)) << w.status().message;
+    const double v1 = down_slope.dot(CentreOfMassVelocity(w, b));
+    ASSERT_TRUE(w.RunUntil(4.0)) << w.status().message;
+    const double v2 = down_slope.dot(CentreOfMassVelocity(w, b));
+    const double a = kG * (std::sin(alpha) - mu * std::cos(alpha));
+    EXPECT_NEAR((v2 - v1) / 2.0, a, 1e-3 * a) << (heightfield ? "heightfield" : "plane");
+    EXPECT_EQ(w.linear_contacts(b).list3.size(), 9u);  // the bottom face's 3 × 3 points
+    if (heightfield) EXPECT_GT(CentreOfMass(w, b).x(), 8.0) << "slid over dozens of triangles";
+  }
 }
 
 // 3D, flat: the bottom face's nine points each carry a ninth of the weight. The 3D tests damp

@@ -142,4 +142,16 @@ inline BodyModel3 Chair3() {
   return BodyModel3(def, modes);
 }
 
+// A 3D box of eight corner masses with unequal sides: principal axes along the lattice axes,
+// centre of mass away from the body origin (the lattice corner).
+inline BodyModel3 Box(double a, double b, double c, double mass = 1.0) {
+  BodyDef3 def;
+  def.name = "box";
+  def.lattice = Lattice3(Eigen::Vector3d::Zero(), {Eigen::Vector3d(a, 0, 0), Eigen::Vector3d(0, b, 0), Eigen::Vector3d(0, 0, c)},
+                         {2, 2, 2}, BasisKind::kBernstein);
+  for (int i = 0; i < 8; ++i) def.mass_positions.push_back(Eigen::Vector3d(a * (i & 1), b * ((i >> 1) & 1), c * ((i >> 2) & 1)));
+  def.masses.assign(8, mass);
+  return BodyModel3(def, {});
+}
+
 }  // namespace wobble::testing

@@ -41,6 +41,10 @@ bool ClearOf(const LinearBodyModel& m, const Ground& g, const Eigen::MatrixXd& R
 
 bool ClearOf(const LinearBodyModel& m, const GroundPlane& g, const Eigen::MatrixXd& R) {
   double along_n[10];
+  if (g.heightfield) {  // above the highest node
+    for (int j = 0; j < m.basis_size(); ++j) along_n[j] = R(1, j);
+    return LowerBound(m, along_n) >= g.heightfield->max_height();
+  }
   for (int j = 0; j < m.basis_size(); ++j) along_n[j] = g.normal.dot(R.col(j));
   return LowerBound(m, along_n) - g.normal.dot(g.point) >= 0.0;
 }
@@ -70,20 +74,20 @@ void ForEachContact2(const LinearBodyModel& m, const Ground& g, const Eigen::Mat
   }
 }
 
-// Visits every point below the plane as f(k, p, x, v, anchor).
+// Visits every point below the 3D ground (plane or heightfield) as f(k, p, x, v, anchor, face,
+// face_index), once per face it feels (ForEachFaceFelt3 of step3.h, the FFD bodies' rules).
 template <class F>
 void ForEachContact3(const LinearBodyModel& m, const GroundPlane& g, const Eigen::MatrixXd& R,
                      const Eigen::MatrixXd& R_dot, const std::vector<Contact3<double>>& contacts, F&& f) {
   if (!g.enabled || ClearOf(m, g, R)) return;
   const Eigen::MatrixXd& P = m.point_bases();
-  auto existing = contacts.begin();
   for (int k = 0; k < m.num_points(); ++k) {
     const double* p = P.col(k).data();
     const Vec3<double> x = Times<3>(R, p);
-    if (!(g.Height(x) < 0.0)) continue;
-    while (existing != contacts.end() && existing->point < k) ++existing;
-    const bool touching = existing != contacts.end() && existing->point == k;
-    f(k, p, x, Times<3>(R_dot, p), touching ? existing->anchor : Vec3<double>(x - g.Height(x) * g.normal));
+    ForEachFaceFelt3(g, x, [&] { return ContactsOfPoint3(contacts, k); },
+                     [&](int face_index, const GroundPlane& face, const Vec3<double>& anchor) {
+                       f(k, p, x, Times<3>(R_dot, p), anchor, face, face_index);
+                     });
   }
 }
 
@@ -105,9 +109,8 @@ void AddLinearGroundForce(const LinearBodyModel& model, const LinearGround& g, c
     return;
   }
   ForEachContact3(model, g.plane, R, R_dot, contacts.list3,
-                  [&](int, const double* p, const Vec3<double>& x, const Vec3<double>& v, const Vec3<double>& anchor) {
-                    AddPointForce<3>(GroundForce3(g.plane, x, v, anchor, &slipping), p, Q);
-                  });
+                  [&](int, const double* p, const Vec3<double>& x, const Vec3<double>& v, const Vec3<double>& anchor,
+                      const GroundPlane& face, int) { AddPointForce<3>(GroundForce3(face, x, v, anchor, &slipping), p, Q); });
 }
 
 void UpdateLinearContacts(const LinearBodyModel& model, const LinearGround& g, const Eigen::MatrixXd& R,
@@ -130,12 +133,13 @@ void UpdateLinearContacts(const LinearBodyModel& model, const LinearGround& g, c
     thread_local std::vector<Contact3<double>> next;
     next.clear();
     ForEachContact3(model, g.plane, R, R_dot, contacts->list3,
-                    [&](int k, const double*, const Vec3<double>& x, const Vec3<double>& v, Vec3<double> anchor) {
+                    [&](int k, const double*, const Vec3<double>& x, const Vec3<double>& v, Vec3<double> anchor,
+                        const GroundPlane& face, int face_index) {
                       bool slipping;
-                      Vec3<double> f = GroundForce3(g.plane, x, v, anchor, &slipping);
-                      if (slipping) SlipAnchor3(g.plane, x, v, &anchor, &f);
-                      next.push_back({k, anchor});
-                      deepest = std::max(deepest, -g.plane.Height(x));
+                      Vec3<double> f = GroundForce3(face, x, v, anchor, &slipping);
+                      if (slipping) SlipAnchor3(face, x, v, &anchor, &f);
+                      next.push_back({k, anchor, face_index});
+                      deepest = std::max(deepest, -face.Height(x));
                     });
     contacts->list3.swap(next);
   }
@@ -165,7 +169,8 @@ std::vector<Eigen::VectorXd> LinearContactForces(const LinearBodyModel& model, c
   }
   for (const Contact3<double>& c : contacts.list3) {
     const double* p = P.col(c.point).data();
-    forces.push_back(GroundForce3(g.plane, Times<3>(R, p), Times<3>(R_dot, p), c.anchor, &slipping));
+    const Vec3<double> x = Times<3>(R, p);
+    forces.push_back(GroundForce3(g.plane.Face(c.face, x), x, Times<3>(R_dot, p), c.anchor, &slipping));
   }
   return forces;
 }

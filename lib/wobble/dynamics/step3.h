@@ -20,22 +20,33 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <type_traits>
 #include <vector>
 
 #include "wobble/body/body_model.h"
+#include "wobble/dynamics/heightfield.h"
 #include "wobble/dynamics/kinematics3.h"
 #include "wobble/dynamics/step.h"
 
 namespace wobble {
 
-// A plane of any normal with the ground constants of the 2D Ground (forces.h).
+// The 3D ground: a plane of any normal, or a heightfield in its place (heightfield.h), with the
+// ground constants of the 2D Ground (forces.h).
 struct GroundPlane {
   bool enabled = false;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  // unit, pointing out of the ground
   double stiffness = 4500.0, normal_damping = 550.0, friction_damping = 50.0, friction_cap = 0.1;
+  std::shared_ptr<const Heightfield> heightfield;  // when set, the ground (point and normal unused)
   template <class T> T Height(const Vec3<T>& x) const { return normal.cast<T>().dot(x - point.cast<T>()); }
+  // Face f's plane near x with these constants: the plane itself (face 0) or a heightfield face.
+  GroundPlane Face(int f, const Eigen::Vector3d& x) const {
+    GroundPlane p = *this;
+    p.heightfield = nullptr;
+    if (heightfield) heightfield->FacePlane(f, x, &p.point, &p.normal);
+    return p;
+  }
 };
 
 // A damped spring from a world anchor to a point of the body given by lattice coordinates
@@ -70,7 +81,11 @@ struct WorldParams3 {
 template <class T> struct Contact3 {
   int point;
   Vec3<T> anchor;  // where the point entered the ground (slides when friction is capped)
+  int face = 0;    // which face (a heightfield's; 0 on a plane): one contact per (point, face)
 };
+template <class T> bool ContactBefore3(const Contact3<T>& a, const Contact3<T>& b) {
+  return a.point < b.point || (a.point == b.point && a.face < b.face);
+}
 
 // The mutable half of a 3D body: translation, orientation, mode amplitudes, v = [ṫ, ω, γ̇].
 template <class T> struct BodyState3 {
@@ -116,28 +131,76 @@ template <class T> struct ForceBreakdown3 {
   VecQ3<T> gravity, modes, ground, springs, total;
 };
 
-// Which points the ground acts on during an evaluation (ContactSet of the 2D body).
+// The faces a point x of the body feels, f(face, plane, anchor) with the face's plane: on a
+// plane, the plane when x is below it; on a heightfield, Heightfield::FacesFelt's. The anchor
+// is that of the point's contact on the face — contacts_of_k() gives the range of the point's
+// contacts, asked for only when x is below the ground — or, on a face the point had no contact
+// with, the anchor of the face it leaves projected onto the new one (friction holds across the
+// edges between triangles), else the point's foot on the face. Shared by FFD and linear bodies.
+template <class T, class ContactsOf, class F>
+void ForEachFaceFelt3(const GroundPlane& g, const Vec3<T>& x, ContactsOf&& contacts_of_k, F&& f) {
+  if (!g.heightfield) {
+    const T h = g.Height(x);
+    if (!(ScalarValue(h) < 0.0)) return;
+    const auto [first, last] = contacts_of_k();
+    f(0, g, first != last ? first->anchor : Vec3<T>(x - h * g.normal.cast<T>()));
+    return;
+  }
+  const Heightfield& field = *g.heightfield;
+  const Eigen::Vector3d xd(ScalarValue(x.x()), ScalarValue(x.y()), ScalarValue(x.z()));
+  if (!(xd.y() < field.max_height())) return;
+  thread_local std::vector<int> faces;
+  faces.clear();
+  field.FacesFelt(xd, &faces);
+  if (faces.empty()) return;
+  const auto [first, last] = contacts_of_k();
+  for (int face : faces) {
+    const GroundPlane plane = g.Face(face, xd);
+    const Vec3<T> n = plane.normal.template cast<T>();
+    const auto same = std::find_if(first, last, [face](const auto& c) { return c.face == face; });
+    if (same != last) {
+      f(face, plane, same->anchor);
+    } else if (first != last) {
+      f(face, plane, Vec3<T>(first->anchor - n * plane.Height(first->anchor)));
+    } else {
+      f(face, plane, Vec3<T>(x - n * plane.Height(x)));
+    }
+  }
+}
+
+// The contacts of point k in contacts sorted by (point, face), as a range.
+template <class T> auto ContactsOfPoint3(const std::vector<Contact3<T>>& contacts, int k) {
+  const auto first = std::lower_bound(contacts.begin(), contacts.end(), k,
+                                      [](const Contact3<T>& a, int point) { return a.point < point; });
+  auto last = first;
+  while (last != contacts.end() && last->point == k) ++last;
+  return std::make_pair(first, last);
+}
+
+// The (point, face) pairs the ground acts on during an evaluation (ContactSet of the 2D body):
+// f(k, face, plane, l, x, v, anchor) with the face's plane.
 template <class T, class F>
 void ForEachPointInContact3(const BodyModel3& body, const GroundPlane& g, const BodyState3<T>& s,
                             const Frame3<T>& frame, F&& f, ContactSet set) {
   if (!g.enabled) return;
-  auto visit = [&](int k, const Vec3<T>* anchor) {
-    const auto B = body.mode_matrix(k);
-    const Vec3<T> l = LocalPosition3<T>(body.rest_local(k), B, s.gamma);
-    const Vec3<T> x = frame.t + frame.R * l;
-    const T h = g.Height(x);
-    if (set == ContactSet::kDetect && !(ScalarValue(h) < 0.0)) return;
-    f(k, l, x, PointVelocity3(frame, s.v, l, B), anchor ? *anchor : Vec3<T>(x - h * g.normal.cast<T>()));
-  };
   if (set == ContactSet::kFrozen) {
-    for (const Contact3<T>& c : s.contacts) visit(c.point, &c.anchor);
+    for (const Contact3<T>& c : s.contacts) {
+      const auto B = body.mode_matrix(c.point);
+      const Vec3<T> l = LocalPosition3<T>(body.rest_local(c.point), B, s.gamma);
+      const Vec3<T> x = frame.t + frame.R * l;
+      const Eigen::Vector3d xd(ScalarValue(x.x()), ScalarValue(x.y()), ScalarValue(x.z()));
+      f(c.point, c.face, g.heightfield ? g.Face(c.face, xd) : g, l, x, PointVelocity3(frame, s.v, l, B), c.anchor);
+    }
     return;
   }
-  // decisions on plain values: height = n·(t − p) + (Rᵀn)·l
+  // decisions on plain values: height = n·(t − p) + (Rᵀn)·l; over a heightfield the plane is
+  // the level one through its highest node (nothing above it can touch)
+  const Eigen::Vector3d normal = g.heightfield ? Eigen::Vector3d::UnitY() : g.normal;
+  const Eigen::Vector3d through = g.heightfield ? Eigen::Vector3d(0.0, g.heightfield->max_height(), 0.0) : g.point;
   const Eigen::Vector3d n_local =
-      Mat3<double>(frame.R.unaryExpr([](const T& x) { return double(ScalarValue(x)); })).transpose() * g.normal;
+      Mat3<double>(frame.R.unaryExpr([](const T& x) { return double(ScalarValue(x)); })).transpose() * normal;
   const Eigen::Vector3d t(ScalarValue(s.t.x()), ScalarValue(s.t.y()), ScalarValue(s.t.z()));
-  const double offset = g.normal.dot(t - g.point);
+  const double offset = normal.dot(t - through);
   const int D = body.num_modes();
   // convex-hull test: every deformed control point above the plane means every point is
   bool clear = true;
@@ -148,14 +211,18 @@ void ForEachPointInContact3(const BodyModel3& body, const GroundPlane& g, const 
     clear = h > 0.0;
   }
   if (clear) return;
+  auto visit = [&](int k) {
+    const auto B = body.mode_matrix(k);
+    const Vec3<T> l = LocalPosition3<T>(body.rest_local(k), B, s.gamma);
+    const Vec3<T> x = frame.t + frame.R * l;
+    ForEachFaceFelt3(g, x, [&] { return ContactsOfPoint3(s.contacts, k); },
+                     [&](int face, const GroundPlane& plane, const Vec3<T>& anchor) {
+                       f(k, face, plane, l, x, PointVelocity3(frame, s.v, l, B), anchor);
+                     });
+  };
   const std::vector<PointClusterN<3>>& clusters = body.clusters();
   if (clusters.size() <= 1) {
-    auto existing = s.contacts.begin();
-    for (int k = 0; k < body.num_points(); ++k) {
-      while (existing != s.contacts.end() && existing->point < k) ++existing;
-      const bool has_anchor = existing != s.contacts.end() && existing->point == k;
-      visit(k, has_anchor ? &existing->anchor : nullptr);
-    }
+    for (int k = 0; k < body.num_points(); ++k) visit(k);
     return;
   }
   // large bodies: only point groups whose bounding box reaches below the plane (as in 2D)
@@ -167,12 +234,7 @@ void ForEachPointInContact3(const BodyModel3& body, const GroundPlane& g, const 
       half += std::abs(gamma) * c.half_modes.col(d);
     }
     if (offset + n_local.dot(centre) - n_local.cwiseAbs().dot(half) >= 0.0) continue;
-    for (int k : c.points) {
-      const auto existing = std::lower_bound(s.contacts.begin(), s.contacts.end(), k,
-                                             [](const Contact3<T>& a, int point) { return a.point < point; });
-      const bool has_anchor = existing != s.contacts.end() && existing->point == k;
-      visit(k, has_anchor ? &existing->anchor : nullptr);
-    }
+    for (int k : c.points) visit(k);
   }
 }
 
@@ -216,10 +278,10 @@ void EvaluateForces3(const BodyModel3& body, const WorldParams3& w, const BodySt
     out->ground = *cached;
   } else {
     out->ground.setZero(n);
-    ForEachPointInContact3(body, w.ground, s, frame, [&](int k, const Vec3<T>& l, const Vec3<T>& x, const Vec3<T>& v,
-                                                         const Vec3<T>& anchor) {
+    ForEachPointInContact3(body, w.ground, s, frame, [&](int k, int, const GroundPlane& plane, const Vec3<T>& l,
+                                                         const Vec3<T>& x, const Vec3<T>& v, const Vec3<T>& anchor) {
       bool slipping;
-      AddGeneralizedForce3(frame, l, body.mode_matrix(k), GroundForce3(w.ground, x, v, anchor, &slipping), &out->ground);
+      AddGeneralizedForce3(frame, l, body.mode_matrix(k), GroundForce3(plane, x, v, anchor, &slipping), &out->ground);
     }, set);
   }
   // springs: f = −(K (|Δ| − L) + C v·Δ̂) Δ̂ along Δ = x − anchor
@@ -291,16 +353,16 @@ template <class T> void UpdateContacts3(const BodyModel3& body, const GroundPlan
   const Frame3<T> frame(s->t, s->orientation);
   auto& cache = s->ground_cache;
   cache.force.setZero(body.num_q());
-  ForEachPointInContact3(body, g, *s, frame, [&](int k, const Vec3<T>& l, const Vec3<T>& x, const Vec3<T>& v,
-                                                 Vec3<T> anchor) {
+  ForEachPointInContact3(body, g, *s, frame, [&](int k, int face, const GroundPlane& plane, const Vec3<T>& l,
+                                                 const Vec3<T>& x, const Vec3<T>& v, Vec3<T> anchor) {
     bool slipping;
-    Vec3<T> f = GroundForce3(g, x, v, anchor, &slipping);
-    if (slipping) SlipAnchor3(g, x, v, &anchor, &f);
+    Vec3<T> f = GroundForce3(plane, x, v, anchor, &slipping);
+    if (slipping) SlipAnchor3(plane, x, v, &anchor, &f);
     AddGeneralizedForce3(frame, l, body.mode_matrix(k), f, &cache.force);
-    next.push_back({k, anchor});
+    next.push_back({k, anchor, face});
   }, ContactSet::kDetect);
   if (body.clusters().size() > 1)  // groups are visited in lattice order, not point order
-    std::sort(next.begin(), next.end(), [](const Contact3<T>& a, const Contact3<T>& b) { return a.point < b.point; });
+    std::sort(next.begin(), next.end(), ContactBefore3<T>);
   s->contacts.swap(next);
   cache.t = s->t;
   cache.orientation = s->orientation;
@@ -315,15 +377,15 @@ template <class T> int AddMissingContacts3(const BodyModel3& body, const GroundP
   std::vector<Contact3<T>> added;
   const BodyState3<T>& view = *s;
   ForEachPointInContact3(body, g, view, Frame3<T>(view.t, view.orientation),
-                         [&](int k, const Vec3<T>&, const Vec3<T>&, const Vec3<T>&, const Vec3<T>& anchor) {
+                         [&](int k, int face, const GroundPlane&, const Vec3<T>&, const Vec3<T>&, const Vec3<T>&,
+                             const Vec3<T>& anchor) {
                            for (const Contact3<T>& c : view.contacts)
-                             if (c.point == k) return;
-                           added.push_back({k, anchor});
+                             if (c.point == k && c.face == face) return;
+                           added.push_back({k, anchor, face});
                          }, ContactSet::kDetect);
   if (added.empty()) return 0;
   s->contacts.insert(s->contacts.end(), added.begin(), added.end());
-  std::sort(s->contacts.begin(), s->contacts.end(),
-            [](const Contact3<T>& a, const Contact3<T>& b) { return a.point < b.point; });
+  std::sort(s->contacts.begin(), s->contacts.end(), ContactBefore3<T>);
   return int(added.size());
 }
 

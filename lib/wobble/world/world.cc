@@ -301,7 +301,6 @@ void World::FinishStep() {
 
 // No constraint: each body on its own. FFD bodies on the templated StepBody (the fast path).
 bool World::StepEachBody() {
-  const double h = options_.dt;
   for (int body = 0; body < num_bodies(); ++body) {
     if (slots_[body].kinematic) continue;
     if (slots_[body].kind == BodyKind::kFfd) {

@@ -53,7 +53,7 @@ double World::Penetration(int body) const {
   double deepest = 0.0;
   for (const Contact3<double>& c : s.contacts) {
     const Eigen::Vector3d x = s.t + R * (m.rest_local(c.point) + m.mode_matrix(c.point) * s.gamma);
-    deepest = std::max(deepest, -options_.ground_3d.Height(x));
+    deepest = std::max(deepest, -options_.ground_3d.Face(c.face, x).Height(x));
   }
   return deepest;
 }
