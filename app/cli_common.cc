@@ -14,6 +14,7 @@
 
 #include "wobble/analysis/conditioning.h"
 #include "wobble/formats/deformation_file.h"
+#include "wobble/formats/heightfield_file.h"
 #include "wobble/formats/object_file.h"
 #include "wobble/scene/ffd_object.h"
 #ifdef WOBBLE_HAVE_PIPELINES
@@ -151,6 +152,10 @@ void AddWorldFlags(CLI::App* cmd, WorldFlags* f) {
                   "A terrain in place of the ground line: its profile through these points, left to right, solid "
                   "below (two at the same x: a cliff); the ground flags above are its faces' parameters")
       ->type_name("\"X1 Y1 X2 Y2 ..\"");
+  cmd->add_option("--heightfield", f->heightfield,
+                  "3D objects: the ground is this heightfield y = h(x, z) ('origin X0 Z0', 'spacing DX DZ', a row of "
+                  "heights per z) in place of the plane; the ground flags above are its constants")
+      ->type_name("FILE");
 }
 
 WorldParams MakeWorldParams(const WorldFlags& f) {
@@ -182,6 +187,7 @@ WorldParams MakeWorldParams(const WorldFlags& f) {
       throw UsageError(std::string("--terrain: ") + e.what());
     }
   }
+  if (!f.heightfield.empty()) p.ground.heightfield = formats::ReadHeightfieldFile(f.heightfield);
   return p;
 }
 

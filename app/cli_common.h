@@ -60,6 +60,7 @@ struct WorldFlags {
   double friction_damping = Ground().friction_damping;
   double friction_cap = Ground().friction_cap;
   std::string terrain;  // "X1 Y1 X2 Y2 ...": a terrain profile in place of the line (2D)
+  std::string heightfield;  // a heightfield file: the 3D ground in place of the plane
 };
 void AddWorldFlags(CLI::App* cmd, WorldFlags* flags);
 // Validates the flags (finite, non-negative where it matters) and fills the params.

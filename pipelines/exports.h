@@ -90,7 +90,8 @@ class VtpSeriesWriter {
   const World* world_;
   std::string folder_, stem_;
   std::vector<Part> parts_;  // 3 per body, in part order
-  // A 2D world's terrain: the last part, one file (it does not move) listed at every time
+  // A 2D world's terrain or a 3D one's heightfield: the last part, one file (it does not move)
+  // listed at every time
   vtkSmartPointer<GroundSource> terrain_;
   bool terrain_written_ = false;
   PvdCollection pvd_;

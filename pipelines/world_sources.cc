@@ -470,6 +470,32 @@ int GroundDimensionOf(const World& world, int body) {
   return 0;
 }
 
+// The grid's triangles as the dynamics splits its cells (heightfield.h), with a "height"
+// point array (y) to colour by.
+int GroundSource::DrawHeightfield(const Heightfield& field, vtkPoints* points, vtkPolyData* out) {
+  const int nx = field.nx(), nz = field.nz();
+  auto height = Scalars("height", nx * nz);
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double y = field.Node(i, j);
+      points->InsertNextPoint(field.origin().x() + i * field.spacing().x(), y, field.origin().y() + j * field.spacing().y());
+      height->SetValue(i + nx * j, y);
+    }
+  auto polys = Ptr<vtkCellArray>::New();
+  for (int j = 0; j + 1 < nz; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      const vtkIdType p00 = i + nx * j, p10 = p00 + 1, p01 = p00 + nx, p11 = p01 + 1;
+      // counter-clockwise seen from above (+y), so the normals point up
+      const vtkIdType lower[3] = {p00, p11, p10}, upper[3] = {p00, p01, p11};
+      polys->InsertNextCell(3, lower);
+      polys->InsertNextCell(3, upper);
+    }
+  out->SetPoints(points);
+  out->SetPolys(polys);
+  out->GetPointData()->AddArray(height);
+  return 1;
+}
+
 int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
   if (!Check(Needs::kWorld)) return 0;
   vtkPolyData* out = OutputOf(out_vec);
@@ -486,6 +512,7 @@ int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
     const GroundPlane& plane = world_->options().ground_3d;
     out->SetPoints(points);
     if (!plane.enabled) return 1;
+    if (plane.heightfield) return DrawHeightfield(*plane.heightfield, points, out);
     const Eigen::Vector3d n = plane.normal.normalized();
     const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
     const Eigen::Vector3d foot = bodies3.center() - n * plane.Height(Eigen::Vector3d(bodies3.center()));

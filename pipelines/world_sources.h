@@ -185,6 +185,7 @@ class GroundSource : public WorldSourceBase {
   GroundSource() = default;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int DrawTerrain(const Terrain& terrain, vtkPoints* points, vtkPolyData* out);
+  int DrawHeightfield(const Heightfield& field, vtkPoints* points, vtkPolyData* out);
   double Center[2] = {0, 0};
   double Length = 2000.0, Depth = 100.0;
 };

@@ -125,7 +125,7 @@ bool MassPointSource::DrawFfd3(vtkPolyData* out) {
     for (const Contact3<double>& c : s.contacts) {
       bool slipping;
       const size_t k = size_t(c.point);
-      f[k] += GroundForce3<double>(o.ground_3d, x[k], v[k], c.anchor, &slipping);
+      f[k] += GroundForce3<double>(o.ground_3d.Face(c.face, x[k]), x[k], v[k], c.anchor, &slipping);
     }
   for (vtkIdType k = 0; k < n; ++k) {
     points->SetPoint(k, x[size_t(k)].data());

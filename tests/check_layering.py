@@ -20,8 +20,8 @@ LAYERS = [
     ("core", []),
     ("mpi", ["core"]),
     ("body", ["core"]),
-    ("formats", ["core", "body"]),
     ("dynamics", ["core", "body"]),
+    ("formats", ["core", "body", "dynamics"]),  # dynamics: the heightfield a file makes
     ("world", ["core", "body", "dynamics"]),
     ("control", ["core", "body", "dynamics", "world"]),
     ("record", ["core", "body", "formats", "dynamics", "world", "control"]),

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "wobble/formats/heightfield_file.h"
 #include "wobble/script/interpreter.h"
 #include "wobble/script/variables.h"
 
@@ -73,6 +74,9 @@ INSTANTIATE_TEST_SUITE_P(
         ErrorCase{"linear a 3d affine box 1 1 1", "a body named 'a' exists already"},
         ErrorCase{"linear c 3d quadratic box 1 1 1 grid 2", "linear body 'c': the 8 mass points do not span"},
         ErrorCase{"linear c 2d", "expected 'linear NAME 2d|3d"},
+        // the 3D ground
+        ErrorCase{"heightfield", "expected 'heightfield FILE' or 'heightfield off'"},
+        ErrorCase{"heightfield /nonexistent/hills.heightfield", "/nonexistent/hills.heightfield:0: "},
         // point, place
         ErrorCase{"point q aa 0 0 0", "no body named 'aa'; did you mean 'a'?"},
         ErrorCase{"point q a 0 0", "expected 3 undeformed coordinates for a point of the 3D body 'a'"},
@@ -246,6 +250,45 @@ TEST(SceneScript, GravitySetAfterTheBodiesAppliesToTheNextSimul) {
   ASSERT_EQ(RunScript(interp, "set gravity T\nsimul 1\n"), "");
   // free fall for 1 s from rest: y = −g/2 (the semi-implicit step falls g Δt t further at most)
   EXPECT_NEAR(interp.scene().Point("c")[1], -0.5 * 9.81, 9.81 * 0.01 * 1.0 + 1e-9);
+}
+
+// `heightfield FILE`: a 3D block rests on the level heightfield 2 high as it rests on the plane
+// at 0, 2 higher; `heightfield off` puts the plane back. `save` writes the heightfield beside its script and
+// names it, and the file reads back the same field.
+TEST(SceneScript, HeightfieldIsTheGroundOf3DBodiesAndSaveKeepsIt) {
+  const std::string dir = ::testing::TempDir();
+  const std::string field_path = dir + "/level.heightfield";
+  {
+    std::ofstream f(field_path);
+    f << "# level at 2\norigin -5 -5\nspacing 2.5 2.5\n";
+    for (int j = 0; j < 5; ++j) f << "2, 2, 2, 2, 2\n";
+  }
+  // the same block dropped with and without the heightfield (the plane y = 0 then)
+  auto rest_height = [&](const std::string& ground) {
+    std::ostringstream out;
+    script::Interpreter interp(out);
+    EXPECT_EQ(RunScript(interp, ground + "set dt 0.001\nset grdam 10\nlinear b 3d affine box 0.5 0.5 0.5 at 0 3 0 ground\n"
+                                         "point c b 0 0 0\nsimul 4\n"),
+              "");
+    return interp.scene().Point("c")[1];
+  };
+  const double on_field = rest_height("heightfield " + field_path + "\n");
+  const double on_plane = rest_height("heightfield " + field_path + "\nheightfield off\n");
+  EXPECT_LT(on_plane, 0.0) << "sunk into the plane a little";
+  EXPECT_GT(on_plane, -1e-3);
+  EXPECT_NEAR(on_field, on_plane + 2.0, 1e-9) << "the same rest, 2 higher";
+
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  const std::string saved = dir + "/hills_saved.wob";
+  ASSERT_EQ(RunScript(interp, "load_obj " + kData + "/table3.obj\nheightfield " + kData + "/hills.heightfield\nsave " +
+                                  saved + "\n"),
+            "");
+  std::ifstream in(saved);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string written = dir + "/hills_saved.heightfield";
+  EXPECT_NE(text.find("heightfield off\nheightfield " + written + "\n"), std::string::npos) << text;
+  EXPECT_TRUE(*formats::ReadHeightfieldFile(written) == *formats::ReadHeightfieldFile(kData + "/hills.heightfield"));
 }
 
 }  // namespace

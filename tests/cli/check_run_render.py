@@ -55,4 +55,27 @@ open(bad, "w").write(script.replace("render pics vtp,frames", "render pics vtp e
 r = subprocess.run([wobble, "run", bad], capture_output=True, text=True, cwd=work, env=env)
 check(r.returncode == 2 and "bad_render.wob:10:" in r.stderr and "exr-terrain=: expected on or off" in r.stderr,
       "exr-terrain=maybe exits 2 naming the line: " + r.stderr.strip()[-200:])
+# a 3D object on a heightfield (`--heightfield`): the .pvd lists the heightfield as its terrain
+# part, one file of the grid's triangles; a bad heightfield file: exit 2 with its FILE:LINE
+hf_out = os.path.join(work, "hills")
+shutil.rmtree(hf_out, ignore_errors=True)
+r = subprocess.run([wobble, "render", "--object", f"{data}/pot3.obj", "--modes", f"{data}/pot3_modes.def3",
+                    "--heightfield", f"{data}/hills.heightfield", "--q", "-250 160 0 0 0 0 0 0 0", "--dt", "0.001",
+                    "--ground-stiffness", "20000", "--duration", "0.2", "--what", "vtp", "--out", hf_out],
+                   capture_output=True, text=True, cwd=work, env=env)
+pvd = os.path.join(hf_out, "vtp", "pot3.pvd")
+text = open(pvd).read() if os.path.exists(pvd) else ""
+terrain_files = set(re.findall(r'name="terrain" file="([^"]*)"', text))
+check(r.returncode == 0 and len(terrain_files) == 1, f"--heightfield: one terrain file in the .pvd {terrain_files} " + r.stderr)
+vtp = os.path.join(hf_out, "vtp", next(iter(terrain_files))) if terrain_files else ""
+body = open(vtp, "rb").read().decode("latin-1") if vtp and os.path.exists(vtp) else ""  # appended binary data
+check('NumberOfPoints="651"' in body and 'NumberOfPolys="1200"' in body,
+      "the terrain part is the 31 x 21 grid's 1200 triangles")
+bad_field = os.path.join(work, "bad.heightfield")
+open(bad_field, "w").write("origin 0 0\nspacing 1 1\n1,2,3\n1,x,3\n")
+r = subprocess.run([wobble, "render", "--object", f"{data}/pot3.obj", "--modes", f"{data}/pot3_modes.def3",
+                    "--heightfield", bad_field, "--duration", "0.1", "--what", "vtp", "--out", hf_out],
+                   capture_output=True, text=True, cwd=work, env=env)
+check(r.returncode == 2 and "bad.heightfield:4: expected a height, got 'x'" in r.stderr,
+      "a bad heightfield file: exit 2 naming its line: " + r.stderr.strip())
 sys.exit(1 if failures else 0)

@@ -13,6 +13,7 @@
 
 #include "wobble/body/body_model.h"
 #include "wobble/dynamics/kinematics.h"
+#include "wobble/dynamics/heightfield.h"
 #include "wobble/dynamics/terrain.h"
 
 namespace wobble {
@@ -33,6 +34,9 @@ struct Ground {
   // A terrain of straight faces (terrain.h) in place of the line through `point`; the
   // parameters above are those of every face that has none of its own.
   std::shared_ptr<const Terrain> terrain;
+  // The 3D bodies' ground in place of the plane of this line (GroundPlaneOf in world.h); 2D
+  // bodies never feel it.
+  std::shared_ptr<const Heightfield> heightfield;
 
   Eigen::Vector2d tangent() const { return {std::cos(slope), std::sin(slope)}; }
   Eigen::Vector2d normal() const { return {-std::sin(slope), std::cos(slope)}; }
@@ -40,7 +44,8 @@ struct Ground {
     return enabled == o.enabled && point == o.point && slope == o.slope && stiffness == o.stiffness &&
            normal_damping == o.normal_damping && friction_damping == o.friction_damping &&
            friction_cap == o.friction_cap && max_penetration == o.max_penetration &&
-           (terrain == o.terrain || (terrain && o.terrain && *terrain == *o.terrain));
+           (terrain == o.terrain || (terrain && o.terrain && *terrain == *o.terrain)) &&
+           (heightfield == o.heightfield || (heightfield && o.heightfield && *heightfield == *o.heightfield));
   }
   // Face i of the ground (0 for the line) with its parameters resolved.
   GroundFace Face(int i) const {

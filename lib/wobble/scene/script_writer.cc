@@ -76,6 +76,9 @@ void WriteSetup(std::ostream& s, const ScriptSetup& r) {
       if (!line.empty()) s << "terrain_face " << i + 1 << line << "\n";
     }
   }
+  s << "heightfield off\n";
+  if (!r.heightfield_path.empty()) s << "heightfield " << r.heightfield_path << "\n";
+  else if (r.world.params.ground.heightfield) s << "# the heightfield is kept by `save FILE` only (beside FILE)\n";
   s << "set integrator " << IntegratorName(r.world.integrator) << "\nset dt " << Num(r.world.dt) << "\n";
   s << "set spring " << (r.springs_on ? "T" : "F") << "\nclear springs\n";
   for (const Spring& sp : r.springs)

@@ -46,6 +46,7 @@ struct ScriptSetup {
   std::vector<Spring> springs;
   std::vector<LatticeSpring3> springs3;  // a 3D object's
   Eigen::VectorXd q, qd;                // world coordinates (3D: t, rotation vector, γ | ṫ, ω, γ̇)
+  std::string heightfield_path;         // where world's heightfield was written (empty: none)
 };
 void WriteSetup(std::ostream& s, const ScriptSetup& setup);
 // `set cyclic`, `set switch_width` and one `pose` line per pose.

@@ -15,6 +15,10 @@ const std::vector<Command>& CommandTable() {
        "the ground becomes a profile through these points, left to right, solid below (equal X: a cliff)", TerrainCommand},
       {"terrain_face", "terrain_face SEGMENT NAME VALUE [NAME VALUE ...]",
        "a terrain segment's own grconst, grdam, frconst or frsin (1-based, left to right)", TerrainFaceCommand},
+      {"heightfield", "heightfield FILE | heightfield off",
+       "3D objects stand on the heightfield y = h(x, z) in FILE ('origin X0 Z0', 'spacing DX DZ', a row of heights per "
+       "z) in place of the ground plane; the ground's constants apply",
+       HeightfieldCommand},
       {"assign", "assign MODE STIFFNESS DAMPING", "mode MODE (1-based or name): V = K g^2, force -c g'", Assign},
       {"mode", "mode MODE active|passive", "designate a mode active (PD-controlled) or passive", Mode},
       {"set_vec", "set_vec q|dq V1 .. Vn", "generalized coordinates or velocities, n = 3 + modes", SetVec},

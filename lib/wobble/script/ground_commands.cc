@@ -1,5 +1,7 @@
 // The ground as terrain (issue 19): `terrain` sets the profile, `terrain_face` a segment's own
-// penalty parameters (the names `set` gives the ground's: grconst, grdam, frconst, frsin).
+// penalty parameters (the names `set` gives the ground's: grconst, grdam, frconst, frsin);
+// `heightfield` the 3D objects' ground.
+#include "wobble/formats/heightfield_file.h"
 #include "wobble/script/internal/interpreter_internal.h"
 
 namespace wobble::script {
@@ -57,6 +59,11 @@ void TerrainFaceCommand(State& s, const Words& w, const Context& ctx) {
                   DidYouMean(w[i], {"grconst", "grdam", "frconst", "frsin"}));
   }
   TheGround(s).terrain = MakeTerrain(terrain->vertices(), std::move(faces), ctx);
+}
+
+void HeightfieldCommand(State& s, const Words& w, const Context& ctx) {
+  if (w.size() != 2) ctx.Fail("expected 'heightfield FILE' or 'heightfield off'");
+  TheGround(s).heightfield = w[1] == "off" ? nullptr : formats::ReadHeightfieldFile(Resolve(w[1], ctx.dir));
 }
 
 }  // namespace wobble::script

@@ -6,6 +6,7 @@
 #include "wobble/core/errors.h"
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/csv.h"
+#include "wobble/formats/heightfield_file.h"
 #include "wobble/formats/target_schedule.h"
 #include "wobble/scene/script_writer.h"
 #include "wobble/script/internal/interpreter_internal.h"
@@ -188,8 +189,9 @@ synth::Problem SynthesisProblem(const State& s) {
   return p;
 }
 
-// `schedule_path`: where the scene's target schedule is written, for its `schedule` line.
-std::string ReplayScript(const State& s, const std::string& schedule_path) {
+// `schedule_path`, `heightfield_path`: where the scene's target schedule and heightfield are
+// written, for their lines.
+std::string ReplayScript(const State& s, const std::string& schedule_path, const std::string& heightfield_path) {
   const scene::Scene& sc = s.scene;
   const scene::FfdObject& object = sc.object();
   scene::ScriptSetup setup;
@@ -201,6 +203,7 @@ std::string ReplayScript(const State& s, const std::string& schedule_path) {
   setup.springs_on = sc.springs().enabled;
   setup.springs = sc.springs().list;
   setup.springs3 = sc.springs().list3;
+  setup.heightfield_path = heightfield_path;
   // after an anneal: from the state its trials started from, for one trial's length (the
   // motion the cost judged); otherwise from the current state over the current span
   const bool annealed = s.anneal_start_q.size() > 0;
@@ -225,10 +228,15 @@ void Save(State& s, const Words& w, const Context& ctx) {
   std::string schedule_path;
   if (schedule.size() > 0)
     schedule_path = std::filesystem::absolute(std::filesystem::path(w[1]).replace_extension(".schedule.csv")).string();
+  // and a heightfield beside it too (FILE's stem + .heightfield)
+  const std::shared_ptr<const Heightfield>& field = s.scene.options().params.ground.heightfield;
+  const std::string field_path =
+      field ? std::filesystem::absolute(std::filesystem::path(w[1]).replace_extension(".heightfield")).string() : "";
   try {
     if (!schedule_path.empty())
       formats::WriteTargetSchedule(schedule_path, s.scene.object().mode_names(), s.scene.options().dt, schedule);
-    formats::WriteTextAtomically(w[1], ReplayScript(s, schedule_path));
+    if (field) formats::WriteHeightfieldFile(field_path, *field);
+    formats::WriteTextAtomically(w[1], ReplayScript(s, schedule_path, field_path));
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(std::string("save: ") + e.what());  // the disk failed (full, ...): exit 1
   }

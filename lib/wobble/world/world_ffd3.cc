@@ -41,6 +41,7 @@ GroundPlane GroundPlaneOf(const Ground& g) {
   p.normal_damping = g.normal_damping;
   p.friction_damping = g.friction_damping;
   p.friction_cap = g.friction_cap;
+  p.heightfield = g.heightfield;
   return p;
 }
 

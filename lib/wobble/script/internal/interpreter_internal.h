@@ -118,6 +118,7 @@ void SpringCommand(State& s, const Words& w, const Context& ctx);
 void Clear(State& s, const Words& w, const Context& ctx);
 void TerrainCommand(State& s, const Words& w, const Context& ctx);      // ground_commands.cc
 void TerrainFaceCommand(State& s, const Words& w, const Context& ctx);
+void HeightfieldCommand(State& s, const Words& w, const Context& ctx);
 void Output(State& s, const Words& w, const Context& ctx);
 void Schedule(State& s, const Words& w, const Context& ctx);
 void Print(State& s, const Words& w, const Context& ctx);   // the scene's once it has a body
@@ -136,7 +137,7 @@ synth::Problem MakeProblem(const State& s, long steps);
 synth::Problem SynthesisProblem(const State& s);
 // The `save` script (scene::ReplayScript of the scene; after an anneal, of its trials).
 // `save`'s script; with a schedule_path, the `schedule` line of the target schedule written there
-std::string ReplayScript(const State& s, const std::string& schedule_path = "");
+std::string ReplayScript(const State& s, const std::string& schedule_path = "", const std::string& heightfield_path = "");
 // scene_commands.cc: Witkin & Welch bodies, points, constraints, paths and behaviours
 void Linear(State& s, const Words& w, const Context& ctx);
 void Ffd(State& s, const Words& w, const Context& ctx);
