@@ -7,6 +7,7 @@
 
 #include "wobble/core/errors.h"
 #include "wobble/control/controllers.h"
+#include "wobble/formats/heightfield_file.h"
 #include "wobble/world/world.h"
 
 namespace wobble::python {
@@ -65,6 +66,34 @@ void BindWorld(py::module_& m) {
       .def_property_readonly("normal", &Ground::normal)
       .def_property_readonly("tangent", &Ground::tangent);
 
+  py::class_<Heightfield, std::shared_ptr<Heightfield>>(
+      m, "Heightfield",
+      "The 3D ground y = h(x, z) on a regular grid, two flat triangles per cell, level beyond it\n"
+      "(README: Heightfield terrain). Set it as options.ground_3d.heightfield.")
+      .def(py::init([](const Eigen::Vector2d& origin, const Eigen::Vector2d& spacing, const Eigen::MatrixXd& heights) {
+             std::vector<double> h;  // heights[j, i] is node (i, j): a row per z
+             for (Eigen::Index j = 0; j < heights.rows(); ++j)
+               for (Eigen::Index i = 0; i < heights.cols(); ++i) h.push_back(heights(j, i));
+             return std::const_pointer_cast<Heightfield>(
+                 Heightfield::Make(origin, spacing, int(heights.cols()), int(heights.rows()), std::move(h)));
+           }),
+           py::arg("origin"), py::arg("spacing"), py::arg("heights"),
+           "origin (x0, z0), spacing (dx, dz), heights (nz, nx): heights[j, i] at (x0 + i dx, z0 + j dz)")
+      .def_property_readonly("origin", [](const Heightfield& f) { return f.origin(); })
+      .def_property_readonly("spacing", [](const Heightfield& f) { return f.spacing(); })
+      .def_property_readonly("heights",
+                             [](const Heightfield& f) {
+                               Eigen::MatrixXd h(f.nz(), f.nx());
+                               for (int j = 0; j < f.nz(); ++j)
+                                 for (int i = 0; i < f.nx(); ++i) h(j, i) = f.Node(i, j);
+                               return h;
+                             })
+      .def("height_at", &Heightfield::HeightAt, py::arg("x"), py::arg("z"), "the surface's height over (x, z)");
+  m.def(
+      "read_heightfield",
+      [](const std::string& path) { return std::const_pointer_cast<Heightfield>(formats::ReadHeightfieldFile(path)); },
+      py::arg("path"), "a heightfield file ('origin X0 Z0', 'spacing DX DZ', a row of heights per z)");
+
   py::class_<GroundPlane>(m, "GroundPlane",
                           "The 3D FFD bodies' ground: a plane of any normal with the penalty contact and capped\n"
                           "friction of §4.9 in two tangent directions (off by default).")
@@ -81,7 +110,11 @@ void BindWorld(py::module_& m) {
       .def_readwrite("stiffness", &GroundPlane::stiffness)
       .def_readwrite("normal_damping", &GroundPlane::normal_damping)
       .def_readwrite("friction_damping", &GroundPlane::friction_damping)
-      .def_readwrite("friction_cap", &GroundPlane::friction_cap);
+      .def_readwrite("friction_cap", &GroundPlane::friction_cap)
+      .def_property(
+          "heightfield", [](const GroundPlane& g) { return std::const_pointer_cast<Heightfield>(g.heightfield); },
+          [](GroundPlane& g, std::shared_ptr<Heightfield> f) { g.heightfield = std::move(f); },
+          "a Heightfield in place of the plane (None: the plane)");
 
   py::class_<WorldOptions>(m, "WorldOptions", "What a World is made with; every field is also a keyword of the constructor.")
       .def(py::init<>())
@@ -344,7 +377,7 @@ void BindWorld(py::module_& m) {
             const LinearContacts& c = w.linear_contacts(body);
             py::list out;
             for (const Contact<double>& k : c.list2) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
-            for (const Contact3<double>& k : c.list3) out.append(py::make_tuple(k.point, 0, Eigen::VectorXd(k.anchor)));
+            for (const Contact3<double>& k : c.list3) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
             return out;
           },
           py::arg("body"), "A linear body's ground contacts: (mass point, face, anchor) each")

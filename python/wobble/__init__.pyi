@@ -94,6 +94,16 @@ class Ground:
     tangent: NDArray
     def __init__(self, **fields: Any) -> None: ...
 
+class Heightfield:
+    """The 3D ground y = h(x, z) on a grid (two triangles per cell, level beyond it)."""
+    origin: NDArray
+    spacing: NDArray
+    heights: NDArray
+    def __init__(self, origin: ArrayLike, spacing: ArrayLike, heights: ArrayLike) -> None: ...
+    def height_at(self, x: float, z: float) -> float: ...
+
+def read_heightfield(path: str) -> Heightfield: ...
+
 class GroundPlane:
     """The 3D FFD bodies' ground plane (penalty contact, capped friction); off by default."""
     enabled: bool
@@ -103,6 +113,7 @@ class GroundPlane:
     normal_damping: float
     friction_damping: float
     friction_cap: float
+    heightfield: Optional[Heightfield]
     def __init__(self) -> None: ...
 
 class WorldOptions:

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import wobble
+from conftest import DATA
 
 G = 9.81
 
@@ -92,3 +93,41 @@ def test_a_linear_body_with_ground_contact_rests_on_its_bottom_row():
         assert world.point_position(b, point)[1] == pytest.approx(-6.0 * G / (3 * K), rel=1e-6)
     assert world.linear_contacts(ghost) == []
     assert world.linear_state(ghost)[0][1, 2] < -100  # ½ g t² below where it started
+
+
+def test_a_3d_block_rests_on_a_heightfield_as_on_the_plane_only_higher():
+    # a level heightfield 2 high in place of the plane: the same rest, 2 higher, on its faces
+    def rest(field, height):
+        options = wobble.WorldOptions(dt=0.001)
+        options.ground_3d.enabled = True
+        options.ground_3d.normal_damping = 100
+        options.ground_3d.heightfield = field
+        world = wobble.World(options)
+        b = world.add_linear_body(wobble.linear_box(3, [1.0, 0.5, 0.5], per_side=3, mass=6.0),
+                                  rigidity=2e4, volume=2e4, damping=0.02, ground=True)
+        R, _ = world.linear_state(b)
+        R[1, 3] = height  # 0.5 above the surface
+        world.set_linear_state(b, R)
+        world.run_until(5.0)
+        return world.linear_state(b)[0][1, 3], world.linear_contacts(b)
+
+    level = wobble.Heightfield(origin=[-5, -5], spacing=[2.5, 2.5], heights=np.full((5, 5), 2.0))
+    assert level.height_at(0.3, -1.2) == 2.0 and level.heights.shape == (5, 5)
+    on_plane, plane_contacts = rest(None, 1.0)
+    on_field, field_contacts = rest(level, 3.0)
+    assert len(plane_contacts) == len(field_contacts) == 9  # the bottom face's 3 x 3 points
+    assert on_field == pytest.approx(on_plane + 2.0, abs=1e-9)
+    assert all(face == 0 for _, face, _ in plane_contacts)
+    assert any(face > 0 for _, face, _ in field_contacts)  # triangles of the grid
+
+
+def test_read_heightfield_and_its_errors(tmp_path):
+    hills = wobble.read_heightfield(str(DATA / "hills.heightfield"))
+    assert hills.heights.shape == (21, 31)
+    x, z = -600 + 40 * 7, -400 + 40 * 3  # a node: its height as written (three decimals)
+    h = 80 * (1 - np.tanh((x + 150) / 120)) + 20 * np.sin(x / 95) * np.cos(z / 120) + 0.0002 * z * z
+    assert hills.height_at(x, z) == pytest.approx(h, abs=5e-4)
+    bad = tmp_path / "bad.heightfield"
+    bad.write_text("origin 0 0\nspacing 1 1\n1 2\n")
+    with pytest.raises(wobble.ParseError, match="bad.heightfield:3: expected at least two rows"):
+        wobble.read_heightfield(str(bad))
