@@ -15,6 +15,7 @@
 #include "wobble/analysis/conditioning.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/heightfield_file.h"
+#include "wobble/formats/line_reader.h"
 #include "wobble/formats/object_file.h"
 #include "wobble/scene/ffd_object.h"
 #ifdef WOBBLE_HAVE_PIPELINES
@@ -152,11 +153,44 @@ void AddWorldFlags(CLI::App* cmd, WorldFlags* f) {
                   "A terrain in place of the ground line: its profile through these points, left to right, solid "
                   "below (two at the same x: a cliff); the ground flags above are its faces' parameters")
       ->type_name("\"X1 Y1 X2 Y2 ..\"");
+  cmd->add_option("--terrain-face", f->terrain_faces,
+                  "A terrain segment's own constants (1-based, left to right), as a script's terrain_face: e.g. an icy "
+                  "slope \"3 frsin 0.05\"; NAME is grconst, grdam, frconst or frsin; repeat for more segments")
+      ->type_name("\"SEGMENT NAME VALUE ..\"");
   cmd->add_option("--heightfield", f->heightfield,
                   "3D objects: the ground is this heightfield y = h(x, z) ('origin X0 Z0', 'spacing DX DZ', a row of "
                   "heights per z) in place of the plane; the ground flags above are its constants")
       ->type_name("FILE");
 }
+
+namespace {
+
+// --terrain-face "SEGMENT NAME VALUE .." (each may repeat) as one override per segment.
+std::vector<SurfaceOverrides> TerrainFaces(const std::vector<std::string>& specs, int segments) {
+  std::vector<SurfaceOverrides> faces;
+  if (specs.empty()) return faces;
+  faces.resize(size_t(segments));
+  for (const std::string& spec : specs) {
+    std::istringstream in(spec);
+    std::vector<std::string> w;
+    for (std::string word; in >> word;) w.push_back(word);
+    const std::string where = "--terrain-face \"" + spec + "\": ";
+    if (w.size() < 3 || w.size() % 2 == 0) throw UsageError(where + "expected SEGMENT NAME VALUE [NAME VALUE ..]");
+    int index = 0;
+    if (!formats::detail::ParseInt(w[0], &index) || index < 1 || index > segments)
+      throw UsageError(where + "expected a segment from 1 to " + std::to_string(segments) + ", got '" + w[0] + "'");
+    for (size_t i = 1; i + 1 < w.size(); i += 2) {
+      double value;
+      if (!formats::detail::ParseNumber(w[i + 1], &value) || value < 0)
+        throw UsageError(where + "expected a number >= 0 for " + w[i] + ", got '" + w[i + 1] + "'");
+      if (!faces[size_t(index - 1)].Set(w[i], value))
+        throw UsageError(where + "expected grconst, grdam, frconst or frsin, got '" + w[i] + "'");
+    }
+  }
+  return faces;
+}
+
+}  // namespace
 
 WorldParams MakeWorldParams(const WorldFlags& f) {
   RequireFinite(f.ground_height, "--ground-height");
@@ -181,11 +215,14 @@ WorldParams MakeWorldParams(const WorldFlags& f) {
                                                          std::to_string(xy.size()) + " numbers");
     std::vector<Eigen::Vector2d> vertices;
     for (size_t i = 0; i + 1 < xy.size(); i += 2) vertices.emplace_back(xy[i], xy[i + 1]);
+    const std::vector<SurfaceOverrides> segments = TerrainFaces(f.terrain_faces, int(vertices.size()) - 1);
     try {
-      p.ground.terrain = Terrain::Make(std::move(vertices));
+      p.ground.terrain = Terrain::Make(std::move(vertices), segments);
     } catch (const InputError& e) {
       throw UsageError(std::string("--terrain: ") + e.what());
     }
+  } else if (!f.terrain_faces.empty()) {
+    throw UsageError("--terrain-face needs a --terrain");
   }
   if (!f.heightfield.empty()) p.ground.heightfield = formats::ReadHeightfieldFile(f.heightfield);
   return p;

@@ -60,6 +60,7 @@ struct WorldFlags {
   double friction_damping = Ground().friction_damping;
   double friction_cap = Ground().friction_cap;
   std::string terrain;  // "X1 Y1 X2 Y2 ...": a terrain profile in place of the line (2D)
+  std::vector<std::string> terrain_faces;  // "SEGMENT NAME VALUE ..": a segment's own constants
   std::string heightfield;  // a heightfield file: the 3D ground in place of the plane
 };
 void AddWorldFlags(CLI::App* cmd, WorldFlags* flags);

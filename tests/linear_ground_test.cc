@@ -120,7 +120,9 @@ TEST(LinearGround, BlockAtRestOnEachFaceOfAValley) {
     const std::vector<Eigen::Vector2d> per_face = ForcePerFace(w, b);
     const double weight = 6.0 * kG;
     for (int i = 0; i < int(per_face.size()); ++i) {
-      if (i != face) EXPECT_EQ(per_face[i], Eigen::Vector2d::Zero()) << "face " << i;
+      if (i != face) {
+        EXPECT_EQ(per_face[i], Eigen::Vector2d::Zero()) << "face " << i;
+      }
     }
     EXPECT_NEAR(per_face[face].dot(f.n), weight * std::cos(alpha), 1e-6 * weight);
     EXPECT_NEAR(per_face[face].dot(f.tau), side * weight * std::sin(alpha), 1e-6 * weight);  // up the face
@@ -211,7 +213,9 @@ TEST(LinearGround, SlidesDownATiltedPlaneIn3D) {
     const double a = kG * (std::sin(alpha) - mu * std::cos(alpha));
     EXPECT_NEAR((v2 - v1) / 2.0, a, 1e-3 * a) << (heightfield ? "heightfield" : "plane");
     EXPECT_EQ(w.linear_contacts(b).list3.size(), 9u);  // the bottom face's 3 × 3 points
-    if (heightfield) EXPECT_GT(CentreOfMass(w, b).x(), 8.0) << "slid over dozens of triangles";
+    if (heightfield) {
+      EXPECT_GT(CentreOfMass(w, b).x(), 8.0) << "slid over dozens of triangles";
+    }
   }
 }
 

@@ -78,4 +78,24 @@ r = subprocess.run([wobble, "render", "--object", f"{data}/pot3.obj", "--modes",
                    capture_output=True, text=True, cwd=work, env=env)
 check(r.returncode == 2 and "bad.heightfield:4: expected a height, got 'x'" in r.stderr,
       "a bad heightfield file: exit 2 naming its line: " + r.stderr.strip())
+# --terrain-face: a segment's own constant is that constant on that face. The table slides on
+# segment 1 only, so "1 frsin 0.05" runs bit for bit as --friction-cap 0.05 everywhere, and
+# an override of segment 2 (never touched) changes nothing; bad specs exit 2 saying why
+def slide(*flags):
+    out = os.path.join(work, "slide.csv")
+    r = subprocess.run([wobble, "simulate", "--object", f"{data}/table.obj", "--modes", f"{data}/bend.def",
+                        "--terrain", "-400 0 0 0 400 -231", "--q", "-250 0.2 0 0", "--qdot", "20 0 0 0",
+                        "--duration", "3", "--out", out, *flags], capture_output=True, text=True, cwd=work)
+    return r, (open(out).read() if r.returncode == 0 else "")
+_, icy_face = slide("--friction-cap", "1", "--terrain-face", "1 frsin 0.05")
+_, icy_all = slide("--friction-cap", "0.05")
+_, grippy = slide("--friction-cap", "1")
+_, other_face = slide("--friction-cap", "1", "--terrain-face", "2 frsin 0.05 grdam 10")
+check(icy_face and icy_face == icy_all and grippy == other_face and grippy != icy_face,
+      "--terrain-face: segment 1's own cap is that cap on segment 1; segment 2's changes nothing there")
+for spec, why in [("5 frsin 0.05", "expected a segment from 1 to 2, got '5'"),
+                  ("1 frsn 0.05", "expected grconst, grdam, frconst or frsin, got 'frsn'"),
+                  ("1 frsin -1", "expected a number >= 0 for frsin, got '-1'"), ("1 frsin", "expected SEGMENT NAME VALUE")]:
+    r, _ = slide("--terrain-face", spec)
+    check(r.returncode == 2 and why in r.stderr, f"--terrain-face \"{spec}\": exit 2, {why}: " + r.stderr.strip())
 sys.exit(1 if failures else 0)

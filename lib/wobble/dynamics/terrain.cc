@@ -17,6 +17,20 @@ double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() 
 
 }  // namespace
 
+bool SurfaceOverrides::Set(const std::string& name, double value) {
+  if (name == "grconst") stiffness = value;
+  else if (name == "grdam") normal_damping = value;
+  else if (name == "frconst") friction_damping = value;
+  else if (name == "frsin") friction_cap = value;
+  else return false;
+  return true;
+}
+
+const std::vector<std::string>& SurfaceOverrides::Names() {
+  static const std::vector<std::string> names = {"grconst", "grdam", "frconst", "frsin"};
+  return names;
+}
+
 bool SurfaceOverrides::operator==(const SurfaceOverrides& o) const {
   return SameOrBothNan(stiffness, o.stiffness) && SameOrBothNan(normal_damping, o.normal_damping) &&
          SameOrBothNan(friction_damping, o.friction_damping) && SameOrBothNan(friction_cap, o.friction_cap);

@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <limits>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace wobble {
@@ -30,6 +31,10 @@ struct SurfaceOverrides {
   double friction_damping = std::numeric_limits<double>::quiet_NaN();
   double friction_cap = std::numeric_limits<double>::quiet_NaN();
   bool operator==(const SurfaceOverrides& o) const;
+  // Sets the constant `set` names `name` (grconst, grdam, frconst or frsin: appendix C's names
+  // of K_d, C_dam, FR_dam, tan θ); false for any other name.
+  bool Set(const std::string& name, double value);
+  static const std::vector<std::string>& Names();
 };
 
 // One straight piece of the ground with its parameters resolved: a point on its line, the

@@ -49,15 +49,9 @@ void TerrainFaceCommand(State& s, const Words& w, const Context& ctx) {
   std::vector<SurfaceOverrides> faces = terrain->segments();
   faces.resize(size_t(segments));
   SurfaceOverrides& face = faces[size_t(index) - 1];
-  for (size_t i = 2; i + 1 < w.size(); i += 2) {
-    const double v = NonNegative(w[i + 1], w[i], ctx);
-    if (w[i] == "grconst") face.stiffness = v;
-    else if (w[i] == "grdam") face.normal_damping = v;
-    else if (w[i] == "frconst") face.friction_damping = v;
-    else if (w[i] == "frsin") face.friction_cap = v;
-    else ctx.Fail("expected grconst, grdam, frconst or frsin, got '" + w[i] + "'" +
-                  DidYouMean(w[i], {"grconst", "grdam", "frconst", "frsin"}));
-  }
+  for (size_t i = 2; i + 1 < w.size(); i += 2)
+    if (!face.Set(w[i], NonNegative(w[i + 1], w[i], ctx)))
+      ctx.Fail("expected grconst, grdam, frconst or frsin, got '" + w[i] + "'" + DidYouMean(w[i], SurfaceOverrides::Names()));
   TheGround(s).terrain = MakeTerrain(terrain->vertices(), std::move(faces), ctx);
 }
 
