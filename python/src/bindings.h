@@ -34,6 +34,9 @@ void BindRender(py::module_& m);   // pictures and exports through pipelines/ (r
 // A C-contiguous float64 array of `rows` x `cols` (cols < 0: a vector of `rows`), or
 // InputError naming `what` and the shape expected.
 py::array_t<double, py::array::c_style> AsMatrix(const py::handle& a, long rows, long cols, const std::string& what);
+// An optional keyword vector: `otherwise` for None, else a finite vector of n (InputError naming
+// `what` otherwise).
+Eigen::VectorXd VectorOr(const py::object& v, long n, const Eigen::VectorXd& otherwise, const std::string& what);
 // What `wobble simulate` does with a loaded mode set, for load_body and load_body3: a set that
 // cannot be simulated is an InputError naming the object file; warnings become Python's.
 template <class Body> void CheckLoadedModeSet(const Body& body, const std::string& object) {

@@ -96,6 +96,14 @@ std::shared_ptr<LinearBodyModel> Linear(LinearBodyDef def) { return std::make_sh
 
 }  // namespace
 
+Eigen::VectorXd VectorOr(const py::object& v, long n, const Eigen::VectorXd& otherwise, const std::string& what) {
+  if (v.is_none()) return otherwise;
+  auto a = AsMatrix(v, n, -1, what);
+  Eigen::VectorXd out = Eigen::Map<const Eigen::VectorXd>(a.data(), n);
+  if (!out.allFinite()) throw InputError(what + " must be finite");
+  return out;
+}
+
 py::array_t<double, py::array::c_style> AsMatrix(const py::handle& h, long rows, long cols, const std::string& what) {
   auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(h);
   if (!a) throw InputError(what + ": expected an array of numbers");

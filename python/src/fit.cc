@@ -86,14 +86,6 @@ std::vector<CorrespondenceOf<Dim>> Targets(const BodyModelN<Dim>& body, const py
   return out;
 }
 
-Eigen::VectorXd OptionalVector(const py::object& v, long n, const std::string& what) {
-  if (v.is_none()) return Eigen::VectorXd();
-  auto a = AsMatrix(v, n, -1, what);
-  Eigen::VectorXd out = Eigen::Map<const Eigen::VectorXd>(a.data(), n);
-  if (!out.allFinite()) throw InputError(what + " must be finite");
-  return out;
-}
-
 // Reference frames: times (F,), world positions (F, K, Dim) of the mass points mass_points (K,).
 template <int Dim>
 std::vector<FrameOf<Dim>> Frames(const BodyModelN<Dim>& body, const py::object& times_in, const py::object& points_in,
@@ -187,10 +179,10 @@ template <int Dim> void BindDynamicFit(py::module_& m) {
          const std::string& gradient) {
         const auto frames = Frames(*body, times, points, mass_points);
         fit::DynamicParameters start;
-        start.q0 = OptionalVector(q0, body->num_q(), "q0");
-        start.qd0 = OptionalVector(qd0, body->num_q(), "qd0");
-        start.stiffness = OptionalVector(stiffness, body->num_modes(), "stiffness");
-        start.damping = OptionalVector(damping, body->num_modes(), "damping");
+        start.q0 = VectorOr(q0, body->num_q(), Eigen::VectorXd(), "q0");
+        start.qd0 = VectorOr(qd0, body->num_q(), Eigen::VectorXd(), "qd0");
+        start.stiffness = VectorOr(stiffness, body->num_modes(), Eigen::VectorXd(), "stiffness");
+        start.damping = VectorOr(damping, body->num_modes(), Eigen::VectorXd(), "damping");
         if (!graph.is_none()) start.graph = graph.cast<control::PoseGraph>();
         if (world.integrator != Integrator::kThesis)
           throw InputError("fit_dynamic simulates with the thesis integrator (options.integrator = 'thesis')");

@@ -57,14 +57,6 @@ fit::Axes AxesOf(const std::string& axes) {
   return a;
 }
 
-Eigen::VectorXd VectorOr(const py::object& v, long n, const Eigen::VectorXd& otherwise, const std::string& what) {
-  if (v.is_none()) return otherwise;
-  auto a = AsMatrix(v, n, -1, what);
-  Eigen::VectorXd out = Eigen::Map<const Eigen::VectorXd>(a.data(), n);
-  if (!out.allFinite()) throw InputError(what + " must be finite");
-  return out;
-}
-
 // A rollout from the keyword arguments: the options' world, integrator and dt; the start (at
 // rest in the body frame by default); the gains (the body's own by default); the targets
 // (modes, steps).
