@@ -67,6 +67,14 @@ class PyInterpreter {
     out.view.title = out.name;
     out.fps = 30.0;
     out.t_end = run.time(run.size() - 1);
+    // the NAME=VALUE view options are `wobble run`'s (app/script_render.cc): say so rather than
+    // drop them without a word
+    if (!r.options.empty()) {
+      std::string names;
+      for (const auto& [name, value] : r.options) names += (names.empty() ? "" : " ") + name + "=" + value;
+      out_ << "render: " << names << " not applied (Python's Interpreter draws with the default view; wobble run "
+           << "applies them)\n";
+    }
     std::vector<std::string> words;
     std::istringstream in(r.what.empty() ? "frames,filmstrip,charts" : r.what);
     for (std::string w; std::getline(in, w, ',');)

@@ -104,3 +104,6 @@ def test_a_script_renders_its_object_runs_from_python(data, tmp_path):
     assert any((tmp_path / "pot3" / "vtp").glob("*.pvd"))
     with pytest.raises(wobble.ParseError, match="render: 'gif' is not one of"):
         interp.run(f"render {tmp_path}/pot3 gif", dir=str(data))
+    # view options are wobble run's: Python's Interpreter says it does not apply them
+    interp.run(f"render {tmp_path}/pot3 vtp style=clean fps=10", dir=str(data))
+    assert "render: style=clean fps=10 not applied" in interp.take_output()
