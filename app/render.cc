@@ -100,8 +100,8 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
       ->capture_default_str();
   cmd->add_option("--orbit", a->orbit, "3D: the camera orbits the motion at this many degrees per simulated second")
       ->capture_default_str();
-  cmd->add_option("--camera", a->camera, "2D: whole (frame the whole run, standing still) or follow (the body, smoothed, "
-                                        "the ground under it in view)")
+  cmd->add_option("--camera", a->camera, "whole (frame the whole run, standing still) or follow (the body, smoothed, "
+                                        "the ground under it in view; 3D: a cube about it from --azimuth, --elevation)")
       ->capture_default_str();
   cmd->add_option("--style", a->style, "diagnostic (lattice, mass points, shape) or clean (the character: filled, "
                                       "anti-aliased, no lattice or points)")

@@ -57,4 +57,29 @@ std::vector<Eigen::AlignedBox2d> FollowBoxes(const std::vector<FollowMoment>& mo
   return boxes;
 }
 
+std::vector<Eigen::AlignedBox3d> FollowBoxes3(const std::vector<FollowMoment3>& moments, const FollowOptions& options) {
+  std::vector<Eigen::AlignedBox3d> boxes;
+  if (moments.empty()) return boxes;
+  double reach = 1e-9;
+  for (const FollowMoment3& m : moments) reach = std::max(reach, 0.5 * m.body.sizes().maxCoeff());
+  const double half = options.zoom * reach;
+  std::vector<double> t, cx, cy, cz;
+  for (const FollowMoment3& m : moments) {
+    double y = m.body.center().y();
+    if (m.ground_height) y = *m.ground_height + 0.6 * half;  // the ground a fifth up the cube
+    const double lo = m.body.max().y() - 0.6 * half, hi = m.body.min().y() + 0.85 * half;
+    y = lo <= hi ? std::clamp(y, lo, hi) : m.body.center().y();
+    t.push_back(m.t);
+    cx.push_back(m.body.center().x());
+    cy.push_back(y);
+    cz.push_back(m.body.center().z());
+  }
+  const double sigma = std::max(options.smoothing_s, 1e-9);
+  for (size_t i = 0; i < moments.size(); ++i) {
+    const Eigen::Vector3d c(LocalLinearFit(t, cx, i, sigma), LocalLinearFit(t, cy, i, sigma), LocalLinearFit(t, cz, i, sigma));
+    boxes.emplace_back(c - Eigen::Vector3d::Constant(half), c + Eigen::Vector3d::Constant(half));
+  }
+  return boxes;
+}
+
 }  // namespace wobble::pipelines

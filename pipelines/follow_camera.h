@@ -1,4 +1,4 @@
-// The follow camera of 2D renders (issue 19): for each drawn moment, the box to frame so that
+// The follow camera of renders (issue 19): for each drawn moment, the box to frame so that
 // the body stays in view at one scale for the whole run, the ground under it shows when it can,
 // and the camera moves smoothly. Plain geometry, no VTK: the render driver feeds it the body's
 // box and the ground's height under it at every frame and filmstrip panel.
@@ -28,5 +28,17 @@ struct FollowOptions {
 // in time, so a body moving at constant velocity is followed exactly, to the first and last
 // moment, while jumps (the ground under the body at a cliff's edge) are eased over ~4σ.
 std::vector<Eigen::AlignedBox2d> FollowBoxes(const std::vector<FollowMoment>& moments, const FollowOptions& options);
+
+// 3D: the body's box and the ground's height under its centre (plane or heightfield).
+struct FollowMoment3 {
+  double t = 0;
+  Eigen::AlignedBox3d body;
+  std::optional<double> ground_height;
+};
+// One cube per moment, all of one size (zoom times the body's largest half-extent, as a half
+// side), for the perspective camera to frame (SceneView::FrameBox3d): centred on the body in x
+// and z, and in y placed as the 2D boxes are, so the ground under the body shows in the lower
+// part of the picture; smoothed in time as in 2D.
+std::vector<Eigen::AlignedBox3d> FollowBoxes3(const std::vector<FollowMoment3>& moments, const FollowOptions& options);
 
 }  // namespace wobble::pipelines

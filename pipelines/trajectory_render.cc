@@ -84,6 +84,19 @@ struct Visit {
   }
 };
 
+// The 3D follow camera's view now: the bodies' box and the 3D ground's height under its centre.
+FollowMoment3 FollowMoment3Now(const World& world, const Eigen::AlignedBox3d& bodies) {
+  FollowMoment3 m;
+  m.t = world.time();
+  m.body = bodies;
+  const GroundPlane& g = world.options().ground_3d;
+  const Eigen::Vector3d c = bodies.center();
+  if (g.enabled && g.heightfield) m.ground_height = g.heightfield->HeightAt(c.x(), c.z());
+  else if (g.enabled && std::abs(g.normal.y()) > 1e-9)  // the plane n·(x − p) = 0 solved for y
+    m.ground_height = g.point.y() - (g.normal.x() * (c.x() - g.point.x()) + g.normal.z() * (c.z() - g.point.z())) / g.normal.y();
+  return m;
+}
+
 }  // namespace
 
 std::vector<double> FilmstripCycleTimes(const record::Trajectory& run, int k, int panels) {
@@ -275,8 +288,11 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   // the camera's pass: the box of every drawn state (and the ground below it), the colour range
   Eigen::AlignedBox3d motion, cycle;  // cycle: the panels' states of a gait's filmstrip
   const bool follow = out.camera == RenderOutputs::Camera::kFollow && IsFlat(world);
+  const bool follow3 = out.camera == RenderOutputs::Camera::kFollow && !IsFlat(world);
   std::vector<FollowMoment> moments;
-  std::vector<Eigen::AlignedBox2d> follow_boxes;  // per visit
+  std::vector<FollowMoment3> moments3;
+  std::vector<Eigen::AlignedBox2d> follow_boxes;   // per visit
+  std::vector<Eigen::AlignedBox3d> follow_boxes3;  // per visit
   const bool orbit = out.orbit_deg_per_s != 0.0 && !IsFlat(world);
   if (view || strip_view) {
     double lo = 1e300, hi = -1e300;
@@ -288,6 +304,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       motion.extend(bodies);
       if (v.frame < 0 && out.filmstrip_cycle >= 0) cycle.extend(bodies);
       if (follow) moments.push_back(FollowMomentNow(world, bodies));
+      if (follow3) moments3.push_back(FollowMoment3Now(world, bodies));
       double r[2];
       if (!fixed_range && (view ? view : strip_view)->ColorRangeNow(r)) {
         lo = std::min(lo, r[0]);
@@ -319,6 +336,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       if (lo < hi) v->SetColorRange(lo, hi);  // one colour scale for the whole run
     }
     if (follow) follow_boxes = FollowBoxes(moments, {double(out.view.width) / out.view.height});
+    if (follow3) follow_boxes3 = FollowBoxes3(moments3, {});
     world = caller;  // the writing pass replays the run from the start again
   }
   for (SceneView* v : {view.get(), strip_view.get()})
@@ -356,6 +374,11 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       for (SceneView* sv : {view.get(), strip_view.get()})
         if (sv) sv->FrameBox(box, 0.0);
     }
+    if (!follow_boxes3.empty()) {  // an orbiting view frames its box below, at the frame's angle
+      const Eigen::AlignedBox3d& box3 = follow_boxes3[size_t(&v - visits.data())];
+      if (strip_view) strip_view->FrameBox3d(box3);
+      if (view && !orbit) view->FrameBox3d(box3);
+    }
     if (v.frame < 0) {
       if (out.filmstrip_cycle >= 0) strip_view->SetCaption("pose " + std::to_string(run.pose(v.sample)));
       strip_view->Render();
@@ -366,7 +389,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       if (sv && !out.trail.empty() && sv->trails()) sv->trails()->Record();
     if (view && orbit) {  // the frame's angle of the orbit; the box framed is the whole motion's
       view->SetViewAngles(out.view.azimuth + out.orbit_deg_per_s * (world.time() - run.time(0)), out.view.elevation);
-      view->FrameBox3d(motion);
+      view->FrameBox3d(follow_boxes3.empty() ? motion : follow_boxes3[size_t(&v - visits.data())]);
     }
     if (view) {
       view->Render();

@@ -71,6 +71,22 @@ vtp = os.path.join(hf_out, "vtp", next(iter(terrain_files))) if terrain_files el
 body = open(vtp, "rb").read().decode("latin-1") if vtp and os.path.exists(vtp) else ""  # appended binary data
 check('NumberOfPoints="651"' in body and 'NumberOfPolys="1200"' in body,
       "the terrain part is the 31 x 21 grid's 1200 triangles")
+# the 3D follow camera (--camera follow): the filmstrip draws, and its panels differ from the
+# whole-run camera's (the cube about the pot, not the motion's box)
+if has_display:
+    strips = {}
+    for camera in ("whole", "follow"):
+        out = os.path.join(work, "hills_" + camera)
+        shutil.rmtree(out, ignore_errors=True)
+        r = subprocess.run([wobble, "render", "--object", f"{data}/pot3.obj", "--modes", f"{data}/pot3_modes.def3",
+                            "--heightfield", f"{data}/hills.heightfield", "--q", "-250 160 0 0 0 0 0 0 0", "--qdot",
+                            "20 0 0 0 0 0 0 0 0", "--dt", "0.001", "--ground-stiffness", "20000", "--duration", "1",
+                            "--camera", camera, "--what", "filmstrip", "--out", out], capture_output=True, text=True,
+                           cwd=work, env=env)
+        png = os.path.join(out, "filmstrip.png")
+        strips[camera] = open(png, "rb").read() if r.returncode == 0 and os.path.exists(png) else b""
+    check(strips["whole"] and strips["follow"] and strips["whole"] != strips["follow"],
+          "--camera follow in 3D draws its own framing")
 bad_field = os.path.join(work, "bad.heightfield")
 open(bad_field, "w").write("origin 0 0\nspacing 1 1\n1,2,3\n1,x,3\n")
 r = subprocess.run([wobble, "render", "--object", f"{data}/pot3.obj", "--modes", f"{data}/pot3_modes.def3",
