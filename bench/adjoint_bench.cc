@@ -6,6 +6,9 @@
 // to every parameter) in the same run: the gradient's cost is the ratio of the two rows with
 // the same arguments. In the air (second argument 0) and falling onto the ground (1; contacts
 // add 2 inputs per point to each step's differentiation).
+// The 3D rows (Simulation3, Gradient3) do the same for the chair of tests/support (about 300
+// mass points, 3 modes; 12 + 2·3 state coordinates), controls/3 steps of 0.002 s, falling onto
+// a plane in the grounded case.
 // Run: build/bench/adjoint_bench --benchmark_min_time=0.5
 #include <benchmark/benchmark.h>
 
@@ -13,6 +16,7 @@
 
 #include "support/test_bodies.h"
 #include "wobble/fit/adjoint.h"
+#include "wobble/fit/adjoint3.h"
 
 namespace wobble {
 namespace {
@@ -72,8 +76,65 @@ void BM_Gradient(benchmark::State& state) {
   state.counters["states_held"] = held;
 }
 
+const BodyModel3& Chair() {
+  static const BodyModel3 body = testing::Chair3();
+  return body;
+}
+
+fit::ControlledRollout3 Rollout3(int controls, bool grounded) {
+  fit::ControlledRollout3 r;
+  r.integrator = Integrator::kThesis;
+  r.dt = 0.002;
+  r.world.ground.enabled = grounded;
+  r.world.ground.stiffness = 2e4;  // per point of 1/3 kg
+  r.world.ground.normal_damping = 100;
+  r.world.ground.friction_damping = 100;
+  r.world.ground.friction_cap = 0.3;
+  r.start = RestState3<double>(Chair());
+  r.start.t.y() = grounded ? 3.0 : 200.0;
+  r.start.v[0] = 30.0;
+  r.stiffness = Eigen::VectorXd::Constant(3, 2e4);
+  r.damping = Eigen::VectorXd::Constant(3, 200);
+  const int steps = (controls + 2) / 3;
+  r.targets.resize(3, steps);
+  for (int n = 0; n < steps; ++n)
+    for (int d = 0; d < 3; ++d) r.targets(d, n) = 0.05 * std::sin(0.01 * n + d);
+  return r;
+}
+
+// ½ |x − y|² of a rigid point l of the chair's frame against a fixed goal, every step:
+// x = t + R l, so ∂/∂δt = e and ∂/∂ε = l × Rᵀe.
+double Stage3(int, const BodyState3<double>& s, Eigen::VectorXd* dz) {
+  const Eigen::Vector3d goal(400.0, 120.0, 50.0), l(50.0, 50.0, 30.0);
+  const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
+  const Eigen::Vector3d e = s.t + R * l - goal;
+  dz->head<3>() += e;
+  dz->segment<3>(3) += l.cross(R.transpose() * e);
+  return 0.5 * e.squaredNorm();
+}
+
+void BM_Simulation3(benchmark::State& state) {
+  const fit::ControlledRollout3 r = Rollout3(int(state.range(0)), state.range(1) != 0);
+  for (auto _ : state) benchmark::DoNotOptimize(fit::RolloutCost3(Chair(), r, Stage3));
+  state.counters["controls"] = double(3 * r.steps());
+}
+
+void BM_Gradient3(benchmark::State& state) {
+  const fit::ControlledRollout3 r = Rollout3(int(state.range(0)), state.range(1) != 0);
+  int held = 0;
+  for (auto _ : state) {
+    const fit::RolloutGradient3 g = fit::RolloutCostGradient3(Chair(), r, Stage3);
+    if (!g.ok) state.SkipWithError(g.message.c_str());
+    held = g.states_held;
+  }
+  state.counters["controls"] = double(3 * r.steps());
+  state.counters["states_held"] = held;
+}
+
 BENCHMARK(BM_Simulation)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Gradient)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Simulation3)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Gradient3)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace wobble

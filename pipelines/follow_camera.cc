@@ -26,6 +26,16 @@ double LocalLinearFit(const std::vector<double>& t, const std::vector<double>& y
   return (s2 * sy - s1 * sty) / det;  // the intercept at d = 0
 }
 
+// The view's centre height for a body spanning [body_min_y, body_max_y] in a view half_h
+// high: the ground a fifth up the picture, but the body in view wins over the ground (7.5 %
+// inside the bottom edge, and below the top fifth, where the overlay's text lines are).
+double PlacedCentreY(double body_min_y, double body_max_y, const std::optional<double>& ground_height, double half_h) {
+  const double centre = 0.5 * (body_min_y + body_max_y);
+  const double y = ground_height ? *ground_height + 0.6 * half_h : centre;
+  const double lo = body_max_y - 0.6 * half_h, hi = body_min_y + 0.85 * half_h;
+  return lo <= hi ? std::clamp(y, lo, hi) : centre;
+}
+
 }  // namespace
 
 std::vector<Eigen::AlignedBox2d> FollowBoxes(const std::vector<FollowMoment>& moments, const FollowOptions& options) {
@@ -39,15 +49,9 @@ std::vector<Eigen::AlignedBox2d> FollowBoxes(const std::vector<FollowMoment>& mo
   const double half_h = options.zoom * reach, half_w = half_h * options.aspect;
   std::vector<double> t, cx, cy;
   for (const FollowMoment& m : moments) {
-    double y = m.body.center().y();
-    if (m.ground_height) y = *m.ground_height + 0.6 * half_h;  // the ground a fifth up the picture
-    // the body in view wins over the ground: 7.5 % inside the bottom edge, and below the top
-    // fifth, where the overlay's text lines are
-    const double lo = m.body.max().y() - 0.6 * half_h, hi = m.body.min().y() + 0.85 * half_h;
-    y = lo <= hi ? std::clamp(y, lo, hi) : m.body.center().y();
     t.push_back(m.t);
     cx.push_back(m.body.center().x());
-    cy.push_back(y);
+    cy.push_back(PlacedCentreY(m.body.min().y(), m.body.max().y(), m.ground_height, half_h));
   }
   const double sigma = std::max(options.smoothing_s, 1e-9);
   for (size_t i = 0; i < moments.size(); ++i) {
@@ -65,13 +69,9 @@ std::vector<Eigen::AlignedBox3d> FollowBoxes3(const std::vector<FollowMoment3>& 
   const double half = options.zoom * reach;
   std::vector<double> t, cx, cy, cz;
   for (const FollowMoment3& m : moments) {
-    double y = m.body.center().y();
-    if (m.ground_height) y = *m.ground_height + 0.6 * half;  // the ground a fifth up the cube
-    const double lo = m.body.max().y() - 0.6 * half, hi = m.body.min().y() + 0.85 * half;
-    y = lo <= hi ? std::clamp(y, lo, hi) : m.body.center().y();
     t.push_back(m.t);
     cx.push_back(m.body.center().x());
-    cy.push_back(y);
+    cy.push_back(PlacedCentreY(m.body.min().y(), m.body.max().y(), m.ground_height, half));
     cz.push_back(m.body.center().z());
   }
   const double sigma = std::max(options.smoothing_s, 1e-9);

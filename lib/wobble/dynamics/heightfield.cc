@@ -1,6 +1,7 @@
 #include "wobble/dynamics/heightfield.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -54,6 +55,14 @@ std::shared_ptr<const Heightfield> Heightfield::Make(const Eigen::Vector2d& orig
         h->normals_[size_t(f)] = Eigen::Vector3d(-slopes[t][0], 1.0, -slopes[t][1]).normalized();
       }
     }
+  // which edges are valleys depends on the heights only: decided once here, not per query
+  h->valleys_.resize(size_t(triangles));
+  for (int a = 0; a < triangles; ++a) {
+    std::array<int, 3> across = h->Across(a);
+    for (int& b : across)
+      if (b >= 0 && !h->Concave(a, b)) b = -1;
+    h->valleys_[size_t(a)] = across;
+  }
   return h;
 }
 
@@ -110,21 +119,22 @@ void Heightfield::FacesFelt(const Eigen::Vector3d& x, std::vector<int>* out) con
   if (!(Behind(a, x) < 0.0)) return;
   const size_t first = out->size();
   out->push_back(a);
-  // the three triangles across a's edges
-  const int cell = a / 2, i = cell % (nx_ - 1), j = cell / (nx_ - 1);
-  int across[3];
-  int count = 0;
-  across[count++] = a % 2 == 0 ? a + 1 : a - 1;  // the diagonal
-  if (a % 2 == 0) {
-    if (j > 0) across[count++] = 2 * (i + (nx_ - 1) * (j - 1)) + 1;       // the edge at z_j
-    if (i + 2 < nx_) across[count++] = 2 * (i + 1 + (nx_ - 1) * j) + 1;  // the edge at x_{i+1}
-  } else {
-    if (i > 0) across[count++] = 2 * (i - 1 + (nx_ - 1) * j);            // the edge at x_i
-    if (j + 2 < nz_) across[count++] = 2 * (i + (nx_ - 1) * (j + 1));    // the edge at z_{j+1}
-  }
-  for (int k = 0; k < count; ++k)
-    if (Behind(across[k], x) < 0.0 && Concave(a, across[k])) out->push_back(across[k]);
+  for (int b : valleys_[size_t(a)])
+    if (b >= 0 && Behind(b, x) < 0.0) out->push_back(b);
   std::sort(out->begin() + long(first), out->end());
+}
+
+std::array<int, 3> Heightfield::Across(int a) const {
+  const int cell = a / 2, i = cell % (nx_ - 1), j = cell / (nx_ - 1);
+  std::array<int, 3> across = {a % 2 == 0 ? a + 1 : a - 1, -1, -1};  // the diagonal first
+  if (a % 2 == 0) {
+    if (j > 0) across[1] = 2 * (i + (nx_ - 1) * (j - 1)) + 1;       // the edge at z_j
+    if (i + 2 < nx_) across[2] = 2 * (i + 1 + (nx_ - 1) * j) + 1;  // the edge at x_{i+1}
+  } else {
+    if (i > 0) across[1] = 2 * (i - 1 + (nx_ - 1) * j);            // the edge at x_i
+    if (j + 2 < nz_) across[2] = 2 * (i + (nx_ - 1) * (j + 1));    // the edge at z_{j+1}
+  }
+  return across;
 }
 
 }  // namespace wobble

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -60,12 +61,16 @@ class Heightfield {
   int TriangleUnder(double x, double z) const;
   // Whether faces a and b (sharing an edge) meet in a valley.
   bool Concave(int a, int b) const;
+  // The triangles across a's three edges (diagonal, then the two cell edges), −1 where a's edge
+  // is the grid's.
+  std::array<int, 3> Across(int a) const;
   double Behind(int f, const Eigen::Vector3d& x) const;  // signed height above f's plane
 
   Eigen::Vector2d origin_, spacing_;
   int nx_ = 0, nz_ = 0;
   std::vector<double> heights_;
   std::vector<Eigen::Vector3d> normals_, points_;  // per triangle
+  std::vector<std::array<int, 3>> valleys_;         // per triangle: Across(), −1 unless concave
   double max_height_ = 0;
 };
 

@@ -41,10 +41,21 @@ struct GroundPlane {
   std::shared_ptr<const Heightfield> heightfield;  // when set, the ground (point and normal unused)
   template <class T> T Height(const Vec3<T>& x) const { return normal.cast<T>().dot(x - point.cast<T>()); }
   // Face f's plane near x with these constants: the plane itself (face 0) or a heightfield face.
+  // Built field by field, not copied: a copy would touch the shared_ptr's atomic count once
+  // per (point, face) per force evaluation.
   GroundPlane Face(int f, const Eigen::Vector3d& x) const {
-    GroundPlane p = *this;
-    p.heightfield = nullptr;
-    if (heightfield) heightfield->FacePlane(f, x, &p.point, &p.normal);
+    GroundPlane p;
+    p.enabled = enabled;
+    p.stiffness = stiffness;
+    p.normal_damping = normal_damping;
+    p.friction_damping = friction_damping;
+    p.friction_cap = friction_cap;
+    if (heightfield) {
+      heightfield->FacePlane(f, x, &p.point, &p.normal);
+    } else {
+      p.point = point;
+      p.normal = normal;
+    }
     return p;
   }
 };
@@ -189,7 +200,11 @@ void ForEachPointInContact3(const BodyModel3& body, const GroundPlane& g, const 
       const Vec3<T> l = LocalPosition3<T>(body.rest_local(c.point), B, s.gamma);
       const Vec3<T> x = frame.t + frame.R * l;
       const Eigen::Vector3d xd(ScalarValue(x.x()), ScalarValue(x.y()), ScalarValue(x.z()));
-      f(c.point, c.face, g.heightfield ? g.Face(c.face, xd) : g, l, x, PointVelocity3(frame, s.v, l, B), c.anchor);
+      if (g.heightfield) {
+        f(c.point, c.face, g.Face(c.face, xd), l, x, PointVelocity3(frame, s.v, l, B), c.anchor);
+      } else {
+        f(c.point, c.face, g, l, x, PointVelocity3(frame, s.v, l, B), c.anchor);
+      }
     }
     return;
   }

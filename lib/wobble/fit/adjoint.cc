@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "wobble/fit/internal/adjoint_sweep.h"
 #include "wobble/fit/internal/mode_force.h"
 
 namespace wobble::fit {
@@ -19,8 +20,10 @@ namespace {
 
 // Inputs differentiated per Jet pass: the table's step has 2·7 + 3·4 = 26 inputs in the air
 // (two passes) and 22 more with all 11 points on the ground.
-constexpr int kChunk = 16;
-using Jet = ceres::Jet<double, kChunk>;
+constexpr int kChunk = internal::kAdjointChunk;
+using Jet = internal::AdjointJet;
+using internal::Pull;
+using internal::Seed;
 
 using ContactKey = std::pair<int, int>;  // (point, face): a contact's identity across steps
 
@@ -29,14 +32,6 @@ struct Adjoint {
   Eigen::VectorXd q, qd;
   std::map<ContactKey, Eigen::Vector2d> anchor;
 };
-
-// Input i as a Jet whose derivative part is the unit vector of i when i is in the chunk that
-// starts at `offset`, and zero otherwise.
-Jet Seed(double value, int i, int offset) {
-  Jet x(value);
-  if (i >= offset && i < offset + kChunk) x.v[i - offset] = 1.0;
-  return x;
-}
 
 // q and q̇ as Jets: inputs 0 … nq − 1 and nq … 2 nq − 1 of the chunk at `offset`.
 void SeedState(const VecQ<double>& q, const VecQ<double>& qd, int offset, VecQ<Jet>* qj, VecQ<Jet>* qdj) {
@@ -47,13 +42,6 @@ void SeedState(const VecQ<double>& q, const VecQ<double>& qd, int offset, VecQ<J
     (*qj)[i] = Seed(q[i], i, offset);
     (*qdj)[i] = Seed(qd[i], nq + i, offset);
   }
-}
-
-// g[offset + k] += λ ∂y/∂(input offset + k) for the inputs of the chunk.
-void Pull(const Jet& y, double lambda, int offset, Eigen::VectorXd* g) {
-  if (lambda == 0.0) return;
-  const int n = std::min(kChunk, int(g->size()) - offset);
-  for (int k = 0; k < n; ++k) (*g)[offset + k] += lambda * y.v[k];
 }
 
 // g += (∂(state)/∂(chunk inputs))ᵀ λ: every output of a step, weighted by its adjoint.
@@ -450,13 +438,11 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
   CheckRollout(body, rollout);
   const Rollout r(body, rollout);
   const int nq = r.nq(), D = r.modes(), N = rollout.steps();
-  const int interval = checkpoint_interval > 0 ? checkpoint_interval : std::max(1, int(std::ceil(std::sqrt(double(N)))));
+  const int interval = internal::CheckpointInterval(N, checkpoint_interval);
   RolloutGradient g;
   g.stiffness = Eigen::VectorXd::Zero(D);
   g.damping = Eigen::VectorXd::Zero(D);
   g.targets = Eigen::MatrixXd::Zero(D, N);
-
-  // the stage cost at state n: its value into the total, its gradient into λ
   Eigen::VectorXd dq(nq), dqd(nq);
   auto stage = [&](int n, const BodyState<double>& s, Adjoint* lambda) {
     dq.setZero();
@@ -465,42 +451,14 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
     lambda->q += dq;
     lambda->qd += dqd;
   };
-
-  // forward: a checkpoint every `interval` steps
-  std::vector<BodyState<double>> checkpoints;
-  BodyState<double> s = r.Start();
-  for (int n = 0; n < N; ++n) {
-    if (n % interval == 0) checkpoints.push_back(s);
-    if (!r.Step(n, &s, &g.message)) return g;
-  }
+  auto step = [&](int n, BodyState<double>* s) { return r.Step(n, s, &g.message); };
+  auto vjp = [&](int n, const BodyState<double>& state, const BodyState<double>& next, const Adjoint& out, Adjoint* in) {
+    if (!r.ByHand()) return r.StepVjp(n, state, out, in, &g, &g.message);
+    r.HandVjp(n, state, next, out, in, &g);
+    return true;
+  };
   Adjoint lambda{Eigen::VectorXd::Zero(nq), Eigen::VectorXd::Zero(nq), {}};
-  stage(N, s, &lambda);
-
-  // backward, one interval at a time from its checkpoint
-  std::vector<BodyState<double>> segment;
-  Adjoint before;
-  for (int c = int(checkpoints.size()) - 1; c >= 0; --c) {
-    const int begin = c * interval, end = std::min(N, begin + interval);
-    segment.assign(1, checkpoints[c]);
-    for (int n = begin; n + 1 < end; ++n) {
-      segment.push_back(segment.back());
-      if (!r.Step(n, &segment.back(), &g.message)) return g;
-    }
-    g.states_held = std::max(g.states_held, int(checkpoints.size() + segment.size()));
-    for (int n = end - 1; n >= begin; --n) {
-      const BodyState<double>& state = segment[n - begin];
-      // state n + 1: in this interval, or the next interval's checkpoint, or the last state
-      const BodyState<double>& next = n + 1 < end                          ? segment[n + 1 - begin]
-                                      : c + 1 < int(checkpoints.size()) ? checkpoints[c + 1]
-                                                                          : s;
-      if (r.ByHand())
-        r.HandVjp(n, state, next, lambda, &before, &g);
-      else if (!r.StepVjp(n, state, lambda, &before, &g, &g.message))
-        return g;
-      stage(n, state, &before);
-      std::swap(lambda, before);
-    }
-  }
+  if (!internal::CheckpointedAdjointSweep(N, interval, r.Start(), &lambda, step, vjp, stage, &g.states_held)) return g;
   g.q0 = lambda.q;
   g.qd0 = lambda.qd;
   r.StartVjp(lambda, &g.q0, &g.qd0);

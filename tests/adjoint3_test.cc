@@ -1,0 +1,330 @@
+// The adjoint gradient of a 3D rollout (lib/wobble/fit/adjoint3.h, issue 18), checked as the
+// 2D one is (adjoint_test.cc) against two independent derivatives of the same cost:
+//  - forward-mode Jets through the WHOLE simulation (written here, with its own PD force, its
+//    own passive body and its own perturbation of the orientation, R0 exp(ε̂)): single
+//    parameters and random directions in the space of every parameter, to 1e-9 relative;
+//  - central differences of the plain cost, per parameter, to 1e-7 relative, in the air.
+// In the air, through contacts with friction on a tilted plane (contacts begin, slip and end)
+// and on a heightfield valley with a spring, for the thesis and symplectic Euler integrators.
+#include <ceres/jet.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "support/test_bodies.h"
+#include "wobble/core/rotation3.h"
+#include "wobble/dynamics/step3.h"
+#include "wobble/fit/adjoint3.h"
+
+namespace wobble {
+namespace {
+
+constexpr int kModes = 3;                  // the chair's bend, twist and squash
+constexpr int kNz = 12 + 2 * kModes;       // tangent coordinates of a state
+constexpr int kPoint = 7;                  // the cost follows this mass point
+
+BodyModel3 PassiveChair() {
+  const BodyModel3 chair = testing::Chair3();
+  std::vector<DeformationMode3> modes = chair.modes();
+  for (DeformationMode3& m : modes) m.stiffness = m.damping = 0.0;
+  return BodyModel3(chair.def(), modes);
+}
+
+// ℓ_n = ½ w |x_k − y(n)|² + ½ ρ |v|² + ½ σ |γ|²: a point chasing a moving target, a velocity
+// penalty and a shape penalty. Templated so that the reference can run it on Jets.
+template <class T> T Stage(const BodyModel3& body, int n, const BodyState3<T>& s) {
+  const Vec3<T> l = LocalPosition3<T>(body.rest_local(kPoint), body.mode_matrix(kPoint), s.gamma);
+  const Vec3<T> x = s.t + s.orientation.toRotationMatrix() * l;
+  const Eigen::Vector3d y(20.0 + 2.0 * n, 60.0 - 0.5 * n, 10.0 + 1.0 * n);
+  T cost = T(0.5e-2) * (x - y.cast<T>()).squaredNorm();
+  for (int i = 0; i < s.v.size(); ++i) cost += T(0.5e-3) * s.v[i] * s.v[i];
+  for (int d = 0; d < s.gamma.size(); ++d) cost += T(0.5) * s.gamma[d] * s.gamma[d];
+  return cost;
+}
+
+// The stage cost's gradient in the tangent coordinates (δt, ε, δγ, δv) of adjoint3.h, by Jets.
+fit::StageCost3 StageOf(const BodyModel3& body) {
+  return [&body](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) {
+    using J = ceres::Jet<double, kNz>;
+    BodyState3<J> sj;
+    Vec3<J> eps;
+    for (int i = 0; i < 3; ++i) {
+      sj.t[i] = J(s.t[i], i);
+      eps[i] = J(0.0, 3 + i);
+    }
+    sj.orientation = s.orientation.cast<J>() * ExpRotation<J>(eps);
+    sj.gamma.resize(kModes);
+    for (int d = 0; d < kModes; ++d) sj.gamma[d] = J(s.gamma[d], 6 + d);
+    sj.v.resize(6 + kModes);
+    for (int i = 0; i < 6 + kModes; ++i) sj.v[i] = J(s.v[i], 6 + kModes + i);
+    const J c = Stage(body, n, sj);
+    *dz += c.v;
+    return c.a;
+  };
+}
+
+// The reference's mode forces −2K (γ − γ0(n)) − c γ̇, written out here.
+template <class T> struct PdForce3 {
+  const std::vector<T>* K;
+  const std::vector<T>* c;
+  const std::vector<T>* target;
+  void operator()(const BodyState3<T>& s, VecQ3<T>* Q) const {
+    for (int d = 0; d < kModes; ++d)
+      (*Q)[6 + d] += -T(2.0) * (*K)[d] * (s.gamma[d] - (*target)[d]) - (*c)[d] * s.v[6 + d];
+  }
+};
+
+// Every parameter in one flat vector: the start's tangent coordinates (zero: the start
+// itself), K, c, then the targets step by step.
+Eigen::VectorXd Flatten(const fit::ControlledRollout3& r) {
+  const int N = r.steps();
+  Eigen::VectorXd p(kNz + 2 * kModes + kModes * N);
+  p << Eigen::VectorXd::Zero(kNz), r.stiffness, r.damping, Eigen::Map<const Eigen::VectorXd>(r.targets.data(), kModes * N);
+  return p;
+}
+Eigen::VectorXd Flatten(const fit::RolloutGradient3& g) {
+  const int N = int(g.targets.cols());
+  Eigen::VectorXd p(kNz + 2 * kModes + kModes * N);
+  p << g.start, g.stiffness, g.damping, Eigen::Map<const Eigen::VectorXd>(g.targets.data(), kModes * N);
+  return p;
+}
+
+// The cost with parameters p + ε v (Flatten's order; the start moved along its tangent
+// coordinates), ε a Jet of one dimension (or double, v unused).
+template <class T>
+T ReferenceCost(const BodyModel3& passive, const fit::ControlledRollout3& r, const Eigen::VectorXd& p,
+                const Eigen::VectorXd& v) {
+  auto param = [&](int i) {
+    T x(p[i]);
+    if constexpr (!std::is_same_v<T, double>) x.v[0] = v[i];
+    return x;
+  };
+  BodyState3<T> s;
+  Vec3<T> eps;
+  for (int i = 0; i < 3; ++i) {
+    s.t[i] = T(r.start.t[i]) + param(i);
+    eps[i] = param(3 + i);
+  }
+  s.orientation = r.start.orientation.normalized().cast<T>() * ExpRotation<T>(eps);
+  s.gamma.resize(kModes);
+  for (int d = 0; d < kModes; ++d) s.gamma[d] = T(r.start.gamma[d]) + param(6 + d);
+  s.v.resize(6 + kModes);
+  for (int i = 0; i < 6 + kModes; ++i) s.v[i] = T(r.start.v[i]) + param(6 + kModes + i);
+  std::vector<T> K(kModes), c(kModes), target(kModes);
+  for (int d = 0; d < kModes; ++d) {
+    K[d] = param(kNz + d);
+    c[d] = param(kNz + kModes + d);
+  }
+  UpdateContacts3(passive, r.world.ground, &s);
+  T total = Stage(passive, 0, s);
+  for (int n = 0; n < r.steps(); ++n) {
+    for (int d = 0; d < kModes; ++d) target[d] = param(kNz + 2 * kModes + kModes * n + d);
+    EXPECT_TRUE(StepBody3(passive, r.world, r.integrator, r.dt, &s, PdForce3<T>{&K, &c, &target}).ok());
+    total += Stage(passive, n + 1, s);
+  }
+  return total;
+}
+
+struct Case {
+  BodyModel3 body;     // the chair with its own mode gains, which the rollout's replace
+  BodyModel3 passive;  // the same with none: the reference's
+  fit::ControlledRollout3 rollout;
+};
+
+// The chair with random gains, random PD targets every step and a random start; `grounded`:
+// thrown onto a tilted plane, sliding (friction slips) and bouncing; else in the air.
+Case MakeCase(Integrator integrator, bool grounded, int steps, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Case k{testing::Chair3(), PassiveChair(), {}};
+  fit::ControlledRollout3& r = k.rollout;
+  r.integrator = integrator;
+  r.dt = 2e-3;
+  if (grounded) {
+    r.world.ground.enabled = true;
+    r.world.ground.normal = Eigen::Vector3d(-0.1, 1.0, 0.05).normalized();
+    r.world.ground.stiffness = 2e4;  // per point of 1/3 kg
+    r.world.ground.normal_damping = 100;
+    r.world.ground.friction_damping = 100;
+    r.world.ground.friction_cap = 0.3;
+  }
+  BodyState3<double>& s = r.start;
+  s = RestState3<double>(k.passive);
+  s.t = Eigen::Vector3d(10 * u(rng), grounded ? 25.0 : 200.0, 10 * u(rng));
+  s.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3 + 0.1 * u(rng), Eigen::Vector3d(1, 0.2 * u(rng), 1).normalized()));
+  for (int d = 0; d < kModes; ++d) s.gamma[d] = 0.05 * u(rng);
+  s.v.head<3>() = grounded ? Eigen::Vector3d(60, -120, 25) : Eigen::Vector3d(20 * u(rng), 20 * u(rng), 20 * u(rng));
+  s.v.segment<3>(3) = Eigen::Vector3d(0.3 * u(rng), 0.5 * u(rng), 0.3 * u(rng));
+  for (int d = 0; d < kModes; ++d) s.v[6 + d] = 0.2 * u(rng);
+  r.stiffness.resize(kModes);
+  r.damping.resize(kModes);
+  for (int d = 0; d < kModes; ++d) {
+    r.stiffness[d] = 2e4 * (1.0 + 0.5 * u(rng));
+    r.damping[d] = 200 * (1.0 + 0.5 * u(rng));
+  }
+  r.targets = 0.1 * Eigen::MatrixXd::NullaryExpr(kModes, steps, [&] { return u(rng); });
+  return k;
+}
+
+// Contact onsets, ends and slips along the plain run (proof that a grounded case went through
+// the branches it is meant to test), and the faces touched.
+void ContactEvents(const Case& k, int* onsets, int* ends, int* slips, std::set<int>* faces) {
+  BodyState3<double> s = k.rollout.start;
+  UpdateContacts3(k.passive, k.rollout.world.ground, &s);
+  *onsets = *ends = *slips = 0;
+  std::vector<double> K(k.rollout.stiffness.data(), k.rollout.stiffness.data() + kModes);
+  std::vector<double> c(k.rollout.damping.data(), k.rollout.damping.data() + kModes);
+  auto find = [](const std::vector<Contact3<double>>& set, const Contact3<double>& x) -> const Contact3<double>* {
+    for (const auto& y : set)
+      if (y.point == x.point && y.face == x.face) return &y;
+    return nullptr;
+  };
+  for (int n = 0; n < k.rollout.steps(); ++n) {
+    std::vector<double> target(k.rollout.targets.col(n).data(), k.rollout.targets.col(n).data() + kModes);
+    const auto before = s.contacts;
+    ASSERT_TRUE(StepBody3(k.passive, k.rollout.world, k.rollout.integrator, k.rollout.dt, &s,
+                          PdForce3<double>{&K, &c, &target}).ok());
+    for (const auto& x : s.contacts) {
+      faces->insert(x.face);
+      const Contact3<double>* was = find(before, x);
+      *onsets += !was;
+      *slips += was && was->anchor != x.anchor;
+    }
+    for (const auto& x : before) *ends += !find(s.contacts, x);
+  }
+}
+
+void ExpectJetDirectionalDerivatives(const Case& k, unsigned seed) {
+  const fit::RolloutGradient3 g = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive));
+  ASSERT_TRUE(g.ok) << g.message;
+  const Eigen::VectorXd p = Flatten(k.rollout), grad = Flatten(g);
+  using J1 = ceres::Jet<double, 1>;
+  EXPECT_NEAR(g.cost, ReferenceCost<double>(k.passive, k.rollout, p, p), 1e-12 * std::abs(g.cost));
+  const int N = k.rollout.steps(), first_target = kNz + 2 * kModes;
+  // every start coordinate (translation, rotation, shape, velocity), a gain of each kind and
+  // targets early, midway and last
+  std::vector<int> probes = {kNz, kNz + kModes + 2, first_target, first_target + kModes * (N / 2) + 1,
+                             first_target + kModes * N - 1};
+  for (int i = 0; i < kNz; ++i) probes.push_back(i);
+  for (int i : probes) {
+    const J1 ref = ReferenceCost<J1>(k.passive, k.rollout, p, Eigen::VectorXd::Unit(p.size(), i));
+    EXPECT_NEAR(grad[i], ref.v[0], 1e-9 * std::abs(ref.v[0]) + 1e-12 * std::abs(g.cost)) << "parameter " << i;
+  }
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int trial = 0; trial < 3; ++trial) {
+    Eigen::VectorXd v(p.size());
+    for (int i = 0; i < p.size(); ++i) v[i] = normal(rng) * (i < kNz ? 1.0 : i < first_target ? 0.01 * p[i] : 0.1);
+    const J1 ref = ReferenceCost<J1>(k.passive, k.rollout, p, v);
+    const double scale = (grad.array() * v.array()).abs().sum();  // cancellation cannot hide an error
+    EXPECT_NEAR(grad.dot(v), ref.v[0], 1e-9 * scale) << "direction " << trial;
+  }
+}
+
+TEST(Adjoint3, MatchesJetsThroughTheWholeRunInTheAir) {
+  for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler}) {
+    SCOPED_TRACE(IntegratorName(integrator));
+    ExpectJetDirectionalDerivatives(MakeCase(integrator, false, 60, 3), 11);
+  }
+}
+
+TEST(Adjoint3, MatchesJetsThroughContactsThatBeginSlipAndEnd) {
+  for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler}) {
+    SCOPED_TRACE(IntegratorName(integrator));
+    const Case k = MakeCase(integrator, true, 150, 5);
+    int onsets = 0, ends = 0, slips = 0;
+    std::set<int> faces;
+    ContactEvents(k, &onsets, &ends, &slips, &faces);
+    EXPECT_GE(onsets, 10) << "the run must bring points onto the ground";
+    EXPECT_GE(slips, 10) << "slide them along it";
+    EXPECT_GE(ends, 1) << "and lift some off again";
+    RecordProperty("contact_onsets_ends_slips", std::to_string(onsets) + " " + std::to_string(ends) + " " + std::to_string(slips));
+    ExpectJetDirectionalDerivatives(k, 13);
+  }
+}
+
+// A V valley of heightfield triangles (contacts on both walls and carried across edges) and a
+// spring holding the chair's back.
+TEST(Adjoint3, MatchesJetsInAHeightfieldValleyWithASpring) {
+  for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler}) {
+    SCOPED_TRACE(IntegratorName(integrator));
+    Case k = MakeCase(integrator, true, 150, 41);
+    const int nx = 21, nz = 21;
+    std::vector<double> heights;
+    for (int j = 0; j < nz; ++j)
+      for (int i = 0; i < nx; ++i) heights.push_back(0.25 * std::abs(-200.0 + 20.0 * i - 50.0));
+    k.rollout.world.ground.heightfield = Heightfield::Make({-200, -200}, {20, 20}, nx, nz, heights);
+    k.rollout.world.springs.push_back(MakeSpring3(k.passive, Eigen::Vector3d(0.1, 0.9, 0.5), Eigen::Vector3d(0, 150, 0), 50.0, 5.0, 80.0));
+    int onsets = 0, ends = 0, slips = 0;
+    std::set<int> faces;
+    ContactEvents(k, &onsets, &ends, &slips, &faces);
+    EXPECT_GE(faces.size(), 4u) << "contacts on several triangles";
+    ExpectJetDirectionalDerivatives(k, 43);
+  }
+}
+
+// Central differences of the plain cost, one parameter at a time (five-point stencil, its
+// rounding bound added as in adjoint_test.cc).
+TEST(Adjoint3, MatchesCentralDifferencesInTheAir) {
+  for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler}) {
+    SCOPED_TRACE(IntegratorName(integrator));
+    const Case k = MakeCase(integrator, false, 60, 7);
+    const fit::RolloutGradient3 g = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive));
+    ASSERT_TRUE(g.ok) << g.message;
+    const Eigen::VectorXd p = Flatten(k.rollout), grad = Flatten(g);
+    const int N = k.rollout.steps(), first_target = kNz + 2 * kModes;
+    auto cost_at = [&](int i, double offset) {
+      Eigen::VectorXd x = p;
+      x[i] += offset;
+      return ReferenceCost<double>(k.passive, k.rollout, x, x);
+    };
+    const double cost = cost_at(0, 0.0);
+    for (int i : {0, 1, 3, 4, 5, 6, 8, 12, 15, 17, first_target, first_target + kModes * (N / 2) + 2,
+                  first_target + kModes * (N - 1) + 1}) {
+      const double h = 1e-4 * std::max(1.0, std::abs(p[i]));
+      const double fd = (8.0 * (cost_at(i, h) - cost_at(i, -h)) - (cost_at(i, 2 * h) - cost_at(i, -2 * h))) / (12.0 * h);
+      const double rounding = 10.0 * std::numeric_limits<double>::epsilon() * std::abs(cost) / h;
+      EXPECT_NEAR(grad[i], fd, 1e-7 * std::abs(fd) + rounding) << "parameter " << i;
+    }
+  }
+}
+
+TEST(Adjoint3, CheckpointIntervalDoesNotChangeTheGradient) {
+  const Case k = MakeCase(Integrator::kThesis, true, 90, 17);
+  const fit::RolloutGradient3 a = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive), 1);
+  const fit::RolloutGradient3 b = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive), 0);
+  const fit::RolloutGradient3 c = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive), 90);
+  ASSERT_TRUE(a.ok && b.ok && c.ok);
+  EXPECT_EQ(Flatten(a), Flatten(b));
+  EXPECT_EQ(Flatten(a), Flatten(c));
+  EXPECT_EQ(b.states_held, 9 + 10) << "intervals of ⌈√90⌉ = 10: 9 checkpoints and one interval";
+  EXPECT_EQ(a.states_held, 90 + 1);
+}
+
+TEST(Adjoint3, RefusesBadInputWithAMessage) {
+  const Case good = MakeCase(Integrator::kThesis, false, 5, 1);
+  auto refused = [&](auto&& edit, const std::string& words) {
+    Case k = good;
+    edit(&k.rollout);
+    try {
+      fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive));
+      ADD_FAILURE() << "accepted: " << words;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  refused([](fit::ControlledRollout3* r) { r->integrator = Integrator::kRK4; }, "thesis and symplectic_euler");
+  refused([](fit::ControlledRollout3* r) { r->dt = 0.0; }, "dt must be positive");
+  refused([](fit::ControlledRollout3* r) { r->stiffness.resize(2); }, "one value per mode");
+  refused([](fit::ControlledRollout3* r) { r->targets.resize(2, 5); }, "one row per mode");
+  refused([](fit::ControlledRollout3* r) { r->start.v[2] = std::nan(""); }, "finite");
+  refused([](fit::ControlledRollout3* r) { r->start.orientation.coeffs().setZero(); }, "must not be zero");
+  refused([](fit::ControlledRollout3* r) { r->start.gamma.resize(1); }, "mode amplitudes");
+}
+
+}  // namespace
+}  // namespace wobble
