@@ -317,7 +317,7 @@ TEST(Adjoint3, RefusesBadInputWithAMessage) {
       EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
     }
   };
-  refused([](fit::ControlledRollout3* r) { r->integrator = Integrator::kRK4; }, "thesis and symplectic_euler");
+  refused([](fit::ControlledRollout3* r) { r->integrator = Integrator::kRK4; }, "thesis and symplectic integrators");
   refused([](fit::ControlledRollout3* r) { r->dt = 0.0; }, "dt must be positive");
   refused([](fit::ControlledRollout3* r) { r->stiffness.resize(2); }, "one value per mode");
   refused([](fit::ControlledRollout3* r) { r->targets.resize(2, 5); }, "one row per mode");

@@ -397,7 +397,7 @@ TEST(Adjoint, RefusesBadInputWithAMessage) {
   };
   fit::ControlledRollout r = k.rollout;
   r.integrator = Integrator::kRK4;
-  expect_refused(r, "thesis and symplectic_euler");
+  expect_refused(r, "thesis and symplectic integrators");
   r = k.rollout;
   r.q0.resize(3);
   expect_refused(r, "q0 and qdot0 need 7 values");

@@ -551,7 +551,9 @@ TEST(io3DFiles, GeneratorsMakeTheFieldsTheyDescribe) {
     EXPECT_NEAR(d.y(), 0, 1e-12);
     EXPECT_NEAR(d.dot(r_across), 0, 1e-9);
     EXPECT_NEAR(d.norm(), 40 * M_PI / 180 * std::abs(u.y() - 0.5) * r_across.norm(), 1e-9);
-    if (u.y() > 0.5 && r_across.norm() > 0) EXPECT_GT(Eigen::Vector3d::UnitY().dot(r_across.cross(d)), 0);
+    if (u.y() > 0.5 && r_across.norm() > 0) {
+      EXPECT_GT(Eigen::Vector3d::UnitY().dot(r_across.cross(d)), 0);
+    }
     // squash: y scaled by 1.5 about the centre, x and z by 0.75
     EXPECT_NEAR((squash.displacement[c] - Eigen::Vector3d(-0.25 * r.x(), 0.5 * r.y(), -0.25 * r.z())).norm(), 0, 1e-9);
     // shear: x shift from −50 (feet) to +50 (top)

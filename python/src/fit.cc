@@ -188,12 +188,7 @@ template <int Dim> void BindDynamicFit(py::module_& m) {
           throw InputError("fit_dynamic simulates with the thesis integrator (options.integrator = 'thesis')");
         fit::DynamicFitOptions o;
         o.world = world.params;
-        // a 3D body's world, as World::Params3 makes it
-        o.world3.gravity_on = world.params.gravity_on;
-        o.world3.gravity = world.gravity_3d;
-        o.world3.ground = world.ground_3d;
-        o.world3.springs = world.springs_3d;
-        o.world3.max_condition = world.params.max_condition;
+        o.world3 = Params3Of(world);  // a 3D body's world, as World steps it
         o.dt = world.dt;
         o.fit_q0 = fit_q0;
         o.fit_qd0 = fit_qd0;

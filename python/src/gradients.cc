@@ -68,7 +68,7 @@ fit::ControlledRollout RolloutOf(const BodyModel& body, const WorldOptions& opti
   r.world = options.params;
   r.integrator = options.integrator;
   if (r.integrator != Integrator::kThesis && r.integrator != Integrator::kSymplecticEuler)
-    throw InputError("gradients need the thesis or the symplectic_euler integrator (options.integrator), got " +
+    throw InputError("gradients need the thesis or the symplectic integrator (options.integrator), got " +
                      IntegratorName(r.integrator));
   r.dt = options.dt;
   r.q0 = VectorOr(q0, nq, Eigen::VectorXd::Zero(nq), "q0");
@@ -174,7 +174,7 @@ void BindGradients(py::module_& m) {
       py::arg("q0") = py::none(), py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(),
       py::arg("damping") = py::none(), py::arg("checkpoint_interval") = 0,
       "The cost sum_n l_n(q_n, qd_n) of a rollout of the 2D body (PD targets (modes, steps), one per\n"
-      "step; gains K, c per mode; options' world, dt and integrator: thesis or symplectic_euler) and its\n"
+      "step; gains K, c per mode; options' world, dt and integrator: thesis or symplectic) and its\n"
       "gradient with respect to q0, qd0, K, c and every target, by one adjoint sweep (about 2-4\n"
       "simulations whatever the number of parameters).");
   m.def(

@@ -125,7 +125,7 @@ void BindWorld(py::module_& m) {
             if (!ParseIntegrator(name, &o.integrator))
               throw InputError("integrator: '" + name + "' is not one of " + IntegratorNames());
           },
-          "the FFD bodies' integrator: thesis (Eq. 4.22/4.23), symplectic_euler, rk4, implicit_euler, variational")
+          "the FFD bodies' integrator: thesis (Eq. 4.22/4.23), symplectic, rk4, implicit, variational")
       .def_property(
           "gravity", [](const WorldOptions& o) { return Eigen::Vector2d(o.params.gravity); },
           [](WorldOptions& o, const Eigen::Vector2d& g) { o.params.gravity = g; }, "2D gravity (m/s²)")

@@ -104,6 +104,14 @@ template <int Dim> class BodyModelN {
   // positive and finite, or there are more than kMaxModes modes.
   BodyModelN(BodyDefN<Dim> def, std::vector<DeformationModeN<Dim>> modes);
 
+  // This body with every mode's stiffness and damping zero (the fits and the adjoint apply
+  // their own mode forces). A copy: nothing is recomputed, the moments do not depend on gains.
+  BodyModelN WithoutModeGains() const {
+    BodyModelN passive = *this;
+    for (DeformationModeN<Dim>& m : passive.modes_) m.stiffness = m.damping = 0.0;
+    return passive;
+  }
+
   static constexpr int dim() { return Dim; }
   const std::string& name() const { return def_.name; }
   const BodyDefN<Dim>& def() const { return def_; }

@@ -22,7 +22,7 @@ enum class Integrator {
 };
 std::string IntegratorName(Integrator integrator);
 bool ParseIntegrator(const std::string& text, Integrator* integrator);
-std::string IntegratorNames();  // "thesis, symplectic_euler, ...": every name ParseIntegrator takes
+std::string IntegratorNames();  // "thesis, symplectic, ...": every name ParseIntegrator takes
 
 // Why a run stopped: one list of causes for a body's step (StepStatus) and the world's
 // (WorldStatus, wobble/world). Never a silent NaN: the step loop checks every accepted state.

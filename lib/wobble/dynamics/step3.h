@@ -7,7 +7,7 @@
 //
 // Integrators (the 2D set, carried to the group):
 //   thesis            v' = v + Δt a(g, v), then g' = g·exp(Δt v')  (Eq. 4.22/4.23's Störmer form)
-//   symplectic_euler  g' = g·exp(Δt v), then v' = v + Δt a(g', v)  (position first, as in 2D)
+//   symplectic        g' = g·exp(Δt v), then v' = v + Δt a(g', v)  (position first, as in 2D)
 //   rk4               Runge–Kutta–Munthe-Kaas: the classical tableau on (t, Θ, γ, v) with
 //                     R = R0 exp(Θ̂), Θ̇ = dexp⁻¹_{−Θ}(ω), so every stage stays on SO(3)
 //   implicit_euler    v' = v + Δt a(g·exp(Δt v'), v'), by Newton

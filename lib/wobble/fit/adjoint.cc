@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <map>
 #include <stdexcept>
 #include <type_traits>
@@ -62,7 +61,7 @@ void CheckRollout(const BodyModel& body, const ControlledRollout& r) {
   const int nq = body.num_q(), D = body.num_modes();
   auto fail = [](const std::string& what) { throw std::invalid_argument("rollout: " + what); };
   if (r.integrator != Integrator::kThesis && r.integrator != Integrator::kSymplecticEuler)
-    fail("the adjoint takes the thesis and symplectic_euler integrators, not " + IntegratorName(r.integrator));
+    fail("the adjoint takes the thesis and symplectic integrators, not " + IntegratorName(r.integrator));
   if (!(r.dt > 0.0) || !std::isfinite(r.dt)) fail("dt must be positive and finite");
   if (r.q0.size() != nq || r.qd0.size() != nq)
     fail("q0 and qdot0 need " + std::to_string(nq) + " values (tx ty theta and one per mode)");
@@ -76,7 +75,7 @@ void CheckRollout(const BodyModel& body, const ControlledRollout& r) {
 // The rollout's step, plain and differentiated, on the body with its own mode forces off.
 class Rollout {
  public:
-  Rollout(const BodyModel& body, const ControlledRollout& r) : passive_(PassiveCopy(body)), r_(r) {
+  Rollout(const BodyModel& body, const ControlledRollout& r) : passive_(body.WithoutModeGains()), r_(r) {
     params_.K = r.stiffness;
     params_.c = r.damping;
   }
@@ -94,8 +93,8 @@ class Rollout {
   bool Step(int n, BodyState<double>* s, std::string* why) const {
     const VecD<double> target = r_.targets.col(n);
     const StepStatus st = StepBody(passive_, r_.world, 0, r_.integrator, r_.dt, s, ModeForce<double>{&params_, &target});
-    if (!st.ok()) return Failed(n, StatusCodeName(st.code), why);
-    if (!s->q.allFinite() || !s->qd.allFinite()) return Failed(n, "non-finite state", why);
+    if (!st.ok()) return internal::StepFailed(n, StatusCodeName(st.code), why);
+    if (!s->q.allFinite() || !s->qd.allFinite()) return internal::StepFailed(n, "non-finite state", why);
     return true;
   }
 
@@ -126,7 +125,7 @@ class Rollout {
         mp.c[d] = Seed(params_.c[d], controls + 2 * D + d, offset);
       }
       const StepStatus st = StepBody(passive_, r_.world, 0, r_.integrator, r_.dt, &sj, ModeForce<Jet>{&mp, &target});
-      if (!st.ok()) return Failed(n, StatusCodeName(st.code) + " (differentiated step)", why);
+      if (!st.ok()) return internal::StepFailed(n, StatusCodeName(st.code) + " (differentiated step)", why);
       PullState(sj, out, offset, &grad);
     }
     in->q = grad.head(nq);
@@ -404,10 +403,6 @@ class Rollout {
     for (int d = 0; d < B.cols(); ++d) (*out)[kRigidDofs + d] += u[2] * Perp(Eigen::Vector2d(B.col(d))).dot(w_local);
   }
 
-  static bool Failed(int n, const std::string& what, std::string* why) {
-    *why = "step " + std::to_string(n) + " failed: " + what;
-    return false;
-  }
 
   const BodyModel passive_;
   const ControlledRollout& r_;
@@ -420,17 +415,14 @@ double RolloutCost(const BodyModel& body, const ControlledRollout& rollout, cons
   CheckRollout(body, rollout);
   const Rollout r(body, rollout);
   Eigen::VectorXd dq(r.nq()), dqd(r.nq());
-  BodyState<double> s = r.Start();
-  double total = 0.0;
   std::string why;
-  for (int n = 0;; ++n) {
-    dq.setZero();
-    dqd.setZero();
-    total += cost(n, s.q, s.qd, &dq, &dqd);
-    if (n == rollout.steps()) break;
-    if (!r.Step(n, &s, &why)) return std::numeric_limits<double>::infinity();
-  }
-  return total;
+  return internal::PlainRolloutCost(
+      rollout.steps(), r.Start(), [&](int n, BodyState<double>* s) { return r.Step(n, s, &why); },
+      [&](int n, const BodyState<double>& s) {
+        dq.setZero();
+        dqd.setZero();
+        return cost(n, s.q, s.qd, &dq, &dqd);
+      });
 }
 
 RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollout& rollout, const StageCost& cost,

@@ -1,7 +1,6 @@
 #include "wobble/fit/adjoint3.h"
 
 #include <cmath>
-#include <limits>
 #include <map>
 #include <stdexcept>
 #include <utility>
@@ -31,7 +30,7 @@ void CheckRollout3(const BodyModel3& body, const ControlledRollout3& r) {
   const int D = body.num_modes();
   auto fail = [](const std::string& what) { throw std::invalid_argument("3D rollout: " + what); };
   if (r.integrator != Integrator::kThesis && r.integrator != Integrator::kSymplecticEuler)
-    fail("the adjoint takes the thesis and symplectic_euler integrators, not " + IntegratorName(r.integrator));
+    fail("the adjoint takes the thesis and symplectic integrators, not " + IntegratorName(r.integrator));
   if (!(r.dt > 0.0) || !std::isfinite(r.dt)) fail("dt must be positive and finite");
   if (r.start.gamma.size() != D || r.start.v.size() != body.num_q())
     fail("the start needs " + std::to_string(D) + " mode amplitudes and " + std::to_string(body.num_q()) +
@@ -48,7 +47,7 @@ void CheckRollout3(const BodyModel3& body, const ControlledRollout3& r) {
 // The rollout's step, plain and differentiated, on the body with its own mode forces off.
 class Rollout3 {
  public:
-  Rollout3(const BodyModel3& body, const ControlledRollout3& r) : passive_(PassiveCopy(body)), r_(r) {
+  Rollout3(const BodyModel3& body, const ControlledRollout3& r) : passive_(body.WithoutModeGains()), r_(r) {
     params_.K = r.stiffness;
     params_.c = r.damping;
   }
@@ -69,7 +68,7 @@ class Rollout3 {
     const VecD<double> target = r_.targets.col(n);
     const StepStatus st =
         StepBody3(passive_, r_.world, r_.integrator, r_.dt, s, ModeForce<double>{&params_, &target});
-    if (!st.ok()) return Failed(n, StatusCodeName(st.code), why);
+    if (!st.ok()) return internal::StepFailed(n, StatusCodeName(st.code), why);
     return true;
   }
 
@@ -92,7 +91,7 @@ class Rollout3 {
         mp.c[d] = Seed(params_.c[d], controls + 2 * D + d, offset);
       }
       const StepStatus st = StepBody3(passive_, r_.world, r_.integrator, r_.dt, &sj, ModeForce<Jet>{&mp, &target});
-      if (!st.ok()) return Failed(n, StatusCodeName(st.code) + " (differentiated step)", why);
+      if (!st.ok()) return internal::StepFailed(n, StatusCodeName(st.code) + " (differentiated step)", why);
       PullState(sj, out, offset, &grad);
     }
     in->z = grad.head(nz);
@@ -168,10 +167,6 @@ class Rollout3 {
     }
   }
 
-  static bool Failed(int n, const std::string& what, std::string* why) {
-    *why = "step " + std::to_string(n) + " failed: " + what;
-    return false;
-  }
 
   const BodyModel3 passive_;
   const ControlledRollout3& r_;
@@ -186,16 +181,13 @@ double RolloutCost3(const BodyModel3& body, const ControlledRollout3& rollout, c
   CheckRollout3(body, rollout);
   const Rollout3 r(body, rollout);
   Eigen::VectorXd dz(r.tangent());
-  BodyState3<double> s = r.Start();
-  double total = 0.0;
   std::string why;
-  for (int n = 0;; ++n) {
-    dz.setZero();
-    total += cost(n, s, &dz);
-    if (n == rollout.steps()) break;
-    if (!r.Step(n, &s, &why)) return std::numeric_limits<double>::infinity();
-  }
-  return total;
+  return internal::PlainRolloutCost(
+      rollout.steps(), r.Start(), [&](int n, BodyState3<double>* s) { return r.Step(n, s, &why); },
+      [&](int n, const BodyState3<double>& s) {
+        dz.setZero();
+        return cost(n, s, &dz);
+      });
 }
 
 RolloutGradient3 RolloutCostGradient3(const BodyModel3& body, const ControlledRollout3& rollout, const StageCost3& cost,

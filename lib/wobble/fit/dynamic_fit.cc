@@ -100,7 +100,7 @@ DynamicFitResult FitDynamic(const BodyModelN<Dim>& body, const std::vector<typen
   if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
-  const BodyModelN<Dim> passive = PassiveCopy(body);
+  const BodyModelN<Dim> passive = body.WithoutModeGains();
   const Reference<Dim> ref = MakeReference(body, frames, o.dt);
   const VecD<double> G = ModeMasses(body);
   Blocks<Dim> blocks = Blocks<Dim>::From(start, G);

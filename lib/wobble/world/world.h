@@ -98,6 +98,11 @@ struct WorldOptions {
   int dense_max_rows = 24;
 };
 
+// The 3D FFD bodies' world from the options: gravity_3d (off with params.gravity_on),
+// ground_3d, springs_3d and params.max_condition. What World steps them in, and the world of
+// a 3D rollout (fit/adjoint3.h) built from the same options.
+WorldParams3 Params3Of(const WorldOptions& options);
+
 // A material point of a body. Linear bodies: u in undeformed coordinates (any point, inside
 // or outside the mass points). FFD bodies: u = lattice coordinates (s, t) in [0, 1]². Or
 // mass_point = k ≥ 0: the body's k-th mass point (u is then ignored).
@@ -358,7 +363,6 @@ class World {
   bool StepEachBody();
   // world_ffd3.cc: the 3D FFD bodies; their ends of constraints (the kFfd3 branches of the
   // End functions in world_constraints.cc)
-  WorldParams3 Params3() const;
   void Ffd3Resolve(const MaterialPoint& point, End* e) const;
   PointVec Ffd3EndPosition(const End& e) const;
   PointVec Ffd3EndVelocity(const End& e) const;

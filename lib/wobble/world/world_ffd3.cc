@@ -60,13 +60,13 @@ double World::Penetration(int body) const {
 }
 const BodyState3<double>& World::state3(int i) const { return Ffd3(i).state; }
 
-WorldParams3 World::Params3() const {
+WorldParams3 Params3Of(const WorldOptions& options) {
   WorldParams3 p;
-  p.gravity_on = options_.params.gravity_on;
-  p.gravity = options_.gravity_3d;
-  p.ground = options_.ground_3d;
-  p.springs = options_.springs_3d;
-  p.max_condition = options_.params.max_condition;
+  p.gravity_on = options.params.gravity_on;
+  p.gravity = options.gravity_3d;
+  p.ground = options.ground_3d;
+  p.springs = options.springs_3d;
+  p.max_condition = options.params.max_condition;
   return p;
 }
 
@@ -110,7 +110,7 @@ bool World::StepFfd3Body(int body) {
   Ffd3Entry& e = ffd3_[slots_[body].index];
   const BodyState3<double> before = e.state;
   const bool pushed = !e.applied.isZero(0.0);
-  const StepStatus st = StepBody3(*e.model, Params3(), options_.integrator, options_.dt, &e.state,
+  const StepStatus st = StepBody3(*e.model, Params3Of(options_), options_.integrator, options_.dt, &e.state,
                                   AppliedForce3{pushed ? &e.applied : nullptr});
   if (pushed) e.applied.setZero();
   if (st.ok() && std::isfinite(Ffd3Energies(body).total())) return true;
@@ -226,7 +226,7 @@ void World::Ffd3ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::Vect
 
 bool World::Ffd3FreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st) const {
   VecQ3<double> a;
-  *st = Accelerations3(*Ffd3(body).model, Params3(), Ffd3(body).state, &a);
+  *st = Accelerations3(*Ffd3(body).model, Params3Of(options_), Ffd3(body).state, &a);
   if (!st->ok()) return false;
   *acc = a;
   if (!Ffd3(body).applied.isZero(0.0)) Ffd3ApplyGeneralized(body, Ffd3(body).applied, acc);

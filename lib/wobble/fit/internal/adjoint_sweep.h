@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
 #include <vector>
 
 namespace wobble::fit::internal {
@@ -28,6 +30,24 @@ inline void Pull(const AdjointJet& y, double lambda, int offset, Eigen::VectorXd
   if (lambda == 0.0) return;
   const int n = std::min(kAdjointChunk, int(g->size()) - offset);
   for (int k = 0; k < n; ++k) (*g)[offset + k] += lambda * y.v[k];
+}
+
+// Sets *why to which step failed and why; returns false.
+inline bool StepFailed(int n, const std::string& what, std::string* why) {
+  *why = "step " + std::to_string(n) + " failed: " + what;
+  return false;
+}
+
+// The plain cost Σ_n stage(n, state_n) of a rollout from `state`, for n = 0 … steps, with
+// step(n, &state) → bool between; +∞ when a step fails.
+template <class State, class Step, class Stage>
+double PlainRolloutCost(int steps, State state, const Step& step, const Stage& stage) {
+  double total = 0.0;
+  for (int n = 0;; ++n) {
+    total += stage(n, state);
+    if (n == steps) return total;
+    if (!step(n, &state)) return std::numeric_limits<double>::infinity();
+  }
 }
 
 // The checkpoint interval: `requested` when > 0, else ⌈√steps⌉.

@@ -286,7 +286,7 @@ bool SimulatePlain(const BodyModelN<Dim>& body, const DynamicFitOptions& o, cons
                    const std::vector<int>& frame_steps, F&& on_frame) {
   using Dims = Dimension<Dim>;
   CheckParameters(body, p);
-  const BodyModelN<Dim> passive = PassiveCopy(body);
+  const BodyModelN<Dim> passive = body.WithoutModeGains();
   ModeParams<double> mp;
   mp.K = p.stiffness;
   mp.c = p.damping;

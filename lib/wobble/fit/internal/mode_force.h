@@ -1,6 +1,6 @@
 // The mode forces of the fits and of the adjoint (not public): the body's own mode potentials
-// switched off and replaced by StepBody's extra generalized force, whose gains and PD targets
-// are of the scalar type being differentiated (Ceres Jets, or double).
+// switched off (BodyModelN::WithoutModeGains) and replaced by StepBody's extra generalized
+// force, whose gains and PD targets are of the scalar type being differentiated (Jets, double).
 #pragma once
 
 #include <vector>
@@ -10,14 +10,6 @@
 #include "wobble/dynamics/step3.h"
 
 namespace wobble::fit {
-
-// The body with its mode potentials switched off: K and c come from the parameters instead
-// (lib/wobble/dynamics reads them from the model as doubles; see ThesisStep).
-template <int Dim> BodyModelN<Dim> PassiveCopy(const BodyModelN<Dim>& body) {
-  std::vector<DeformationModeN<Dim>> modes = body.modes();
-  for (DeformationModeN<Dim>& m : modes) m.stiffness = m.damping = 0.0;
-  return BodyModelN<Dim>(body.def(), modes);
-}
 
 template <class T> struct ModeParams {
   VecD<T> K, c;
