@@ -1,5 +1,5 @@
-// `wobble fit spacetime`: the PD targets of a whole motion (fit/spacetime.h) for a 2D object
-// from its start, with the task given as flags; the targets go to a schedule file that a
+// `wobble fit spacetime`: the PD targets of a whole motion (fit/spacetime.h) for a 2D or 3D
+// object from its start, with the task given as flags; the targets go to a schedule file that a
 // script plays with `schedule FILE` (formats/target_schedule.h).
 #include <unistd.h>
 
@@ -9,6 +9,7 @@
 
 #include "fit.h"
 #include "progress.h"
+#include "wobble/core/rotation3.h"
 #include "wobble/fit/spacetime.h"
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/csv.h"
@@ -26,20 +27,127 @@ int StepAt(double t, double dt, int steps, const std::string& flag) {
   return int(std::round(n));
 }
 
+template <class Mode> std::vector<std::string> ModeNames(const std::vector<Mode>& modes) {
+  std::vector<std::string> names;
+  for (const Mode& m : modes) names.push_back(m.name);
+  return names;
+}
+
+// The body's own gains, which the fitted targets drive (as a script's `schedule` plays them).
+template <class Body> void OwnGains(const Body& body, Eigen::VectorXd* stiffness, Eigen::VectorXd* damping) {
+  stiffness->resize(body.num_modes());
+  damping->resize(body.num_modes());
+  for (int d = 0; d < body.num_modes(); ++d) {
+    (*stiffness)[d] = body.modes()[d].stiffness;
+    (*damping)[d] = body.modes()[d].damping;
+  }
+}
+
+template <class Problem> void SetBounds(const FitSpacetimeArgs& a, int D, Problem* p) {
+  p->knots = a.knots;
+  p->lower = Eigen::VectorXd::Constant(D, -a.bound);
+  p->upper = Eigen::VectorXd::Constant(D, a.bound);
+  p->control_weight = a.effort;
+}
+
+// The 2D body's problem from the flags: --reach "X Y T".
+fit::SpacetimeResult Fit2(const FitSpacetimeArgs& a, const StartingWorld& start, const Eigen::MatrixXd& first_guess,
+                          const fit::SpacetimeOptions& o, nlohmann::json* task) {
+  const BodyModel& body = *start.body;
+  const int steps = int(first_guess.cols()), D = body.num_modes();
+  fit::SpacetimeProblem p;
+  p.rollout.world = start.options.params;
+  p.rollout.integrator = Integrator::kThesis;
+  p.rollout.dt = a.dt;
+  p.rollout.q0 = start.q0;
+  p.rollout.qd0 = start.qd0;
+  OwnGains(body, &p.rollout.stiffness, &p.rollout.damping);
+  p.rollout.targets = first_guess;
+  SetBounds(a, D, &p);
+  std::vector<fit::StageCost> terms;
+  const MassMoments& mm = body.moments();
+  const Eigen::Vector2d com0 =
+      start.q0.head<2>() + Eigen::Rotation2Dd(start.q0[2]) * ((mm.c0 + mm.C * start.q0.tail(D)) / mm.m);
+  if (!a.rise.empty()) {
+    const std::vector<double> v = ParseNumbers(a.rise, "--rise");
+    if (v.size() != 2) throw UsageError("--rise takes \"DY T\"");
+    fit::Axes y_only;
+    y_only.x = false;
+    const int top = StepAt(v[1], a.dt, steps, "--rise");
+    terms.push_back(fit::CentreOfMassAt(body, top, {0.0, com0.y() + v[0]}, a.weight, y_only));
+    // at the top: not rising any more (a velocity of 1 weighs as a height of 0.1)
+    terms.push_back(fit::CentreOfMassVelocityAt(body, top, {0.0, 0.0}, 0.01 * a.weight, y_only));
+    (*task)["rise"] = {{"dy", v[0]}, {"t", v[1]}};
+  }
+  if (!a.reach.empty()) {
+    const std::vector<double> v = ParseNumbers(a.reach, "--reach");
+    if (v.size() != 3) throw UsageError("--reach takes \"X Y T\" for a 2D object");
+    terms.push_back(fit::CentreOfMassAt(body, StepAt(v[2], a.dt, steps, "--reach"), {v[0], v[1]}, a.weight));
+    (*task)["reach"] = {{"x", v[0]}, {"y", v[1]}, {"t", v[2]}};
+  }
+  if (a.upright) terms.push_back(fit::UprightAt(steps, a.weight, 0.1)), (*task)["upright"] = true;
+  if (a.still) terms.push_back(fit::StillAt(steps, a.weight)), (*task)["still"] = true;
+  p.task = fit::SumOf(terms);
+  return fit::FitSpacetime(body, p, o);
+}
+
+// The 3D body's problem from the same flags: --reach "X Y Z T"; --upright leaves the heading free.
+fit::SpacetimeResult Fit3(const FitSpacetimeArgs& a, const StartingWorld& start, const Eigen::MatrixXd& first_guess,
+                          const fit::SpacetimeOptions& o, nlohmann::json* task) {
+  const BodyModel3& body = *start.body3;
+  const int steps = int(first_guess.cols()), D = body.num_modes();
+  fit::SpacetimeProblem3 p;
+  p.rollout.world = Params3Of(start.options);
+  p.rollout.integrator = Integrator::kThesis;
+  p.rollout.dt = a.dt;
+  p.rollout.start.t = start.q0.head<3>();
+  p.rollout.start.orientation = ExpRotation<double>(start.q0.segment<3>(3));
+  p.rollout.start.gamma = start.q0.tail(D);
+  p.rollout.start.v = start.qd0;
+  OwnGains(body, &p.rollout.stiffness, &p.rollout.damping);
+  p.rollout.targets = first_guess;
+  SetBounds(a, D, &p);
+  std::vector<fit::StageCost3> terms;
+  const MassMoments3& mm = body.moments();
+  const Eigen::Vector3d com0 =
+      p.rollout.start.t + p.rollout.start.orientation * ((mm.c0 + mm.C * p.rollout.start.gamma) / mm.m);
+  if (!a.rise.empty()) {
+    const std::vector<double> v = ParseNumbers(a.rise, "--rise");
+    if (v.size() != 2) throw UsageError("--rise takes \"DY T\"");
+    fit::Axes y_only;
+    y_only.x = y_only.z = false;
+    const int top = StepAt(v[1], a.dt, steps, "--rise");
+    terms.push_back(fit::CentreOfMassAt3(body, top, {0.0, com0.y() + v[0], 0.0}, a.weight, y_only));
+    terms.push_back(fit::CentreOfMassVelocityAt3(body, top, Eigen::Vector3d::Zero(), 0.01 * a.weight, y_only));
+    (*task)["rise"] = {{"dy", v[0]}, {"t", v[1]}};
+  }
+  if (!a.reach.empty()) {
+    const std::vector<double> v = ParseNumbers(a.reach, "--reach");
+    if (v.size() != 4) throw UsageError("--reach takes \"X Y Z T\" for a 3D object");
+    terms.push_back(
+        fit::CentreOfMassAt3(body, StepAt(v[3], a.dt, steps, "--reach"), {v[0], v[1], v[2]}, a.weight));
+    (*task)["reach"] = {{"x", v[0]}, {"y", v[1]}, {"z", v[2]}, {"t", v[3]}};
+  }
+  if (a.upright) terms.push_back(fit::UprightAt3(steps, a.weight, 0.1)), (*task)["upright"] = true;
+  if (a.still) terms.push_back(fit::StillAt3(steps, a.weight)), (*task)["still"] = true;
+  p.task = fit::SumOf3(terms);
+  return fit::FitSpacetime3(body, p, o);
+}
+
 }  // namespace
 
 CLI::App* AddFitSpacetimeCommand(CLI::App* fit, FitSpacetimeArgs* a) {
-  CLI::App* c = fit->add_subcommand("spacetime", "Fit the PD targets of a whole motion to a task (2D; README: Gradients)");
+  CLI::App* c = fit->add_subcommand("spacetime", "Fit the PD targets of a whole motion to a task (2D or 3D; README: Gradients)");
   AddBodyFlags(c, &a->files);
   AddWorldFlags(c, &a->world);
-  c->add_option("--q", a->q, "Start q \"tx ty theta g1 ..\" (default: rest at the origin)")->type_name("\"NUMS\"");
+  c->add_option("--q", a->q, "Start q \"tx ty theta g1 ..\" (3D: \"tx ty tz rx ry rz g1 ..\"; default: rest at the origin)")->type_name("\"NUMS\"");
   c->add_option("--qdot", a->qdot, "Start q-dot (default 0)")->type_name("\"NUMS\"");
   c->add_option("--dt", a->dt, "Time step (thesis integrator)")->capture_default_str();
   c->add_option("--duration", a->duration, "Length of the motion, seconds")->capture_default_str();
   c->add_option("--knots", a->knots, "Targets at this many evenly spaced knots, linear between")->capture_default_str();
   c->add_option("--rise", a->rise, "Task: the centre of mass at the top of a rise of DY above its start at time T")
       ->type_name("\"DY T\"");
-  c->add_option("--reach", a->reach, "Task: the centre of mass at (X, Y) at time T")->type_name("\"X Y T\"");
+  c->add_option("--reach", a->reach, "Task: the centre of mass at (X, Y) at time T (3D: \"X Y Z T\")")->type_name("\"X Y T\"");
   c->add_flag("--upright", a->upright, "Task: upright and not turning at the end");
   c->add_flag("--still", a->still, "Task: at rest at the end");
   c->add_option("--weight", a->weight, "Weight of every task term")->capture_default_str();
@@ -88,62 +196,19 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
       }
     }
   const StartingWorld start = LoadStartingWorld(a.files, a.q, a.qdot, a.world, Integrator::kThesis, a.dt);
-  if (!start.body) throw UsageError("fit spacetime takes 2D objects (the adjoint is 2D)");
-  const BodyModel& body = *start.body;
-  const int steps = int(std::lround(a.duration / a.dt)), D = body.num_modes();
+  const int steps = int(std::lround(a.duration / a.dt));
+  const std::vector<std::string> names = start.body3 ? ModeNames(start.body3->modes()) : ModeNames(start.body->modes());
+  const int D = int(names.size());
   if (D == 0) throw UsageError("the object has no modes to control (--modes)");
   if (a.knots < 2 || a.knots > steps + 1)
     throw UsageError("--knots must be from 2 to " + std::to_string(steps + 1) + " (the steps + 1)");
 
-  fit::SpacetimeProblem p;
-  p.rollout.world = start.options.params;
-  p.rollout.integrator = Integrator::kThesis;
-  p.rollout.dt = a.dt;
-  p.rollout.q0 = start.q0;
-  p.rollout.qd0 = start.qd0;
-  p.rollout.stiffness.resize(D);
-  p.rollout.damping.resize(D);
-  for (int d = 0; d < D; ++d) {
-    p.rollout.stiffness[d] = body.modes()[d].stiffness;
-    p.rollout.damping[d] = body.modes()[d].damping;
-  }
-  std::vector<std::string> names;
-  for (const DeformationMode& m : body.modes()) names.push_back(m.name);
-  p.rollout.targets = Eigen::MatrixXd::Zero(D, steps);
-  if (!a.start.empty()) {  // its steps, the last one held past its end
+  // the first guess: zero, or a schedule's steps with its last one held past its end
+  Eigen::MatrixXd first_guess = Eigen::MatrixXd::Zero(D, steps);
+  if (!a.start.empty()) {
     const Eigen::MatrixXd given = formats::ReadTargetSchedule(a.start, names, a.dt);
-    for (int n = 0; n < steps; ++n) p.rollout.targets.col(n) = given.col(std::min<Eigen::Index>(n, given.cols() - 1));
+    for (int n = 0; n < steps; ++n) first_guess.col(n) = given.col(std::min<Eigen::Index>(n, given.cols() - 1));
   }
-  p.knots = a.knots;
-  p.lower = Eigen::VectorXd::Constant(D, -a.bound);
-  p.upper = Eigen::VectorXd::Constant(D, a.bound);
-  p.control_weight = a.effort;
-  std::vector<fit::StageCost> terms;
-  nlohmann::json task;
-  const MassMoments& mm = body.moments();
-  const Eigen::Vector2d com0 =
-      start.q0.head<2>() + Eigen::Rotation2Dd(start.q0[2]) * ((mm.c0 + mm.C * start.q0.tail(D)) / mm.m);
-  if (!a.rise.empty()) {
-    const std::vector<double> v = ParseNumbers(a.rise, "--rise");
-    if (v.size() != 2) throw UsageError("--rise takes \"DY T\"");
-    fit::Axes y_only;
-    y_only.x = false;
-    const int top = StepAt(v[1], a.dt, steps, "--rise");
-    terms.push_back(fit::CentreOfMassAt(body, top, {0.0, com0.y() + v[0]}, a.weight, y_only));
-    // at the top: not rising any more (a velocity of 1 weighs as a height of 0.1)
-    terms.push_back(fit::CentreOfMassVelocityAt(body, top, {0.0, 0.0}, 0.01 * a.weight, y_only));
-    task["rise"] = {{"dy", v[0]}, {"t", v[1]}};
-  }
-  if (!a.reach.empty()) {
-    const std::vector<double> v = ParseNumbers(a.reach, "--reach");
-    if (v.size() != 3) throw UsageError("--reach takes \"X Y T\"");
-    terms.push_back(fit::CentreOfMassAt(body, StepAt(v[2], a.dt, steps, "--reach"), {v[0], v[1]}, a.weight));
-    task["reach"] = {{"x", v[0]}, {"y", v[1]}, {"t", v[2]}};
-  }
-  if (a.upright) terms.push_back(fit::UprightAt(steps, a.weight, 0.1)), task["upright"] = true;
-  if (a.still) terms.push_back(fit::StillAt(steps, a.weight)), task["still"] = true;
-  p.task = fit::SumOf(terms);
-
   fit::SpacetimeOptions o;
   o.max_iterations = a.max_iterations;
   o.starts = a.starts;
@@ -156,14 +221,16 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
   } else {
     o.on_start = [&bar](int done, int starts, double best) { bar.Update(double(done) / starts, best); };
   }
-  const fit::SpacetimeResult r = fit::FitSpacetime(body, p, o);
+  nlohmann::json task;
+  const fit::SpacetimeResult r = start.body3 ? Fit3(a, start, first_guess, o, &task) : Fit2(a, start, first_guess, o, &task);
   if (a.starts == 1) EndIterationLine();
   bar.Finish();
+  const std::string body_name = start.body3 ? start.body3->name() : start.body->name();
 
   if (!a.targets.empty()) formats::WriteTargetSchedule(a.targets, names, a.dt, r.targets);
   nlohmann::json j;
   j["kind"] = "spacetime";
-  j["body"] = body.name();
+  j["body"] = body_name;
   j["modes"] = names;
   j["dt"] = a.dt;
   j["steps"] = steps;
@@ -186,7 +253,7 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
     j["knots"].push_back(col);
   }
   if (!a.out.empty()) formats::WriteTextAtomically(a.out, j.dump(2) + "\n");
-  std::cout << body.name() << ": spacetime fit of " << D << " x " << a.knots << " knot targets over " << steps
+  std::cout << body_name << ": spacetime fit of " << D << " x " << a.knots << " knot targets over " << steps
             << " steps: " << r.message << "\ncost " << r.initial_cost << " -> " << r.cost << " (control energy "
             << r.control_energy << ") with " << r.gradients << " gradients.";
   if (a.starts > 1) std::cout << "\nbest of " << a.starts << " starts: start " << r.best_start;

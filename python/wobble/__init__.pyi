@@ -458,6 +458,43 @@ def fit_spacetime(body: BodyModel, task: StageCost, *, targets: ArrayLike, knots
                   qd0: Optional[ArrayLike] = None, stiffness: Optional[ArrayLike] = None,
                   damping: Optional[ArrayLike] = None, max_iterations: int = 100, starts: int = 1,
                   start_spread: float = 1.0, seed: int = 1, threads: int = 0) -> SpacetimeResult: ...
+class StageCost3:
+    """l_n(q, qd) of one step of a 3D rollout with its gradient, in World.q3 / qd3 coordinates
+    (q = [t, rotation vector, gamma], qd = [t dot, body omega, gamma dot])."""
+    def __init__(self, fn: Callable[[int, NDArray, NDArray], tuple[float, Optional[ArrayLike], Optional[ArrayLike]]]) -> None: ...
+    def __call__(self, n: int, q: ArrayLike, qd: ArrayLike) -> tuple[float, NDArray, NDArray]: ...
+    def __add__(self, other: StageCost3) -> StageCost3: ...
+
+def centre_of_mass_at3(body: BodyModel3, step: int, goal: ArrayLike, *, weight: float = 1.0,
+                       axes: str = "xyz") -> StageCost3: ...
+def centre_of_mass_velocity_at3(body: BodyModel3, step: int, goal: ArrayLike, *, weight: float = 1.0,
+                                axes: str = "xyz") -> StageCost3: ...
+def upright_at3(step: int, *, weight: float = 1.0, time_scale: float = 0.0) -> StageCost3: ...
+def still_at3(step: int, *, weight: float = 1.0) -> StageCost3: ...
+
+class RolloutGradient3:
+    ok: bool
+    message: str
+    cost: float
+    q0: NDArray
+    qd0: NDArray
+    stiffness: NDArray
+    damping: NDArray
+    targets: NDArray
+    states_held: int
+
+def rollout_gradient3(body: BodyModel3, cost: StageCost3, *, targets: ArrayLike, options: WorldOptions = ...,
+                      q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
+                      stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None,
+                      checkpoint_interval: int = 0) -> RolloutGradient3: ...
+def rollout_cost3(body: BodyModel3, cost: StageCost3, *, targets: ArrayLike, options: WorldOptions = ...,
+                  q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
+                  stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None) -> float: ...
+def fit_spacetime3(body: BodyModel3, task: StageCost3, *, targets: ArrayLike, knots: int = 21, bound: float = 0.3,
+                   control_weight: float = 1.0, options: WorldOptions = ..., q0: Optional[ArrayLike] = None,
+                   qd0: Optional[ArrayLike] = None, stiffness: Optional[ArrayLike] = None,
+                   damping: Optional[ArrayLike] = None, max_iterations: int = 100, starts: int = 1,
+                   start_spread: float = 1.0, seed: int = 1, threads: int = 0) -> SpacetimeResult: ...
 def write_target_schedule(path: str, modes: Sequence[str], dt: float, targets: ArrayLike) -> None: ...
 def read_target_schedule(path: str, modes: Sequence[str], dt: float) -> NDArray: ...
 def fit_pose_to_curves(body: BodyModel, polylines: Sequence[ArrayLike], *, closed: bool = False,

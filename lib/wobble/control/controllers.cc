@@ -43,8 +43,10 @@ void PoseGraphController::BeforeStep(World& world) {
 
 TargetScheduleController::TargetScheduleController(const World& world, int body, Eigen::MatrixXd targets)
     : body_(body), targets_(std::move(targets)) {
-  if (world.kind(body) != BodyKind::kFfd) throw std::invalid_argument("target schedule: a 2D FFD body only");
-  if (targets_.rows() != world.body(body).num_modes() || targets_.cols() < 1)
+  const BodyKind kind = world.kind(body);
+  if (kind != BodyKind::kFfd && kind != BodyKind::kFfd3) throw std::invalid_argument("target schedule: an FFD body only");
+  const int modes = kind == BodyKind::kFfd3 ? world.body3(body).num_modes() : world.body(body).num_modes();
+  if (targets_.rows() != modes || targets_.cols() < 1)
     throw std::invalid_argument("target schedule: one row per mode and at least one column needed");
 }
 

@@ -41,7 +41,7 @@ class PoseGraphController : public Controller, public PoseSource {
   int pose_ = -1;
 };
 
-// Per-step PD targets of every mode of one 2D FFD body, as a spacetime fit finds them
+// Per-step PD targets of every mode of one FFD body (2D or 3D), as a spacetime fit finds them
 // (fit/spacetime.h): column n before the run's step n; the last column holds after the end.
 class TargetScheduleController : public Controller {
  public:

@@ -26,7 +26,29 @@ void KnotWeights(int n, int steps, int knots, int* j, double* f) {
 
 double Logistic(double x) { return 1.0 / (1.0 + std::exp(-x)); }
 
-void CheckProblem(const BodyModel& body, const SpacetimeProblem& p) {
+// The rollout of either body: what the one templated fit below calls.
+double CostOf(const BodyModel& body, const ControlledRollout& r, const StageCost& cost) {
+  return RolloutCost(body, r, cost);
+}
+double CostOf(const BodyModel3& body, const ControlledRollout3& r, const StageCost3& cost) {
+  return RolloutCost3(body, r, cost);
+}
+RolloutGradient GradientOf(const BodyModel& body, const ControlledRollout& r, const StageCost& cost) {
+  return RolloutCostGradient(body, r, cost);
+}
+RolloutGradient3 GradientOf(const BodyModel3& body, const ControlledRollout3& r, const StageCost3& cost) {
+  return RolloutCostGradient3(body, r, cost);
+}
+
+// The problem's cost at these knots: one plain simulation, +inf when it fails.
+template <class Body, class Problem>
+double CostAtKnots(const Body& body, const Problem& problem, const Eigen::MatrixXd& knots) {
+  auto r = problem.rollout;
+  r.targets = KnotTargets(knots, r.steps());
+  return CostOf(body, r, problem.task) + problem.control_weight * r.dt * r.targets.squaredNorm();
+}
+
+template <class Body, class Problem> void CheckProblem(const Body& body, const Problem& p) {
   const int D = body.num_modes(), steps = p.rollout.steps();
   auto fail = [](const std::string& what) { throw std::invalid_argument("spacetime fit: " + what); };
   if (D == 0) fail("the body has no modes to control");
@@ -41,9 +63,9 @@ void CheckProblem(const BodyModel& body, const SpacetimeProblem& p) {
 }
 
 // The cost as Ceres sees it: x (modes × knots, column-major) → knots → targets → rollout.
-class SpacetimeCost final : public ceres::FirstOrderFunction {
+template <class Body, class Problem> class SpacetimeCost final : public ceres::FirstOrderFunction {
  public:
-  SpacetimeCost(const BodyModel& body, const SpacetimeProblem& p, long* evaluations)
+  SpacetimeCost(const Body& body, const Problem& p, long* evaluations)
       : body_(body), p_(p), rollout_(p.rollout), evaluations_(evaluations) {}
 
   int NumParameters() const override { return int(p_.lower.size()) * p_.knots; }
@@ -64,11 +86,11 @@ class SpacetimeCost final : public ceres::FirstOrderFunction {
     const int D = int(p_.lower.size()), steps = rollout_.steps();
     ++*evaluations_;
     if (!gradient) {
-      *cost = SpacetimeCostOf(body_, p_, Knots(x));
+      *cost = CostAtKnots(body_, p_, Knots(x));
       return std::isfinite(*cost);
     }
     rollout_.targets = KnotTargets(Knots(x), steps);
-    const RolloutGradient g = RolloutCostGradient(body_, rollout_, p_.task);
+    const auto g = GradientOf(body_, rollout_, p_.task);
     if (!g.ok) return false;  // the line search steps back
     *cost = g.cost + ControlEnergy(rollout_.targets);
     const Eigen::MatrixXd g_targets = g.targets + (2.0 * p_.control_weight * rollout_.dt) * rollout_.targets;
@@ -91,9 +113,9 @@ class SpacetimeCost final : public ceres::FirstOrderFunction {
   }
 
  private:
-  const BodyModel& body_;
-  const SpacetimeProblem& p_;
-  mutable ControlledRollout rollout_;  // its targets are each evaluation's
+  const Body& body_;
+  const Problem& p_;
+  mutable decltype(Problem::rollout) rollout_;  // its targets are each evaluation's
   long* evaluations_;
 };
 
@@ -109,96 +131,7 @@ class Progress final : public ceres::IterationCallback {
   const SpacetimeOptions& o_;
 };
 
-void CheckTerm(int step, double weight, const char* what) {
-  if (step < 0) throw std::invalid_argument(std::string(what) + ": the step must be >= 0");
-  if (!(weight >= 0.0) || !std::isfinite(weight)) throw std::invalid_argument(std::string(what) + ": the weight must be >= 0");
-}
-
 }  // namespace
-
-StageCost CentreOfMassAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight, Axes axes) {
-  CheckTerm(step, weight, "CentreOfMassAt");
-  if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassAt: the goal must be finite");
-  const MassMoments mm = body.moments();
-  return [mm, step, goal, weight, axes](int n, const Eigen::VectorXd& q, const Eigen::VectorXd&, Eigen::VectorXd* dq,
-                                        Eigen::VectorXd*) {
-    if (n != step) return 0.0;
-    const int D = int(q.size()) - kRigidDofs;
-    const Eigen::Vector2d c = (mm.c0 + mm.C * q.tail(D)) / mm.m;  // body frame
-    const Eigen::Rotation2Dd R(q[2]);
-    const Eigen::Vector2d Rc = R * c, x = q.head<2>() + Rc;
-    Eigen::Vector2d miss = x - goal;
-    if (!axes.x) miss.x() = 0.0;
-    if (!axes.y) miss.y() = 0.0;
-    const Eigen::Vector2d r = weight * miss;
-    dq->head<2>() += r;                                 // ∂x/∂t = I
-    (*dq)[2] += r.y() * Rc.x() - r.x() * Rc.y();        // ∂x/∂θ = S R c
-    dq->tail(D) += mm.C.transpose() * (R.inverse() * r) / mm.m;  // ∂x/∂γ = R C / m
-    return 0.5 * weight * miss.squaredNorm();
-  };
-}
-
-StageCost CentreOfMassVelocityAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight,
-                                 Axes axes) {
-  CheckTerm(step, weight, "CentreOfMassVelocityAt");
-  if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassVelocityAt: the goal must be finite");
-  const MassMoments mm = body.moments();
-  return [mm, step, goal, weight, axes](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                                        Eigen::VectorXd* dq, Eigen::VectorXd* dqd) {
-    if (n != step) return 0.0;
-    const int D = int(q.size()) - kRigidDofs;
-    Eigen::Matrix2d S;
-    S << 0.0, -1.0, 1.0, 0.0;
-    const Eigen::Matrix2d R = Eigen::Rotation2Dd(q[2]).toRotationMatrix();
-    const Eigen::Vector2d c = (mm.c0 + mm.C * q.tail(D)) / mm.m, cd = mm.C * qd.tail(D) / mm.m;
-    const double thd = qd[2];
-    const Eigen::Vector2d v = qd.head<2>() + thd * (S * R * c) + R * cd;
-    Eigen::Vector2d miss = v - goal;
-    if (!axes.x) miss.x() = 0.0;
-    if (!axes.y) miss.y() = 0.0;
-    const Eigen::Vector2d r = weight * miss;
-    // ∂v/∂ṫ = I, ∂v/∂θ̇ = S R c, ∂v/∂γ̇ = R C/m; ∂v/∂θ = θ̇ S S R c + S R ċ, ∂v/∂γ = θ̇ S R C/m
-    dqd->head<2>() += r;
-    (*dqd)[2] += r.dot(S * R * c);
-    dqd->tail(D) += mm.C.transpose() * (R.transpose() * r) / mm.m;
-    (*dq)[2] += r.dot(thd * (S * S * R * c) + S * R * cd);
-    dq->tail(D) += thd * mm.C.transpose() * ((S * R).transpose() * r) / mm.m;
-    return 0.5 * weight * miss.squaredNorm();
-  };
-}
-
-StageCost UprightAt(int step, double weight, double time_scale) {
-  CheckTerm(step, weight, "UprightAt");
-  if (!(time_scale >= 0.0) || !std::isfinite(time_scale)) throw std::invalid_argument("UprightAt: the time scale must be >= 0");
-  return [step, weight, time_scale](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq,
-                                    Eigen::VectorXd* dqd) {
-    if (n != step) return 0.0;
-    const double s2 = time_scale * time_scale;
-    (*dq)[2] += weight * q[2];
-    (*dqd)[2] += weight * s2 * qd[2];
-    return 0.5 * weight * (q[2] * q[2] + s2 * qd[2] * qd[2]);
-  };
-}
-
-StageCost StillAt(int step, double weight) {
-  CheckTerm(step, weight, "StillAt");
-  return [step, weight](int n, const Eigen::VectorXd&, const Eigen::VectorXd& qd, Eigen::VectorXd*, Eigen::VectorXd* dqd) {
-    if (n != step) return 0.0;
-    *dqd += weight * qd;
-    return 0.5 * weight * qd.squaredNorm();
-  };
-}
-
-StageCost SumOf(std::vector<StageCost> terms) {
-  for (const StageCost& t : terms)
-    if (!t) throw std::invalid_argument("SumOf: an empty term");
-  return [terms = std::move(terms)](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq,
-                                     Eigen::VectorXd* dqd) {
-    double total = 0.0;
-    for (const StageCost& t : terms) total += t(n, q, qd, dq, dqd);
-    return total;
-  };
-}
 
 Eigen::MatrixXd KnotTargets(const Eigen::MatrixXd& knots, int steps) {
   if (knots.cols() < 2 || steps < 1) throw std::invalid_argument("KnotTargets: needs two knots and a step");
@@ -212,19 +145,15 @@ Eigen::MatrixXd KnotTargets(const Eigen::MatrixXd& knots, int steps) {
   return targets;
 }
 
-double SpacetimeCostOf(const BodyModel& body, const SpacetimeProblem& problem, const Eigen::MatrixXd& knots) {
-  ControlledRollout r = problem.rollout;
-  r.targets = KnotTargets(knots, r.steps());
-  return RolloutCost(body, r, problem.task) + problem.control_weight * r.dt * r.targets.squaredNorm();
-}
-
 namespace {
 
+
 // One L-BFGS descent from x (the logistic coordinates of the knots); `progress` may be null.
-SpacetimeResult DescendFrom(const BodyModel& body, const SpacetimeProblem& problem, int max_iterations,
+template <class Body, class Problem>
+SpacetimeResult DescendFrom(const Body& body, const Problem& problem, int max_iterations,
                             Eigen::VectorXd x, ceres::IterationCallback* progress) {
   SpacetimeResult r;
-  auto* cost = new SpacetimeCost(body, problem, &r.gradients);
+  auto* cost = new SpacetimeCost<Body, Problem>(body, problem, &r.gradients);
   ceres::GradientProblem ceres_problem(cost);  // owns cost
   double first = 0.0;
   if (!cost->Evaluate(x.data(), &first, nullptr)) {
@@ -254,9 +183,8 @@ SpacetimeResult DescendFrom(const BodyModel& body, const SpacetimeProblem& probl
   return r;
 }
 
-}  // namespace
-
-SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem, const SpacetimeOptions& options) {
+template <class Body, class Problem>
+SpacetimeResult Fit(const Body& body, const Problem& problem, const SpacetimeOptions& options) {
   CheckProblem(body, problem);
   if (options.starts < 1) throw std::invalid_argument("spacetime fit: starts must be >= 1");
   if (!(options.start_spread >= 0.0) || !std::isfinite(options.start_spread))
@@ -310,6 +238,21 @@ SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& prob
     r.start_costs.push_back(run.ok ? run.cost : std::numeric_limits<double>::quiet_NaN());
   }
   return r;
+}
+
+}  // namespace
+
+double SpacetimeCostOf(const BodyModel& body, const SpacetimeProblem& problem, const Eigen::MatrixXd& knots) {
+  return CostAtKnots(body, problem, knots);
+}
+double SpacetimeCostOf3(const BodyModel3& body, const SpacetimeProblem3& problem, const Eigen::MatrixXd& knots) {
+  return CostAtKnots(body, problem, knots);
+}
+SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem, const SpacetimeOptions& options) {
+  return Fit(body, problem, options);
+}
+SpacetimeResult FitSpacetime3(const BodyModel3& body, const SpacetimeProblem3& problem, const SpacetimeOptions& options) {
+  return Fit(body, problem, options);
 }
 
 }  // namespace wobble::fit

@@ -6,9 +6,10 @@
 // (every step its own knot when knots == steps + 1 … any count ≥ 2). The cost is
 //     ρ Σ_n |γ0(n)|² Δt  +  Σ_n ℓ_n(q_n, q̇_n)
 // (control energy, then the task as a stage cost: reach a point at a time, land upright, …).
-// Its gradient with respect to every knot comes from one adjoint sweep (adjoint.h), so the
-// solver is Ceres' L-BFGS on the gradient alone; the bounds lo ≤ γ0 ≤ hi are kept by solving
-// for x with knot = lo + (hi − lo) σ(x), σ the logistic function.
+// Its gradient with respect to every knot comes from one adjoint sweep (adjoint.h, adjoint3.h),
+// so the solver is Ceres' L-BFGS on the gradient alone; the bounds lo ≤ γ0 ≤ hi are kept by
+// solving for x with knot = lo + (hi − lo) σ(x), σ the logistic function. One fit serves the 2D
+// body (FitSpacetime) and the 3D body (FitSpacetime3); only their task terms differ.
 #pragma once
 
 #include <Eigen/Core>
@@ -17,16 +18,19 @@
 #include <vector>
 
 #include "wobble/fit/adjoint.h"
+#include "wobble/fit/adjoint3.h"
 
 namespace wobble::fit {
 
-struct SpacetimeProblem {
-  ControlledRollout rollout;     // world, integrator, dt, start, gains; targets: the first guess
+template <class Rollout, class Cost> struct SpacetimeProblemOf {
+  Rollout rollout;               // world, integrator, dt, start, gains; targets: the first guess
   int knots = 2;                 // ≥ 2, at most steps + 1
   Eigen::VectorXd lower, upper;  // per mode bounds of the targets, lower < upper
   double control_weight = 0.0;   // ρ
-  StageCost task;                // ℓ_n, with its gradient
+  Cost task;                     // ℓ_n, with its gradient
 };
+using SpacetimeProblem = SpacetimeProblemOf<ControlledRollout, StageCost>;
+using SpacetimeProblem3 = SpacetimeProblemOf<ControlledRollout3, StageCost3>;
 
 struct SpacetimeOptions {
   int max_iterations = 100;  // per start
@@ -66,7 +70,7 @@ Eigen::MatrixXd KnotTargets(const Eigen::MatrixXd& knots, int steps);
 //   StillAt:        w/2 |q̇_n|² (every coordinate's rate): "be at rest".
 // n is a step index (0 … steps). Throws std::invalid_argument on a negative step or weight.
 struct Axes {
-  bool x = true, y = true;
+  bool x = true, y = true, z = true;  // z: 3D terms only
 };
 StageCost CentreOfMassAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight, Axes axes = {});
 //   CentreOfMassVelocityAt: w/2 |v_c − goal|² on the axes asked for, v_c the velocity of the
@@ -77,12 +81,30 @@ StageCost UprightAt(int step, double weight, double time_scale = 0.0);
 StageCost StillAt(int step, double weight);
 StageCost SumOf(std::vector<StageCost> terms);
 
+// The same for the 3D body, in the tangent coordinates z = (δt, ε, δγ, δv) of adjoint3.h, with
+// v = (ṫ, ω, γ̇) and ω in the body frame (y up, as in 2D):
+//   CentreOfMassAt3:         w/2 |x_c − goal|², x_c = t + R c/m, c = c0 + C γ (kinematics3.h).
+//   CentreOfMassVelocityAt3: w/2 |v_c − goal|², v_c = ṫ + R (ω × c + C γ̇)/m.
+//   UprightAt3:              w/2 (|R e_y − e_y|² + τ² |ω|²): the body's up axis up and not
+//                            turning; any heading (a turn about the vertical costs nothing).
+//   StillAt3:                w/2 |v|².
+StageCost3 CentreOfMassAt3(const BodyModel3& body, int step, const Eigen::Vector3d& goal, double weight, Axes axes = {});
+StageCost3 CentreOfMassVelocityAt3(const BodyModel3& body, int step, const Eigen::Vector3d& goal, double weight,
+                                   Axes axes = {});
+StageCost3 UprightAt3(int step, double weight, double time_scale = 0.0);
+StageCost3 StillAt3(int step, double weight);
+StageCost3 SumOf3(std::vector<StageCost3> terms);
+
 // The problem's cost at these knots (modes × knots, not bounded here): one plain simulation,
 // +inf when it fails. What FitSpacetime minimises, for other optimisers to compare on.
 double SpacetimeCostOf(const BodyModel& body, const SpacetimeProblem& problem, const Eigen::MatrixXd& knots);
 
+double SpacetimeCostOf3(const BodyModel3& body, const SpacetimeProblem3& problem, const Eigen::MatrixXd& knots);
+
 // Throws std::invalid_argument on inconsistent sizes, bounds or knot counts.
 SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem,
                              const SpacetimeOptions& options = SpacetimeOptions());
+SpacetimeResult FitSpacetime3(const BodyModel3& body, const SpacetimeProblem3& problem,
+                              const SpacetimeOptions& options = SpacetimeOptions());
 
 }  // namespace wobble::fit

@@ -289,7 +289,6 @@ void Schedule(State& s, const Words& w, const Context& ctx) {
     s.scene.control().schedule.resize(0, 0);
     return;
   }
-  if (s.scene.object().dim() != 2) ctx.Fail("schedule: 2D objects only");
   try {
     s.scene.control().schedule =
         formats::ReadTargetSchedule(w[1], s.scene.object().mode_names(), s.scene.options().dt);
