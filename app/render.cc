@@ -10,7 +10,6 @@
 #include <memory>
 #include <set>
 #include <sstream>
-#include <tuple>
 
 #include "pipelines/scene_view.h"
 #include "pipelines/trajectory_render.h"
@@ -22,20 +21,6 @@ namespace {
 
 namespace pl = wobble::pipelines;
 
-
-struct Size {
-  int w = 0, h = 0;
-};
-
-Size ParseSize(const std::string& text, const std::string& flag) {
-  Size s;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &s.w, &x, &s.h, &extra) != 3 || (x != 'x' && x != 'X'))
-    throw UsageError(flag + ": expected WIDTHxHEIGHT such as 640x480, got '" + text + "'");
-  if (s.w < 16 || s.h < 16 || s.w > 8192 || s.h > 8192)
-    throw UsageError(flag + ": each side must be between 16 and 8192 pixels, got '" + text + "'");
-  return s;
-}
 
 std::set<std::string> ParseWhat(const std::string& text) {
   const std::vector<std::string> words = ListWords(text);
@@ -71,46 +56,15 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
                   "What to write, comma separated: frames, filmstrip, charts, vtp, exr, disp (default: " +
                       default_what + ")")
       ->type_name("LIST");
-  cmd->add_option("--size", a->size, "Frame size (PNG and EXR frames)")->capture_default_str()->type_name("WxH");
-  cmd->add_option("--fps", a->fps, "Frames per simulated second")->capture_default_str();
-  cmd->add_option("--color-by", a->color_by,
-                  "Colour mass points by mass | velocity | applied_force | in_contact, or lattice points by "
-                  "displacement")
-      ->type_name("ARRAY");
-  cmd->add_option("--shape-samples", a->shape_samples, "Samples per drawing segment (the shape is drawn finer "
-                                                       "than the mass points)")
-      ->capture_default_str();
-  cmd->add_option("--filmstrip", a->filmstrip_times, "Times of the filmstrip's panels (default: 6 evenly spaced)")
-      ->type_name("\"T T ..\"");
-  cmd->add_option("--filmstrip-size", a->filmstrip_size, "Size of one filmstrip panel")
-      ->capture_default_str()
-      ->type_name("WxH");
-  cmd->add_option("--filmstrip-columns", a->filmstrip_columns, "Panels per filmstrip row (0: one row)")
-      ->capture_default_str();
-  cmd->add_option("--filmstrip-cycle", a->filmstrip_cycle,
-                  "Gaits: the panels sample cycle K of the pose graph (0 the first) at PANELS equal steps (6) and "
-                  "its end, each labelled with its active pose (in place of --filmstrip)")
-      ->type_name("\"K [PANELS]\"");
-  cmd->add_option("--disp-size", a->disp_size, "Size of the displacement image (default: 256 wide, lattice aspect)")
-      ->type_name("WxH");
-  cmd->add_option("--chart-size", a->chart_size, "Size of the charts")->capture_default_str()->type_name("WxH");
-  cmd->add_option("--azimuth", a->azimuth, "3D: the camera's angle about +y, degrees from +z towards +x")
-      ->capture_default_str();
-  cmd->add_option("--elevation", a->elevation, "3D: the camera's angle above the ground plane, degrees")
-      ->capture_default_str();
-  cmd->add_option("--orbit", a->orbit, "3D: the camera orbits the motion at this many degrees per simulated second")
-      ->capture_default_str();
-  cmd->add_option("--camera", a->camera, "whole (frame the whole run, standing still) or follow (the body, smoothed, "
-                                        "the ground under it in view; 3D: a cube about it from --azimuth, --elevation)")
-      ->capture_default_str();
-  cmd->add_option("--style", a->style, "diagnostic (lattice, mass points, shape) or clean (the character: filled, "
-                                      "anti-aliased, no lattice or points)")
-      ->capture_default_str();
-  cmd->add_flag("--exr-terrain", a->exr_terrain,
-                "EXR frames: write the rest of the picture (terrain or ground, springs, trails) as its own layer "
-                "terrain.R,G,B,A too (the characters' R,G,B,A are always written)");
-  cmd->add_option("--trail", a->trail, "Trace points given by lattice coordinates \"s t s t ..\" in the frames")
-      ->type_name("\"S T ..\"");
+  for (const scene::RenderOptionInfo& o : scene::RenderOptionTable()) {
+    const std::string name = o.name;
+    const std::string help = o.help + (o.default_value.empty() || o.flag ? "" : " [" + o.default_value + "]");
+    if (o.flag)
+      cmd->add_flag_callback("--" + name, [a, name] { a->picture[name] = "on"; }, help);
+    else
+      cmd->add_option_function<std::string>("--" + name, [a, name](const std::string& v) { a->picture[name] = v; }, help)
+          ->type_name(o.value_name);
+  }
   return cmd;
 }
 
@@ -119,9 +73,8 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   const Integrator integrator = ParseIntegratorFlag(a.integrator);
   RequirePositive(a.dt, "--dt");
   RequireNonNegative(a.duration, "--duration");
-  RequirePositive(a.fps, "--fps");
-  if (!(a.duration * a.fps <= 1e6)) throw UsageError("--duration * --fps asks for more than a million frames");
-  CheckRenderOptions(a, default_what);
+  const scene::RenderSettings picture = CheckRenderOptions(a, default_what);
+  if (!(a.duration * picture.fps <= 1e6)) throw UsageError("--duration * --fps asks for more than a million frames");
 
   // the body in its world, simulated from (q0, q̇0) into a trajectory of every step
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, integrator, a.dt);
@@ -146,79 +99,32 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   return kExitOk;
 }
 
-// --filmstrip-cycle "K [PANELS]": (K, PANELS), (-1, 6) when not given.
-std::pair<int, int> FilmstripCycleOf(const RenderArgs& a) {
-  if (a.filmstrip_cycle.empty()) return {-1, 6};
-  const std::vector<double> v = ParseNumbers(a.filmstrip_cycle, "--filmstrip-cycle");
-  const bool whole = std::all_of(v.begin(), v.end(), [](double x) { return x == std::floor(x); });
-  if (v.empty() || v.size() > 2 || !whole || v[0] < 0 || v[0] > 1e6 || (v.size() == 2 && (v[1] < 1 || v[1] > 100)))
-    throw UsageError("--filmstrip-cycle: expected a cycle K >= 0 and optionally 1 to 100 panels, got '" +
-                     a.filmstrip_cycle + "'");
-  if (!a.filmstrip_times.empty()) throw UsageError("--filmstrip-cycle and --filmstrip both place the panels: give one");
-  return {int(v[0]), v.size() == 2 ? int(v[1]) : 6};
-}
-
-void CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
-  RequirePositive(a.fps, "--fps");
-  if (a.shape_samples < 1 || a.shape_samples > 10000) throw UsageError("--shape-samples must be between 1 and 10000");
+scene::RenderSettings CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
   const std::set<std::string> what = ParseWhat(a.what.empty() ? default_what : a.what);
-  ParseSize(a.size, "--size");
-  ParseSize(a.filmstrip_size, "--filmstrip-size");
-  ParseSize(a.chart_size, "--chart-size");
-  ParseNumbers(a.filmstrip_times, "--filmstrip");
-  FilmstripCycleOf(a);
-  if (ParseNumbers(a.trail, "--trail").size() % 2) throw UsageError("--trail: lattice coordinates come in pairs s t");
-  RequireFinite(a.azimuth, "--azimuth");
-  RequireFinite(a.orbit, "--orbit");
-  if (!(std::abs(a.elevation) < 90.0)) throw UsageError("--elevation must be between -90 and 90 degrees");
-  if (a.camera != "whole" && a.camera != "follow") throw UsageError("--camera: expected whole or follow, got '" + a.camera + "'");
-  if (a.style != "diagnostic" && a.style != "clean")
-    throw UsageError("--style: expected diagnostic or clean, got '" + a.style + "'");
+  scene::RenderSettings settings;
+  try {
+    settings = scene::ParseRenderOptions(a.picture);
+  } catch (const scene::RenderOptionError& e) {
+    throw UsageError("--" + e.option + ": " + e.what());
+  }
   const bool renders = what.count("frames") || what.count("filmstrip") || what.count("charts") || what.count("exr");
   if (renders && !pl::HasDisplay())
     throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"
                      "  xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble ...\n"
                      "or ask only for --what vtp,disp");
   CheckOutputFolder(a.out);
+  return settings;
 }
 
 pl::RenderOutputs RenderOutputsOf(const RenderArgs& a, const std::string& default_what, const std::string& name) {
-  CheckRenderOptions(a, default_what);
+  const scene::RenderSettings settings = CheckRenderOptions(a, default_what);
   const std::set<std::string> what = ParseWhat(a.what.empty() ? default_what : a.what);
   pl::RenderOutputs out;
   out.folder = a.out;
   out.name = name;
   pl::SetOutputs(std::vector<std::string>(what.begin(), what.end()), &out);  // checked by ParseWhat
-  out.fps = a.fps;
-  const Size frame_size = ParseSize(a.size, "--size");
-  out.view.width = frame_size.w;
-  out.view.height = frame_size.h;
-  out.view.color_by = a.color_by;
-  out.view.shape_samples = a.shape_samples;
+  pl::ApplyRenderSettings(settings, &out);
   out.view.title = name;
-  const Size strip_size = ParseSize(a.filmstrip_size, "--filmstrip-size");
-  out.filmstrip_times = ParseNumbers(a.filmstrip_times, "--filmstrip");
-  out.filmstrip_width = strip_size.w;
-  out.filmstrip_height = strip_size.h;
-  out.filmstrip_columns = a.filmstrip_columns;
-  std::tie(out.filmstrip_cycle, out.filmstrip_panels) = FilmstripCycleOf(a);
-  if (!a.disp_size.empty()) {
-    const Size disp = ParseSize(a.disp_size, "--disp-size");
-    out.disp_width = disp.w;
-    out.disp_height = disp.h;
-  }
-  const Size chart_size = ParseSize(a.chart_size, "--chart-size");
-  out.chart_width = chart_size.w;
-  out.chart_height = chart_size.h;
-  const std::vector<double> trail = ParseNumbers(a.trail, "--trail");
-  for (size_t i = 0; i + 1 < trail.size(); i += 2) out.trail.emplace_back(trail[i], trail[i + 1]);
-  out.view.show_trails = !out.trail.empty();
-  out.view.azimuth = a.azimuth;
-  out.view.elevation = a.elevation;
-  out.orbit_deg_per_s = a.orbit;
-  out.camera = a.camera == "follow" ? pl::RenderOutputs::Camera::kFollow : pl::RenderOutputs::Camera::kWhole;
-  out.view.style = a.style == "clean" ? pl::RenderStyle::kClean : pl::RenderStyle::kDiagnostic;
-  out.view.exr_terrain_layer = a.exr_terrain;
   return out;
 }
 
@@ -234,7 +140,7 @@ void RenderRun(const RenderArgs& a, const std::string& default_what, World& worl
   const pl::RenderReport report = pl::RenderTrajectory(world, run, pl::SceneSpec{}, out);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.Finish();
-  std::cout << name << ": " << report.frames << " frames at " << Num(a.fps) << " fps over "
+  std::cout << name << ": " << report.frames << " frames at " << Num(out.fps) << " fps over "
             << Num(run.time(run.size() - 1)) << " s, " << Num(wall) << " s wall ("
             << (wall > 0 ? Num(report.frames / wall) : std::string("-")) << " frames/s).\n";
   for (const pl::RenderReport::File& f : report.files) std::cout << "  " << f.Line() << "\n";

@@ -12,10 +12,12 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <map>
 #include <string>
 
 #include "cli_common.h"
 #include "wobble/record/trajectory.h"
+#include "wobble/scene/render_options.h"
 #include "wobble/world/world.h"
 
 namespace wobble::pipelines {
@@ -33,22 +35,9 @@ struct RenderArgs {
   double duration = 10.0;
   std::string out;                  // output folder
   std::string what;                 // comma list; empty: the command's default
-  std::string size = "640x480";     // frames
-  double fps = 30.0;
-  std::string color_by;             // mass-point array or "displacement"
-  int shape_samples = 16;
-  std::string filmstrip_times;      // "0 0.5 1 ..."; empty: 6 evenly spaced
-  std::string filmstrip_size = "320x240";
-  int filmstrip_columns = 3;
-  std::string filmstrip_cycle;      // "K [PANELS]": the panels sample the pose graph's cycle K
-  std::string disp_size;            // "WxH"; empty: 256 wide, lattice aspect
-  std::string chart_size = "800x500";
-  std::string trail;                // lattice coords "s t s t ..." of points to trace
-  double azimuth = 30.0, elevation = 20.0;  // 3D camera, degrees
-  double orbit = 0.0;               // 3D camera turn, degrees per simulated second
-  std::string camera = "whole";     // 2D: whole (the run framed once) or follow
-  std::string style = "diagnostic"; // diagnostic (lattice, mass points) or clean (the character only)
-  bool exr_terrain = false;         // EXR frames: the terrain as its own layer too
+  // the picture options as typed, by name (scene/render_options.h: one table for these flags and
+  // a script's NAME=VALUE)
+  std::map<std::string, std::string> picture;
   Limits limits;
 };
 
@@ -57,8 +46,9 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
                            const std::string& default_what, RenderArgs* args);
 int RunRender(const RenderArgs& args, const std::string& default_what);
 
-// Checks the picture options (--what, sizes, display, --out) before anything is simulated.
-void CheckRenderOptions(const RenderArgs& args, const std::string& default_what);
+// Checks the picture options (--what, the table's options, display, --out) before anything is
+// simulated; returns them parsed.
+scene::RenderSettings CheckRenderOptions(const RenderArgs& args, const std::string& default_what);
 // What the picture options ask of the render driver; `name` is the .pvd's stem and the title.
 pipelines::RenderOutputs RenderOutputsOf(const RenderArgs& args, const std::string& default_what, const std::string& name);
 // Draws `run` (put back into `world`, a world of its bodies) as the options ask and prints

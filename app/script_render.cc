@@ -1,11 +1,8 @@
 #include "script_render.h"
 
-#include <algorithm>
-#include <cmath>
 #include <iostream>
 
 #include "cli_common.h"
-#include "wobble/formats/line_reader.h"
 #include "pipelines/scene_view.h"
 #include "pipelines/trajectory_render.h"
 #include "render.h"
@@ -14,62 +11,18 @@ namespace wobble::app {
 
 namespace pl = wobble::pipelines;
 
-namespace {
-
-// One `NAME=VALUE` of a script's render line: the option of `wobble render` by the same name
-// (lists take commas: filmstrip=0.5,1,1.5).
-void ApplyRenderOption(const std::string& name, const std::string& value, RenderArgs* a) {
-  auto number = [&] {
-    double v;
-    if (!formats::detail::ParseNumber(value, &v) || !std::isfinite(v))
-      throw std::invalid_argument(name + "=: expected a number, got '" + value + "'");
-    return v;
-  };
-  auto spaced = [&] {
-    std::string t = value;
-    std::replace(t.begin(), t.end(), ',', ' ');
-    return t;
-  };
-  if (name == "size") a->size = value;
-  else if (name == "fps") a->fps = number();
-  else if (name == "filmstrip") a->filmstrip_times = spaced();
-  else if (name == "filmstrip-size") a->filmstrip_size = value;
-  else if (name == "filmstrip-cycle") a->filmstrip_cycle = spaced();
-  else if (name == "filmstrip-columns") {
-    const double v = number();
-    if (!(v >= 0 && v <= 100 && v == std::floor(v)))
-      throw std::invalid_argument("filmstrip-columns=: expected a whole number from 0 to 100, got '" + value + "'");
-    a->filmstrip_columns = int(v);
-  } else if (name == "color-by") a->color_by = value;
-  else if (name == "shape-samples") {
-    const double v = number();
-    if (!(v >= 1 && v <= 10000 && v == std::floor(v)))
-      throw std::invalid_argument("shape-samples=: expected a whole number from 1 to 10000, got '" + value + "'");
-    a->shape_samples = int(v);
-  } else if (name == "chart-size") a->chart_size = value;
-  else if (name == "disp-size") a->disp_size = value;
-  else if (name == "trail") a->trail = spaced();
-  else if (name == "azimuth") a->azimuth = number();
-  else if (name == "elevation") a->elevation = number();
-  else if (name == "orbit") a->orbit = number();
-  else if (name == "camera") a->camera = value;
-  else if (name == "style") a->style = value;
-  else if (name == "exr-terrain") {
-    if (value != "on" && value != "off") throw std::invalid_argument("exr-terrain=: expected on or off, got '" + value + "'");
-    a->exr_terrain = value == "on";
-  } else
-    throw std::invalid_argument("unknown option '" + name + "' (" + script::RenderOptionNames() + ")");
-}
-
-}  // namespace
-
 void RenderScriptRuns(const script::RenderRequest& r) {
   const record::Trajectory& run = *r.trajectory;
   const std::string default_what = "frames,filmstrip,charts";
   RenderArgs a;
   a.out = r.dir;
   a.what = r.what.empty() ? default_what : r.what;
-  for (const auto& [name, value] : r.options) ApplyRenderOption(name, value, &a);
+  for (const auto& [name, value] : r.options) a.picture[name] = value;  // a later one wins
+  try {
+    scene::ParseRenderOptions(a.picture);  // checked here to name the options as the script spells them
+  } catch (const scene::RenderOptionError& e) {
+    throw std::invalid_argument(e.option + "=: " + e.what());
+  }
   if (!pl::HasDisplay()) {
     std::string kept;
     for (const char* w : {"vtp", "disp"})

@@ -211,6 +211,34 @@ FollowMoment FollowMomentNow(const World& world, const Eigen::AlignedBox3d& bodi
 
 }  // namespace
 
+void ApplyRenderSettings(const scene::RenderSettings& s, RenderOutputs* out) {
+  out->fps = s.fps;
+  out->view.width = s.width;
+  out->view.height = s.height;
+  out->view.color_by = s.color_by;
+  out->view.shape_samples = s.shape_samples;
+  out->filmstrip_times = s.filmstrip_times;
+  out->filmstrip_width = s.filmstrip_width;
+  out->filmstrip_height = s.filmstrip_height;
+  out->filmstrip_columns = s.filmstrip_columns;
+  out->filmstrip_cycle = s.filmstrip_cycle;
+  out->filmstrip_panels = s.filmstrip_panels;
+  if (s.disp_width > 0) {
+    out->disp_width = s.disp_width;
+    out->disp_height = s.disp_height;
+  }
+  out->chart_width = s.chart_width;
+  out->chart_height = s.chart_height;
+  out->trail = s.trail;
+  out->view.show_trails = !s.trail.empty();
+  out->view.azimuth = s.azimuth;
+  out->view.elevation = s.elevation;
+  out->orbit_deg_per_s = s.orbit;
+  out->camera = s.follow ? RenderOutputs::Camera::kFollow : RenderOutputs::Camera::kWhole;
+  out->view.style = s.clean ? RenderStyle::kClean : RenderStyle::kDiagnostic;
+  out->view.exr_terrain_layer = s.exr_terrain;
+}
+
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out) {
   out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = false;
   for (const std::string& w : what) {

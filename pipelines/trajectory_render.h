@@ -30,6 +30,7 @@
 
 #include "pipelines/scene_view.h"
 #include "wobble/record/trajectory.h"
+#include "wobble/scene/render_options.h"
 #include "wobble/world/world.h"
 
 namespace wobble::pipelines {
@@ -104,6 +105,10 @@ std::vector<double> FilmstripCycleTimes(const record::Trajectory& run, int k, in
 // A world holding the run's bodies (FFD bodies at their models, linear bodies with the default
 // material) with these options: somewhere to draw a run whose world is gone.
 World WorldFor(const record::Trajectory& run, const WorldOptions& options);
+
+// The picture options (scene/render_options.h: the one table of `wobble render`'s flags and a
+// script's NAME=VALUE) put into `out`: sizes, fps, filmstrip, camera, style, trails, ...
+void ApplyRenderSettings(const scene::RenderSettings& settings, RenderOutputs* out);
 
 // The outputs the words of `what` name (frames, filmstrip, charts, vtp, exr, disp) on, the
 // others off: "" when every word is one of them and one at least is given, else what is wrong

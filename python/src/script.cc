@@ -3,6 +3,7 @@
 // synthesis problem, the last run's trajectory), with the same FILE:LINE errors.
 #include "support.h"
 
+#include <map>
 #include <sstream>
 
 #include "wobble/core/errors.h"
@@ -65,15 +66,14 @@ class PyInterpreter {
     out.folder = r.dir;
     out.name = run.bodies().empty() ? "run" : run.bodies()[0].name;
     out.view.title = out.name;
-    out.fps = 30.0;
     out.t_end = run.time(run.size() - 1);
-    // the NAME=VALUE view options are `wobble run`'s (app/script_render.cc): say so rather than
-    // drop them without a word
-    if (!r.options.empty()) {
-      std::string names;
-      for (const auto& [name, value] : r.options) names += (names.empty() ? "" : " ") + name + "=" + value;
-      out_ << "render: " << names << " not applied (Python's Interpreter draws with the default view; wobble run "
-           << "applies them)\n";
+    // the NAME=VALUE options, as `wobble run` applies them (scene/render_options.h)
+    std::map<std::string, std::string> options;
+    for (const auto& [name, value] : r.options) options[name] = value;  // a later one wins
+    try {
+      pl::ApplyRenderSettings(scene::ParseRenderOptions(options), &out);
+    } catch (const scene::RenderOptionError& e) {
+      throw InputError(e.option + "=: " + e.what());
     }
     std::vector<std::string> words;
     std::istringstream in(r.what.empty() ? "frames,filmstrip,charts" : r.what);

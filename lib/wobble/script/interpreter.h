@@ -43,7 +43,7 @@ class SimulationStopped : public NumericalStop {
 struct RenderRequest {
   std::string dir;   // output folder
   std::string what;  // comma list (frames, filmstrip, charts, vtp, exr, disp); empty: the default
-  // NAME=VALUE words: the options of `wobble render` by name (RenderOptionNames), in order
+  // NAME=VALUE words: the options of `wobble render` by name (scene/render_options.h), in order
   std::vector<std::pair<std::string, std::string>> options;
   std::shared_ptr<const record::Trajectory> trajectory;  // one FFD body
   WorldOptions world;  // ground, gravity, springs, dt
@@ -59,9 +59,6 @@ struct SceneRenderRequest {
   std::shared_ptr<const record::Trajectory> recorded;  // the scene's bodies
   WorldOptions world;  // the scene world's: ground, gravity, dt
 };
-
-// The names a script's `render NAME=VALUE` takes (those of `wobble render`'s picture options).
-std::string RenderOptionNames();
 
 struct CommandInfo {
   std::string name, usage, summary;

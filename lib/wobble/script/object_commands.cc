@@ -3,12 +3,12 @@
 // (`output`, `render`), and the few commands every mode shares (print, echo, help, quit).
 #include <algorithm>
 #include <cmath>
-#include <set>
 #include <sstream>
 
 #include "wobble/record/trajectory_csv.h"
 #include "wobble/formats/csv.h"
 #include "wobble/formats/target_schedule.h"
+#include "wobble/scene/render_options.h"
 #include "wobble/script/internal/interpreter_internal.h"
 
 namespace wobble::script {
@@ -332,23 +332,6 @@ void Print(State& s, const Words& w, const Context& ctx) {
   s.out << "]  control energy " << Num(s.scene.control_energy().consumed) << "\n";
 }
 
-namespace {
-
-const std::set<std::string>& RenderOptionNamesList() {
-  static const std::set<std::string> names = {"size",  "fps",         "filmstrip", "filmstrip-size", "filmstrip-columns", "filmstrip-cycle",
-                                              "color-by", "shape-samples", "chart-size", "disp-size", "trail",
-                                              "azimuth", "elevation", "orbit", "camera", "style", "exr-terrain"};
-  return names;
-}
-
-}  // namespace
-
-std::string RenderOptionNames() {
-  std::string all;
-  for (const std::string& n : RenderOptionNamesList()) all += (all.empty() ? "" : ", ") + n;
-  return all;
-}
-
 void Render(State& s, const Words& w, const Context& ctx) {
   if (s.scene.has_bodies()) return SceneRender(s, w, ctx);
   if (w.size() < 2) ctx.Fail("expected '" + ctx.usage + "'");
@@ -363,8 +346,8 @@ void Render(State& s, const Words& w, const Context& ctx) {
       continue;
     }
     const std::string name = w[i].substr(0, eq);
-    if (RenderOptionNamesList().count(name) == 0)
-      ctx.Fail("unknown render option '" + name + "' (" + RenderOptionNames() + ")");
+    if (!scene::IsRenderOption(name))
+      ctx.Fail("unknown render option '" + name + "' (" + scene::RenderOptionNames() + ")");
     request.options.emplace_back(name, w[i].substr(eq + 1));
   }
   if (s.track.empty()) ctx.Fail("render: nothing to draw yet (run 'simul' or 'keyframe' first)");
