@@ -247,6 +247,7 @@ void InteractiveView::Frame() {
   }
   if (m.character) {
     m.UpdateTimeSlider();
+    m.ShowGraphTargets();
     if (m.options.chart_every > 0 && m.pacer.stats.frames % m.options.chart_every == 0) m.UpdateCharts();
   }
   m.UpdateDragLine();

@@ -88,6 +88,7 @@ struct InteractiveView::Impl {
   void StartSession();        // a new run of the object from the setup, with the sliders
   void RecordFrame();
   void UpdateTimeSlider();
+  void ShowGraphTargets();
   void UpdateCharts();
   void FrameBody();
   std::string SessionStatus() const;

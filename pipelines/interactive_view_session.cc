@@ -235,6 +235,18 @@ void InteractiveView::Impl::UpdateTimeSlider() {
   rep->SetValue(scrubbing ? double(scrub_frame) : last);
 }
 
+// While the pose graph drives, the mode sliders show its targets as they change (its smoothed
+// switches included); moving one hands control to the sliders (SetModeTarget). Setting a
+// representation's value fires no interaction callback.
+void InteractiveView::Impl::ShowGraphTargets() {
+  if (!graph_drives) return;
+  const Eigen::VectorXd& targets = sliders->targets();
+  for (size_t d = 0; d < mode_sliders.size() && Eigen::Index(d) < targets.size(); ++d) {
+    auto* rep = static_cast<vtkSliderRepresentation*>(mode_sliders[d]->GetRepresentation());
+    if (rep->GetValue() != targets[Eigen::Index(d)]) rep->SetValue(targets[Eigen::Index(d)]);
+  }
+}
+
 void InteractiveView::Impl::UpdateCharts() {
   if (!options.charts || recorder->time().size() < 2) return;  // a line needs two points
   ChartSpec energy = recorder->EnergyChart("energy");

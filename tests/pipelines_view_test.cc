@@ -18,6 +18,8 @@
 //     releasing removes the constraint; the key `a` hides the anchors (their pixels go away).
 // Without DISPLAY every test skips (VTK 9.1 needs X).
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <vtkCommand.h>
 #include <vtkImageData.h>
 #include <vtkInteractorEventRecorder.h>
@@ -314,6 +316,11 @@ TEST(InteractiveView, ScriptPoseGraphDrivesTheTargetsAndReplays) {
   view.Initialize();
   for (int k = 0; k < 40; ++k) view.Frame();  // 1.33 s: poses 0..3 and 0 again
   EXPECT_NE(view.mode_targets().norm(), 0.0);
+  // the sliders show the graph's targets as it drives them (within the sliders' range)
+  for (int d = 0; d < view.mode_targets().size(); ++d)
+    EXPECT_EQ(static_cast<vtkSliderRepresentation*>(view.mode_slider(d)->GetRepresentation())->GetValue(),
+              std::clamp(view.mode_targets()[d], -TestOptions().slider_range, TestOptions().slider_range))
+        << "mode " << d;
   view.SetModeTarget(3, 0.05);  // the slider takes over from the graph
   const Eigen::VectorXd held = view.mode_targets();
   for (int k = 0; k < 30; ++k) view.Frame();
