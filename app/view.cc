@@ -24,8 +24,9 @@ namespace fs = std::filesystem;
 bool IsScript(const std::string& path) { return fs::path(path).extension() == ".wob"; }
 
 // Runs the script in the interpreter up to (not including) its first `simul` or `keyframe`:
-// the viewer plays that simulation live. Returns the line it stopped at (0: the whole script).
-int RunScriptSetup(script::Interpreter* interp, const std::string& path) {
+// the viewer plays that run live (*at_keyframe: the keys first, then the simulation). Returns
+// the line it stopped at (0: the whole script).
+int RunScriptSetup(script::Interpreter* interp, const std::string& path, bool* at_keyframe) {
   const std::string kind = formats::NonRegularKind(path);
   if (!kind.empty()) throw UsageError(path + ": is " + kind + ", not a regular file");
   std::ifstream in(path);
@@ -36,6 +37,7 @@ int RunScriptSetup(script::Interpreter* interp, const std::string& path) {
     std::istringstream words(line.substr(0, line.find('#')));
     std::string first;
     words >> first;
+    *at_keyframe = first == "keyframe";
     if (first == "simul" || first == "keyframe") return number;
     if (!interp->RunLine(line, path, number, dir)) return number;  // quit
   }
@@ -153,17 +155,19 @@ int RunView(const ViewArgs& a) {
   scene::Scene object_scene;
   scene::Scene* scene = &object_scene;
   const bool script = !a.scene.empty() && IsScript(a.scene);
+  bool keys_first = false;
   if (script) {
     if (!a.q.empty() || !a.qdot.empty() || !a.modes.empty())
       throw UsageError("view: --q, --qdot and --modes apply to object files; a script sets them itself");
     if (!a.object.empty()) interp.LoadObject(a.object);
-    const int stop = RunScriptSetup(&interp, a.scene);
+    const int stop = RunScriptSetup(&interp, a.scene, &keys_first);
     scene = &interp.scene();
     if (!scene->has_bodies() && !scene->object().loaded())
       throw UsageError(a.scene + ": the script loads no object (load_obj FILE, or --object FILE)");
     if (stop > 0)
       std::cout << "wobble view: " << a.scene << " ran up to line " << stop << "; the viewer "
-                << (scene->has_bodies() ? "steps its scene" : "plays its simulation") << " from there\n";
+                << (scene->has_bodies() ? "steps its scene" : keys_first ? "plays its keys, then simulates on" : "plays its simulation")
+                << " from there\n";
   } else {
     BodyFiles files;
     files.object = a.object.empty() ? a.scene : a.object;
@@ -182,7 +186,9 @@ int RunView(const ViewArgs& a) {
   if (!a.save_session.empty() && scene->has_bodies())
     throw UsageError("--save-session: sessions are saved for FFD objects, not for scenes");
 
-  pl::InteractiveView view(*scene, MakeViewerOptions(a, width, height));
+  pl::ViewerOptions options = MakeViewerOptions(a, width, height);
+  options.keys_first = keys_first;
+  pl::InteractiveView view(*scene, options);
   view.Run(a.frames, a.play_events, a.frames > 0);
 
   if (!a.screenshot.empty()) pl::WritePng(a.screenshot, view.Capture());

@@ -48,6 +48,7 @@ bool InteractiveView::Impl::StepWorld() {
   if (stopped) return false;
   std::string why;
   try {
+    if (in_keys && world->time() >= keys_end - 0.5 * world->options().dt) HandOverFromKeys();
     if (scene->Step()) {
       ++session_steps;
       ++pacer.stats.steps;

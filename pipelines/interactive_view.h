@@ -69,6 +69,9 @@ struct ViewerOptions {
   bool charts = true;
   int chart_every = 10;  // frames between chart redraws
   bool start_playing = true;
+  // A character session plays the scene's keys first (a script stopped at `keyframe`), then
+  // simulates on from where they end: the hand-over of q and q̇ of §4.10.1, as `keyframe` does.
+  bool keys_first = false;
   int shape_samples = 16;
   long max_history = 36000;  // recorded frames kept for the time slider (20 min at 30 fps)
   std::string session_path = "wobble_session.wob";  // where `w` writes

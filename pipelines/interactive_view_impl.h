@@ -59,6 +59,8 @@ struct InteractiveView::Impl {
   std::vector<vtkSmartPointer<vtkCallbackCommand>> callbacks;
   std::vector<Eigen::Vector2d> pickable;  // mass points and drawing samples, by lattice coordinates
   bool scrubbing = false, graph_drives = false;
+  bool in_keys = false;  // the session's keyframed part is playing (ViewerOptions::keys_first)
+  double keys_end = 0.0;
   std::shared_ptr<control::ModeTargetController> sliders;
   Eigen::VectorXd slider_targets;  // kept over a restart
   long session_steps = 0;
@@ -86,6 +88,8 @@ struct InteractiveView::Impl {
   // interactive_view_session.cc
   void BuildSessionPanels();  // sliders, charts, the time slider; what can be pulled
   void StartSession();        // a new run of the object from the setup, with the sliders
+  void BeginSessionRun(scene::RunKind kind);  // the scene's run of that kind, the sliders on it
+  void HandOverFromKeys();    // the keys are done: simulate on from their last state
   void RecordFrame();
   void UpdateTimeSlider();
   void ShowGraphTargets();

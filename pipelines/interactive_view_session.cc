@@ -105,13 +105,9 @@ void InteractiveView::Impl::StartSession() {
   if (scene->running()) scene->EndRun();
   scene->object().SetState(setup.q, setup.qd);
   scene->set_time(setup.time);
-  scene->BeginRun(scene::RunKind::kSimulate, /*keep_steps=*/false);
-  world = scene->run_world();
-  if (!graph_drives) scene->StopPoseGraph();
-  world->SetModeTargets(0, slider_targets);
-  sliders = std::make_shared<control::ModeTargetController>(*world, 0);
-  world->AddController(sliders);
-  spring_pull.reset();
+  in_keys = options.keys_first && scene->control().keys.Duration() > 0.0;
+  keys_end = setup.time + (in_keys ? scene->control().keys.Duration() : 0.0);
+  BeginSessionRun(in_keys ? scene::RunKind::kKeyframes : scene::RunKind::kSimulate);
   stopped = false;
   pacer.SetGoal(world->time());
   session_steps = 0;
@@ -219,6 +215,23 @@ void InteractiveView::Impl::BuildSessionPanels() {
   RecordFrame();
   UpdateTimeSlider();
   UpdateCharts();
+}
+
+void InteractiveView::Impl::BeginSessionRun(scene::RunKind kind) {
+  scene->BeginRun(kind, /*keep_steps=*/false);
+  world = scene->run_world();
+  if (!graph_drives) scene->StopPoseGraph();
+  world->SetModeTargets(0, slider_targets);
+  sliders = std::make_shared<control::ModeTargetController>(*world, 0);
+  world->AddController(sliders);
+  spring_pull.reset();  // a pull acts on the run's world
+}
+
+void InteractiveView::Impl::HandOverFromKeys() {
+  in_keys = false;
+  scene->EndRun();  // the object takes the keys' last state and time
+  BeginSessionRun(scene::RunKind::kSimulate);
+  view->SetWorld(world);
 }
 
 void InteractiveView::Impl::RecordFrame() {

@@ -357,6 +357,42 @@ TEST(InteractiveView, CharacterSessionIsTheScenesRunAsSimulRunsIt) {
   EXPECT_LT((interp.q() - q).cwiseAbs().maxCoeff(), 1e-15);
 }
 
+// A script stopped at `keyframe` (ViewerOptions::keys_first): the viewer plays the keys, then
+// simulates on from where they end, as the interpreter's `keyframe` and `simul` do.
+TEST(InteractiveView, KeysPlayFirstThenTheSimulationGoesOn) {
+  REQUIRE_DISPLAY();
+  const std::string dir = testing::TempDir("view_keys");
+  const std::string script = dir + "/keys.wob";
+  std::ofstream(script) << "load_obj " << kData << "/table.obj\nload_def " << kData << "/table_modes.def\n"
+                        << "set integrator thesis\nset dt 0.01\nset_vec q 0 0 0 0 0 0 0\n"
+                        << "key 0 bend=0\nkey 0.3 bend=0.2\nkey 0.5 bend=-0.1\n";
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  interp.RunFile(script);
+  ViewerOptions options = TestOptions();
+  options.keys_first = true;
+  Eigen::VectorXd at_keys_end, q;
+  {
+    InteractiveView view(interp.scene(), options);
+    view.Initialize();
+    for (int k = 0; k < 15; ++k) view.Frame();  // 0.5 s: the keys
+    EXPECT_NEAR(view.world().time(), 0.5, 1e-12);
+    at_keys_end = view.world().state(0).q;
+    for (int k = 0; k < 15; ++k) view.Frame();  // 0.5 s more, simulated
+    EXPECT_EQ(view.session_steps(), 100);
+    q = view.world().state(0).q;
+  }
+  script::Interpreter ref(out);
+  ref.RunFile(script);
+  ref.RunLine("keyframe", "<test>", 1, dir);
+  EXPECT_NEAR(ref.q()[3], -0.1, 1e-12) << "the last key's bend";
+  EXPECT_LT((ref.q() - at_keys_end).cwiseAbs().maxCoeff(), 1e-12) << "keyframe " << ref.q().transpose()
+                                                                   << "\nviewer " << at_keys_end.transpose();
+  ref.RunLine("simul 0.5", "<test>", 2, dir);
+  EXPECT_LT((ref.q() - q).cwiseAbs().maxCoeff(), 1e-12) << "simul " << ref.q().transpose() << "\nviewer " << q.transpose();
+  EXPECT_GT((q - at_keys_end).cwiseAbs().maxCoeff(), 1e-3) << "the body moves on after the keys";
+}
+
 TEST(InteractiveView, SessionWithADragSaysTheReplayStopsFollowing) {
   REQUIRE_DISPLAY();
   auto table = TableScene(Vec({0, 0, 0, 0, 0, 0, 0}));
