@@ -1,10 +1,12 @@
 #include "view.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <vector>
 
 #include <vtkImageData.h>
 
@@ -23,25 +25,63 @@ namespace fs = std::filesystem;
 
 bool IsScript(const std::string& path) { return fs::path(path).extension() == ".wob"; }
 
+std::string FirstWord(const std::string& line) {
+  std::istringstream words(line.substr(0, line.find('#')));
+  std::string first;
+  words >> first;
+  return first;
+}
+
 // Runs the script in the interpreter up to (not including) its first `simul` or `keyframe`:
-// the viewer plays that run live (*at_keyframe: the keys first, then the simulation). Returns
-// the line it stopped at (0: the whole script).
-int RunScriptSetup(script::Interpreter* interp, const std::string& path, bool* at_keyframe) {
+// the viewer plays that run live (at_keyframe: the keys first, then the simulation). The stop:
+// which script ran (this one or its saved result, below) and its line (0: the whole script).
+struct ScriptStop {
+  std::string path;
+  int line = 0;
+  bool at_keyframe = false;
+};
+
+// A synthesis script anneals (or runs CMA-ES on) its pose graph first, which takes minutes; the
+// viewer does that again only when asked (`anneal`). Otherwise, when the script `save`s its
+// result after the search and an earlier `wobble run` wrote that file, the viewer opens the
+// saved script (the annealed pose graph) in its place; without one it skips the search and that
+// `save` (which would write an unsearched graph where the result belongs) and says so.
+ScriptStop RunScriptSetup(script::Interpreter* interp, const std::string& path, bool anneal) {
   const std::string kind = formats::NonRegularKind(path);
   if (!kind.empty()) throw UsageError(path + ": is " + kind + ", not a regular file");
   std::ifstream in(path);
   if (!in) throw UsageError(path + ": cannot open the script");
-  const std::string dir = fs::path(path).parent_path().string();
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    std::istringstream words(line.substr(0, line.find('#')));
-    std::string first;
-    words >> first;
-    *at_keyframe = first == "keyframe";
-    if (first == "simul" || first == "keyframe") return number;
-    if (!interp->RunLine(line, path, number, dir)) return number;  // quit
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  const auto search = std::find_if(lines.begin(), lines.end(), [](const std::string& l) {
+    const std::string w = FirstWord(l);
+    return w == "anneal" || w == "cmaes";
+  });
+  bool skip_search = false;
+  if (!anneal && search != lines.end()) {
+    const auto save = std::find_if(search, lines.end(), [](const std::string& l) { return FirstWord(l) == "save"; });
+    std::istringstream words(save == lines.end() ? "" : save->substr(0, save->find('#')));
+    std::string word, saved;
+    words >> word >> saved;
+    if (!saved.empty() && fs::is_regular_file(saved)) {
+      std::cout << "wobble view: " << path << " searches its pose graph (" << FirstWord(*search)
+                << "); the viewer opens the result an earlier run saved, " << saved << " (--anneal searches again)\n";
+      return RunScriptSetup(interp, saved, true);
+    }
+    skip_search = true;
+    std::cout << "wobble view: " << path << ": " << FirstWord(*search) << " skipped, the pose graph as written"
+              << (saved.empty() ? "" : " (`wobble run " + path + "` saves the searched one to " + saved + ")")
+              << "; --anneal searches here\n";
   }
-  return 0;
+  const std::string dir = fs::path(path).parent_path().string();
+  for (int number = 1; number <= int(lines.size()); ++number) {
+    const std::string& line = lines[size_t(number - 1)];
+    const std::string first = FirstWord(line);
+    if (first == "simul" || first == "keyframe") return {path, number, first == "keyframe"};
+    if (skip_search && (first == "anneal" || first == "cmaes" || first == "save")) continue;
+    if (!interp->RunLine(line, path, number, dir)) return {path, number, false};  // quit
+  }
+  return {path, 0, false};
 }
 
 int ParseSide(const std::string& text, int* w, int* h) {
@@ -121,6 +161,9 @@ CLI::App* AddViewCommand(CLI::App* app, ViewArgs* a) {
       ->type_name("FILE");
   cmd->add_flag("--report-fps", a->report_fps, "Print frames drawn per second and steps per frame at the end");
   cmd->add_option("--slider-range", a->slider_range, "Mode target sliders span -R..R")->capture_default_str();
+  cmd->add_flag("--anneal", a->anneal,
+                "A synthesis script: run its anneal (or cmaes) here; by default the viewer opens the result an earlier "
+                "`wobble run` saved (the script's `save FILE` after the search), or plays the pose graph as written");
   cmd->add_option("--drag-stiffness", a->drag_stiffness, "Stiffness of the mouse spring (0: automatic, ~1 Hz)")
       ->capture_default_str();
   cmd->footer(
@@ -160,12 +203,13 @@ int RunView(const ViewArgs& a) {
     if (!a.q.empty() || !a.qdot.empty() || !a.modes.empty())
       throw UsageError("view: --q, --qdot and --modes apply to object files; a script sets them itself");
     if (!a.object.empty()) interp.LoadObject(a.object);
-    const int stop = RunScriptSetup(&interp, a.scene, &keys_first);
+    const ScriptStop stop = RunScriptSetup(&interp, a.scene, a.anneal);
+    keys_first = stop.at_keyframe;
     scene = &interp.scene();
     if (!scene->has_bodies() && !scene->object().loaded())
       throw UsageError(a.scene + ": the script loads no object (load_obj FILE, or --object FILE)");
-    if (stop > 0)
-      std::cout << "wobble view: " << a.scene << " ran up to line " << stop << "; the viewer "
+    if (stop.line > 0)
+      std::cout << "wobble view: " << stop.path << " ran up to line " << stop.line << "; the viewer "
                 << (scene->has_bodies() ? "steps its scene" : keys_first ? "plays its keys, then simulates on" : "plays its simulation")
                 << " from there\n";
   } else {

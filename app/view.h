@@ -24,6 +24,7 @@ struct ViewArgs {
   std::string size = "1280x720";
   double fps = 30.0, speed = 1.0;
   bool paused = false, fixed_frame_time = false, no_charts = false, report_fps = false;
+  bool anneal = false;  // a synthesis script's anneal / cmaes runs again (else its saved result is used)
   long frames = 0;                 // > 0: quit after this many frames
   std::string play_events;         // vtkInteractorEventRecorder file
   std::string screenshot;          // PNG of the window at the end
