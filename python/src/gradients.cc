@@ -2,7 +2,7 @@
 // fit/spacetime.h, issue 18), and the target schedule files that scripts play (`schedule`).
 // A stage cost is a StageCost: one of the task terms, a sum of them (`+`), or a Python callable
 // fn(n, q, qd) -> (value, dq, dqd) called with the GIL taken for each step.
-#include "support.h"
+#include "gradients.h"
 
 #include <cmath>
 #include <memory>
@@ -19,32 +19,16 @@ struct StageCostHandle {
   fit::StageCost cost;
 };
 
-// A Python callable as a stage cost. The function object is shared with a deleter that takes the
-// GIL, because the C++ side copies and drops std::functions on threads that do not hold it.
+// A Python fn(n, q, qd) -> (value, dq, dqd) as a stage cost (the GIL taken for each call).
 fit::StageCost FromPython(py::function fn) {
-  std::shared_ptr<py::function> held(new py::function(std::move(fn)), [](py::function* f) {
-    py::gil_scoped_acquire gil;
-    delete f;
-  });
+  std::shared_ptr<py::function> held = HoldWithGil(std::move(fn));
   return [held](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq,
                 Eigen::VectorXd* dqd) -> double {
     py::gil_scoped_acquire gil;
-    const py::object r = (*held)(n, q, qd);
-    if (!py::isinstance<py::tuple>(r) || py::len(r) != 3)
-      throw InputError("a stage cost must return (value, dq, dqd), got " + std::string(py::str(r)));
-    const py::tuple t = r.cast<py::tuple>();
-    const double value = t[0].cast<double>();
-    if (!std::isfinite(value)) throw InputError("a stage cost returned " + std::to_string(value) + " at step " + std::to_string(n));
-    const char* names[2] = {"dq", "dqd"};
-    Eigen::VectorXd* out[2] = {dq, dqd};
-    for (int i = 0; i < 2; ++i) {
-      if (t[i + 1].is_none()) continue;
-      const Eigen::VectorXd g = t[i + 1].cast<Eigen::VectorXd>();
-      if (g.size() != out[i]->size() || !g.allFinite())
-        throw InputError(std::string("a stage cost's ") + names[i] + " must be " + std::to_string(out[i]->size()) +
-                         " finite numbers (num_q)");
-      *out[i] += g;
-    }
+    Eigen::VectorXd g_q, g_qd;
+    const double value = StageResult((*held)(n, q, qd), n, q.size(), &g_q, &g_qd);
+    *dq += g_q;
+    *dqd += g_qd;
     return value;
   };
 }
@@ -63,29 +47,71 @@ fit::Axes AxesOf(const std::string& axes) {
 fit::ControlledRollout RolloutOf(const BodyModel& body, const WorldOptions& options, const py::object& targets,
                                  const py::object& q0, const py::object& qd0, const py::object& stiffness,
                                  const py::object& damping) {
-  const int nq = body.num_q(), D = body.num_modes();
+  const int nq = body.num_q();
   fit::ControlledRollout r;
   r.world = options.params;
   r.integrator = options.integrator;
-  if (r.integrator != Integrator::kThesis && r.integrator != Integrator::kSymplecticEuler)
-    throw InputError("gradients need the thesis or the symplectic integrator (options.integrator), got " +
-                     IntegratorName(r.integrator));
+  CheckGradientIntegrator(r.integrator);
   r.dt = options.dt;
   r.q0 = VectorOr(q0, nq, Eigen::VectorXd::Zero(nq), "q0");
   r.qd0 = VectorOr(qd0, nq, Eigen::VectorXd::Zero(nq), "qd0");
-  Eigen::VectorXd K(D), c(D);
-  for (int d = 0; d < D; ++d) K[d] = body.modes()[d].stiffness, c[d] = body.modes()[d].damping;
-  r.stiffness = VectorOr(stiffness, D, K, "stiffness");
-  r.damping = VectorOr(damping, D, c, "damping");
-  auto probe = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(targets);
-  if (!probe || probe.ndim() != 2 || probe.shape(0) != D || probe.shape(1) < 1)
-    throw InputError("targets: expected (modes, steps) = (" + std::to_string(D) + ", steps >= 1)");
-  r.targets = probe.cast<Eigen::MatrixXd>();
-  if (!r.targets.allFinite()) throw InputError("targets must be finite");
+  GainsOf(body, stiffness, damping, &r.stiffness, &r.damping);
+  r.targets = TargetsOf(targets, body.num_modes());
   return r;
 }
 
 }  // namespace
+
+std::shared_ptr<py::function> HoldWithGil(py::function fn) {
+  return std::shared_ptr<py::function>(new py::function(std::move(fn)), [](py::function* f) {
+    py::gil_scoped_acquire gil;
+    delete f;
+  });
+}
+
+double StageResult(const py::object& r, int n, long size, Eigen::VectorXd* dq, Eigen::VectorXd* dqd) {
+  if (!py::isinstance<py::tuple>(r) || py::len(r) != 3)
+    throw InputError("a stage cost must return (value, dq, dqd), got " + std::string(py::str(r)));
+  const py::tuple t = r.cast<py::tuple>();
+  const double value = t[0].cast<double>();
+  if (!std::isfinite(value)) throw InputError("a stage cost returned " + std::to_string(value) + " at step " + std::to_string(n));
+  const char* names[2] = {"dq", "dqd"};
+  Eigen::VectorXd* out[2] = {dq, dqd};
+  for (int i = 0; i < 2; ++i) {
+    *out[i] = Eigen::VectorXd::Zero(size);
+    if (t[i + 1].is_none()) continue;
+    *out[i] = t[i + 1].cast<Eigen::VectorXd>();
+    if (out[i]->size() != size || !out[i]->allFinite())
+      throw InputError(std::string("a stage cost's ") + names[i] + " must be " + std::to_string(size) +
+                       " finite numbers (num_q)");
+  }
+  return value;
+}
+
+void CheckGradientIntegrator(Integrator integrator) {
+  if (integrator != Integrator::kThesis && integrator != Integrator::kSymplecticEuler)
+    throw InputError("gradients need the thesis or the symplectic integrator (options.integrator), got " +
+                     IntegratorName(integrator));
+}
+
+Eigen::MatrixXd TargetsOf(const py::object& targets, int modes) {
+  auto probe = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(targets);
+  if (!probe || probe.ndim() != 2 || probe.shape(0) != modes || probe.shape(1) < 1)
+    throw InputError("targets: expected (modes, steps) = (" + std::to_string(modes) + ", steps >= 1)");
+  Eigen::MatrixXd t = probe.cast<Eigen::MatrixXd>();
+  if (!t.allFinite()) throw InputError("targets must be finite");
+  return t;
+}
+
+fit::SpacetimeOptions SpacetimeOptionsOf(int max_iterations, int starts, double start_spread, unsigned seed, int threads) {
+  fit::SpacetimeOptions o;
+  o.max_iterations = max_iterations;
+  o.starts = starts;
+  o.start_spread = start_spread;
+  o.seed = seed;
+  o.threads = threads;
+  return o;
+}
 
 void BindGradients(py::module_& m) {
   py::class_<StageCostHandle>(m, "StageCost",
@@ -211,18 +237,9 @@ void BindGradients(py::module_& m) {
         fit::SpacetimeProblem p;
         p.rollout = RolloutOf(*body, options, targets, q0, qd0, stiffness, damping);
         p.knots = knots;
-        if (!(bound > 0) || !std::isfinite(bound)) throw InputError("bound must be a finite number > 0");
-        p.lower = Eigen::VectorXd::Constant(body->num_modes(), -bound);
-        p.upper = Eigen::VectorXd::Constant(body->num_modes(), bound);
-        if (!(control_weight >= 0) || !std::isfinite(control_weight)) throw InputError("control_weight must be >= 0");
-        p.control_weight = control_weight;
+        SetSpacetimeBounds(body->num_modes(), bound, control_weight, &p);
         p.task = task.cost;
-        fit::SpacetimeOptions o;
-        o.max_iterations = max_iterations;
-        o.starts = starts;
-        o.start_spread = start_spread;
-        o.seed = seed;
-        o.threads = threads;
+        const fit::SpacetimeOptions o = SpacetimeOptionsOf(max_iterations, starts, start_spread, seed, threads);
         try {
           return WithCtrlC([&] { return fit::FitSpacetime(*body, p, o); });
         } catch (const std::invalid_argument& e) {

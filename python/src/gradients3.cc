@@ -6,7 +6,7 @@
 #include <cmath>
 #include <memory>
 
-#include "support.h"
+#include "gradients.h"
 #include "wobble/core/rotation3.h"
 #include "wobble/fit/adjoint3.h"
 #include "wobble/fit/spacetime.h"
@@ -61,32 +61,16 @@ void QGradients(const Eigen::Vector3d& theta, const Eigen::VectorXd& dz, Eigen::
   *dqd = dz.tail(nq);
 }
 
-// A Python fn(n, q, qd) -> (value, dq, dqd) as a 3D stage cost (the GIL is taken for each call
-// and for dropping the function, as gradients.cc does for 2D).
+// A Python fn(n, q, qd) -> (value, dq, dqd) in World.q3 coordinates as a 3D stage cost (the
+// GIL taken for each call).
 fit::StageCost3 FromPython(py::function fn) {
-  std::shared_ptr<py::function> held(new py::function(std::move(fn)), [](py::function* f) {
-    py::gil_scoped_acquire gil;
-    delete f;
-  });
+  std::shared_ptr<py::function> held = HoldWithGil(std::move(fn));
   return [held](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) -> double {
     py::gil_scoped_acquire gil;
     const Eigen::VectorXd q = QOf(s);
-    const py::object r = (*held)(n, q, Eigen::VectorXd(s.v));
-    if (!py::isinstance<py::tuple>(r) || py::len(r) != 3)
-      throw InputError("a stage cost must return (value, dq, dqd), got " + std::string(py::str(r)));
-    const py::tuple t = r.cast<py::tuple>();
-    const double value = t[0].cast<double>();
-    if (!std::isfinite(value)) throw InputError("a stage cost returned " + std::to_string(value) + " at step " + std::to_string(n));
-    Eigen::VectorXd g[2] = {Eigen::VectorXd::Zero(q.size()), Eigen::VectorXd::Zero(q.size())};
-    const char* names[2] = {"dq", "dqd"};
-    for (int i = 0; i < 2; ++i) {
-      if (t[i + 1].is_none()) continue;
-      g[i] = t[i + 1].cast<Eigen::VectorXd>();
-      if (g[i].size() != q.size() || !g[i].allFinite())
-        throw InputError(std::string("a stage cost's ") + names[i] + " must be " + std::to_string(q.size()) +
-                         " finite numbers (num_q)");
-    }
-    AddTangentGradient(q.segment<3>(3), g[0], g[1], dz);
+    Eigen::VectorXd dq, dqd;
+    const double value = StageResult((*held)(n, q, Eigen::VectorXd(s.v)), n, q.size(), &dq, &dqd);
+    AddTangentGradient(q.segment<3>(3), dq, dqd, dz);
     return value;
   };
 }
@@ -107,24 +91,15 @@ fit::Axes AxesOf3(const std::string& axes) {
 fit::ControlledRollout3 Rollout3Of(const BodyModel3& body, const WorldOptions& options, const py::object& targets,
                                    const py::object& q0, const py::object& qd0, const py::object& stiffness,
                                    const py::object& damping) {
-  const int nq = body.num_q(), D = body.num_modes();
+  const int nq = body.num_q();
   fit::ControlledRollout3 r;
   r.world = Params3Of(options);
   r.integrator = options.integrator;
-  if (r.integrator != Integrator::kThesis && r.integrator != Integrator::kSymplecticEuler)
-    throw InputError("gradients need the thesis or the symplectic integrator (options.integrator), got " +
-                     IntegratorName(r.integrator));
+  CheckGradientIntegrator(r.integrator);
   r.dt = options.dt;
   r.start = StateOf(VectorOr(q0, nq, Eigen::VectorXd::Zero(nq), "q0"), VectorOr(qd0, nq, Eigen::VectorXd::Zero(nq), "qd0"));
-  Eigen::VectorXd K(D), c(D);
-  for (int d = 0; d < D; ++d) K[d] = body.modes()[d].stiffness, c[d] = body.modes()[d].damping;
-  r.stiffness = VectorOr(stiffness, D, K, "stiffness");
-  r.damping = VectorOr(damping, D, c, "damping");
-  auto probe = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(targets);
-  if (!probe || probe.ndim() != 2 || probe.shape(0) != D || probe.shape(1) < 1)
-    throw InputError("targets: expected (modes, steps) = (" + std::to_string(D) + ", steps >= 1)");
-  r.targets = probe.cast<Eigen::MatrixXd>();
-  if (!r.targets.allFinite()) throw InputError("targets must be finite");
+  GainsOf(body, stiffness, damping, &r.stiffness, &r.damping);
+  r.targets = TargetsOf(targets, body.num_modes());
   return r;
 }
 
@@ -252,17 +227,9 @@ void BindGradients3(py::module_& m) {
         fit::SpacetimeProblem3 p;
         p.rollout = Rollout3Of(*body, options, targets, q0, qd0, stiffness, damping);
         p.knots = knots;
-        if (!(bound > 0) || !std::isfinite(bound)) throw InputError("bound must be a finite number > 0");
-        p.lower = Eigen::VectorXd::Constant(body->num_modes(), -bound);
-        p.upper = Eigen::VectorXd::Constant(body->num_modes(), bound);
-        p.control_weight = control_weight;
+        SetSpacetimeBounds(body->num_modes(), bound, control_weight, &p);
         p.task = task.cost;
-        fit::SpacetimeOptions o;
-        o.max_iterations = max_iterations;
-        o.starts = starts;
-        o.start_spread = start_spread;
-        o.seed = seed;
-        o.threads = threads;
+        const fit::SpacetimeOptions o = SpacetimeOptionsOf(max_iterations, starts, start_spread, seed, threads);
         return Checked("fit_spacetime3", [&] { return WithCtrlC([&] { return fit::FitSpacetime3(*body, p, o); }); });
       },
       py::arg("body"), py::arg("task"), py::kw_only(), py::arg("targets"), py::arg("knots") = 21, py::arg("bound") = 0.3,
