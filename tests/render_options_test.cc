@@ -28,7 +28,9 @@ TEST(RenderOptions, TheTableHasEachNameOnceWithHelpAndItsDefaultsParse) {
     EXPECT_FALSE(o.help.empty()) << o.name;
     EXPECT_TRUE(IsRenderOption(o.name));
     // every default, typed back in, is the default setting
-    if (!o.default_value.empty()) EXPECT_EQ(ErrorOf(o.name, o.default_value), "") << o.name;
+    if (!o.default_value.empty()) {
+      EXPECT_EQ(ErrorOf(o.name, o.default_value), "") << o.name;
+    }
   }
   EXPECT_FALSE(IsRenderOption("sizes"));
   EXPECT_EQ(RenderOptionNames().substr(0, 32), "azimuth, camera, chart-size, col");
