@@ -73,8 +73,9 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   const Integrator integrator = ParseIntegratorFlag(a.integrator);
   RequirePositive(a.dt, "--dt");
   RequireNonNegative(a.duration, "--duration");
-  const scene::RenderSettings picture = CheckRenderOptions(a, default_what);
-  if (!(a.duration * picture.fps <= 1e6)) throw UsageError("--duration * --fps asks for more than a million frames");
+  if (!(a.duration * PictureSettings(a).fps <= 1e6))
+    throw UsageError("--duration * --fps asks for more than a million frames");
+  CheckRenderOptions(a, default_what);
 
   // the body in its world, simulated from (q0, q̇0) into a trajectory of every step
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, integrator, a.dt);
@@ -99,14 +100,17 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   return kExitOk;
 }
 
-scene::RenderSettings CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
-  const std::set<std::string> what = ParseWhat(a.what.empty() ? default_what : a.what);
-  scene::RenderSettings settings;
+scene::RenderSettings PictureSettings(const RenderArgs& a) {
   try {
-    settings = scene::ParseRenderOptions(a.picture);
+    return scene::ParseRenderOptions(a.picture);
   } catch (const scene::RenderOptionError& e) {
     throw UsageError("--" + e.option + ": " + e.what());
   }
+}
+
+scene::RenderSettings CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
+  const std::set<std::string> what = ParseWhat(a.what.empty() ? default_what : a.what);
+  const scene::RenderSettings settings = PictureSettings(a);
   const bool renders = what.count("frames") || what.count("filmstrip") || what.count("charts") || what.count("exr");
   if (renders && !pl::HasDisplay())
     throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"

@@ -46,6 +46,8 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
                            const std::string& default_what, RenderArgs* args);
 int RunRender(const RenderArgs& args, const std::string& default_what);
 
+// The table's options parsed (a UsageError naming the flag otherwise).
+scene::RenderSettings PictureSettings(const RenderArgs& args);
 // Checks the picture options (--what, the table's options, display, --out) before anything is
 // simulated; returns them parsed.
 scene::RenderSettings CheckRenderOptions(const RenderArgs& args, const std::string& default_what);
