@@ -9,7 +9,6 @@
 
 #include "fit.h"
 #include "progress.h"
-#include "wobble/core/rotation3.h"
 #include "wobble/fit/spacetime.h"
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/csv.h"
@@ -34,15 +33,6 @@ template <class Mode> std::vector<std::string> ModeNames(const std::vector<Mode>
 }
 
 // The body's own gains, which the fitted targets drive (as a script's `schedule` plays them).
-template <class Body> void OwnGains(const Body& body, Eigen::VectorXd* stiffness, Eigen::VectorXd* damping) {
-  stiffness->resize(body.num_modes());
-  damping->resize(body.num_modes());
-  for (int d = 0; d < body.num_modes(); ++d) {
-    (*stiffness)[d] = body.modes()[d].stiffness;
-    (*damping)[d] = body.modes()[d].damping;
-  }
-}
-
 template <class Problem> void SetBounds(const FitSpacetimeArgs& a, int D, Problem* p) {
   p->knots = a.knots;
   p->lower = Eigen::VectorXd::Constant(D, -a.bound);
@@ -61,7 +51,7 @@ fit::SpacetimeResult Fit2(const FitSpacetimeArgs& a, const StartingWorld& start,
   p.rollout.dt = a.dt;
   p.rollout.q0 = start.q0;
   p.rollout.qd0 = start.qd0;
-  OwnGains(body, &p.rollout.stiffness, &p.rollout.damping);
+  body.ModeGains(&p.rollout.stiffness, &p.rollout.damping);
   p.rollout.targets = first_guess;
   SetBounds(a, D, &p);
   std::vector<fit::StageCost> terms;
@@ -100,11 +90,8 @@ fit::SpacetimeResult Fit3(const FitSpacetimeArgs& a, const StartingWorld& start,
   p.rollout.world = Params3Of(start.options);
   p.rollout.integrator = Integrator::kThesis;
   p.rollout.dt = a.dt;
-  p.rollout.start.t = start.q0.head<3>();
-  p.rollout.start.orientation = ExpRotation<double>(start.q0.segment<3>(3));
-  p.rollout.start.gamma = start.q0.tail(D);
-  p.rollout.start.v = start.qd0;
-  OwnGains(body, &p.rollout.stiffness, &p.rollout.damping);
+  p.rollout.start = State3FromQ(start.q0, start.qd0);
+  body.ModeGains(&p.rollout.stiffness, &p.rollout.damping);
   p.rollout.targets = first_guess;
   SetBounds(a, D, &p);
   std::vector<fit::StageCost3> terms;

@@ -26,8 +26,8 @@ template <class Body>
 void GainsOf(const Body& body, const py::object& stiffness, const py::object& damping, Eigen::VectorXd* K,
              Eigen::VectorXd* c) {
   const int D = body.num_modes();
-  Eigen::VectorXd own_K(D), own_c(D);
-  for (int d = 0; d < D; ++d) own_K[d] = body.modes()[d].stiffness, own_c[d] = body.modes()[d].damping;
+  Eigen::VectorXd own_K, own_c;
+  body.ModeGains(&own_K, &own_c);
   *K = VectorOr(stiffness, D, own_K, "stiffness");
   *c = VectorOr(damping, D, own_c, "damping");
 }

@@ -26,23 +26,6 @@ Eigen::Matrix3d RotationVectorPerTangent(const Eigen::Vector3d& theta) {
   return A;
 }
 
-Eigen::VectorXd QOf(const BodyState3<double>& s) {
-  const int D = int(s.gamma.size());
-  Eigen::VectorXd q(kRigidDofs3 + D);
-  q << s.t, LogRotation<double>(s.orientation), s.gamma;
-  return q;
-}
-
-BodyState3<double> StateOf(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  BodyState3<double> s;
-  const int D = int(q.size()) - kRigidDofs3;
-  s.t = q.head<3>();
-  s.orientation = ExpRotation<double>(q.segment<3>(3));
-  s.gamma = q.tail(D);
-  s.v = qd;
-  return s;
-}
-
 // ∂ℓ/∂z from ∂ℓ/∂q, ∂ℓ/∂q̇ at Θ: the ε part is Aᵀ ∂ℓ/∂Θ, the rest is the same numbers.
 void AddTangentGradient(const Eigen::Vector3d& theta, const Eigen::VectorXd& dq, const Eigen::VectorXd& dqd,
                         Eigen::VectorXd* dz) {
@@ -67,7 +50,7 @@ fit::StageCost3 FromPython(py::function fn) {
   std::shared_ptr<py::function> held = HoldWithGil(std::move(fn));
   return [held](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) -> double {
     py::gil_scoped_acquire gil;
-    const Eigen::VectorXd q = QOf(s);
+    const Eigen::VectorXd q = QOfState3(s);
     Eigen::VectorXd dq, dqd;
     const double value = StageResult((*held)(n, q, Eigen::VectorXd(s.v)), n, q.size(), &dq, &dqd);
     AddTangentGradient(q.segment<3>(3), dq, dqd, dz);
@@ -97,7 +80,8 @@ fit::ControlledRollout3 Rollout3Of(const BodyModel3& body, const WorldOptions& o
   r.integrator = options.integrator;
   CheckGradientIntegrator(r.integrator);
   r.dt = options.dt;
-  r.start = StateOf(VectorOr(q0, nq, Eigen::VectorXd::Zero(nq), "q0"), VectorOr(qd0, nq, Eigen::VectorXd::Zero(nq), "qd0"));
+  r.start = State3FromQ(VectorOr(q0, nq, Eigen::VectorXd::Zero(nq), "q0"),
+                        VectorOr(qd0, nq, Eigen::VectorXd::Zero(nq), "qd0"));
   GainsOf(body, stiffness, damping, &r.stiffness, &r.damping);
   r.targets = TargetsOf(targets, body.num_modes());
   return r;
@@ -132,7 +116,7 @@ void BindGradients3(py::module_& m) {
             if (q.size() != qd.size() || q.size() < kRigidDofs3)
               throw InputError("q and qd must have the same size, at least 6");
             Eigen::VectorXd dz = Eigen::VectorXd::Zero(2 * q.size()), dq, dqd;
-            const double value = c.cost(n, StateOf(q, qd), &dz);
+            const double value = c.cost(n, State3FromQ(q, qd), &dz);
             QGradients(q.segment<3>(3), dz, &dq, &dqd);
             return py::make_tuple(value, dq, dqd);
           },

@@ -112,6 +112,16 @@ template <int Dim> class BodyModelN {
     return passive;
   }
 
+  // Every mode's own stiffness K_d and damping c_d, as vectors (the gains the fits start from).
+  void ModeGains(Eigen::VectorXd* stiffness, Eigen::VectorXd* damping) const {
+    stiffness->resize(num_modes());
+    damping->resize(num_modes());
+    for (int d = 0; d < num_modes(); ++d) {
+      (*stiffness)[d] = modes_[size_t(d)].stiffness;
+      (*damping)[d] = modes_[size_t(d)].damping;
+    }
+  }
+
   static constexpr int dim() { return Dim; }
   const std::string& name() const { return def_.name; }
   const BodyDefN<Dim>& def() const { return def_; }

@@ -118,6 +118,22 @@ template <class T> struct BodyState3 {
   } ground_cache;
 };
 
+// A state from q = [t, Θ, γ] (Θ the orientation's rotation vector: World's q3 coordinates) and
+// q̇ = v, without contacts; and the q of a state (|Θ| ≤ π).
+inline BodyState3<double> State3FromQ(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  BodyState3<double> s;
+  s.t = q.head<3>();
+  s.orientation = ExpRotation<double>(q.segment<3>(3));
+  s.gamma = q.tail(q.size() - kRigidDofs3);
+  s.v = qd;
+  return s;
+}
+inline Eigen::VectorXd QOfState3(const BodyState3<double>& s) {
+  Eigen::VectorXd q(kRigidDofs3 + s.gamma.size());
+  q << s.t, LogRotation<double>(s.orientation), s.gamma;
+  return q;
+}
+
 // The cached ground force of s, when it was computed at s's current state (doubles only).
 template <class T> const VecQ3<T>* CachedGroundForce3(const BodyState3<T>& s) {
   if constexpr (!std::is_same_v<T, double>) {

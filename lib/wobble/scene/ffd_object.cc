@@ -187,16 +187,13 @@ std::shared_ptr<const BodyModel3> FfdObject::Body3() const {
 }
 
 void SetState3FromQ(World* world, int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  const int D = int(q.size()) - kRigidDofs3;
-  world->SetState3(body, q.head<3>(), ExpRotation<double>(q.segment<3>(3)), q.tail(D), qd);
+  const BodyState3<double> s = State3FromQ(q, qd);
+  world->SetState3(body, s.t, s.orientation, s.gamma, s.v);
 }
 
 void QFromState3(const World& world, int body, Eigen::VectorXd* q, Eigen::VectorXd* qd) {
   const BodyState3<double>& s = world.state3(body);
-  q->resize(kRigidDofs3 + s.gamma.size());
-  q->head<3>() = s.t;
-  q->segment<3>(3) = LogRotation<double>(s.orientation);
-  q->tail(s.gamma.size()) = s.gamma;
+  *q = QOfState3(s);
   *qd = s.v;
 }
 

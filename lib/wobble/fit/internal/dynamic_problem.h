@@ -253,14 +253,7 @@ template <int Dim>
 DynamicParameters Completed(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
                             DynamicParameters p) {
   using Dims = Dimension<Dim>;
-  if (p.stiffness.size() == 0 && p.damping.size() == 0) {
-    p.stiffness.resize(body.num_modes());
-    p.damping.resize(body.num_modes());
-    for (int d = 0; d < body.num_modes(); ++d) {
-      p.stiffness[d] = body.modes()[d].stiffness;
-      p.damping[d] = body.modes()[d].damping;
-    }
-  }
+  if (p.stiffness.size() == 0 && p.damping.size() == 0) body.ModeGains(&p.stiffness, &p.damping);
   if (p.q0.size() && p.qd0.size()) return p;
   PoseFitOptions o;
   o.gamma_lower = -10;
