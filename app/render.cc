@@ -73,9 +73,10 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   const Integrator integrator = ParseIntegratorFlag(a.integrator);
   RequirePositive(a.dt, "--dt");
   RequireNonNegative(a.duration, "--duration");
-  if (!(a.duration * PictureSettings(a).fps <= 1e6))
+  const RenderRequest request = ParseRenderRequest(a, default_what);
+  if (!(a.duration * request.settings.fps <= 1e6))
     throw UsageError("--duration * --fps asks for more than a million frames");
-  CheckRenderOptions(a, default_what);
+  CheckRenderRequest(request, a.out);
 
   // the body in its world, simulated from (q0, q̇0) into a trajectory of every step
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, integrator, a.dt);
@@ -92,7 +93,7 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   progress.Finish();
 
   World start = setup.MakeWorld();  // the run is drawn from its start, ground contacts as they were
-  RenderRun(a, default_what, start, *run, a.duration);
+  RenderRun(a, request, start, *run, a.duration);
   if (!ok) {
     std::cerr << "wobble: simulation stopped: " << world.status().message << std::endl;
     return kExitSimStopped;
@@ -100,43 +101,37 @@ int RunRender(const RenderArgs& a, const std::string& default_what) {
   return kExitOk;
 }
 
-scene::RenderSettings PictureSettings(const RenderArgs& a) {
+RenderRequest ParseRenderRequest(const RenderArgs& a, const std::string& default_what, OptionSpelling spelling) {
+  RenderRequest r;
   try {
-    return scene::ParseRenderOptions(a.picture);
+    r.settings = scene::ParseRenderOptions(a.picture);
   } catch (const scene::RenderOptionError& e) {
+    if (spelling == OptionSpelling::kScript) throw std::invalid_argument(e.option + "=: " + e.what());
     throw UsageError("--" + e.option + ": " + e.what());
   }
+  r.what = ParseWhat(a.what.empty() ? default_what : a.what);
+  return r;
 }
 
-scene::RenderSettings CheckRenderOptions(const RenderArgs& a, const std::string& default_what) {
-  const std::set<std::string> what = ParseWhat(a.what.empty() ? default_what : a.what);
-  const scene::RenderSettings settings = PictureSettings(a);
-  const bool renders = what.count("frames") || what.count("filmstrip") || what.count("charts") || what.count("exr");
-  if (renders && !pl::HasDisplay())
+void CheckRenderRequest(const RenderRequest& r, const std::string& out) {
+  const bool draws = r.what.count("frames") || r.what.count("filmstrip") || r.what.count("charts") || r.what.count("exr");
+  if (draws && !pl::HasDisplay())
     throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"
                      "  xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble ...\n"
                      "or ask only for --what vtp,disp");
-  CheckOutputFolder(a.out);
-  return settings;
+  CheckOutputFolder(out);
 }
 
-pl::RenderOutputs RenderOutputsOf(const RenderArgs& a, const std::string& default_what, const std::string& name) {
-  const scene::RenderSettings settings = CheckRenderOptions(a, default_what);
-  const std::set<std::string> what = ParseWhat(a.what.empty() ? default_what : a.what);
-  pl::RenderOutputs out;
-  out.folder = a.out;
-  out.name = name;
-  pl::SetOutputs(std::vector<std::string>(what.begin(), what.end()), &out);  // checked by ParseWhat
-  pl::ApplyRenderSettings(settings, &out);
-  out.view.title = name;
-  return out;
-}
-
-void RenderRun(const RenderArgs& a, const std::string& default_what, World& world, const record::Trajectory& run,
+void RenderRun(const RenderArgs& a, const RenderRequest& request, World& world, const record::Trajectory& run,
                double t_end) {
   if (run.empty()) throw std::invalid_argument("nothing was recorded: no frames to render");
   const std::string name = run.bodies().empty() ? "run" : run.bodies()[0].name;
-  pl::RenderOutputs out = RenderOutputsOf(a, default_what, name);
+  pl::RenderOutputs out;
+  out.folder = a.out;
+  out.name = name;  // the .pvd's stem and the pictures' title
+  pl::SetOutputs(std::vector<std::string>(request.what.begin(), request.what.end()), &out);  // checked by ParseWhat
+  pl::ApplyRenderSettings(request.settings, &out);
+  out.view.title = name;
   out.t_end = t_end;
   Progress progress(isatty(STDERR_FILENO) == 1, "t");
   out.progress = [&](double fraction, double t) { progress.Update(fraction, t); };

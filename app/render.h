@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 #include <map>
+#include <set>
 #include <string>
 
 #include "cli_common.h"
@@ -46,17 +47,25 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
                            const std::string& default_what, RenderArgs* args);
 int RunRender(const RenderArgs& args, const std::string& default_what);
 
-// The table's options parsed (a UsageError naming the flag otherwise).
-scene::RenderSettings PictureSettings(const RenderArgs& args);
-// Checks the picture options (--what, the table's options, display, --out) before anything is
-// simulated; returns them parsed.
-scene::RenderSettings CheckRenderOptions(const RenderArgs& args, const std::string& default_what);
-// What the picture options ask of the render driver; `name` is the .pvd's stem and the title.
-pipelines::RenderOutputs RenderOutputsOf(const RenderArgs& args, const std::string& default_what, const std::string& name);
-// Draws `run` (put back into `world`, a world of its bodies) as the options ask and prints
-// what was written: `wobble render`/`export` and a script's `render` of its FFD runs. Frames
-// at --fps from the first sample up to t_end (the run's intended end), those the run reached.
-void RenderRun(const RenderArgs& args, const std::string& default_what, World& world, const record::Trajectory& run,
+// A render's options, checked once: which outputs (--what) and the picture settings.
+struct RenderRequest {
+  std::set<std::string> what;
+  scene::RenderSettings settings;
+};
+// How an error names a bad picture option: as the flag (--size: a UsageError) or as a script's
+// NAME=VALUE (size=: std::invalid_argument, which the interpreter puts at the script's line).
+enum class OptionSpelling { kFlag, kScript };
+// --what (`default_what` when empty) and the table's options, parsed.
+RenderRequest ParseRenderRequest(const RenderArgs& args, const std::string& default_what,
+                                 OptionSpelling spelling = OptionSpelling::kFlag);
+// Stops before anything is simulated when the request draws without an X display or the
+// output folder cannot be written.
+void CheckRenderRequest(const RenderRequest& request, const std::string& out);
+// Draws `run` (put back into `world`, a world of its bodies) as the request asks, into
+// args.out, and prints what was written: `wobble render`/`export` and a script's `render` of
+// its FFD runs. Frames at the request's fps from the first sample up to t_end (the run's
+// intended end), those the run reached.
+void RenderRun(const RenderArgs& args, const RenderRequest& request, World& world, const record::Trajectory& run,
                double t_end);
 
 }  // namespace wobble::app

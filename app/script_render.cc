@@ -1,6 +1,7 @@
 #include "script_render.h"
 
 #include <iostream>
+#include <set>
 
 #include "cli_common.h"
 #include "pipelines/scene_view.h"
@@ -18,23 +19,22 @@ void RenderScriptRuns(const script::RenderRequest& r) {
   a.out = r.dir;
   a.what = r.what.empty() ? default_what : r.what;
   for (const auto& [name, value] : r.options) a.picture[name] = value;  // a later one wins
-  try {
-    scene::ParseRenderOptions(a.picture);  // checked here to name the options as the script spells them
-  } catch (const scene::RenderOptionError& e) {
-    throw std::invalid_argument(e.option + "=: " + e.what());
-  }
+  RenderRequest request = ParseRenderRequest(a, default_what, OptionSpelling::kScript);
   if (!pl::HasDisplay()) {
-    std::string kept;
+    std::set<std::string> kept;
     for (const char* w : {"vtp", "disp"})
-      if (("," + a.what + ",").find(std::string(",") + w + ",") != std::string::npos) kept += (kept.empty() ? "" : ",") + std::string(w);
+      if (request.what.count(w)) kept.insert(w);
+    std::string listed;
+    for (const std::string& w : kept) listed += (listed.empty() ? "" : ",") + w;
     std::cout << "no X display: render draws no pictures (run under xvfb-run -a -s \"-screen 0 1280x1024x24\")"
-              << (kept.empty() ? "" : "; writing " + kept + " only") << "\n";
+              << (kept.empty() ? "" : "; writing " + listed + " only") << "\n";
     if (kept.empty()) return;
-    a.what = kept;
+    request.what = kept;
   }
   if (run.empty()) throw std::runtime_error("nothing was recorded: no frames to render");
+  CheckRenderRequest(request, a.out);
   World world = pl::WorldFor(run, r.world);
-  RenderRun(a, default_what, world, run, run.time(run.size() - 1));  // a bad option: the script's line
+  RenderRun(a, request, world, run, run.time(run.size() - 1));
 }
 
 std::vector<std::string> RenderScriptScene(const script::SceneRenderRequest& r) {
