@@ -36,6 +36,27 @@ template <class T> Eigen::Quaternion<T> ExpRotation(const Vec3<T>& x) {
   return Eigen::Quaternion<T>(real, scale * x.x(), scale * x.y(), scale * x.z());
 }
 
+// The right Jacobian of exp on SO(3): exp((x + δ)^) = exp(x̂) exp((J_r(x) δ)^) to first order,
+// J_r(x) = 1 − (1 − cos θ)/θ² x̂ + (θ − sin θ)/θ³ x̂², θ = |x| (series near 0). The 3D adjoint
+// pulls a step's turn exp(Δt ω̂) back to ω with it.
+template <class T> Mat3<T> RightJacobianExp(const Vec3<T>& x) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  const T angle2 = x.squaredNorm();
+  T a, b;  // (1 − cos θ)/θ², (θ − sin θ)/θ³
+  if (ScalarValue(angle2) < 1e-8) {
+    a = T(0.5) - angle2 / T(24.0);
+    b = T(1.0 / 6.0) - angle2 / T(120.0);
+  } else {
+    const T angle = sqrt(angle2);
+    a = (T(1.0) - cos(angle)) / angle2;
+    b = (angle - sin(angle)) / (angle2 * angle);
+  }
+  const Mat3<T> s = Skew(x);
+  return Mat3<T>::Identity() - a * s + b * s * s;
+}
+
 // log of a unit quaternion: the rotation vector r (|r| ≤ π) with ExpRotation(r) = ±q.
 template <class T> Vec3<T> LogRotation(const Eigen::Quaternion<T>& q_in) {
   using std::atan2;

@@ -270,21 +270,48 @@ void ForEachPointInContact3(const BodyModel3& body, const GroundPlane& g, const 
 }
 
 // Eq. 4.24/4.25 in the plane's frame: f_n = −K Δn − C_dam v_n (never pulling),
-// f_t = −K Δt − FR_dam v_t (tangent-plane vectors), scaled back onto |f_t| ≤ tan θ f_n.
+// f_t = −K Δt − FR_dam v_t (tangent-plane vectors), scaled back onto |f_t| ≤ tan θ f_n. The
+// parts are kept for the 3D adjoint's partials (fit/internal/step3_vjp.cc).
+template <class T> struct GroundForceParts3 {
+  T fn;             // the normal force, after the clamp at 0
+  bool pressing;    // the spring-damper pushed (fn was not clamped)
+  Vec3<T> ft;       // the tangential force before the cap, and its norm
+  T ft_norm;
+  bool slipping;    // |f_t| above the cap
+  Vec3<T> f;        // the force
+};
 template <class T>
-Vec3<T> GroundForce3(const GroundPlane& g, const Vec3<T>& x, const Vec3<T>& v, const Vec3<T>& anchor, bool* slipping) {
+GroundForceParts3<T> GroundForcePartsOf3(const GroundPlane& g, const Vec3<T>& x, const Vec3<T>& v, const Vec3<T>& anchor) {
   using std::sqrt;
+  GroundForceParts3<T> p;
   const Vec3<T> n = g.normal.cast<T>();
   const Vec3<T> dl = x - anchor;
-  T fn = -T(g.stiffness) * n.dot(dl) - T(g.normal_damping) * n.dot(v);
-  if (fn < T(0.0)) fn = T(0.0);
+  p.fn = -T(g.stiffness) * n.dot(dl) - T(g.normal_damping) * n.dot(v);
+  p.pressing = !(p.fn < T(0.0));
+  if (!p.pressing) p.fn = T(0.0);
   const Vec3<T> dl_t = dl - n * n.dot(dl), v_t = v - n * n.dot(v);
-  Vec3<T> ft = -T(g.stiffness) * dl_t - T(g.friction_damping) * v_t;
-  const T cap = T(g.friction_cap) * fn;
-  const T ft_norm = sqrt(ft.squaredNorm() + T(1e-300));
-  *slipping = ft_norm > cap;
-  if (*slipping) ft *= cap / ft_norm;
-  return fn * n + ft;
+  p.ft = -T(g.stiffness) * dl_t - T(g.friction_damping) * v_t;
+  const T cap = T(g.friction_cap) * p.fn;
+  p.ft_norm = sqrt(p.ft.squaredNorm() + T(1e-300));
+  p.slipping = p.ft_norm > cap;
+  p.f = p.fn * n + (p.slipping ? Vec3<T>(p.ft * (cap / p.ft_norm)) : p.ft);
+  return p;
+}
+template <class T>
+Vec3<T> GroundForce3(const GroundPlane& g, const Vec3<T>& x, const Vec3<T>& v, const Vec3<T>& anchor, bool* slipping) {
+  const GroundForceParts3<T> p = GroundForcePartsOf3(g, x, v, anchor);
+  *slipping = p.slipping;
+  return p.f;
+}
+
+// A damped spring's pull on its point at x moving at v: f = −(K (|Δ| − L) + C v·Δ̂) Δ̂ along
+// Δ = x − anchor.
+template <class T> Vec3<T> SpringForce3(const Spring3& sp, const Vec3<T>& x, const Vec3<T>& v) {
+  using std::sqrt;
+  const Vec3<T> delta = x - sp.anchor.cast<T>();
+  const T len = sqrt(delta.squaredNorm() + T(1e-300));
+  const Vec3<T> dir = delta / len;
+  return -(T(sp.stiffness) * (len - T(sp.rest_length)) + T(sp.damping) * dir.dot(v)) * dir;
 }
 
 template <class T>
@@ -315,17 +342,11 @@ void EvaluateForces3(const BodyModel3& body, const WorldParams3& w, const BodySt
       AddGeneralizedForce3(frame, l, body.mode_matrix(k), GroundForce3(plane, x, v, anchor, &slipping), &out->ground);
     }, set);
   }
-  // springs: f = −(K (|Δ| − L) + C v·Δ̂) Δ̂ along Δ = x − anchor
   out->springs.setZero(n);
   for (const Spring3& sp : w.springs) {
-    using std::sqrt;
     const Vec3<T> l = LocalPosition3<T>(sp.rest_local, sp.mode_matrix, s.gamma);
     const Vec3<T> x = frame.t + frame.R * l;
-    const Vec3<T> v = PointVelocity3(frame, s.v, l, sp.mode_matrix);
-    const Vec3<T> delta = x - sp.anchor.cast<T>();
-    const T len = sqrt(delta.squaredNorm() + T(1e-300));
-    const Vec3<T> dir = delta / len;
-    const Vec3<T> f = -(T(sp.stiffness) * (len - T(sp.rest_length)) + T(sp.damping) * dir.dot(v)) * dir;
+    const Vec3<T> f = SpringForce3(sp, x, PointVelocity3(frame, s.v, l, sp.mode_matrix));
     AddGeneralizedForce3(frame, l, sp.mode_matrix, f, &out->springs);
   }
   out->total = out->gravity + out->modes + out->ground + out->springs;

@@ -13,12 +13,11 @@
 // v + δv) — ε a rotation vector in the body frame, the perturbation of step3.h's g·exp(h v).
 // With these, λ_n is a plain vector of 12 + 2D numbers whatever the quaternion's sign.
 //
-// Each step's vector–Jacobian product is taken with forward-mode Jets over the step's own
-// inputs only (the 12 + 2D state numbers, 3 per ground contact's anchor and the 3D gains and
-// targets of the step, in chunks of 16), so a gradient costs a fixed number of differentiated
-// steps per step, not one simulation per parameter; it is the 2D adjoint's fallback path, not
-// its hand-derived one (see the note of issue 18 for the measured cost). Contact decisions are
-// taken on plain values, as in every Jet run: one-sided at a contact's onset.
+// Each step's vector–Jacobian product is derived by hand (internal/step3_vjp.h): one mass
+// solve, the mass-moment formulas' derivatives in O(D²) and each contact's and spring's force by
+// its partials, so a gradient costs a few plain steps per step whatever the number of parameters.
+// Contact decisions are taken on plain values, as in every Jet run: one-sided at a contact's
+// onset.
 //
 // Memory: a checkpoint every ⌈√steps⌉ steps, one interval recomputed at a time (adjoint.h).
 #pragma once

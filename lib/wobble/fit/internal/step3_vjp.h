@@ -1,0 +1,65 @@
+// The 3D adjoint's per-step vector–Jacobian product, derived by hand (not public; adjoint3.h).
+//
+// A step of StepBody3 (thesis or symplectic integrator) maps a state s, its contacts' anchors A
+// and the step's controls u = (PD targets, K, c) to s' and A'. Given λ' = ∂cost/∂(s', A'), this
+// gives ∂cost/∂(s, A, u) = (∂(s', A')/∂(s, A, u))ᵀ λ' in the tangent coordinates of adjoint3.h,
+// for about the price of two plain steps, whatever the number of contacts:
+//  - the mass solve a = M⁻¹ (Q − w) is pulled back through one solve λ_r = M⁻¹ λ_a and the
+//    scalar ψ = λ_rᵀ (Q − w − M a) at fixed a and λ_r, whose gradient is that of λ_aᵀ a;
+//  - ψ's mass-moment terms (M, w, gravity: kinematics3.h) are differentiated by hand, in O(D²)
+//    whatever the number of mass points;
+//  - a contact's force (Eq. 4.24/4.25: its one-sided normal force and capped friction) and its
+//    anchor's update (SlipAnchor3) by their partials in the point's x, ẋ and anchor, from the
+//    parts the forward force keeps (GroundForcePartsOf3), and a spring's the same way; x and ẋ
+//    are pulled back to the state by x = t + R l, ẋ = ṫ + R (ω × l + B γ̇);
+//  - the turn R' = R exp(Δt ω̂) moves ε by exp(−Δt ω̂) and ω by Δt J_r(Δt ω) (rotation3.h).
+// tests/adjoint3_test.cc checks whole runs against forward-mode Jets and central differences.
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <utility>
+
+#include "wobble/body/body_model.h"
+#include "wobble/dynamics/step3.h"
+#include "wobble/fit/internal/mode_force.h"
+
+namespace wobble::fit::internal {
+
+using ContactKey3 = std::pair<int, int>;  // (point, face): a contact's identity across steps
+
+// λ of one 3D state: ∂cost/∂z in tangent coordinates (δt, ε, δγ, δv), and ∂cost/∂(the anchor
+// of each contact).
+struct StateAdjoint3 {
+  Eigen::VectorXd z;
+  std::map<ContactKey3, Eigen::Vector3d> anchor;
+};
+
+// What a step is: the body (its own mode gains off), the world, the integrator, the step and
+// the mode forces' gains.
+struct StepModel3 {
+  const BodyModel3& passive;
+  const WorldParams3& world;
+  Integrator integrator;  // kThesis or kSymplecticEuler
+  double dt;
+  const ModeParams<double>& gains;
+};
+
+// ∂cost/∂(one step's controls).
+struct ControlAdjoint3 {
+  VecD<double> target;                  // this step's PD targets (set)
+  Eigen::VectorXd *stiffness, *damping;  // the gains' (added to, across steps)
+};
+
+// in = λ of state s from out = λ of the state after the step taken from s with PD targets
+// `target`; adds the gains' part to controls->stiffness/damping and sets controls->target.
+// Fails as the step does (a singular mass matrix).
+StepStatus StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& s,
+                    const StateAdjoint3& out, StateAdjoint3* in, ControlAdjoint3* controls);
+
+// The start's contact update (UpdateContacts3 on `s`, whose contacts are ignored): adds the
+// part of ∂cost/∂z that reaches s through the anchors it gives.
+void StartContactsVjp3(const BodyModel3& passive, const GroundPlane& ground, BodyState3<double> s,
+                       const std::map<ContactKey3, Eigen::Vector3d>& anchor, Eigen::VectorXd* dz);
+
+}  // namespace wobble::fit::internal
