@@ -2,16 +2,24 @@
 // a plane given as a grid is that plane (heights, faces, and whole runs of a body on it); a
 // point in a crease feels both faces; a box at rest in a frictionless V valley is held by
 // m g / (2 cos α) on each face; sliding down a slope of many triangles at g (sin α − μ cos α);
-// sliding off the edge of a drop into free fall without touching the drop's face.
+// a region of cells with its own friction cap deciding whether a box slides; sliding off the
+// edge of a drop into free fall without touching the drop's face.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <random>
+#include <utility>
 
 #include "support/test_bodies.h"
 #include "wobble/core/errors.h"
 #include "wobble/dynamics/heightfield.h"
 #include "wobble/dynamics/step3.h"
+#include "wobble/formats/heightfield_file.h"
+#include "wobble/formats/parse_error.h"
 
 namespace wobble {
 namespace {
@@ -153,6 +161,40 @@ TEST(Heightfield, ABoxInAFrictionlessValleyIsHeldByBothWalls) {
   EXPECT_LT((on_face[1] - N * Vector3d(-std::sin(alpha), std::cos(alpha), 0)).norm(), 1e-6 * N);
 }
 
+// A box let go at rest on the slope y = x tan α of `field`'s triangles, ground cap `mu`: its
+// speed downhill after 1 s and 2 s, and its contacts at the end.
+struct Slide {
+  double v_at_1, v_at_2, travelled;
+  size_t contacts;
+};
+Slide SlideDownTheSlope(const BodyModel3& block, double alpha, double mu, std::shared_ptr<const Heightfield> field) {
+  WorldParams3 w;
+  w.ground.enabled = true;
+  w.ground.friction_cap = mu;
+  w.ground.stiffness = 2e4;
+  w.ground.normal_damping = 100.0;
+  w.ground.friction_damping = 100.0;
+  w.ground.heightfield = std::move(field);
+  const Vector3d downhill(-std::cos(alpha), -std::sin(alpha), 0.0);
+  BodyState3<double> s = RestState3<double>(block);
+  s.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(alpha, Vector3d::UnitZ()));
+  s.t = Vector3d(0, 1e-4, -0.15);
+  const double dt = 2e-4;
+  Slide out{};
+  for (int step = 1; step <= int(2.0 / dt); ++step) {
+    EXPECT_TRUE(StepBody3(block, w, Integrator::kSymplecticEuler, dt, &s).ok());
+    if (step == int(1.0 / dt)) out.v_at_1 = LinearMomentum(block, s).dot(downhill) / block.moments().m;
+  }
+  out.v_at_2 = LinearMomentum(block, s).dot(downhill) / block.moments().m;
+  out.travelled = -s.t.x();
+  out.contacts = s.contacts.size();
+  return out;
+}
+
+std::shared_ptr<const Heightfield> SlopeOfTriangles(double alpha) {
+  return Sampled([&](double x, double) { return x * std::tan(alpha); }, {-30, -2}, {0.2, 0.2}, 161, 21);
+}
+
 // Down a 35° slope made of triangles 0.2 wide (the box crosses dozens of them) with friction
 // cap μ = 0.4: the acceleration is g (sin α − μ cos α); at 15° (tan α < μ) it holds.
 TEST(Heightfield, SlidesDownASlopeOfTrianglesAtTheClosedForm) {
@@ -160,33 +202,67 @@ TEST(Heightfield, SlidesDownASlopeOfTrianglesAtTheClosedForm) {
   const double mu = 0.4, g = 9.81;
   for (double alpha_deg : {15.0, 35.0}) {
     const double alpha = alpha_deg * M_PI / 180.0;
-    WorldParams3 w;
-    w.ground.enabled = true;
-    w.ground.friction_cap = mu;
-    w.ground.stiffness = 2e4;
-    w.ground.normal_damping = 100.0;
-    w.ground.friction_damping = 100.0;
-    w.ground.heightfield =
-        Sampled([&](double x, double) { return x * std::tan(alpha); }, {-30, -2}, {0.2, 0.2}, 161, 21);
-    const Vector3d downhill(-std::cos(alpha), -std::sin(alpha), 0.0);
-    BodyState3<double> s = RestState3<double>(block);
-    s.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(alpha, Vector3d::UnitZ()));
-    s.t = Vector3d(0, 1e-4, -0.15);
-    const double dt = 2e-4;
-    double v_at_1 = 0.0;
-    for (int step = 1; step <= int(2.0 / dt); ++step) {
-      ASSERT_TRUE(StepBody3(block, w, Integrator::kSymplecticEuler, dt, &s).ok());
-      if (step == int(1.0 / dt)) v_at_1 = LinearMomentum(block, s).dot(downhill) / block.moments().m;
-    }
-    const double v_at_2 = LinearMomentum(block, s).dot(downhill) / block.moments().m;
+    const Slide slide = SlideDownTheSlope(block, alpha, mu, SlopeOfTriangles(alpha));
     if (std::tan(alpha) < mu) {
-      EXPECT_LT(std::abs(v_at_2), 1e-3) << alpha_deg << " degrees";
+      EXPECT_LT(std::abs(slide.v_at_2), 1e-3) << alpha_deg << " degrees";
     } else {
       const double expected = g * (std::sin(alpha) - mu * std::cos(alpha));
-      EXPECT_NEAR(v_at_2 - v_at_1, expected, 0.01 * expected) << alpha_deg << " degrees";
-      EXPECT_GT(-s.t.x(), 3.5) << "it slid over many triangles (3.5 is 17 of them)";
+      EXPECT_NEAR(slide.v_at_2 - slide.v_at_1, expected, 0.01 * expected) << alpha_deg << " degrees";
+      EXPECT_GT(slide.travelled, 3.5) << "it slid over many triangles (3.5 is 17 of them)";
     }
-    EXPECT_EQ(s.contacts.size(), 4u) << alpha_deg << " degrees: the four bottom corners";
+    EXPECT_EQ(slide.contacts, 4u) << alpha_deg << " degrees: the four bottom corners";
+  }
+}
+
+// A region's own friction cap: on the 35° slope (tan α = 0.70) with the ground's cap 0.8 the
+// box holds, but where a region of the cells under its path sets frsin 0.4 it slides at
+// g (sin α − 0.4 cos α); and the other way round. Cells outside the region keep the ground's.
+TEST(Heightfield, ARegionsOwnFrictionCapDecidesWhetherItSlides) {
+  const BodyModel3 block = Box(0.4, 0.2, 0.3, 0.5);
+  const double alpha = 35.0 * M_PI / 180.0, g = 9.81;
+  const Vector2d lo(-30, -2), hi(2, 1);  // the box's path, z from −0.3 to 0.15; not the cells beyond z = 1
+  for (const auto& [ground_cap, region_cap] : {std::pair{0.8, 0.4}, std::pair{0.4, 0.8}}) {
+    SCOPED_TRACE(region_cap);
+    SurfaceOverrides own;
+    own.friction_cap = region_cap;
+    const std::shared_ptr<const Heightfield> field = SlopeOfTriangles(alpha)->WithRegion(lo, hi, own);
+    const Slide slide = SlideDownTheSlope(block, alpha, ground_cap, field);
+    if (region_cap < std::tan(alpha)) {
+      const double expected = g * (std::sin(alpha) - region_cap * std::cos(alpha));
+      EXPECT_NEAR(slide.v_at_2 - slide.v_at_1, expected, 0.01 * expected);
+    } else {
+      EXPECT_LT(std::abs(slide.v_at_2), 1e-3);
+    }
+    // a face of a cell in the region has the region's cap and the ground's other constants; one
+    // beyond it (z = 1.5) the ground's cap
+    GroundPlane ground;
+    ground.enabled = true;
+    ground.friction_cap = ground_cap;
+    ground.stiffness = 2e4;
+    ground.heightfield = field;
+    std::vector<int> in, out;
+    field->FacesFelt(Vector3d(-1.05, -1.05 * std::tan(alpha) - 0.01, 0.05), &in);
+    field->FacesFelt(Vector3d(-1.05, -1.05 * std::tan(alpha) - 0.01, 1.5), &out);
+    ASSERT_FALSE(in.empty());
+    ASSERT_FALSE(out.empty());
+    EXPECT_EQ(ground.Face(in[0], Vector3d(-1.05, 0, 0.05)).friction_cap, region_cap);
+    EXPECT_EQ(ground.Face(in[0], Vector3d(-1.05, 0, 0.05)).stiffness, 2e4);
+    EXPECT_EQ(ground.Face(out[0], Vector3d(-1.05, 0, 1.5)).friction_cap, ground_cap);
+  }
+}
+
+TEST(Heightfield, RefusesBadRegions) {
+  const std::shared_ptr<const Heightfield> field = SlopeOfTriangles(0.3);
+  SurfaceOverrides negative;
+  negative.stiffness = -1;
+  EXPECT_THROW(field->WithRegion({-30, -2}, {2, 2}, negative), InputError);
+  SurfaceOverrides fine;
+  fine.friction_cap = 0.2;
+  try {
+    field->WithRegion({5, 5}, {6, 6}, fine);  // beyond the grid
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no cell's centre is in the region"), std::string::npos) << e.what();
   }
 }
 
@@ -254,6 +330,49 @@ TEST(Heightfield, RefusesBadGrids) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("node (1, 2)"), std::string::npos) << e.what();
   }
+}
+
+// A heightfield file's regions (formats/heightfield_file.h): read as the cells' own constants
+// (later over earlier), written back cell by cell and read again bit for bit; a bad region is
+// refused with its FILE:LINE.
+TEST(HeightfieldFile, RegionsAreReadWrittenAndRefusedWithTheirLine) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("wobble_heightfield_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string path = (dir / "f.heightfield").string();
+  auto write = [&](const std::string& text) { std::ofstream(path) << text; };
+  // 3 x 3 nodes, 2 x 2 cells with centres (0.5, 1), (1.5, 1), (0.5, 3), (1.5, 3)
+  write("origin 0 0\nspacing 1 2\nregion 0 0 1 2 frsin 0.25 grconst 900\n0 1 2\n0 1 2\n0 1 2\n"
+        "region 1 0 2 4 grdam 7 frsin 0.5\n");
+  const std::shared_ptr<const Heightfield> field = formats::ReadHeightfieldFile(path);
+  EXPECT_EQ(field->CellOverrides(0).friction_cap, 0.25);
+  EXPECT_EQ(field->CellOverrides(0).stiffness, 900.0);
+  EXPECT_TRUE(std::isnan(field->CellOverrides(0).normal_damping));
+  for (int cell : {1, 3}) {
+    EXPECT_EQ(field->CellOverrides(cell).normal_damping, 7.0);
+    EXPECT_EQ(field->CellOverrides(cell).friction_cap, 0.5);
+  }
+  EXPECT_TRUE(field->CellOverrides(2) == SurfaceOverrides());
+  formats::WriteHeightfieldFile(path + ".again", *field);
+  EXPECT_TRUE(*formats::ReadHeightfieldFile(path + ".again") == *field);
+  EXPECT_FALSE(*Heightfield::Make(field->origin(), field->spacing(), 3, 3, field->heights()) == *field);
+  const std::pair<const char*, const char*> bad[] = {
+      {"region 0 0 1 1 fric 0.1", ":5: expected grconst, grdam, frconst or frsin, got 'fric'"},
+      {"region 0 0 1 1 frsin -0.5", ":5: heightfield: frsin must be a finite number >= 0"},
+      {"region 5 5 6 6 frsin 0.1", ":5: heightfield: no cell's centre is in the region"},
+      {"region 0 0 1 frsin 0.1", ":5: expected 'region X0 Z0 X1 Z1 NAME VALUE"},
+      {"region 0 0 1 1 frsin x", ":5: expected a number for frsin, got 'x'"},
+  };
+  for (const auto& [line, message] : bad) {
+    write(std::string("origin 0 0\nspacing 1 1\n0 1\n0 1\n") + line + "\n");
+    try {
+      formats::ReadHeightfieldFile(path);
+      ADD_FAILURE() << line;
+    } catch (const formats::ParseError& e) {
+      EXPECT_NE(std::string(e.what()).find(path + message), std::string::npos) << e.what();
+    }
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -289,6 +289,24 @@ TEST(SceneScript, HeightfieldIsTheGroundOf3DBodiesAndSaveKeepsIt) {
   const std::string written = dir + "/hills_saved.heightfield";
   EXPECT_NE(text.find("heightfield off\nheightfield " + written + "\n"), std::string::npos) << text;
   EXPECT_TRUE(*formats::ReadHeightfieldFile(written) == *formats::ReadHeightfieldFile(kData + "/hills.heightfield"));
+
+  // a region's own constants go into the saved heightfield: an icy valley floor
+  script::Interpreter with_region(out);
+  ASSERT_EQ(RunScript(with_region, "load_obj " + kData + "/table3.obj\nheightfield " + kData +
+                                       "/hills.heightfield\nheightfield_region -200 -400 200 400 frsin 0.05 grdam 900\nsave " +
+                                       saved + "\n"),
+            "");
+  const std::shared_ptr<const Heightfield> icy = formats::ReadHeightfieldFile(written);
+  EXPECT_TRUE(*icy == *formats::ReadHeightfieldFile(kData + "/hills.heightfield")->WithRegion(
+                          {-200, -400}, {200, 400}, [] {
+                            SurfaceOverrides o;
+                            o.friction_cap = 0.05;
+                            o.normal_damping = 900;
+                            return o;
+                          }()));
+  int icy_cells = 0;
+  for (int c = 0; c < icy->num_cells(); ++c) icy_cells += icy->CellOverrides(c).friction_cap == 0.05;
+  EXPECT_EQ(icy_cells, 10 * 20) << "cells 40 wide with centres from -180 to 180 in x, all 20 in z";
 }
 
 }  // namespace

@@ -139,6 +139,8 @@ TEST(Interpreter, EveryCommandsErrorsNameTheLineAndWhatWasExpected) {
       {"terrain 0 0 1 0\nterrain_face 2 frsin 0.1", "expected a segment from 1 to 1, got 2"},
       {"terrain 0 0 1 0\nterrain_face 1 fric 0.1", "expected grconst, grdam, frconst or frsin, got 'fric'"},
       {"terrain 0 0 1 0\nterrain_face 1 frsin -1", "expected a non-negative frsin"},
+      {"heightfield_region 0 0 1 1 frsin 0.1", "no heightfield yet"},
+      {"heightfield_region 0 0 1 frsin", "expected 'heightfield_region X0 Z0 X1 Z1 NAME VALUE"},
       {"terrain 0 0 1 0\nset ground_slope 5", "the ground is a terrain"},
       {"set g -1", "expected a non-negative"},
       {"output out.csv 0", "expected EVERY as a whole number >= 1"},

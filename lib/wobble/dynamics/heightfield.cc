@@ -137,4 +137,42 @@ std::array<int, 3> Heightfield::Across(int a) const {
   return across;
 }
 
+std::shared_ptr<const Heightfield> Heightfield::WithRegion(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
+                                                           const SurfaceOverrides& overrides) const {
+  const double values[] = {overrides.stiffness, overrides.normal_damping, overrides.friction_damping,
+                           overrides.friction_cap};
+  for (size_t k = 0; k < 4; ++k)
+    if (!std::isnan(values[k]) && !(values[k] >= 0 && values[k] <= 1e15))
+      Refuse(SurfaceOverrides::Names()[k] + " must be a finite number >= 0, got " + std::to_string(values[k]));
+  auto copy = std::make_shared<Heightfield>(*this);
+  if (copy->cells_.empty()) copy->cells_.resize(size_t(num_cells()));
+  int covered = 0;
+  for (int j = 0; j + 1 < nz_; ++j)
+    for (int i = 0; i + 1 < nx_; ++i) {
+      const Eigen::Vector2d centre = origin_ + spacing_.cwiseProduct(Eigen::Vector2d(i + 0.5, j + 0.5));
+      if ((centre.array() < lo.array()).any() || (centre.array() > hi.array()).any()) continue;
+      SurfaceOverrides& cell = copy->cells_[size_t(i + (nx_ - 1) * j)];
+      for (size_t k = 0; k < 4; ++k)
+        if (!std::isnan(values[k])) cell.Set(SurfaceOverrides::Names()[k], values[k]);
+      ++covered;
+    }
+  if (covered == 0) {
+    std::ostringstream m;
+    m << "no cell's centre is in the region x " << lo.x() << " .. " << hi.x() << ", z " << lo.y() << " .. " << hi.y();
+    Refuse(m.str());
+  }
+  return copy;
+}
+
+const SurfaceOverrides& Heightfield::CellOverrides(int cell) const {
+  static const SurfaceOverrides kNone;
+  return cells_.empty() ? kNone : cells_.at(size_t(cell));
+}
+
+bool Heightfield::CellsEqual(const Heightfield& o) const {
+  for (int c = 0; c < num_cells(); ++c)
+    if (!(CellOverrides(c) == o.CellOverrides(c))) return false;
+  return true;
+}
+
 }  // namespace wobble

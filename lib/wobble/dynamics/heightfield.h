@@ -14,12 +14,18 @@
 //   - never a face across a convex edge (a ridge, a cliff's top), so a point that passes the
 //     edge of a drop leaves the top face at once: no sticking, no tunnelling.
 // Outside the grid a point feels the level continuation only.
+//
+// Each cell (both its triangles) may have its own penalty constants, as a 2D terrain's
+// segments do (SurfaceOverrides: K_d, C_dam, FR_dam, tan θ; unset ones are the ground's): an
+// icy patch, a soft bank. The level continuation has the ground's.
 #pragma once
 
 #include <Eigen/Core>
 #include <array>
 #include <memory>
 #include <vector>
+
+#include "wobble/dynamics/terrain.h"
 
 namespace wobble {
 
@@ -51,8 +57,22 @@ class Heightfield {
   // The faces point x feels (rules above), in increasing order; appends to *out.
   void FacesFelt(const Eigen::Vector3d& x, std::vector<int>* out) const;
 
+  // This field with the constants set in `overrides` (those not NaN) on every cell whose
+  // centre lies in the box [lo, hi] of (x, z). Throws InputError when a constant is negative or
+  // not finite, or when no cell's centre is in the box.
+  std::shared_ptr<const Heightfield> WithRegion(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi,
+                                                const SurfaceOverrides& overrides) const;
+  // Cell (i, j)'s constants (all NaN unless set), i < nx − 1, j < nz − 1; face f's, null when
+  // it has none of its own (no cell has, or f is the level continuation).
+  int num_cells() const { return (nx_ - 1) * (nz_ - 1); }
+  const SurfaceOverrides& CellOverrides(int cell) const;
+  const SurfaceOverrides* FaceOverrides(int f) const {
+    return cells_.empty() || f >= outside_face() ? nullptr : &cells_[size_t(f / 2)];
+  }
+
   bool operator==(const Heightfield& o) const {
-    return origin_ == o.origin_ && spacing_ == o.spacing_ && nx_ == o.nx_ && nz_ == o.nz_ && heights_ == o.heights_;
+    return origin_ == o.origin_ && spacing_ == o.spacing_ && nx_ == o.nx_ && nz_ == o.nz_ && heights_ == o.heights_ &&
+           CellsEqual(o);
   }
 
  private:
@@ -65,6 +85,7 @@ class Heightfield {
   // is the grid's.
   std::array<int, 3> Across(int a) const;
   double Behind(int f, const Eigen::Vector3d& x) const;  // signed height above f's plane
+  bool CellsEqual(const Heightfield& o) const;
 
   Eigen::Vector2d origin_, spacing_;
   int nx_ = 0, nz_ = 0;
@@ -72,6 +93,7 @@ class Heightfield {
   std::vector<Eigen::Vector3d> normals_, points_;  // per triangle
   std::vector<std::array<int, 3>> valleys_;         // per triangle: Across(), −1 unless concave
   double max_height_ = 0;
+  std::vector<SurfaceOverrides> cells_;  // per cell, i + (nx − 1) j; empty: none set
 };
 
 }  // namespace wobble

@@ -40,7 +40,8 @@ struct GroundPlane {
   double stiffness = 4500.0, normal_damping = 550.0, friction_damping = 50.0, friction_cap = 0.1;
   std::shared_ptr<const Heightfield> heightfield;  // when set, the ground (point and normal unused)
   template <class T> T Height(const Vec3<T>& x) const { return normal.cast<T>().dot(x - point.cast<T>()); }
-  // Face f's plane near x with these constants: the plane itself (face 0) or a heightfield face.
+  // Face f's plane near x with its constants: the plane itself (face 0) or a heightfield face
+  // (with its cell's own constants, where set).
   // Built field by field, not copied: a copy would touch the shared_ptr's atomic count once
   // per (point, face) per force evaluation.
   GroundPlane Face(int f, const Eigen::Vector3d& x) const {
@@ -52,6 +53,12 @@ struct GroundPlane {
     p.friction_cap = friction_cap;
     if (heightfield) {
       heightfield->FacePlane(f, x, &p.point, &p.normal);
+      if (const SurfaceOverrides* own = heightfield->FaceOverrides(f)) {  // the cell's own constants
+        if (!std::isnan(own->stiffness)) p.stiffness = own->stiffness;
+        if (!std::isnan(own->normal_damping)) p.normal_damping = own->normal_damping;
+        if (!std::isnan(own->friction_damping)) p.friction_damping = own->friction_damping;
+        if (!std::isnan(own->friction_cap)) p.friction_cap = own->friction_cap;
+      }
     } else {
       p.point = point;
       p.normal = normal;

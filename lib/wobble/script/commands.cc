@@ -17,8 +17,11 @@ const std::vector<Command>& CommandTable() {
        "a terrain segment's own grconst, grdam, frconst or frsin (1-based, left to right)", TerrainFaceCommand},
       {"heightfield", "heightfield FILE | heightfield off",
        "3D objects stand on the heightfield y = h(x, z) in FILE ('origin X0 Z0', 'spacing DX DZ', a row of heights per "
-       "z) in place of the ground plane; the ground's constants apply",
+       "z) in place of the ground plane; the ground's constants apply unless a region sets its own",
        HeightfieldCommand},
+      {"heightfield_region", "heightfield_region X0 Z0 X1 Z1 NAME VALUE [NAME VALUE ...]",
+       "the heightfield's cells whose centres lie in [X0, X1] x [Z0, Z1] get their own grconst, grdam, frconst or frsin",
+       HeightfieldRegionCommand},
       {"assign", "assign MODE STIFFNESS DAMPING", "mode MODE (1-based or name): V = K g^2, force -c g'", Assign},
       {"mode", "mode MODE active|passive", "designate a mode active (PD-controlled) or passive", Mode},
       {"set_vec", "set_vec q|dq V1 .. Vn", "generalized coordinates or velocities, n = 3 + modes", SetVec},

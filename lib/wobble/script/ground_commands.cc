@@ -1,6 +1,6 @@
 // The ground as terrain (issue 19): `terrain` sets the profile, `terrain_face` a segment's own
 // penalty parameters (the names `set` gives the ground's: grconst, grdam, frconst, frsin);
-// `heightfield` the 3D objects' ground.
+// `heightfield` the 3D objects' ground, `heightfield_region` its cells' own parameters.
 #include "wobble/formats/heightfield_file.h"
 #include "wobble/script/internal/interpreter_internal.h"
 
@@ -58,6 +58,23 @@ void TerrainFaceCommand(State& s, const Words& w, const Context& ctx) {
 void HeightfieldCommand(State& s, const Words& w, const Context& ctx) {
   if (w.size() != 2) ctx.Fail("expected 'heightfield FILE' or 'heightfield off'");
   TheGround(s).heightfield = w[1] == "off" ? nullptr : formats::ReadHeightfieldFile(Resolve(w[1], ctx.dir));
+}
+
+void HeightfieldRegionCommand(State& s, const Words& w, const Context& ctx) {
+  if (w.size() < 7 || w.size() % 2 == 0) ctx.Fail("expected '" + ctx.usage + "'");
+  const std::shared_ptr<const Heightfield>& field = TheGround(s).heightfield;
+  if (!field) ctx.Fail("no heightfield yet: 'heightfield FILE' first");
+  const Eigen::Vector2d lo(Number(w[1], "X0", ctx), Number(w[2], "Z0", ctx));
+  const Eigen::Vector2d hi(Number(w[3], "X1", ctx), Number(w[4], "Z1", ctx));
+  SurfaceOverrides constants;
+  for (size_t i = 5; i + 1 < w.size(); i += 2)
+    if (!constants.Set(w[i], NonNegative(w[i + 1], w[i], ctx)))
+      ctx.Fail("expected grconst, grdam, frconst or frsin, got '" + w[i] + "'" + DidYouMean(w[i], SurfaceOverrides::Names()));
+  try {
+    TheGround(s).heightfield = field->WithRegion(lo, hi, constants);
+  } catch (const InputError& e) {
+    ctx.Fail(e.what());
+  }
 }
 
 }  // namespace wobble::script

@@ -138,7 +138,7 @@ Energies World::Ffd3Energies(int body) const {
   }
   for (const Contact3<double>& c : s.contacts) {
     const Eigen::Vector3d x = frame.t + frame.R * LocalPosition3<double>(m.rest_local(c.point), m.mode_matrix(c.point), s.gamma);
-    out.ground += 0.5 * options_.ground_3d.stiffness * (x - c.anchor).squaredNorm();
+    out.ground += 0.5 * options_.ground_3d.Face(c.face, x).stiffness * (x - c.anchor).squaredNorm();
   }
   // springs: ½ K (|x − anchor| − L)², the potential of step3.h's force
   for (const Spring3& sp : options_.springs_3d) {

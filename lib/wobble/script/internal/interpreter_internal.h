@@ -119,6 +119,7 @@ void Clear(State& s, const Words& w, const Context& ctx);
 void TerrainCommand(State& s, const Words& w, const Context& ctx);      // ground_commands.cc
 void TerrainFaceCommand(State& s, const Words& w, const Context& ctx);
 void HeightfieldCommand(State& s, const Words& w, const Context& ctx);
+void HeightfieldRegionCommand(State& s, const Words& w, const Context& ctx);
 void Output(State& s, const Words& w, const Context& ctx);
 void Schedule(State& s, const Words& w, const Context& ctx);
 void Print(State& s, const Words& w, const Context& ctx);   // the scene's once it has a body
