@@ -5,8 +5,8 @@
 //   render: frames (PNG sequence), filmstrip (one PNG of chosen frames), charts (energy and
 //           cond(M) against time, PNG + CSV)
 //   export: vtp (.vtp per frame + .pvd), exr (per frame the characters' R,G,B,A,
-//           depth.Z, motion forward.u/v; with --exr-terrain terrain.R,G,B,A), disp (disp.X,
-//           disp.Y over the rest lattice per frame)
+//           depth.Z, motion forward.u/v (--exr-motion: and/or ViewLayer.Vector.X/Y/Z/W); with --exr-terrain
+//           terrain.R,G,B,A), disp (disp.X, disp.Y over the rest lattice per frame)
 // Rendering needs an X display: without DISPLAY the command stops with exit code 2 and says
 // to use xvfb-run (VTK 9.1 would abort).
 #pragma once

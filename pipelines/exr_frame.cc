@@ -20,12 +20,20 @@ bool PixelRange(double lo, double hi, int n, int* first, int* last) {
 
 class Raster {
  public:
-  Raster(const ScreenGeometry& g, const std::vector<Eigen::Vector3d>& next, int width, int height)
-      : g_(g), next_(next), now_(NextPixels(g, ScreenGeometry())), width_(width), height_(height),
+  Raster(const ScreenGeometry& g, const std::vector<Eigen::Vector3d>& next, const std::vector<Eigen::Vector3d>* previous,
+         int width, int height)
+      : g_(g), next_(next), now_(NextPixels(g, ScreenGeometry())), previous_(previous ? *previous : now_),
+        backward_(previous != nullptr), width_(width), height_(height),
         depth_(size_t(width) * height, std::numeric_limits<double>::infinity()) {
-    out_.alpha.assign(size_t(width) * height, 0.0f);
-    out_.forward_u.assign(size_t(width) * height, 0.0f);
-    out_.forward_v.assign(size_t(width) * height, 0.0f);
+    for (std::vector<float>* layer : {&out_.alpha, &out_.forward_u, &out_.forward_v})
+      layer->assign(size_t(width) * height, 0.0f);
+    if (backward_)
+      for (std::vector<float>* layer : {&out_.backward_u, &out_.backward_v}) layer->assign(size_t(width) * height, 0.0f);
+  }
+
+  // The motion to the previous frame, when asked for (at: a point's position on a frame).
+  template <class At> Eigen::Vector2d Back(const At& at, const Eigen::Vector2d& here) const {
+    return backward_ ? Eigen::Vector2d(at(previous_) - here) : Eigen::Vector2d::Zero();
   }
 
   bool Usable(int v) const { return g_.vertices[size_t(v)].allFinite() && g_.w[size_t(v)] > 0; }
@@ -56,11 +64,14 @@ class Raster {
         pa /= sum;
         pb /= sum;
         pc /= sum;
-        // where the surface point is now and on the next frame, both interpolated alike (so
-        // that a still surface gives exactly 0; now is the pixel's centre up to rounding)
-        const Eigen::Vector3d h = pa * next_[size_t(t[0])] + pb * next_[size_t(t[1])] + pc * next_[size_t(t[2])];
-        const Eigen::Vector3d h0 = pa * now_[size_t(t[0])] + pb * now_[size_t(t[1])] + pc * now_[size_t(t[2])];
-        Write(x, y, z, h.head<2>() / h.z() - h0.head<2>() / h0.z());
+        // where the surface point is now and on the next and previous frames, all interpolated
+        // alike (so that a still surface gives exactly 0; now is the pixel's centre up to rounding)
+        auto at = [&](const std::vector<Eigen::Vector3d>& h) {
+          const Eigen::Vector3d p = pa * h[size_t(t[0])] + pb * h[size_t(t[1])] + pc * h[size_t(t[2])];
+          return Eigen::Vector2d(p.head<2>() / p.z());
+        };
+        const Eigen::Vector2d here = at(now_);
+        Write(x, y, z, at(next_) - here, Back(at, here));
       }
   }
 
@@ -84,40 +95,51 @@ class Raster {
         // the point of the line's centre at t, now and (perspective-correct) on the next frame
         const double ta = (1 - t) / g_.w[size_t(s.a)], tb = t / g_.w[size_t(s.b)];
         const double u = tb / (ta + tb);
-        const Eigen::Vector3d h = (1 - u) * next_[size_t(s.a)] + u * next_[size_t(s.b)];
-        const Eigen::Vector3d h0 = (1 - u) * now_[size_t(s.a)] + u * now_[size_t(s.b)];
-        Write(x, y, (1 - t) * a.z() + t * b.z(), h.head<2>() / h.z() - h0.head<2>() / h0.z());
+        auto at = [&](const std::vector<Eigen::Vector3d>& h) {
+          const Eigen::Vector3d p = (1 - u) * h[size_t(s.a)] + u * h[size_t(s.b)];
+          return Eigen::Vector2d(p.head<2>() / p.z());
+        };
+        const Eigen::Vector2d here = at(now_);
+        Write(x, y, (1 - t) * a.z() + t * b.z(), at(next_) - here, Back(at, here));
       }
   }
 
   void Dot(const ScreenGeometry::Dot& d) {
     if (!Usable(d.v)) return;
     const Eigen::Vector3d& c = g_.vertices[size_t(d.v)];
-    const Eigen::Vector3d& h = next_[size_t(d.v)];
-    const Eigen::Vector2d motion = h.head<2>() / h.z() - now_[size_t(d.v)].head<2>() / now_[size_t(d.v)].z();  // with its vertex
+    auto at = [&](const std::vector<Eigen::Vector3d>& h) {
+      return Eigen::Vector2d(h[size_t(d.v)].head<2>() / h[size_t(d.v)].z());
+    };
+    const Eigen::Vector2d here = at(now_), motion = at(next_) - here, back = Back(at, here);  // with its vertex
     const double half = 0.5 * d.size;
     int x0, x1, y0, y1;
     if (!PixelRange(c.x() - half, c.x() + half, width_, &x0, &x1) || !PixelRange(c.y() - half, c.y() + half, height_, &y0, &y1))
       return;
     for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) Write(x, y, c.z(), motion);
+      for (int x = x0; x <= x1; ++x) Write(x, y, c.z(), motion, back);
   }
 
   CharacterLayers Take() { return std::move(out_); }
 
  private:
-  void Write(int x, int y, double z, const Eigen::Vector2d& m) {
+  void Write(int x, int y, double z, const Eigen::Vector2d& forward, const Eigen::Vector2d& backward) {
     const size_t at = size_t(height_ - 1 - y) * width_ + x;  // row 0 at the top
     if (z > depth_[at] || !std::isfinite(z)) return;
     depth_[at] = z;
     out_.alpha[at] = 1.0f;
-    out_.forward_u[at] = std::isfinite(m.x()) ? float(m.x()) : 0.0f;  // a next position behind the camera
-    out_.forward_v[at] = std::isfinite(m.y()) ? float(m.y()) : 0.0f;
+    auto finite = [](double m) { return std::isfinite(m) ? float(m) : 0.0f; };  // a position behind the camera
+    out_.forward_u[at] = finite(forward.x());
+    out_.forward_v[at] = finite(forward.y());
+    if (!backward_) return;
+    out_.backward_u[at] = finite(backward.x());
+    out_.backward_v[at] = finite(backward.y());
   }
 
   const ScreenGeometry& g_;
   const std::vector<Eigen::Vector3d>& next_;
   const std::vector<Eigen::Vector3d> now_;  // the vertices now, homogeneous as next_
+  const std::vector<Eigen::Vector3d>& previous_;
+  const bool backward_;  // the motion to the previous frame is asked for
   const int width_, height_;
   std::vector<double> depth_;
   CharacterLayers out_;
@@ -147,22 +169,28 @@ std::vector<Eigen::Vector3d> NextPixels(const ScreenGeometry& now, const ScreenG
 }
 
 CharacterLayers RasterizeCharacters(const ScreenGeometry& g, const std::vector<Eigen::Vector3d>& next, int width,
-                                    int height) {
-  if (g.w.size() != g.vertices.size() || next.size() != g.vertices.size() || width < 1 || height < 1)
-    throw std::invalid_argument("RasterizeCharacters: a w and a next position per vertex, and a size of at least one pixel");
-  Raster r(g, next, width, height);
+                                    int height, const std::vector<Eigen::Vector3d>* previous) {
+  if (g.w.size() != g.vertices.size() || next.size() != g.vertices.size() || width < 1 || height < 1 ||
+      (previous && previous->size() != g.vertices.size()))
+    throw std::invalid_argument(
+        "RasterizeCharacters: a w, a next (and a previous) position per vertex, and a size of at least one pixel");
+  Raster r(g, next, previous, width, height);
   for (const std::array<int, 3>& t : g.triangles) r.Triangle(t);
   for (const ScreenGeometry::Segment& s : g.segments) r.Segment(s);
   for (const ScreenGeometry::Dot& d : g.dots) r.Dot(d);
   return r.Take();
 }
 
-std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeometry* next) {
+std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeometry* next,
+                                         const ScreenGeometry* previous) {
   const size_t n = size_t(frame.width) * size_t(frame.height);
   if (frame.rgb.size() != 3 * n || frame.depth.size() != n || (!frame.overlay.empty() && frame.overlay.size() != n))
     throw std::invalid_argument("ExrFrameChannels: an image of another size");
+  const std::vector<Eigen::Vector3d> before =
+      frame.blender_motion ? NextPixels(frame.characters, previous ? *previous : ScreenGeometry())
+                           : std::vector<Eigen::Vector3d>();
   CharacterLayers c = RasterizeCharacters(frame.characters, NextPixels(frame.characters, next ? *next : ScreenGeometry()),
-                                          frame.width, frame.height);
+                                          frame.width, frame.height, frame.blender_motion ? &before : nullptr);
   // the characters' R, G, B, A, and terrain.R, G, B, A of the rest only when asked for
   std::vector<ExrChannel> ch = {{"R", {}, true}, {"G", {}, true}, {"B", {}, true}, {"A", {}, true}};
   if (frame.terrain_layer)
@@ -172,7 +200,10 @@ std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeom
     const float a = frame.overlay.empty() || !frame.overlay[i] ? c.alpha[i] : 0.0f;
     for (int k = 0; k < 3; ++k) ch[size_t(k)].data[i] = a * frame.rgb[3 * i + size_t(k)];
     ch[3].data[i] = a;
-    if (a == 0.0f) c.forward_u[i] = c.forward_v[i] = 0.0f;  // under the overlay
+    if (a == 0.0f) {  // under the overlay
+      c.forward_u[i] = c.forward_v[i] = 0.0f;
+      if (frame.blender_motion) c.backward_u[i] = c.backward_v[i] = 0.0f;
+    }
     if (frame.terrain_layer) {
       const float rest = std::isinf(frame.depth[i]) ? 0.0f : 1.0f - a;  // drawn, and not a character
       for (int k = 0; k < 3; ++k) ch[size_t(4 + k)].data[i] = rest * frame.rgb[3 * i + size_t(k)];
@@ -180,13 +211,29 @@ std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeom
     }
   }
   ch.push_back({"depth.Z", frame.depth});
-  ch.push_back({"forward.u", std::move(c.forward_u), true});
-  ch.push_back({"forward.v", std::move(c.forward_v), true});
+  if (frame.blender_motion) {
+    // Blender's Vector pass, as Cycles fills it: X, Y the motion to the previous frame and Z, W
+    // minus the motion to the next (both pixels, y up)
+    std::vector<float> minus_u(n), minus_v(n);
+    for (size_t i = 0; i < n; ++i) {
+      minus_u[i] = -c.forward_u[i];
+      minus_v[i] = -c.forward_v[i];
+    }
+    ch.push_back({"ViewLayer.Vector.X", std::move(c.backward_u), true});
+    ch.push_back({"ViewLayer.Vector.Y", std::move(c.backward_v), true});
+    ch.push_back({"ViewLayer.Vector.Z", std::move(minus_u), true});
+    ch.push_back({"ViewLayer.Vector.W", std::move(minus_v), true});
+  }
+  if (frame.nuke_motion) {
+    ch.push_back({"forward.u", std::move(c.forward_u), true});
+    ch.push_back({"forward.v", std::move(c.forward_v), true});
+  }
   return ch;
 }
 
-void WriteExrFrame(const std::string& path, const ExrFrame& frame, const ScreenGeometry* next, ExrCompression compression) {
-  WriteExrChannels(path, frame.width, frame.height, ExrFrameChannels(frame, next), compression, frame.metadata);
+void WriteExrFrame(const std::string& path, const ExrFrame& frame, const ScreenGeometry* next,
+                   const ScreenGeometry* previous, ExrCompression compression) {
+  WriteExrChannels(path, frame.width, frame.height, ExrFrameChannels(frame, next, previous), compression, frame.metadata);
 }
 
 }  // namespace wobble::pipelines

@@ -2,7 +2,8 @@
 // render driver): the characters' colour with an alpha that covers them alone, the rest of
 // the picture (terrain or ground, springs, trails) as its own layer, the depth, and where each
 // of the characters' pixels is on the next frame (the motion-vector layer, as Nuke's
-// forward.u / forward.v). Which pixels the characters cover and how they move comes from
+// forward.u / forward.v, and as Blender's Vector pass, which also holds the motion to the
+// previous frame). Which pixels the characters cover and how they move comes from
 // their geometry as SceneView drew it (filled shapes and surfaces, outlines, lattices, mass
 // points), projected to pixels and rasterised here on the CPU at pixel centres as OpenGL
 // does, with a depth test, so that a pixel's motion is that of the surface in front. No VTK.
@@ -54,16 +55,18 @@ struct CharacterLayers {
   std::vector<float> alpha;      // 1 where a character covers the pixel's centre, else 0
   std::vector<float> forward_u;  // the covering surface's motion to the next frame, pixels
   std::vector<float> forward_v;  // (0 where nothing covers the pixel)
+  std::vector<float> backward_u;  // and to the previous frame (empty unless asked for)
+  std::vector<float> backward_v;
 };
 
 // Rasterises `g` into a width x height image, sampling at pixel centres: triangles (with
 // perspective-correct weights), segments as rectangles of their width along the line (no
 // caps, as OpenGL's wide lines; every pixel of the width moves with the line's centre), dots
 // as squares (moving with their vertex); the nearest primitive (smallest z) wins, ties to the
-// later one. `next` is NextPixels(g, ...). Primitives with a vertex that is not finite or
-// behind the camera (w <= 0) are skipped.
+// later one. `next` is NextPixels(g, ...), and so is `previous` (null: no motion back).
+// Primitives with a vertex that is not finite or behind the camera (w <= 0) are skipped.
 CharacterLayers RasterizeCharacters(const ScreenGeometry& g, const std::vector<Eigen::Vector3d>& next, int width,
-                                    int height);
+                                    int height, const std::vector<Eigen::Vector3d>* previous = nullptr);
 
 // What the frame buffer held after a render, and the characters drawn: everything of an EXR
 // frame but the motion, which needs the next frame's geometry (a render driver keeps a frame
@@ -76,6 +79,8 @@ struct ExrFrame {
   ScreenGeometry characters;   // the bodies as drawn
   ExrMetadata metadata;        // the camera (and the frame's time, when in a series)
   bool terrain_layer = false;  // write the terrain.R/G/B/A layer (it costs a third of the file's time)
+  bool nuke_motion = true;      // write forward.u/v
+  bool blender_motion = false;  // write ViewLayer.Vector.X/Y/Z/W (four channels: a quarter more time)
 };
 
 // The frame's channels: R, G, B, A of the characters (colour premultiplied by A, A from the
@@ -84,12 +89,17 @@ struct ExrFrame {
 // depth.Z of whatever is nearest;
 // pixels of the 2D overlay are in no layer (its text hides what is under it, so a character
 // under the text has a hole there: render without the overlay for compositing);
-// and forward.u, forward.v: each character pixel's motion to the next frame in pixels (x
-// right, y up; zero without a next frame). Colour, alpha and motion are half floats (motion to
-// 2^-11 of its size: 0.03 px at 60 px), depth 32-bit floats.
-std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeometry* next);
+// and with frame.nuke_motion forward.u, forward.v: each character pixel's motion to the next
+// frame in pixels (x right, y up; zero without a next frame), as Nuke reads it; with
+// frame.blender_motion the same motions as Blender's Vector pass of a multilayer file,
+// ViewLayer.Vector.X, .Y (the motion to the previous frame: zero without one) and .Z, .W
+// (minus the motion to the next), as Cycles writes it. Colour, alpha and motion are half floats (motion to 2^-11 of its size: 0.03 px
+// at 60 px), depth 32-bit floats.
+std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeometry* next,
+                                         const ScreenGeometry* previous = nullptr);
 
 // ExrFrameChannels written atomically to `path` (WriteExrChannels).
-void WriteExrFrame(const std::string& path, const ExrFrame& frame, const ScreenGeometry* next, ExrCompression compression);
+void WriteExrFrame(const std::string& path, const ExrFrame& frame, const ScreenGeometry* next,
+                   const ScreenGeometry* previous, ExrCompression compression);
 
 }  // namespace wobble::pipelines

@@ -582,6 +582,8 @@ ExrFrame SceneView::CaptureExrFrame() {
   f.characters = CharacterGeometry();
   f.metadata = ExrCameraMetadata();
   f.terrain_layer = options_.exr_terrain_layer;
+  f.nuke_motion = options_.exr_nuke_motion;
+  f.blender_motion = options_.exr_blender_motion;
   return f;
 }
 
@@ -669,8 +671,8 @@ void SceneView::WriteExr(const std::string& path, BackgroundWriter* writer, doub
   ExrFrame f = CaptureExrFrame();
   f.metadata.frames_per_second = fps;
   f.metadata.frame = frame;
-  if (!writer) return WriteExrFrame(path, f, nullptr, compression);
-  writer->Submit([path, compression, f = std::move(f)] { WriteExrFrame(path, f, nullptr, compression); });
+  if (!writer) return WriteExrFrame(path, f, nullptr, nullptr, compression);
+  writer->Submit([path, compression, f = std::move(f)] { WriteExrFrame(path, f, nullptr, nullptr, compression); });
 }
 
 bool SceneView::ColorRangeNow(double range[2]) {

@@ -53,6 +53,8 @@ struct SceneOptions {
   double point_size = 8.0, line_width = 3.0;
   ExrCompression exr_compression = ExrCompression::kZip;  // of WriteExr's frames
   bool exr_terrain_layer = false;  // EXR frames: the rest of the picture as terrain.R/G/B/A too
+  bool exr_nuke_motion = true;      // EXR frames: motion as forward.u/v (Nuke)
+  bool exr_blender_motion = false;  // and as ViewLayer.Vector.X/Y/Z/W (Blender)
   int png_compression = 1;                                // zlib level 0-9 of WritePng
   // The interactive viewer (interactive_view.h) draws on screen, in a part of its window:
   // offscreen false opens a visible window; viewport = {xmin, ymin, xmax, ymax} of the window

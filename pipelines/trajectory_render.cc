@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 #include <vtkImageData.h>
 #include <vtkSmartPointer.h>
 
@@ -237,6 +238,8 @@ void ApplyRenderSettings(const scene::RenderSettings& s, RenderOutputs* out) {
   out->camera = s.follow ? RenderOutputs::Camera::kFollow : RenderOutputs::Camera::kWhole;
   out->view.style = s.clean ? RenderStyle::kClean : RenderStyle::kDiagnostic;
   out->view.exr_terrain_layer = s.exr_terrain;
+  out->view.exr_nuke_motion = s.exr_nuke_motion;
+  out->view.exr_blender_motion = s.exr_blender_motion;
 }
 
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out) {
@@ -376,17 +379,25 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   PvdCollection volumes;  // 3D bodies' displacement volumes
   std::vector<vtkSmartPointer<vtkImageData>> panels;
   BackgroundWriter writer;  // files are compressed and written while the next frame renders
-  // An EXR frame waits for the next frame's characters: its motion vectors point to them.
+  // An EXR frame waits for the next frame's characters: its motion vectors point to them (and,
+  // in Blender's Vector pass, to the previous frame's too).
   struct PendingExr {
     std::string path;
     ExrFrame frame;
   };
   std::optional<PendingExr> pending_exr;
+  std::optional<ScreenGeometry> before_pending;  // the characters of the frame before it
   const ExrCompression exr_compression = out.view.exr_compression;
   auto submit_exr = [&](const ScreenGeometry* next) {
     if (!pending_exr) return;
+    std::optional<ScreenGeometry> previous =  // kept only when Blender's pass needs it
+        std::exchange(before_pending, pending_exr->frame.blender_motion ? std::optional<ScreenGeometry>(
+                                                                              pending_exr->frame.characters)
+                                                                        : std::nullopt);
     writer.Submit([p = std::move(*pending_exr), next_copy = next ? std::optional<ScreenGeometry>(*next) : std::nullopt,
-                   exr_compression] { WriteExrFrame(p.path, p.frame, next_copy ? &*next_copy : nullptr, exr_compression); });
+                   previous = std::move(previous), exr_compression] {
+      WriteExrFrame(p.path, p.frame, next_copy ? &*next_copy : nullptr, previous ? &*previous : nullptr, exr_compression);
+    });
     pending_exr.reset();
   };
   Replay replay(run, &world);
@@ -456,7 +467,8 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   if (out.exr)
     report.files.push_back({out.folder + "/exr/frame_NNNN.exr",
                             std::string("characters R, G, B, A; ") + (out.view.exr_terrain_layer ? "terrain.R, G, B, A; " : "") +
-                                "depth.Z; motion to the next frame forward.u, forward.v"});
+                                "depth.Z; motion vectors" + (out.view.exr_nuke_motion ? " forward.u, forward.v" : "") +
+                                (out.view.exr_blender_motion ? " ViewLayer.Vector.X, Y, Z, W" : "")});
   bool any_volume = false;
   for (const DispTarget& d : disp) {
     if (d.depth == 0) {

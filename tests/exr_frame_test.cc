@@ -42,6 +42,46 @@ TEST(CharacterRaster, TriangleCoversThePixelCentresInsideIt) {
   EXPECT_EQ(covered, 55);
 }
 
+// Blender's Vector pass needs the motion to the previous frame too: with a previous position
+// that is another affine map of this one, both motions are exact at every covered pixel, and
+// without a previous frame the motion back is zero.
+TEST(CharacterRaster, MotionToThePreviousFrameIsExactToo) {
+  const std::vector<Eigen::Vector3d> now = {{3, 2, 0.5}, {37, 5, 0.5}, {33, 27, 0.5}, {6, 24, 0.5}};
+  auto mapped = [&](const Eigen::Matrix2d& A, const Eigen::Vector2d& b) {
+    std::vector<Eigen::Vector3d> out;
+    for (const Eigen::Vector3d& v : now) {
+      const Eigen::Vector2d p = A * v.head<2>() + b;
+      out.emplace_back(p.x(), p.y(), 0.5);
+    }
+    return out;
+  };
+  Eigen::Matrix2d A_next, A_before;
+  A_next << 1.05, 0.1, -0.05, 0.95;
+  A_before << 0.9, -0.2, 0.15, 1.1;
+  const Eigen::Vector2d b_next(2.0, 1.5), b_before(-3.25, 4.0);
+  ScreenGeometry g = Flat(now);
+  g.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const std::vector<Eigen::Vector3d> before = NextPixels(g, Flat(mapped(A_before, b_before)));
+  const CharacterLayers c = RasterizeCharacters(g, NextPixels(g, Flat(mapped(A_next, b_next))), 40, 30, &before);
+  const CharacterLayers alone = RasterizeCharacters(g, NextPixels(g, Flat(mapped(A_next, b_next))), 40, 30);
+  int covered = 0;
+  for (int y = 0; y < 30; ++y)
+    for (int x = 0; x < 40; ++x) {
+      if (At(c.alpha, 40, 30, x, y) == 0) continue;
+      const Eigen::Vector2d p(x + 0.5, y + 0.5), forward = A_next * p + b_next - p, back = A_before * p + b_before - p;
+      EXPECT_NEAR(At(c.forward_u, 40, 30, x, y), forward.x(), 1e-4) << x << "," << y;
+      EXPECT_NEAR(At(c.forward_v, 40, 30, x, y), forward.y(), 1e-4) << x << "," << y;
+      EXPECT_NEAR(At(c.backward_u, 40, 30, x, y), back.x(), 1e-4) << x << "," << y;
+      EXPECT_NEAR(At(c.backward_v, 40, 30, x, y), back.y(), 1e-4) << x << "," << y;
+      ++covered;
+    }
+  EXPECT_GT(covered, 600);
+  // without a previous frame the backward layers are not made at all (they cost a raster pass)
+  EXPECT_TRUE(alone.backward_u.empty());
+  EXPECT_TRUE(alone.backward_v.empty());
+  EXPECT_EQ(alone.forward_u, c.forward_u);
+}
+
 TEST(CharacterRaster, AffineMotionIsExactAtEveryCoveredPixel) {
   // a quad of two triangles, its next position an affine map of this one: motion A p + b − p
   const std::vector<Eigen::Vector3d> now = {{3, 2, 0.5}, {37, 5, 0.5}, {33, 27, 0.5}, {6, 24, 0.5}};

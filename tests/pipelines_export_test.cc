@@ -319,6 +319,7 @@ TEST(RenderedExr, ColourAlphaAndDepthAtKnownPixels) {
   for (const char* c : {"R", "G", "B", "A", "terrain.R", "terrain.G", "terrain.B", "terrain.A", "depth.Z", "forward.u",
                         "forward.v"})
     ASSERT_TRUE(img.channels.count(c)) << c;
+  EXPECT_EQ(img.channels.count("ViewLayer.Vector.X"), 0u) << "Blender's pass only when asked for (exr-motion)";
   // pixel (10, 110) is at world (−50 + 10.5·2.5, 200 − 110.5·2.5) = (−23.75, −76.25): the
   // ground band, drawn at z = 0, so its depth is the camera's height above z = 0
   double cam[3];
@@ -497,7 +498,8 @@ TEST(RenderedExr, TheTextOverlayIsInNoLayer) {
 // The render driver writes each EXR frame once the next is drawn: a table in free flight
 // (no gravity, no ground) translates at constant velocity v, so every character pixel of
 // every frame but the last moves v / fps world units (scaled to pixels), and the last, which
-// has no next frame, does not move.
+// has no next frame, does not move. Blender's Vector pass holds the same: X, Y the motion to
+// the previous frame (−v / fps; zero on the first) and Z, W minus the motion to the next.
 TEST(RenderedExr, SeriesMotionPointsToTheNextFrameAndTheLastStandsStill) {
   if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
   WorldOptions o;
@@ -520,6 +522,10 @@ TEST(RenderedExr, SeriesMotionPointsToTheNextFrameAndTheLastStandsStill) {
   out.view.width = 160;
   out.view.height = 120;
   out.view.overlay = false;
+  ApplyRenderSettings(scene::ParseRenderOptions({{"exr-motion", "both"}}), &out);  // Nuke's layer and Blender's pass
+  out.fps = 10;
+  out.view.width = 160;
+  out.view.height = 120;
   World world = WorldFor(*run, o);
   const RenderReport report = RenderTrajectory(world, *run, SceneSpec(), out);
   ASSERT_EQ(report.frames, 4);
@@ -531,7 +537,9 @@ TEST(RenderedExr, SeriesMotionPointsToTheNextFrameAndTheLastStandsStill) {
     EXPECT_EQ(img.channels.count("terrain.A"), 0u);  // the terrain layer is asked for (--exr-terrain)
     // pixels per world unit from the header's worldToNDC (row vectors: x_ndc = x M00 + ...)
     const double sx = (*img.metadata.world_to_ndc)[0] * img.width, sy = -(*img.metadata.world_to_ndc)[5] * img.height;
-    const Eigen::Vector2d expected = k < 3 ? Eigen::Vector2d(v.x() / out.fps * sx, v.y() / out.fps * sy) : Eigen::Vector2d::Zero();
+    const Eigen::Vector2d step(v.x() / out.fps * sx, v.y() / out.fps * sy);
+    const Eigen::Vector2d expected = k < 3 ? step : Eigen::Vector2d::Zero();
+    const Eigen::Vector2d back = k > 0 ? Eigen::Vector2d(-step) : Eigen::Vector2d::Zero();
     int covered = 0;
     for (int y = 0; y < img.height; ++y)
       for (int x = 0; x < img.width; ++x) {
@@ -540,6 +548,10 @@ TEST(RenderedExr, SeriesMotionPointsToTheNextFrameAndTheLastStandsStill) {
         // stored as half floats: to 2^-11 of their size
         ASSERT_NEAR(img.At("forward.u", x, y), expected.x(), 1e-3 + std::abs(expected.x()) / 2048) << x << "," << y;
         ASSERT_NEAR(img.At("forward.v", x, y), expected.y(), 1e-3 + std::abs(expected.y()) / 2048) << x << "," << y;
+        ASSERT_EQ(img.At("ViewLayer.Vector.Z", x, y), -img.At("forward.u", x, y)) << x << "," << y;
+        ASSERT_EQ(img.At("ViewLayer.Vector.W", x, y), -img.At("forward.v", x, y)) << x << "," << y;
+        ASSERT_NEAR(img.At("ViewLayer.Vector.X", x, y), back.x(), 1e-3 + std::abs(back.x()) / 2048) << x << "," << y;
+        ASSERT_NEAR(img.At("ViewLayer.Vector.Y", x, y), back.y(), 1e-3 + std::abs(back.y()) / 2048) << x << "," << y;
       }
     EXPECT_GT(covered, 100);
   }

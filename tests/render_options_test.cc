@@ -50,6 +50,7 @@ TEST(RenderOptions, ValuesParseAsTyped) {
                                                {"camera", "follow"},
                                                {"style", "clean"},
                                                {"exr-terrain", "on"},
+                                               {"exr-motion", "blender"},
                                                {"orbit", "-12.5"}});
   EXPECT_EQ(s.width, 800);
   EXPECT_EQ(s.height, 500);
@@ -59,6 +60,10 @@ TEST(RenderOptions, ValuesParseAsTyped) {
   ASSERT_EQ(s.trail.size(), 2u);
   EXPECT_EQ(s.trail[1], Eigen::Vector2d(1.0, 0.0));
   EXPECT_TRUE(s.follow && s.clean && s.exr_terrain);
+  EXPECT_TRUE(s.exr_blender_motion && !s.exr_nuke_motion);
+  const RenderSettings both = ParseRenderOptions({{"exr-motion", "both"}}), plain = ParseRenderOptions({});
+  EXPECT_TRUE(both.exr_blender_motion && both.exr_nuke_motion);
+  EXPECT_TRUE(!plain.exr_blender_motion && plain.exr_nuke_motion) << "Nuke's forward.u/v by default";
   EXPECT_EQ(s.orbit, -12.5);
   const RenderSettings cycle = ParseRenderOptions({{"filmstrip-cycle", "2 8"}});
   EXPECT_EQ(cycle.filmstrip_cycle, 2);
@@ -75,6 +80,7 @@ TEST(RenderOptions, BadValuesNameTheOptionAndWhatWasExpected) {
   EXPECT_NE(ErrorOf("camera", "orbit").find("expected whole or follow"), std::string::npos);
   EXPECT_NE(ErrorOf("style", "pretty").find("expected diagnostic or clean"), std::string::npos);
   EXPECT_NE(ErrorOf("exr-terrain", "maybe").find("expected on or off"), std::string::npos);
+  EXPECT_NE(ErrorOf("exr-motion", "natron").find("expected nuke, blender or both"), std::string::npos);
   EXPECT_NE(ErrorOf("trail", "0.5").find("pairs"), std::string::npos);
   EXPECT_NE(ErrorOf("filmstrip-cycle", "-1").find("cycle K >= 0"), std::string::npos);
   EXPECT_NE(ErrorOf("sizes", "1x1").find("unknown option (azimuth,"), std::string::npos);

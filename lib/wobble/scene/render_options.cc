@@ -35,6 +35,9 @@ const std::vector<RenderOptionInfo>& RenderOptionTable() {
        "EXR frames: write the rest of the picture (terrain or ground, springs, trails) as its own layer terrain.R,G,B,A "
        "too (the characters' R,G,B,A are always written)",
        true},
+      {"exr-motion", "nuke|blender|both", "nuke",
+       "EXR frames: the motion vectors as Nuke's forward.u,v (to the next frame), as Blender's Vector pass "
+       "ViewLayer.Vector.X,Y,Z,W (to the previous frame and from the next; four channels more per frame), or both"},
       {"trail", "\"S T ..\"", "", "Trace points given by lattice coordinates \"s t s t ..\" in the frames"},
   };
   return table;
@@ -149,6 +152,13 @@ RenderSettings ParseRenderOptions(const std::map<std::string, std::string>& valu
     if (text("exr-terrain") != "on" && text("exr-terrain") != "off")
       throw RenderOptionError("exr-terrain", "expected on or off, got '" + text("exr-terrain") + "'");
     s.exr_terrain = text("exr-terrain") == "on";
+  }
+  if (has("exr-motion")) {
+    const std::string m = text("exr-motion");
+    if (m != "nuke" && m != "blender" && m != "both")
+      throw RenderOptionError("exr-motion", "expected nuke, blender or both, got '" + m + "'");
+    s.exr_nuke_motion = m != "blender";
+    s.exr_blender_motion = m != "nuke";
   }
   return s;
 }

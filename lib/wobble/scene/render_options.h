@@ -52,6 +52,8 @@ struct RenderSettings {
   bool follow = false;       // camera=follow; else whole
   bool clean = false;        // style=clean; else diagnostic
   bool exr_terrain = false;  // EXR frames: the terrain as its own layer too
+  // EXR frames' motion vectors: Nuke's forward.u/v, Blender's Vector pass, or both (exr-motion)
+  bool exr_nuke_motion = true, exr_blender_motion = false;
 };
 
 // Values by name as typed (a flag's value "on"); the rest keep their defaults. Throws
