@@ -450,7 +450,7 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
     return true;
   };
   Adjoint lambda{Eigen::VectorXd::Zero(nq), Eigen::VectorXd::Zero(nq), {}};
-  if (!internal::CheckpointedAdjointSweep(N, interval, r.Start(), &lambda, step, vjp, stage, &g.states_held)) return g;
+  if (!internal::CheckpointedAdjointSweep(N, interval, r.Start(), &lambda, step, step, vjp, stage, &g.states_held)) return g;
   g.q0 = lambda.q;
   g.qd0 = lambda.qd;
   r.StartVjp(lambda, &g.q0, &g.qd0);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "wobble/fit/internal/adjoint_sweep.h"
 #include "wobble/fit/internal/mode_force.h"
@@ -60,15 +61,28 @@ class Rollout3 {
     return true;
   }
 
-  // λ_n from λ_{n+1} = `out` through step n from state s; adds the step's part of the gains'
-  // gradient to *g and sets its targets' column.
-  bool StepVjp(int n, const BodyState3<double>& s, const StateAdjoint3& out, StateAdjoint3* in, RolloutGradient3* g,
-               std::string* why) const {
+  // Step n from *s like Step, keeping its tape (internal/step3_vjp.h) for StepVjp.
+  bool Record(int n, BodyState3<double>* s, internal::StepTape3* tape, std::string* why) const {
     const VecD<double> target = r_.targets.col(n);
-    const internal::StepModel3 model{passive_, r_.world, r_.integrator, r_.dt, params_};
+    const StepStatus st = internal::RecordStep3(Model(), target, *s, tape, s);
+    if (!st.ok()) return internal::StepFailed(n, StatusCodeName(st.code), why);
+    return true;
+  }
+
+  // λ_n from λ_{n+1} = `out` through step n from state s, whose tape is `tape` (null: taken
+  // again here); adds the step's part of the gains' gradient to *g and sets its targets' column.
+  bool StepVjp(int n, const BodyState3<double>& s, const internal::StepTape3* tape, const StateAdjoint3& out,
+               StateAdjoint3* in, RolloutGradient3* g, std::string* why) const {
+    const VecD<double> target = r_.targets.col(n);
+    internal::StepTape3 fresh;
+    if (!tape) {
+      BodyState3<double> next;
+      const StepStatus st = internal::RecordStep3(Model(), target, s, &fresh, &next);
+      if (!st.ok()) return internal::StepFailed(n, StatusCodeName(st.code) + " (differentiated step)", why);
+      tape = &fresh;
+    }
     internal::ControlAdjoint3 controls{{}, &g->stiffness, &g->damping};
-    const StepStatus st = internal::StepVjp3(model, target, s, out, in, &controls);
-    if (!st.ok()) return internal::StepFailed(n, StatusCodeName(st.code) + " (differentiated step)", why);
+    internal::StepVjp3(Model(), target, s, *tape, out, in, &controls);
     g->targets.col(n) = controls.target;
     return true;
   }
@@ -80,6 +94,8 @@ class Rollout3 {
   }
 
  private:
+  internal::StepModel3 Model() const { return {passive_, r_.world, r_.integrator, r_.dt, params_}; }
+
   const BodyModel3 passive_;
   const ControlledRollout3& r_;
   ModeParams<double> params_;
@@ -118,13 +134,25 @@ RolloutGradient3 RolloutCostGradient3(const BodyModel3& body, const ControlledRo
     lambda->z += dz;
   };
   auto step = [&](int n, BodyState3<double>* s) { return r.Step(n, s, &g.message); };
+  // The recompute of an interval keeps each step's tape (slot n mod interval; `taped` says
+  // which step a slot holds), so the product does not evaluate the step a third time: about
+  // one simulation less per gradient (the interval's last step has none and is taken again).
+  const int interval = internal::CheckpointInterval(N, checkpoint_interval);
+  std::vector<internal::StepTape3> tapes(size_t(std::min(interval, std::max(N, 1))));
+  std::vector<int> taped(tapes.size(), -1);
+  auto recompute = [&](int n, BodyState3<double>* s) {
+    const size_t slot = size_t(n % int(tapes.size()));
+    taped[slot] = n;
+    return r.Record(n, s, &tapes[slot], &g.message);
+  };
   auto vjp = [&](int n, const BodyState3<double>& state, const BodyState3<double>&, const StateAdjoint3& out,
                  StateAdjoint3* in) {
-    return r.StepVjp(n, state, out, in, &g, &g.message);
+    const size_t slot = size_t(n % int(tapes.size()));
+    return r.StepVjp(n, state, taped[slot] == n ? &tapes[slot] : nullptr, out, in, &g, &g.message);
   };
   StateAdjoint3 lambda{Eigen::VectorXd::Zero(nz), {}};
-  if (!internal::CheckpointedAdjointSweep(N, internal::CheckpointInterval(N, checkpoint_interval), r.Start(), &lambda,
-                                          step, vjp, stage, &g.states_held))
+  if (!internal::CheckpointedAdjointSweep(N, interval, r.Start(), &lambda, step, recompute, vjp, stage,
+                                          &g.states_held))
     return g;
   g.start = lambda.z;
   r.StartVjp(lambda, &g.start);

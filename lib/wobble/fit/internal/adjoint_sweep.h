@@ -59,12 +59,15 @@ inline int CheckpointInterval(int steps, int requested) {
 // interval at a time recomputed from its checkpoint, so about 2√steps states are held at once
 // (*states_held: the most). On entry *lambda is the zero adjoint of a state; on return, λ_0.
 //   step(n, &state) → bool       advances state n to n + 1
+//   recompute(n, &state) → bool  the same, in the backward sweep's recompute of an interval
+//                                (steps begin … end − 2 of it, in order): where the product
+//                                can keep what the step computed (3D: StepTape3)
 //   vjp(n, state, next, λ_{n+1}, &λ_n) → bool
 //   stage(n, state, &λ)          adds ℓ_n's value to the cost and its gradient to λ
 // Returns false as soon as step or vjp does (they say why).
-template <class State, class Adjoint, class Step, class Vjp, class Stage>
+template <class State, class Adjoint, class Step, class Recompute, class Vjp, class Stage>
 bool CheckpointedAdjointSweep(int steps, int interval, const State& start, Adjoint* lambda, const Step& step,
-                              const Vjp& vjp, const Stage& stage, int* states_held) {
+                              const Recompute& recompute, const Vjp& vjp, const Stage& stage, int* states_held) {
   std::vector<State> checkpoints;
   State last = start;
   for (int n = 0; n < steps; ++n) {
@@ -79,7 +82,7 @@ bool CheckpointedAdjointSweep(int steps, int interval, const State& start, Adjoi
     segment.assign(1, checkpoints[size_t(c)]);
     for (int n = begin; n + 1 < end; ++n) {
       segment.push_back(segment.back());
-      if (!step(n, &segment.back())) return false;
+      if (!recompute(n, &segment.back())) return false;
     }
     *states_held = std::max(*states_held, int(checkpoints.size() + segment.size()));
     for (int n = end - 1; n >= begin; --n) {

@@ -293,53 +293,69 @@ void PullAccelerations(const StepModel3& m, const VecD<double>& target, const Bo
 
 }  // namespace
 
-StepStatus StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& s,
-                    const StateAdjoint3& out, StateAdjoint3* in, ControlAdjoint3* controls) {
+StepStatus RecordStep3(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& s,
+                       StepTape3* tape, BodyState3<double>* next) {
   const BodyModel3& body = m.passive;
   const MassMoments3& mm = body.moments();
-  const int D = body.num_modes(), nv = kRigidDofs3 + D;
-  const Tangent ix(D);
   const double h = m.dt;
   const bool thesis = m.integrator == Integrator::kThesis;
-
-  // The forward step again: accelerations at `eval` (the start for the thesis integrator, the
-  // advanced configuration for the symplectic one), keeping M's factor for λ_r.
-  BodyState3<double> eval = s;
-  if (!thesis) AdvanceConfiguration3(s.v, h, &eval);
-  const Frame3<double> frame(eval.t, eval.orientation);
-  const ShapeMoments3<double> sm(mm, eval.gamma);
+  // accelerations at `eval`: the start for the thesis integrator, the advanced configuration
+  // for the symplectic one (StepBody3 and Accelerations3, operation for operation)
+  tape->eval = s;
+  if (!thesis) AdvanceConfiguration3(s.v, h, &tape->eval);
+  const BodyState3<double>& eval = tape->eval;
+  const Frame3<double>& frame = tape->frame.emplace(eval.t, eval.orientation);
+  const ShapeMoments3<double>& sm = tape->moments.emplace(mm, eval.gamma);
+  VecQ3<double> w;
+  VelocityTerms3(mm, sm, frame.R, eval.v, &w);
   ForceBreakdown3<double> forces;
   EvaluateForces3(body, m.world, eval, frame, sm, &forces);
   ModeForce<double>{&m.gains, &target}(eval, &forces.total);
-  VecQ3<double> w;
-  VelocityTerms3(mm, sm, frame.R, eval.v, &w);
-  MatQ3<double> M;
-  MassMatrix3(mm, sm, frame.R, &M);
-  if (!CholeskyInPlace(&M)) return {StatusCode::kSingularMass, 0.0};
-  VecQ3<double> a = forces.total - w;
-  CholeskySolveInPlace(M, &a);
-  BodyState3<double> after = eval;  // the state after the step, with the contacts before it
-  after.v = eval.v + h * a;
-  if (thesis) AdvanceConfiguration3(after.v, h, &after);
+  MassMatrix3(mm, sm, frame.R, &tape->mass_factor);
+  if (!CholeskyInPlace(&tape->mass_factor)) {
+    if (!forces.total.allFinite()) return {StatusCode::kOverflowingForce, 0.0};
+    return {StatusCode::kSingularMass, 0.0};
+  }
+  double lo = HUGE_VAL, hi = 0.0;
+  CholeskyPivotRange(tape->mass_factor, &lo, &hi);
+  tape->a = forces.total - w;
+  CholeskySolveInPlace(tape->mass_factor, &tape->a);
+  if (hi / lo > m.world.max_condition) return {StatusCode::kIllConditioned, hi / lo};
+  tape->after = eval;  // the state after the step, with the contacts before it
+  tape->after.v += h * tape->a;
+  if (thesis) AdvanceConfiguration3(tape->after.v, h, &tape->after);
+  const BodyState3<double>& after = tape->after;
+  if (!after.v.allFinite() || !after.t.allFinite() || !after.gamma.allFinite() ||
+      !after.orientation.coeffs().allFinite())
+    return {StatusCode::kNonFinite, 0.0};
+  *next = after;
+  UpdateContacts3(body, m.world.ground, next);
+  return {};
+}
 
+void StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& s, const StepTape3& tape,
+              const StateAdjoint3& out, StateAdjoint3* in, ControlAdjoint3* controls) {
+  const int D = m.passive.num_modes(), nv = kRigidDofs3 + D;
+  const Tangent ix(D);
+  const double h = m.dt;
+  const bool thesis = m.integrator == Integrator::kThesis;
   // backwards: the contact update at `after`, the thesis integrator's advance by v', then
   // v' = v + h a(eval), then the symplectic integrator's advance by v
   in->anchor.clear();
   in->z = out.z;
-  PullContactUpdate(body, m.world.ground, after, out.anchor, ix, &in->z, &in->anchor);
+  PullContactUpdate(m.passive, m.world.ground, tape.after, out.anchor, ix, &in->z, &in->anchor);
   VecQ3<double> lambda_v = in->z.tail(nv);
-  if (thesis) PullAdvance(after.v, h, ix, &in->z, &lambda_v);
+  if (thesis) PullAdvance(tape.after.v, h, ix, &in->z, &lambda_v);
   VecQ3<double> lr = h * lambda_v;
-  CholeskySolveInPlace(M, &lr);
+  CholeskySolveInPlace(tape.mass_factor, &lr);
   in->z.tail(nv) = lambda_v;
   controls->target = VecD<double>::Zero(D);
-  PullAccelerations(m, target, eval, frame, sm, a, lr, ix, in, controls);
+  PullAccelerations(m, target, tape.eval, *tape.frame, *tape.moments, tape.a, lr, ix, in, controls);
   if (!thesis) {
     VecQ3<double> lambda_u = VecQ3<double>::Zero(nv);
     PullAdvance(s.v, h, ix, &in->z, &lambda_u);
     in->z.tail(nv) += lambda_u;
   }
-  return {};
 }
 
 void StartContactsVjp3(const BodyModel3& passive, const GroundPlane& ground, BodyState3<double> s,

@@ -18,9 +18,11 @@
 
 #include <Eigen/Core>
 #include <map>
+#include <optional>
 #include <utility>
 
 #include "wobble/body/body_model.h"
+#include "wobble/dynamics/kinematics3.h"
 #include "wobble/dynamics/step3.h"
 #include "wobble/fit/internal/mode_force.h"
 
@@ -51,11 +53,29 @@ struct ControlAdjoint3 {
   Eigen::VectorXd *stiffness, *damping;  // the gains' (added to, across steps)
 };
 
+// What the product needs of the forward step from s (StepBody3's thesis or symplectic step,
+// the same operations in the same order): where the accelerations were evaluated, the mass
+// matrix's Cholesky factor there, the accelerations, and the state after the step before its
+// contact update. The adjoint's recompute keeps one per step of an interval, so the product
+// does not factor M a second time.
+struct StepTape3 {
+  BodyState3<double> eval, after;
+  std::optional<Frame3<double>> frame;
+  std::optional<ShapeMoments3<double>> moments;
+  MatQ3<double> mass_factor;
+  VecQ3<double> a;
+};
+
+// One step from s with PD targets `target`, as StepBody3 takes it, keeping its tape: *next is
+// StepBody3's result (contacts updated). Fails as StepBody3 does.
+StepStatus RecordStep3(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& s,
+                       StepTape3* tape, BodyState3<double>* next);
+
 // in = λ of state s from out = λ of the state after the step taken from s with PD targets
-// `target`; adds the gains' part to controls->stiffness/damping and sets controls->target.
-// Fails as the step does (a singular mass matrix).
-StepStatus StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& s,
-                    const StateAdjoint3& out, StateAdjoint3* in, ControlAdjoint3* controls);
+// `target` (whose tape RecordStep3 kept); adds the gains' part to controls->stiffness/damping
+// and sets controls->target.
+void StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& s, const StepTape3& tape,
+              const StateAdjoint3& out, StateAdjoint3* in, ControlAdjoint3* controls);
 
 // The start's contact update (UpdateContacts3 on `s`, whose contacts are ignored): adds the
 // part of ∂cost/∂z that reaches s through the anchors it gives.
