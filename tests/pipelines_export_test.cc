@@ -44,6 +44,8 @@
 #include "wobble/record/trajectory.h"
 #include "pipelines/scene_view.h"
 #include "support/pipelines_test_util.h"
+#include "support/test_bodies.h"
+#include "wobble/dynamics/heightfield.h"
 #include "wobble/formats/atomic_file.h"
 
 namespace wobble::pipelines {
@@ -446,6 +448,68 @@ TEST(RenderedExr, CharactersAlphaAndMotionOfARigidMotionAtEveryPixel) {
     }
     EXPECT_GT(interior_checked, 100);
   }
+}
+
+// A 3D heightfield is terrain: with the terrain layer asked for, every interior grid node in view
+// (a point of the drawn surface, found through the header's worldToNDC) is in terrain.R,G,B,A and
+// not in the characters' A, its depth.Z is the node's worldToCamera z, and the chair floating
+// above it is in A. No pixel is in both layers.
+TEST(RenderedExr, A3dHeightfieldIsTheTerrainLayer) {
+  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
+  const int nx = 13, nz = 13;
+  const Eigen::Vector2d origin(-300.0, -300.0), spacing(50.0, 50.0);
+  std::vector<double> heights;
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) heights.push_back(60.0 + 0.15 * (origin.x() + spacing.x() * i));  // a slope in x
+  WorldOptions o;
+  o.ground_3d.enabled = true;
+  o.ground_3d.heightfield = Heightfield::Make(origin, spacing, nx, nz, heights);
+  World world(o);
+  world.AddBody(std::make_shared<const BodyModel3>(testing::Chair3()));
+  world.SetState3(0, Eigen::Vector3d(-50, 200, -30), Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())),
+                  Eigen::VectorXd::Zero(3), Eigen::VectorXd::Zero(9));
+  SceneOptions opt;
+  opt.width = 320;
+  opt.height = 240;
+  opt.overlay = false;
+  opt.elevation = 30;
+  opt.exr_terrain_layer = true;
+  SceneView view(&world, opt);
+  view.FrameBounds(Eigen::AlignedBox3d(Eigen::Vector3d(-250, 0, -250), Eigen::Vector3d(250, 320, 250)));
+  view.Render();
+  const ExrFrame frame = view.CaptureExrFrame();
+  ASSERT_TRUE(frame.metadata.world_to_ndc && frame.metadata.world_to_camera);
+  std::map<std::string, std::vector<float>> ch;
+  for (ExrChannel& c : ExrFrameChannels(frame, nullptr)) ch[c.name] = std::move(c.data);
+  auto times = [](const Eigen::Vector3d& p, const std::array<float, 16>& m) {  // p M, row vector
+    Eigen::Vector4d r = Eigen::Vector4d::Zero();
+    for (int j = 0; j < 4; ++j)
+      r[j] = p.x() * m[size_t(j)] + p.y() * m[size_t(4 + j)] + p.z() * m[size_t(8 + j)] + m[size_t(12 + j)];
+    return Eigen::Vector3d(r[0] / r[3], r[1] / r[3], r[2] / r[3]);
+  };
+  int nodes = 0;
+  for (int j = 1; j + 1 < nz; ++j)  // the interior nodes: a border node's pixel is half off the surface
+    for (int i = 1; i + 1 < nx; ++i) {
+      const Eigen::Vector3d node(origin.x() + spacing.x() * i, heights[size_t(i + nx * j)], origin.y() + spacing.y() * j);
+      const Eigen::Vector3d ndc = times(node, *frame.metadata.world_to_ndc);
+      const int px = int(ndc.x() * opt.width), py = int(ndc.y() * opt.height);
+      if (px < 2 || py < 2 || px >= opt.width - 2 || py >= opt.height - 2) continue;
+      const size_t at = size_t(py) * opt.width + px;
+      if (ch.at("A")[at] > 0.0f) continue;  // behind the chair
+      SCOPED_TRACE(std::to_string(i) + ", " + std::to_string(j));
+      EXPECT_EQ(ch.at("terrain.A")[at], 1.0f);
+      EXPECT_GT(ch.at("terrain.R")[at] + ch.at("terrain.G")[at] + ch.at("terrain.B")[at], 0.0f);
+      const double z = times(node, *frame.metadata.world_to_camera).z();
+      EXPECT_NEAR(ch.at("depth.Z")[at], z, 0.01 * z);
+      ++nodes;
+    }
+  EXPECT_GE(nodes, 40);
+  int chair = 0;
+  for (size_t k = 0; k < ch.at("A").size(); ++k) {
+    EXPECT_LE(ch.at("A")[k] + ch.at("terrain.A")[k], 1.0f) << k;
+    chair += ch.at("A")[k] == 1.0f;
+  }
+  EXPECT_GT(chair, 500);
 }
 
 // The 2D overlay (title, time, energy) is drawn at window depth 0, which no geometry reaches:
