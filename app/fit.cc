@@ -349,7 +349,7 @@ FitCommands AddFitCommand(CLI::App* app, FitPoseArgs* pose, FitTrajectoryArgs* t
   c.trajectory->add_option("--qdot0", traj->qdot0, "Dynamic: starting q-dot (default: from the first two frames)");
   c.trajectory->add_option("--gradient", traj->gradient,
                            "Dynamic: jets (Levenberg-Marquardt, Jacobians by forward-mode Jets) or adjoint (BFGS on "
-                           "the adjoint gradient, a few simulations whatever the parameters; 2D)")
+                           "the adjoint gradient, a few simulations whatever the parameters; 2D and 3D)")
       ->check(CLI::IsMember({"jets", "adjoint"}))
       ->capture_default_str();
   c.trajectory->add_flag("--anneal", traj->anneal, "Dynamic: also run simulated annealing with the same number of simulations");
@@ -664,10 +664,7 @@ template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shar
     o.dt = a.dt;
     o.max_iterations = po.max_iterations;
     o.full_report = po.full_report;
-    if (a.gradient == "adjoint") {
-      if (Dim == 3) throw UsageError("--gradient adjoint: the adjoint takes 2D bodies (3D fits use jets)");
-      o.gradient = fit::FitGradient::kAdjoint;
-    }
+    if (a.gradient == "adjoint") o.gradient = fit::FitGradient::kAdjoint;
     o.fit_q0 = o.fit_qd0 = o.fit_stiffness = o.fit_damping = false;
     std::stringstream what(a.fit_what);
     for (std::string item; std::getline(what, item, ',');) {

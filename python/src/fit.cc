@@ -199,7 +199,6 @@ template <int Dim> void BindDynamicFit(py::module_& m) {
         o.switch_width = switch_width;
         o.max_iterations = max_iterations;
         if (gradient != "jets" && gradient != "adjoint") throw InputError("gradient: expected 'jets' or 'adjoint', got '" + gradient + "'");
-        if (gradient == "adjoint" && Dim == 3) throw InputError("gradient='adjoint': 2D bodies only (the 3D body has no adjoint yet)");
         o.gradient = gradient == "adjoint" ? fit::FitGradient::kAdjoint : fit::FitGradient::kJets;
         return WithCtrlC([&] { return fit::FitDynamicTrajectory(*body, frames, start, o); });
       },

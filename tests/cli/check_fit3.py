@@ -111,6 +111,17 @@ c_err = max(abs(c / 2e4 - 1) for c in j["damping"])
 v_err = max(abs(a - b) for a, b in zip(j["qdot0"], [20, 40, 0, 1, 2, -1, 0, 0, 0]))
 check(k_err < 1e-6 and c_err < 1e-5 and v_err < 1e-6,
       f"stiffness, damping and q-dot0 recovered (relative {k_err:.2g}, {c_err:.2g}; |dv| {v_err:.2g})")
+# the same fit on the 3D adjoint gradient (BFGS): the same numbers
+r = run("fit", "trajectory", "--object", f"{data}/pot3.obj", "--modes", start, "--reference", sim, "--every", "5",
+        "--points", ",".join(str(k) for k in range(0, 627, 50)), "--dynamic", "--dt", "0.005", "--no-ground",
+        "--gradient", "adjoint", "--max-iterations", "2000", "--out", f"{work}/dyn_adjoint.json")
+check(r.returncode == 0, "fit trajectory --dynamic --gradient adjoint (3D) exits 0: " + r.stderr.strip())
+j = json.load(open(f"{work}/dyn_adjoint.json"))
+k_err = max(abs(k / 2e6 - 1) for k in j["stiffness"])
+c_err = max(abs(c / 2e4 - 1) for c in j["damping"])
+v_err = max(abs(a - b) for a, b in zip(j["qdot0"], [20, 40, 0, 1, 2, -1, 0, 0, 0]))
+check(j["gradient"] == "adjoint" and k_err < 1e-6 and c_err < 1e-5 and v_err < 1e-6,
+      f"the adjoint fit recovers the same (relative {k_err:.2g}, {c_err:.2g}; |dv| {v_err:.2g})")
 
 # bad 3D input: exit 2, file and line, nothing written
 out = f"{work}/never.json"

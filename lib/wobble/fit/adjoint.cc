@@ -463,15 +463,15 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
 }
 
 namespace {
-void CheckGraph(const BodyModel& body, const control::PoseGraph& graph, double width) {
+template <int Dim> void CheckGraph(const BodyModelN<Dim>& body, const control::PoseGraph& graph, double width) {
   const std::string invalid = graph.Validate(int(control::ActiveModes(body).size()));
   if (!invalid.empty()) throw std::invalid_argument("pose graph: " + invalid);
   if (!(width > 0.0) || !std::isfinite(width)) throw std::invalid_argument("pose graph: the switch width must be > 0");
 }
-}  // namespace
 
-Eigen::MatrixXd PoseGraphTargets(const BodyModel& body, const control::PoseGraph& graph, double dt, int steps,
-                                 double width) {
+template <int Dim>
+Eigen::MatrixXd PoseGraphTargetsOf(const BodyModelN<Dim>& body, const control::PoseGraph& graph, double dt, int steps,
+                                   double width) {
   CheckGraph(body, graph, width);
   const control::PoseGraphOf<double> c = control::PoseGraphOf<double>::From(body, graph);
   Eigen::MatrixXd targets(body.num_modes(), steps);
@@ -479,8 +479,9 @@ Eigen::MatrixXd PoseGraphTargets(const BodyModel& body, const control::PoseGraph
   return targets;
 }
 
-PoseGraphGradient PoseGraphGradientOf(const BodyModel& body, const control::PoseGraph& graph, double dt,
-                                      double width, const Eigen::MatrixXd& target_gradient) {
+template <int Dim>
+PoseGraphGradient PoseGraphGradientFor(const BodyModelN<Dim>& body, const control::PoseGraph& graph, double dt,
+                                       double width, const Eigen::MatrixXd& target_gradient) {
   CheckGraph(body, graph, width);
   const int D = body.num_modes(), steps = int(target_gradient.cols());
   if (target_gradient.rows() != D) throw std::invalid_argument("pose graph gradient: one row per mode needed");
@@ -509,6 +510,24 @@ PoseGraphGradient PoseGraphGradientOf(const BodyModel& body, const control::Pose
   for (int i = 0; i < poses; ++i) g.poses.push_back(grad.segment(i * entries, entries));
   for (size_t i = 0; i < graph.durations.size(); ++i) g.durations.push_back(grad[poses * entries + int(i)]);
   return g;
+}
+}  // namespace
+
+Eigen::MatrixXd PoseGraphTargets(const BodyModel& body, const control::PoseGraph& graph, double dt, int steps,
+                                 double width) {
+  return PoseGraphTargetsOf(body, graph, dt, steps, width);
+}
+Eigen::MatrixXd PoseGraphTargets(const BodyModel3& body, const control::PoseGraph& graph, double dt, int steps,
+                                 double width) {
+  return PoseGraphTargetsOf(body, graph, dt, steps, width);
+}
+PoseGraphGradient PoseGraphGradientOf(const BodyModel& body, const control::PoseGraph& graph, double dt,
+                                      double width, const Eigen::MatrixXd& target_gradient) {
+  return PoseGraphGradientFor(body, graph, dt, width, target_gradient);
+}
+PoseGraphGradient PoseGraphGradientOf(const BodyModel3& body, const control::PoseGraph& graph, double dt,
+                                      double width, const Eigen::MatrixXd& target_gradient) {
+  return PoseGraphGradientFor(body, graph, dt, width, target_gradient);
 }
 
 }  // namespace wobble::fit

@@ -70,8 +70,10 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
                                     int checkpoint_interval = 0);
 
 // A smoothed pose-graph controller (control::SmoothPoseTargets, switch width w > 0) as
-// per-step targets: column n is γ0(n dt), the dynamic fit's convention.
+// per-step targets: column n is γ0(n dt), the dynamic fit's convention. 2D or 3D body.
 Eigen::MatrixXd PoseGraphTargets(const BodyModel& body, const control::PoseGraph& graph, double dt, int steps,
+                                 double width);
+Eigen::MatrixXd PoseGraphTargets(const BodyModel3& body, const control::PoseGraph& graph, double dt, int steps,
                                  double width);
 
 // The chain rule through PoseGraphTargets: from ∂cost/∂γ0(n) (RolloutGradient::targets) to
@@ -81,6 +83,8 @@ struct PoseGraphGradient {
   std::vector<double> durations;
 };
 PoseGraphGradient PoseGraphGradientOf(const BodyModel& body, const control::PoseGraph& graph, double dt,
+                                      double width, const Eigen::MatrixXd& target_gradient);
+PoseGraphGradient PoseGraphGradientOf(const BodyModel3& body, const control::PoseGraph& graph, double dt,
                                       double width, const Eigen::MatrixXd& target_gradient);
 
 }  // namespace wobble::fit

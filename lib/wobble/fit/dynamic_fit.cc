@@ -194,8 +194,7 @@ DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<R
 }
 DynamicFitResult FitDynamicTrajectory(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
                                       const DynamicParameters& initial, const DynamicFitOptions& o) {
-  if (o.gradient == FitGradient::kAdjoint)
-    throw std::invalid_argument("dynamic fit: the adjoint gradient takes 2D bodies (3D fits use Jets)");
+  if (o.gradient == FitGradient::kAdjoint) return FitDynamicByAdjoint(body, frames, initial, o);
   return FitDynamic(body, frames, initial, o);
 }
 

@@ -307,5 +307,7 @@ double CostOf(const BodyModelN<Dim>& body, const std::vector<typename Dimension<
 // kAdjoint): dynamic_fit_adjoint.cc.
 DynamicFitResult FitDynamicByAdjoint(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
                                      const DynamicParameters& initial, const DynamicFitOptions& o);
+DynamicFitResult FitDynamicByAdjoint(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
+                                     const DynamicParameters& initial, const DynamicFitOptions& o);
 
 }  // namespace wobble::fit::internal
