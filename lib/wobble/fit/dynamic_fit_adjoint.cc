@@ -85,6 +85,21 @@ struct BlockGradient {
   Eigen::MatrixXd targets;
 };
 
+// step → the frames observed there
+std::vector<std::vector<int>> FramesAt(const std::vector<int>& steps) {
+  std::vector<std::vector<int>> at(size_t(steps.back()) + 1);
+  for (size_t f = 0; f < steps.size(); ++f) at[size_t(steps[f])].push_back(int(f));
+  return at;
+}
+
+// The gains' and targets' parts of a rollout gradient (2D or 3D), moved into *g.
+template <class Gradient> void TakeControls(Gradient* r, BlockGradient* g) {
+  g->cost = r->cost;
+  g->stiffness = std::move(r->stiffness);
+  g->damping = std::move(r->damping);
+  g->targets = std::move(r->targets);
+}
+
 // The rollout of each dimension: Run fills *g (with gradient) or only g->cost; false when the
 // simulation fails.
 template <int Dim> class FitRollout;
@@ -93,8 +108,7 @@ template <> class FitRollout<2> {
  public:
   FitRollout(const Reference<2>& ref, const DynamicFitOptions& o) {
     cost_.ref = &ref;
-    cost_.frames_at.resize(ref.steps.back() + 1);
-    for (size_t f = 0; f < ref.steps.size(); ++f) cost_.frames_at[ref.steps[f]].push_back(int(f));
+    cost_.frames_at = FramesAt(ref.steps);
     rollout_.world = o.world;
     rollout_.integrator = Integrator::kThesis;
     rollout_.dt = o.dt;
@@ -114,12 +128,9 @@ template <> class FitRollout<2> {
     }
     RolloutGradient r = RolloutCostGradient(body, rollout_, stage);
     if (!r.ok) return false;
-    g->cost = r.cost;
+    TakeControls(&r, g);
     g->q0 = std::move(r.q0);
     g->qd0 = std::move(r.qd0);
-    g->stiffness = std::move(r.stiffness);
-    g->damping = std::move(r.damping);
-    g->targets = std::move(r.targets);
     return true;
   }
 
@@ -132,8 +143,7 @@ template <> class FitRollout<3> {
  public:
   FitRollout(const Reference<3>& ref, const DynamicFitOptions& o) {
     cost_.ref = &ref;
-    cost_.frames_at.resize(ref.steps.back() + 1);
-    for (size_t f = 0; f < ref.steps.size(); ++f) cost_.frames_at[ref.steps[f]].push_back(int(f));
+    cost_.frames_at = FramesAt(ref.steps);
     rollout_.world = o.world3;
     rollout_.integrator = Integrator::kThesis;
     rollout_.dt = o.dt;
@@ -158,16 +168,13 @@ template <> class FitRollout<3> {
     }
     RolloutGradient3 r = RolloutCostGradient3(body, rollout_, stage);
     if (!r.ok) return false;
-    g->cost = r.cost;
+    TakeControls(&r, g);
     // z = (δt, ε, δγ, δv); the block's δ moves R = chart exp(δ̂) by ε = J_r(δ) δδ
     g->q0.resize(kRigidDofs3 + D);
     g->q0.head<3>() = r.start.head<3>();
     g->q0.segment<3>(3) = RightJacobianExp<double>(delta).transpose() * r.start.segment<3>(3);
     g->q0.tail(D) = r.start.segment(6, D);
     g->qd0 = r.start.tail(kRigidDofs3 + D);
-    g->stiffness = std::move(r.stiffness);
-    g->damping = std::move(r.damping);
-    g->targets = std::move(r.targets);
     return true;
   }
 
