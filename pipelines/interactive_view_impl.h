@@ -64,6 +64,7 @@ struct InteractiveView::Impl {
   std::shared_ptr<control::ModeTargetController> sliders;
   Eigen::VectorXd slider_targets;  // kept over a restart
   long session_steps = 0;
+  long key_steps = 0;  // of session_steps, the keys' (set at the hand-over)
   int drags = 0;
   long first_drag_step = -1;
   std::vector<Eigen::VectorXd> recorded_poses;

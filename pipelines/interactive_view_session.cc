@@ -111,6 +111,7 @@ void InteractiveView::Impl::StartSession() {
   stopped = false;
   pacer.SetGoal(world->time());
   session_steps = 0;
+  key_steps = 0;
   drags = 0;
   first_drag_step = -1;
   recorded_poses.clear();
@@ -229,6 +230,7 @@ void InteractiveView::Impl::BeginSessionRun(scene::RunKind kind) {
 
 void InteractiveView::Impl::HandOverFromKeys() {
   in_keys = false;
+  key_steps = session_steps;
   scene->EndRun();  // the object takes the keys' last state and time
   BeginSessionRun(scene::RunKind::kSimulate);
   view->SetWorld(world);
@@ -385,6 +387,11 @@ std::string InteractiveView::SessionScriptText() const {
   r.steps = m.session_steps;
   r.drags = m.drags;
   r.first_drag_step = m.first_drag_step;
+  if (m.options.keys_first && m.scene->control().keys.Duration() > 0.0) {  // the session began with the keys
+    r.keys = m.scene->control().keys;
+    r.hold = m.scene->control().hold;
+    r.key_steps = m.in_keys ? m.session_steps : m.key_steps;
+  }
   return scene::SessionScript(r);
 }
 

@@ -393,6 +393,36 @@ TEST(InteractiveView, KeysPlayFirstThenTheSimulationGoesOn) {
   EXPECT_GT((q - at_keys_end).cwiseAbs().maxCoeff(), 1e-3) << "the body moves on after the keys";
 }
 
+// The saved session of a keyframed start plays the same keys (a held foot, smooth
+// interpolation) before it simulates with the slider changes made after the hand-over.
+TEST(InteractiveView, SavedSessionOfAKeyframedStartReplaysTheKeys) {
+  REQUIRE_DISPLAY();
+  const std::string dir = testing::TempDir("view_keys_save");
+  const std::string script = dir + "/keys.wob";
+  std::ofstream(script) << "load_obj " << kData << "/table.obj\nload_def " << kData << "/table_modes.def\n"
+                        << "set integrator thesis\nset dt 0.01\nset_vec q 0 0 0 0 0 0 0\nhold 0.1 0\nset interp smooth\n"
+                        << "key 0 bend=0\nkey 0.3 bend=0.2 shear=0.05\nkey 0.5 bend=-0.1\n";
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  interp.RunFile(script);
+  ViewerOptions options = TestOptions();
+  options.keys_first = true;
+  InteractiveView view(interp.scene(), options);
+  view.Initialize();
+  for (int k = 0; k < 6; ++k) view.Frame();  // inside the keys: the replay plays them all
+  EXPECT_NE(view.SessionScriptText().find("saved while the keys played"), std::string::npos) << view.SessionScriptText();
+  for (int k = 0; k < 14; ++k) view.Frame();  // past the hand-over at 0.5 s
+  view.SetModeTarget(0, 0.15);
+  for (int k = 0; k < 12; ++k) view.Frame();
+  view.SetModeTarget(1, -0.1);
+  for (int k = 0; k < 8; ++k) view.Frame();
+  const std::string text = view.SessionScriptText();
+  EXPECT_NE(text.find("keyframe"), std::string::npos) << text;
+  EXPECT_NE(text.find("hold 0.1 0"), std::string::npos) << text;
+  EXPECT_NE(text.find("set interp smooth"), std::string::npos) << text;
+  ExpectReplayMatches(view, "view_keys_replay");
+}
+
 TEST(InteractiveView, SessionWithADragSaysTheReplayStopsFollowing) {
   REQUIRE_DISPLAY();
   auto table = TableScene(Vec({0, 0, 0, 0, 0, 0, 0}));

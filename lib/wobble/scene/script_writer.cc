@@ -137,7 +137,7 @@ std::string SessionScript(const SessionRecord& r) {
       const long to = r.segments[i + 1].step;
       duration = i == 0 ? (double(to) - 0.5) * dt : double(to - seg.step) * dt;
     } else {
-      duration = double(std::max(1L, r.steps - seg.step + 1)) * dt;  // the last pose is held after the end
+      duration = double(std::max(1L, r.steps - r.key_steps - seg.step + 1)) * dt;  // the last pose is held after the end
     }
     graph.poses.push_back(seg.targets);
     graph.durations.push_back(duration);
@@ -151,9 +151,29 @@ std::string SessionScript(const SessionRecord& r) {
       << r.first_drag_step << " on: the language has no moving spring, so the replay follows the session only "
       << "until then.\n";
   WriteSetup(s, setup);
-  if (!graph.empty()) WritePoseGraph(s, graph, 0.0);
   s << "set time " << Num(r.t0) << "\n";
-  s << "simul " << Num(double(r.steps) * dt) << "\n";
+  long simulated = r.steps;
+  if (!r.keys.times.empty()) {
+    if (r.keys.amplitudes.size() != r.keys.times.size()) throw std::invalid_argument("SessionScript: one amplitude set per key");
+    if (r.hold.enabled) s << "hold " << Num(r.hold.lattice_coords.x()) << " " << Num(r.hold.lattice_coords.y()) << "\n";
+    s << "set interp " << (r.keys.interpolation == control::Interpolation::kSmooth ? "smooth" : "linear") << "\n";
+    for (size_t k = 0; k < r.keys.times.size(); ++k) {
+      if (r.keys.amplitudes[k].size() != D) throw std::invalid_argument("SessionScript: a key has the wrong number of amplitudes");
+      s << "key " << Num(r.keys.times[k]);
+      for (int d = 0; d < D; ++d) s << " " << d + 1 << "=" << Num(r.keys.amplitudes[k][d]);
+      s << "\n";
+    }
+    s << "keyframe\n";
+    simulated = r.steps - r.key_steps;
+    if (simulated <= 0) {
+      s << "# saved while the keys played (" << r.steps << " of their steps): the replay plays them to their end\n";
+      simulated = 0;
+    }
+  }
+  if (simulated > 0) {
+    if (!graph.empty()) WritePoseGraph(s, graph, 0.0);
+    s << "simul " << Num(double(simulated) * dt) << "\n";
+  }
   s << "print\n";
   return s.str();
 }

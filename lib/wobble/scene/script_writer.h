@@ -78,6 +78,13 @@ struct SessionRecord {
   // many there were and from which step on the replay differs.
   int drags = 0;
   long first_drag_step = -1;
+  // A session that began with the scene's keys (the viewer's keys_first): the script plays
+  // them (`hold`, `set interp`, `key` lines, `keyframe`) before it simulates; the first
+  // key_steps of `steps` were theirs, and `segments` count from the hand-over. key_steps < the
+  // keys' own steps: saved while they played (the replay plays them to their end).
+  control::Keyframes keys;  // none: the session simulated from its start
+  control::HeldPoint hold;
+  long key_steps = 0;
 };
 
 // The replay script (ends with `simul DURATION` and `print`). std::invalid_argument for a
