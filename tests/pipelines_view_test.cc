@@ -357,15 +357,21 @@ TEST(InteractiveView, CharacterSessionIsTheScenesRunAsSimulRunsIt) {
   EXPECT_LT((interp.q() - q).cwiseAbs().maxCoeff(), 1e-15);
 }
 
+// The table at rest at the origin (thesis integrator, dt 0.01) with `keys` (script lines), as
+// dir/keys.wob; returns its path.
+std::string KeyedTableScript(const std::string& dir, const std::string& keys) {
+  const std::string script = dir + "/keys.wob";
+  std::ofstream(script) << "load_obj " << kData << "/table.obj\nload_def " << kData << "/table_modes.def\n"
+                        << "set integrator thesis\nset dt 0.01\nset_vec q 0 0 0 0 0 0 0\n" << keys;
+  return script;
+}
+
 // A script stopped at `keyframe` (ViewerOptions::keys_first): the viewer plays the keys, then
 // simulates on from where they end, as the interpreter's `keyframe` and `simul` do.
 TEST(InteractiveView, KeysPlayFirstThenTheSimulationGoesOn) {
   REQUIRE_DISPLAY();
   const std::string dir = testing::TempDir("view_keys");
-  const std::string script = dir + "/keys.wob";
-  std::ofstream(script) << "load_obj " << kData << "/table.obj\nload_def " << kData << "/table_modes.def\n"
-                        << "set integrator thesis\nset dt 0.01\nset_vec q 0 0 0 0 0 0 0\n"
-                        << "key 0 bend=0\nkey 0.3 bend=0.2\nkey 0.5 bend=-0.1\n";
+  const std::string script = KeyedTableScript(dir, "key 0 bend=0\nkey 0.3 bend=0.2\nkey 0.5 bend=-0.1\n");
   std::ostringstream out;
   script::Interpreter interp(out);
   interp.RunFile(script);
@@ -397,11 +403,9 @@ TEST(InteractiveView, KeysPlayFirstThenTheSimulationGoesOn) {
 // interpolation) before it simulates with the slider changes made after the hand-over.
 TEST(InteractiveView, SavedSessionOfAKeyframedStartReplaysTheKeys) {
   REQUIRE_DISPLAY();
-  const std::string dir = testing::TempDir("view_keys_save");
-  const std::string script = dir + "/keys.wob";
-  std::ofstream(script) << "load_obj " << kData << "/table.obj\nload_def " << kData << "/table_modes.def\n"
-                        << "set integrator thesis\nset dt 0.01\nset_vec q 0 0 0 0 0 0 0\nhold 0.1 0\nset interp smooth\n"
-                        << "key 0 bend=0\nkey 0.3 bend=0.2 shear=0.05\nkey 0.5 bend=-0.1\n";
+  const std::string script = KeyedTableScript(testing::TempDir("view_keys_save"),
+                                              "hold 0.1 0\nset interp smooth\nkey 0 bend=0\n"
+                                              "key 0.3 bend=0.2 shear=0.05\nkey 0.5 bend=-0.1\n");
   std::ostringstream out;
   script::Interpreter interp(out);
   interp.RunFile(script);
