@@ -224,11 +224,12 @@ int RunView(const ViewArgs& a) {
     object_scene.object().LoadModes(files.modes);
     object_scene.object().SetState(start.q0, start.qd0);
   }
-  // a 3D object is viewed as a scene of one body: the camera orbits ([ and ]), a drag pulls a
-  // mass point (the character session's sliders and charts are 2D only so far)
-  if (!scene->has_bodies() && scene->object().dim() == 3) scene->AddObjectBody(scene->object().Body3()->name());
-  if (!a.save_session.empty() && scene->has_bodies())
-    throw UsageError("--save-session: sessions are saved for FFD objects, not for scenes");
+  // a 3D object is drawn as a scene (the camera orbits with [ and ], a drag pulls a mass point)
+  // and runs as `keyframe` and `simul` run it; the character session's sliders, charts and
+  // session script are 2D only so far
+  const bool object3 = !scene->has_bodies() && scene->object().dim() == 3;
+  if (!a.save_session.empty() && (scene->has_bodies() || object3))
+    throw UsageError("--save-session: sessions are saved for 2D FFD objects, not for scenes or 3D objects");
 
   pl::ViewerOptions options = MakeViewerOptions(a, width, height);
   options.keys_first = keys_first;
@@ -239,9 +240,12 @@ int RunView(const ViewArgs& a) {
   if (!a.save_session.empty())
     for (const std::string& f : view.SaveSession(a.save_session)) std::cout << "wrote " << f << "\n";
   if (a.report_fps) ReportFps(view.stats(), a, view.world().options().dt);
-  if (view.character()) {
+  if (view.character() || object3) {
+    Eigen::VectorXd q, qd;
+    if (object3) scene::QFromState3(view.world(), 0, &q, &qd);  // rotation vector, as the script's q
+    else q = view.world().state(0).q;
     std::printf("t = %.6g, q =", view.time());
-    for (int i = 0; i < view.world().state(0).q.size(); ++i) std::printf(" %.17g", view.world().state(0).q[i]);
+    for (int i = 0; i < q.size(); ++i) std::printf(" %.17g", q[i]);
     std::printf("\n");
   } else {
     std::printf("t = %.6g, largest constraint violation %.3g\n", view.time(), view.world().MaxViolation());

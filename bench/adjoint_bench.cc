@@ -8,7 +8,8 @@
 // add 2 inputs per point to each step's differentiation).
 // The 3D rows (Simulation3, Gradient3) do the same for the chair of tests/support (about 300
 // mass points, 3 modes; 12 + 2·3 state coordinates), controls/3 steps of 0.002 s, falling onto
-// a plane in the grounded case.
+// a plane in the grounded case; Gradient3's third argument is its checkpoint interval (0: the
+// default, the whole run kept within the budget; -1: ⌈√steps⌉ checkpoints), to compare the two.
 // Run: build/bench/adjoint_bench --benchmark_min_time=0.5
 #include <benchmark/benchmark.h>
 
@@ -123,7 +124,7 @@ void BM_Gradient3(benchmark::State& state) {
   const fit::ControlledRollout3 r = Rollout3(int(state.range(0)), state.range(1) != 0);
   int held = 0;
   for (auto _ : state) {
-    const fit::RolloutGradient3 g = fit::RolloutCostGradient3(Chair(), r, Stage3);
+    const fit::RolloutGradient3 g = fit::RolloutCostGradient3(Chair(), r, Stage3, int(state.range(2)));
     if (!g.ok) state.SkipWithError(g.message.c_str());
     held = g.states_held;
   }
@@ -134,7 +135,9 @@ void BM_Gradient3(benchmark::State& state) {
 BENCHMARK(BM_Simulation)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Gradient)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Simulation3)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_Gradient3)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Gradient3)
+    ->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}, {fit::kCheckpointAuto, fit::kCheckpointSqrt}})
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace wobble

@@ -65,6 +65,19 @@ bool InteractiveView::Impl::StepWorld() {
   return false;
 }
 
+void InteractiveView::Impl::HandOverFromKeys() {
+  in_keys = false;
+  scene->EndRun();  // the object takes the keys' last state and time (§4.10.1)
+  if (character) {
+    key_steps = session_steps;
+    BeginSessionRun(scene::RunKind::kSimulate);
+  } else {
+    scene->BeginRun(scene::RunKind::kSimulate, false);
+    world = scene->run_world();
+  }
+  view->SetWorld(world);
+}
+
 void InteractiveView::Impl::Advance(double duration) {
   pacer.Advance(duration, world->options().dt, [&] { return world->time(); }, [&] { return StepWorld(); });
 }
@@ -133,15 +146,14 @@ InteractiveView::InteractiveView(scene::Scene& scene, ViewerOptions options) : i
     throw std::invalid_argument("the slider range must be positive");
   if (!scene.has_bodies() && !scene.object().loaded())
     throw std::invalid_argument("InteractiveView: the scene has no bodies and no FFD object");
-  if (!scene.has_bodies() && scene.object().dim() == 3)
-    throw std::invalid_argument("InteractiveView: a 3D object is viewed as a scene body (Scene::AddObjectBody first)");
   Impl& m = *impl_;
   m.self = this;
   m.scene = &scene;
   m.options = options;
   m.speed = options.speed;
   m.playing = options.start_playing;
-  m.character = !scene.has_bodies();
+  m.object3 = !scene.has_bodies() && scene.object().dim() == 3;
+  m.character = !scene.has_bodies() && !m.object3;
   const scene::SceneDrawing drawing = scene.Drawing();
   if (m.character) {
     m.setup = scene.CurrentSetup();
@@ -150,7 +162,15 @@ InteractiveView::InteractiveView(scene::Scene& scene, ViewerOptions options) : i
     m.StartSession();
   } else {
     m.spec = SceneSpecOf(drawing.drawings, drawing.anchors);
-    scene.BeginRun();
+    if (m.object3) {
+      // the 3D object's own runs, as `keyframe` and `simul` make them: its keys first when asked,
+      // then its simulation (pose graph and springs included); no record of every step
+      m.in_keys = options.keys_first && scene.control().keys.Duration() > 0.0;
+      m.keys_end = scene.time() + (m.in_keys ? scene.control().keys.Duration() : 0.0);
+      scene.BeginRun(m.in_keys ? scene::RunKind::kKeyframes : scene::RunKind::kSimulate, false);
+    } else {
+      scene.BeginRun();
+    }
     m.world = scene.run_world();
     m.pacer.SetGoal(m.world->time());
   }
@@ -350,6 +370,7 @@ bool InteractiveView::BeginDrag(int x, int y) {
   Impl& m = *impl_;
   EndDrag();
   if (m.character) return m.BeginSpringPull(x, y);
+  if (m.in_keys) return false;  // a keyframed body is placed, not pulled
   World& w = *m.world;
   // candidates: named points of bodies first (a tie goes to them), then every mass point
   std::vector<MaterialPoint> candidates;
@@ -425,8 +446,9 @@ std::string InteractiveView::StatusLine() const {
   const Impl& m = *impl_;
   if (m.character) return m.SessionStatus();
   char buf[256];
-  std::snprintf(buf, sizeof(buf), "%s x%g   largest constraint violation %.2g%s", m.playing ? "playing" : "paused",
-                m.speed, m.world->MaxViolation(), m.constraint_pull ? "   dragging" : "");
+  std::snprintf(buf, sizeof(buf), "%s x%g   t %.2f%s   largest constraint violation %.2g%s",
+                m.playing ? "playing" : "paused", m.speed, m.world->time(), m.in_keys ? " (keys)" : "",
+                m.world->MaxViolation(), m.constraint_pull ? "   dragging" : "");
   return std::string(buf) + (m.message.empty() ? "" : "\n" + m.message);
 }
 

@@ -31,7 +31,8 @@ struct InteractiveView::Impl {
   InteractiveView* self = nullptr;
   scene::Scene* scene = nullptr;
   ViewerOptions options;
-  bool character = false;
+  bool character = false;  // a 2D FFD object: a character session
+  bool object3 = false;    // a 3D FFD object: drawn as a scene, run as the object's runs
   World* world = nullptr;  // the scene's run world (the live one)
   SceneSpec spec;          // a scene's drawings and named points
   std::unique_ptr<SceneView> view;
@@ -47,6 +48,8 @@ struct InteractiveView::Impl {
   std::string message;  // one line shown under the status (saved files, trouble)
   FramePacer pacer;     // frame clock, the simulated time asked for, measurements
   bool initialized = false;
+  bool in_keys = false;  // the object's keyframed part is playing (ViewerOptions::keys_first)
+  double keys_end = 0.0;
 
   // ---- a character session (interactive_view_session.cc) ----
   scene::SimulationSetup setup;  // the start: body, world options, state, time, files
@@ -59,8 +62,6 @@ struct InteractiveView::Impl {
   std::vector<vtkSmartPointer<vtkCallbackCommand>> callbacks;
   std::vector<Eigen::Vector2d> pickable;  // mass points and drawing samples, by lattice coordinates
   bool scrubbing = false, graph_drives = false;
-  bool in_keys = false;  // the session's keyframed part is playing (ViewerOptions::keys_first)
-  double keys_end = 0.0;
   std::shared_ptr<control::ModeTargetController> sliders;
   Eigen::VectorXd slider_targets;  // kept over a restart
   long session_steps = 0;
@@ -85,12 +86,12 @@ struct InteractiveView::Impl {
   void UpdateDragLine();
   void UpdateStatus();
   void RequireCharacter(const char* what) const;
+  void HandOverFromKeys();  // the keys are done: simulate on from their last state
 
   // interactive_view_session.cc
   void BuildSessionPanels();  // sliders, charts, the time slider; what can be pulled
   void StartSession();        // a new run of the object from the setup, with the sliders
   void BeginSessionRun(scene::RunKind kind);  // the scene's run of that kind, the sliders on it
-  void HandOverFromKeys();    // the keys are done: simulate on from their last state
   void RecordFrame();
   void UpdateTimeSlider();
   void ShowGraphTargets();

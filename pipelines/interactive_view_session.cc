@@ -228,14 +228,6 @@ void InteractiveView::Impl::BeginSessionRun(scene::RunKind kind) {
   spring_pull.reset();  // a pull acts on the run's world
 }
 
-void InteractiveView::Impl::HandOverFromKeys() {
-  in_keys = false;
-  key_steps = session_steps;
-  scene->EndRun();  // the object takes the keys' last state and time
-  BeginSessionRun(scene::RunKind::kSimulate);
-  view->SetWorld(world);
-}
-
 void InteractiveView::Impl::RecordFrame() {
   if (history.size() >= size_t(std::max(1L, options.max_history))) history.erase(history.begin());
   history.push_back({world->time(), world->state(0).q, world->state(0).qd});

@@ -296,13 +296,17 @@ TEST(Adjoint3, MatchesCentralDifferencesInTheAir) {
 TEST(Adjoint3, CheckpointIntervalDoesNotChangeTheGradient) {
   const Case k = MakeCase(Integrator::kThesis, true, 90, 17);
   const fit::RolloutGradient3 a = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive), 1);
-  const fit::RolloutGradient3 b = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive), 0);
+  const fit::RolloutGradient3 b = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive), fit::kCheckpointSqrt);
   const fit::RolloutGradient3 c = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive), 90);
-  ASSERT_TRUE(a.ok && b.ok && c.ok);
+  const fit::RolloutGradient3 d = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive));
+  ASSERT_TRUE(a.ok && b.ok && c.ok && d.ok);
   EXPECT_EQ(Flatten(a), Flatten(b));
   EXPECT_EQ(Flatten(a), Flatten(c));
+  EXPECT_EQ(Flatten(a), Flatten(d));
   EXPECT_EQ(b.states_held, 9 + 10) << "intervals of ⌈√90⌉ = 10: 9 checkpoints and one interval";
   EXPECT_EQ(a.states_held, 90 + 1);
+  EXPECT_EQ(c.states_held, 90 + 1) << "the whole run kept by its forward run";
+  EXPECT_EQ(d.states_held, 90 + 1) << "a 90-step run is kept whole by default";
 }
 
 TEST(Adjoint3, RefusesBadInputWithAMessage) {

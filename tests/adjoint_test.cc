@@ -360,17 +360,31 @@ TEST(Adjoint, PoseGraphPosesAndSwitchTimesMatchJets) {
 TEST(Adjoint, CheckpointIntervalDoesNotChangeTheGradient) {
   const Case k = MakeCase(Integrator::kThesis, true, 100, 17);
   const fit::RolloutGradient every = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive), 1);
-  const fit::RolloutGradient sqrt_n = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive));
+  const fit::RolloutGradient sqrt_n = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive), fit::kCheckpointSqrt);
   const fit::RolloutGradient odd = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive), 7);
   const fit::RolloutGradient whole = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive), 100);
-  ASSERT_TRUE(every.ok && sqrt_n.ok && odd.ok && whole.ok);
+  const fit::RolloutGradient automatic = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive));
+  ASSERT_TRUE(every.ok && sqrt_n.ok && odd.ok && whole.ok && automatic.ok);
   // recomputation from a checkpoint repeats the same arithmetic: the same numbers exactly
   EXPECT_EQ(Flatten(every), Flatten(sqrt_n));
   EXPECT_EQ(Flatten(every), Flatten(odd));
   EXPECT_EQ(Flatten(every), Flatten(whole));
-  // ⌈√100⌉ = 10 checkpoints and one interval of 10 states; all 100 when not checkpointing
+  EXPECT_EQ(Flatten(every), Flatten(automatic));
+  // ⌈√100⌉ = 10 checkpoints and one interval of 10 states; all 100 when not checkpointing,
+  // which a 100-step run does by default (far below the budget)
   EXPECT_EQ(sqrt_n.states_held, 20);
   EXPECT_EQ(whole.states_held, 101);
+  EXPECT_EQ(automatic.states_held, 101);
+}
+
+TEST(Adjoint, CheckpointIntervalKeepsTheWholeRunOnlyWithinTheBudget) {
+  const size_t mib = size_t(1) << 20;
+  EXPECT_EQ(fit::CheckpointInterval(10000, 0, 4096, 64 * mib), 10000);  // 39 MiB: kept whole
+  EXPECT_EQ(fit::CheckpointInterval(10000, 0, 8192, 64 * mib), 100);    // 78 MiB: ⌈√10000⌉
+  EXPECT_EQ(fit::CheckpointInterval(10001, 0, 8192, 64 * mib), 101);
+  EXPECT_EQ(fit::CheckpointInterval(10000, fit::kCheckpointSqrt, 1, 64 * mib), 100);
+  EXPECT_EQ(fit::CheckpointInterval(10000, 7, 1 << 30, 64 * mib), 7);  // an interval asked for
+  EXPECT_EQ(fit::CheckpointInterval(0, 0, 4096, 64 * mib), 1);
 }
 
 TEST(Adjoint, ZeroStepsIsTheGradientOfTheFirstStageCost) {

@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <vtkCommand.h>
 #include <vtkImageData.h>
 #include <vtkInteractorEventRecorder.h>
@@ -425,6 +426,56 @@ TEST(InteractiveView, SavedSessionOfAKeyframedStartReplaysTheKeys) {
   EXPECT_NE(text.find("hold 0.1 0"), std::string::npos) << text;
   EXPECT_NE(text.find("set interp smooth"), std::string::npos) << text;
   ExpectReplayMatches(view, "view_keys_replay");
+}
+
+// A 3D object's script stopped at `keyframe`: the viewer draws it as a scene and plays its keys
+// (the bend follows them, the body is placed, not pulled), then simulates on from their end,
+// exactly as the interpreter's `keyframe` and `simul` do; the object goes on from the viewer's state.
+TEST(InteractiveViewOfAScene, A3DObjectsKeysPlayFirstThenItSimulatesOn) {
+  REQUIRE_DISPLAY();
+  const std::string dir = testing::TempDir("view_keys3");
+  const std::string script = dir + "/keys3.wob";
+  std::ofstream(script) << "load_obj " << kData << "/table3.obj\nload_def " << kData << "/table3_modes.def3\n"
+                        << "set integrator thesis\nset dt 0.01\nset_vec q 0 0 0 0 0 0 0 0 0 0\n"
+                        << "key 0 bend=0\nkey 0.3 bend=0.2\nkey 0.5 bend=-0.1\n";
+  const int bend = 6;  // q = (translation, rotation vector, bend, shear, squash, twist)
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  interp.RunFile(script);
+  ViewerOptions options = TestOptions();
+  options.keys_first = true;
+  Eigen::VectorXd at_key2, at_keys_end, q, qd;
+  {
+    InteractiveView view(interp.scene(), options);
+    EXPECT_FALSE(view.character());
+    view.Initialize();
+    for (int k = 0; k < 9; ++k) view.Frame();  // 0.3 s: the second key
+    scene::QFromState3(view.world(), 0, &at_key2, &qd);
+    EXPECT_NEAR(at_key2[bend], 0.2, 1e-12);
+    // right on a mass point: a keyframed body is placed, not pulled
+    const Eigen::Vector3d on_point = view.WorldToDisplay(view.world().PointPosition(MassPointOf(0, 0)));
+    EXPECT_FALSE(view.BeginDrag(int(std::lround(on_point[0])), int(std::lround(on_point[1]))));
+    for (int k = 0; k < 6; ++k) view.Frame();  // 0.5 s: the keys' end
+    EXPECT_NEAR(view.world().time(), 0.5, 1e-12);
+    scene::QFromState3(view.world(), 0, &at_keys_end, &qd);
+    for (int k = 0; k < 15; ++k) view.Frame();  // 0.5 s more, simulated
+    EXPECT_EQ(view.stats().steps, 100);
+    scene::QFromState3(view.world(), 0, &q, &qd);
+    // once the body simulates, a press on a mass point picks it (so the refusal above meant something)
+    const Eigen::Vector3d now = view.WorldToDisplay(view.world().PointPosition(MassPointOf(0, 0)));
+    EXPECT_TRUE(view.BeginDrag(int(std::lround(now[0])), int(std::lround(now[1]))));
+    view.EndDrag();
+  }
+  EXPECT_LT((interp.q() - q).cwiseAbs().maxCoeff(), 1e-15) << "the object goes on from the viewer's state";
+  script::Interpreter ref(out);
+  ref.RunFile(script);
+  ref.RunLine("keyframe", "<test>", 1, dir);
+  EXPECT_NEAR(ref.q()[bend], -0.1, 1e-12) << "the last key's bend";
+  EXPECT_LT((ref.q() - at_keys_end).cwiseAbs().maxCoeff(), 1e-12) << "keyframe " << ref.q().transpose()
+                                                                   << "\nviewer " << at_keys_end.transpose();
+  ref.RunLine("simul 0.5", "<test>", 2, dir);
+  EXPECT_LT((ref.q() - q).cwiseAbs().maxCoeff(), 1e-12) << "simul " << ref.q().transpose() << "\nviewer " << q.transpose();
+  EXPECT_GT((q - at_keys_end).cwiseAbs().maxCoeff(), 1e-3) << "the body moves on after the keys";
 }
 
 TEST(InteractiveView, SessionWithADragSaysTheReplayStopsFollowing) {

@@ -202,7 +202,9 @@ void BindGradients(py::module_& m) {
       "The cost sum_n l_n(q_n, qd_n) of a rollout of the 2D body (PD targets (modes, steps), one per\n"
       "step; gains K, c per mode; options' world, dt and integrator: thesis or symplectic) and its\n"
       "gradient with respect to q0, qd0, K, c and every target, by one adjoint sweep (about 2-4\n"
-      "simulations whatever the number of parameters).");
+      "simulations whatever the number of parameters).\n"
+      "checkpoint_interval: 0 keeps the whole run when it fits in 64 MiB, else checkpoints every\n"
+      "ceil(sqrt(steps)) steps; -1 always does; N > 0 every N steps.");
   m.def(
       "rollout_cost",
       [](std::shared_ptr<BodyModel> body, const StageCostHandle& cost, const py::object& targets, const WorldOptions& options,

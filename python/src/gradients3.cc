@@ -188,7 +188,9 @@ void BindGradients3(py::module_& m) {
       "The cost sum_n l_n(q_n, qd_n) of a rollout of the 3D body (PD targets (modes, steps), one per\n"
       "step; gains K, c per mode; options' 3D world (ground_3d, gravity_3d, springs_3d), dt and integrator:\n"
       "thesis or symplectic) and its gradient with respect to q0, qd0, K, c and every target, by one\n"
-      "adjoint sweep: its cost does not grow with the number of parameters (README: Gradients).");
+      "adjoint sweep: its cost does not grow with the number of parameters (README: Gradients).\n"
+      "checkpoint_interval: 0 keeps the whole run when it fits in 64 MiB, else checkpoints every\n"
+      "ceil(sqrt(steps)) steps; -1 always does; N > 0 every N steps.");
   m.def(
       "rollout_cost3",
       [](std::shared_ptr<BodyModel3> body, const StageCost3Handle& cost, const py::object& targets,

@@ -430,7 +430,10 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
   CheckRollout(body, rollout);
   const Rollout r(body, rollout);
   const int nq = r.nq(), D = r.modes(), N = rollout.steps();
-  const int interval = internal::CheckpointInterval(N, checkpoint_interval);
+  const BodyState<double> start = r.Start();
+  // a kept state: the struct and its contacts (the start's count: an estimate)
+  const size_t state_bytes = sizeof(start) + start.contacts.size() * sizeof(start.contacts[0]);
+  const int interval = CheckpointInterval(N, checkpoint_interval, state_bytes);
   RolloutGradient g;
   g.stiffness = Eigen::VectorXd::Zero(D);
   g.damping = Eigen::VectorXd::Zero(D);
@@ -450,7 +453,7 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
     return true;
   };
   Adjoint lambda{Eigen::VectorXd::Zero(nq), Eigen::VectorXd::Zero(nq), {}};
-  if (!internal::CheckpointedAdjointSweep(N, interval, r.Start(), &lambda, step, step, vjp, stage, &g.states_held)) return g;
+  if (!internal::CheckpointedAdjointSweep(N, interval, start, &lambda, step, step, vjp, stage, &g.states_held)) return g;
   g.q0 = lambda.q;
   g.qd0 = lambda.qd;
   r.StartVjp(lambda, &g.q0, &g.qd0);

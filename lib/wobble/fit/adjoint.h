@@ -20,9 +20,11 @@
 // Jets over every parameter. Contact decisions are taken on plain values, as in every Jet
 // run: the gradient is one-sided at a contact's onset, as the fits' are.
 //
-// Memory: the forward run keeps a checkpoint every `checkpoint_interval` steps (default
-// ⌈√steps⌉); the backward sweep recomputes one interval at a time from its checkpoint, so a
-// gradient holds about 2√steps states (200 for 10,000 steps) for one extra plain simulation.
+// Memory (checkpoints.h): by default the forward run keeps every state when they fit in
+// kWholeRunMemoryBudget, and nothing is recomputed. Beyond it (or with kCheckpointSqrt or an
+// interval), the forward run keeps a checkpoint every `checkpoint_interval` steps (⌈√steps⌉);
+// the backward sweep recomputes one interval at a time from its checkpoint, so a gradient
+// holds about 2√steps states (200 for 10,000 steps) for one extra plain simulation.
 #pragma once
 
 #include <Eigen/Core>
@@ -32,6 +34,7 @@
 #include "wobble/body/body_model.h"
 #include "wobble/control/control.h"
 #include "wobble/dynamics/step.h"
+#include "wobble/fit/checkpoints.h"
 
 namespace wobble::fit {
 
@@ -65,7 +68,7 @@ double RolloutCost(const BodyModel& body, const ControlledRollout& rollout, cons
 
 // The cost and its gradient with respect to every parameter of the rollout. Throws
 // std::invalid_argument on inconsistent sizes, non-finite numbers or another integrator.
-// checkpoint_interval ≤ 0 means ⌈√steps⌉.
+// checkpoint_interval: an interval, kCheckpointAuto or kCheckpointSqrt (checkpoints.h).
 RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollout& rollout, const StageCost& cost,
                                     int checkpoint_interval = 0);
 

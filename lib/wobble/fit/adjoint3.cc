@@ -136,8 +136,14 @@ RolloutGradient3 RolloutCostGradient3(const BodyModel3& body, const ControlledRo
   auto step = [&](int n, BodyState3<double>* s) { return r.Step(n, s, &g.message); };
   // The recompute of an interval keeps each step's tape (slot n mod interval; `taped` says
   // which step a slot holds), so the product does not evaluate the step a third time: about
-  // one simulation less per gradient (the interval's last step has none and is taken again).
-  const int interval = internal::CheckpointInterval(N, checkpoint_interval);
+  // one simulation less per gradient (the interval's last step has none and is taken again,
+  // except when the interval is the whole run, whose forward run keeps every tape).
+  const BodyState3<double> start = r.Start();
+  // a kept step: its state and its tape (which holds two more), with the start's number of
+  // contacts in each (an estimate)
+  const size_t step_bytes =
+      sizeof(internal::StepTape3) + sizeof(start) + 3 * start.contacts.size() * sizeof(Contact3<double>);
+  const int interval = CheckpointInterval(N, checkpoint_interval, step_bytes);
   std::vector<internal::StepTape3> tapes(size_t(std::min(interval, std::max(N, 1))));
   std::vector<int> taped(tapes.size(), -1);
   auto recompute = [&](int n, BodyState3<double>* s) {
@@ -151,7 +157,7 @@ RolloutGradient3 RolloutCostGradient3(const BodyModel3& body, const ControlledRo
     return r.StepVjp(n, state, taped[slot] == n ? &tapes[slot] : nullptr, out, in, &g, &g.message);
   };
   StateAdjoint3 lambda{Eigen::VectorXd::Zero(nz), {}};
-  if (!internal::CheckpointedAdjointSweep(N, interval, r.Start(), &lambda, step, recompute, vjp, stage,
+  if (!internal::CheckpointedAdjointSweep(N, interval, start, &lambda, step, recompute, vjp, stage,
                                           &g.states_held))
     return g;
   g.start = lambda.z;

@@ -50,39 +50,51 @@ double PlainRolloutCost(int steps, State state, const Step& step, const Stage& s
   }
 }
 
-// The checkpoint interval: `requested` when > 0, else ⌈√steps⌉.
-inline int CheckpointInterval(int steps, int requested) {
-  return requested > 0 ? requested : std::max(1, int(std::ceil(std::sqrt(double(steps)))));
-}
-
 // One forward run keeping a checkpoint every `interval` steps, then the backward sweep, one
 // interval at a time recomputed from its checkpoint, so about 2√steps states are held at once
-// (*states_held: the most). On entry *lambda is the zero adjoint of a state; on return, λ_0.
+// for √steps intervals (*states_held: the most). When one interval is the whole run, the
+// forward run is that interval's recompute: every state (and tape) is kept from the start and
+// no step is taken twice. On entry *lambda is the zero adjoint of a state; on return, λ_0.
 //   step(n, &state) → bool       advances state n to n + 1
-//   recompute(n, &state) → bool  the same, in the backward sweep's recompute of an interval
-//                                (steps begin … end − 2 of it, in order): where the product
-//                                can keep what the step computed (3D: StepTape3)
+//   recompute(n, &state) → bool  the same, where the product can keep what the step computed
+//                                (3D: StepTape3): in the backward sweep's recompute of an
+//                                interval (steps begin … end − 2 of it, in order), or for every
+//                                step, in order, when the interval is the whole run
 //   vjp(n, state, next, λ_{n+1}, &λ_n) → bool
 //   stage(n, state, &λ)          adds ℓ_n's value to the cost and its gradient to λ
 // Returns false as soon as step or vjp does (they say why).
 template <class State, class Adjoint, class Step, class Recompute, class Vjp, class Stage>
 bool CheckpointedAdjointSweep(int steps, int interval, const State& start, Adjoint* lambda, const Step& step,
                               const Recompute& recompute, const Vjp& vjp, const Stage& stage, int* states_held) {
-  std::vector<State> checkpoints;
+  const bool whole = steps > 0 && interval >= steps;
+  std::vector<State> checkpoints, segment;
   State last = start;
-  for (int n = 0; n < steps; ++n) {
-    if (n % interval == 0) checkpoints.push_back(last);
-    if (!step(n, &last)) return false;
+  if (whole) {
+    checkpoints.push_back(start);
+    segment.reserve(size_t(std::max(steps, 1)));
+    segment.push_back(start);
+    for (int n = 0; n < steps; ++n) {
+      if (n + 1 < steps) segment.push_back(segment.back());
+      State* after = n + 1 < steps ? &segment.back() : &last;
+      if (n + 1 == steps) last = segment.back();
+      if (!recompute(n, after)) return false;
+    }
+  } else {
+    for (int n = 0; n < steps; ++n) {
+      if (n % interval == 0) checkpoints.push_back(last);
+      if (!step(n, &last)) return false;
+    }
   }
   stage(steps, last, lambda);
-  std::vector<State> segment;
   Adjoint before = *lambda;
   for (int c = int(checkpoints.size()) - 1; c >= 0; --c) {
     const int begin = c * interval, end = std::min(steps, begin + interval);
-    segment.assign(1, checkpoints[size_t(c)]);
-    for (int n = begin; n + 1 < end; ++n) {
-      segment.push_back(segment.back());
-      if (!recompute(n, &segment.back())) return false;
+    if (!whole) {
+      segment.assign(1, checkpoints[size_t(c)]);
+      for (int n = begin; n + 1 < end; ++n) {
+        segment.push_back(segment.back());
+        if (!recompute(n, &segment.back())) return false;
+      }
     }
     *states_held = std::max(*states_held, int(checkpoints.size() + segment.size()));
     for (int n = end - 1; n >= begin; --n) {
