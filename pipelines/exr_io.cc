@@ -3,7 +3,6 @@
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
-#include <Imath/half.h>
 #include <ImfIO.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
@@ -11,10 +10,12 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
 
+#include "pipelines/half_floats.h"
 #include "wobble/formats/atomic_file.h"
 
 namespace wobble::pipelines {
@@ -112,14 +113,15 @@ void WriteExrChannels(const std::string& path, int width, int height, const std:
       case ExrCompression::kPiz: header.compression() = Imf::PIZ_COMPRESSION; break;
     }
     Imf::FrameBuffer fb;
-    std::vector<std::vector<Imath::half>> halves;  // the half channels' values, converted here
+    std::vector<std::vector<std::uint16_t>> halves;  // the half channels' bits, converted here
     halves.reserve(channels.size());
     for (const ExrChannel& c : channels) {
       if (c.half) {
-        halves.emplace_back(c.data.begin(), c.data.end());
+        halves.emplace_back(c.data.size());
+        FloatsToHalves(c.data.data(), c.data.size(), halves.back().data());
         header.channels().insert(c.name, Imf::Channel(Imf::HALF));
-        fb.insert(c.name, Imf::Slice(Imf::HALF, (char*)halves.back().data(), sizeof(Imath::half),
-                                     sizeof(Imath::half) * size_t(width)));
+        fb.insert(c.name, Imf::Slice(Imf::HALF, (char*)halves.back().data(), sizeof(std::uint16_t),
+                                     sizeof(std::uint16_t) * size_t(width)));
         continue;
       }
       header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
