@@ -1,12 +1,26 @@
 #include "pipelines/exr_frame.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
 namespace wobble::pipelines {
 namespace {
+
+// 8-bit sRGB-encoded values (IEC 61966-2-1) decoded to linear light.
+const std::array<float, 256>& LinearOfSrgb() {
+  static const std::array<float, 256> linear = [] {
+    std::array<float, 256> lut;
+    for (int v = 0; v < 256; ++v) {
+      const double c = v / 255.0;
+      lut[size_t(v)] = float(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+    }
+    return lut;
+  }();
+  return linear;
+}
 
 // The pixels whose centres may lie in [lo, hi] along one axis of an image n pixels wide.
 bool PixelRange(double lo, double hi, int n, int* first, int* last) {
@@ -184,7 +198,7 @@ CharacterLayers RasterizeCharacters(const ScreenGeometry& g, const std::vector<E
 std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeometry* next,
                                          const ScreenGeometry* previous) {
   const size_t n = size_t(frame.width) * size_t(frame.height);
-  if (frame.rgb.size() != 3 * n || frame.depth.size() != n || (!frame.overlay.empty() && frame.overlay.size() != n))
+  if (frame.srgb.size() != 3 * n || frame.depth.size() != n || (!frame.overlay.empty() && frame.overlay.size() != n))
     throw std::invalid_argument("ExrFrameChannels: an image of another size");
   const std::vector<Eigen::Vector3d> before =
       frame.blender_motion ? NextPixels(frame.characters, previous ? *previous : ScreenGeometry())
@@ -196,9 +210,10 @@ std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeom
   if (frame.terrain_layer)
     for (const char* name : {"terrain.R", "terrain.G", "terrain.B", "terrain.A"}) ch.push_back({name, {}, true});
   for (ExrChannel& x : ch) x.data.resize(n);
+  const std::array<float, 256>& linear = LinearOfSrgb();
   for (size_t i = 0; i < n; ++i) {
     const float a = frame.overlay.empty() || !frame.overlay[i] ? c.alpha[i] : 0.0f;
-    for (int k = 0; k < 3; ++k) ch[size_t(k)].data[i] = a * frame.rgb[3 * i + size_t(k)];
+    for (int k = 0; k < 3; ++k) ch[size_t(k)].data[i] = a * linear[frame.srgb[3 * i + size_t(k)]];
     ch[3].data[i] = a;
     if (a == 0.0f) {  // under the overlay
       c.forward_u[i] = c.forward_v[i] = 0.0f;
@@ -206,7 +221,7 @@ std::vector<ExrChannel> ExrFrameChannels(const ExrFrame& frame, const ScreenGeom
     }
     if (frame.terrain_layer) {
       const float rest = std::isinf(frame.depth[i]) ? 0.0f : 1.0f - a;  // drawn, and not a character
-      for (int k = 0; k < 3; ++k) ch[size_t(4 + k)].data[i] = rest * frame.rgb[3 * i + size_t(k)];
+      for (int k = 0; k < 3; ++k) ch[size_t(4 + k)].data[i] = rest * linear[frame.srgb[3 * i + size_t(k)]];
       ch[7].data[i] = rest;
     }
   }

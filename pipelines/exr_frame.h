@@ -73,7 +73,7 @@ CharacterLayers RasterizeCharacters(const ScreenGeometry& g, const std::vector<E
 // until the next is drawn). Rows of the images start at the TOP.
 struct ExrFrame {
   int width = 0, height = 0;
-  std::vector<float> rgb;      // linear-light colour, 3 per pixel (the frame buffer's sRGB decoded)
+  std::vector<uint8_t> srgb;   // the frame buffer's colour, 3 per pixel, 8-bit sRGB (ExrFrameChannels decodes it)
   std::vector<float> depth;    // distance from the camera along the view direction; +inf: nothing drawn
   std::vector<uint8_t> overlay;  // 1 where the 2D text overlay or colour bar was drawn (empty: none)
   ScreenGeometry characters;   // the bodies as drawn
@@ -83,8 +83,8 @@ struct ExrFrame {
   bool blender_motion = false;  // write ViewLayer.Vector.X/Y/Z/W (four channels: a quarter more time)
 };
 
-// The frame's channels: R, G, B, A of the characters (colour premultiplied by A, A from the
-// rasterised characters), with frame.terrain_layer terrain.R/G/B/A of everything else drawn
+// The frame's channels: R, G, B, A of the characters (linear-light colour premultiplied by A,
+// A from the rasterised characters), with frame.terrain_layer terrain.R/G/B/A of everything else drawn
 // (the ground or terrain, springs, trails, named points) where no character covers it,
 // depth.Z of whatever is nearest;
 // pixels of the 2D overlay are in no layer (its text hides what is under it, so a character

@@ -549,34 +549,27 @@ ExrFrame SceneView::CaptureExrFrame() {
   auto eye_distance = [&](double d) {
     return parallel ? range[0] + d * (range[1] - range[0]) : range[0] * range[1] / (range[1] - d * (range[1] - range[0]));
   };
-  // the frame buffer holds sRGB-encoded 8-bit values (IEC 61966-2-1): decoded to linear light
-  static const std::array<float, 256> linear = [] {
-    std::array<float, 256> lut;
-    for (int v = 0; v < 256; ++v) {
-      const double c = v / 255.0;
-      lut[size_t(v)] = float(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
-    }
-    return lut;
-  }();
+  // the colour stays sRGB-encoded here (ExrFrameChannels decodes it on a writer thread), and
+  // the images are filled row by row, top first, without zeroing them first
   ExrFrame f;
   f.width = w;
   f.height = h;
-  f.rgb.resize(3 * size_t(w) * h);
-  f.depth.resize(size_t(w) * h);
-  f.overlay.resize(size_t(w) * h);
+  const size_t n = size_t(w) * h;
   const auto* px = static_cast<const unsigned char*>(rgb->GetScalarPointer());
   const float* zp = z->GetPointer(0);
   const float inf = std::numeric_limits<float>::infinity();
-  for (int y = 0; y < h; ++y) {
-    const size_t row_out = size_t(h - 1 - y) * w;  // VTK's rows start at the bottom
-    for (int x = 0; x < w; ++x) {
-      const size_t in = size_t(y) * w + x, out = row_out + x;
-      for (int c = 0; c < 3; ++c) f.rgb[3 * out + size_t(c)] = linear[px[3 * in + c]];
+  f.srgb.reserve(3 * n);
+  f.depth.reserve(n);
+  f.overlay.reserve(n);
+  for (int y = h - 1; y >= 0; --y) {  // VTK's rows start at the bottom
+    const size_t row = size_t(y) * w;
+    f.srgb.insert(f.srgb.end(), px + 3 * row, px + 3 * (row + w));
+    for (size_t in = row; in < row + size_t(w); ++in) {
       // VTK draws the 2D overlay (text, colour bar) at window depth 0, the near plane, which
       // no geometry reaches (the cameras keep the near plane in front of everything framed):
       // those pixels are the overlay's, in no layer of the EXR
-      f.overlay[out] = zp[in] == 0.0f;
-      f.depth[out] = zp[in] < 1.0f && zp[in] > 0.0f ? float(eye_distance(zp[in])) : inf;
+      f.overlay.push_back(zp[in] == 0.0f);
+      f.depth.push_back(zp[in] < 1.0f && zp[in] > 0.0f ? float(eye_distance(zp[in])) : inf);
     }
   }
   f.characters = CharacterGeometry();
