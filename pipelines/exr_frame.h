@@ -84,8 +84,8 @@ struct ExrFrame {
 };
 
 // The frame's channels: R, G, B, A of the characters (linear-light colour premultiplied by A,
-// A from the rasterised characters), with frame.terrain_layer terrain.R/G/B/A of everything else drawn
-// (the ground or terrain, springs, trails, named points) where no character covers it,
+// A from the rasterised characters), with frame.terrain_layer terrain.R/G/B/A of everything
+// else drawn (the ground or terrain, springs, trails, named points) where no character covers it,
 // depth.Z of whatever is nearest;
 // pixels of the 2D overlay are in no layer (its text hides what is under it, so a character
 // under the text has a hole there: render without the overlay for compositing);
