@@ -3,10 +3,10 @@
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
-#include <ImfIO.h>
 #include <ImfInputFile.h>
-#include <ImfOutputFile.h>
 #include <ImfStandardAttributes.h>
+#include <openexr.h>
+#include <zlib.h>
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -22,35 +22,7 @@
 namespace wobble::pipelines {
 
 namespace {
-// Imf::OStream over a FILE*: a short write throws with the system's reason, and is
-// remembered for writes OpenEXR makes in destructors (which cannot throw).
-class StdioStream : public Imf::OStream {
- public:
-  StdioStream(std::FILE* f, const std::string& name) : Imf::OStream(name.c_str()), f_(f) {}
-  void write(const char c[], int n) override {
-    if (n > 0 && std::fwrite(c, 1, size_t(n), f_) != size_t(n)) Fail();
-  }
-  uint64_t tellp() override { return uint64_t(ftello(f_)); }
-  void seekp(uint64_t pos) override {
-    if (fseeko(f_, off_t(pos), SEEK_SET) != 0) Fail();
-  }
-  bool failed() const { return failed_; }
 
- private:
-  void Fail() {
-    failed_ = true;
-    throw std::runtime_error(std::string(fileName()) + ": " + std::strerror(errno));
-  }
-  std::FILE* f_;
-  bool failed_ = false;
-};
-}  // namespace
-
-namespace {
-
-Imath::M44f ToImath(const std::array<float, 16>& m) {
-  return Imath::M44f(m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11], m[12], m[13], m[14], m[15]);
-}
 std::array<float, 16> FromImath(const Imath::M44f& m) {
   std::array<float, 16> a;
   for (int i = 0; i < 4; ++i)
@@ -60,19 +32,6 @@ std::array<float, 16> FromImath(const Imath::M44f& m) {
 
 // A whole frame rate up to 60 (a timeCode's frame field), or 0.
 int WholeFps(double fps) { return fps >= 1 && fps <= 60 && fps == std::floor(fps) ? int(fps) : 0; }
-
-void AddMetadata(const ExrMetadata& m, Imf::Header* header) {
-  if (m.world_to_camera) Imf::addWorldToCamera(*header, ToImath(*m.world_to_camera));
-  if (m.world_to_ndc) Imf::addWorldToNDC(*header, ToImath(*m.world_to_ndc));
-  if (m.frames_per_second > 0) Imf::addFramesPerSecond(*header, Imf::Rational(m.frames_per_second));
-  const int fps = WholeFps(m.frames_per_second);
-  if (fps > 0 && m.frame >= 0) {
-    const long seconds = m.frame / fps;
-    if (seconds < 24 * 3600)  // a day: the hours field's range
-      Imf::addTimeCode(*header, Imf::TimeCode(int(seconds / 3600), int(seconds / 60 % 60), int(seconds % 60),
-                                              int(m.frame % fps)));
-  }
-}
 
 ExrMetadata ReadMetadata(const Imf::Header& header) {
   ExrMetadata m;
@@ -92,6 +51,145 @@ ExrMetadata ReadMetadata(const Imf::Header& header) {
 
 }  // namespace
 
+namespace {
+
+// The file through stdio (OpenEXR Core writes the header, the chunk table and our chunks
+// through it). A failed write is remembered with its errno, and Core's messages are kept
+// instead of printed, so that the exception can say what went wrong.
+struct CoreSink {
+  std::FILE* file = nullptr;
+  int write_errno = 0;
+  std::string message;
+};
+
+int64_t WriteAt(exr_const_context_t, void* user, const void* buffer, uint64_t size, uint64_t offset,
+                exr_stream_error_func_ptr_t) {
+  CoreSink& sink = *static_cast<CoreSink*>(user);
+  if ((uint64_t(ftello(sink.file)) != offset && fseeko(sink.file, off_t(offset), SEEK_SET) != 0) ||
+      std::fwrite(buffer, 1, size, sink.file) != size) {
+    sink.write_errno = errno;
+    return -1;
+  }
+  return int64_t(size);
+}
+
+void KeepMessage(exr_const_context_t context, exr_result_t, const char* message) {
+  void* user = nullptr;
+  if (exr_get_user_data(context, &user) == EXR_ERR_SUCCESS && user) static_cast<CoreSink*>(user)->message = message;
+}
+
+void Check(exr_result_t result, const CoreSink& sink, const std::string& path) {
+  if (result == EXR_ERR_SUCCESS) return;
+  const std::string reason = sink.write_errno ? std::strerror(sink.write_errno)
+                             : sink.message.empty() ? exr_get_default_error_message(result) : sink.message;
+  throw std::runtime_error(path + ": " + reason);
+}
+
+void AddMetadata(const ExrMetadata& m, exr_context_t context, const CoreSink& sink, const std::string& path) {
+  auto matrix = [&](const char* name, const std::optional<std::array<float, 16>>& value) {
+    if (!value) return;
+    exr_attr_m44f_t a;
+    std::copy(value->begin(), value->end(), a.m);  // row-major, as Imath's M44f
+    Check(exr_attr_set_m44f(context, 0, name, &a), sink, path);
+  };
+  matrix("worldToCamera", m.world_to_camera);
+  matrix("worldToNDC", m.world_to_ndc);
+  if (m.frames_per_second > 0) {
+    const Imf::Rational r(m.frames_per_second);  // OpenEXR's nearest fraction
+    const exr_attr_rational_t a = {r.n, r.d};
+    Check(exr_attr_set_rational(context, 0, "framesPerSecond", &a), sink, path);
+  }
+  const int fps = WholeFps(m.frames_per_second);
+  if (fps > 0 && m.frame >= 0) {
+    const long seconds = m.frame / fps;
+    if (seconds < 24 * 3600) {  // a day: the hours field's range
+      const Imf::TimeCode code(int(seconds / 3600), int(seconds / 60 % 60), int(seconds % 60), int(m.frame % fps));
+      const exr_attr_timecode_t a = {code.timeAndFlags(), code.userData()};
+      Check(exr_attr_set_timecode(context, 0, "timeCode", &a), sink, path);
+    }
+  }
+}
+
+// Rows [y, y + rows) of every channel as the file stores them: line after line, in each line
+// the channels in the order of `sorted` (by name), half channels converted, little-endian as
+// EXR is (x86 is).
+void PackRows(const std::vector<const ExrChannel*>& sorted, int width, int y, int rows, std::uint16_t* out) {
+  for (int row = y; row < y + rows; ++row)
+    for (const ExrChannel* c : sorted) {
+      const float* in = c->data.data() + size_t(row) * size_t(width);
+      if (c->half) {
+        FloatsToHalves(in, size_t(width), out);
+        out += width;
+      } else {
+        std::memcpy(out, in, sizeof(float) * size_t(width));
+        out += 2 * width;
+      }
+    }
+}
+
+// OpenEXR's ZIP_COMPRESSION of one block (ImfZip.cpp): the even bytes, then the odd ones
+// (the low and high bytes of halves apart), each replaced by its difference to the byte before
+// plus 128, deflated by zlib at level 1. A block that would not shrink is stored as it is
+// (readers tell by its size).
+void ZipBlock(const unsigned char* raw, size_t n, std::vector<unsigned char>* scratch, std::vector<unsigned char>* out) {
+  scratch->resize(2 * n);
+  unsigned char* split = scratch->data();
+  unsigned char* even = split;
+  unsigned char* odd = split + (n + 1) / 2;
+  for (size_t i = 0; i < n / 2; ++i) {
+    even[i] = raw[2 * i];
+    odd[i] = raw[2 * i + 1];
+  }
+  if (n % 2) even[n / 2] = raw[n - 1];
+  unsigned char* differences = split + n;
+  differences[0] = split[0];
+  for (size_t i = 1; i < n; ++i) differences[i] = (unsigned char)(split[i] - split[i - 1] + 128);
+  out->resize(compressBound(uLong(n)));
+  uLongf size = uLongf(out->size());
+  if (compress2(out->data(), &size, differences, uLong(n), 1) != Z_OK || size >= n) {
+    out->assign(raw, raw + n);
+    return;
+  }
+  out->resize(size);
+}
+
+// The compressed bytes of blocks this thread compressed before, reused for a block with the
+// same bytes: the same block of its previous file, or the block above in this file. Rendered
+// frames are mostly background, and 59% of the demo's EXR blocks repeat the previous frame's:
+// deflating them again was half of a frame's writing time. Compressed bytes depend on the raw
+// bytes alone, so any match is exact. Holds at most kBytes of raw blocks.
+class ZipBlockCache {
+ public:
+  const std::vector<unsigned char>& Packed(size_t block, const unsigned char* raw, size_t n) {
+    if (blocks_.size() <= block) blocks_.resize(block + 1);
+    Block& b = blocks_[block];
+    auto same = [&](const Block& o) { return o.raw.size() == n && std::memcmp(o.raw.data(), raw, n) == 0; };
+    if (same(b)) return b.packed;
+    if (block > 0 && same(blocks_[block - 1])) {
+      b = blocks_[block - 1];
+      return b.packed;
+    }
+    if (n * (block + 1) <= kBytes) {
+      b.raw.assign(raw, raw + n);
+      ZipBlock(raw, n, &scratch_, &b.packed);
+      return b.packed;
+    }
+    b = Block();  // an image too large to keep
+    ZipBlock(raw, n, &scratch_, &uncached_);
+    return uncached_;
+  }
+
+ private:
+  static constexpr size_t kBytes = size_t(64) << 20;
+  struct Block {
+    std::vector<unsigned char> raw, packed;
+  };
+  std::vector<Block> blocks_;
+  std::vector<unsigned char> scratch_, uncached_;
+};
+
+}  // namespace
+
 void WriteExrChannels(const std::string& path, int width, int height, const std::vector<ExrChannel>& channels,
                       ExrCompression compression, const ExrMetadata& metadata) {
   if (width <= 0 || height <= 0)
@@ -101,45 +199,66 @@ void WriteExrChannels(const std::string& path, int width, int height, const std:
     if (c.data.size() != size_t(width) * size_t(height))
       throw std::invalid_argument(path + ": channel '" + c.name + "' has " + std::to_string(c.data.size()) +
                                   " values, expected " + std::to_string(size_t(width) * height));
+  std::vector<const ExrChannel*> sorted;  // a file's channels are sorted by name
+  for (const ExrChannel& c : channels) sorted.push_back(&c);
+  std::sort(sorted.begin(), sorted.end(), [](const ExrChannel* a, const ExrChannel* b) { return a->name < b->name; });
+  for (size_t i = 1; i < sorted.size(); ++i)
+    if (sorted[i]->name == sorted[i - 1]->name)
+      throw std::invalid_argument(path + ": two channels named '" + sorted[i]->name + "'");
+  size_t line_halves = 0;  // a line's size in 16-bit units
+  for (const ExrChannel* c : sorted) line_halves += size_t(width) * (c->half ? 1 : 2);
+  thread_local ZipBlockCache cache;
+
   formats::WriteFileAtomically(path, [&](const std::string& tmp) {
-    Imf::Header header(width, height);
-    AddMetadata(metadata, &header);
-    switch (compression) {
-      case ExrCompression::kNone: header.compression() = Imf::NO_COMPRESSION; break;
-      case ExrCompression::kRle: header.compression() = Imf::RLE_COMPRESSION; break;
-      case ExrCompression::kZip:
-        header.compression() = Imf::ZIP_COMPRESSION;
-        header.zipCompressionLevel() = 1;  // a few percent larger than the default, several times faster
-        break;
-      case ExrCompression::kPiz: header.compression() = Imf::PIZ_COMPRESSION; break;
-    }
-    Imf::FrameBuffer fb;
-    // the half channels' bits, converted here (into uninitialised memory: a frame's worth of
-    // zeroing cost as much as the conversion)
-    std::vector<std::unique_ptr<std::uint16_t[]>> halves;
-    halves.reserve(channels.size());
-    for (const ExrChannel& c : channels) {
-      if (c.half) {
-        halves.emplace_back(new std::uint16_t[c.data.size()]);
-        FloatsToHalves(c.data.data(), c.data.size(), halves.back().get());
-        header.channels().insert(c.name, Imf::Channel(Imf::HALF));
-        fb.insert(c.name, Imf::Slice(Imf::HALF, (char*)halves.back().get(), sizeof(std::uint16_t),
-                                     sizeof(std::uint16_t) * size_t(width)));
-        continue;
-      }
-      header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
-      fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.data.data(), sizeof(float), sizeof(float) * size_t(width)));
-    }
-    // through stdio, whose every failure (the close's included) is reported with its errno:
-    // OpenEXR's own std::ofstream lost a full disk's error and left an empty file
+    // through stdio, whose every failure (the close's included) is reported with its errno
     formats::WriteWithStdio(tmp, [&](std::FILE* f) {
-      StdioStream stream(f, tmp);
-      {
-        Imf::OutputFile file(stream, header);
-        file.setFrameBuffer(fb);
-        file.writePixels(height);
-      }  // the destructor writes the line offsets
-      return !stream.failed();
+      CoreSink sink;
+      sink.file = f;
+      exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+      init.user_data = &sink;
+      init.write_fn = WriteAt;
+      init.error_handler_fn = KeepMessage;
+      exr_context_t context = nullptr;
+      Check(exr_start_write(&context, tmp.c_str(), EXR_WRITE_FILE_DIRECTLY, &init), sink, tmp);
+      struct Finish {  // frees the context when a step throws (exr_finish also nulls it)
+        exr_context_t* context;
+        ~Finish() {
+          if (*context) exr_finish(context);
+        }
+      } finish{&context};
+      const bool long_names =  // over 31 characters: a flag in the file's version field
+          std::any_of(sorted.begin(), sorted.end(), [](const ExrChannel* c) { return c->name.size() > 31; });
+      if (long_names) Check(exr_set_longname_support(context, 1), sink, tmp);
+      int part = 0;
+      Check(exr_add_part(context, "", EXR_STORAGE_SCANLINE, &part), sink, tmp);
+      const bool zip = compression == ExrCompression::kZip;
+      Check(exr_initialize_required_attr_simple(context, part, width, height,
+                                                zip ? EXR_COMPRESSION_ZIP : EXR_COMPRESSION_NONE),
+            sink, tmp);
+      for (const ExrChannel* c : sorted)
+        Check(exr_add_channel(context, part, c->name.c_str(), c->half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT,
+                              EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1),
+              sink, tmp);
+      if (zip) Check(exr_set_zip_compression_level(context, part, 1), sink, tmp);
+      AddMetadata(metadata, context, sink, tmp);
+      Check(exr_write_header(context), sink, tmp);
+      int32_t lines = 1;  // per chunk: 16 for ZIP, 1 uncompressed
+      Check(exr_get_scanlines_per_chunk(context, part, &lines), sink, tmp);
+      std::vector<std::uint16_t> raw(line_halves * size_t(lines));
+      for (int y = 0; y < height; y += lines) {
+        const int rows = std::min(lines, height - y);
+        PackRows(sorted, width, y, rows, raw.data());
+        const auto* bytes = reinterpret_cast<const unsigned char*>(raw.data());
+        const size_t n = 2 * line_halves * size_t(rows);
+        if (!zip) {
+          Check(exr_write_scanline_chunk(context, part, y, bytes, n), sink, tmp);
+          continue;
+        }
+        const std::vector<unsigned char>& packed = cache.Packed(size_t(y / lines), bytes, n);
+        Check(exr_write_scanline_chunk(context, part, y, packed.data(), packed.size()), sink, tmp);
+      }
+      Check(exr_finish(&context), sink, tmp);  // writes the chunk table
+      return sink.write_errno == 0;
     });
   });
 }

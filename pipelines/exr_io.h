@@ -19,9 +19,10 @@ struct ExrChannel {
   bool half = false;        // stored as 16-bit half floats (colour); read back as float
 };
 
-// Rendered frames use kZip (level 1: RLE was hardly faster and 13 times larger); float data
-// that zlib cannot shrink uses kNone (the displacement images: 5% smaller at 7.5 times the time).
-enum class ExrCompression { kNone, kRle, kZip, kPiz };
+// OpenEXR's ZIP_COMPRESSION (16 lines a chunk, zlib level 1) for rendered frames (RLE was
+// hardly faster and 13 times larger); kNone for float data that zlib cannot shrink (the
+// displacement images: 5% smaller at 7.5 times the time).
+enum class ExrCompression { kNone, kZip };
 
 // OpenEXR's standard attributes of a rendered frame (ImfStandardAttributes.h), for compositors:
 // the camera (worldToCamera: left-handed, +z the viewing direction; worldToNDC: (0, 0) the top
@@ -34,9 +35,13 @@ struct ExrMetadata {
   long frame = -1;               // < 0: no timeCode
 };
 
-// Writes a scan-line EXR of 32-bit float channels, atomically (temporary file + rename).
-// Throws std::invalid_argument for a bad size or channel length, std::runtime_error (naming
-// the path and reason) when the file cannot be written; an earlier file is then left intact.
+// Writes a scan-line EXR of the channels (32-bit floats, or halves), atomically (temporary file
+// + rename). OpenEXR Core writes the header and chunk table; the chunks are packed here, and a
+// ZIP chunk whose bytes this thread compressed before (the same block of the previous frame, or
+// the block above: background) reuses those compressed bytes.
+// Throws std::invalid_argument for a bad size, channel length or two channels of one name,
+// std::runtime_error (naming the path and reason) when the file cannot be written; an earlier
+// file is then left intact.
 void WriteExrChannels(const std::string& path, int width, int height, const std::vector<ExrChannel>& channels,
                       ExrCompression compression = ExrCompression::kZip, const ExrMetadata& metadata = {});
 

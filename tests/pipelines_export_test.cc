@@ -207,7 +207,7 @@ TEST(ExrIo, NamedChannelsRoundTripExactly) {
   std::vector<ExrChannel> ch = {{"cond", {}}, {"angle.X", {}}, {"zeta", {}}};
   for (size_t c = 0; c < ch.size(); ++c)
     for (int i = 0; i < w * h; ++i) ch[c].data.push_back(float(1e-3 * i * i - 0.25 * c + (i % 3 ? 1e6 : -2.5)));
-  for (ExrCompression comp : {ExrCompression::kNone, ExrCompression::kRle, ExrCompression::kZip, ExrCompression::kPiz}) {
+  for (ExrCompression comp : {ExrCompression::kNone, ExrCompression::kZip}) {
     WriteExrChannels(dir + "/c.exr", w, h, ch, comp);
     const ExrImage back = ReadExrChannels(dir + "/c.exr");
     ASSERT_EQ(back.width, w);
