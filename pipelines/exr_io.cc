@@ -6,7 +6,6 @@
 #include <ImfInputFile.h>
 #include <ImfStandardAttributes.h>
 #include <openexr.h>
-#include <zlib.h>
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -16,6 +15,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "pipelines/exr_zip.h"
 #include "pipelines/half_floats.h"
 #include "wobble/formats/atomic_file.h"
 
@@ -127,67 +127,6 @@ void PackRows(const std::vector<const ExrChannel*>& sorted, int width, int y, in
     }
 }
 
-// OpenEXR's ZIP_COMPRESSION of one block (ImfZip.cpp): the even bytes, then the odd ones
-// (the low and high bytes of halves apart), each replaced by its difference to the byte before
-// plus 128, deflated by zlib at level 1. A block that would not shrink is stored as it is
-// (readers tell by its size).
-void ZipBlock(const unsigned char* raw, size_t n, std::vector<unsigned char>* scratch, std::vector<unsigned char>* out) {
-  scratch->resize(2 * n);
-  unsigned char* split = scratch->data();
-  unsigned char* even = split;
-  unsigned char* odd = split + (n + 1) / 2;
-  for (size_t i = 0; i < n / 2; ++i) {
-    even[i] = raw[2 * i];
-    odd[i] = raw[2 * i + 1];
-  }
-  if (n % 2) even[n / 2] = raw[n - 1];
-  unsigned char* differences = split + n;
-  differences[0] = split[0];
-  for (size_t i = 1; i < n; ++i) differences[i] = (unsigned char)(split[i] - split[i - 1] + 128);
-  out->resize(compressBound(uLong(n)));
-  uLongf size = uLongf(out->size());
-  if (compress2(out->data(), &size, differences, uLong(n), 1) != Z_OK || size >= n) {
-    out->assign(raw, raw + n);
-    return;
-  }
-  out->resize(size);
-}
-
-// The compressed bytes of blocks this thread compressed before, reused for a block with the
-// same bytes: the same block of its previous file, or the block above in this file. Rendered
-// frames are mostly background, and 59% of the demo's EXR blocks repeat the previous frame's:
-// deflating them again was half of a frame's writing time. Compressed bytes depend on the raw
-// bytes alone, so any match is exact. Holds at most kBytes of raw blocks.
-class ZipBlockCache {
- public:
-  const std::vector<unsigned char>& Packed(size_t block, const unsigned char* raw, size_t n) {
-    if (blocks_.size() <= block) blocks_.resize(block + 1);
-    Block& b = blocks_[block];
-    auto same = [&](const Block& o) { return o.raw.size() == n && std::memcmp(o.raw.data(), raw, n) == 0; };
-    if (same(b)) return b.packed;
-    if (block > 0 && same(blocks_[block - 1])) {
-      b = blocks_[block - 1];
-      return b.packed;
-    }
-    if (n * (block + 1) <= kBytes) {
-      b.raw.assign(raw, raw + n);
-      ZipBlock(raw, n, &scratch_, &b.packed);
-      return b.packed;
-    }
-    b = Block();  // an image too large to keep
-    ZipBlock(raw, n, &scratch_, &uncached_);
-    return uncached_;
-  }
-
- private:
-  static constexpr size_t kBytes = size_t(64) << 20;
-  struct Block {
-    std::vector<unsigned char> raw, packed;
-  };
-  std::vector<Block> blocks_;
-  std::vector<unsigned char> scratch_, uncached_;
-};
-
 }  // namespace
 
 void WriteExrChannels(const std::string& path, int width, int height, const std::vector<ExrChannel>& channels,
@@ -207,7 +146,7 @@ void WriteExrChannels(const std::string& path, int width, int height, const std:
       throw std::invalid_argument(path + ": two channels named '" + sorted[i]->name + "'");
   size_t line_halves = 0;  // a line's size in 16-bit units
   for (const ExrChannel* c : sorted) line_halves += size_t(width) * (c->half ? 1 : 2);
-  thread_local ZipBlockCache cache;
+  thread_local ZipChunkCache cache;
 
   formats::WriteFileAtomically(path, [&](const std::string& tmp) {
     // through stdio, whose every failure (the close's included) is reported with its errno
@@ -254,7 +193,7 @@ void WriteExrChannels(const std::string& path, int width, int height, const std:
           Check(exr_write_scanline_chunk(context, part, y, bytes, n), sink, tmp);
           continue;
         }
-        const std::vector<unsigned char>& packed = cache.Packed(size_t(y / lines), bytes, n);
+        const std::vector<unsigned char>& packed = cache.Encoded(size_t(y / lines), bytes, n, 2 * line_halves);
         Check(exr_write_scanline_chunk(context, part, y, packed.data(), packed.size()), sink, tmp);
       }
       Check(exr_finish(&context), sink, tmp);  // writes the chunk table
