@@ -1,6 +1,7 @@
 // Benchmarks of pipelines/: frames rendered offscreen per second at 640x480, and .png, .exr
 // (R,G,B,A,depth.Z), displacement .exr and .vtp frames written per second, each for the
-// table of data/ falling onto a sloped ground; and the goal of issue 3 in one number: 300
+// table of data/ falling onto a sloped ground; a rendered frame's EXR channels written by
+// wobble's writer against OpenEXR's own (issue 19); and the goal of issue 3 in one number: 300
 // frames (10 s at 30 fps) simulated, rendered and exported (PNG + EXR + VTP + displacement).
 // `wobble view`'s frame (issue 8): one frame of the interactive viewer (1280x720 window: scene,
 // two live charts, sliders) for the thesis' table and pot, each frame advancing 1/30 s.
@@ -14,11 +15,17 @@
 #include <string>
 #include <vector>
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
 #include <Imath/half.h>
 #include <vtkImageData.h>
 #include <vtkPNGWriter.h>
 
 #include "pipelines/exports.h"
+#include "pipelines/exr_frame.h"
+#include "pipelines/exr_io.h"
 #include "pipelines/half_floats.h"
 #include "pipelines/interactive_view.h"
 #include "pipelines/scene_view.h"
@@ -151,6 +158,57 @@ void BM_FloatsToHalves640x480(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * int64_t(n));
 }
 BENCHMARK(BM_FloatsToHalves640x480)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// Writing one rendered 640x480 EXR frame's channels (R, G, B, A, forward.u/v halves, depth.Z
+// float; ZIP): OpenEXR's C++ writer at zlib level 1 (the baseline, arg 0, what wobble used
+// before) against WriteExrChannels (arg 1: its own chunk encoder, and chunks reused from the
+// previous frame). The frames: 30 consecutive frames of the demo, cycled, so that each write
+// follows the one before it as in a render.
+void BM_WriteExrChannels640x480(benchmark::State& state) {
+  if (!NeedDisplay(state)) return;
+  auto world = DemoWorld();
+  SceneView view(world.get());
+  std::vector<std::vector<ExrChannel>> frames;
+  long frame = 0;
+  for (int k = 0; k < 30; ++k) {
+    Advance(&world, &frame);
+    view.Render();
+    frames.push_back(ExrFrameChannels(view.CaptureExrFrame(), nullptr, nullptr));
+  }
+  const std::string path = OutDir() + "/channels.exr";
+  const bool openexr = state.range(0) == 0;
+  size_t k = 0;
+  for (auto _ : state) {
+    const std::vector<ExrChannel>& ch = frames[k++ % frames.size()];
+    if (!openexr) {
+      WriteExrChannels(path, 640, 480, ch, ExrCompression::kZip);
+      continue;
+    }
+    Imf::Header header(640, 480);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    header.zipCompressionLevel() = 1;
+    Imf::FrameBuffer fb;
+    std::vector<std::vector<std::uint16_t>> halves;  // converted as before, with F16C
+    halves.reserve(ch.size());
+    for (const ExrChannel& c : ch) {
+      if (c.half) {
+        halves.emplace_back(c.data.size());
+        FloatsToHalves(c.data.data(), c.data.size(), halves.back().data());
+        header.channels().insert(c.name, Imf::Channel(Imf::HALF));
+        fb.insert(c.name, Imf::Slice(Imf::HALF, (char*)halves.back().data(), 2, 2 * 640));
+      } else {
+        header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+        fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.data.data(), 4, 4 * 640));
+      }
+    }
+    Imf::OutputFile file(path.c_str(), header);
+    file.setFrameBuffer(fb);
+    file.writePixels(480);
+  }
+  state.SetLabel(openexr ? "OpenEXR OutputFile, zlib level 1 (baseline)" : "wobble WriteExrChannels");
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_WriteExrChannels640x480)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_WriteExrFrame640x480(benchmark::State& state) {
   if (!NeedDisplay(state)) return;

@@ -2,7 +2,8 @@
 // rendered frames are nearly all flat: background, and surfaces whose values repeat along the
 // line or from one line to the next. zlib spent ~200 us a 16-line chunk on such data whatever
 // it held (it compares every byte of every match); a deflate encoder that only looks for those
-// repeats does the same job in a fraction of that (bench: EncodeZipChunk).
+// repeats does the same job in a fraction of that (bench/pipelines_bench.cc,
+// BM_WriteExrChannels640x480: the whole frame against OpenEXR's own writer).
 //
 // A chunk (ImfZip.cpp; OpenEXR file layout): the lines' bytes split into the even and the odd
 // ones, each byte replaced by its difference to the byte before plus 128, then a zlib stream

@@ -549,8 +549,9 @@ ExrFrame SceneView::CaptureExrFrame() {
   auto eye_distance = [&](double d) {
     return parallel ? range[0] + d * (range[1] - range[0]) : range[0] * range[1] / (range[1] - d * (range[1] - range[0]));
   };
-  // the colour stays sRGB-encoded here (ExrFrameChannels decodes it on a writer thread), and
-  // the images are filled row by row, top first, without zeroing them first
+  // the colour stays sRGB-encoded here (ExrFrameChannels decodes it on a writer thread); rows
+  // are flipped to top first by copies and plain per-row loops, no per-pixel push_back: this
+  // runs on the render thread, which the writer threads wait for
   ExrFrame f;
   f.width = w;
   f.height = h;
@@ -558,19 +559,19 @@ ExrFrame SceneView::CaptureExrFrame() {
   const auto* px = static_cast<const unsigned char*>(rgb->GetScalarPointer());
   const float* zp = z->GetPointer(0);
   const float inf = std::numeric_limits<float>::infinity();
-  f.srgb.reserve(3 * n);
-  f.depth.reserve(n);
-  f.overlay.reserve(n);
-  for (int y = h - 1; y >= 0; --y) {  // VTK's rows start at the bottom
-    const size_t row = size_t(y) * w;
-    f.srgb.insert(f.srgb.end(), px + 3 * row, px + 3 * (row + w));
-    for (size_t in = row; in < row + size_t(w); ++in) {
-      // VTK draws the 2D overlay (text, colour bar) at window depth 0, the near plane, which
-      // no geometry reaches (the cameras keep the near plane in front of everything framed):
-      // those pixels are the overlay's, in no layer of the EXR
-      f.overlay.push_back(zp[in] == 0.0f);
-      f.depth.push_back(zp[in] < 1.0f && zp[in] > 0.0f ? float(eye_distance(zp[in])) : inf);
-    }
+  f.srgb.resize(3 * n);
+  f.depth.resize(n);
+  f.overlay.resize(n);
+  for (int y = h - 1, out = 0; y >= 0; --y, out += w) {  // VTK's rows start at the bottom
+    const float* zr = zp + size_t(y) * w;
+    std::memcpy(f.srgb.data() + 3 * size_t(out), px + 3 * size_t(y) * w, 3 * size_t(w));
+    float* depth = f.depth.data() + out;
+    uint8_t* overlay = f.overlay.data() + out;
+    // VTK draws the 2D overlay (text, colour bar) at window depth 0, the near plane, which no
+    // geometry reaches (the cameras keep the near plane in front of everything framed): those
+    // pixels are the overlay's, in no layer of the EXR
+    for (int x = 0; x < w; ++x) overlay[x] = zr[x] == 0.0f;
+    for (int x = 0; x < w; ++x) depth[x] = zr[x] < 1.0f && zr[x] > 0.0f ? float(eye_distance(zr[x])) : inf;
   }
   f.characters = CharacterGeometry();
   f.metadata = ExrCameraMetadata();
