@@ -113,7 +113,7 @@ demo: demo-build
 	echo "  frames      $(OUT)/frames/frame_NNNN.png  (640x480, 30 fps)"
 	echo "  filmstrip   $(OUT)/filmstrip.png"
 	echo "  ParaView    $(OUT)/vtp/table.pvd  (lattice, mass points, shape per frame; the terrain as its last part)"
-	echo "  EXR         $(OUT)/exr/frame_NNNN.exr  (R,G,B,A, depth.Z; camera and timeCode in the header), $(OUT)/exr/disp_NNNN.exr  (disp.X, disp.Y)"
+	echo "  EXR         $(OUT)/exr/frame_NNNN.exr  (R,G,B,A, depth.Z, forward.u/v motion to the next frame; camera and timeCode in the header), $(OUT)/exr/disp_NNNN.exr  (disp.X, disp.Y)"
 	echo "  plots       $(OUT)/energy.png, $(OUT)/condition.png  (numbers in the .csv beside them)"
 	echo "  table drop  $(OUT)/table_drop.csv  (the sloped-ground drop, simulated only: README, Pictures and exports)"
 	echo "  sky hook    out/fig3/filmstrip.png, out/fig3/frames/, out/fig3/vtp/fig3_sky_hook.pvd  (Witkin & Welch Fig. 3)"
