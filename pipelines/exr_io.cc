@@ -178,7 +178,6 @@ void WriteExrChannels(const std::string& path, int width, int height, const std:
         Check(exr_add_channel(context, part, c->name.c_str(), c->half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT,
                               EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1),
               sink, tmp);
-      if (zip) Check(exr_set_zip_compression_level(context, part, 1), sink, tmp);
       AddMetadata(metadata, context, sink, tmp);
       Check(exr_write_header(context), sink, tmp);
       int32_t lines = 1;  // per chunk: 16 for ZIP, 1 uncompressed
