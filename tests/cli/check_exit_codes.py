@@ -193,11 +193,14 @@ def main():
              [wobble, "run", script("folder_out.wob", f"load_obj {obj}\nload_def {modes}\n{line}\nsimul 1\n")], work, 2,
              "folder_out.wob:3:", "names a folder")
 
-    # ---- a full disk (a 200 kB tmpfs, when this machine lets us mount one): exit 1 with the
-    # system's text, and the files of the earlier run unchanged (was: exit 0, empty EXRs)
+    # ---- a full disk (a 400 kB tmpfs, when this machine lets us mount one): exit 1 with the
+    # system's text, and the files of the earlier run unchanged (was: exit 0, empty EXRs). A
+    # displacement EXR is 176 kB and two are written at once (one writer thread per core): the
+    # disk holds two, so the first always completes whatever the threads' timing (at 200 kB, two
+    # in flight could both fail, leaving nothing to compare), and the 61 files still fill it
     full = os.path.join(work, "full")
     os.makedirs(full)
-    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=200k", "tmpfs", full], capture_output=True).returncode == 0
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=400k", "tmpfs", full], capture_output=True).returncode == 0
     if not mounted:
         print("skip a full disk: cannot mount a tmpfs here")
     else:
