@@ -49,10 +49,10 @@ bool HasDisplay() {
   static const bool has = [] {
     const char* d = std::getenv("DISPLAY");
     if (!d || !*d) return false;
-    // Xvfb under a parallel ctest refuses a connection now and then (a render test then
-    // skipped although the display was there): retry for about a second before giving up
+    // Xvfb under a parallel ctest refuses a connection now and then: retry for about three
+    // seconds before giving up (the tests then fail, since DISPLAY was set)
     static Display* probe = nullptr;
-    for (int attempt = 0; attempt < 10 && !probe; ++attempt) {
+    for (int attempt = 0; attempt < 30 && !probe; ++attempt) {
       if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
       probe = XOpenDisplay(nullptr);
     }

@@ -237,7 +237,7 @@ TEST(SceneRun, WritesAPvdSeriesThatVtkReadsBack) {
 }
 
 TEST(SceneRun, FramesAndFilmstripWithADisplay) {
-  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display: VTK 9.1 renders only through X";
+  REQUIRE_DISPLAY();
   World w(testing::WitkinWelchOptions());
   auto model = std::make_shared<const LinearBodyModel>(MakeBoxBody("cube", 3, LinearOrder::kAffine, V({0.5, 0.5, 0.5}), 2, 1.0));
   const int b = w.AddLinearBody(model);

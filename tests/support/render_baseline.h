@@ -17,6 +17,7 @@
 
 #include "pipelines/exports.h"
 #include "pipelines/scene_view.h"
+#include "support/source_paths.h"
 
 namespace wobble::pipelines::testing_render {
 
@@ -42,7 +43,7 @@ inline bool PixelNear(vtkImageData* a, int x, int y, vtkImageData* b, int comps)
 }
 
 inline void CompareWithBaseline(const std::string& name, vtkImageData* image) {
-  const std::string baseline_path = std::string(WOBBLE_BASELINE_DIR) + "/" + name + ".png";
+  const std::string baseline_path = wobble::test_env::BaselineDir() + "/" + name + ".png";
   if (const char* update = std::getenv("WOBBLE_UPDATE_BASELINES"); update && std::string(update) == "1") {
     WritePng(baseline_path, image, 9);
     std::cout << "wrote baseline " << baseline_path << "\n";
@@ -75,7 +76,7 @@ inline void CompareWithBaseline(const std::string& name, vtkImageData* image) {
     }
   const double fraction = double(bad) / (double(dn[0]) * dn[1]);
   if (fraction > kMaxBadFraction) {
-    const std::string out = WOBBLE_RENDER_FAILURE_DIR;
+    const std::string out = wobble::test_env::RenderFailureDir();
     WritePng(out + "/" + name + "_new.png", image);
     WritePng(out + "/" + name + "_diff.png", diff);
     ADD_FAILURE() << name << ": " << bad << " pixels (" << 100 * fraction << "%) differ from " << baseline_path
@@ -84,6 +85,3 @@ inline void CompareWithBaseline(const std::string& name, vtkImageData* image) {
 }
 
 }  // namespace wobble::pipelines::testing_render
-
-#define REQUIRE_DISPLAY() \
-  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run"
