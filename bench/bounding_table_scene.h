@@ -10,18 +10,19 @@
 
 #include "wobble/script/interpreter.h"
 #include "wobble/synth/anneal.h"
+#include "support/source_paths.h"
 
 namespace wobble::bench {
 
 // bounding_table (2D) or bounding_table3 (the 3D table, issue 15).
 struct BoundingTable {
   explicit BoundingTable(const std::string& name = "bounding_table") : interp(sink) {
-    const std::string path = std::string(WOBBLE_DATA_DIR) + "/" + name + ".wob";
+    const std::string path = wobble::test_env::DataDir() + "/" + name + ".wob";
     std::ifstream f(path);
     std::string line;
     for (int n = 1; std::getline(f, line); ++n) {
       if (line.rfind("anneal", 0) == 0) break;
-      interp.RunLine(line, path, n, WOBBLE_DATA_DIR);
+      interp.RunLine(line, path, n, wobble::test_env::DataDir());
     }
     problem = interp.SynthesisProblem();
     graph = interp.pose_graph();

@@ -31,11 +31,12 @@
 #include "pipelines/scene_view.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "support/source_paths.h"
 
 namespace wobble::pipelines {
 namespace {
 
-const std::string kData = WOBBLE_DATA_DIR;
+const std::string kData = wobble::test_env::DataDir();
 
 std::shared_ptr<const BodyModel> Table() {
   static auto body = std::make_shared<const BodyModel>(formats::ReadObjectFile(kData + "/table.obj"),

@@ -16,11 +16,12 @@
 
 #include "wobble/control/controllers.h"
 #include "wobble/script/interpreter.h"
+#include "support/source_paths.h"
 
 namespace wobble {
 namespace {
 
-const std::string kData = WOBBLE_DATA_DIR;
+const std::string kData = wobble::test_env::DataDir();
 
 // A script run up to (not including) its first `simul`, `render` or `anneal`.
 struct ScriptUpToSimul {

@@ -18,6 +18,7 @@
 #include "wobble/world/world.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "support/source_paths.h"
 
 namespace wobble {
 namespace {
@@ -67,7 +68,7 @@ std::vector<DeformationMode> TableModesInCode() {
           ModeFromRows("vsquash", vsq_x, vsq_y), ModeFromRows("hsquash", hsq_x, hsq_y)};
 }
 
-const std::string kDataDir = WOBBLE_DATA_DIR;
+const std::string kDataDir = wobble::test_env::DataDir();
 
 BodyDef TableDef() {
   const std::string path = kDataDir + "/table.obj";

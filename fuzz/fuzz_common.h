@@ -16,10 +16,11 @@
 #include "wobble/formats/object_file.h"
 #include "wobble/formats/parse_error.h"
 #include "wobble/script/interpreter.h"
+#include "support/source_paths.h"
 
 namespace wobble::fuzz {
 
-inline const std::string kDataDir = WOBBLE_DATA_DIR;
+inline const std::string kDataDir = wobble::test_env::DataDir();
 
 // Runs f; the failures hostile input is allowed to cause (a named error of core/errors.h, a
 // reader's ParseError, a stopped simulation) are swallowed. Anything else escapes: an

@@ -18,6 +18,7 @@
 #include "wobble/body/linear_body.h"
 #include "wobble/body/linear_shapes.h"
 #include "wobble/world/world.h"
+#include "support/source_paths.h"
 
 namespace wobble {
 namespace {
@@ -587,9 +588,9 @@ TEST(Body3, TableDroppedFlatLandsOnItsFourLegsAndSettles) {
 
 // One world with a 2D table, a 3D table and a Witkin & Welch box: each steps as it would alone.
 TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
-  const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
+  const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
   auto table3 = std::make_shared<const BodyModel3>(
-      def, formats::ReadDeformationFile3(std::string(WOBBLE_DATA_DIR) + "/table3_modes.def3", def.lattice));
+      def, formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
   WorldOptions o;
   o.ground_3d.enabled = true;
   o.integrator = Integrator::kSymplecticEuler;
@@ -619,7 +620,7 @@ TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
 }
 
 TEST(Body3InWorld, RefusesBadStatesAndPoints) {
-  const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
+  const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
   World world;
   const int b = world.AddBody(std::make_shared<const BodyModel3>(def, std::vector<DeformationMode3>{}));
   EXPECT_THROW(world.body(b), std::invalid_argument);  // not a 2D FFD body
@@ -643,9 +644,9 @@ TEST(Body3InWorld, RefusesBadStatesAndPoints) {
 // points at the step's start configuration. On the free path and on the constrained one (a
 // nail on another body makes every body step together).
 TEST(Body3InWorld, APointForceGivesTheBodyItsImpulse) {
-  const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
+  const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
   auto table3 = std::make_shared<const BodyModel3>(
-      def, formats::ReadDeformationFile3(std::string(WOBBLE_DATA_DIR) + "/table3_modes.def3", def.lattice));
+      def, formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
   for (const bool constrained : {false, true}) {
     const char* path = constrained ? "constrained" : "free";
     WorldOptions o;

@@ -12,11 +12,12 @@
 #include "wobble/body/body_model.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "support/source_paths.h"
 
 namespace wobble::formats {
 namespace {
 
-const std::string kData = WOBBLE_DATA_DIR;
+const std::string kData = wobble::test_env::DataDir();
 
 // Displacement of a body-frame point under a mode: Σ_ij B_i(s) B_j(t) d_ij.
 Eigen::Vector2d ModeDisplacement(const Lattice& lattice, const DeformationMode& mode, const Eigen::Vector2d& p) {

@@ -11,6 +11,7 @@
 #include "wobble/dynamics/step3.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "support/source_paths.h"
 
 namespace wobble {
 namespace {
@@ -103,9 +104,9 @@ Eigen::Matrix<T, Eigen::Dynamic, 1> Simulate3(const BodyModel3& body, const Worl
 }
 
 TEST(Jet, Step3DerivativesMatchFiniteDifferences) {
-  const BodyDef3 def = formats::ReadObjectFile3(std::string(WOBBLE_DATA_DIR) + "/table3.obj");
+  const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
   std::vector<DeformationMode3> modes =
-      formats::ReadDeformationFile3(std::string(WOBBLE_DATA_DIR) + "/table3_modes.def3", def.lattice);
+      formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice);
   for (DeformationMode3& m : modes) m.stiffness = 4e5, m.damping = 1e4;
   const BodyModel3 body(def, modes);
   WorldParams3 w;

@@ -47,6 +47,7 @@
 #include "support/test_bodies.h"
 #include "wobble/dynamics/heightfield.h"
 #include "wobble/formats/atomic_file.h"
+#include "support/source_paths.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -257,7 +258,7 @@ TEST(DisplacementExr, ValuesAtKnownPixelsMatchTheFfdEvaluatedIndependently) {
 // position through worldToNDC lands on the pixel where that point is drawn (red, opaque), its
 // worldToCamera z is its depth.Z, and the frame number comes back from the timeCode at 30 fps.
 TEST(RenderedExr, CameraAndTimeInTheHeaderAtKnownPixels) {
-  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
+  REQUIRE_DISPLAY();
   const std::string dir = TempDir("frame_exr_meta");
   auto world = AirborneWorld();  // deformed and turned: the camera is not the identity on it
   SceneOptions opt;
@@ -301,7 +302,7 @@ TEST(RenderedExr, CameraAndTimeInTheHeaderAtKnownPixels) {
 }
 
 TEST(RenderedExr, ColourAlphaAndDepthAtKnownPixels) {
-  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
+  REQUIRE_DISPLAY();
   const std::string dir = TempDir("frame_exr");
   World world;  // flat ground through the origin, the table at rest standing on it
   world.AddBody(testing::Table());
@@ -356,12 +357,12 @@ TEST(RenderedExr, ColourAlphaAndDepthAtKnownPixels) {
 // the pixel's centre, in pixels (lines and dots: see below); the alpha agrees with what VTK
 // drew away from the edges, in both styles.
 TEST(RenderedExr, CharactersAlphaAndMotionOfARigidMotionAtEveryPixel) {
-  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
+  REQUIRE_DISPLAY();
   WorldOptions o;
   o.params.ground.enabled = false;
   World world(o);
   // the pot: its closed outline is filled in the clean style
-  const std::string data = WOBBLE_DATA_DIR;
+  const std::string data = wobble::test_env::DataDir();
   world.AddBody(std::make_shared<const BodyModel>(formats::ReadObjectFile(data + "/pot.obj"),
                                                   formats::ReadDeformationFile(data + "/def_pot")));
   const int dofs = world.body(0).num_q();
@@ -455,7 +456,7 @@ TEST(RenderedExr, CharactersAlphaAndMotionOfARigidMotionAtEveryPixel) {
 // not in the characters' A, its depth.Z is the node's worldToCamera z, and the chair floating
 // above it is in A. No pixel is in both layers.
 TEST(RenderedExr, A3dHeightfieldIsTheTerrainLayer) {
-  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
+  REQUIRE_DISPLAY();
   const int nx = 13, nz = 13;
   const Eigen::Vector2d origin(-300.0, -300.0), spacing(50.0, 50.0);
   std::vector<double> heights;
@@ -516,7 +517,7 @@ TEST(RenderedExr, A3dHeightfieldIsTheTerrainLayer) {
 // the EXR frame leaves those pixels out of every layer. Every pixel so marked lies inside the
 // text's box, and the ground band behind the text is in the terrain layer only around it.
 TEST(RenderedExr, TheTextOverlayIsInNoLayer) {
-  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
+  REQUIRE_DISPLAY();
   auto world = AirborneWorld();
   SceneOptions opt;
   opt.width = 320;
@@ -565,7 +566,7 @@ TEST(RenderedExr, TheTextOverlayIsInNoLayer) {
 // has no next frame, does not move. Blender's Vector pass holds the same: X, Y the motion to
 // the previous frame (−v / fps; zero on the first) and Z, W minus the motion to the next.
 TEST(RenderedExr, SeriesMotionPointsToTheNextFrameAndTheLastStandsStill) {
-  if (!HasDisplay()) GTEST_SKIP() << "no reachable X display (DISPLAY): VTK 9.1 renders only through X; make test runs ctest under xvfb-run";
+  REQUIRE_DISPLAY();
   WorldOptions o;
   o.params.ground.enabled = false;
   o.params.gravity_on = false;

@@ -26,13 +26,14 @@
 #include "wobble/formats/parse_error.h"
 #include "wobble/core/rotation3.h"
 #include "wobble/record/trajectory.h"
+#include "support/source_paths.h"
 
 namespace wobble::pipelines {
 namespace {
 
 using testing::Source;
 using Vec3 = Eigen::Vector3d;
-const std::string kData = WOBBLE_DATA_DIR;
+const std::string kData = wobble::test_env::DataDir();
 
 std::string TempDir() {
   const std::string dir = (std::filesystem::temp_directory_path() / "wobble_mesh3_test").string();

@@ -7,7 +7,7 @@
 // directions are checked (new against baseline and baseline against new, so a missing line
 // counts as well as an extra one), and an image passes when at most kMaxBadFraction of its
 // pixels fail. On failure the new image and a diff image (|new − baseline| × 4) are written to
-// WOBBLE_RENDER_FAILURE_DIR (in the build folder).
+// tests/render_failures in the build folder (test_env::RenderFailureDir()).
 //
 // Without DISPLAY the tests skip with a message (VTK 9.1 aborts without X). To remake the
 // baselines after an intended change: WOBBLE_UPDATE_BASELINES=1 xvfb-run -a -s "-screen 0
@@ -41,6 +41,7 @@
 #include "support/pipelines_test_util.h"
 #include "support/render_baseline.h"
 #include "support/test_bodies.h"
+#include "support/source_paths.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -258,8 +259,8 @@ TEST(RenderOverlay, EnergyIsTheSumOfTheTermsListedAndTheColourBarClearsTheText) 
 // turned above the ground plane, with its lattice and mass points, in perspective.
 TEST(RenderRegression, MeshCharacter3d) {
   REQUIRE_DISPLAY();
-  BodyDef3 def = ReadObject3(std::string(WOBBLE_DATA_DIR) + "/pot3.obj");
-  std::vector<DeformationMode3> modes = formats::ReadDeformationFile3(std::string(WOBBLE_DATA_DIR) + "/pot3_modes.def3", def.lattice);
+  BodyDef3 def = ReadObject3(wobble::test_env::DataDir() + "/pot3.obj");
+  std::vector<DeformationMode3> modes = formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/pot3_modes.def3", def.lattice);
   WorldOptions options;
   options.ground_3d.enabled = true;
   World world(options);

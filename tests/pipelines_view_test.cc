@@ -36,6 +36,7 @@
 #include "support/pipelines_test_util.h"
 #include "support/render_baseline.h"
 #include "wobble/script/interpreter.h"
+#include "support/source_paths.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -44,7 +45,7 @@ using testing::Table;
 using testing::Vec;
 using testing_render::CompareWithBaseline;
 
-const std::string kData = WOBBLE_DATA_DIR;
+const std::string kData = wobble::test_env::DataDir();
 
 // The table of data/ in a scene, as `wobble view data/table.obj --modes data/table_modes.def`
 // loads it: the thesis integrator, dt 0.01, at rest at q0.

@@ -12,12 +12,13 @@
 #include "wobble/scene/object_runs.h"
 #include "wobble/scene/scene.h"
 #include "wobble/script/interpreter.h"
+#include "support/source_paths.h"
 
 namespace wobble {
 namespace {
 
 namespace fs = std::filesystem;
-const std::string kData = WOBBLE_DATA_DIR;
+const std::string kData = wobble::test_env::DataDir();
 
 // The table of data/ under a two-pose graph on the ground, recorded by `output`; its last line
 // is the run (`simul 3`: 300 steps).
@@ -142,7 +143,7 @@ TEST(Scene, Fig2SimulAndTheSceneSteppedByHandRecordTheSameFrames) {
     EXPECT_LE((interp.scene().Point(name) - by_hand.scene().Point(name)).norm(), 1e-12) << name;
 }
 
-#ifdef WOBBLE_CLI
+#ifdef WOBBLE_HAVE_CLI
 TEST(Scene, TheCliWritesTheTrajectoryOfTheInterpreterAsItsOutputCsv) {
   ScratchFolder scratch("wobble_scene_test_cli");
   std::ofstream(scratch.path / "table.wob") << kTableScript;
@@ -153,7 +154,7 @@ TEST(Scene, TheCliWritesTheTrajectoryOfTheInterpreterAsItsOutputCsv) {
   interp.RunFile((scratch.path / "table.wob").string());
   fs::current_path(scratch.path);
   fs::create_directories("cli");
-  const std::string command = "cd cli && \"" + std::string(WOBBLE_CLI) + "\" run ../table.wob > run.log 2>&1";
+  const std::string command = "cd cli && \"" + wobble::test_env::CliPath() + "\" run ../table.wob > run.log 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   std::string header_cli, header_interp;
   const auto cli = ReadCsv(scratch.path / "cli/out.csv", &header_cli);

@@ -11,11 +11,12 @@
 #include "wobble/formats/heightfield_file.h"
 #include "wobble/script/interpreter.h"
 #include "wobble/script/variables.h"
+#include "support/source_paths.h"
 
 namespace wobble {
 namespace {
 
-const std::string kData = WOBBLE_DATA_DIR;
+const std::string kData = wobble::test_env::DataDir();
 
 // Runs `text` as a script named "s.wob"; returns the error message ("" when it ran).
 std::string RunScript(script::Interpreter& interp, const std::string& text) {

@@ -13,11 +13,12 @@
 #include "wobble/formats/object_file.h"
 #include "wobble/script/interpreter.h"
 #include "wobble/script/variables.h"
+#include "support/source_paths.h"
 
 namespace wobble {
 namespace {
 
-const std::string kData = WOBBLE_DATA_DIR;
+const std::string kData = wobble::test_env::DataDir();
 
 double KineticEnergy(const BodyModel& body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
   MatQ<double> M;

@@ -13,11 +13,12 @@
 #include "wobble/formats/object_file.h"
 #include "wobble/script/interpreter.h"
 #include "wobble/scene/script_writer.h"
+#include "support/source_paths.h"
 
 namespace wobble {
 namespace {
 
-const std::string kData = WOBBLE_DATA_DIR;
+const std::string kData = wobble::test_env::DataDir();
 
 struct Session {
   std::shared_ptr<const BodyModel> body;

@@ -12,11 +12,12 @@
 #include "wobble/script/interpreter.h"
 #include "wobble/script/sweep.h"
 #include "wobble/script/variables.h"
+#include "support/source_paths.h"
 
 namespace wobble::script {
 namespace {
 
-const std::string kData = WOBBLE_DATA_DIR;
+const std::string kData = wobble::test_env::DataDir();
 
 TEST(Variables, ValuesThenDefaultsFillTheWords) {
   const std::string text = "set dt ${dt}\nset seed ${seed:-4}\n# ${unused:-x} in a comment too\n";

@@ -16,12 +16,13 @@
 #include "wobble/synth/anneal.h"
 #ifdef WOBBLE_HAVE_PAGMO
 #include "wobble/synth/cmaes.h"
+#include "support/source_paths.h"
 #endif
 
 namespace wobble {
 namespace {
 
-const std::string kData = WOBBLE_DATA_DIR;
+const std::string kData = wobble::test_env::DataDir();
 
 // data/bounding_table.wob's setup (table, modes, ground, the initial pose graph), without its
 // optimisation: the tests add theirs.
@@ -254,7 +255,7 @@ namespace {
 // body's centre moves uniformly whatever it does about it (momentum), here spinning about an
 // axis away from the centre and with its modes free to ring.
 TEST(Synthesis3d, ATrialMeasuresTheUniformTravelOfAFreeBodysCentre) {
-  const std::string data = WOBBLE_DATA_DIR;
+  const std::string data = wobble::test_env::DataDir();
   const BodyDef3 def = formats::ReadObjectFile3(data + "/table3.obj");
   synth::Problem p;
   p.body3 = std::make_shared<const BodyModel3>(def, formats::ReadDeformationFile3(data + "/table3_modes.def3", def.lattice));
@@ -284,7 +285,7 @@ TEST(Synthesis3d, ATrialMeasuresTheUniformTravelOfAFreeBodysCentre) {
 // the cost, the gait travels forward every cycle, and the motion stays in its plane (the body
 // and its in-plane modes are symmetric about z = 100: no force leaves the x-y plane).
 TEST(Synthesis3d, TheBoundingTableIn3dLearnsToTravelForwardInItsPlane) {
-  std::ifstream file(std::string(WOBBLE_DATA_DIR) + "/bounding_table3.wob");
+  std::ifstream file(wobble::test_env::DataDir() + "/bounding_table3.wob");
   std::string script, line;
   while (std::getline(file, line))
     if (line.rfind("output", 0) != 0 && line.rfind("render", 0) != 0 && line.rfind("set anneal_csv", 0) != 0 &&
@@ -293,14 +294,14 @@ TEST(Synthesis3d, TheBoundingTableIn3dLearnsToTravelForwardInItsPlane) {
   std::ostringstream out;
   script::Interpreter interp(out);
   std::istringstream in(script);
-  interp.RunStream(in, "bounding_table3.wob", WOBBLE_DATA_DIR);
+  interp.RunStream(in, "bounding_table3.wob", wobble::test_env::DataDir());
   const synth::AnnealResult& result = *interp.last_anneal();
   EXPECT_LT(result.best_outcome.cost, result.initial_outcome.cost);
   const std::vector<double> d = synth::DistancePerCycle(interp.SynthesisProblem(), interp.pose_graph(), 2, 6);
   ASSERT_EQ(d.size(), 6u);
   for (double x : d) EXPECT_GT(x, 5.0);
   std::istringstream run("simul 12\n");
-  interp.RunStream(run, "bounding_table3.wob", WOBBLE_DATA_DIR);
+  interp.RunStream(run, "bounding_table3.wob", wobble::test_env::DataDir());
   const Eigen::VectorXd q = interp.q();
   EXPECT_GT(q[0], 100.0);                                  // travelled forward
   EXPECT_LT(std::abs(q[2]) + std::abs(q[3]) + std::abs(q[4]), 1e-6);  // tz, rx, ry: still in the plane

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdlib>
 #include <unistd.h>
 
 #include <filesystem>
@@ -13,15 +14,17 @@
 
 #include <vtkSmartPointer.h>
 
+#include "pipelines/scene_view.h"
 #include "wobble/world/world.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "support/source_paths.h"
 
 namespace wobble::testing {
 
 inline std::shared_ptr<const BodyModel> Table() {
-  static auto body = std::make_shared<const BodyModel>(formats::ReadObjectFile(std::string(WOBBLE_DATA_DIR) + "/table.obj"),
-                                                       formats::ReadDeformationFile(std::string(WOBBLE_DATA_DIR) + "/table_modes.def"));
+  static auto body = std::make_shared<const BodyModel>(formats::ReadObjectFile(wobble::test_env::DataDir() + "/table.obj"),
+                                                       formats::ReadDeformationFile(wobble::test_env::DataDir() + "/table_modes.def"));
   return body;
 }
 
@@ -81,3 +84,14 @@ inline std::string TempDir(const std::string& name) {
 }
 
 }  // namespace wobble::testing
+
+// A render test skips only when there is no display to use (DISPLAY unset: VTK 9.1 renders only
+// through X). When DISPLAY is set and no X server answers on it, the test fails: a lost X
+// connection under a parallel ctest must not pass as a silent skip.
+#define REQUIRE_DISPLAY()                                                                          \
+  do {                                                                                             \
+    const char* display_name = std::getenv("DISPLAY");                                             \
+    if (!display_name || !*display_name)                                                           \
+      GTEST_SKIP() << "DISPLAY is not set: VTK 9.1 renders only through X; make test runs ctest under xvfb-run"; \
+    ASSERT_TRUE(::wobble::pipelines::HasDisplay()) << "DISPLAY=" << display_name << " is set but no X server answers on it";        \
+  } while (false)

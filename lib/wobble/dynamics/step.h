@@ -246,4 +246,13 @@ StepStatus StepBody(const BodyModel& body, const WorldParams& w, int body_index,
   return {};
 }
 
+// The plain (double) step is compiled once, in step_instances.cc, not in every unit that steps
+// a body (each copy cost several seconds of compile time); Jet steps are instantiated where used.
+extern template StepStatus Accelerations<double, NoExtraForce>(const BodyModel&, const WorldParams&, int,
+                                                               const BodyState<double>&, VecQ<double>*,
+                                                               ForceBreakdown<double>*, ContactSet, const NoExtraForce&);
+extern template StepStatus StepBody<double, NoExtraForce>(const BodyModel&, const WorldParams&, int, Integrator, double,
+                                                          BodyState<double>*, const NoExtraForce&);
+extern template void UpdateContacts<double>(const BodyModel&, const Ground&, BodyState<double>*);
+
 }  // namespace wobble

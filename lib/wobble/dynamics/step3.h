@@ -619,4 +619,9 @@ StepStatus StepBody3(const BodyModel3& body, const WorldParams3& w, Integrator i
   return {};
 }
 
+// compiled once, in step_instances.cc (see step.h)
+extern template StepStatus StepBody3<double, NoExtraForce>(const BodyModel3&, const WorldParams3&, Integrator, double,
+                                                           BodyState3<double>*, const NoExtraForce&);
+extern template void UpdateContacts3<double>(const BodyModel3&, const GroundPlane&, BodyState3<double>*);
+
 }  // namespace wobble
