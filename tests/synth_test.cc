@@ -16,8 +16,8 @@
 #include "wobble/synth/anneal.h"
 #ifdef WOBBLE_HAVE_PAGMO
 #include "wobble/synth/cmaes.h"
-#include "support/source_paths.h"
 #endif
+#include "support/source_paths.h"
 
 namespace wobble {
 namespace {
