@@ -88,10 +88,12 @@ inline std::string TempDir(const std::string& name) {
 // A render test skips only when there is no display to use (DISPLAY unset: VTK 9.1 renders only
 // through X). When DISPLAY is set and no X server answers on it, the test fails: a lost X
 // connection under a parallel ctest must not pass as a silent skip.
-#define REQUIRE_DISPLAY()                                                                          \
-  do {                                                                                             \
-    const char* display_name = std::getenv("DISPLAY");                                             \
-    if (!display_name || !*display_name)                                                           \
-      GTEST_SKIP() << "DISPLAY is not set: VTK 9.1 renders only through X; make test runs ctest under xvfb-run"; \
-    ASSERT_TRUE(::wobble::pipelines::HasDisplay()) << "DISPLAY=" << display_name << " is set but no X server answers on it";        \
+#define REQUIRE_DISPLAY()                                                                      \
+  do {                                                                                         \
+    const char* display_name = std::getenv("DISPLAY");                                         \
+    if (!display_name || !*display_name)                                                       \
+      GTEST_SKIP() << "DISPLAY is not set: VTK 9.1 renders only through X (make test runs "    \
+                      "ctest under xvfb-run)";                                                 \
+    ASSERT_TRUE(::wobble::pipelines::HasDisplay())                                             \
+        << "DISPLAY=" << display_name << " is set but no X server answers on it";              \
   } while (false)
