@@ -1,0 +1,157 @@
+// Every shipped deformation file, and every input of the committed fuzz corpora, reads to the
+// very modes (bit for bit) that the reader gave before 2D and 3D files shared one grammar
+// (issue 45, item 8). The expected text is tests/reference/deformation_modes.txt; its header
+// says how it was produced. Suites are named io* so that `ctest -R io` runs them.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "wobble/formats/deformation_file.h"
+#include "wobble/formats/object_file.h"
+#include "support/source_paths.h"
+
+namespace wobble::formats {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kSource = wobble::test_env::DataDir() + "/..";
+const std::string kReference = kSource + "/tests/reference/deformation_modes.txt";
+
+// %.17g round-trips every double, so equal text means equal bits (and -0 prints as "-0").
+std::string Exact(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", v);
+  return buffer;
+}
+
+// FNV-1a over the text of a mode list: a short stand-in for the corpora's many inputs.
+std::string Digest(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  char buffer[20];
+  std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(h));
+  return buffer;
+}
+
+template <int Dim> std::string Describe(const std::vector<DeformationModeN<Dim>>& modes) {
+  std::ostringstream out;
+  for (const DeformationModeN<Dim>& m : modes) {
+    // the source is "FILE:LINE"; only the line is independent of the checkout's folder
+    out << "mode " << m.name << " size";
+    for (int n : m.lattice_size) out << " " << n;
+    out << " stiffness " << Exact(m.stiffness) << " damping " << Exact(m.damping) << " active " << m.active
+        << " line " << m.source.substr(m.source.rfind(':') + 1) << "\n";
+    for (const auto& d : m.displacement) {
+      for (int a = 0; a < Dim; ++a) out << (a ? " " : "") << Exact(d[a]);
+      out << "\n";
+    }
+  }
+  return out.str();
+}
+
+// A lattice that is neither axis-aligned nor cubic, so that the 3D generators' use of the
+// axes, their lengths and the sizes all show in the reference.
+const Lattice3& SkewLattice3() {
+  static const Lattice3 lattice(Eigen::Vector3d(-10, 5, 2),
+                                {Eigen::Vector3d(200, 30, 0), Eigen::Vector3d(-20, 150, 10), Eigen::Vector3d(5, 0, 90)},
+                                {5, 4, 3}, BasisKind::kBernstein);
+  return lattice;
+}
+
+std::vector<std::string> Sorted(const fs::path& folder, const std::vector<std::string>& extensions) {
+  std::vector<std::string> out;
+  for (const fs::directory_entry& e : fs::directory_iterator(folder)) {
+    if (!e.is_regular_file()) continue;
+    const std::string name = e.path().filename().string();
+    for (const std::string& ext : extensions)
+      if ((ext.empty() && e.path().extension().empty() && name.rfind("def_", 0) == 0) ||
+          (!ext.empty() && e.path().extension() == ext))
+        out.push_back(name);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+template <class F> std::string Outcome(F&& parse) {
+  try {
+    return "ok " + parse();
+  } catch (const ParseError& e) {
+    return "error line " + std::to_string(e.line());
+  }
+}
+
+// The reference text as the reader in this build produces it.
+std::string Current() {
+  std::ostringstream out;
+  const Lattice3& table3 = ReadObjectFile3(kSource + "/data/table3.obj").lattice;
+  // shipped 2D files: data/*.def, data/def_* and the command-line tests' files, in full
+  for (const std::string& folder : {std::string("data"), std::string("tests/cli")})
+    for (const std::string& name : Sorted(kSource + "/" + folder, {".def", ""})) {
+      out << "file2 " << folder << "/" << name << "\n"
+          << Describe(ReadDeformationFile(kSource + "/" + folder + "/" + name));
+    }
+  // shipped 3D files in full over the 3D table's lattice, and as digests over a skew one
+  for (const std::string& name : Sorted(kSource + "/data", {".def3"})) {
+    const std::string path = kSource + "/data/" + name;
+    out << "file3 data/" << name << " table3\n" << Describe(ReadDeformationFile3(path, table3));
+    out << "file3 data/" << name << " skew "
+        << Digest(Describe(ReadDeformationFile3(path, SkewLattice3()))) << "\n";
+  }
+  // the fuzz corpora: hostile inputs read the same way (same modes or an error on the same line)
+  std::vector<std::string> corpus2, corpus3;
+  for (const fs::directory_entry& e : fs::directory_iterator(kSource + "/fuzz/corpus/deformation"))
+    corpus2.push_back(e.path().filename().string());
+  for (const fs::directory_entry& e : fs::directory_iterator(kSource + "/fuzz/corpus/deformation3"))
+    corpus3.push_back(e.path().filename().string());
+  std::sort(corpus2.begin(), corpus2.end());
+  std::sort(corpus3.begin(), corpus3.end());
+  for (const std::string& name : corpus2) {
+    const std::string path = kSource + "/fuzz/corpus/deformation/" + name;
+    out << "corpus2 " << name << " "
+        << Outcome([&] { return Digest(Describe(ReadDeformationFile(path))); }) << "\n";
+  }
+  for (const std::string& name : corpus3) {
+    const std::string path = kSource + "/fuzz/corpus/deformation3/" + name;
+    out << "corpus3 " << name << " "
+        << Outcome([&] { return Digest(Describe(ReadDeformationFile3(path, table3))); }) << "\n";
+  }
+  return out.str();
+}
+
+// Lines of the reference, without its '#' header.
+std::vector<std::string> Lines(std::istream& in) {
+  std::vector<std::string> out;
+  for (std::string line; std::getline(in, line);)
+    if (line.empty() || line[0] != '#') out.push_back(line);
+  return out;
+}
+
+TEST(ioDeformationReference, EveryShippedFileAndCorpusInputReadsAsBefore) {
+  const std::string current = Current();
+  if (const char* write = std::getenv("WOBBLE_WRITE_DEFORMATION_REFERENCE")) {
+    std::ofstream(write) << current;  // the header is added by hand (see the reference file)
+    GTEST_SKIP() << "wrote " << write;
+  }
+  std::ifstream file(kReference);
+  ASSERT_TRUE(file) << "cannot open " << kReference;
+  const std::vector<std::string> expected = Lines(file);
+  std::istringstream in(current);
+  const std::vector<std::string> got = Lines(in);
+  ASSERT_GT(expected.size(), 1000u);  // the reference is not empty or cut short
+  std::string where;
+  for (size_t i = 0; i < std::min(expected.size(), got.size()); ++i) {
+    if (expected[i].rfind("file", 0) == 0 || expected[i].rfind("corpus", 0) == 0) where = expected[i];
+    ASSERT_EQ(got[i], expected[i]) << "line " << i + 1 << " of the reference (not counting its header), in " << where;
+  }
+  EXPECT_EQ(got.size(), expected.size());
+}
+
+}  // namespace
+}  // namespace wobble::formats
