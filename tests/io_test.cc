@@ -364,7 +364,7 @@ TEST(ioDeformationFileErrors, LatticeSizeDiffersFromTheFirstMode) {
 
 TEST(ioDeformationFileErrors, UnknownKeywordAndHeaderOptions) {
   ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\nz: 1 2\n", 5, "unknown keyword 'z:' (expected 'mode', 'x:', 'y:' or a row");
-  ExpectModesError("z: 1 2\n", 1, "unknown keyword 'z:' (expected 'mode', 'x:' or 'y:')");
+  ExpectModesError("z: 1 2\n", 1, "unknown keyword 'z:' (expected 'mode', 'x:' or 'y:', or a generator: bend, squash");
   ExpectModesError("\nmode m stiff 5\nx: 1 2\n3 4\ny: 0 0\n0 0\n", 2, "unknown mode option 'stiff'");
   ExpectModesError("mode m stiffness\n", 1, "expected a number after 'stiffness'");
   ExpectModesError("mode m damping x\n", 1, "expected a number after 'damping', got 'x'");
@@ -380,8 +380,8 @@ TEST(ioDeformationFileErrors, SectionsOutOfPlace) {
   ExpectModesError("y: 1 2\n", 1, "'y:' section before any 'x:' section");
   ExpectModesError("mode m\ny: 1 2\n", 2, "'y:' section before any 'x:' section of mode 'm'");
   ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\ny: 0 0\n", 5, "second 'y:' section");
-  ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\nmode lonely\n", 5, "mode 'lonely' has no 'x:' section");
-  ExpectModesError("mode a\nmode b\n", 1, "mode 'a' has no 'x:' section (found a 'mode' header on line 2)");
+  ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\nmode lonely\n", 5, "mode 'lonely' has no 'x:' section and no generator");
+  ExpectModesError("mode a\nmode b\n", 1, "mode 'a' has no 'x:' section and no generator line (found a 'mode' header on line 2)");
   ExpectModesError("x:\ny: 0 0\n", 1, "has no rows");
 }
 
