@@ -52,7 +52,7 @@ std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_mod
   std::vector<DeformationMode> modes;
   for (const std::string& path : files.modes) {
     if (path.empty()) throw UsageError("--modes: empty file name in the list");
-    std::vector<DeformationMode> more = formats::ReadDeformationFile(path);
+    std::vector<DeformationMode> more = formats::ReadDeformationFile(path, def.lattice);  // generators need it
     modes.insert(modes.end(), more.begin(), more.end());
   }
   auto body = std::make_shared<const BodyModel>(std::move(def), std::move(modes));
