@@ -97,31 +97,42 @@ std::vector<std::string> CorpusNames(const std::string& folder) {
   return out;
 }
 
-// The reference text as the reader in this build produces it, for the given corpus inputs
-// (those of the reference: seeds added since are replayed by fuzz_replay_* only).
-std::string Current(const std::vector<std::string>& corpus2, const std::vector<std::string>& corpus3) {
+// The reference text as the reader in this build produces it, for the given inputs (those of
+// the reference: files and seeds added since are checked elsewhere, in io_test and fuzz_replay_*).
+struct Names {
+  std::vector<std::string> files2, files3, corpus2, corpus3;  // files relative to the checkout
+};
+
+// The inputs as they are now in the checkout (to write a reference).
+Names InCheckout() {
+  Names n;
+  for (const std::string& folder : {std::string("data"), std::string("tests/cli")})
+    for (const std::string& name : Sorted(kSource + "/" + folder, {".def", ""})) n.files2.push_back(folder + "/" + name);
+  for (const std::string& name : Sorted(kSource + "/data", {".def3"})) n.files3.push_back("data/" + name);
+  n.corpus2 = CorpusNames("deformation");
+  n.corpus3 = CorpusNames("deformation3");
+  return n;
+}
+
+std::string Current(const Names& names) {
   std::ostringstream out;
   const Lattice3& table3 = ReadObjectFile3(kSource + "/data/table3.obj").lattice;
   // shipped 2D files: data/*.def, data/def_* and the command-line tests' files, in full
-  for (const std::string& folder : {std::string("data"), std::string("tests/cli")})
-    for (const std::string& name : Sorted(kSource + "/" + folder, {".def", ""})) {
-      out << "file2 " << folder << "/" << name << "\n"
-          << Describe(ReadDeformationFile(kSource + "/" + folder + "/" + name));
-    }
+  for (const std::string& file : names.files2)
+    out << "file2 " << file << "\n" << Describe(ReadDeformationFile(kSource + "/" + file));
   // shipped 3D files in full over the 3D table's lattice, and as digests over a skew one
-  for (const std::string& name : Sorted(kSource + "/data", {".def3"})) {
-    const std::string path = kSource + "/data/" + name;
-    out << "file3 data/" << name << " table3\n" << Describe(ReadDeformationFile3(path, table3));
-    out << "file3 data/" << name << " skew "
-        << Digest(Describe(ReadDeformationFile3(path, SkewLattice3()))) << "\n";
+  for (const std::string& file : names.files3) {
+    const std::string path = kSource + "/" + file;
+    out << "file3 " << file << " table3\n" << Describe(ReadDeformationFile3(path, table3));
+    out << "file3 " << file << " skew " << Digest(Describe(ReadDeformationFile3(path, SkewLattice3()))) << "\n";
   }
   // the fuzz corpora: hostile inputs read the same way (same modes or an error on the same line)
-  for (const std::string& name : corpus2) {
+  for (const std::string& name : names.corpus2) {
     const std::string path = kSource + "/fuzz/corpus/deformation/" + name;
     out << "corpus2 " << name << " "
         << Outcome([&] { return Digest(Describe(ReadDeformationFile(path))); }) << "\n";
   }
-  for (const std::string& name : corpus3) {
+  for (const std::string& name : names.corpus3) {
     const std::string path = kSource + "/fuzz/corpus/deformation3/" + name;
     out << "corpus3 " << name << " "
         << Outcome([&] { return Digest(Describe(ReadDeformationFile3(path, table3))); }) << "\n";
@@ -150,7 +161,7 @@ std::vector<std::string> Lines(std::istream& in) {
 TEST(ioDeformationReference, EveryShippedFileAndCorpusInputReadsAsBefore) {
   if (const char* write = std::getenv("WOBBLE_WRITE_DEFORMATION_REFERENCE")) {
     // the header is added by hand (see the reference file)
-    std::ofstream(write) << Current(CorpusNames("deformation"), CorpusNames("deformation3"));
+    std::ofstream(write) << Current(InCheckout());
     GTEST_SKIP() << "wrote " << write;
   }
   std::ifstream file(kReference);
@@ -161,14 +172,22 @@ TEST(ioDeformationReference, EveryShippedFileAndCorpusInputReadsAsBefore) {
     ASSERT_NE(it, expected.end()) << before;
     *it = after;
   }
-  std::vector<std::string> corpus2, corpus3;
+  Names names;
   for (const std::string& line : expected) {
-    if (line.rfind("corpus2 ", 0) == 0) corpus2.push_back(line.substr(8, line.find(' ', 8) - 8));
-    if (line.rfind("corpus3 ", 0) == 0) corpus3.push_back(line.substr(8, line.find(' ', 8) - 8));
+    if (line.find(' ') == std::string::npos) continue;
+    const std::string word = line.substr(0, line.find(' ')), rest = line.substr(word.size() + 1);
+    const std::string name = rest.substr(0, rest.find(' '));
+    if (word == "file2") names.files2.push_back(name);
+    if (word == "file3" && rest.find(" table3") != std::string::npos) names.files3.push_back(name);
+    if (word == "corpus2") names.corpus2.push_back(name);
+    if (word == "corpus3") names.corpus3.push_back(name);
   }
-  ASSERT_GT(corpus2.size(), 50u);  // the reference is not cut short
-  ASSERT_GT(corpus3.size(), 300u);
-  std::istringstream in(Current(corpus2, corpus3));
+  // the reference is not cut short: every shipped file of a29e55e, and the corpora
+  ASSERT_EQ(names.files2.size(), 11u);
+  ASSERT_EQ(names.files3.size(), 3u);
+  ASSERT_GT(names.corpus2.size(), 50u);
+  ASSERT_GT(names.corpus3.size(), 300u);
+  std::istringstream in(Current(names));
   const std::vector<std::string> got = Lines(in);
   std::string where;
   for (size_t i = 0; i < std::min(expected.size(), got.size()); ++i) {
