@@ -4,8 +4,9 @@
 Fails (exit 1, one line per problem, FILE:LINE: what) when
   - a lib/wobble folder includes a folder it may not (LAYERS below, the documented order);
   - lib/ includes VTK or OpenEXR, or pipelines/ includes the script interpreter;
-  - a header under an `internal/` folder is included from outside its own folder tree;
-  - a public fit/ header includes Ceres;
+  - a header under an `internal/` folder is included from outside its own folder tree, or by a
+    public header (one not under `internal/`: it is installed, the internal ones are not);
+  - a public (installed) header of lib/ or pipelines/ includes Ceres;
   - a lib/wobble/<folder> file declares a namespace other than the folder's (NAMESPACES);
   - a source file in lib/, pipelines/ or app/ is longer than MAX_LINES.
 Usage: check_layering.py [PROJECT_ROOT]
@@ -89,12 +90,15 @@ def main():
                             inner = os.path.join("lib", *target[:target.index("internal")])
                             if not rel.startswith(inner + os.sep):
                                 problems.append(f"{where}: {inc} is internal to lib/{'/'.join(target[:target.index('internal')])}")
+                            elif rel.endswith(".h") and "internal" not in parts:
+                                problems.append(f"{where}: the public header includes {inc}, which is not "
+                                                "installed; include it from the .cc files")
                         if folder and target[1] != folder and target[1] not in allowed.get(folder, []):
                             problems.append(f"{where}: lib/wobble/{folder} may not include {inc} "
                                             f"(it may include: {', '.join(allowed.get(folder, [])) or 'nothing of wobble'})")
-                    if (top == "lib" and folder == "fit" and "internal" not in parts and rel.endswith(".h")
-                            and inc.startswith("ceres/")):
-                        problems.append(f"{where}: a public fit/ header includes Ceres ({inc}); move it to fit/internal/")
+                    if top != "app" and "internal" not in parts and rel.endswith(".h") and inc.startswith("ceres/"):
+                        problems.append(f"{where}: a public header includes Ceres ({inc}); move what needs it to an "
+                                        "internal/ header or a .cc")
                 m = NAMESPACE.match(line)
                 if m and folder:
                     ns = m.group(1)
