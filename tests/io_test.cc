@@ -7,11 +7,13 @@
 #include <Eigen/SVD>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <sstream>
 
 #include "wobble/body/body_model.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "wobble/world/world.h"
 #include "support/source_paths.h"
 
 namespace wobble::formats {
@@ -584,6 +586,35 @@ TEST(io3DFiles, SquashKeepsVolumeToFirstOrder) {
   }
   const double ratio = J.determinant() / (300.0 * 100.0 * 200.0);
   EXPECT_LT(std::abs(ratio - 1.0), 10 * gamma * gamma);
+}
+
+// The body frame of a 3D object file is the file's own frame: its origin is the file's
+// (0, 0, 0), not the lattice corner. A lattice with its corner at (10, 20, 30) keeps every mass
+// point at its file coordinates, and q places the origin: at t = (1, 2, 3) turned 90 degrees
+// about z (R (x, y, z) = (-y, x, z)) a point p goes to t + R p, worked out by hand below.
+TEST(io3DFiles, BodyOriginIsTheFileOriginNotTheLatticeCorner) {
+  const BodyDef3 def = Object3(
+      "dimension 3\nlattice 10 20 30 40 50 60\n"
+      "mass 10 20 30 1\n"   // the lattice corner
+      "mass 50 70 90 2\n"   // the opposite corner
+      "mass 20 45 60 3\n");
+  EXPECT_EQ(def.lattice.origin(), Eigen::Vector3d(10, 20, 30));
+  auto body = std::make_shared<const BodyModel3>(def, std::vector<DeformationMode3>{});
+  const Eigen::Vector3d file[3] = {{10, 20, 30}, {50, 70, 90}, {20, 45, 60}};
+  for (int k = 0; k < 3; ++k) EXPECT_LT((body->rest_local(k) - file[k]).norm(), 1e-12) << "mass point " << k;
+  // Σ m p = (10 + 100 + 60, 20 + 140 + 135, 30 + 180 + 180)
+  EXPECT_LT((body->moments().c0 - Eigen::Vector3d(170, 295, 390)).norm(), 1e-11);
+
+  World world{WorldOptions{}};
+  world.AddBody(body);
+  world.SetState3(0, Eigen::Vector3d(1, 2, 3), Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())),
+                  Eigen::VectorXd(), Eigen::VectorXd::Zero(6));
+  const Eigen::Vector3d placed[3] = {{-19, 12, 33}, {-69, 52, 93}, {-44, 22, 63}};
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::VectorXd x = world.PointPosition(MassPointOf(0, k));
+    ASSERT_EQ(x.size(), 3);
+    EXPECT_LT((Eigen::Vector3d(x) - placed[k]).norm(), 1e-12) << "mass point " << k << " at " << x.transpose();
+  }
 }
 
 TEST(io3DFileErrors, ObjectFiles) {
