@@ -94,6 +94,9 @@ constexpr ExrCompression kAllCompressions[] = {ExrCompression::kZip, ExrCompress
 Imf::Header MakeHeader(int width, int height, ExrCompression compression, const ExrMetadata& m) {
   Imf::Header header(width, height);
   header.compression() = ToImf(compression);
+  // zlib level 1, not OpenEXR's 4: on the demo's frames half the time (18 against 35 ms a
+  // frame) for files 45% larger (67 against 46 kB, of 4.9 MB of channels)
+  header.zipCompressionLevel() = 1;
   if (m.world_to_camera) Imf::addWorldToCamera(header, ToImath(*m.world_to_camera));
   if (m.world_to_ndc) Imf::addWorldToNDC(header, ToImath(*m.world_to_ndc));
   if (m.frames_per_second > 0) Imf::addFramesPerSecond(header, Imf::Rational(m.frames_per_second));  // nearest fraction

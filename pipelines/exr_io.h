@@ -19,10 +19,12 @@ struct ExrChannel {
   bool half = false;        // stored as 16-bit half floats (colour); read back as float
 };
 
-// The compressions OpenEXR offers that wobble writes with. kZip (zlib, 16 lines a chunk) is
-// the default of rendered frames: lossless, small and fast on their flat pictures. kDwaa is
-// lossy on colour channels (R, G, B and layers' .R/.G/.B); OpenEXR keeps the others (alpha,
-// depth, motion) lossless. kNone for float data zlib cannot shrink (the displacement images).
+// The compressions of OpenEXR that wobble writes with (zlib at level 1 where zlib is used).
+// kZip (16 lines a block) is the default of rendered frames: lossless, small (1.4% of the
+// channels' bytes on the demo's frames) and the fastest of those that shrink them (ZIPS is as
+// fast and larger, PIZ slower and larger). kDwaa is lossy on colour channels (R, G, B and layers' .R/.G/.B); OpenEXR keeps
+// the others (alpha, depth, motion) exact. kNone for float data zlib cannot shrink (the
+// displacement images).
 enum class ExrCompression { kNone, kZip, kZips, kPiz, kDwaa };
 
 // "none", "zip", "zips", "piz", "dwaa": the names of options (--exr-compression).
