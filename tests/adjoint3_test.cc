@@ -100,7 +100,7 @@ T ReferenceCost(const BodyModel3& passive, const fit::ControlledRollout3& r, con
                 const Eigen::VectorXd& v) {
   auto param = [&](int i) {
     T x(p[i]);
-    if constexpr (!std::is_same_v<T, double>) x.qd[0] = v[i];
+    if constexpr (!std::is_same_v<T, double>) x.v[0] = v[i];
     return x;
   };
   BodyState<3, T> s;
@@ -212,7 +212,7 @@ void ExpectJetDirectionalDerivatives(const Case& k, unsigned seed) {
   for (int i = 0; i < kNz; ++i) probes.push_back(i);
   for (int i : probes) {
     const J1 ref = ReferenceCost<J1>(k.passive, k.rollout, p, Eigen::VectorXd::Unit(p.size(), i));
-    EXPECT_NEAR(grad[i], ref.qd[0], 1e-9 * std::abs(ref.qd[0]) + 1e-12 * std::abs(g.cost)) << "parameter " << i;
+    EXPECT_NEAR(grad[i], ref.v[0], 1e-9 * std::abs(ref.v[0]) + 1e-12 * std::abs(g.cost)) << "parameter " << i;
   }
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -221,7 +221,7 @@ void ExpectJetDirectionalDerivatives(const Case& k, unsigned seed) {
     for (int i = 0; i < p.size(); ++i) v[i] = normal(rng) * (i < kNz ? 1.0 : i < first_target ? 0.01 * p[i] : 0.1);
     const J1 ref = ReferenceCost<J1>(k.passive, k.rollout, p, v);
     const double scale = (grad.array() * v.array()).abs().sum();  // cancellation cannot hide an error
-    EXPECT_NEAR(grad.dot(v), ref.qd[0], 1e-9 * scale) << "direction " << trial;
+    EXPECT_NEAR(grad.dot(v), ref.v[0], 1e-9 * scale) << "direction " << trial;
   }
 }
 

@@ -303,8 +303,7 @@ TEST(Body3, PointGroupsFindExactlyThePointsBelowTheGround) {
     s.translation() = Vector3d(n(rng), n(rng), n(rng)) * 60.0;
     const Frame<3, double> frame(s.q);
     std::vector<int> visited, below;
-    ForEachPointInContact(body, g, s, frame, [&](int k, int, const GroundPlane&, const Vector3d&, const Vector3d&,
-                                                  const Vector3d&, const Vector3d&) { visited.push_back(k); },
+    ForEachPointInContact(body, g, s, frame, [&](int k, const Vector3d&, const Vector3d&, const Vector3d&, const Vector3d&, const GroundPlane&, int) { visited.push_back(k); },
                            ContactSet::kDetect);
     for (int k = 0; k < body.num_points(); ++k) {
       const PointKinematics p = DirectPoint(body, k, s.gamma());
@@ -613,8 +612,8 @@ TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
     ASSERT_TRUE(world.Step()) << world.status().message;
     ASSERT_TRUE(StepBody(*table3, p, 0, o.integrator, o.dt, &alone).ok());
   }
-  EXPECT_EQ(world.state3(b3).t, alone.t);
-  EXPECT_EQ(world.state3(b3).v, alone.v);
+  EXPECT_EQ(world.state3(b3).translation(), alone.translation());
+  EXPECT_EQ(world.state3(b3).qd, alone.qd);
   EXPECT_FALSE(world.state3(b3).contacts.empty());  // it landed
   EXPECT_TRUE(std::isfinite(world.ComputeEnergies(b3).total()));
 }
@@ -634,7 +633,7 @@ TEST(Body3InWorld, RefusesBadStatesAndPoints) {
   EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, v), std::invalid_argument);
   v[0] = 1e160;  // finite, but its kinetic energy is not
   EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, v), std::invalid_argument);
-  EXPECT_EQ(world.state3(b).v[0], 0.0);  // the refused states left it as it was
+  EXPECT_EQ(world.state3(b).qd[0], 0.0);  // the refused states left it as it was
 }
 
 // A point force for one step from rest gives the body exactly its impulse. The explicit step
@@ -664,7 +663,7 @@ TEST(Body3InWorld, APointForceGivesTheBodyItsImpulse) {
     const Vector3d f(30, -50, 20), x_p = world.PointPosition(p);
     world.ApplyPointForce(p, f);
     ASSERT_TRUE(world.Step()) << world.status().message;
-    const Eigen::VectorXd v = world.state3(b).v;
+    const Eigen::VectorXd v = world.state3(b).qd;
     auto momenta = [&](const Eigen::VectorXd& vel, Vector3d* P, Vector3d* L) {
       P->setZero();
       L->setZero();
@@ -688,7 +687,7 @@ TEST(Body3InWorld, APointForceGivesTheBodyItsImpulse) {
     twin.SetState3(tb, s1.translation(), s1.orientation(), s1.gamma(), s1.qd);
     ASSERT_TRUE(world.Step());
     ASSERT_TRUE(twin.Step());
-    EXPECT_EQ(world.state3(b).v, twin.state3(tb).v) << path;
+    EXPECT_EQ(world.state3(b).qd, twin.state3(tb).qd) << path;
   }
 }
 
@@ -710,10 +709,10 @@ TEST(Body3InWorld, NailedBoxSwingsWithThePhysicalPendulumPeriod) {
   const double M = 8 * m, d = b / 2, I_pivot = 8 * m * (a * a + b * b) / 4 + M * d * d;
   const double period = 2 * M_PI * std::sqrt(I_pivot / (M * g * d)) * (1 + theta0 * theta0 / 16);
   std::vector<double> crossings;
-  double previous = world.state3(body).v[5], worst_violation = 0.0;
+  double previous = world.state3(body).qd[5], worst_violation = 0.0;
   while (world.time() < 2.2 * period) {
     ASSERT_TRUE(world.Step()) << world.status().message;
-    const double now = world.state3(body).v[5];
+    const double now = world.state3(body).qd[5];
     if (previous > 0 && now <= 0) crossings.push_back(world.time() - o.dt * now / (now - previous));
     previous = now;
     worst_violation = std::max(worst_violation, world.MaxViolation());

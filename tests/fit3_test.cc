@@ -91,7 +91,7 @@ TEST(PoseFit3, CorrespondencesGiveBackTheQTheyWereMadeWith) {
   const QError e = Compare(r.q, truth);
   EXPECT_LT(e.translation, 1e-7);
   EXPECT_LT(e.angle, 1e-9);
-  EXPECT_LT(e.gamma(), 1e-9);
+  EXPECT_LT(e.gamma, 1e-9);
   EXPECT_LT(r.rms_residual, 1e-7);
   EXPECT_TRUE(r.at_bound.empty());
   // every coordinate is seen: nothing undetermined
@@ -110,7 +110,7 @@ TEST(PoseFit3, FarStartTurnsOnTheGroupToTheAnswer) {
   const fit::PoseFitResult r = fit::FitPose3(c.body, MassPointTargets(c, truth), o);
   const QError e = Compare(r.q, truth);
   EXPECT_LT(e.angle, 1e-8) << r.report.brief_report;
-  EXPECT_LT(e.gamma(), 1e-8);
+  EXPECT_LT(e.gamma, 1e-8);
   EXPECT_LT(e.translation, 1e-6);
 }
 
@@ -175,7 +175,7 @@ TEST(PoseFit3, SurfaceWithoutCorrespondencesFindsThePoseAndTheShape) {
   const QError e = Compare(r.q, truth);
   EXPECT_LT(e.translation, 1e-5) << r.report.brief_report;
   EXPECT_LT(e.angle, 1e-7);
-  EXPECT_LT(e.gamma(), 1e-7);
+  EXPECT_LT(e.gamma, 1e-7);
   EXPECT_LT(r.rms_residual, 1e-6);
   EXPECT_EQ(r.point_residuals.size(), target_mesh.points.size());
 }
@@ -195,7 +195,7 @@ TEST(PoseFit3, PointCloudWithoutCorrespondences) {
   const QError e = Compare(r.q, truth);
   EXPECT_LT(e.translation, 1e-6) << r.report.brief_report;
   EXPECT_LT(e.angle, 1e-8);
-  EXPECT_LT(e.gamma(), 1e-8);
+  EXPECT_LT(e.gamma, 1e-8);
 }
 
 // A tumbling, squashing motion whose turn passes through π (where rotation vectors wrap).
@@ -230,7 +230,7 @@ TEST(TrajectoryFit3, ExactFramesGiveBackTheMotion) {
     const QError e = Compare(r.q[f], Motion(r.times[f]));
     EXPECT_LT(e.translation, 1e-7) << "frame " << f;
     EXPECT_LT(e.angle, 1e-9) << "frame " << f;
-    EXPECT_LT(e.gamma(), 1e-9) << "frame " << f;
+    EXPECT_LT(e.gamma, 1e-9) << "frame " << f;
   }
   EXPECT_LT(r.rms_residual, 1e-7);
 }

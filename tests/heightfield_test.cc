@@ -151,8 +151,7 @@ TEST(Heightfield, ABoxInAFrictionlessValleyIsHeldByBothWalls) {
   EXPECT_LT(s.qd.norm(), 1e-6);
   Vector3d on_face[2] = {Vector3d::Zero(), Vector3d::Zero()};
   const Frame<3, double> frame(s.q);
-  ForEachPointInContact(box, w.ground, s, frame, [&](int, int, const GroundPlane& plane, const Vector3d&, const Vector3d& x,
-                                                      const Vector3d& v, const Vector3d& anchor) {
+  ForEachPointInContact(box, w.ground, s, frame, [&](int, const Vector3d&, const Vector3d& x, const Vector3d& v, const Vector3d& anchor, const GroundPlane& plane, int) {
     bool slipping;
     on_face[plane.normal.x() > 0 ? 0 : 1] += GroundForce(plane, x, v, anchor, &slipping);
   }, ContactSet::kFrozen);
@@ -293,8 +292,7 @@ TEST(Heightfield, SlidesOffTheEdgeOfADropIntoFreeFall) {
   for (int step = 0; step < int(1.2 / dt); ++step) {
     ASSERT_TRUE(StepBody(box, w, 0, Integrator::kSymplecticEuler, dt, &s).ok());
     ForEachPointInContact(box, w.ground, s, Frame<3, double>(s.q),
-                           [&](int, int, const GroundPlane& plane, const Vector3d&, const Vector3d& x, const Vector3d&,
-                               const Vector3d&) {
+                           [&](int, const Vector3d&, const Vector3d& x, const Vector3d&, const Vector3d&, const GroundPlane& plane, int) {
                              if (plane.normal.y() < 0.99) {
                                ++drop_contacts;
                                ASSERT_LT(-plane.Height(x), sink) << "step " << step << ": deep in the drop's face";
@@ -304,7 +302,7 @@ TEST(Heightfield, SlidesOffTheEdgeOfADropIntoFreeFall) {
       ASSERT_TRUE(StepBody(box, no_ground, 0, Integrator::kSymplecticEuler, dt, &free).ok());
       landed = !s.contacts.empty();
       if (!landed) {
-        ASSERT_TRUE(free.t == s.translation() && free.v == s.qd && free.orientation.coeffs() == s.orientation().coeffs())
+        ASSERT_TRUE(free.translation() == s.translation() && free.qd == s.qd && free.orientation().coeffs() == s.orientation().coeffs())
             << "step " << step;
         ++checked;
       }

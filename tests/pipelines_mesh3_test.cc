@@ -278,8 +278,7 @@ TEST(Mesh3Sources, AppliedForcesSumToTheGeneralizedForcesTranslationRows) {
   params.gravity = options.gravity_3d;
   params.ground = options.ground_3d;
   ForceBreakdown<3, double> Q;
-  EvaluateForces3(w.body3(0), params, s, Frame<3, double>(s.q), ShapeMoments<double>(w.body3(0).moments(), s.gamma()),
-                  &Q, ContactSet::kFrozen);
+  EvaluateForces(w.body3(0), params, 0, s, Frame<3, double>(s.q), &Q, ContactSet::kFrozen);
   const Vec3 expected = (Q.gravity + Q.ground).head<3>();
   EXPECT_LT((sum - expected).norm(), 1e-9 * expected.norm()) << sum.transpose() << " vs " << expected.transpose();
 }

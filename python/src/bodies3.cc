@@ -137,7 +137,7 @@ void BindBodies3(py::module_& m) {
           "qd3",
           [](const World& w, int body) {
             Check3(w, body);
-            return Eigen::VectorXd(w.state3(body).v);
+            return Eigen::VectorXd(w.state3(body).qd);
           },
           py::arg("body") = 0, "a copy of the 3D body's q̇ = [ṫ, body ω, γ̇]")
       .def(

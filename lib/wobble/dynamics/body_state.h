@@ -30,8 +30,8 @@ template <int Dim> struct SpringN {
 using Spring = SpringN<2>;
 
 template <int Dim>
-SpringN<Dim> MakeSpring(const BodyModelN<Dim>& body, const Eigen::Matrix<double, Dim, 1>& lattice_coords,
-                        const Eigen::Matrix<double, Dim, 1>& anchor, double stiffness, double damping = 0.0,
+SpringN<Dim> MakeSpring(const BodyModelN<Dim>& body, const typename SpringN<Dim>::Point& lattice_coords,
+                        const typename SpringN<Dim>::Point& anchor, double stiffness, double damping = 0.0,
                         double rest_length = 0.0) {
   SpringN<Dim> s;
   s.lattice_coords = lattice_coords;
