@@ -52,7 +52,7 @@ std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_mod
   std::vector<DeformationMode> modes;
   for (const std::string& path : files.modes) {
     if (path.empty()) throw UsageError("--modes: empty file name in the list");
-    std::vector<DeformationMode> more = formats::ReadDeformationFile(path);
+    std::vector<DeformationMode> more = formats::ReadDeformationFile(path, def.lattice);  // generators need it
     modes.insert(modes.end(), more.begin(), more.end());
   }
   auto body = std::make_shared<const BodyModel>(std::move(def), std::move(modes));
@@ -335,6 +335,20 @@ Integrator ParseIntegratorFlag(const std::string& name) {
   if (ParseIntegrator(name, &integrator)) return integrator;
   throw UsageError("--integrator: '" + name + "' is not one of " + IntegratorNames());
 }
+
+std::string StateFlagHelp(const std::string& default_text) {
+  return "Initial q: 2D \"tx ty theta g1 .. gD\"; 3D (a 'dimension 3' object) \"tx ty tz rx ry rz g1 .. gD\", "
+         "r a rotation vector: the turn by |r| radians about r (" +
+         default_text + ")";
+}
+
+std::string VelocityFlagHelp(const std::string& default_text) {
+  return "Initial q-dot: 2D the layout of --q; 3D \"vx vy vz wx wy wz dg1 .. dgD\", v the velocity of the body "
+         "origin, w the angular velocity in the body frame (" +
+         default_text + ")";
+}
+
+std::string IntegratorFlagHelp() { return "One of " + IntegratorNames(); }
 
 // A one-line "iteration N, cost C" on stderr when it is a terminal (quiet otherwise).
 std::function<void(int, double)> IterationLine() {

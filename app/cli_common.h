@@ -105,6 +105,14 @@ StartingWorld LoadStartingWorld(const BodyFiles& files, const std::string& q, co
 // --integrator NAME; a UsageError listing the known names otherwise.
 Integrator ParseIntegratorFlag(const std::string& name);
 
+// The help of --q, --qdot and --integrator for the subcommands that start a body through
+// LoadStartingWorld: both layouts, 2D and 3D, and every name ParseIntegrator takes (made from
+// IntegratorNames(), so the help cannot fall behind the parser). `default_text` ends each one,
+// e.g. "default: zeros".
+std::string StateFlagHelp(const std::string& default_text);
+std::string VelocityFlagHelp(const std::string& default_text);
+std::string IntegratorFlagHelp();
+
 // "tx ty theta g1 .. gD" for a body; "tx ty tz rx ry rz g1 .." and "vx vy vz wx wy wz dg1 .."
 // for a 3D body's --q and --qdot.
 std::string CoordinateNames(const BodyModel& body);

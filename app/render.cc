@@ -42,9 +42,9 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
                            const std::string& default_what, RenderArgs* a) {
   CLI::App* cmd = app->add_subcommand(name, description);
   AddBodyFlags(cmd, &a->files);
-  cmd->add_option("--q", a->q, "Initial q = \"tx ty theta g1 ..\" (default: at rest at the origin)")->type_name("\"NUMS\"");
-  cmd->add_option("--qdot", a->qdot, "Initial q-dot, same layout (default: zeros)")->type_name("\"NUMS\"");
-  cmd->add_option("--integrator", a->integrator, "thesis | symplectic | rk4 | implicit | variational")
+  cmd->add_option("--q", a->q, StateFlagHelp("default: at rest at the origin"))->type_name("\"NUMS\"");
+  cmd->add_option("--qdot", a->qdot, VelocityFlagHelp("default: zeros"))->type_name("\"NUMS\"");
+  cmd->add_option("--integrator", a->integrator, IntegratorFlagHelp())
       ->capture_default_str()
       ->type_name("NAME");
   cmd->add_option("--dt", a->dt, "Time step")->capture_default_str();

@@ -36,10 +36,9 @@ std::string VectorText(const Eigen::VectorXd& v) {
 CLI::App* AddSimulateCommand(CLI::App* app, SimulateArgs* a) {
   CLI::App* cmd = app->add_subcommand("simulate", "Simulate one body over the ground and write its trajectory as CSV");
   AddBodyFlags(cmd, &a->files);
-  cmd->add_option("--q", a->q, "Initial q = \"tx ty theta g1 ..\" (default: at rest at the origin)")
-      ->type_name("\"NUMS\"");
-  cmd->add_option("--qdot", a->qdot, "Initial q-dot, same layout (default: zeros)")->type_name("\"NUMS\"");
-  cmd->add_option("--integrator", a->integrator, "thesis | symplectic | rk4 | implicit")
+  cmd->add_option("--q", a->q, StateFlagHelp("default: at rest at the origin"))->type_name("\"NUMS\"");
+  cmd->add_option("--qdot", a->qdot, VelocityFlagHelp("default: zeros"))->type_name("\"NUMS\"");
+  cmd->add_option("--integrator", a->integrator, IntegratorFlagHelp())
       ->capture_default_str()
       ->type_name("NAME");
   cmd->add_option("--dt", a->dt, "Time step")->capture_default_str();
@@ -53,7 +52,9 @@ CLI::App* AddSimulateCommand(CLI::App* app, SimulateArgs* a) {
   cmd->footer(
       "Example:\n"
       "  wobble simulate --object data/table.obj --modes data/table_modes.def \\\n"
-      "      --q \"0 50 0 0 0 0 0\" --duration 10 --out out/table_drop.csv");
+      "      --q \"0 50 0 0 0 0 0\" --duration 10 --out out/table_drop.csv\n"
+      "  wobble simulate --object data/pot3.obj --modes data/pot3_modes.def3 \\\n"
+      "      --q \"0 40 0 0.3 0 0.2 0 0 0\" --duration 2 --out out/pot3.csv");
   return cmd;
 }
 

@@ -132,10 +132,9 @@ CLI::App* AddViewCommand(CLI::App* app, ViewArgs* a) {
   cmd->add_option("--modes", a->modes, "Deformation files of the object; the modes of all files, in order")
       ->delimiter(',')
       ->type_name("FILE[,FILE...]");
-  cmd->add_option("--q", a->q, "Initial q = \"tx ty theta g1 ..\" (object files; a script uses set_vec)")
-      ->type_name("\"NUMS\"");
-  cmd->add_option("--qdot", a->qdot, "Initial q-dot, same layout")->type_name("\"NUMS\"");
-  cmd->add_option("--integrator", a->integrator, "thesis | symplectic | rk4 | implicit | variational (object files)")
+  cmd->add_option("--q", a->q, StateFlagHelp("object files; a script uses set_vec"))->type_name("\"NUMS\"");
+  cmd->add_option("--qdot", a->qdot, VelocityFlagHelp("object files"))->type_name("\"NUMS\"");
+  cmd->add_option("--integrator", a->integrator, IntegratorFlagHelp() + " (object files)")
       ->capture_default_str()
       ->type_name("NAME");
   cmd->add_option("--dt", a->dt, "Time step (object files)")->capture_default_str();

@@ -1,5 +1,6 @@
-// formats::ParseDeformations on arbitrary bytes; modes that fit the table's 4 x 4 lattice are
-// then given to BodyModel as `load_def` and `wobble simulate --modes` do.
+// formats::ParseDeformations on arbitrary bytes over the table's 4 x 4 lattice (matrix modes and
+// 2D generator lines); modes that fit it are then given to BodyModel as `load_def` and
+// `wobble simulate --modes` do.
 #include <sstream>
 
 #include "fuzz_common.h"
@@ -8,7 +9,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace wobble;
   fuzz::IgnoringExpectedErrors([&] {
     std::istringstream in(fuzz::AsText(data, size));
-    std::vector<DeformationMode> modes = formats::ParseDeformations(in, "fuzz.def");
+    const BodyModel& table = *fuzz::TableBody();
+    std::vector<DeformationMode> modes = formats::ParseDeformations(in, "fuzz.def", table.lattice());
     if (modes.empty()) std::abort();  // the reader promises at least one mode
     for (const DeformationMode& m : modes) {
       if (m.lattice_size[0] < 2 || m.lattice_size[1] < 2) std::abort();
@@ -17,7 +19,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       for (const Eigen::Vector2d& d : m.displacement)
         if (!d.allFinite()) std::abort();
     }
-    const BodyModel& table = *fuzz::TableBody();
     if (modes.front().lattice_size == table.lattice().sizes() &&
         modes.size() <= 8)
       BodyModel body(table.def(), std::move(modes));

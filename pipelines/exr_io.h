@@ -19,10 +19,18 @@ struct ExrChannel {
   bool half = false;        // stored as 16-bit half floats (colour); read back as float
 };
 
-// OpenEXR's ZIP_COMPRESSION (16 lines a chunk, zlib level 1) for rendered frames (RLE was
-// hardly faster and 13 times larger); kNone for float data that zlib cannot shrink (the
-// displacement images: 5% smaller at 7.5 times the time).
-enum class ExrCompression { kNone, kZip };
+// The compressions of OpenEXR that wobble writes with (zlib at level 1 where zlib is used).
+// kZip (16 lines a block) is the default of rendered frames: lossless, small (1.4% of the
+// channels' bytes on the demo's frames) and the fastest of those that shrink them (ZIPS is as
+// fast and larger, PIZ slower and larger). kDwaa is lossy on colour channels (R, G, B and layers' .R/.G/.B); OpenEXR keeps
+// the others (alpha, depth, motion) exact. kNone for float data zlib cannot shrink (the
+// displacement images).
+enum class ExrCompression { kNone, kZip, kZips, kPiz, kDwaa };
+
+// "none", "zip", "zips", "piz", "dwaa": the names of options (--exr-compression).
+const char* ExrCompressionName(ExrCompression compression);
+// Throws std::invalid_argument naming the value and the names accepted.
+ExrCompression ExrCompressionFromName(const std::string& name);
 
 // OpenEXR's standard attributes of a rendered frame (ImfStandardAttributes.h), for compositors:
 // the camera (worldToCamera: left-handed, +z the viewing direction; worldToNDC: (0, 0) the top
@@ -35,10 +43,8 @@ struct ExrMetadata {
   long frame = -1;               // < 0: no timeCode
 };
 
-// Writes a scan-line EXR of the channels (32-bit floats, or halves), atomically (temporary file
-// + rename). OpenEXR Core writes the header and chunk table; the chunks are packed here, and a
-// ZIP chunk whose bytes this thread compressed before (the same block of the previous frame, or
-// the block above: background) reuses those compressed bytes.
+// Writes a scan-line EXR of the channels (32-bit floats, or halves) with OpenEXR's writer,
+// atomically (temporary file + rename).
 // Throws std::invalid_argument for a bad size, channel length or two channels of one name,
 // std::runtime_error (naming the path and reason) when the file cannot be written; an earlier
 // file is then left intact.

@@ -240,6 +240,7 @@ void ApplyRenderSettings(const scene::RenderSettings& s, RenderOutputs* out) {
   out->view.exr_terrain_layer = s.exr_terrain;
   out->view.exr_nuke_motion = s.exr_nuke_motion;
   out->view.exr_blender_motion = s.exr_blender_motion;
+  out->view.exr_compression = ExrCompressionFromName(s.exr_compression);
 }
 
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out) {

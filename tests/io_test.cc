@@ -7,11 +7,13 @@
 #include <Eigen/SVD>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <sstream>
 
 #include "wobble/body/body_model.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
+#include "wobble/world/world.h"
 #include "support/source_paths.h"
 
 namespace wobble::formats {
@@ -364,7 +366,7 @@ TEST(ioDeformationFileErrors, LatticeSizeDiffersFromTheFirstMode) {
 
 TEST(ioDeformationFileErrors, UnknownKeywordAndHeaderOptions) {
   ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\nz: 1 2\n", 5, "unknown keyword 'z:' (expected 'mode', 'x:', 'y:' or a row");
-  ExpectModesError("z: 1 2\n", 1, "unknown keyword 'z:' (expected 'mode', 'x:' or 'y:')");
+  ExpectModesError("z: 1 2\n", 1, "unknown keyword 'z:' (expected 'mode', 'x:' or 'y:', or a generator: bend, squash");
   ExpectModesError("\nmode m stiff 5\nx: 1 2\n3 4\ny: 0 0\n0 0\n", 2, "unknown mode option 'stiff'");
   ExpectModesError("mode m stiffness\n", 1, "expected a number after 'stiffness'");
   ExpectModesError("mode m damping x\n", 1, "expected a number after 'damping', got 'x'");
@@ -380,8 +382,8 @@ TEST(ioDeformationFileErrors, SectionsOutOfPlace) {
   ExpectModesError("y: 1 2\n", 1, "'y:' section before any 'x:' section");
   ExpectModesError("mode m\ny: 1 2\n", 2, "'y:' section before any 'x:' section of mode 'm'");
   ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\ny: 0 0\n", 5, "second 'y:' section");
-  ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\nmode lonely\n", 5, "mode 'lonely' has no 'x:' section");
-  ExpectModesError("mode a\nmode b\n", 1, "mode 'a' has no 'x:' section (found a 'mode' header on line 2)");
+  ExpectModesError("x: 1 2\n3 4\ny: 0 0\n0 0\nmode lonely\n", 5, "mode 'lonely' has no 'x:' section and no generator");
+  ExpectModesError("mode a\nmode b\n", 1, "mode 'a' has no 'x:' section and no generator line (found a 'mode' header on line 2)");
   ExpectModesError("x:\ny: 0 0\n", 1, "has no rows");
 }
 
@@ -586,6 +588,35 @@ TEST(io3DFiles, SquashKeepsVolumeToFirstOrder) {
   EXPECT_LT(std::abs(ratio - 1.0), 10 * gamma * gamma);
 }
 
+// The body frame of a 3D object file is the file's own frame: its origin is the file's
+// (0, 0, 0), not the lattice corner. A lattice with its corner at (10, 20, 30) keeps every mass
+// point at its file coordinates, and q places the origin: at t = (1, 2, 3) turned 90 degrees
+// about z (R (x, y, z) = (-y, x, z)) a point p goes to t + R p, worked out by hand below.
+TEST(io3DFiles, BodyOriginIsTheFileOriginNotTheLatticeCorner) {
+  const BodyDef3 def = Object3(
+      "dimension 3\nlattice 10 20 30 40 50 60\n"
+      "mass 10 20 30 1\n"   // the lattice corner
+      "mass 50 70 90 2\n"   // the opposite corner
+      "mass 20 45 60 3\n");
+  EXPECT_EQ(def.lattice.origin(), Eigen::Vector3d(10, 20, 30));
+  auto body = std::make_shared<const BodyModel3>(def, std::vector<DeformationMode3>{});
+  const Eigen::Vector3d file[3] = {{10, 20, 30}, {50, 70, 90}, {20, 45, 60}};
+  for (int k = 0; k < 3; ++k) EXPECT_LT((body->rest_local(k) - file[k]).norm(), 1e-12) << "mass point " << k;
+  // Σ m p = (10 + 100 + 60, 20 + 140 + 135, 30 + 180 + 180)
+  EXPECT_LT((body->moments().c0 - Eigen::Vector3d(170, 295, 390)).norm(), 1e-11);
+
+  World world{WorldOptions{}};
+  world.AddBody(body);
+  world.SetState3(0, Eigen::Vector3d(1, 2, 3), Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())),
+                  Eigen::VectorXd(), Eigen::VectorXd::Zero(6));
+  const Eigen::Vector3d placed[3] = {{-19, 12, 33}, {-69, 52, 93}, {-44, 22, 63}};
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::VectorXd x = world.PointPosition(MassPointOf(0, k));
+    ASSERT_EQ(x.size(), 3);
+    EXPECT_LT((Eigen::Vector3d(x) - placed[k]).norm(), 1e-12) << "mass point " << k << " at " << x.transpose();
+  }
+}
+
 TEST(io3DFileErrors, ObjectFiles) {
   const std::string head = "dimension 3\nlattice 0 0 0 300 100 200\n";
   ExpectObject3Error("lattice 0 0 0 300 100 200\nmass 1 1 1 1\n", 1, "starts with 'dimension 3'");
@@ -614,6 +645,176 @@ TEST(io3DFileErrors, DeformationFiles) {
   ExpectModes3Error("dimension 3\nmode m\nbend x y 1\nmode m\nbend x y 2\n", 4, "already used on line 2");
   ExpectModes3Error("dimension 3\n", 1, "no modes after 'dimension 3'");
   ExpectModesError("dimension 3\nmode m\nbend x y 1\n", 1, "this is a 3D deformation file");
+}
+
+// ---------------------------------------------------------------- 2D generators (issue 45)
+// One grammar for 2D and 3D: the generators over a 2D lattice, each against its closed form at
+// the control points worked out here by hand (not by the reader's code).
+
+// origin (10, -20), axes (300, 0) and (0, 100), 4 x 3 control points: point (i, j) sits at
+// (10 + 100 i, -20 + 50 j), u = (i/3, j/2), and the centre is (160, 30).
+const Lattice& Lattice4x3() {
+  static const Lattice lattice(Eigen::Vector2d(10, -20), Eigen::Vector2d(300, 0), Eigen::Vector2d(0, 100), 4, 3);
+  return lattice;
+}
+std::vector<DeformationMode> Modes2(const std::string& text, const Lattice& lattice = Lattice4x3()) {
+  std::istringstream in(text);
+  return ParseDeformations(in, "test.def", lattice);
+}
+DeformationMode Generated(const std::string& line) { return Modes2("mode m\n" + line + "\n").front(); }
+void ExpectModes2Error(const std::string& text, int line, const std::string& message_part) {
+  ExpectParseError([&] { Modes2(text); }, "test.def", line, message_part);
+}
+
+TEST(io2DGenerators, EachGeneratorGivesItsClosedForm) {
+  const DeformationMode bend_x = Generated("bend x y 90"), bend_y = Generated("bend y x 40"),
+                        squash_y = Generated("squash y 0.5"), squash_x = Generated("squash x -0.4"),
+                        shear_y = Generated("shear y x 150"), shear_x = Generated("shear x y 60"),
+                        taper_y = Generated("taper y 0.4"), taper_x = Generated("taper x 0.3"),
+                        point = Generated("point 2 1 5 -7");
+  for (const DeformationMode* m : {&bend_x, &squash_y, &shear_y, &taper_y, &point}) {
+    EXPECT_EQ(m->lattice_size, (std::array<int, 2>{4, 3}));
+    ASSERT_EQ(m->displacement.size(), 12u);
+  }
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 3; ++j) {
+      SCOPED_TRACE("control point (" + std::to_string(i) + ", " + std::to_string(j) + ")");
+      const int c = i * 3 + j;  // flat index i*num_t + j
+      const double rx = 100.0 * i - 150.0, ry = 50.0 * j - 50.0;  // offset from the centre (160, 30)
+      const auto expect = [&](const DeformationMode& m, double dx, double dy) {
+        EXPECT_NEAR(m.displacement[c].x(), dx, 1e-12);
+        EXPECT_NEAR(m.displacement[c].y(), dy, 1e-12);
+      };
+      // bend x y 90: the inner columns rise by 90 (1 - 1/9) = 80, the outer ones stay
+      expect(bend_x, 0, i == 1 || i == 2 ? 80.0 : 0.0);
+      // bend y x 40: the middle row moves 40 along x, the bottom and top rows stay
+      expect(bend_y, j == 1 ? 40.0 : 0.0, 0);
+      // squash y 0.5: y offsets scaled by 1.5, x offsets by 0.75
+      expect(squash_y, -0.25 * rx, 0.5 * ry);
+      // squash x -0.4: x offsets scaled by 0.6, y offsets by 1.2
+      expect(squash_x, -0.4 * rx, 0.2 * ry);
+      // shear y x 150: rows slide along x from -75 (bottom) to +75 (top)
+      expect(shear_y, j == 0 ? -75.0 : j == 1 ? 0.0 : 75.0, 0);
+      // shear x y 60: columns slide along y from -30 (left) to +30 (right)
+      expect(shear_x, 0, -30.0 + 20.0 * i);
+      // taper y 0.4: each row's x offsets scaled by 0.8, 1, 1.2 from the bottom up
+      expect(taper_y, (j == 0 ? -0.2 : j == 1 ? 0.0 : 0.2) * rx, 0);
+      // taper x 0.3: each column's y offsets scaled by 1 + 0.3 (i/3 - 1/2)
+      expect(taper_x, 0, 0.1 * (i - 1.5) * ry);
+      expect(point, i == 2 && j == 1 ? 5.0 : 0.0, i == 2 && j == 1 ? -7.0 : 0.0);
+    }
+}
+
+// On a parallelogram lattice the generators use the unit axes and the part of r across an axis.
+// Axes a = (200, 0), b = (50, 100), 4 x 4 points: r = (i/3 - 1/2) a + (j/3 - 1/2) b, so across
+// b it is (i/3 - 1/2) (a - b (a·b)/|b|²) = (i/3 - 1/2) (160, -80), and across a it is
+// (j/3 - 1/2) (0, 100).
+TEST(io2DGenerators, SkewLatticeUsesUnitAxesAndTheAcrossPart) {
+  const Lattice skew(Eigen::Vector2d(0, 0), Eigen::Vector2d(200, 0), Eigen::Vector2d(50, 100));
+  const std::vector<DeformationMode> modes =
+      Modes2("mode taper\ntaper y 0.6\nmode shear\nshear x y 30\nmode bend\nbend x y 9\nmode squash\nsquash x 0.2\n",
+             skew);
+  ASSERT_EQ(modes.size(), 4u);
+  const double root = std::sqrt(12500.0);  // |b|
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      const int c = i * 4 + j;
+      const double si = i / 3.0 - 0.5, tj = j / 3.0 - 0.5;
+      EXPECT_NEAR((modes[0].displacement[c] - 0.6 * tj * si * Eigen::Vector2d(160, -80)).norm(), 0, 1e-9);
+      // shear x y 30: along the unit b, 30 (i/3 - 1/2)
+      EXPECT_NEAR((modes[1].displacement[c] - 30 * si * Eigen::Vector2d(50, 100) / root).norm(), 0, 1e-12);
+      // bend x y 9: along the unit b, 9 (1 - (2i/3 - 1)^2) = 8 at the inner columns
+      EXPECT_NEAR((modes[2].displacement[c] - (i == 1 || i == 2 ? 8.0 : 0.0) * Eigen::Vector2d(50, 100) / root).norm(), 0,
+                  1e-12);
+      // squash x 0.2: 0.2 (r·x̂) x̂ - 0.1 r⊥, with r·x̂ = 200 si + 50 tj
+      const Eigen::Vector2d expected =
+          0.2 * (200 * si + 50 * tj) * Eigen::Vector2d(1, 0) - 0.1 * tj * Eigen::Vector2d(0, 100);
+      EXPECT_NEAR((modes[3].displacement[c] - expected).norm(), 0, 1e-9);
+    }
+}
+
+// The table's shipped shear and vertical squash (typed as matrices, our numbers) are the 2D
+// generators up to a translation, which a body's rigid motion absorbs: shear.def is
+// shear y x 150 moved by (75, 0), vsquash.def is squash y -1 moved by (0, -50).
+TEST(io2DGenerators, TableShearAndSquashAreGeneratorsPlusATranslation) {
+  const Lattice table = ReadObjectFile(kData + "/table.obj").lattice;
+  const std::vector<DeformationMode> generated = Modes2("mode shear\nshear y x 150\nmode vsquash\nsquash y -1\n", table);
+  const DeformationMode shear = ReadDeformationFile(kData + "/shear.def")[0],
+                        vsquash = ReadDeformationFile(kData + "/vsquash.def")[0];
+  for (int c = 0; c < table.size(); ++c) {
+    // the file's 12 decimals (-33.333333333333) bound the difference
+    EXPECT_NEAR((shear.displacement[c] - generated[0].displacement[c] - Eigen::Vector2d(75, 0)).norm(), 0, 1e-9);
+    EXPECT_NEAR((vsquash.displacement[c] - generated[1].displacement[c] - Eigen::Vector2d(0, -50)).norm(), 0, 1e-9);
+  }
+}
+
+TEST(io2DGenerators, OneFileMixesMatricesAndGeneratorsWithHeaders) {
+  const std::vector<DeformationMode> modes = Modes2(
+      "dimension 2          # optional in 2D\n"
+      "x: 1 2 3 4\n0 0 0 0\n0 0 0 0\ny: 0 0 0 0\n0 0 0 0\n0 0 0 0\n"  // no header: named after the file
+      "mode lean stiffness 5 damping 2 active\n"
+      "  shear y x 150\n"
+      "  point 0 0 1 2     # generators add\n"
+      "mode grow\n"
+      "  squash y 0.5\n");
+  ASSERT_EQ(modes.size(), 3u);
+  EXPECT_EQ(modes[0].name, "test_1");
+  EXPECT_EQ(modes[0].source, "test.def:2");
+  EXPECT_EQ(modes[0].displacement[3 * 3], Eigen::Vector2d(4, 0));  // column 4 of the bottom row: i = 3, j = 0
+  EXPECT_EQ(modes[1].name, "lean");
+  EXPECT_EQ(modes[1].source, "test.def:8");
+  EXPECT_EQ(modes[1].stiffness, 5.0);
+  EXPECT_EQ(modes[1].damping, 2.0);
+  EXPECT_TRUE(modes[1].active);
+  EXPECT_EQ(modes[1].displacement[0], Eigen::Vector2d(-75 + 1, 2));
+  EXPECT_EQ(modes[1].displacement[1], Eigen::Vector2d(0, 0));
+  EXPECT_EQ(modes[2].name, "grow");
+  EXPECT_FALSE(modes[2].active);
+  // a body takes them (BodyModel checks every mode's lattice size against the object's)
+  BodyDef def;
+  def.lattice = Lattice4x3();
+  def.masses = {1, 1, 1};
+  def.mass_positions = {Eigen::Vector2d(20, -10), Eigen::Vector2d(200, 40), Eigen::Vector2d(300, 70)};
+  EXPECT_NO_THROW(BodyModel body(def, modes));
+}
+
+TEST(io2DGenerators, ErrorsNameFileLineAndWhatWasExpected) {
+  // twist has no 2D form; axis z none either
+  ExpectModes2Error("dimension 2\nmode m\ntwist y 30\n", 3, "twist needs dimension 3");
+  ExpectModes2Error("mode m\ntwist y 30\n", 2, "twist needs dimension 3");
+  ExpectModes2Error("mode m\nbend x z 10\n", 2, "expected an axis x or y, got 'z': axis z needs dimension 3 (bend <along>");
+  ExpectModes2Error("mode m\nshear w x 10\n", 2, "expected an axis x or y, got 'w' (shear <axis> <toward> <amount>)");
+  // generators belong to a mode with a header and no matrix
+  ExpectModes2Error("bend x y 1\n", 1, "'bend' before the first 'mode <name>");
+  ExpectModes2Error("mode m\nx: 1 2 3 4\n0 0 0 0\n0 0 0 0\ny: 0 0 0 0\n0 0 0 0\n0 0 0 0\nsquash y 1\n", 8,
+                    "'squash' after the matrix of mode 'm' (x: on line 2): a mode is either a matrix or generator lines");
+  ExpectModes2Error("mode m\n", 1, "mode 'm' has no 'x:' section and no generator line");
+  // arguments
+  ExpectModes2Error("mode m\nbend x x 1\n", 2, "bend needs two different axes");
+  ExpectModes2Error("mode m\nshear y\n", 2, "expected 3 values after 'shear', got 1 (shear <axis> <toward> <amount>)");
+  ExpectModes2Error("mode m\ntaper y wide\n", 2, "expected a number, got 'wide' (taper <axis> <fraction>)");
+  ExpectModes2Error("mode m\nsquash y nan\n", 2, "expected a number, got 'nan'");
+  ExpectModes2Error("mode m\npoint 4 0 1 1\n", 2, "index i in 0..3, got '4' (point <i> <j> <dx> <dy>; the lattice is 4x3)");
+  ExpectModes2Error("mode m\npoint 0 3 1 1\n", 2, "index j in 0..2, got '3'");
+  ExpectModes2Error("mode m\npoint 0 0 0 1 1 1\n", 2, "expected 4 values after 'point', got 6 (point <i> <j> <dx> <dy>)");
+  ExpectModes2Error("mode m\nsquash y 1e308\n", 2, "the displacements of mode 'm' overflow");  // 1e308 x 50
+  ExpectModes2Error("mode m\npoint 0 0 1e308 0\npoint 0 0 1e308 0\n", 3, "the displacements of mode 'm' overflow");
+  // the dimension line: first, and 2 or 3
+  ExpectModes2Error("dimension 2\nmode m\ndimension 2\n", 3, "'dimension' must be the first line");
+  ExpectModes2Error("dimension 4\nmode m\nbend x y 1\n", 1, "expected 'dimension 2' or 'dimension 3'");
+  ExpectModes2Error("dimension 2\n", 1, "no modes after 'dimension 2'");
+  ExpectModes2Error("dimension 3\nmode m\nbend x y 1\n", 1, "this is a 3D deformation file; a 2D body was expected");
+  // without the body's lattice, generators cannot be computed
+  ExpectModesError("mode m\nbend x y 1\n", 2, "'bend' needs the body's lattice");
+}
+
+TEST(io3DFileErrors, OneGrammarKeywordsOfTheOtherDimension) {
+  ExpectModes3Error("dimension 3\nmode m\nx: 1 2 3 4\n", 3, "'x:' sections are for 2D files");
+  ExpectModes3Error("dimension 3\nmode m\nbend x y 1\ny: 1 2\n", 4, "'y:' sections are for 2D files");
+  ExpectModes3Error("dimension 3\nmode m\npoint 0 0 1 1\n", 3, "expected 6 values after 'point', got 4");
+  ExpectModes3Error("dimension 2\nmode m\nbend x y 1\n", 1, "this is a 2D deformation file; a 3D body was expected");
+  ExpectModes3Error("mode m\nbend x y 1\n", 1, "a file without it is 2D");
+  ExpectModes3Error("dimension 3\nmode m\nbend x y 1\ndimension 3\n", 4, "'dimension' must be the first line");
 }
 
 }  // namespace

@@ -623,6 +623,19 @@ TEST(RenderedExr, SeriesMotionPointsToTheNextFrameAndTheLastStandsStill) {
   fs::remove_all(out.folder);
 }
 
+// exr-compression (wobble render --exr-compression, a script's render line) reaches the frames'
+// writer under each of its names.
+TEST(RenderedExr, EveryCompressionNameReachesTheWriter) {
+  for (const char* name : {"zip", "zips", "piz", "dwaa", "none"}) {
+    RenderOutputs out;
+    ApplyRenderSettings(scene::ParseRenderOptions({{"exr-compression", name}}), &out);
+    EXPECT_STREQ(ExrCompressionName(out.view.exr_compression), name);
+  }
+  RenderOutputs plain;
+  ApplyRenderSettings(scene::ParseRenderOptions({}), &plain);
+  EXPECT_EQ(plain.view.exr_compression, ExrCompression::kZip);
+}
+
 TEST(VtiExport, ImageReadsBackWithItsGeometryAndValues) {
   const std::string dir = TempDir("vti");
   auto image = vtkSmartPointer<vtkImageData>::New();

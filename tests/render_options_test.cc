@@ -51,6 +51,7 @@ TEST(RenderOptions, ValuesParseAsTyped) {
                                                {"style", "clean"},
                                                {"exr-terrain", "on"},
                                                {"exr-motion", "blender"},
+                                               {"exr-compression", "piz"},
                                                {"orbit", "-12.5"}});
   EXPECT_EQ(s.width, 800);
   EXPECT_EQ(s.height, 500);
@@ -64,6 +65,8 @@ TEST(RenderOptions, ValuesParseAsTyped) {
   const RenderSettings both = ParseRenderOptions({{"exr-motion", "both"}}), plain = ParseRenderOptions({});
   EXPECT_TRUE(both.exr_blender_motion && both.exr_nuke_motion);
   EXPECT_TRUE(!plain.exr_blender_motion && plain.exr_nuke_motion) << "Nuke's forward.u/v by default";
+  EXPECT_EQ(s.exr_compression, "piz");
+  EXPECT_EQ(plain.exr_compression, "zip");
   EXPECT_EQ(s.orbit, -12.5);
   const RenderSettings cycle = ParseRenderOptions({{"filmstrip-cycle", "2 8"}});
   EXPECT_EQ(cycle.filmstrip_cycle, 2);
@@ -81,6 +84,7 @@ TEST(RenderOptions, BadValuesNameTheOptionAndWhatWasExpected) {
   EXPECT_NE(ErrorOf("style", "pretty").find("expected diagnostic or clean"), std::string::npos);
   EXPECT_NE(ErrorOf("exr-terrain", "maybe").find("expected on or off"), std::string::npos);
   EXPECT_NE(ErrorOf("exr-motion", "natron").find("expected nuke, blender or both"), std::string::npos);
+  EXPECT_NE(ErrorOf("exr-compression", "rle").find("expected zip, zips, piz, dwaa or none, got 'rle'"), std::string::npos);
   EXPECT_NE(ErrorOf("trail", "0.5").find("pairs"), std::string::npos);
   EXPECT_NE(ErrorOf("filmstrip-cycle", "-1").find("cycle K >= 0"), std::string::npos);
   EXPECT_NE(ErrorOf("sizes", "1x1").find("unknown option (azimuth,"), std::string::npos);

@@ -46,6 +46,22 @@ TEST(AppendixC, RunsUnchangedToAFiniteSettledEnd) {
   EXPECT_LT(std::abs(interp.q()[2]), 1e-9);
 }
 
+// load_def reads 2D files with the object's lattice, so generator modes load (issue 45): the
+// table's generator file holds the typed bend and shear y x 150 = data/shear.def − (75, 0).
+TEST(Interpreter, LoadDefReadsTwoDGeneratorsOverTheObjectsLattice) {
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  std::istringstream script("load_obj table.obj\nload_def table_generated.def\n");
+  interp.RunStream(script, "generators.wob", kData);
+  const BodyModel& table = *interp.body();
+  ASSERT_EQ(table.num_modes(), 4);
+  EXPECT_EQ(table.modes()[1].name, "lean");
+  EXPECT_TRUE(table.modes()[1].active);
+  const DeformationMode shear = formats::ReadDeformationFile(kData + "/shear.def")[0];
+  for (int c = 0; c < 16; ++c)
+    EXPECT_NEAR((table.modes()[1].displacement[c] - (shear.displacement[c] - Eigen::Vector2d(75, 0))).norm(), 0, 1e-12);
+}
+
 TEST(AppendixC, ExplicitSchemeAtItsTimeStepStopsWithAStatusNamingTheLine) {
   // the thesis' explicit scheme at dt 0.1 is beyond its stability limit for these dampings:
   // the run must stop with a status, not produce NaN

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """The installed wobble, used as a stranger would (issue 16).
 
-Installs the build tree into a fresh prefix (cmake --install), checks the layout, configures
+Installs the build tree into a fresh prefix (cmake --install), checks the layout and that only
+public headers are installed (no internal/ folder, no Ceres include, nothing left out that an
+installed header includes; issue 45), configures
 examples/cpp against the *installed* package (find_package(wobble)), builds and runs it, and
 imports the installed Python package: both must drop the table to the same resting height.
 
@@ -21,6 +23,45 @@ def run(cmd, **kw):
     return r.stdout
 
 
+INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]')
+
+
+def check_public_headers(include_dir):
+    """Only public headers are installed (issue 45): nothing under an internal/ folder, no
+    header that includes Ceres, and every wobble or pipelines header an installed one includes
+    is installed too (so no public header leans on one left out)."""
+    problems = []
+    headers = 0
+    for root, dirs, files in os.walk(include_dir):
+        rel_root = os.path.relpath(root, include_dir)
+        if "internal" in rel_root.split(os.sep):
+            problems.append(f"{rel_root}: an internal folder is installed")
+        for name in files:
+            path = os.path.join(root, name)
+            rel = os.path.relpath(path, include_dir)
+            headers += 1
+            with open(path, encoding="utf-8") as f:
+                for number, line in enumerate(f, 1):
+                    m = INCLUDE.match(line)
+                    if not m:
+                        continue
+                    quote, inc = m.groups()
+                    where = f"{rel}:{number}"
+                    if inc.startswith("ceres/"):
+                        problems.append(f"{where}: includes Ceres ({inc})")
+                    if "internal/" in inc:
+                        problems.append(f"{where}: includes an internal header ({inc})")
+                    # every quoted include is one of ours (wobble/..., pipelines/...)
+                    if quote == '"' or inc.startswith(("wobble/", "pipelines/")):
+                        found = os.path.exists(os.path.join(include_dir, inc)) or \
+                            (quote == '"' and os.path.exists(os.path.join(root, inc)))
+                        if not found:
+                            problems.append(f"{where}: includes {inc}, which is not installed")
+    if headers < 50:
+        problems.append(f"only {headers} headers installed under {include_dir}")
+    return problems
+
+
 def main():
     cmake, build, source, work, python = sys.argv[1:6]
     shutil.rmtree(work, ignore_errors=True)
@@ -34,9 +75,9 @@ def main():
     site = [os.path.join(root) for root, dirs, files in os.walk(prefix) if "__init__.pyi" in files]
     if missing or len(site) != 1:
         sys.exit(f"FAILED: the install lacks {missing}; Python packages found: {site}")
-    internal = [f for f in ("include/wobble/fit/internal",) if not os.path.isdir(os.path.join(prefix, f))]
-    if internal:
-        sys.exit(f"FAILED: headers the public ones include are missing: {internal}")
+    problems = check_public_headers(os.path.join(prefix, "include"))
+    if problems:
+        sys.exit("FAILED: the installed headers are not the public ones:\n  " + "\n  ".join(problems))
 
     # the consumer project, against the installed tree only
     hello_build = os.path.join(work, "hello")

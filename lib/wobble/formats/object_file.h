@@ -51,7 +51,11 @@ BodyDef ParseObject(std::istream& in, const std::string& name_for_errors);
 //   mass <x> <y> <z> <m>
 //   polyline <x1> <y1> <z1> <x2> <y2> <z2> ... [closed]
 //
-// s runs along x, t along y (up), u along z; the body origin is the lattice corner (x0, y0, z0).
+// s runs along x, t along y (up), u along z. Every coordinate of the file (mass points,
+// polylines, the mesh) is in the body frame, whose origin is the file's (0, 0, 0): q's
+// translation puts it at t and the body turns about it (a point p at rest is at t + R p). It
+// is the lattice corner only when the lattice line starts with 0 0 0 (data/table3.obj); a
+// fitted lattice's corner lies wherever the mesh's box does.
 //
 // A 3D character may be a user's triangle mesh (issue 15), in the body frame:
 //

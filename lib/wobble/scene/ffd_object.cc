@@ -88,7 +88,7 @@ void FfdObject::LoadModes(const std::vector<std::string>& paths) {
   }
   std::vector<DeformationMode> modes;
   for (const std::string& path : paths) {
-    std::vector<DeformationMode> more = formats::ReadDeformationFile(path);
+    std::vector<DeformationMode> more = formats::ReadDeformationFile(path, def_->lattice);  // generators need it
     modes.insert(modes.end(), more.begin(), more.end());
   }
   BodyModel check(*def_, modes);  // throws when the modes do not fit the object

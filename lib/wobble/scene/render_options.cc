@@ -38,6 +38,9 @@ const std::vector<RenderOptionInfo>& RenderOptionTable() {
       {"exr-motion", "nuke|blender|both", "nuke",
        "EXR frames: the motion vectors as Nuke's forward.u,v (to the next frame), as Blender's Vector pass "
        "ViewLayer.Vector.X,Y,Z,W (to the previous frame and from the next; four channels more per frame), or both"},
+      {"exr-compression", "zip|zips|piz|dwaa|none", "zip",
+       "EXR frames: OpenEXR's compression. zip, zips (zlib, 16 lines or 1 line a block), piz (wavelet) and none are "
+       "lossless; dwaa is lossy on the colour channels (alpha, depth and motion stay exact)"},
       {"trail", "\"S T ..\"", "", "Trace points given by lattice coordinates \"s t s t ..\" in the frames"},
   };
   return table;
@@ -159,6 +162,12 @@ RenderSettings ParseRenderOptions(const std::map<std::string, std::string>& valu
       throw RenderOptionError("exr-motion", "expected nuke, blender or both, got '" + m + "'");
     s.exr_nuke_motion = m != "blender";
     s.exr_blender_motion = m != "nuke";
+  }
+  if (has("exr-compression")) {
+    const std::string c = text("exr-compression");
+    if (c != "zip" && c != "zips" && c != "piz" && c != "dwaa" && c != "none")
+      throw RenderOptionError("exr-compression", "expected zip, zips, piz, dwaa or none, got '" + c + "'");
+    s.exr_compression = c;
   }
   return s;
 }

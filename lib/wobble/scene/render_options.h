@@ -54,6 +54,7 @@ struct RenderSettings {
   bool exr_terrain = false;  // EXR frames: the terrain as its own layer too
   // EXR frames' motion vectors: Nuke's forward.u/v, Blender's Vector pass, or both (exr-motion)
   bool exr_nuke_motion = true, exr_blender_motion = false;
+  std::string exr_compression = "zip";  // EXR frames: OpenEXR's compression, by name (exr-compression)
 };
 
 // Values by name as typed (a flag's value "on"); the rest keep their defaults. Throws
