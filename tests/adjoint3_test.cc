@@ -51,6 +51,8 @@ fit::StageCost3 StageOf(const BodyModel3& body) {
   return [&body](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     using J = ceres::Jet<double, kNz>;
     BodyState<3, J> sj;
+    sj.q.resize(s.q.size());
+    sj.qd.resize(s.qd.size());
     Vec3<J> eps;
     for (int i = 0; i < 3; ++i) {
       sj.translation()[i] = J(s.translation()[i], i);
@@ -104,6 +106,8 @@ T ReferenceCost(const BodyModel3& passive, const fit::ControlledRollout3& r, con
     return x;
   };
   BodyState<3, T> s;
+  s.q.resize(r.start.q.size());
+  s.qd.resize(r.start.qd.size());
   Vec3<T> eps;
   for (int i = 0; i < 3; ++i) {
     s.translation()[i] = T(r.start.translation()[i]) + param(i);
@@ -326,8 +330,8 @@ TEST(Adjoint3, RefusesBadInputWithAMessage) {
   refused([](fit::ControlledRollout3* r) { r->stiffness.resize(2); }, "one value per mode");
   refused([](fit::ControlledRollout3* r) { r->targets.resize(2, 5); }, "one row per mode");
   refused([](fit::ControlledRollout3* r) { r->start.qd[2] = std::nan(""); }, "finite");
-  refused([](fit::ControlledRollout3* r) { r->start.orientation().coeffs().setZero(); }, "must not be zero");
-  refused([](fit::ControlledRollout3* r) { r->start.gamma().resize(1); }, "mode amplitudes");
+  refused([](fit::ControlledRollout3* r) { r->start.q.segment<4>(3).setZero(); }, "must not be zero");
+  refused([](fit::ControlledRollout3* r) { r->start.q.conservativeResize(Group<3>::kRigidParams + 1); }, "mode amplitudes");
 }
 
 }  // namespace

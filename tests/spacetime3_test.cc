@@ -24,7 +24,7 @@ const BodyModel3& Chair() {
 
 BodyState<3, double> RandomState(std::mt19937* rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
-  BodyState<3, double> s;
+  BodyState<3, double> s = RestState<3, double>(Chair());
   s.translation() = Eigen::Vector3d(normal(*rng), normal(*rng), normal(*rng)) * 50.0;
   s.set_orientation(Eigen::Quaterniond(normal(*rng), normal(*rng), normal(*rng), normal(*rng)).normalized());
   s.gamma() = VecD<double>(kModes);
@@ -126,7 +126,7 @@ TEST(Spacetime3, TaskTermsHaveTheirExactGradients) {
 
 // A tilted chair turned by a yaw stays upright; one tipped over does not.
 TEST(Spacetime3, UprightIgnoresHeadingOnly) {
-  BodyState<3, double> s;
+  BodyState<3, double> s = RestState<3, double>(Chair());
   s.gamma() = VecD<double>::Zero(kModes);
   s.qd = VecQ<double>::Zero(6 + kModes);
   Eigen::VectorXd dz = Eigen::VectorXd::Zero(kNz);
@@ -145,6 +145,7 @@ fit::SpacetimeProblem3 SquashAtTheEnd(double goal, double bound, int steps, int 
   r.world.ground.enabled = false;
   r.integrator = Integrator::kSymplecticEuler;
   r.dt = 0.01;
+  r.start = RestState<3, double>(Chair());
   r.start.translation() = Eigen::Vector3d(0.0, 100.0, 0.0);
   r.start.gamma() = VecD<double>::Zero(kModes);
   r.start.qd = VecQ<double>::Zero(6 + kModes);

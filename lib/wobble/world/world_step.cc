@@ -72,8 +72,9 @@ bool World::RefuseFfdStep(int body, const VecQ<double>& q_before, const VecQ<dou
   s.q = q_before;
   s.qd = qd_before;
   UpdateContacts(*e.model, options_.params.ground, &s);
-  if (!st.ok()) return Fail(st.code, body, "", st.value);
-  // a state that overflowed because its forces did: the force is the cause to name
+  // a state that overflowed because its forces did: the force is the cause to name (the step
+  // reports only that its state is not finite)
+  if (!st.ok() && st.code != StatusCode::kNonFinite) return Fail(st.code, body, "", st.value);
   if (!finite) return ForcesFinite(body) ? Fail(StatusCode::kNonFinite, body) : Fail(StatusCode::kOverflowingForce, body);
   if (!too_deep)
     return Fail(StatusCode::kNonFiniteEnergy, body, EnergyTerms(energies) + " after the step (refused: the state is the one before it)");
