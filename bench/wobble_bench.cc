@@ -289,7 +289,7 @@ void BM_Table3RestingOnGround(benchmark::State& state) {
   WorldParamsN<3> w;
   w.ground.enabled = true;
   BodyState<3, double> s = RestState<3, double>(*body);
-  s.t.y() = 10.0;
+  s.translation().y() = 10.0;
   for (int i = 0; i < 3000; ++i)
     if (!StepBody(*body, w, 0, Integrator::kThesis, 0.01, &s).ok()) {
       state.SkipWithError("the table did not settle");
@@ -321,7 +321,7 @@ void BM_Table3kRestingOnGround(benchmark::State& state) {
   WorldParamsN<3> w;
   w.ground.enabled = true;
   BodyState<3, double> s = RestState<3, double>(*body);
-  s.t.y() = 10.0;
+  s.translation().y() = 10.0;
   for (int i = 0; i < 3000; ++i)
     if (!StepBody(*body, w, 0, Integrator::kThesis, 0.01, &s).ok()) {
       state.SkipWithError("the table did not settle");
