@@ -244,7 +244,7 @@ StartingWorld LoadStartingWorld(const BodyFiles& files, const std::string& q, co
     // the 3D ground: the plane through y = height, tilted by the slope about z as the 2D line
     s.options.ground_3d = GroundPlaneOf(s.options.params.ground);
     s.body3 = LoadBody3(files);
-    const int n = kRigidDofs3 + s.body3->num_modes();
+    const int n = Group<3>::kRigidDofs + s.body3->num_modes();
     s.q0 = ParseNumbers(q, "--q", n, CoordinateNames3(*s.body3), s.body3->name());
     s.qd0 = ParseNumbers(qdot, "--qdot", n, VelocityNames3(*s.body3), s.body3->name());
     return s;

@@ -90,14 +90,14 @@ fit::SpacetimeResult Fit3(const FitSpacetimeArgs& a, const StartingWorld& start,
   p.rollout.world = Params3Of(start.options);
   p.rollout.integrator = Integrator::kThesis;
   p.rollout.dt = a.dt;
-  p.rollout.start = State3FromQ(start.q0, start.qd0);
+  p.rollout.start = StateFromCoordinates<3>(start.q0, start.qd0);
   body.ModeGains(&p.rollout.stiffness, &p.rollout.damping);
   p.rollout.targets = first_guess;
   SetBounds(a, D, &p);
   std::vector<fit::StageCost3> terms;
   const MassMoments3& mm = body.moments();
   const Eigen::Vector3d com0 =
-      p.rollout.start.t + p.rollout.start.orientation * ((mm.c0 + mm.C * p.rollout.start.gamma) / mm.m);
+      p.rollout.start.translation() + p.rollout.start.orientation() * ((mm.c0 + mm.C * p.rollout.start.gamma()) / mm.m);
   if (!a.rise.empty()) {
     const std::vector<double> v = ParseNumbers(a.rise, "--rise");
     if (v.size() != 2) throw UsageError("--rise takes \"DY T\"");

@@ -60,7 +60,7 @@ int RunInspect(const InspectArgs& a) {
   if (setup.body3) throw UsageError("inspect takes 2D objects only so far; for a 3D object use condition check or simulate");
   const std::shared_ptr<const BodyModel>& body = setup.body;
   const World world = setup.MakeWorld();
-  const BodyState<double>& s = world.state(0);
+  const BodyState<2, double>& s = world.state(0);
   const Lattice& lat = body->lattice();
 
   json out = json::object();
@@ -87,7 +87,7 @@ int RunInspect(const InspectArgs& a) {
   VecQ<double> w;
   VelocityTerms(body->moments(), s.q, s.qd, &w);
   out["velocity_terms"] = Vector(-w);
-  const ForceBreakdown<double> f = world.Forces(0);
+  const ForceBreakdown<2, double> f = world.Forces(0);
   out["forces"] = {{"gravity", Vector(f.gravity)}, {"modes", Vector(f.modes)}, {"ground", Vector(f.ground)},
                    {"total", Vector(f.total)}};
   VecQ<double> qdd;

@@ -91,9 +91,9 @@ fit::ControlledRollout3 Rollout3(int controls, bool grounded) {
   r.world.ground.normal_damping = 100;
   r.world.ground.friction_damping = 100;
   r.world.ground.friction_cap = 0.3;
-  r.start = RestState3<double>(Chair());
-  r.start.t.y() = grounded ? 3.0 : 200.0;
-  r.start.v[0] = 30.0;
+  r.start = RestState<3, double>(Chair());
+  r.start.translation().y() = grounded ? 3.0 : 200.0;
+  r.start.qd[0] = 30.0;
   r.stiffness = Eigen::VectorXd::Constant(3, 2e4);
   r.damping = Eigen::VectorXd::Constant(3, 200);
   const int steps = (controls + 2) / 3;
@@ -105,10 +105,10 @@ fit::ControlledRollout3 Rollout3(int controls, bool grounded) {
 
 // ½ |x − y|² of a rigid point l of the chair's frame against a fixed goal, every step:
 // x = t + R l, so ∂/∂δt = e and ∂/∂ε = l × Rᵀe.
-double Stage3(int, const BodyState3<double>& s, Eigen::VectorXd* dz) {
+double Stage3(int, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
   const Eigen::Vector3d goal(400.0, 120.0, 50.0), l(50.0, 50.0, 30.0);
-  const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
-  const Eigen::Vector3d e = s.t + R * l - goal;
+  const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
+  const Eigen::Vector3d e = s.translation() + R * l - goal;
   dz->head<3>() += e;
   dz->segment<3>(3) += l.cross(R.transpose() * e);
   return 0.5 * e.squaredNorm();

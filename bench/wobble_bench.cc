@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "support/reference.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 #include "wobble/world/world.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
@@ -270,10 +270,10 @@ std::shared_ptr<const BodyModel3> Table3(int points = 0, int mesh_vertices = 0) 
   return std::make_shared<const BodyModel3>(def, modes);
 }
 
-void TimeSteps3(benchmark::State& state, const BodyModel3& body, const WorldParams3& w, double dt,
-                BodyState3<double>* s) {
+void TimeSteps3(benchmark::State& state, const BodyModel3& body, const WorldParamsN<3>& w, double dt,
+                BodyState<3, double>* s) {
   for (auto _ : state) {
-    const StepStatus st = StepBody3(body, w, Integrator::kThesis, dt, s);
+    const StepStatus st = StepBody(body, w, 0, Integrator::kThesis, dt, s);
     if (!st.ok()) {
       state.SkipWithError(StatusCodeName(st.code).c_str());
       break;
@@ -286,12 +286,12 @@ void TimeSteps3(benchmark::State& state, const BodyModel3& body, const WorldPara
 // Resting on its four feet after a drop, as BM_TableRestingOnGround does for the 2D table.
 void BM_Table3RestingOnGround(benchmark::State& state) {
   const std::shared_ptr<const BodyModel3> body = Table3();
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.ground.enabled = true;
-  BodyState3<double> s = RestState3<double>(*body);
-  s.t.y() = 10.0;
+  BodyState<3, double> s = RestState<3, double>(*body);
+  s.translation().y() = 10.0;
   for (int i = 0; i < 3000; ++i)
-    if (!StepBody3(*body, w, Integrator::kThesis, 0.01, &s).ok()) {
+    if (!StepBody(*body, w, 0, Integrator::kThesis, 0.01, &s).ok()) {
       state.SkipWithError("the table did not settle");
       return;
     }
@@ -304,10 +304,10 @@ BENCHMARK(BM_Table3RestingOnGround);
 void BM_Table3OutOfContact(benchmark::State& state) {
   const std::shared_ptr<const BodyModel3> body = Table3(int(state.range(0)), int(state.range(2)));
   state.counters["mesh_vertices"] = double(body->def().mesh.points.size());
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.ground.enabled = state.range(1) != 0;
   w.ground.point = Eigen::Vector3d(0.0, -1e12, 0.0);
-  BodyState3<double> s = RestState3<double>(*body);
+  BodyState<3, double> s = RestState<3, double>(*body);
   TimeSteps3(state, *body, w, 0.01, &s);
 }
 BENCHMARK(BM_Table3OutOfContact)
@@ -318,12 +318,12 @@ BENCHMARK(BM_Table3OutOfContact)
 // Resting with 1,000 points: the point groups keep the scan near the feet.
 void BM_Table3kRestingOnGround(benchmark::State& state) {
   const std::shared_ptr<const BodyModel3> body = Table3(1000);
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.ground.enabled = true;
-  BodyState3<double> s = RestState3<double>(*body);
-  s.t.y() = 10.0;
+  BodyState<3, double> s = RestState<3, double>(*body);
+  s.translation().y() = 10.0;
   for (int i = 0; i < 3000; ++i)
-    if (!StepBody3(*body, w, Integrator::kThesis, 0.01, &s).ok()) {
+    if (!StepBody(*body, w, 0, Integrator::kThesis, 0.01, &s).ok()) {
       state.SkipWithError("the table did not settle");
       return;
     }

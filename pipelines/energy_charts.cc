@@ -57,10 +57,10 @@ std::vector<double> ConditionNumbers(const record::Trajectory& run, int body, in
       cond.push_back(analysis::MassMatrixCondition(*info.ffd, q).cond);  // +∞ when M is singular
     } else {
       // a 3D row: tx ty tz qw qx qy qz γ..
-      BodyState3<double> s = RestState3<double>(*info.ffd3);
-      s.t = q.head<3>();
-      s.orientation = Eigen::Quaterniond(q[3], q[4], q[5], q[6]).normalized();
-      s.gamma = q.tail(info.ffd3->num_modes());
+      BodyState<3, double> s = RestState<3, double>(*info.ffd3);
+      s.translation() = q.head<3>();
+      Group<3>::SetOrientation(Eigen::Quaterniond(q[3], q[4], q[5], q[6]).normalized(), &s.q);
+      s.gamma() = q.tail(info.ffd3->num_modes());
       cond.push_back(analysis::MassMatrixCondition(*info.ffd3, s).cond);
     }
   }

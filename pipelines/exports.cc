@@ -118,7 +118,7 @@ std::vector<ExrChannel> DisplacementImage(const World& world, int body_index, in
   const BodyModel& body = world.body(body_index);
   const Lattice& lat = body.lattice();
   const VecQ<double>& q = world.state(body_index).q;
-  const Frame<double> frame(q);
+  const Frame<2, double> frame(q);
   // deformed control points in the world, W_ij = t + R (L_ij + Σ γ_d d^d_ij); the weights are
   // a partition of unity, so x(s, t) = Σ_ij W_ij B_i(s) B_j(t) is Eq. 4.2 with the rigid motion
   const int ns = lat.num_s(), nt = lat.num_t();
@@ -159,14 +159,14 @@ vtkSmartPointer<vtkImageData> DisplacementVolume(const World& world, int body_in
   if (nx <= 0 || ny <= 0 || nz <= 0) throw std::invalid_argument("displacement volume size must be positive");
   const BodyModel3& body = world.body3(body_index);
   const Lattice3& lat = body.lattice();
-  const BodyState3<double>& s = world.state3(body_index);
+  const BodyState<3, double>& s = world.state3(body_index);
   // deformed control points in the world, W_c = t + R (L_c + Σ γ_d d^d_c): the weights are a
   // partition of unity, so x(s, t, u) = Σ_c W_c B_c(s, t, u) is Eq. 4.2 with the rigid motion
   std::vector<Eigen::Vector3d> W(size_t(lat.size()));
   for (int c = 0; c < lat.size(); ++c) {
     Eigen::Vector3d l = body.rest_control()[size_t(c)];
-    for (int m = 0; m < body.num_modes(); ++m) l += body.modes()[size_t(m)].displacement[size_t(c)] * s.gamma[m];
-    W[size_t(c)] = s.t + s.orientation * l;
+    for (int m = 0; m < body.num_modes(); ++m) l += body.modes()[size_t(m)].displacement[size_t(c)] * s.gamma()[m];
+    W[size_t(c)] = s.translation() + s.orientation() * l;
   }
   const std::vector<Eigen::Vector3d> rest = lat.RestPoints();
   auto image = vtkSmartPointer<vtkImageData>::New();

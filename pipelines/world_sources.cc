@@ -74,7 +74,7 @@ Eigen::Vector2d WorldPositionOf(const World& world, int body, const Eigen::Vecto
   Mat2D<double> B;
   world.body(body).LocalBasis(st, &b0, &B);
   const VecQ<double>& q = world.state(body).q;
-  return WorldFromLocal(Frame<double>(q), LocalPosition<double>(b0, B, q));
+  return WorldFromLocal(Frame<2, double>(q), LocalPosition<double>(b0, B, q));
 }
 
 Eigen::Vector3d LinearWorldPoint(const World& world, int body, const Eigen::VectorXd& u) {
@@ -137,7 +137,7 @@ bool LatticeSource::DrawFfd(vtkPolyData* out) {
   const BodyModel& body = world_->body(Body);
   const VecQ<double>& q = world_->state(Body).q;
   const Lattice& lat = body.lattice();
-  const Frame<double> frame(q);
+  const Frame<2, double> frame(q);
   const int n = lat.size();
 
   // deformed control points: L_ij + Σ γ_d d^d_ij (Eq. 4.2), then into the world
@@ -230,9 +230,9 @@ vtkStandardNewMacro(MassPointSource);
 
 bool MassPointSource::DrawFfd(vtkPolyData* out) {
   const BodyModel& body = world_->body(Body);
-  const BodyState<double>& s = world_->state(Body);
+  const BodyState<2, double>& s = world_->state(Body);
   const WorldParams& params = world_->options().params;
-  const Frame<double> frame(s.q);
+  const Frame<2, double> frame(s.q);
   const int n = body.num_points();
 
   auto points = DoublePoints();
@@ -254,7 +254,7 @@ bool MassPointSource::DrawFfd(vtkPolyData* out) {
   }
   // the ground's force on every point tied to it (Eq. 4.24, 4.25)
   if (params.ground.enabled) {
-    for (const Contact<double>& c : s.contacts) {
+    for (const Contact<2, double>& c : s.contacts) {
       bool slipping;
       f[c.point] += GroundForce(params.ground.Face(c.face), Vec2<double>(x[c.point]), Vec2<double>(v[c.point]), c.anchor,
                                 &slipping);
@@ -347,7 +347,7 @@ std::vector<Eigen::Vector2d> ShapeSource::SampleLatticeCoords() const { return s
 bool ShapeSource::DrawFfd(vtkPolyData* out) {
   UpdateCache();
   const VecQ<double>& q = world_->state(Body).q;
-  const Frame<double> frame(q);
+  const Frame<2, double> frame(q);
   const vtkIdType n = vtkIdType(sample_st_.size());
   auto points = DoublePoints();
   points->SetNumberOfPoints(n);
@@ -565,7 +565,7 @@ int SpringSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
   for (const Spring& sp : world_->options().params.springs) {
     if (sp.body < 0 || sp.body >= world_->num_bodies() || world_->kind(sp.body) != BodyKind::kFfd) continue;
     const VecQ<double>& q = world_->state(sp.body).q;
-    const Eigen::Vector2d x = WorldFromLocal(Frame<double>(q), LocalPosition<double>(sp.rest_local, sp.mode_matrix, q));
+    const Eigen::Vector2d x = WorldFromLocal(Frame<2, double>(q), LocalPosition<double>(sp.rest_local, sp.mode_matrix, q));
     const vtkIdType ids[2] = {points->InsertNextPoint(sp.anchor.x(), sp.anchor.y(), 0.0),
                               points->InsertNextPoint(x.x(), x.y(), 0.0)};
     lines->InsertNextCell(2, ids);
@@ -574,9 +574,9 @@ int SpringSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
   // 3D FFD bodies: every spring of springs_3d acts on every such body (world.h)
   for (int b = 0; b < world_->num_bodies(); ++b) {
     if (world_->kind(b) != BodyKind::kFfd3) continue;
-    const BodyState3<double>& s = world_->state3(b);
-    for (const Spring3& sp : world_->options().springs_3d) {
-      const Eigen::Vector3d x = s.t + s.orientation * LocalPosition3<double>(sp.rest_local, sp.mode_matrix, s.gamma);
+    const BodyState<3, double>& s = world_->state3(b);
+    for (const SpringN<3>& sp : world_->options().springs_3d) {
+      const Eigen::Vector3d x = s.translation() + s.orientation() * LocalPosition<double>(sp.rest_local, sp.mode_matrix, s.q);
       const vtkIdType ids[2] = {points->InsertNextPoint(sp.anchor.data()), points->InsertNextPoint(x.data())};
       lines->InsertNextCell(2, ids);
       stretch->InsertNextValue((x - sp.anchor).norm() - sp.rest_length);

@@ -34,25 +34,25 @@ Ptr<vtkPoints> DoublePoints(vtkIdType n) {
 }  // namespace
 
 Eigen::Vector3d WorldPosition3(const World& world, int body, const Eigen::Vector3d& b0, const Mat3D<double>& B) {
-  const BodyState3<double>& s = world.state3(body);
-  return s.t + s.orientation * (b0 + B * s.gamma);
+  const BodyState<3, double>& s = world.state3(body);
+  return s.translation() + s.orientation() * (b0 + B * s.gamma());
 }
 
 Eigen::AlignedBox3d BodyBounds3(const World& world, int body) {
   const BodyModel3& m = world.body3(body);
-  const BodyState3<double>& s = world.state3(body);
+  const BodyState<3, double>& s = world.state3(body);
   Eigen::AlignedBox3d box;
   for (int c = 0; c < m.lattice().size(); ++c) {
     Eigen::Vector3d l = m.rest_control()[size_t(c)];
-    for (int d = 0; d < m.num_modes(); ++d) l += m.modes()[size_t(d)].displacement[size_t(c)] * s.gamma[d];
-    box.extend(s.t + s.orientation * l);
+    for (int d = 0; d < m.num_modes(); ++d) l += m.modes()[size_t(d)].displacement[size_t(c)] * s.gamma()[d];
+    box.extend(s.translation() + s.orientation() * l);
   }
   return box;
 }
 
 bool LatticeSource::DrawFfd3(vtkPolyData* out) {
   const BodyModel3& body = world_->body3(Body);
-  const BodyState3<double>& s = world_->state3(Body);
+  const BodyState<3, double>& s = world_->state3(Body);
   const Lattice3& lat = body.lattice();
   const int n = lat.size();
   auto points = DoublePoints(n);
@@ -60,9 +60,9 @@ bool LatticeSource::DrawFfd3(vtkPolyData* out) {
   auto disp = Array("displacement", 3, n);
   for (int c = 0; c < n; ++c) {
     Eigen::Vector3d d = Eigen::Vector3d::Zero();  // Σ γ_d d^d_ijk (Eq. 4.2 in 3D), body frame
-    for (int m = 0; m < body.num_modes(); ++m) d += body.modes()[size_t(m)].displacement[size_t(c)] * s.gamma[m];
+    for (int m = 0; m < body.num_modes(); ++m) d += body.modes()[size_t(m)].displacement[size_t(c)] * s.gamma()[m];
     const Eigen::Vector3d& r = body.rest_control()[size_t(c)];
-    const Eigen::Vector3d x = s.t + s.orientation * (r + d);
+    const Eigen::Vector3d x = s.translation() + s.orientation() * (r + d);
     points->SetPoint(c, x.data());
     rest->SetTuple(c, r.data());
     disp->SetTuple(c, d.data());
@@ -94,8 +94,8 @@ bool LatticeSource::DrawFfd3(vtkPolyData* out) {
 
 bool MassPointSource::DrawFfd3(vtkPolyData* out) {
   const BodyModel3& body = world_->body3(Body);
-  const BodyState3<double>& s = world_->state3(Body);
-  const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
+  const BodyState<3, double>& s = world_->state3(Body);
+  const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
   const WorldOptions& o = world_->options();
   const int n = body.num_points();
   const int D = body.num_modes();
@@ -107,25 +107,25 @@ bool MassPointSource::DrawFfd3(vtkPolyData* out) {
   contact->SetName("in_contact");
   contact->SetNumberOfTuples(n);
   contact->FillValue(0);
-  for (const Contact3<double>& c : s.contacts) contact->SetValue(c.point, 1);
+  for (const Contact<3, double>& c : s.contacts) contact->SetValue(c.point, 1);
   auto verts = Ptr<vtkCellArray>::New();
-  const Eigen::Vector3d v_t = s.v.head<3>(), omega = s.v.segment<3>(3);
+  const Eigen::Vector3d v_t = s.qd.head<3>(), omega = s.qd.segment<3>(3);
   const size_t count = size_t(n);
   std::vector<Eigen::Vector3d> x(count), v(count), f(count);
   for (int k = 0; k < n; ++k) {
     const auto B = body.mode_matrix(k);
-    const Eigen::Vector3d l = body.rest_local(k) + B * s.gamma;
-    x[size_t(k)] = s.t + R * l;
+    const Eigen::Vector3d l = body.rest_local(k) + B * s.gamma();
+    x[size_t(k)] = s.translation() + R * l;
     // ẋ = ṫ + R (ω × l + B γ̇): J v of kinematics3.h, body-frame ω
-    v[size_t(k)] = v_t + R * (omega.cross(l) + B * s.v.tail(D));
+    v[size_t(k)] = v_t + R * (omega.cross(l) + B * s.qd.tail(D));
     f[size_t(k)] = o.params.gravity_on ? Eigen::Vector3d(body.mass(k) * o.gravity_3d) : Eigen::Vector3d::Zero();
   }
   // the ground's penalty and capped friction on every point tied to it (§4.9, step3.h)
   if (o.ground_3d.enabled)
-    for (const Contact3<double>& c : s.contacts) {
+    for (const Contact<3, double>& c : s.contacts) {
       bool slipping;
       const size_t k = size_t(c.point);
-      f[k] += GroundForce3<double>(o.ground_3d.Face(c.face, x[k]), x[k], v[k], c.anchor, &slipping);
+      f[k] += GroundForce<double>(o.ground_3d.Face(c.face, x[k]), x[k], v[k], c.anchor, &slipping);
     }
   for (vtkIdType k = 0; k < n; ++k) {
     points->SetPoint(k, x[size_t(k)].data());
@@ -144,8 +144,8 @@ bool MassPointSource::DrawFfd3(vtkPolyData* out) {
 
 bool ShapeSource::DrawFfd3(vtkPolyData* out) {
   const BodyModel3& body = world_->body3(Body);
-  const BodyState3<double>& s = world_->state3(Body);
-  const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
+  const BodyState<3, double>& s = world_->state3(Body);
+  const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
   const SurfaceMesh& mesh = body.def().mesh;
   auto points = Ptr<vtkPoints>::New();
   points->SetDataTypeToDouble();
@@ -153,8 +153,8 @@ bool ShapeSource::DrawFfd3(vtkPolyData* out) {
   disp->SetName("displacement");
   disp->SetNumberOfComponents(3);
   auto add = [&](const Eigen::Vector3d& b0, const Eigen::Ref<const Mat3D<double>>& B) {
-    const Eigen::Vector3d d = B * s.gamma;
-    const Eigen::Vector3d x = s.t + R * (b0 + d);
+    const Eigen::Vector3d d = B * s.gamma();
+    const Eigen::Vector3d x = s.translation() + R * (b0 + d);
     disp->InsertNextTuple(d.data());
     return points->InsertNextPoint(x.data());
   };

@@ -17,7 +17,7 @@
 
 #include "support/test_bodies.h"
 #include "wobble/core/rotation3.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 #include "wobble/fit/adjoint3.h"
 
 namespace wobble {
@@ -36,31 +36,33 @@ BodyModel3 PassiveChair() {
 
 // ℓ_n = ½ w |x_k − y(n)|² + ½ ρ |v|² + ½ σ |γ|²: a point chasing a moving target, a velocity
 // penalty and a shape penalty. Templated so that the reference can run it on Jets.
-template <class T> T Stage(const BodyModel3& body, int n, const BodyState3<T>& s) {
-  const Vec3<T> l = LocalPosition3<T>(body.rest_local(kPoint), body.mode_matrix(kPoint), s.gamma);
-  const Vec3<T> x = s.t + s.orientation.toRotationMatrix() * l;
+template <class T> T Stage(const BodyModel3& body, int n, const BodyState<3, T>& s) {
+  const Vec3<T> l = LocalPosition<T>(body.rest_local(kPoint), body.mode_matrix(kPoint), s.q);
+  const Vec3<T> x = s.translation() + s.orientation().toRotationMatrix() * l;
   const Eigen::Vector3d y(20.0 + 2.0 * n, 60.0 - 0.5 * n, 10.0 + 1.0 * n);
   T cost = T(0.5e-2) * (x - y.cast<T>()).squaredNorm();
-  for (int i = 0; i < s.v.size(); ++i) cost += T(0.5e-3) * s.v[i] * s.v[i];
-  for (int d = 0; d < s.gamma.size(); ++d) cost += T(0.5) * s.gamma[d] * s.gamma[d];
+  for (int i = 0; i < s.qd.size(); ++i) cost += T(0.5e-3) * s.qd[i] * s.qd[i];
+  for (int d = 0; d < s.gamma().size(); ++d) cost += T(0.5) * s.gamma()[d] * s.gamma()[d];
   return cost;
 }
 
 // The stage cost's gradient in the tangent coordinates (δt, ε, δγ, δv) of adjoint3.h, by Jets.
 fit::StageCost3 StageOf(const BodyModel3& body) {
-  return [&body](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) {
+  return [&body](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     using J = ceres::Jet<double, kNz>;
-    BodyState3<J> sj;
+    BodyState<3, J> sj;
+    sj.q.resize(s.q.size());
+    sj.qd.resize(s.qd.size());
     Vec3<J> eps;
     for (int i = 0; i < 3; ++i) {
-      sj.t[i] = J(s.t[i], i);
+      sj.translation()[i] = J(s.translation()[i], i);
       eps[i] = J(0.0, 3 + i);
     }
-    sj.orientation = s.orientation.cast<J>() * ExpRotation<J>(eps);
-    sj.gamma.resize(kModes);
-    for (int d = 0; d < kModes; ++d) sj.gamma[d] = J(s.gamma[d], 6 + d);
-    sj.v.resize(6 + kModes);
-    for (int i = 0; i < 6 + kModes; ++i) sj.v[i] = J(s.v[i], 6 + kModes + i);
+    sj.set_orientation(s.orientation().cast<J>() * ExpRotation<J>(eps));
+    sj.gamma().resize(kModes);
+    for (int d = 0; d < kModes; ++d) sj.gamma()[d] = J(s.gamma()[d], 6 + d);
+    sj.qd.resize(6 + kModes);
+    for (int i = 0; i < 6 + kModes; ++i) sj.qd[i] = J(s.qd[i], 6 + kModes + i);
     const J c = Stage(body, n, sj);
     *dz += c.v;
     return c.a;
@@ -72,9 +74,9 @@ template <class T> struct PdForce3 {
   const std::vector<T>* K;
   const std::vector<T>* c;
   const std::vector<T>* target;
-  void operator()(const BodyState3<T>& s, VecQ3<T>* Q) const {
+  void operator()(const BodyState<3, T>& s, VecQ<T>* Q) const {
     for (int d = 0; d < kModes; ++d)
-      (*Q)[6 + d] += -T(2.0) * (*K)[d] * (s.gamma[d] - (*target)[d]) - (*c)[d] * s.v[6 + d];
+      (*Q)[6 + d] += -T(2.0) * (*K)[d] * (s.gamma()[d] - (*target)[d]) - (*c)[d] * s.qd[6 + d];
   }
 };
 
@@ -103,27 +105,29 @@ T ReferenceCost(const BodyModel3& passive, const fit::ControlledRollout3& r, con
     if constexpr (!std::is_same_v<T, double>) x.v[0] = v[i];
     return x;
   };
-  BodyState3<T> s;
+  BodyState<3, T> s;
+  s.q.resize(r.start.q.size());
+  s.qd.resize(r.start.qd.size());
   Vec3<T> eps;
   for (int i = 0; i < 3; ++i) {
-    s.t[i] = T(r.start.t[i]) + param(i);
+    s.translation()[i] = T(r.start.translation()[i]) + param(i);
     eps[i] = param(3 + i);
   }
-  s.orientation = r.start.orientation.normalized().cast<T>() * ExpRotation<T>(eps);
-  s.gamma.resize(kModes);
-  for (int d = 0; d < kModes; ++d) s.gamma[d] = T(r.start.gamma[d]) + param(6 + d);
-  s.v.resize(6 + kModes);
-  for (int i = 0; i < 6 + kModes; ++i) s.v[i] = T(r.start.v[i]) + param(6 + kModes + i);
+  s.set_orientation(r.start.orientation().normalized().cast<T>() * ExpRotation<T>(eps));
+  s.gamma().resize(kModes);
+  for (int d = 0; d < kModes; ++d) s.gamma()[d] = T(r.start.gamma()[d]) + param(6 + d);
+  s.qd.resize(6 + kModes);
+  for (int i = 0; i < 6 + kModes; ++i) s.qd[i] = T(r.start.qd[i]) + param(6 + kModes + i);
   std::vector<T> K(kModes), c(kModes), target(kModes);
   for (int d = 0; d < kModes; ++d) {
     K[d] = param(kNz + d);
     c[d] = param(kNz + kModes + d);
   }
-  UpdateContacts3(passive, r.world.ground, &s);
+  UpdateContacts(passive, r.world.ground, &s);
   T total = Stage(passive, 0, s);
   for (int n = 0; n < r.steps(); ++n) {
     for (int d = 0; d < kModes; ++d) target[d] = param(kNz + 2 * kModes + kModes * n + d);
-    EXPECT_TRUE(StepBody3(passive, r.world, r.integrator, r.dt, &s, PdForce3<T>{&K, &c, &target}).ok());
+    EXPECT_TRUE(StepBody(passive, r.world, 0, r.integrator, r.dt, &s, PdForce3<T>{&K, &c, &target}).ok());
     total += Stage(passive, n + 1, s);
   }
   return total;
@@ -152,14 +156,14 @@ Case MakeCase(Integrator integrator, bool grounded, int steps, unsigned seed) {
     r.world.ground.friction_damping = 100;
     r.world.ground.friction_cap = 0.3;
   }
-  BodyState3<double>& s = r.start;
-  s = RestState3<double>(k.passive);
-  s.t = Eigen::Vector3d(10 * u(rng), grounded ? 25.0 : 200.0, 10 * u(rng));
-  s.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3 + 0.1 * u(rng), Eigen::Vector3d(1, 0.2 * u(rng), 1).normalized()));
-  for (int d = 0; d < kModes; ++d) s.gamma[d] = 0.05 * u(rng);
-  s.v.head<3>() = grounded ? Eigen::Vector3d(60, -120, 25) : Eigen::Vector3d(20 * u(rng), 20 * u(rng), 20 * u(rng));
-  s.v.segment<3>(3) = Eigen::Vector3d(0.3 * u(rng), 0.5 * u(rng), 0.3 * u(rng));
-  for (int d = 0; d < kModes; ++d) s.v[6 + d] = 0.2 * u(rng);
+  BodyState<3, double>& s = r.start;
+  s = RestState<3, double>(k.passive);
+  s.translation() = Eigen::Vector3d(10 * u(rng), grounded ? 25.0 : 200.0, 10 * u(rng));
+  s.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(0.3 + 0.1 * u(rng), Eigen::Vector3d(1, 0.2 * u(rng), 1).normalized())));
+  for (int d = 0; d < kModes; ++d) s.gamma()[d] = 0.05 * u(rng);
+  s.qd.head<3>() = grounded ? Eigen::Vector3d(60, -120, 25) : Eigen::Vector3d(20 * u(rng), 20 * u(rng), 20 * u(rng));
+  s.qd.segment<3>(3) = Eigen::Vector3d(0.3 * u(rng), 0.5 * u(rng), 0.3 * u(rng));
+  for (int d = 0; d < kModes; ++d) s.qd[6 + d] = 0.2 * u(rng);
   r.stiffness.resize(kModes);
   r.damping.resize(kModes);
   for (int d = 0; d < kModes; ++d) {
@@ -173,12 +177,12 @@ Case MakeCase(Integrator integrator, bool grounded, int steps, unsigned seed) {
 // Contact onsets, ends and slips along the plain run (proof that a grounded case went through
 // the branches it is meant to test), and the faces touched.
 void ContactEvents(const Case& k, int* onsets, int* ends, int* slips, std::set<int>* faces) {
-  BodyState3<double> s = k.rollout.start;
-  UpdateContacts3(k.passive, k.rollout.world.ground, &s);
+  BodyState<3, double> s = k.rollout.start;
+  UpdateContacts(k.passive, k.rollout.world.ground, &s);
   *onsets = *ends = *slips = 0;
   std::vector<double> K(k.rollout.stiffness.data(), k.rollout.stiffness.data() + kModes);
   std::vector<double> c(k.rollout.damping.data(), k.rollout.damping.data() + kModes);
-  auto find = [](const std::vector<Contact3<double>>& set, const Contact3<double>& x) -> const Contact3<double>* {
+  auto find = [](const std::vector<Contact<3, double>>& set, const Contact<3, double>& x) -> const Contact<3, double>* {
     for (const auto& y : set)
       if (y.point == x.point && y.face == x.face) return &y;
     return nullptr;
@@ -186,11 +190,11 @@ void ContactEvents(const Case& k, int* onsets, int* ends, int* slips, std::set<i
   for (int n = 0; n < k.rollout.steps(); ++n) {
     std::vector<double> target(k.rollout.targets.col(n).data(), k.rollout.targets.col(n).data() + kModes);
     const auto before = s.contacts;
-    ASSERT_TRUE(StepBody3(k.passive, k.rollout.world, k.rollout.integrator, k.rollout.dt, &s,
+    ASSERT_TRUE(StepBody(k.passive, k.rollout.world, 0, k.rollout.integrator, k.rollout.dt, &s,
                           PdForce3<double>{&K, &c, &target}).ok());
     for (const auto& x : s.contacts) {
       faces->insert(x.face);
-      const Contact3<double>* was = find(before, x);
+      const Contact<3, double>* was = find(before, x);
       *onsets += !was;
       *slips += was && was->anchor != x.anchor;
     }
@@ -258,7 +262,7 @@ TEST(Adjoint3, MatchesJetsInAHeightfieldValleyWithASpring) {
     for (int j = 0; j < nz; ++j)
       for (int i = 0; i < nx; ++i) heights.push_back(0.25 * std::abs(-200.0 + 20.0 * i - 50.0));
     k.rollout.world.ground.heightfield = Heightfield::Make({-200, -200}, {20, 20}, nx, nz, heights);
-    k.rollout.world.springs.push_back(MakeSpring3(k.passive, Eigen::Vector3d(0.1, 0.9, 0.5), Eigen::Vector3d(0, 150, 0), 50.0, 5.0, 80.0));
+    k.rollout.world.springs.push_back(MakeSpring(k.passive, Eigen::Vector3d(0.1, 0.9, 0.5), Eigen::Vector3d(0, 150, 0), 50.0, 5.0, 80.0));
     int onsets = 0, ends = 0, slips = 0;
     std::set<int> faces;
     ContactEvents(k, &onsets, &ends, &slips, &faces);
@@ -325,9 +329,9 @@ TEST(Adjoint3, RefusesBadInputWithAMessage) {
   refused([](fit::ControlledRollout3* r) { r->dt = 0.0; }, "dt must be positive");
   refused([](fit::ControlledRollout3* r) { r->stiffness.resize(2); }, "one value per mode");
   refused([](fit::ControlledRollout3* r) { r->targets.resize(2, 5); }, "one row per mode");
-  refused([](fit::ControlledRollout3* r) { r->start.v[2] = std::nan(""); }, "finite");
-  refused([](fit::ControlledRollout3* r) { r->start.orientation.coeffs().setZero(); }, "must not be zero");
-  refused([](fit::ControlledRollout3* r) { r->start.gamma.resize(1); }, "mode amplitudes");
+  refused([](fit::ControlledRollout3* r) { r->start.qd[2] = std::nan(""); }, "finite");
+  refused([](fit::ControlledRollout3* r) { r->start.q.segment<4>(3).setZero(); }, "must not be zero");
+  refused([](fit::ControlledRollout3* r) { r->start.q.conservativeResize(Group<3>::kRigidParams + 1); }, "mode amplitudes");
 }
 
 }  // namespace

@@ -31,7 +31,7 @@ constexpr int kPoint = 1;           // the cost follows this mass point (the top
 // ℓ_n = ½ w |x_k(q_n) − y(n)|² + ½ ρ |q̇_n|²: a point chasing a moving target, and a velocity
 // penalty. Templated so that the reference can run it on Jets.
 template <class T> T Stage(const BodyModel& body, int n, const VecQ<T>& q, const VecQ<T>& qd) {
-  const Frame<T> frame(q);
+  const Frame<2, T> frame(q);
   const Vec2<T> x = WorldFromLocal(frame, LocalPosition<T>(body.rest_local(kPoint), body.mode_matrix(kPoint), q));
   const Eigen::Vector2d y(100.0 + 2.0 * n, 80.0 - 0.5 * n);
   T cost = T(0.5e-2) * (x - y.cast<T>()).squaredNorm();
@@ -60,7 +60,7 @@ template <class T> struct PdForce {
   const std::vector<T>* K;
   const std::vector<T>* c;
   const std::vector<T>* target;
-  void operator()(const BodyState<T>& s, VecQ<T>* Q) const {
+  void operator()(const BodyState<2, T>& s, VecQ<T>* Q) const {
     for (int d = 0; d < kModes; ++d)
       (*Q)[3 + d] += -T(2.0) * (*K)[d] * (s.q[3 + d] - (*target)[d]) - (*c)[d] * s.qd[3 + d];
   }
@@ -84,7 +84,7 @@ Eigen::VectorXd Flatten(const fit::RolloutGradient& g) {
 template <class T, class Targets>
 T ReferenceCostOf(const BodyModel& passive, const fit::ControlledRollout& r, const std::vector<T>& start,
                   const std::vector<T>& K, const std::vector<T>& c, const Targets& target_of) {
-  BodyState<T> s;
+  BodyState<2, T> s;
   s.q.resize(kNq);
   s.qd.resize(kNq);
   for (int i = 0; i < kNq; ++i) {
@@ -174,7 +174,7 @@ Eigen::VectorXd Direction(const Eigen::VectorXd& p, std::mt19937& rng) {
 // Contact onsets, ends and slips (a kept contact whose anchor moved: the friction cap was hit)
 // along the plain run: proof that a grounded case went through the branches it is meant to test.
 void ContactEvents(const Case& k, int* onsets, int* ends, int* slips, std::set<int>* faces = nullptr) {
-  BodyState<double> s;
+  BodyState<2, double> s;
   s.q = k.rollout.q0;
   s.qd = k.rollout.qd0;
   UpdateContacts(k.passive, k.rollout.world.ground, &s);
@@ -186,14 +186,14 @@ void ContactEvents(const Case& k, int* onsets, int* ends, int* slips, std::set<i
     const auto before = s.contacts;
     ASSERT_TRUE(StepBody(k.passive, k.rollout.world, 0, k.rollout.integrator, k.rollout.dt, &s,
                          PdForce<double>{&K, &c, &target}).ok());
-    auto find = [](const std::vector<Contact<double>>& set, int point) -> const Contact<double>* {
+    auto find = [](const std::vector<Contact<2, double>>& set, int point) -> const Contact<2, double>* {
       for (const auto& x : set)
         if (x.point == point) return &x;
       return nullptr;
     };
     for (const auto& x : s.contacts) {
       if (faces) faces->insert(x.face);
-      const Contact<double>* was = find(before, x.point);
+      const Contact<2, double>* was = find(before, x.point);
       *onsets += !was;
       *slips += was && was->anchor != x.anchor;
     }

@@ -12,7 +12,7 @@
 
 #include "support/test_bodies.h"
 #include "wobble/dynamics/step.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
 #include "wobble/body/linear_body.h"
@@ -60,13 +60,13 @@ BodyModel3 RandomBody3(std::mt19937& rng, std::array<int, 3> sizes, BasisKind ba
   return BodyModel3(def, modes);
 }
 
-BodyState3<double> RandomState3(std::mt19937& rng, const BodyModel3& body, double speed = 1.0) {
+BodyState<3, double> RandomState3(std::mt19937& rng, const BodyModel3& body, double speed = 1.0) {
   std::normal_distribution<double> n(0.0, 1.0);
-  BodyState3<double> s = RestState3<double>(body);
-  s.t = Vector3d(n(rng), n(rng), n(rng)) * 50.0;
-  s.orientation = Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized();
-  for (int d = 0; d < body.num_modes(); ++d) s.gamma[d] = 0.3 * n(rng);
-  for (int i = 0; i < body.num_q(); ++i) s.v[i] = speed * n(rng) * (i < 3 ? 30.0 : 1.0);
+  BodyState<3, double> s = RestState<3, double>(body);
+  s.translation() = Vector3d(n(rng), n(rng), n(rng)) * 50.0;
+  s.set_orientation(Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized());
+  for (int d = 0; d < body.num_modes(); ++d) s.gamma()[d] = 0.3 * n(rng);
+  for (int i = 0; i < body.num_q(); ++i) s.qd[i] = speed * n(rng) * (i < 3 ? 30.0 : 1.0);
   return s;
 }
 
@@ -93,7 +93,7 @@ PointKinematics DirectPoint(const BodyModel3& body, int k, const VecD<double>& g
 
 // J_k = [1 | −R[l]× | R B] of kinematics3.h, from its definition ẋ = ṫ + R(ω × l + B γ̇).
 Eigen::MatrixXd Jacobian(const Matrix3d& R, const PointKinematics& p) {
-  Eigen::MatrixXd J(3, kRigidDofs3 + p.B.cols());
+  Eigen::MatrixXd J(3, Group<3>::kRigidDofs + p.B.cols());
   J.block<3, 3>(0, 0).setIdentity();
   for (int i = 0; i < 3; ++i) J.col(3 + i) = R * Vector3d::Unit(i).cross(p.l);
   J.rightCols(p.B.cols()) = R * p.B;
@@ -111,23 +111,23 @@ TEST(Body3, FastPathMatchesSumsOverThePoints) {
                         Case{{3, 5, 2}, BasisKind::kBernstein, 5}, Case{{5, 4, 6}, BasisKind::kCubicBSpline, 4}}) {
     const BodyModel3 body = RandomBody3(rng, c.sizes, c.basis, c.modes, 25);
     for (int trial = 0; trial < 5; ++trial) {
-      const BodyState3<double> s = RandomState3(rng, body);
-      const Matrix3d R = s.orientation.toRotationMatrix();
+      const BodyState<3, double> s = RandomState3(rng, body);
+      const Matrix3d R = s.orientation().toRotationMatrix();
       const int n = body.num_q();
       const Vector3d g(0.3, -9.81, 1.2);
       Eigen::MatrixXd M_ref = Eigen::MatrixXd::Zero(n, n);
       Eigen::VectorXd w_ref = Eigen::VectorXd::Zero(n), Q_ref = Eigen::VectorXd::Zero(n);
       double T_ref = 0.0;
       Vector3d P_ref = Vector3d::Zero(), L_ref = Vector3d::Zero();
-      const Vector3d omega = s.v.segment<3>(3);
+      const Vector3d omega = s.qd.segment<3>(3);
       for (int k = 0; k < body.num_points(); ++k) {
-        const PointKinematics p = DirectPoint(body, k, s.gamma);
+        const PointKinematics p = DirectPoint(body, k, s.gamma());
         const Eigen::MatrixXd J = Jacobian(R, p);
         const double m = body.mass(k);
-        const Vector3d Bgd = p.B * s.v.tail(body.num_modes());
+        const Vector3d Bgd = p.B * s.qd.tail(body.num_modes());
         // centripetal and Coriolis acceleration of the point, J̇ v = R(ω×(ω×l) + 2ω×Bγ̇)
         const Vector3d Jdot_v = R * (omega.cross(omega.cross(p.l)) + 2.0 * omega.cross(Bgd));
-        const Vector3d x = s.t + R * p.l, xdot = J * Eigen::VectorXd(s.v);
+        const Vector3d x = s.translation() + R * p.l, xdot = J * Eigen::VectorXd(s.qd);
         M_ref += m * J.transpose() * J;
         w_ref += m * J.transpose() * Jdot_v;
         Q_ref += m * J.transpose() * g;
@@ -135,18 +135,18 @@ TEST(Body3, FastPathMatchesSumsOverThePoints) {
         P_ref += m * xdot;
         L_ref += m * x.cross(xdot);
       }
-      const ShapeMoments3<double> sm(body.moments(), s.gamma);
-      MatQ3<double> M;
-      MassMatrix3(body.moments(), sm, R, &M);
-      VecQ3<double> w, Q;
-      VelocityTerms3(body.moments(), sm, R, s.v, &w);
-      GravityForce3(body.moments(), sm, R, g, &Q);
+      const ShapeMoments<double> sm(body.moments(), s.gamma());
+      MatQ<double> M;
+      MassMatrix(body.moments(), sm, R, &M);
+      VecQ<double> w, Q;
+      VelocityTerms(body.moments(), sm, R, s.qd, &w);
+      GravityForce(body.moments(), sm, R, g, &Q);
       Vector3d P, L;
-      Momentum3(body.moments(), sm, Frame3<double>(s.t, s.orientation), s.v, &P, &L);
+      Momentum(body.moments(), sm, Frame<3, double>(s.q), s.qd, &P, &L);
       EXPECT_LE(MaxAbs(Eigen::MatrixXd(M) - M_ref), 1e-9 * MaxAbs(M_ref));
       EXPECT_LE(MaxAbs(Eigen::VectorXd(w) - w_ref), 1e-9 * MaxAbs(w_ref));
       EXPECT_LE(MaxAbs(Eigen::VectorXd(Q) - Q_ref), 1e-9 * MaxAbs(Q_ref));
-      EXPECT_NEAR(KineticEnergy3(body.moments(), sm, R, s.v), T_ref, 1e-9 * T_ref);
+      EXPECT_NEAR(KineticEnergy(body.moments(), sm, R, s.qd), T_ref, 1e-9 * T_ref);
       EXPECT_LE((P - P_ref).norm(), 1e-9 * P_ref.norm());
       EXPECT_LE((L - L_ref).norm(), 1e-9 * L_ref.norm());
     }
@@ -158,19 +158,19 @@ TEST(Body3, FastPathMatchesSumsOverThePoints) {
 TEST(Body3, PointAccelerationFormulaMatchesFiniteDifference) {
   std::mt19937 rng(11);
   const BodyModel3 body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 3, 4);
-  const BodyState3<double> s = RandomState3(rng, body);
+  const BodyState<3, double> s = RandomState3(rng, body);
   auto velocity = [&](double eps, int k) {
-    BodyState3<double> moved = s;
-    AdvanceConfiguration3<double>(s.v, eps, &moved);
-    const PointKinematics p = DirectPoint(body, k, moved.gamma);
-    return Vector3d(Jacobian(moved.orientation.toRotationMatrix(), p) * Eigen::VectorXd(s.v));
+    BodyState<3, double> moved = s;
+    Group<3>::Advance(s.qd, eps, &moved.q);
+    const PointKinematics p = DirectPoint(body, k, moved.gamma());
+    return Vector3d(Jacobian(moved.orientation().toRotationMatrix(), p) * Eigen::VectorXd(s.qd));
   };
   const double eps = 1e-5;
-  const Matrix3d R = s.orientation.toRotationMatrix();
-  const Vector3d omega = s.v.segment<3>(3);
+  const Matrix3d R = s.orientation().toRotationMatrix();
+  const Vector3d omega = s.qd.segment<3>(3);
   for (int k = 0; k < body.num_points(); ++k) {
-    const PointKinematics p = DirectPoint(body, k, s.gamma);
-    const Vector3d formula = R * (omega.cross(omega.cross(p.l)) + 2.0 * omega.cross(p.B * s.v.tail(3)));
+    const PointKinematics p = DirectPoint(body, k, s.gamma());
+    const Vector3d formula = R * (omega.cross(omega.cross(p.l)) + 2.0 * omega.cross(p.B * s.qd.tail(3)));
     const Vector3d numeric = (velocity(eps, k) - velocity(-eps, k)) / (2 * eps);
     EXPECT_LE((formula - numeric).norm(), 1e-7 * formula.norm());
   }
@@ -180,28 +180,28 @@ TEST(Body3, PointAccelerationFormulaMatchesFiniteDifference) {
 TEST(Body3, KineticGradientMatchesFiniteDifference) {
   std::mt19937 rng(5);
   const BodyModel3 body = RandomBody3(rng, {4, 3, 3}, BasisKind::kBernstein, 4, 20);
-  const BodyState3<double> s = RandomState3(rng, body);
+  const BodyState<3, double> s = RandomState3(rng, body);
   auto energy = [&](const Eigen::Quaterniond& q, const VecD<double>& gamma) {
-    const ShapeMoments3<double> sm(body.moments(), gamma);
-    return KineticEnergy3(body.moments(), sm, Matrix3d(q.toRotationMatrix()), s.v);
+    const ShapeMoments<double> sm(body.moments(), gamma);
+    return KineticEnergy(body.moments(), sm, Matrix3d(q.toRotationMatrix()), s.qd);
   };
-  const ShapeMoments3<double> sm(body.moments(), s.gamma);
-  VecQ3<double> grad;
-  KineticGradient3(body.moments(), sm, Matrix3d(s.orientation.toRotationMatrix()), s.v, &grad);
+  const ShapeMoments<double> sm(body.moments(), s.gamma());
+  VecQ<double> grad;
+  KineticGradient(body.moments(), sm, Matrix3d(s.orientation().toRotationMatrix()), s.qd, &grad);
   const double h = 1e-6;
   for (int i = 0; i < 3; ++i) {
     const Vector3d e = Vector3d::Unit(i) * h;
-    const double numeric = (energy(s.orientation * ExpRotation<double>(e), s.gamma) -
-                            energy(s.orientation * ExpRotation<double>(Vector3d(-e)), s.gamma)) / (2 * h);
+    const double numeric = (energy(s.orientation() * ExpRotation<double>(e), s.gamma()) -
+                            energy(s.orientation() * ExpRotation<double>(Vector3d(-e)), s.gamma())) / (2 * h);
     EXPECT_NEAR(grad[3 + i], numeric, 1e-6 * (1.0 + std::abs(numeric))) << "rotation " << i;
     EXPECT_EQ(grad[i], 0.0);
   }
   for (int d = 0; d < body.num_modes(); ++d) {
-    VecD<double> up = s.gamma, down = s.gamma;
+    VecD<double> up = s.gamma(), down = s.gamma();
     up[d] += h;
     down[d] -= h;
-    const double numeric = (energy(s.orientation, up) - energy(s.orientation, down)) / (2 * h);
-    EXPECT_NEAR(grad[kRigidDofs3 + d], numeric, 1e-6 * (1.0 + std::abs(numeric))) << "mode " << d;
+    const double numeric = (energy(s.orientation(), up) - energy(s.orientation(), down)) / (2 * h);
+    EXPECT_NEAR(grad[Group<3>::kRigidDofs + d], numeric, 1e-6 * (1.0 + std::abs(numeric))) << "mode " << d;
   }
 }
 
@@ -247,32 +247,32 @@ TEST(Body3, PlanarMotionReproducesThe2DBody) {
       WorldParams w2;
       w2.ground.enabled = ground;
       w2.ground.point = Eigen::Vector2d(0, -10);
-      WorldParams3 w3;
+      WorldParamsN<3> w3;
       w3.ground.enabled = ground;
       w3.ground.point = Vector3d(0, -10, 0);
-      BodyState<double> s2;
+      BodyState<2, double> s2;
       s2.q.setZero(flat.num_q());
       s2.qd.setZero(flat.num_q());
       s2.q << 10, 20, 0.4, 0.2, -0.1, 0.05;
       s2.qd << 30, -40, 1.5, 0.5, 0.0, -0.3;
-      BodyState3<double> s3 = RestState3<double>(body);
-      s3.t = Vector3d(10, 20, 0);
-      s3.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Vector3d::UnitZ()));
-      s3.gamma << 0.2, -0.1, 0.05;
-      s3.v << 30, -40, 0, 0, 0, 1.5, 0.5, 0.0, -0.3;
+      BodyState<3, double> s3 = RestState<3, double>(body);
+      s3.translation() = Vector3d(10, 20, 0);
+      s3.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Vector3d::UnitZ())));
+      s3.gamma() << 0.2, -0.1, 0.05;
+      s3.qd << 30, -40, 0, 0, 0, 1.5, 0.5, 0.0, -0.3;
       const double dt = 1e-3;
       double worst = 0.0;
       int contacts_seen = 0;
       for (int step = 0; step < 3000; ++step) {
         ASSERT_TRUE(StepBody(flat, w2, 0, integrator, dt, &s2).ok());
-        ASSERT_TRUE(StepBody3(body, w3, integrator, dt, &s3).ok());
+        ASSERT_TRUE(StepBody(body, w3, 0, integrator, dt, &s3).ok());
         ASSERT_EQ(s2.contacts.size(), s3.contacts.size()) << "step " << step;
         contacts_seen += int(s3.contacts.size());
-        const Frame<double> f2(s2.q);
-        const Frame3<double> f3(s3.t, s3.orientation);
+        const Frame<2, double> f2(s2.q);
+        const Frame<3, double> f3(s3.q);
         for (int k = 0; k < flat.num_points(); ++k) {
           const Eigen::Vector2d x2 = WorldFromLocal(f2, LocalPosition<double>(flat.rest_local(k), flat.mode_matrix(k), s2.q));
-          const Vector3d x3 = f3.t + f3.R * LocalPosition3<double>(body.rest_local(k), body.mode_matrix(k), s3.gamma);
+          const Vector3d x3 = f3.t + f3.R * LocalPosition<double>(body.rest_local(k), body.mode_matrix(k), s3.q);
           worst = std::max(worst, (Vector3d(x2.x(), x2.y(), 0.0) - x3).norm());
         }
       }
@@ -299,15 +299,14 @@ TEST(Body3, PointGroupsFindExactlyThePointsBelowTheGround) {
   std::normal_distribution<double> n(0.0, 1.0);
   int found = 0;
   for (int trial = 0; trial < 20; ++trial) {
-    BodyState3<double> s = RandomState3(rng, body);
-    s.t = Vector3d(n(rng), n(rng), n(rng)) * 60.0;
-    const Frame3<double> frame(s.t, s.orientation);
+    BodyState<3, double> s = RandomState3(rng, body);
+    s.translation() = Vector3d(n(rng), n(rng), n(rng)) * 60.0;
+    const Frame<3, double> frame(s.q);
     std::vector<int> visited, below;
-    ForEachPointInContact3(body, g, s, frame, [&](int k, int, const GroundPlane&, const Vector3d&, const Vector3d&,
-                                                  const Vector3d&, const Vector3d&) { visited.push_back(k); },
+    ForEachPointInContact(body, g, s, frame, [&](int k, const Vector3d&, const Vector3d&, const Vector3d&, const Vector3d&, const GroundPlane&, int) { visited.push_back(k); },
                            ContactSet::kDetect);
     for (int k = 0; k < body.num_points(); ++k) {
-      const PointKinematics p = DirectPoint(body, k, s.gamma);
+      const PointKinematics p = DirectPoint(body, k, s.gamma());
       if (g.Height(Vector3d(frame.t + frame.R * p.l)) < 0.0) below.push_back(k);
     }
     std::sort(visited.begin(), visited.end());
@@ -318,40 +317,40 @@ TEST(Body3, PointGroupsFindExactlyThePointsBelowTheGround) {
 }
 
 // Spinning about its centre of mass (ṫ chosen so the centre stays put), no gravity.
-BodyState3<double> Spinning(const BodyModel3& body, const Vector3d& omega) {
-  BodyState3<double> s = RestState3<double>(body);
-  s.v.segment<3>(3) = omega;
+BodyState<3, double> Spinning(const BodyModel3& body, const Vector3d& omega) {
+  BodyState<3, double> s = RestState<3, double>(body);
+  s.qd.segment<3>(3) = omega;
   const Vector3d com_local = body.moments().c0 / body.moments().m;
-  s.v.head<3>() = -(omega.cross(com_local));  // ẋ_com = ṫ + R(ω × c/m) = 0
+  s.qd.head<3>() = -(omega.cross(com_local));  // ẋ_com = ṫ + R(ω × c/m) = 0
   return s;
 }
 
-double TotalEnergy(const BodyModel3& body, const BodyState3<double>& s) {
-  const ShapeMoments3<double> sm(body.moments(), s.gamma);
+double TotalEnergy(const BodyModel3& body, const BodyState<3, double>& s) {
+  const ShapeMoments<double> sm(body.moments(), s.gamma());
   double V = 0.0;
-  for (int d = 0; d < body.num_modes(); ++d) V += body.modes()[d].stiffness * s.gamma[d] * s.gamma[d];
-  return KineticEnergy3(body.moments(), sm, Matrix3d(s.orientation.toRotationMatrix()), s.v) + V;
+  for (int d = 0; d < body.num_modes(); ++d) V += body.modes()[d].stiffness * s.gamma()[d] * s.gamma()[d];
+  return KineticEnergy(body.moments(), sm, Matrix3d(s.orientation().toRotationMatrix()), s.qd) + V;
 }
 
-Vector3d AngularMomentum(const BodyModel3& body, const BodyState3<double>& s, Vector3d* linear = nullptr) {
-  const ShapeMoments3<double> sm(body.moments(), s.gamma);
+Vector3d AngularMomentum(const BodyModel3& body, const BodyState<3, double>& s, Vector3d* linear = nullptr) {
+  const ShapeMoments<double> sm(body.moments(), s.gamma());
   Vector3d P, L;
-  Momentum3(body.moments(), sm, Frame3<double>(s.t, s.orientation), s.v, &P, &L);
+  Momentum(body.moments(), sm, Frame<3, double>(s.q), s.qd, &P, &L);
   if (linear) *linear = P;
   return L;
 }
 
 TEST(Body3, TorqueFreeTumblingKeepsEnergyAndMomentumOver1e5Steps) {
   const BodyModel3 body = Box(1.0, 2.0, 3.0);
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.gravity_on = false;
-  BodyState3<double> s = Spinning(body, Vector3d(0.8, 1.5, -0.6));
+  BodyState<3, double> s = Spinning(body, Vector3d(0.8, 1.5, -0.6));
   const double E0 = TotalEnergy(body, s);
   const Vector3d L0 = AngularMomentum(body, s);
   double worst_energy = 0.0, worst_momentum = 0.0, energy_at_half = 0.0;
   const int steps = 100000;
   for (int step = 1; step <= steps; ++step) {
-    ASSERT_TRUE(StepBody3(body, w, Integrator::kVariational, 0.01, &s).ok());
+    ASSERT_TRUE(StepBody(body, w, 0, Integrator::kVariational, 0.01, &s).ok());
     const double dE = std::abs(TotalEnergy(body, s) - E0) / E0;
     worst_energy = std::max(worst_energy, dE);
     worst_momentum = std::max(worst_momentum, (AngularMomentum(body, s) - L0).norm() / L0.norm());
@@ -384,12 +383,12 @@ TEST(Body3, IntermediateAxisFlipPeriodMatchesTheEllipticIntegral) {
   // principal moments about the centre, from the eight corners (±a/2, ±b/2, ±c/2)
   const double I1 = 8 * m * (b * b + c * c) / 4, I2 = 8 * m * (a * a + c * c) / 4, I3 = 8 * m * (a * a + b * b) / 4;
   ASSERT_TRUE(I3 < I2 && I2 < I1);  // the box's axes in increasing inertia: z, y, x
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.gravity_on = false;
   for (Integrator integrator : {Integrator::kRK4, Integrator::kVariational}) {
     // spin about y (intermediate) with a small push about x and z
-    BodyState3<double> s = Spinning(body, Vector3d(0.02, 2.0, 0.03));
-    const Vector3d w0 = s.v.segment<3>(3);
+    BodyState<3, double> s = Spinning(body, Vector3d(0.02, 2.0, 0.03));
+    const Vector3d w0 = s.qd.segment<3>(3);
     // in the notation above: smallest inertia first
     const double J1 = I3, J2 = I2, J3 = I1;
     const Vector3d wj(w0.z(), w0.y(), w0.x());
@@ -407,10 +406,10 @@ TEST(Body3, IntermediateAxisFlipPeriodMatchesTheEllipticIntegral) {
     // measure: times at which ω_y crosses zero going down
     const double dt = 1e-3;
     std::vector<double> crossings;
-    double previous = s.v[4];
+    double previous = s.qd[4];
     for (int step = 1; step <= int(3.2 * period / dt) && crossings.size() < 3; ++step) {
-      ASSERT_TRUE(StepBody3(body, w, integrator, dt, &s).ok());
-      const double now = s.v[4];
+      ASSERT_TRUE(StepBody(body, w, 0, integrator, dt, &s).ok());
+      const double now = s.qd[4];
       if (previous > 0 && now <= 0) crossings.push_back(dt * (step - 1 + previous / (previous - now)));
       previous = now;
     }
@@ -427,19 +426,19 @@ TEST(Body3, SpringAtTheCentreOscillatesWithTheClosedFormPeriod) {
   const BodyModel3 box = Box(1.0, 2.0, 3.0, 0.5);
   const double m = box.moments().m, k = 40.0, A = 0.1;
   const Vector3d centre(0.5, 1.0, 1.5);
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.gravity_on = false;
-  w.springs.push_back(MakeSpring3(box, Vector3d::Constant(0.5), centre + Vector3d(A, 0, 0), k));
-  BodyState3<double> s = RestState3<double>(box);  // the centre starts A from the anchor, at rest
+  w.springs.push_back(MakeSpring(box, Vector3d::Constant(0.5), centre + Vector3d(A, 0, 0), k));
+  BodyState<3, double> s = RestState<3, double>(box);  // the centre starts A from the anchor, at rest
   const double omega = std::sqrt(k / m), dt = 1e-3;
   double worst = 0.0;
   for (int step = 1; step <= int(2 * M_PI / omega / dt); ++step) {
-    ASSERT_TRUE(StepBody3(box, w, Integrator::kRK4, dt, &s).ok());
+    ASSERT_TRUE(StepBody(box, w, 0, Integrator::kRK4, dt, &s).ok());
     const double expected = A - A * std::cos(omega * step * dt);  // the centre's x
-    worst = std::max(worst, std::abs(s.t.x() - expected));
+    worst = std::max(worst, std::abs(s.translation().x() - expected));
   }
   EXPECT_LT(worst, 1e-9);
-  EXPECT_LT(std::abs(s.orientation.w() - 1.0), 1e-12);
+  EXPECT_LT(std::abs(s.orientation().w() - 1.0), 1e-12);
 }
 
 // A spring pulls toward its anchor only: angular momentum about the anchor is kept, and with
@@ -447,20 +446,20 @@ TEST(Body3, SpringAtTheCentreOscillatesWithTheClosedFormPeriod) {
 TEST(Body3, OffCentreSpringKeepsMomentumAboutTheAnchor) {
   std::mt19937 rng(29);
   const BodyModel3 body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20, 3000.0);
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.gravity_on = false;
   const Vector3d anchor(40, -30, 20);
-  w.springs.push_back(MakeSpring3(body, Vector3d(0.2, 0.9, 0.4), anchor, 50.0, 0.0, 10.0));
-  BodyState3<double> s = RandomState3(rng, body, 0.3);
-  auto about_anchor = [&](const BodyState3<double>& st) {
+  w.springs.push_back(MakeSpring(body, Vector3d(0.2, 0.9, 0.4), anchor, 50.0, 0.0, 10.0));
+  BodyState<3, double> s = RandomState3(rng, body, 0.3);
+  auto about_anchor = [&](const BodyState<3, double>& st) {
     Vector3d P;
     const Vector3d L = AngularMomentum(body, st, &P);
     return Vector3d(L - anchor.cross(P));
   };
-  auto energy = [&](const BodyState3<double>& st) {
-    const Frame3<double> f(st.t, st.orientation);
-    const Spring3& sp = w.springs[0];
-    const Vector3d x = f.t + f.R * LocalPosition3<double>(sp.rest_local, sp.mode_matrix, st.gamma);
+  auto energy = [&](const BodyState<3, double>& st) {
+    const Frame<3, double> f(st.q);
+    const SpringN<3>& sp = w.springs[0];
+    const Vector3d x = f.t + f.R * LocalPosition<double>(sp.rest_local, sp.mode_matrix, st.q);
     const double stretch = (x - anchor).norm() - sp.rest_length;
     return TotalEnergy(body, st) + 0.5 * sp.stiffness * stretch * stretch;
   };
@@ -468,7 +467,7 @@ TEST(Body3, OffCentreSpringKeepsMomentumAboutTheAnchor) {
   const double E0 = energy(s);
   double worst_L = 0.0, worst_E = 0.0;
   for (int step = 0; step < 5000; ++step) {
-    ASSERT_TRUE(StepBody3(body, w, Integrator::kVariational, 2e-3, &s).ok());
+    ASSERT_TRUE(StepBody(body, w, 0, Integrator::kVariational, 2e-3, &s).ok());
     worst_L = std::max(worst_L, (about_anchor(s) - L0).norm() / L0.norm());
     worst_E = std::max(worst_E, std::abs(energy(s) - E0) / E0);
   }
@@ -479,21 +478,21 @@ TEST(Body3, OffCentreSpringKeepsMomentumAboutTheAnchor) {
 TEST(Body3, VibratingBodyTumblingKeepsItsMomenta) {
   std::mt19937 rng(17);
   const BodyModel3 body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 4, 30, 2000.0);
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.gravity_on = false;
-  BodyState3<double> s = RandomState3(rng, body, 0.5);
+  BodyState<3, double> s = RandomState3(rng, body, 0.5);
   Vector3d P0;
   const Vector3d L0 = AngularMomentum(body, s, &P0);
   const double E0 = TotalEnergy(body, s);
   double worst_L = 0.0, worst_P = 0.0, worst_E = 0.0, gamma_range = 0.0;
   for (int step = 0; step < 5000; ++step) {
-    ASSERT_TRUE(StepBody3(body, w, Integrator::kVariational, 2e-3, &s).ok());
+    ASSERT_TRUE(StepBody(body, w, 0, Integrator::kVariational, 2e-3, &s).ok());
     Vector3d P;
     const Vector3d L = AngularMomentum(body, s, &P);
     worst_L = std::max(worst_L, (L - L0).norm() / L0.norm());
     worst_P = std::max(worst_P, (P - P0).norm() / P0.norm());
     worst_E = std::max(worst_E, std::abs(TotalEnergy(body, s) - E0) / E0);
-    gamma_range = std::max(gamma_range, s.gamma.cwiseAbs().maxCoeff());
+    gamma_range = std::max(gamma_range, s.gamma().cwiseAbs().maxCoeff());
   }
   EXPECT_GT(gamma_range, 0.1);  // it does vibrate
   EXPECT_LT(worst_L, 1e-9);
@@ -510,7 +509,7 @@ TEST(Body3, BlockOnAnInclineHoldsBelowTheCapAndSlidesAbove) {
   const double mu = 0.4, g = 9.81;
   for (double alpha_deg : {15.0, 35.0}) {
     const double alpha = alpha_deg * M_PI / 180.0;
-    WorldParams3 w;
+    WorldParamsN<3> w;
     w.ground.enabled = true;
     w.ground.friction_cap = mu;
     w.ground.stiffness = 2e4;
@@ -519,9 +518,9 @@ TEST(Body3, BlockOnAnInclineHoldsBelowTheCapAndSlidesAbove) {
     // the plane through 0 tilted about z: downhill is −x' = (−cos α, −sin α, 0)... normal n
     w.ground.normal = Vector3d(-std::sin(alpha), std::cos(alpha), 0.0);
     const Vector3d downhill(-std::cos(alpha), -std::sin(alpha), 0.0);
-    BodyState3<double> s = RestState3<double>(block);
-    s.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(alpha, Vector3d::UnitZ()));
-    s.t = w.ground.normal * 1e-4;  // resting on the plane
+    BodyState<3, double> s = RestState<3, double>(block);
+    s.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(alpha, Vector3d::UnitZ())));
+    s.translation() = w.ground.normal * 1e-4;  // resting on the plane
     const double dt = 2e-4;
     auto com_velocity = [&] {
       Vector3d P;
@@ -530,7 +529,7 @@ TEST(Body3, BlockOnAnInclineHoldsBelowTheCapAndSlidesAbove) {
     };
     double v_at_1 = 0.0;
     for (int step = 1; step <= int(2.0 / dt); ++step) {
-      ASSERT_TRUE(StepBody3(block, w, Integrator::kSymplecticEuler, dt, &s).ok());
+      ASSERT_TRUE(StepBody(block, w, 0, Integrator::kSymplecticEuler, dt, &s).ok());
       if (step == int(1.0 / dt)) v_at_1 = com_velocity().dot(downhill);
     }
     const double v_at_2 = com_velocity().dot(downhill);
@@ -563,24 +562,24 @@ TEST(Body3, TableDroppedFlatLandsOnItsFourLegsAndSettles) {
       }
   def.masses.assign(def.mass_positions.size(), 2.0);
   const BodyModel3 table(def, {});
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.ground.enabled = true;
   w.ground.stiffness = 2e4;
   w.ground.normal_damping = 300.0;
   w.ground.friction_damping = 300.0;
   w.ground.friction_cap = 0.5;
-  BodyState3<double> s = RestState3<double>(table);
-  s.t = Vector3d(0, 0.5, 0);
-  for (int step = 0; step < int(3.0 / 5e-4); ++step) ASSERT_TRUE(StepBody3(table, w, Integrator::kSymplecticEuler, 5e-4, &s).ok());
+  BodyState<3, double> s = RestState<3, double>(table);
+  s.translation() = Vector3d(0, 0.5, 0);
+  for (int step = 0; step < int(3.0 / 5e-4); ++step) ASSERT_TRUE(StepBody(table, w, 0, Integrator::kSymplecticEuler, 5e-4, &s).ok());
   std::vector<int> touching;
-  for (const Contact3<double>& c : s.contacts) touching.push_back(c.point);
+  for (const Contact<3, double>& c : s.contacts) touching.push_back(c.point);
   EXPECT_EQ(touching, feet);
-  EXPECT_LT(s.v.norm(), 1e-3);
+  EXPECT_LT(s.qd.norm(), 1e-3);
   // level: the top's normal still points up
-  EXPECT_GT((s.orientation * Vector3d::UnitY()).y(), 1.0 - 1e-9);
+  EXPECT_GT((s.orientation() * Vector3d::UnitY()).y(), 1.0 - 1e-9);
   // each foot carries a quarter of the weight: sinks mg/(4K)
   const double sink = table.moments().m * 9.81 / (4 * w.ground.stiffness);
-  EXPECT_NEAR(s.t.y(), -sink, 0.02 * sink);
+  EXPECT_NEAR(s.translation().y(), -sink, 0.02 * sink);
 }
 
 
@@ -606,15 +605,15 @@ TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
   v << 10, -20, 5, 0.1, 0.3, -0.2, 0, 0, 0, 0;
   world.SetState3(b3, Vector3d(0, 30, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Vector3d::UnitX())), gamma, v);
   // the same body alone, by StepBody3
-  WorldParams3 p;
+  WorldParamsN<3> p;
   p.ground = o.ground_3d;
-  BodyState3<double> alone = world.state3(b3);
+  BodyState<3, double> alone = world.state3(b3);
   for (int step = 0; step < 2000; ++step) {
     ASSERT_TRUE(world.Step()) << world.status().message;
-    ASSERT_TRUE(StepBody3(*table3, p, o.integrator, o.dt, &alone).ok());
+    ASSERT_TRUE(StepBody(*table3, p, 0, o.integrator, o.dt, &alone).ok());
   }
-  EXPECT_EQ(world.state3(b3).t, alone.t);
-  EXPECT_EQ(world.state3(b3).v, alone.v);
+  EXPECT_EQ(world.state3(b3).translation(), alone.translation());
+  EXPECT_EQ(world.state3(b3).qd, alone.qd);
   EXPECT_FALSE(world.state3(b3).contacts.empty());  // it landed
   EXPECT_TRUE(std::isfinite(world.ComputeEnergies(b3).total()));
 }
@@ -634,7 +633,7 @@ TEST(Body3InWorld, RefusesBadStatesAndPoints) {
   EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, v), std::invalid_argument);
   v[0] = 1e160;  // finite, but its kinetic energy is not
   EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, v), std::invalid_argument);
-  EXPECT_EQ(world.state3(b).v[0], 0.0);  // the refused states left it as it was
+  EXPECT_EQ(world.state3(b).qd[0], 0.0);  // the refused states left it as it was
 }
 
 // A point force for one step from rest gives the body exactly its impulse. The explicit step
@@ -664,7 +663,7 @@ TEST(Body3InWorld, APointForceGivesTheBodyItsImpulse) {
     const Vector3d f(30, -50, 20), x_p = world.PointPosition(p);
     world.ApplyPointForce(p, f);
     ASSERT_TRUE(world.Step()) << world.status().message;
-    const Eigen::VectorXd v = world.state3(b).v;
+    const Eigen::VectorXd v = world.state3(b).qd;
     auto momenta = [&](const Eigen::VectorXd& vel, Vector3d* P, Vector3d* L) {
       P->setZero();
       L->setZero();
@@ -684,11 +683,11 @@ TEST(Body3InWorld, APointForceGivesTheBodyItsImpulse) {
     World twin(o);
     const int tb = twin.AddBody(table3);
     if (constrained) twin.AddNail(MassPointOf(twin.AddBody(table3), 0));
-    const BodyState3<double>& s1 = world.state3(b);
-    twin.SetState3(tb, s1.t, s1.orientation, s1.gamma, s1.v);
+    const BodyState<3, double>& s1 = world.state3(b);
+    twin.SetState3(tb, s1.translation(), s1.orientation(), s1.gamma(), s1.qd);
     ASSERT_TRUE(world.Step());
     ASSERT_TRUE(twin.Step());
-    EXPECT_EQ(world.state3(b).v, twin.state3(tb).v) << path;
+    EXPECT_EQ(world.state3(b).qd, twin.state3(tb).qd) << path;
   }
 }
 
@@ -710,10 +709,10 @@ TEST(Body3InWorld, NailedBoxSwingsWithThePhysicalPendulumPeriod) {
   const double M = 8 * m, d = b / 2, I_pivot = 8 * m * (a * a + b * b) / 4 + M * d * d;
   const double period = 2 * M_PI * std::sqrt(I_pivot / (M * g * d)) * (1 + theta0 * theta0 / 16);
   std::vector<double> crossings;
-  double previous = world.state3(body).v[5], worst_violation = 0.0;
+  double previous = world.state3(body).qd[5], worst_violation = 0.0;
   while (world.time() < 2.2 * period) {
     ASSERT_TRUE(world.Step()) << world.status().message;
-    const double now = world.state3(body).v[5];
+    const double now = world.state3(body).qd[5];
     if (previous > 0 && now <= 0) crossings.push_back(world.time() - o.dt * now / (now - previous));
     previous = now;
     worst_violation = std::max(worst_violation, world.MaxViolation());
@@ -743,13 +742,13 @@ AttachedRun RunAttached(double dt) {
   o.dt = dt;
   World world(o);
   const int a = world.AddBody(body_a), b = world.AddBody(body_b), s = world.AddLinearBody(slab);
-  BodyState3<double> sa = RandomState3(rng, *body_a, 0.2), sb = RandomState3(rng, *body_b, 0.2);
-  world.SetState3(a, Vector3d::Zero(), Eigen::Quaterniond::Identity(), sa.gamma, sa.v);
+  BodyState<3, double> sa = RandomState3(rng, *body_a, 0.2), sb = RandomState3(rng, *body_b, 0.2);
+  world.SetState3(a, Vector3d::Zero(), Eigen::Quaterniond::Identity(), sa.gamma(), sa.qd);
   // b and the slab placed so that their joint points coincide with a's
   const Vector3d joint_ab = world.PointPosition(At(a, Vector3d(1, 0.5, 0.5)));
-  world.SetState3(b, Vector3d::Zero(), Eigen::Quaterniond::Identity(), sb.gamma, sb.v);
+  world.SetState3(b, Vector3d::Zero(), Eigen::Quaterniond::Identity(), sb.gamma(), sb.qd);
   const Vector3d b_local = world.PointPosition(At(b, Vector3d(0, 0.5, 0.5)));
-  world.SetState3(b, joint_ab - b_local, Eigen::Quaterniond::Identity(), sb.gamma, sb.v);
+  world.SetState3(b, joint_ab - b_local, Eigen::Quaterniond::Identity(), sb.gamma(), sb.qd);
   const Vector3d joint_as = world.PointPosition(At(a, Vector3d(0.5, 1, 0.5)));
   Eigen::MatrixXd R = slab->RestState();
   R.col(3) = joint_as - Vector3d(0, -15, 0);  // x = u + R.col(3): the slab point (0, −15, 0) at the joint

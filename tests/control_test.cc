@@ -210,7 +210,7 @@ TEST(Keyframes, HeldPointStaysPutWhileTheBodyDeforms) {
       Mat2D<double> B;
       body->LocalBasis(hold.lattice_coords, &b0, &B);
       const VecQ<double> qq = q, qqd = qd;
-      const Frame<double> frame(qq);
+      const Frame<2, double> frame(qq);
       EXPECT_NEAR(PointVelocity(frame, qqd, LocalPosition<double>(b0, B, qq), B).norm(), 0.0, 1e-10) << t;
       EXPECT_DOUBLE_EQ(q[2], theta);
     }

@@ -346,9 +346,9 @@ std::vector<fit::ReferenceFrame3> WorldFrames(const std::shared_ptr<const BodyMo
   std::vector<fit::ReferenceFrame3> frames;
   for (int k = 0; k <= steps; ++k) {
     if (k % every == 0) {
-      const BodyState3<double>& s = world.state3(b);
+      const BodyState<3, double>& s = world.state3(b);
       Eigen::VectorXd q(9);
-      q << s.t, LogRotation<double>(s.orientation), s.gamma;
+      q << s.translation(), LogRotation<double>(s.orientation()), s.gamma();
       fit::ReferenceFrame3 f;
       f.time = k * dt;
       for (int i = 0; i < body->num_points(); i += 4) {

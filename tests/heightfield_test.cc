@@ -17,7 +17,7 @@
 #include "support/test_bodies.h"
 #include "wobble/core/errors.h"
 #include "wobble/dynamics/heightfield.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 #include "wobble/formats/heightfield_file.h"
 #include "wobble/formats/parse_error.h"
 
@@ -37,10 +37,10 @@ std::shared_ptr<const Heightfield> Sampled(F&& f, Vector2d origin, Vector2d spac
   return Heightfield::Make(origin, spacing, nx, nz, std::move(h));
 }
 
-Vector3d LinearMomentum(const BodyModel3& body, const BodyState3<double>& s) {
-  const ShapeMoments3<double> sm(body.moments(), s.gamma);
+Vector3d LinearMomentum(const BodyModel3& body, const BodyState<3, double>& s) {
+  const ShapeMoments<double> sm(body.moments(), s.gamma());
   Vector3d P, L;
-  Momentum3(body.moments(), sm, Frame3<double>(s.t, s.orientation), s.v, &P, &L);
+  Momentum(body.moments(), sm, Frame<3, double>(s.q), s.qd, &P, &L);
   return P;
 }
 
@@ -77,26 +77,26 @@ TEST(Heightfield, APlaneGivenAsAGridIsThatPlane) {
 TEST(Heightfield, ABodyOnAGridOfAPlaneMovesAsOnThePlane) {
   const BodyModel3 chair = testing::Chair3();
   const double a = 0.1, b = -0.05;  // y = a x + b z
-  WorldParams3 on_plane;
+  WorldParamsN<3> on_plane;
   on_plane.ground.enabled = true;
   on_plane.ground.normal = Vector3d(-a, 1.0, -b).normalized();
   on_plane.ground.stiffness = 2e4;  // per point of 1/3 kg
   on_plane.ground.normal_damping = 100;
   on_plane.ground.friction_damping = 100;
   on_plane.ground.friction_cap = 0.3;
-  WorldParams3 on_grid = on_plane;
+  WorldParamsN<3> on_grid = on_plane;
   on_grid.ground.heightfield = Sampled([&](double x, double z) { return a * x + b * z; }, {-300, -300}, {15, 15}, 41, 41);
-  BodyState3<double> s1 = RestState3<double>(chair), s2;
-  s1.t = Vector3d(-40, 2, 10);
-  s1.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Vector3d(1, 0, 1).normalized()));
-  s1.v.head<3>() = Vector3d(60, -5, 25);  // it slides across many triangles
-  s1.v.segment<3>(3) = Vector3d(0.2, 0.5, -0.3);
+  BodyState<3, double> s1 = RestState<3, double>(chair), s2;
+  s1.translation() = Vector3d(-40, 2, 10);
+  s1.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Vector3d(1, 0, 1).normalized())));
+  s1.qd.head<3>() = Vector3d(60, -5, 25);  // it slides across many triangles
+  s1.qd.segment<3>(3) = Vector3d(0.2, 0.5, -0.3);
   s2 = s1;
   int contacts_seen = 0, faces_seen = 0;
   std::vector<char> face_used(size_t(on_grid.ground.heightfield->num_faces()), 0);
   for (int step = 0; step < 3000; ++step) {
-    ASSERT_TRUE(StepBody3(chair, on_plane, Integrator::kSymplecticEuler, 5e-4, &s1).ok());
-    ASSERT_TRUE(StepBody3(chair, on_grid, Integrator::kSymplecticEuler, 5e-4, &s2).ok());
+    ASSERT_TRUE(StepBody(chair, on_plane, 0, Integrator::kSymplecticEuler, 5e-4, &s1).ok());
+    ASSERT_TRUE(StepBody(chair, on_grid, 0, Integrator::kSymplecticEuler, 5e-4, &s2).ok());
     ASSERT_EQ(s1.contacts.size(), s2.contacts.size()) << "step " << step;
     for (size_t c = 0; c < s1.contacts.size(); ++c) {
       ASSERT_EQ(s1.contacts[c].point, s2.contacts[c].point);
@@ -105,9 +105,9 @@ TEST(Heightfield, ABodyOnAGridOfAPlaneMovesAsOnThePlane) {
     }
     contacts_seen += int(s1.contacts.size());
   }
-  EXPECT_LT((s1.t - s2.t).norm(), 1e-7);
-  EXPECT_LT((s1.v - s2.v).norm(), 1e-7 * s1.v.norm() + 1e-9);
-  EXPECT_LT((s1.gamma - s2.gamma).norm(), 1e-9);
+  EXPECT_LT((s1.translation() - s2.translation()).norm(), 1e-7);
+  EXPECT_LT((s1.qd - s2.qd).norm(), 1e-7 * s1.qd.norm() + 1e-9);
+  EXPECT_LT((s1.gamma() - s2.gamma()).norm(), 1e-9);
   EXPECT_GT(contacts_seen, 1000) << "it bounces and slides along the ground";
   EXPECT_GE(faces_seen, 10) << "contacts on many triangles";
 }
@@ -138,23 +138,22 @@ TEST(Heightfield, APointInACreaseFeelsBothFaces) {
 TEST(Heightfield, ABoxInAFrictionlessValleyIsHeldByBothWalls) {
   const double alpha = 0.4, width = 1.0, mass = 1.0, g = 9.81;
   const BodyModel3 box = Box(width, 0.4, 0.6, mass);
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.ground.enabled = true;
   w.ground.stiffness = 2e4;
   w.ground.normal_damping = 200.0;
   w.ground.friction_damping = 0.0;
   w.ground.friction_cap = 0.0;
   w.ground.heightfield = Sampled([&](double x, double) { return std::abs(x) * std::tan(alpha); }, {-3, -2}, {0.5, 0.5}, 13, 9);
-  BodyState3<double> s = RestState3<double>(box);
-  s.t = Vector3d(-width / 2, width / 2 * std::tan(alpha) + 0.01, -0.3);
-  for (int step = 0; step < 8000; ++step) ASSERT_TRUE(StepBody3(box, w, Integrator::kSymplecticEuler, 5e-4, &s).ok());
-  EXPECT_LT(s.v.norm(), 1e-6);
+  BodyState<3, double> s = RestState<3, double>(box);
+  s.translation() = Vector3d(-width / 2, width / 2 * std::tan(alpha) + 0.01, -0.3);
+  for (int step = 0; step < 8000; ++step) ASSERT_TRUE(StepBody(box, w, 0, Integrator::kSymplecticEuler, 5e-4, &s).ok());
+  EXPECT_LT(s.qd.norm(), 1e-6);
   Vector3d on_face[2] = {Vector3d::Zero(), Vector3d::Zero()};
-  const Frame3<double> frame(s.t, s.orientation);
-  ForEachPointInContact3(box, w.ground, s, frame, [&](int, int, const GroundPlane& plane, const Vector3d&, const Vector3d& x,
-                                                      const Vector3d& v, const Vector3d& anchor) {
+  const Frame<3, double> frame(s.q);
+  ForEachPointInContact(box, w.ground, s, frame, [&](int, const Vector3d&, const Vector3d& x, const Vector3d& v, const Vector3d& anchor, const GroundPlane& plane, int) {
     bool slipping;
-    on_face[plane.normal.x() > 0 ? 0 : 1] += GroundForce3(plane, x, v, anchor, &slipping);
+    on_face[plane.normal.x() > 0 ? 0 : 1] += GroundForce(plane, x, v, anchor, &slipping);
   }, ContactSet::kFrozen);
   const double N = mass * 8 * g / (2 * std::cos(alpha));
   EXPECT_LT((on_face[0] - N * Vector3d(std::sin(alpha), std::cos(alpha), 0)).norm(), 1e-6 * N);
@@ -168,7 +167,7 @@ struct Slide {
   size_t contacts;
 };
 Slide SlideDownTheSlope(const BodyModel3& block, double alpha, double mu, std::shared_ptr<const Heightfield> field) {
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.ground.enabled = true;
   w.ground.friction_cap = mu;
   w.ground.stiffness = 2e4;
@@ -176,17 +175,17 @@ Slide SlideDownTheSlope(const BodyModel3& block, double alpha, double mu, std::s
   w.ground.friction_damping = 100.0;
   w.ground.heightfield = std::move(field);
   const Vector3d downhill(-std::cos(alpha), -std::sin(alpha), 0.0);
-  BodyState3<double> s = RestState3<double>(block);
-  s.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(alpha, Vector3d::UnitZ()));
-  s.t = Vector3d(0, 1e-4, -0.15);
+  BodyState<3, double> s = RestState<3, double>(block);
+  s.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(alpha, Vector3d::UnitZ())));
+  s.translation() = Vector3d(0, 1e-4, -0.15);
   const double dt = 2e-4;
   Slide out{};
   for (int step = 1; step <= int(2.0 / dt); ++step) {
-    EXPECT_TRUE(StepBody3(block, w, Integrator::kSymplecticEuler, dt, &s).ok());
+    EXPECT_TRUE(StepBody(block, w, 0, Integrator::kSymplecticEuler, dt, &s).ok());
     if (step == int(1.0 / dt)) out.v_at_1 = LinearMomentum(block, s).dot(downhill) / block.moments().m;
   }
   out.v_at_2 = LinearMomentum(block, s).dot(downhill) / block.moments().m;
-  out.travelled = -s.t.x();
+  out.travelled = -s.translation().x();
   out.contacts = s.contacts.size();
   return out;
 }
@@ -273,7 +272,7 @@ TEST(Heightfield, RefusesBadRegions) {
 // had sunk into the top (m g / 4K): it feels that face only that shallowly, never deeper.
 TEST(Heightfield, SlidesOffTheEdgeOfADropIntoFreeFall) {
   const BodyModel3 box = Box(0.5, 0.3, 0.4, 1.0);
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.ground.enabled = true;
   w.ground.stiffness = 2e4;
   w.ground.normal_damping = 0.0;
@@ -281,35 +280,34 @@ TEST(Heightfield, SlidesOffTheEdgeOfADropIntoFreeFall) {
   w.ground.friction_cap = 0.0;
   w.ground.heightfield = Sampled([](double x, double) { return x < 0.5 ? 3.0 : 0.0; }, {-3, -2}, {1, 1}, 7, 5);
   const double sink = box.moments().m * 9.81 / (4 * w.ground.stiffness);
-  BodyState3<double> s = RestState3<double>(box);
-  s.t = Vector3d(-1.0, 3.0 - sink, -0.2);
-  s.v.head<3>() = Vector3d(2.0, 0, 0);
+  BodyState<3, double> s = RestState<3, double>(box);
+  s.translation() = Vector3d(-1.0, 3.0 - sink, -0.2);
+  s.qd.head<3>() = Vector3d(2.0, 0, 0);
   const double dt = 1e-4;
   bool airborne = false, landed = false;
-  WorldParams3 no_ground = w;
+  WorldParamsN<3> no_ground = w;
   no_ground.ground.enabled = false;
-  BodyState3<double> free;
+  BodyState<3, double> free;
   int checked = 0, drop_contacts = 0;
   for (int step = 0; step < int(1.2 / dt); ++step) {
-    ASSERT_TRUE(StepBody3(box, w, Integrator::kSymplecticEuler, dt, &s).ok());
-    ForEachPointInContact3(box, w.ground, s, Frame3<double>(s.t, s.orientation),
-                           [&](int, int, const GroundPlane& plane, const Vector3d&, const Vector3d& x, const Vector3d&,
-                               const Vector3d&) {
+    ASSERT_TRUE(StepBody(box, w, 0, Integrator::kSymplecticEuler, dt, &s).ok());
+    ForEachPointInContact(box, w.ground, s, Frame<3, double>(s.q),
+                           [&](int, const Vector3d&, const Vector3d& x, const Vector3d&, const Vector3d&, const GroundPlane& plane, int) {
                              if (plane.normal.y() < 0.99) {
                                ++drop_contacts;
                                ASSERT_LT(-plane.Height(x), sink) << "step " << step << ": deep in the drop's face";
                              }
                            }, ContactSet::kFrozen);
     if (airborne && !landed) {
-      ASSERT_TRUE(StepBody3(box, no_ground, Integrator::kSymplecticEuler, dt, &free).ok());
+      ASSERT_TRUE(StepBody(box, no_ground, 0, Integrator::kSymplecticEuler, dt, &free).ok());
       landed = !s.contacts.empty();
       if (!landed) {
-        ASSERT_TRUE(free.t == s.t && free.v == s.v && free.orientation.coeffs() == s.orientation.coeffs())
+        ASSERT_TRUE(free.translation() == s.translation() && free.qd == s.qd && free.orientation().coeffs() == s.orientation().coeffs())
             << "step " << step;
         ++checked;
       }
     }
-    if (!airborne && s.contacts.empty() && s.t.x() > 0) {
+    if (!airborne && s.contacts.empty() && s.translation().x() > 0) {
       airborne = true;
       free = s;
     }

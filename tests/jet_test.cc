@@ -8,7 +8,7 @@
 
 #include "support/test_bodies.h"
 #include "wobble/dynamics/step.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
 #include "support/source_paths.h"
@@ -27,8 +27,8 @@ WorldParams GroundedParams() {
 }
 
 // State with one leg pushed into a sloped ground, turning and wobbling.
-BodyState<double> Start() {
-  BodyState<double> s;
+BodyState<2, double> Start() {
+  BodyState<2, double> s;
   s.q.resize(kNq);
   s.qd.resize(kNq);
   s.q << 10, 0.5, 0.05, 0.02, -0.01, 0.03, 0.01;
@@ -38,7 +38,7 @@ BodyState<double> Start() {
 
 template <class T> VecQ<T> Simulate(const BodyModel& body, const WorldParams& p, Integrator integrator,
                                     const VecQ<T>& q0, const VecQ<T>& qd0, int steps) {
-  BodyState<T> s;
+  BodyState<2, T> s;
   s.q = q0;
   s.qd = qd0;
   UpdateContacts(body, p.ground, &s);
@@ -51,7 +51,7 @@ template <class T> VecQ<T> Simulate(const BodyModel& body, const WorldParams& p,
 TEST(Jet, StepDerivativesMatchFiniteDifferences) {
   const BodyModel body(testing::TableDef(), testing::TableModes(4e5, 1e4));
   const WorldParams p = GroundedParams();
-  const BodyState<double> s0 = Start();
+  const BodyState<2, double> s0 = Start();
   for (Integrator integrator : {Integrator::kThesis, Integrator::kRK4}) {
     // contacts are created in the first step and kept: the same branch for every probe
     VecQ<Jet> q(kNq), qd(kNq);
@@ -89,17 +89,17 @@ TEST(Jet, StepDerivativesMatchFiniteDifferences) {
 using Jet3 = ceres::Jet<double, 10>;  // the 3D table: 6 + 4 velocities
 
 template <class T>
-Eigen::Matrix<T, Eigen::Dynamic, 1> Simulate3(const BodyModel3& body, const WorldParams3& w, Integrator integrator,
-                                              const VecQ3<T>& v0, int steps) {
-  BodyState3<T> s = RestState3<T>(body);
-  s.t = Vec3<T>(T(0.0), T(-0.5), T(0.0));
-  s.orientation = Eigen::Quaternion<T>(T(0.999), T(0.02), T(0.01), T(-0.03)).normalized();
-  for (int d = 0; d < body.num_modes(); ++d) s.gamma[d] = T(0.01 * (d + 1));
-  s.v = v0;
-  UpdateContacts3(body, w.ground, &s);
-  for (int i = 0; i < steps; ++i) EXPECT_TRUE(StepBody3(body, w, integrator, 0.005, &s).ok());
+Eigen::Matrix<T, Eigen::Dynamic, 1> Simulate3(const BodyModel3& body, const WorldParamsN<3>& w, Integrator integrator,
+                                              const VecQ<T>& v0, int steps) {
+  BodyState<3, T> s = RestState<3, T>(body);
+  s.translation() = Vec3<T>(T(0.0), T(-0.5), T(0.0));
+  s.set_orientation(Eigen::Quaternion<T>(T(0.999), T(0.02), T(0.01), T(-0.03)).normalized());
+  for (int d = 0; d < body.num_modes(); ++d) s.gamma()[d] = T(0.01 * (d + 1));
+  s.qd = v0;
+  UpdateContacts(body, w.ground, &s);
+  for (int i = 0; i < steps; ++i) EXPECT_TRUE(StepBody(body, w, 0, integrator, 0.005, &s).ok());
   Eigen::Matrix<T, Eigen::Dynamic, 1> out(7 + 2 * body.num_modes() + 6);
-  out << s.t, s.orientation.coeffs(), s.gamma, s.v;
+  out << s.translation(), s.orientation().coeffs(), s.gamma(), s.qd;
   return out;
 }
 
@@ -109,19 +109,19 @@ TEST(Jet, Step3DerivativesMatchFiniteDifferences) {
       formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice);
   for (DeformationMode3& m : modes) m.stiffness = 4e5, m.damping = 1e4;
   const BodyModel3 body(def, modes);
-  WorldParams3 w;
+  WorldParamsN<3> w;
   w.ground.enabled = true;
   w.ground.normal = Eigen::Vector3d(0.1, 1.0, 0.05).normalized();
-  VecQ3<double> v0(10);
+  VecQ<double> v0(10);
   v0 << 0.3, -2, 0.2, 0.05, 0.1, -0.08, 0.05, 0.02, -0.04, 0.03;
   for (Integrator integrator : {Integrator::kThesis, Integrator::kRK4}) {
-    VecQ3<Jet3> v(10);
+    VecQ<Jet3> v(10);
     for (int i = 0; i < 10; ++i) v[i] = Jet3(v0[i], i);
     const auto out = Simulate3<Jet3>(body, w, integrator, v, 10);
     const Eigen::VectorXd plain = Simulate3<double>(body, w, integrator, v0, 10);
     for (int j = 0; j < 10; ++j) {
       const double h = 1e-6;
-      VecQ3<double> vp = v0, vm = v0;
+      VecQ<double> vp = v0, vm = v0;
       vp[j] += h;
       vm[j] -= h;
       const Eigen::VectorXd fd = (Simulate3<double>(body, w, integrator, vp, 10) -

@@ -82,7 +82,7 @@ TEST(LinearGround, RestsOnFlatGroundWithTheWeightOnItsBottomRow) {
   const double weight = 6.0 * kG, K = o.params.ground.stiffness;
   const LinearContacts& c = w.linear_contacts(b);
   ASSERT_EQ(c.list2.size(), 3u);
-  for (const Contact<double>& contact : c.list2) {
+  for (const Contact<2, double>& contact : c.list2) {
     EXPECT_NEAR(w.linear_model(b).def().points[contact.point].y(), -0.5, 0.0);  // the bottom row
     EXPECT_NEAR(Point(w, b, contact.point).y(), -weight / (3 * K), 1e-6 * weight / K);
   }
@@ -152,7 +152,7 @@ TEST(LinearGround, BlockCornerDownInAValleyFeelsBothFaces) {
     EXPECT_NEAR(per_face[face].dot(o.params.ground.Face(face).tau), 0.0, 1e-12 * weight);  // no friction
   }
   int corner_contacts = 0;
-  for (const Contact<double>& c : w.linear_contacts(b).list2) corner_contacts += c.point == 0;
+  for (const Contact<2, double>& c : w.linear_contacts(b).list2) corner_contacts += c.point == 0;
   EXPECT_EQ(corner_contacts, 2);  // point 0 is u = (−0.5, −0.5)
 }
 
@@ -235,7 +235,7 @@ TEST(LinearGround, RestsOnThePlaneIn3DWithTheWeightOnItsBottomFace) {
   ASSERT_TRUE(w.RunUntil(6.0)) << w.status().message;
   const double weight = 6.0 * kG, K = o.ground_3d.stiffness;
   ASSERT_EQ(w.linear_contacts(b).list3.size(), 9u);
-  for (const Contact3<double>& c : w.linear_contacts(b).list3)
+  for (const Contact<3, double>& c : w.linear_contacts(b).list3)
     EXPECT_NEAR(Point(w, b, c.point).y(), -weight / (9 * K), 1e-6 * weight / K);
 }
 
@@ -263,10 +263,10 @@ TEST(LinearGround, BlockSlidingOffACliffEdgeFollowsTheFreeFall) {
     ASSERT_TRUE(w.Step()) << w.status().message;
     const LinearContacts& c = w.linear_contacts(b);
     for (int k = 0; k < w.linear_model(b).num_points(); ++k) {
-      const bool has = std::any_of(c.list2.begin(), c.list2.end(), [k](const Contact<double>& x) { return x.point == k; });
+      const bool has = std::any_of(c.list2.begin(), c.list2.end(), [k](const Contact<2, double>& x) { return x.point == k; });
       ASSERT_EQ(terrain.Inside(Point(w, b, k)), has) << "point " << k << " at t = " << w.time();
     }
-    for (const Contact<double>& contact : c.list2) {
+    for (const Contact<2, double>& contact : c.list2) {
       if (contact.face == 1) wall_depth = std::max(wall_depth, 10 - Point(w, b, contact.point).y());
       landed = landed || contact.face == 2;
     }
@@ -375,7 +375,7 @@ TEST(LinearGround, TheBoundNeverSkipsAPointBelowTheGround) {
         const Eigen::Vector2d x = R * model.point_bases().col(k);
         if (terrain ? g.terrain->Inside(x) : g.Face(0).Height(x) < 0) expected.push_back(k);
       }
-      for (const Contact<double>& contact : c.list2)
+      for (const Contact<2, double>& contact : c.list2)
         if (got.empty() || got.back() != contact.point) got.push_back(contact.point);
       ASSERT_EQ(got, expected) << "trial " << trial;
       touching += !expected.empty() && int(expected.size()) < model.num_points();

@@ -41,8 +41,8 @@ Eigen::VectorXd State(std::initializer_list<double> v) {
 // Linear momentum Σ m ẋ and angular momentum Σ m x × ẋ about the world origin, point by point.
 std::pair<Eigen::Vector2d, double> Momenta(const World& w) {
   const BodyModel& b = w.body(0);
-  const BodyState<double>& s = w.state(0);
-  const Frame<double> frame(s.q);
+  const BodyState<2, double>& s = w.state(0);
+  const Frame<2, double> frame(s.q);
   Eigen::Vector2d p = Eigen::Vector2d::Zero();
   double L = 0;
   for (int k = 0; k < b.num_points(); ++k) {
@@ -225,12 +225,12 @@ TEST(Ground, GroupedScanVisitsExactlyThePointsBelowTheGround) {
       Ground g;
       g.slope = 0.3 * u(rng);
       g.point = Eigen::Vector2d(0.0, 40.0 * u(rng));
-      BodyState<double> s;
+      BodyState<2, double> s;
       s.q = VecQ<double>::Zero(body.num_q());
       s.qd = VecQ<double>::Zero(body.num_q());
       s.q << 30 * u(rng), 30 * u(rng), 0.5 * u(rng), 0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng);
       std::vector<int> visited, expected;
-      const Frame<double> frame(s.q);
+      const Frame<2, double> frame(s.q);
       ForEachPointInContact(body, g, s, frame, [&](int k, const Vec2<double>&, const Vec2<double>&,
                                                    const Vec2<double>&, const Vec2<double>&, const GroundFace&,
                                                    int) { visited.push_back(k); });

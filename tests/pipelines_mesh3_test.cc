@@ -21,7 +21,7 @@
 #include "pipelines/mesh_io.h"
 #include "pipelines/world_sources.h"
 #include "support/pipelines_test_util.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/parse_error.h"
 #include "wobble/core/rotation3.h"
@@ -139,11 +139,11 @@ World MovingPot() {
 // the point's lattice coordinates, then into the world.
 Vec3 DirectWorldPoint(const World& w, const Vec3& body_point) {
   const BodyModel3& m = w.body3(0);
-  const BodyState3<double>& s = w.state3(0);
+  const BodyState<3, double>& s = w.state3(0);
   std::vector<Vec3> control = m.lattice().RestPoints();
   for (size_t c = 0; c < control.size(); ++c)
-    for (int d = 0; d < m.num_modes(); ++d) control[c] += s.gamma[d] * m.modes()[size_t(d)].displacement[c];
-  return s.t + s.orientation * m.lattice().Evaluate(control, m.lattice().LocalCoords(body_point));
+    for (int d = 0; d < m.num_modes(); ++d) control[c] += s.gamma()[d] * m.modes()[size_t(d)].displacement[c];
+  return s.translation() + s.orientation() * m.lattice().Evaluate(control, m.lattice().LocalCoords(body_point));
 }
 
 TEST(Mesh3Sources, SpringsOfA3dBodyRunFromTheAnchorToTheHeldPoint) {
@@ -152,7 +152,7 @@ TEST(Mesh3Sources, SpringsOfA3dBodyRunFromTheAnchorToTheHeldPoint) {
   auto body = std::make_shared<const BodyModel3>(std::move(def), std::move(modes));
   WorldOptions options;
   const Vec3 coords(0.5, 1.0, 0.25), anchor(0, 300, 20);
-  options.springs_3d.push_back(MakeSpring3(*body, coords, anchor, 100.0, 1.0, 20.0));
+  options.springs_3d.push_back(MakeSpring(*body, coords, anchor, 100.0, 1.0, 20.0));
   World w(options);
   w.AddBody(body);
   w.SetState3(0, Vec3(10, 40, -5), Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Vec3(1, 2, -1).normalized())),
@@ -175,7 +175,7 @@ TEST(Mesh3Sources, SpringsOfA3dBodyRunFromTheAnchorToTheHeldPoint) {
 TEST(Mesh3Sources, DisplacementVolumeHoldsEachVoxelsMotion) {
   const World w = MovingPot();
   const BodyModel3& body = w.body3(0);
-  const BodyState3<double>& s = w.state3(0);
+  const BodyState<3, double>& s = w.state3(0);
   const int nx = 8, ny = 6, nz = 5;
   const vtkSmartPointer<vtkImageData> image = pipelines::DisplacementVolume(w, 0, nx, ny, nz);
   int dims[3];
@@ -191,7 +191,7 @@ TEST(Mesh3Sources, DisplacementVolumeHoldsEachVoxelsMotion) {
         BodyModel3::ModeMatrix B;
         body.LocalBasis(u, &b0, &B);
         const Vec3 rest = body.lattice().Evaluate(body.lattice().RestPoints(), u);
-        const Vec3 moved = s.t + s.orientation * (b0 + B * s.gamma);
+        const Vec3 moved = s.translation() + s.orientation() * (b0 + B * s.gamma());
         const vtkIdType id = image->ComputePointId(std::array<int, 3>{i, j, k}.data());
         double d[3], x[3];
         disp->GetTuple(id, d);
@@ -229,13 +229,13 @@ TEST(Mesh3Sources, LatticeAndMassPointsOfA3dBody) {
   ASSERT_EQ(pd->GetNumberOfPoints(), m.num_points());
   // velocities against a central difference of the positions: t + h ṫ, R exp(h ω̂) (ω in the
   // body frame), γ + h γ̇
-  const BodyState3<double>& s = w.state3(0);
+  const BodyState<3, double>& s = w.state3(0);
   const double h = 1e-6;
   auto moved = [&](double sign) {
     World copy = w;
-    const Vec3 omega = s.v.segment<3>(3);
+    const Vec3 omega = s.qd.segment<3>(3);
     const Eigen::Quaterniond turn(Eigen::AngleAxisd(sign * h * omega.norm(), omega.normalized()));
-    copy.SetState3(0, s.t + sign * h * s.v.head<3>(), s.orientation * turn, s.gamma + sign * h * s.v.tail(3), s.v);
+    copy.SetState3(0, s.translation() + sign * h * s.qd.head<3>(), s.orientation() * turn, s.gamma() + sign * h * s.qd.tail(3), s.qd);
     return copy;
   };
   const World ahead = moved(1), behind = moved(-1);
@@ -273,13 +273,12 @@ TEST(Mesh3Sources, AppliedForcesSumToTheGeneralizedForcesTranslationRows) {
     applied->GetTuple(k, f.data());
     sum += f;
   }
-  const BodyState3<double>& s = w.state3(0);
-  WorldParams3 params;
+  const BodyState<3, double>& s = w.state3(0);
+  WorldParamsN<3> params;
   params.gravity = options.gravity_3d;
   params.ground = options.ground_3d;
-  ForceBreakdown3<double> Q;
-  EvaluateForces3(w.body3(0), params, s, Frame3<double>(s.t, s.orientation), ShapeMoments3<double>(w.body3(0).moments(), s.gamma),
-                  &Q, ContactSet::kFrozen);
+  ForceBreakdown<3, double> Q;
+  EvaluateForces(w.body3(0), params, 0, s, Frame<3, double>(s.q), &Q, ContactSet::kFrozen);
   const Vec3 expected = (Q.gravity + Q.ground).head<3>();
   EXPECT_LT((sum - expected).norm(), 1e-9 * expected.norm()) << sum.transpose() << " vs " << expected.transpose();
 }
@@ -333,12 +332,12 @@ TEST(Mesh3Record, A3dBodyRecordsAndRestoresExactly) {
   World fresh = MovingPot();
   fresh.SetState3(0, Vec3::Zero(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(), Eigen::VectorXd::Zero(9));
   run.Restore(0, fresh);
-  const BodyState3<double>& a = w.state3(0);
-  const BodyState3<double>& b = fresh.state3(0);
-  EXPECT_EQ(a.t, b.t);
-  EXPECT_LT((a.orientation.coeffs() - b.orientation.coeffs()).norm(), 1e-15);
-  EXPECT_EQ(a.gamma, b.gamma);
-  EXPECT_EQ(a.v, b.v);
+  const BodyState<3, double>& a = w.state3(0);
+  const BodyState<3, double>& b = fresh.state3(0);
+  EXPECT_EQ(a.translation(), b.translation());
+  EXPECT_LT((a.orientation().coeffs() - b.orientation().coeffs()).norm(), 1e-15);
+  EXPECT_EQ(a.gamma(), b.gamma());
+  EXPECT_EQ(a.qd, b.qd);
   EXPECT_EQ(a.mode_target, b.mode_target);
   // the recorded energies are the world's, and the per-mode terms K (γ − γ0)² sum to the modes'
   const Energies e = run.energies(0, 0), direct = w.ComputeEnergies(0);

@@ -110,7 +110,7 @@ TEST(MassPointSource, ContactFlagsAndForcesAgreeWithTheGeneralizedForce) {
     EXPECT_EQ(out->GetPointData()->GetArray("in_contact")->GetTuple1(k), touching[k] ? 1.0 : 0.0) << k;
     sum += Tuple2(out, "applied_force", k);
   }
-  const ForceBreakdown<double> f = world->Forces(0);
+  const ForceBreakdown<2, double> f = world->Forces(0);
   const Eigen::Vector2d expected(f.gravity[0] + f.ground[0], f.gravity[1] + f.ground[1]);
   EXPECT_GT((expected - f.gravity.head<2>()).norm(), 1.0);  // the ground does push
   EXPECT_NEAR((sum - expected).norm(), 0.0, 1e-9 * expected.norm());

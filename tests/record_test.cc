@@ -149,8 +149,8 @@ TEST(Trajectory, RestoreAtInterpolatesBetweenSamples) {
   const Eigen::Map<const Eigen::VectorXd> qa = run3->q(2, b), qb = run3->q(3, b);
   const Eigen::Vector4d wxyz = 0.5 * (qa.segment<4>(3) + qb.segment<4>(3));  // recorded as qw qx qy qz
   const Eigen::Quaterniond mid = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).normalized();
-  EXPECT_LT(std::abs(std::abs(at3.state3(b).orientation.dot(mid)) - 1.0), 1e-12);
-  EXPECT_LT((at3.state3(b).t - 0.5 * (qa.head<3>() + qb.head<3>())).norm(), 1e-12);
+  EXPECT_LT(std::abs(std::abs(at3.state3(b).orientation().dot(mid)) - 1.0), 1e-12);
+  EXPECT_LT((at3.state3(b).translation() - 0.5 * (qa.head<3>() + qb.head<3>())).norm(), 1e-12);
   EXPECT_EQ(at3.time(), t3);
 }
 

@@ -22,47 +22,47 @@ const BodyModel3& Chair() {
   return chair;
 }
 
-BodyState3<double> RandomState(std::mt19937* rng) {
+BodyState<3, double> RandomState(std::mt19937* rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
-  BodyState3<double> s;
-  s.t = Eigen::Vector3d(normal(*rng), normal(*rng), normal(*rng)) * 50.0;
-  s.orientation = Eigen::Quaterniond(normal(*rng), normal(*rng), normal(*rng), normal(*rng)).normalized();
-  s.gamma = VecD<double>(kModes);
-  s.v = VecQ3<double>(6 + kModes);
-  for (int d = 0; d < kModes; ++d) s.gamma[d] = 0.3 * normal(*rng);
-  for (int i = 0; i < s.v.size(); ++i) s.v[i] = (i < 3 ? 40.0 : 1.0) * normal(*rng);
+  BodyState<3, double> s = RestState<3, double>(Chair());
+  s.translation() = Eigen::Vector3d(normal(*rng), normal(*rng), normal(*rng)) * 50.0;
+  s.set_orientation(Eigen::Quaterniond(normal(*rng), normal(*rng), normal(*rng), normal(*rng)).normalized());
+  s.gamma() = VecD<double>(kModes);
+  s.qd = VecQ<double>(6 + kModes);
+  for (int d = 0; d < kModes; ++d) s.gamma()[d] = 0.3 * normal(*rng);
+  for (int i = 0; i < s.qd.size(); ++i) s.qd[i] = (i < 3 ? 40.0 : 1.0) * normal(*rng);
   return s;
 }
 
 // The state moved by h along tangent coordinate i: (t + δt, R exp(ε̂), γ + δγ, v + δv).
-BodyState3<double> Moved(const BodyState3<double>& s, int i, double h) {
-  BodyState3<double> m = s;
+BodyState<3, double> Moved(const BodyState<3, double>& s, int i, double h) {
+  BodyState<3, double> m = s;
   if (i < 3) {
-    m.t[i] += h;
+    m.translation()[i] += h;
   } else if (i < 6) {
     Eigen::Vector3d eps = Eigen::Vector3d::Zero();
     eps[i - 3] = h;
-    m.orientation = s.orientation * ExpRotation<double>(eps);
+    m.set_orientation(s.orientation() * ExpRotation<double>(eps));
   } else if (i < 6 + kModes) {
-    m.gamma[i - 6] += h;
+    m.gamma()[i - 6] += h;
   } else {
-    m.v[i - 6 - kModes] += h;
+    m.qd[i - 6 - kModes] += h;
   }
   return m;
 }
 
 // Centre of mass and its velocity by the direct per-point formulas: x_k = t + R l_k,
 // ẋ_k = ṫ + R (ω × l_k + B_k γ̇), l_k = b0_k + B_k γ, summed with the point masses.
-void PerPointCentre(const BodyModel3& body, const BodyState3<double>& s, Eigen::Vector3d* x, Eigen::Vector3d* v) {
-  const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
-  const Eigen::Vector3d omega = s.v.segment<3>(3);
+void PerPointCentre(const BodyModel3& body, const BodyState<3, double>& s, Eigen::Vector3d* x, Eigen::Vector3d* v) {
+  const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
+  const Eigen::Vector3d omega = s.qd.segment<3>(3);
   double m = 0.0;
   x->setZero();
   v->setZero();
   for (int k = 0; k < body.num_points(); ++k) {
-    const Eigen::Vector3d l = body.rest_local(k) + body.mode_matrix(k) * s.gamma;
-    *x += body.mass(k) * (s.t + R * l);
-    *v += body.mass(k) * (s.v.head<3>() + R * (omega.cross(l) + body.mode_matrix(k) * s.v.tail(kModes)));
+    const Eigen::Vector3d l = body.rest_local(k) + body.mode_matrix(k) * s.gamma();
+    *x += body.mass(k) * (s.translation() + R * l);
+    *v += body.mass(k) * (s.qd.head<3>() + R * (omega.cross(l) + body.mode_matrix(k) * s.qd.tail(kModes)));
     m += body.mass(k);
   }
   *x /= m;
@@ -72,7 +72,7 @@ void PerPointCentre(const BodyModel3& body, const BodyState3<double>& s, Eigen::
 TEST(Spacetime3, CentreOfMassTermsMeasureThePerPointCentre) {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 5; ++trial) {
-    const BodyState3<double> s = RandomState(&rng);
+    const BodyState<3, double> s = RandomState(&rng);
     Eigen::Vector3d x, v;
     PerPointCentre(Chair(), s, &x, &v);
     // with goal 0 and weight 1 the gradient in δt (δṫ) is the centre (its velocity) itself
@@ -101,7 +101,7 @@ TEST(Spacetime3, TaskTermsHaveTheirExactGradients) {
   };
   std::mt19937 rng(11);
   for (int trial = 0; trial < 3; ++trial) {
-    const BodyState3<double> s = RandomState(&rng);
+    const BodyState<3, double> s = RandomState(&rng);
     for (size_t t = 0; t < terms.size(); ++t) {
       Eigen::VectorXd dz = Eigen::VectorXd::Zero(kNz);
       EXPECT_EQ(terms[t](3, s, &dz), 0.0) << "another step adds nothing";
@@ -126,13 +126,13 @@ TEST(Spacetime3, TaskTermsHaveTheirExactGradients) {
 
 // A tilted chair turned by a yaw stays upright; one tipped over does not.
 TEST(Spacetime3, UprightIgnoresHeadingOnly) {
-  BodyState3<double> s;
-  s.gamma = VecD<double>::Zero(kModes);
-  s.v = VecQ3<double>::Zero(6 + kModes);
+  BodyState<3, double> s = RestState<3, double>(Chair());
+  s.gamma() = VecD<double>::Zero(kModes);
+  s.qd = VecQ<double>::Zero(6 + kModes);
   Eigen::VectorXd dz = Eigen::VectorXd::Zero(kNz);
-  s.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitY()));
+  s.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitY())));
   EXPECT_NEAR(fit::UprightAt3(0, 1.0)(0, s, &dz), 0.0, 1e-15);
-  s.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  s.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())));
   EXPECT_NEAR(fit::UprightAt3(0, 1.0)(0, s, &dz), 1.0, 1e-12);  // w (1 − cos 90°)
 }
 
@@ -145,9 +145,10 @@ fit::SpacetimeProblem3 SquashAtTheEnd(double goal, double bound, int steps, int 
   r.world.ground.enabled = false;
   r.integrator = Integrator::kSymplecticEuler;
   r.dt = 0.01;
-  r.start.t = Eigen::Vector3d(0.0, 100.0, 0.0);
-  r.start.gamma = VecD<double>::Zero(kModes);
-  r.start.v = VecQ3<double>::Zero(6 + kModes);
+  r.start = RestState<3, double>(Chair());
+  r.start.translation() = Eigen::Vector3d(0.0, 100.0, 0.0);
+  r.start.gamma() = VecD<double>::Zero(kModes);
+  r.start.qd = VecQ<double>::Zero(6 + kModes);
   // a period of about 0.6 s per mode, damped at about a fifth of critical (the generalized
   // masses are read from the body so the gains fit whatever the sampling)
   r.stiffness = Eigen::VectorXd(kModes);
@@ -163,9 +164,9 @@ fit::SpacetimeProblem3 SquashAtTheEnd(double goal, double bound, int steps, int 
   p.lower = Eigen::VectorXd::Constant(kModes, -bound);
   p.upper = Eigen::VectorXd::Constant(kModes, bound);
   p.control_weight = 1e-3;
-  p.task = fit::SumOf3({fit::StillAt3(steps, 1e3), [goal, steps](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) {
+  p.task = fit::SumOf3({fit::StillAt3(steps, 1e3), [goal, steps](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
                           if (n != steps) return 0.0;
-                          const double miss = s.gamma[2] - goal, w = 1e4;
+                          const double miss = s.gamma()[2] - goal, w = 1e4;
                           (*dz)[6 + 2] += w * miss;
                           return 0.5 * w * miss * miss;
                         }});
@@ -180,8 +181,8 @@ TEST(Spacetime3, ReachesTheGoalAtTheEndWithinBounds) {
   fit::ControlledRollout3 run = p.rollout;
   run.targets = r.targets;
   double squash = 0.0, speed = 0.0;
-  fit::RolloutCost3(Chair(), run, [&](int n, const BodyState3<double>& s, Eigen::VectorXd*) {
-    if (n == steps) squash = s.gamma[2], speed = s.v.norm();
+  fit::RolloutCost3(Chair(), run, [&](int n, const BodyState<3, double>& s, Eigen::VectorXd*) {
+    if (n == steps) squash = s.gamma()[2], speed = s.qd.norm();
     return 0.0;
   });
   EXPECT_NEAR(squash, 0.2, 2e-3) << r.message << " iterations " << r.iterations;

@@ -60,10 +60,10 @@ BodyDef BallDef() {
 std::vector<Eigen::Vector2d> ForcePerFace(const World& w) {
   const Ground& g = w.options().params.ground;
   const BodyModel& body = w.body(0);
-  const BodyState<double>& s = w.state(0);
-  const Frame<double> frame(s.q);
+  const BodyState<2, double>& s = w.state(0);
+  const Frame<2, double> frame(s.q);
   std::vector<Eigen::Vector2d> per_face(g.terrain->num_faces(), Eigen::Vector2d::Zero());
-  for (const Contact<double>& c : s.contacts) {
+  for (const Contact<2, double>& c : s.contacts) {
     const Vec2<double> l = LocalPosition<double>(body.rest_local(c.point), body.mode_matrix(c.point), s.q);
     bool slipping;
     per_face[c.face] += GroundForce(g.Face(c.face), WorldFromLocal(frame, l),
@@ -74,14 +74,14 @@ std::vector<Eigen::Vector2d> ForcePerFace(const World& w) {
 
 Eigen::Vector2d CentreOfMass(const World& w) {
   const MassMoments& mm = w.body(0).moments();
-  const Frame<double> frame(w.state(0).q);
+  const Frame<2, double> frame(w.state(0).q);
   return frame.t + frame.R * (mm.c0 / mm.m);
 }
 
 Eigen::Vector2d CentreOfMassVelocity(const World& w) {
   const MassMoments& mm = w.body(0).moments();
-  const BodyState<double>& s = w.state(0);
-  const Frame<double> frame(s.q);
+  const BodyState<2, double>& s = w.state(0);
+  const Frame<2, double> frame(s.q);
   return Eigen::Vector2d(s.qd[0], s.qd[1]) + s.qd[2] * (frame.R * Perp(Vec2<double>(mm.c0 / mm.m)));
 }
 
@@ -206,7 +206,7 @@ TEST(Terrain, BlockInAValleyCornerFeelsBothFaces) {
     EXPECT_NEAR(f[face].dot(o.params.ground.Face(face).tau), 0.0, 1e-9 * weight);  // no friction
   }
   int corner_contacts = 0;
-  for (const Contact<double>& c : w.state(0).contacts) corner_contacts += c.point == 0;
+  for (const Contact<2, double>& c : w.state(0).contacts) corner_contacts += c.point == 0;
   EXPECT_EQ(corner_contacts, 2);
 }
 
@@ -262,16 +262,16 @@ TEST(Terrain, BallRollingOffACliffEdgeFollowsTheFreeFallParabola) {
   double wall_depth = 0;  // how far below the edge a point touched the cliff face
   while (w.time() < 12.0 && (samples.empty() || !samples.back().on_floor)) {
     ASSERT_TRUE(w.Step()) << w.status().message;
-    const BodyState<double>& s = w.state(0);
-    const Frame<double> frame(s.q);
+    const BodyState<2, double>& s = w.state(0);
+    const Frame<2, double> frame(s.q);
     for (int k = 0; k < w.body(0).num_points(); ++k) {
       const Eigen::Vector2d x = WorldFromLocal(frame, Vec2<double>(w.body(0).rest_local(k)));
       const bool has_contact =
-          std::any_of(s.contacts.begin(), s.contacts.end(), [k](const Contact<double>& c) { return c.point == k; });
+          std::any_of(s.contacts.begin(), s.contacts.end(), [k](const Contact<2, double>& c) { return c.point == k; });
       ASSERT_EQ(terrain.Inside(x), has_contact) << "point " << k << " at t = " << w.time();
     }
     Sample sample{w.time(), CentreOfMass(w), CentreOfMassVelocity(w), false, false};
-    for (const Contact<double>& c : s.contacts) {
+    for (const Contact<2, double>& c : s.contacts) {
       if (c.face == 1)  // the cliff face: only where the ball pivots over the edge
         wall_depth = std::max(wall_depth, 100 - WorldFromLocal(frame, Vec2<double>(w.body(0).rest_local(c.point))).y());
       (c.face == 2 ? sample.on_floor : sample.on_cliff) = true;
@@ -307,12 +307,12 @@ TEST(Terrain, GroupedScanVisitsExactlyThePointsBelowTheSurface) {
   g.terrain = MakeTerrain({{-200, 60}, {-40, 60}, {-40, 0}, {40, -10}, {60, 30}, {200, 30}});
   int partial = 0;
   for (int trial = 0; trial < 40; ++trial) {
-    BodyState<double> s;
+    BodyState<2, double> s;
     s.q = VecQ<double>::Zero(body.num_q());
     s.qd = VecQ<double>::Zero(body.num_q());
     s.q << 120 * u(rng), 30 + 30 * u(rng), 0.5 * u(rng), 0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng);
     std::vector<int> visited, expected;
-    const Frame<double> frame(s.q);
+    const Frame<2, double> frame(s.q);
     ForEachPointInContact(body, g, s, frame,
                           [&](int k, const Vec2<double>&, const Vec2<double>&, const Vec2<double>&,
                               const Vec2<double>&, const GroundFace&, int) { visited.push_back(k); });

@@ -55,7 +55,7 @@ void BindBodies3(py::module_& m) {
       "Make one with wobble.load_body3.")
       .def_property_readonly("name", &BodyModel3::name)
       .def_property_readonly("num_modes", &BodyModel3::num_modes)
-      .def_property_readonly("num_q", [](const BodyModel3& b) { return kRigidDofs3 + b.num_modes(); },
+      .def_property_readonly("num_q", [](const BodyModel3& b) { return Group<3>::kRigidDofs + b.num_modes(); },
                              "6 rigid coordinates + one per mode")
       .def_property_readonly("num_points", &BodyModel3::num_points, "mass points")
       .def_property_readonly("mode_names",
@@ -84,7 +84,7 @@ void BindBodies3(py::module_& m) {
       .def(
           "mesh_vertices",
           [](const BodyModel3& b, const py::object& q_in) {
-            const int n = kRigidDofs3 + b.num_modes();
+            const int n = Group<3>::kRigidDofs + b.num_modes();
             const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
             const Eigen::Quaterniond R = ExpRotation<double>(Eigen::Vector3d(q.segment<3>(3)));
             const Eigen::VectorXd gamma = q.tail(b.num_modes());
@@ -99,7 +99,7 @@ void BindBodies3(py::module_& m) {
       .def(
           "mass_points_at",
           [](const BodyModel3& b, const py::object& q_in) {
-            const int n = kRigidDofs3 + b.num_modes();
+            const int n = Group<3>::kRigidDofs + b.num_modes();
             const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
             std::vector<Eigen::Vector3d> x;
             for (int k = 0; k < b.num_points(); ++k) x.push_back(fit::PointPosition3(fit::BasisOf3(b, k, {}), q));
@@ -137,14 +137,14 @@ void BindBodies3(py::module_& m) {
           "qd3",
           [](const World& w, int body) {
             Check3(w, body);
-            return Eigen::VectorXd(w.state3(body).v);
+            return Eigen::VectorXd(w.state3(body).qd);
           },
           py::arg("body") = 0, "a copy of the 3D body's q̇ = [ṫ, body ω, γ̇]")
       .def(
           "set_state3",
           [](World& w, int body, const py::object& q, const py::object& qd) {
             Check3(w, body);
-            const long n = kRigidDofs3 + w.body3(body).num_modes();
+            const long n = Group<3>::kRigidDofs + w.body3(body).num_modes();
             scene::SetState3FromQ(&w, body, AsVector(q, n, "q"), qd.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(qd, n, "qd"));
           },
           py::arg("body"), py::arg("q"), py::arg("qd") = py::none(),

@@ -48,11 +48,11 @@ void QGradients(const Eigen::Vector3d& theta, const Eigen::VectorXd& dz, Eigen::
 // GIL taken for each call).
 fit::StageCost3 FromPython(py::function fn) {
   std::shared_ptr<py::function> held = HoldWithGil(std::move(fn));
-  return [held](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) -> double {
+  return [held](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) -> double {
     py::gil_scoped_acquire gil;
-    const Eigen::VectorXd q = QOfState3(s);
+    const Eigen::VectorXd q = CoordinatesOf(s);
     Eigen::VectorXd dq, dqd;
-    const double value = StageResult((*held)(n, q, Eigen::VectorXd(s.v)), n, q.size(), &dq, &dqd);
+    const double value = StageResult((*held)(n, q, Eigen::VectorXd(s.qd)), n, q.size(), &dq, &dqd);
     AddTangentGradient(q.segment<3>(3), dq, dqd, dz);
     return value;
   };
@@ -80,7 +80,7 @@ fit::ControlledRollout3 Rollout3Of(const BodyModel3& body, const WorldOptions& o
   r.integrator = options.integrator;
   CheckGradientIntegrator(r.integrator);
   r.dt = options.dt;
-  r.start = State3FromQ(VectorOr(q0, nq, Eigen::VectorXd::Zero(nq), "q0"),
+  r.start = StateFromCoordinates<3>(VectorOr(q0, nq, Eigen::VectorXd::Zero(nq), "q0"),
                         VectorOr(qd0, nq, Eigen::VectorXd::Zero(nq), "qd0"));
   GainsOf(body, stiffness, damping, &r.stiffness, &r.damping);
   r.targets = TargetsOf(targets, body.num_modes());
@@ -113,10 +113,10 @@ void BindGradients3(py::module_& m) {
       .def(
           "__call__",
           [](const StageCost3Handle& c, int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-            if (q.size() != qd.size() || q.size() < kRigidDofs3)
+            if (q.size() != qd.size() || q.size() < Group<3>::kRigidDofs)
               throw InputError("q and qd must have the same size, at least 6");
             Eigen::VectorXd dz = Eigen::VectorXd::Zero(2 * q.size()), dq, dqd;
-            const double value = c.cost(n, State3FromQ(q, qd), &dz);
+            const double value = c.cost(n, StateFromCoordinates<3>(q, qd), &dz);
             QGradients(q.segment<3>(3), dz, &dq, &dqd);
             return py::make_tuple(value, dq, dqd);
           },
@@ -179,7 +179,7 @@ void BindGradients3(py::module_& m) {
           py::gil_scoped_release release;  // a Python stage cost takes it back for its own calls
           out.g = Checked("rollout_gradient3", [&] { return fit::RolloutCostGradient3(*body, r, cost.cost, checkpoint_interval); });
         }
-        if (out.g.ok) QGradients(LogRotation<double>(r.start.orientation), out.g.start, &out.q0, &out.qd0);
+        if (out.g.ok) QGradients(LogRotation<double>(r.start.orientation()), out.g.start, &out.q0, &out.qd0);
         return out;
       },
       py::arg("body"), py::arg("cost"), py::kw_only(), py::arg("targets"), py::arg("options") = WorldOptions(),

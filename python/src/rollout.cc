@@ -40,7 +40,7 @@ void SetStart(World* w, const BodyModel3&, const Eigen::VectorXd& q, const Eigen
   scene::SetState3FromQ(w, 0, q, qd);
 }
 void ReadState(const World& w, const BodyModel&, double* q, double* qd) {
-  const BodyState<double>& s = w.state(0);
+  const BodyState<2, double>& s = w.state(0);
   std::copy(s.q.data(), s.q.data() + s.q.size(), q);
   std::copy(s.qd.data(), s.qd.data() + s.qd.size(), qd);
 }

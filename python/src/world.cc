@@ -23,7 +23,7 @@ void CheckLinear(const World& w, int body) {
   if (w.kind(body) != BodyKind::kLinear) throw InputError("body " + std::to_string(body) + " is not a linear body");
 }
 
-py::dict ForcesDict(const ForceBreakdown<double>& f) {
+py::dict ForcesDict(const ForceBreakdown<2, double>& f) {
   py::dict d;
   d["gravity"] = Eigen::VectorXd(f.gravity);
   d["modes"] = Eigen::VectorXd(f.modes);
@@ -376,8 +376,8 @@ void BindWorld(py::module_& m) {
             CheckLinear(w, body);
             const LinearContacts& c = w.linear_contacts(body);
             py::list out;
-            for (const Contact<double>& k : c.list2) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
-            for (const Contact3<double>& k : c.list3) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
+            for (const Contact<2, double>& k : c.list2) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
+            for (const Contact<3, double>& k : c.list3) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
             return out;
           },
           py::arg("body"), "A linear body's ground contacts: (mass point, face, anchor) each")

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "wobble/dynamics/kinematics.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 
 namespace wobble::analysis {
 namespace {
@@ -152,7 +152,7 @@ std::vector<SweepSample> AngleSweep(const BodyDef3& def, const std::vector<doubl
   std::vector<SweepSample> out;
   for (double phi : phis) {
     const BodyModel3 body(def, {vertical, SquashMode3(def.lattice, phi, squash, "squash(phi)")});
-    out.push_back({phi, MassMatrixCondition(body, RestState3<double>(body))});
+    out.push_back({phi, MassMatrixCondition(body, RestState<3, double>(body))});
   }
   return out;
 }
@@ -172,7 +172,7 @@ namespace {
 template <int Dim>
 ModeSetReport CheckModes(const BodyModelN<Dim>& body, const Eigen::MatrixXd& M, const ModeCheckOptions& options) {
   const int D = body.num_modes(), nq = body.num_q();
-  constexpr int kRigid = Dim == 2 ? kRigidDofs : kRigidDofs3;
+  constexpr int kRigid = Group<Dim>::kRigidDofs;
   ModeSetReport report;
   if (Dim == 2)
     report.dofs = {"translation x", "translation y", "rotation"};
@@ -306,17 +306,17 @@ ModeSetReport CheckModeSet(const BodyModel& body, const Eigen::VectorXd& q_in, c
 }
 
 ModeSetReport CheckModeSet(const BodyModel3& body, const ModeCheckOptions& options) {
-  const BodyState3<double> rest = RestState3<double>(body);
-  const ShapeMoments3<double> sm(body.moments(), rest.gamma);
-  MatQ3<double> M;
-  MassMatrix3(body.moments(), sm, Mat3<double>(Mat3<double>::Identity()), &M);
+  const BodyState<3, double> rest = RestState<3, double>(body);
+  const ShapeMoments<double> sm(body.moments(), rest.gamma());
+  MatQ<double> M;
+  MassMatrix(body.moments(), sm, Mat3<double>(Mat3<double>::Identity()), &M);
   return CheckModes(body, Eigen::MatrixXd(M), options);
 }
 
-ConditionNumber MassMatrixCondition(const BodyModel3& body, const BodyState3<double>& s) {
-  const ShapeMoments3<double> sm(body.moments(), s.gamma);
-  MatQ3<double> M;
-  MassMatrix3(body.moments(), sm, Mat3<double>(s.orientation.toRotationMatrix()), &M);
+ConditionNumber MassMatrixCondition(const BodyModel3& body, const BodyState<3, double>& s) {
+  const ShapeMoments<double> sm(body.moments(), s.gamma());
+  MatQ<double> M;
+  MassMatrix(body.moments(), sm, Mat3<double>(s.orientation().toRotationMatrix()), &M);
   return Condition(Eigen::MatrixXd(M));
 }
 

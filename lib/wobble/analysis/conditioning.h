@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "wobble/body/body_model.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 
 namespace wobble::analysis {
 
@@ -28,7 +28,7 @@ ConditionNumber Condition(const Eigen::MatrixXd& M);
 // M(q) of a body (from its mass moments).
 ConditionNumber MassMatrixCondition(const BodyModel& body, const Eigen::VectorXd& q);
 // M of a 3D body at state s.
-ConditionNumber MassMatrixCondition(const BodyModel3& body, const BodyState3<double>& s);
+ConditionNumber MassMatrixCondition(const BodyModel3& body, const BodyState<3, double>& s);
 
 // Estimate of cond₁(A) = ‖A‖₁ ‖A⁻¹‖₁ by Hager's method (Higham's refinement of the iteration):
 // a few solves with an LU factorization, never A⁻¹ itself. A lower bound of cond₁, usually

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "wobble/body/group.h"
 #include "wobble/body/lattice.h"
 #include "wobble/body/mode.h"
 #include "wobble/body/surface_mesh.h"
@@ -128,8 +129,10 @@ template <int Dim> class BodyModelN {
   const LatticeN<Dim>& lattice() const { return def_.lattice; }
   const std::vector<DeformationModeN<Dim>>& modes() const { return modes_; }
   int num_modes() const { return int(modes_.size()); }
-  // generalized velocities: 3 + D in 2D (ṫ, θ̇, γ̇), 6 + D in 3D (ṫ, body ω, γ̇)
-  int num_q() const { return (Dim == 2 ? kRigidDofs : kRigidDofs3) + num_modes(); }
+  // velocities (the size of M): 3 + D in 2D (ṫ, θ̇, γ̇), 6 + D in 3D (ṫ, body ω, γ̇)
+  int num_q() const { return NumVelocities<Dim>(num_modes()); }
+  // positions: 3 + D in 2D (t, θ, γ), 7 + D in 3D (t, a unit quaternion, γ); group.h
+  int num_positions() const { return NumPositions<Dim>(num_modes()); }
   int num_points() const { return int(def_.masses.size()); }
   double mass(int k) const { return def_.masses[k]; }
   const Point& lattice_coords(int k) const { return lattice_coords_[k]; }

@@ -22,17 +22,17 @@ Eigen::VectorXd PdForces(const Modes& modes, const G& gamma, const Gd& gamma_dot
 }
 }  // namespace
 
-Eigen::VectorXd ModeControlForces(const BodyModel& body, const BodyState<double>& s) {
+Eigen::VectorXd ModeControlForces(const BodyModel& body, const BodyState<2, double>& s) {
   const int D = body.num_modes();
   return PdForces(body.modes(), s.q.tail(D), s.qd.tail(D), s.mode_target);
 }
 
-Eigen::VectorXd ModeControlForces(const BodyModel3& body, const BodyState3<double>& s) {
+Eigen::VectorXd ModeControlForces(const BodyModel3& body, const BodyState<3, double>& s) {
   const int D = body.num_modes();
-  return PdForces(body.modes(), s.gamma, s.v.tail(D), s.mode_target);
+  return PdForces(body.modes(), s.gamma(), s.qd.tail(D), s.mode_target);
 }
 
-void ControlEnergy::Accumulate(const BodyModel& body, const BodyState<double>& s, double dt) {
+void ControlEnergy::Accumulate(const BodyModel& body, const BodyState<2, double>& s, double dt) {
   const Eigen::VectorXd f = ModeControlForces(body, s);
   for (int d = 0; d < f.size(); ++d) {
     const double power = f[d] * s.qd[kRigidDofs + d];
@@ -41,11 +41,11 @@ void ControlEnergy::Accumulate(const BodyModel& body, const BodyState<double>& s
   }
 }
 
-void ControlEnergy::Accumulate(const BodyModel3& body, const BodyState3<double>& s, double dt) {
+void ControlEnergy::Accumulate(const BodyModel3& body, const BodyState<3, double>& s, double dt) {
   const Eigen::VectorXd f = ModeControlForces(body, s);
-  const int first = kRigidDofs3;
+  const int first = Group<3>::kRigidDofs;
   for (int d = 0; d < f.size(); ++d) {
-    const double power = f[d] * s.v[first + d];
+    const double power = f[d] * s.qd[first + d];
     consumed += std::abs(power) * dt;
     work += power * dt;
   }
@@ -144,7 +144,7 @@ Eigen::Vector2d PointAt(const BodyModel& body, const Eigen::Vector2d& lattice_co
   Mat2D<double> B;
   body.LocalBasis(lattice_coords, &b0, &B);
   const VecQ<double> qq = q;
-  return WorldFromLocal(Frame<double>(qq), LocalPosition<double>(b0, B, qq));
+  return WorldFromLocal(Frame<2, double>(qq), LocalPosition<double>(b0, B, qq));
 }
 
 void KeyframedState(const BodyModel& body, const HeldPoint& hold, const Eigen::Vector2d& anchor,
@@ -174,7 +174,7 @@ void KeyframedState3(const BodyModel3& body, const HeldPoint& hold, const Eigen:
                      const Eigen::VectorXd& gamma, const Eigen::VectorXd& gamma_dot, Eigen::Vector3d* t,
                      Eigen::VectorXd* v) {
   const int D = body.num_modes();
-  v->setZero(kRigidDofs3 + D);
+  v->setZero(Group<3>::kRigidDofs + D);
   v->tail(D) = gamma_dot;
   if (!hold.enabled) {
     *t = translation;

@@ -61,14 +61,14 @@ KeyframeController::KeyframeController(World& world, int body, Keyframes keys, H
     const BodyModel3& model = world.body3(body);
     const std::string invalid = keys_.Validate(model.num_modes());
     if (!invalid.empty()) throw std::invalid_argument("keyframe: " + invalid);
-    const BodyState3<double>& s = world.state3(body);
-    translation3_ = s.t;
-    orientation_ = s.orientation;
+    const BodyState<3, double>& s = world.state3(body);
+    translation3_ = s.translation();
+    orientation_ = s.orientation();
     if (hold_.enabled) {
       Eigen::Vector3d b0;
       Mat3D<double> B;
       model.LocalBasis(hold_.lattice_coords3, &b0, &B);
-      anchor3_ = s.t + s.orientation * (b0 + B * s.gamma);
+      anchor3_ = s.translation() + s.orientation() * (b0 + B * s.gamma());
     }
     world.SetKinematic(body, true);
     Place(world, 0.0);

@@ -1,5 +1,5 @@
-// Fixed-capacity Eigen types for generalized coordinates q = [tx, ty, θ, γ1..γD] (Eq. 4.4),
-// and for the 3D body's velocities.
+// Fixed-capacity Eigen types for a body's positions q and velocities q̇ (Eq. 4.4; group.h has
+// the layout of both dimensions: at most 7 + kMaxModes positions, 6 + kMaxModes velocities).
 //
 // Sizes are dynamic but bounded, so per-step vectors and matrices live on the stack: a step
 // of the 11-point table must not touch the heap. Every dynamics routine is a template on the
@@ -11,9 +11,9 @@
 
 namespace wobble {
 
-constexpr int kRigidDofs = 3;   // tx, ty, θ
+constexpr int kRigidDofs = 3;   // tx, ty, θ of a 2D body (Group<2>::kRigidDofs)
 constexpr int kMaxModes = 12;   // deformation modes per body
-constexpr int kMaxQ = kRigidDofs + kMaxModes;
+constexpr int kMaxQ = 7 + kMaxModes;  // a 3D body's positions: t, a unit quaternion, γ
 
 template <class T> using Vec2 = Eigen::Matrix<T, 2, 1>;
 template <class T> using Mat2 = Eigen::Matrix<T, 2, 2>;
@@ -24,15 +24,9 @@ template <class T> using MatD = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic,
 template <class T, int Dim> using MatND = Eigen::Matrix<T, Dim, Eigen::Dynamic, 0, Dim, kMaxModes>;
 template <class T> using Mat2D = MatND<T, 2>;
 
-// 3D bodies: generalized velocities v = [ṫ (3, world), ω (3, body frame), γ̇1..γ̇D]; the
-// orientation is a unit quaternion of the state, not a coordinate (no Euler-angle singularity).
-constexpr int kRigidDofs3 = 6;
-constexpr int kMaxQ3 = kRigidDofs3 + kMaxModes;
 template <class T> using Vec3 = Eigen::Matrix<T, 3, 1>;
 template <class T> using Mat3 = Eigen::Matrix<T, 3, 3>;
 template <class T> using Mat3D = MatND<T, 3>;
-template <class T> using VecQ3 = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, kMaxQ3, 1>;
-template <class T> using MatQ3 = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxQ3, kMaxQ3>;
 
 // R(θ) of Eq. 4.3.
 template <class T> Mat2<T> Rotation(const T& theta) {

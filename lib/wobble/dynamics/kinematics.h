@@ -8,47 +8,66 @@
 #pragma once
 
 #include "wobble/body/body_model.h"
+#include "wobble/body/group.h"
 #include "wobble/core/types.h"
 #include "wobble/core/cholesky.h"
 
 namespace wobble {
 
-// Body-frame position l = b0 + B γ of a point with rest position b0 and mode matrix B.
-template <class T, class Derived>
-Vec2<T> LocalPosition(const Eigen::Vector2d& b0, const Eigen::MatrixBase<Derived>& B, const VecQ<T>& q) {
-  Vec2<T> l = b0.cast<T>();
-  for (int d = 0; d < B.cols(); ++d) l += B.col(d).template cast<T>() * q[kRigidDofs + d];
+// Body-frame position l = b0 + B γ of a point with rest position b0 and mode matrix B, γ read
+// from the positions q (group.h's layout). A plain loop over B's contiguous columns: this runs
+// for every point of every contact scan, and Eigen's per-column expressions over a
+// dynamic-width map cost three times as much in 3D.
+template <class T, int Dim, class Derived>
+Eigen::Matrix<T, Dim, 1> LocalPosition(const Eigen::Matrix<double, Dim, 1>& b0, const Eigen::MatrixBase<Derived>& B,
+                                       const VecQ<T>& q) {
+  Eigen::Matrix<T, Dim, 1> l = b0.template cast<T>();
+  const int D = int(B.cols());
+  const T* gamma = q.data() + Group<Dim>::kRigidParams;
+  for (int d = 0; d < D; ++d)
+    for (int i = 0; i < Dim; ++i) l[i] += T(B(i, d)) * gamma[d];
   return l;
 }
 
-// The rigid part of q: translation t and R(θ), computed once per evaluation (sin and cos
-// per point would dominate a step of a small body).
-template <class T> struct Frame {
-  explicit Frame(const VecQ<T>& q) : t(q[0], q[1]), R(Rotation(q[2])) {}
-  Vec2<T> t;
-  Mat2<T> R;
+// The rigid part of q: translation t and rotation matrix R, computed once per evaluation (sin
+// and cos, or the quaternion's matrix, per point would dominate a step of a small body).
+template <int Dim, class T> struct Frame {
+  explicit Frame(const VecQ<T>& q) : t(q.template head<Dim>()), R(Group<Dim>::RotationOf(q)) {}
+  Eigen::Matrix<T, Dim, 1> t;
+  Eigen::Matrix<T, Dim, Dim> R;
 };
 
 // World position x = t + R l (Eq. 4.2).
-template <class T> Vec2<T> WorldFromLocal(const Frame<T>& frame, const Vec2<T>& l) { return frame.t + frame.R * l; }
-
-// World velocity J q̇ = ṫ + R S l θ̇ + R B γ̇.
-template <class T, class Derived>
-Vec2<T> PointVelocity(const Frame<T>& frame, const VecQ<T>& qd, const Vec2<T>& l, const Eigen::MatrixBase<Derived>& B) {
-  Vec2<T> v_local = Perp(l) * qd[2];
-  for (int d = 0; d < B.cols(); ++d) v_local += B.col(d).template cast<T>() * qd[kRigidDofs + d];
-  return Vec2<T>(qd[0], qd[1]) + frame.R * v_local;
+template <int Dim, class T>
+Eigen::Matrix<T, Dim, 1> WorldFromLocal(const Frame<Dim, T>& frame, const Eigen::Matrix<T, Dim, 1>& l) {
+  return frame.t + frame.R * l;
 }
 
-// Adds Jᵀ f (Eq. 4.20) for a world force f at a point with local position l and mode matrix B.
-template <class T, class Derived>
-void AddGeneralizedForce(const Frame<T>& frame, const Vec2<T>& l, const Eigen::MatrixBase<Derived>& B,
-                         const Vec2<T>& f, VecQ<T>* Q) {
-  const Vec2<T> f_local = frame.R.transpose() * f;  // Rᵀ f
-  (*Q)[0] += f[0];
-  (*Q)[1] += f[1];
-  (*Q)[2] += Perp(l).dot(f_local);  // (R S l)·f = (S l)·(Rᵀ f)
-  for (int d = 0; d < B.cols(); ++d) (*Q)[kRigidDofs + d] += B.col(d).template cast<T>().dot(f_local);
+// World velocity J q̇ = ṫ + R (ω × l + B γ̇) (Eq. 4.6–4.8; planar ω × l = ω S l).
+template <int Dim, class T, class Derived>
+Eigen::Matrix<T, Dim, 1> PointVelocity(const Frame<Dim, T>& frame, const VecQ<T>& qd, const Eigen::Matrix<T, Dim, 1>& l,
+                                       const Eigen::MatrixBase<Derived>& B) {
+  Eigen::Matrix<T, Dim, 1> v_local = Group<Dim>::Turn(qd, l);
+  const T* gamma_dot = qd.data() + Group<Dim>::kRigidDofs;
+  for (int d = 0; d < B.cols(); ++d)
+    for (int i = 0; i < Dim; ++i) v_local[i] += T(B(i, d)) * gamma_dot[d];
+  return qd.template head<Dim>() + frame.R * v_local;
+}
+
+// Adds Jᵀ f (Eq. 4.20) for a world force f at a point with local position l and mode matrix B:
+// Q_t += f, Q_ω += l × Rᵀf, Q_γ += Bᵀ Rᵀ f.
+template <int Dim, class T, class Derived>
+void AddGeneralizedForce(const Frame<Dim, T>& frame, const Eigen::Matrix<T, Dim, 1>& l,
+                         const Eigen::MatrixBase<Derived>& B, const Eigen::Matrix<T, Dim, 1>& f, VecQ<T>* Q) {
+  const Eigen::Matrix<T, Dim, 1> f_local = frame.R.transpose() * f;
+  Q->template head<Dim>() += f;
+  Group<Dim>::AddTorque(l, f_local, Q);
+  T* Q_gamma = Q->data() + Group<Dim>::kRigidDofs;
+  for (int d = 0; d < B.cols(); ++d) {
+    T sum = T(B(0, d)) * f_local[0];
+    for (int i = 1; i < Dim; ++i) sum += T(B(i, d)) * f_local[i];
+    Q_gamma[d] += sum;
+  }
 }
 
 // M(q) from the moments:
@@ -168,6 +187,16 @@ void VelocityTerms(const MassMoments& mm, const VecQ<T>& q, const VecQ<T>& qd, c
 }
 template <class T> void VelocityTerms(const MassMoments& mm, const VecQ<T>& q, const VecQ<T>& qd, VecQ<T>* w) {
   VelocityTerms(mm, q, qd, Rotation(q[2]), w);
+}
+
+// q̈ of Eq. 4.21, M q̈ = Q − w, by SolveMassSystem (the dimension's own mass solve; the 3D one
+// is in spatial_inertia.h).
+template <class T>
+bool SolveAccelerations(const MassMoments& mm, const VecQ<T>& q, const VecQ<T>& qd, const Mat2<T>& R, const VecQ<T>& Q,
+                        VecQ<T>* qdd, double* cond_estimate) {
+  VecQ<T> w;
+  VelocityTerms(mm, q, qd, R, &w);
+  return SolveMassSystem(mm, q, R, VecQ<T>(Q - w), qdd, cond_estimate);
 }
 
 // Generalized gravity force Σ m_k J_kᵀ g = [m g ; (R S (c0 + Cγ))·g ; (R C)ᵀ g].

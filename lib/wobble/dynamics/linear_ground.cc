@@ -50,10 +50,10 @@ bool ClearOf(const LinearBodyModel& m, const GroundPlane& g, const Eigen::Matrix
 }
 
 // Visits every point below the 2D ground as f(k, p, x, v, anchor, face, face_index), once per
-// face it feels (ForEachFaceFelt of forces.h, the FFD bodies' rules).
+// face it feels (ForEachFaceFelt of ground_line.h, the FFD bodies' rules).
 template <class F>
 void ForEachContact2(const LinearBodyModel& m, const Ground& g, const Eigen::MatrixXd& R, const Eigen::MatrixXd& R_dot,
-                     const std::vector<Contact<double>>& contacts, F&& f) {
+                     const std::vector<Contact<2, double>>& contacts, F&& f) {
   if (!g.enabled || ClearOf(m, g, R)) return;
   const GroundFace line = g.Face(0);
   const Eigen::MatrixXd& P = m.point_bases();
@@ -75,16 +75,16 @@ void ForEachContact2(const LinearBodyModel& m, const Ground& g, const Eigen::Mat
 }
 
 // Visits every point below the 3D ground (plane or heightfield) as f(k, p, x, v, anchor, face,
-// face_index), once per face it feels (ForEachFaceFelt3 of step3.h, the FFD bodies' rules).
+// face_index), once per face it feels (ForEachFaceFelt of ground_plane.h, the FFD bodies' rules).
 template <class F>
 void ForEachContact3(const LinearBodyModel& m, const GroundPlane& g, const Eigen::MatrixXd& R,
-                     const Eigen::MatrixXd& R_dot, const std::vector<Contact3<double>>& contacts, F&& f) {
+                     const Eigen::MatrixXd& R_dot, const std::vector<Contact<3, double>>& contacts, F&& f) {
   if (!g.enabled || ClearOf(m, g, R)) return;
   const Eigen::MatrixXd& P = m.point_bases();
   for (int k = 0; k < m.num_points(); ++k) {
     const double* p = P.col(k).data();
     const Vec3<double> x = Times<3>(R, p);
-    ForEachFaceFelt3(g, x, [&] { return ContactsOfPoint3(contacts, k); },
+    ForEachFaceFelt(g, x, [&] { return ContactsOfPoint(contacts, k); },
                      [&](int face_index, const GroundPlane& face, const Vec3<double>& anchor) {
                        f(k, p, x, Times<3>(R_dot, p), anchor, face, face_index);
                      });
@@ -110,14 +110,14 @@ void AddLinearGroundForce(const LinearBodyModel& model, const LinearGround& g, c
   }
   ForEachContact3(model, g.plane, R, R_dot, contacts.list3,
                   [&](int, const double* p, const Vec3<double>& x, const Vec3<double>& v, const Vec3<double>& anchor,
-                      const GroundPlane& face, int) { AddPointForce<3>(GroundForce3(face, x, v, anchor, &slipping), p, Q); });
+                      const GroundPlane& face, int) { AddPointForce<3>(GroundForce(face, x, v, anchor, &slipping), p, Q); });
 }
 
 void UpdateLinearContacts(const LinearBodyModel& model, const LinearGround& g, const Eigen::MatrixXd& R,
                           const Eigen::MatrixXd& R_dot, LinearContacts* contacts) {
   double deepest = 0.0;
   if (model.dim() == 2) {
-    thread_local std::vector<Contact<double>> next;  // no heap traffic while a body rests
+    thread_local std::vector<Contact<2, double>> next;  // no heap traffic while a body rests
     next.clear();
     ForEachContact2(model, g.ground, R, R_dot, contacts->list2,
                     [&](int k, const double*, const Vec2<double>& x, const Vec2<double>& v, Vec2<double> anchor,
@@ -130,14 +130,14 @@ void UpdateLinearContacts(const LinearBodyModel& model, const LinearGround& g, c
                     });
     contacts->list2.swap(next);
   } else {
-    thread_local std::vector<Contact3<double>> next;
+    thread_local std::vector<Contact<3, double>> next;
     next.clear();
     ForEachContact3(model, g.plane, R, R_dot, contacts->list3,
                     [&](int k, const double*, const Vec3<double>& x, const Vec3<double>& v, Vec3<double> anchor,
                         const GroundPlane& face, int face_index) {
                       bool slipping;
-                      Vec3<double> f = GroundForce3(face, x, v, anchor, &slipping);
-                      if (slipping) SlipAnchor3(face, x, v, &anchor, &f);
+                      Vec3<double> f = GroundForce(face, x, v, anchor, &slipping);
+                      if (slipping) SlipAnchor(face, x, v, &anchor, &f);
                       next.push_back({k, anchor, face_index});
                       deepest = std::max(deepest, -face.Height(x));
                     });
@@ -150,9 +150,9 @@ double LinearGroundEnergy(const LinearBodyModel& model, const LinearGround& g, c
                           const LinearContacts& contacts) {
   const Eigen::MatrixXd& P = model.point_bases();
   double energy = 0.0;
-  for (const Contact<double>& c : contacts.list2)
+  for (const Contact<2, double>& c : contacts.list2)
     energy += 0.5 * g.ground.Face(c.face).stiffness * (Times<2>(R, P.col(c.point).data()) - c.anchor).squaredNorm();
-  for (const Contact3<double>& c : contacts.list3)
+  for (const Contact<3, double>& c : contacts.list3)
     energy += 0.5 * g.plane.stiffness * (Times<3>(R, P.col(c.point).data()) - c.anchor).squaredNorm();
   return energy;
 }
@@ -163,14 +163,14 @@ std::vector<Eigen::VectorXd> LinearContactForces(const LinearBodyModel& model, c
   const Eigen::MatrixXd& P = model.point_bases();
   std::vector<Eigen::VectorXd> forces;
   bool slipping;
-  for (const Contact<double>& c : contacts.list2) {
+  for (const Contact<2, double>& c : contacts.list2) {
     const double* p = P.col(c.point).data();
     forces.push_back(GroundForce(g.ground.Face(c.face), Times<2>(R, p), Times<2>(R_dot, p), c.anchor, &slipping));
   }
-  for (const Contact3<double>& c : contacts.list3) {
+  for (const Contact<3, double>& c : contacts.list3) {
     const double* p = P.col(c.point).data();
     const Vec3<double> x = Times<3>(R, p);
-    forces.push_back(GroundForce3(g.plane.Face(c.face, x), x, Times<3>(R_dot, p), c.anchor, &slipping));
+    forces.push_back(GroundForce(g.plane.Face(c.face, x), x, Times<3>(R_dot, p), c.anchor, &slipping));
   }
   return forces;
 }

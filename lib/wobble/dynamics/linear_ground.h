@@ -13,15 +13,15 @@
 
 #include "wobble/body/linear_body.h"
 #include "wobble/dynamics/forces.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 
 namespace wobble {
 
 // The contacts of one linear body: `list2` on a 2D ground (sorted by point, then face),
 // `list3` on the 3D plane (sorted by point); the deepest point at the last update.
 struct LinearContacts {
-  std::vector<Contact<double>> list2;
-  std::vector<Contact3<double>> list3;
+  std::vector<Contact<2, double>> list2;
+  std::vector<Contact<3, double>> list3;
   double penetration = 0.0;
   int size() const { return int(list2.size() + list3.size()); }
   void clear() {

@@ -1,6 +1,6 @@
 // The names of step.h's enums: integrators (as the CLI, scripts and Python spell them) and
 // status codes. Here, beside their declarations, so that the dynamics layer links on its own.
-#include "wobble/dynamics/step.h"
+#include "wobble/dynamics/status.h"
 
 namespace wobble {
 

@@ -44,12 +44,12 @@ void SeedState(const VecQ<double>& q, const VecQ<double>& qd, int offset, VecQ<J
 }
 
 // g += (∂(state)/∂(chunk inputs))ᵀ λ: every output of a step, weighted by its adjoint.
-void PullState(const BodyState<Jet>& s, const Adjoint& lambda, int offset, Eigen::VectorXd* g) {
+void PullState(const BodyState<2, Jet>& s, const Adjoint& lambda, int offset, Eigen::VectorXd* g) {
   for (int i = 0; i < s.q.size(); ++i) {
     Pull(s.q[i], lambda.q[i], offset, g);
     Pull(s.qd[i], lambda.qd[i], offset, g);
   }
-  for (const Contact<Jet>& c : s.contacts) {
+  for (const Contact<2, Jet>& c : s.contacts) {
     const auto it = lambda.anchor.find({c.point, c.face});
     if (it == lambda.anchor.end()) continue;
     Pull(c.anchor[0], it->second[0], offset, g);
@@ -82,15 +82,15 @@ class Rollout {
   int nq() const { return passive_.num_q(); }
   int modes() const { return passive_.num_modes(); }
 
-  BodyState<double> Start() const {
-    BodyState<double> s;
+  BodyState<2, double> Start() const {
+    BodyState<2, double> s;
     s.q = r_.q0;
     s.qd = r_.qd0;
     UpdateContacts(passive_, r_.world.ground, &s);
     return s;
   }
 
-  bool Step(int n, BodyState<double>* s, std::string* why) const {
+  bool Step(int n, BodyState<2, double>* s, std::string* why) const {
     const VecD<double> target = r_.targets.col(n);
     const StepStatus st = StepBody(passive_, r_.world, 0, r_.integrator, r_.dt, s, ModeForce<double>{&params_, &target});
     if (!st.ok()) return internal::StepFailed(n, StatusCodeName(st.code), why);
@@ -100,13 +100,13 @@ class Rollout {
 
   // λ_n from λ_{n+1} = `out` through step n taken from state s; adds the step's part of the
   // gains' gradient to *g and sets its targets' column.
-  bool StepVjp(int n, const BodyState<double>& s, const Adjoint& out, Adjoint* in, RolloutGradient* g,
+  bool StepVjp(int n, const BodyState<2, double>& s, const Adjoint& out, Adjoint* in, RolloutGradient* g,
                std::string* why) const {
     const int nq = this->nq(), D = modes(), nc = int(s.contacts.size());
     const int anchors = 2 * nq, controls = anchors + 2 * nc, width = controls + 3 * D;
     Eigen::VectorXd grad = Eigen::VectorXd::Zero(width);
     for (int offset = 0; offset < width; offset += kChunk) {
-      BodyState<Jet> sj;
+      BodyState<2, Jet> sj;
       SeedState(s.q, s.qd, offset, &sj.q, &sj.qd);
       sj.contacts.resize(nc);
       for (int c = 0; c < nc; ++c) {
@@ -158,20 +158,20 @@ class Rollout {
   // through x = t + R l and v = J q̇ (PullPoint).
   // The step's a is read back from the next state, a = (q̇' − q̇)/h (both integrators), exact
   // up to rounding (~1e-13 relative).
-  void HandVjp(int n, const BodyState<double>& s, const BodyState<double>& next, const Adjoint& out, Adjoint* in,
+  void HandVjp(int n, const BodyState<2, double>& s, const BodyState<2, double>& next, const Adjoint& out, Adjoint* in,
                RolloutGradient* g) const {
     const int nq = this->nq();
     const double h = r_.dt;
     const bool thesis = r_.integrator == Integrator::kThesis;
     Adjoint bar = out;  // λ of (q', q̇') once the anchors' update is pulled back
     std::map<ContactKey, Eigen::Vector2d> anchor_grad;  // of s's anchors
-    auto anchor_slot = [&](const Contact<double>* c) -> Eigen::Vector2d* {  // (Eigen leaves a new one unset)
+    auto anchor_slot = [&](const Contact<2, double>* c) -> Eigen::Vector2d* {  // (Eigen leaves a new one unset)
       return c ? &anchor_grad.try_emplace({c->point, c->face}, Eigen::Vector2d::Zero()).first->second : nullptr;
     };
-    for (const Contact<double>& c : next.contacts) {
+    for (const Contact<2, double>& c : next.contacts) {
       const auto it = out.anchor.find({c.point, c.face});
       if (it == out.anchor.end() || it->second.isZero(0.0)) continue;
-      const Contact<double>* before = Find(s, c);
+      const Contact<2, double>* before = Find(s, c);
       const ContactPoint p = PointAt(c, before, next.q, next.qd);
       PullPoint(p, AnchorUpdatePartials(p, it->second), next.qd, &bar.q, &bar.qd, anchor_slot(before));
     }
@@ -183,8 +183,8 @@ class Rollout {
     ForceVjp(n, Q, V, a, mu, &y, &gQ, &gV, g);
     // the ground force's part: y · Σ J_kᵀ f_k = Σ (J_k y) · f_k; at (q', q̇) the symplectic step
     // feels the contacts of the next state, with the anchors they had before it
-    for (const Contact<double>& c : thesis ? s.contacts : next.contacts) {
-      const Contact<double>* before = thesis ? &c : Find(s, c);
+    for (const Contact<2, double>& c : thesis ? s.contacts : next.contacts) {
+      const Contact<2, double>* before = thesis ? &c : Find(s, c);
       const ContactPoint p = PointAt(c, before, Q, V);
       const Eigen::Vector2d P = PointVelocity(p.frame, y, p.l, passive_.mode_matrix(c.point));  // J_k y
       bool slipping;
@@ -196,7 +196,7 @@ class Rollout {
     in->q = bar.q + gQ;
     in->qd = thesis ? VecQ<double>(h * bar.q + bar.qd + gV) : VecQ<double>(h * (bar.q + gQ) + bar.qd + gV);
     in->anchor.clear();
-    for (const Contact<double>& c : s.contacts) {
+    for (const Contact<2, double>& c : s.contacts) {
       const auto it = anchor_grad.find({c.point, c.face});
       in->anchor[{c.point, c.face}] = it == anchor_grad.end() ? Eigen::Vector2d::Zero() : it->second;
     }
@@ -210,7 +210,7 @@ class Rollout {
     Adjoint anchors_only{Eigen::VectorXd::Zero(nq), Eigen::VectorXd::Zero(nq), start.anchor};
     Eigen::VectorXd grad = Eigen::VectorXd::Zero(2 * nq);
     for (int offset = 0; offset < 2 * nq; offset += kChunk) {
-      BodyState<Jet> sj;
+      BodyState<2, Jet> sj;
       SeedState(r_.q0, r_.qd0, offset, &sj.q, &sj.qd);
       UpdateContacts(passive_, r_.world.ground, &sj);
       PullState(sj, anchors_only, offset, &grad);
@@ -220,8 +220,8 @@ class Rollout {
   }
 
  private:
-  static const Contact<double>* Find(const BodyState<double>& s, const Contact<double>& c) {
-    for (const Contact<double>& x : s.contacts)
+  static const Contact<2, double>* Find(const BodyState<2, double>& s, const Contact<2, double>& c) {
+    for (const Contact<2, double>& x : s.contacts)
       if (x.point == c.point && x.face == c.face) return &x;
     return nullptr;
   }
@@ -287,14 +287,14 @@ class Rollout {
   struct ContactPoint {
     int point;
     GroundFace face;
-    Frame<double> frame;
+    Frame<2, double> frame;
     Eigen::Vector2d l, x, v, anchor;
     bool fresh;
   };
-  ContactPoint PointAt(const Contact<double>& c, const Contact<double>* before, const VecQ<double>& Q,
+  ContactPoint PointAt(const Contact<2, double>& c, const Contact<2, double>* before, const VecQ<double>& Q,
                        const VecQ<double>& V) const {
     const GroundFace face = r_.world.ground.Face(c.face);
-    const Frame<double> frame(Q);
+    const Frame<2, double> frame(Q);
     const Eigen::Vector2d l = LocalPosition<double>(passive_.rest_local(c.point), passive_.mode_matrix(c.point), Q);
     const Eigen::Vector2d x = WorldFromLocal(frame, l);
     const Eigen::Vector2d v = PointVelocity(frame, V, l, passive_.mode_matrix(c.point));
@@ -417,8 +417,8 @@ double RolloutCost(const BodyModel& body, const ControlledRollout& rollout, cons
   Eigen::VectorXd dq(r.nq()), dqd(r.nq());
   std::string why;
   return internal::PlainRolloutCost(
-      rollout.steps(), r.Start(), [&](int n, BodyState<double>* s) { return r.Step(n, s, &why); },
-      [&](int n, const BodyState<double>& s) {
+      rollout.steps(), r.Start(), [&](int n, BodyState<2, double>* s) { return r.Step(n, s, &why); },
+      [&](int n, const BodyState<2, double>& s) {
         dq.setZero();
         dqd.setZero();
         return cost(n, s.q, s.qd, &dq, &dqd);
@@ -430,7 +430,7 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
   CheckRollout(body, rollout);
   const Rollout r(body, rollout);
   const int nq = r.nq(), D = r.modes(), N = rollout.steps();
-  const BodyState<double> start = r.Start();
+  const BodyState<2, double> start = r.Start();
   // a kept state: the struct and its contacts (the start's count: an estimate)
   const size_t state_bytes = sizeof(start) + start.contacts.size() * sizeof(start.contacts[0]);
   const int interval = CheckpointInterval(N, checkpoint_interval, state_bytes);
@@ -439,15 +439,15 @@ RolloutGradient RolloutCostGradient(const BodyModel& body, const ControlledRollo
   g.damping = Eigen::VectorXd::Zero(D);
   g.targets = Eigen::MatrixXd::Zero(D, N);
   Eigen::VectorXd dq(nq), dqd(nq);
-  auto stage = [&](int n, const BodyState<double>& s, Adjoint* lambda) {
+  auto stage = [&](int n, const BodyState<2, double>& s, Adjoint* lambda) {
     dq.setZero();
     dqd.setZero();
     g.cost += cost(n, s.q, s.qd, &dq, &dqd);
     lambda->q += dq;
     lambda->qd += dqd;
   };
-  auto step = [&](int n, BodyState<double>* s) { return r.Step(n, s, &g.message); };
-  auto vjp = [&](int n, const BodyState<double>& state, const BodyState<double>& next, const Adjoint& out, Adjoint* in) {
+  auto step = [&](int n, BodyState<2, double>* s) { return r.Step(n, s, &g.message); };
+  auto vjp = [&](int n, const BodyState<2, double>& state, const BodyState<2, double>& next, const Adjoint& out, Adjoint* in) {
     if (!r.ByHand()) return r.StepVjp(n, state, out, in, &g, &g.message);
     r.HandVjp(n, state, next, out, in, &g);
     return true;

@@ -20,13 +20,13 @@ void CheckRollout3(const BodyModel3& body, const ControlledRollout3& r) {
   if (r.integrator != Integrator::kThesis && r.integrator != Integrator::kSymplecticEuler)
     fail("the adjoint takes the thesis and symplectic integrators, not " + IntegratorName(r.integrator));
   if (!(r.dt > 0.0) || !std::isfinite(r.dt)) fail("dt must be positive and finite");
-  if (r.start.gamma.size() != D || r.start.v.size() != body.num_q())
+  if (r.start.gamma().size() != D || r.start.qd.size() != body.num_q())
     fail("the start needs " + std::to_string(D) + " mode amplitudes and " + std::to_string(body.num_q()) +
          " velocities (t dot, omega, gamma dot)");
   if (r.stiffness.size() != D || r.damping.size() != D) fail("stiffness and damping need one value per mode");
   if (r.targets.rows() != D) fail("targets need one row per mode (" + std::to_string(D) + ")");
-  const double q_norm = r.start.orientation.norm();
-  if (!r.start.t.allFinite() || !r.start.gamma.allFinite() || !r.start.v.allFinite() || !std::isfinite(q_norm) ||
+  const double q_norm = r.start.orientation().norm();
+  if (!r.start.translation().allFinite() || !r.start.gamma().allFinite() || !r.start.qd.allFinite() || !std::isfinite(q_norm) ||
       !r.stiffness.allFinite() || !r.damping.allFinite() || !r.targets.allFinite())
     fail("every number must be finite");
   if (!(q_norm > 1e-12)) fail("the orientation quaternion must not be zero");
@@ -43,26 +43,25 @@ class Rollout3 {
   int modes() const { return passive_.num_modes(); }
   int tangent() const { return StateTangentSize3(passive_); }
 
-  BodyState3<double> Start() const {
-    BodyState3<double> s;
-    s.t = r_.start.t;
-    s.orientation = r_.start.orientation.normalized();
-    s.gamma = r_.start.gamma;
-    s.v = r_.start.v;
-    UpdateContacts3(passive_, r_.world.ground, &s);
+  BodyState<3, double> Start() const {
+    BodyState<3, double> s;
+    s.q = r_.start.q;
+    Group<3>::Normalize(&s.q);
+    s.qd = r_.start.qd;
+    UpdateContacts(passive_, r_.world.ground, &s);
     return s;
   }
 
-  bool Step(int n, BodyState3<double>* s, std::string* why) const {
+  bool Step(int n, BodyState<3, double>* s, std::string* why) const {
     const VecD<double> target = r_.targets.col(n);
     const StepStatus st =
-        StepBody3(passive_, r_.world, r_.integrator, r_.dt, s, ModeForce<double>{&params_, &target});
+        StepBody(passive_, r_.world, 0, r_.integrator, r_.dt, s, ModeForce<double>{&params_, &target});
     if (!st.ok()) return internal::StepFailed(n, StatusCodeName(st.code), why);
     return true;
   }
 
   // Step n from *s like Step, keeping its tape (internal/step3_vjp.h) for StepVjp.
-  bool Record(int n, BodyState3<double>* s, internal::StepTape3* tape, std::string* why) const {
+  bool Record(int n, BodyState<3, double>* s, internal::StepTape3* tape, std::string* why) const {
     const VecD<double> target = r_.targets.col(n);
     const StepStatus st = internal::RecordStep3(Model(), target, *s, tape, s);
     if (!st.ok()) return internal::StepFailed(n, StatusCodeName(st.code), why);
@@ -71,12 +70,12 @@ class Rollout3 {
 
   // λ_n from λ_{n+1} = `out` through step n from state s, whose tape is `tape` (null: taken
   // again here); adds the step's part of the gains' gradient to *g and sets its targets' column.
-  bool StepVjp(int n, const BodyState3<double>& s, const internal::StepTape3* tape, const StateAdjoint3& out,
+  bool StepVjp(int n, const BodyState<3, double>& s, const internal::StepTape3* tape, const StateAdjoint3& out,
                StateAdjoint3* in, RolloutGradient3* g, std::string* why) const {
     const VecD<double> target = r_.targets.col(n);
     internal::StepTape3 fresh;
     if (!tape) {
-      BodyState3<double> next;
+      BodyState<3, double> next;
       const StepStatus st = internal::RecordStep3(Model(), target, s, &fresh, &next);
       if (!st.ok()) return internal::StepFailed(n, StatusCodeName(st.code) + " (differentiated step)", why);
       tape = &fresh;
@@ -111,8 +110,8 @@ double RolloutCost3(const BodyModel3& body, const ControlledRollout3& rollout, c
   Eigen::VectorXd dz(r.tangent());
   std::string why;
   return internal::PlainRolloutCost(
-      rollout.steps(), r.Start(), [&](int n, BodyState3<double>* s) { return r.Step(n, s, &why); },
-      [&](int n, const BodyState3<double>& s) {
+      rollout.steps(), r.Start(), [&](int n, BodyState<3, double>* s) { return r.Step(n, s, &why); },
+      [&](int n, const BodyState<3, double>& s) {
         dz.setZero();
         return cost(n, s, &dz);
       });
@@ -128,30 +127,30 @@ RolloutGradient3 RolloutCostGradient3(const BodyModel3& body, const ControlledRo
   g.damping = Eigen::VectorXd::Zero(D);
   g.targets = Eigen::MatrixXd::Zero(D, N);
   Eigen::VectorXd dz(nz);
-  auto stage = [&](int n, const BodyState3<double>& s, StateAdjoint3* lambda) {
+  auto stage = [&](int n, const BodyState<3, double>& s, StateAdjoint3* lambda) {
     dz.setZero();
     g.cost += cost(n, s, &dz);
     lambda->z += dz;
   };
-  auto step = [&](int n, BodyState3<double>* s) { return r.Step(n, s, &g.message); };
+  auto step = [&](int n, BodyState<3, double>* s) { return r.Step(n, s, &g.message); };
   // The recompute of an interval keeps each step's tape (slot n mod interval; `taped` says
   // which step a slot holds), so the product does not evaluate the step a third time: about
   // one simulation less per gradient (the interval's last step has none and is taken again,
   // except when the interval is the whole run, whose forward run keeps every tape).
-  const BodyState3<double> start = r.Start();
+  const BodyState<3, double> start = r.Start();
   // a kept step: its state and its tape (which holds two more), with the start's number of
   // contacts in each (an estimate)
   const size_t step_bytes =
-      sizeof(internal::StepTape3) + sizeof(start) + 3 * start.contacts.size() * sizeof(Contact3<double>);
+      sizeof(internal::StepTape3) + sizeof(start) + 3 * start.contacts.size() * sizeof(Contact<3, double>);
   const int interval = CheckpointInterval(N, checkpoint_interval, step_bytes);
   std::vector<internal::StepTape3> tapes(size_t(std::min(interval, std::max(N, 1))));
   std::vector<int> taped(tapes.size(), -1);
-  auto recompute = [&](int n, BodyState3<double>* s) {
+  auto recompute = [&](int n, BodyState<3, double>* s) {
     const size_t slot = size_t(n % int(tapes.size()));
     taped[slot] = n;
     return r.Record(n, s, &tapes[slot], &g.message);
   };
-  auto vjp = [&](int n, const BodyState3<double>& state, const BodyState3<double>&, const StateAdjoint3& out,
+  auto vjp = [&](int n, const BodyState<3, double>& state, const BodyState<3, double>&, const StateAdjoint3& out,
                  StateAdjoint3* in) {
     const size_t slot = size_t(n % int(tapes.size()));
     return r.StepVjp(n, state, taped[slot] == n ? &tapes[slot] : nullptr, out, in, &g, &g.message);

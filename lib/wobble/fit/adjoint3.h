@@ -30,16 +30,16 @@
 #include <string>
 
 #include "wobble/body/body_model.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 #include "wobble/fit/checkpoints.h"
 
 namespace wobble::fit {
 
 struct ControlledRollout3 {
-  WorldParams3 world;  // gravity, ground (plane or heightfield), springs
+  WorldParamsN<3> world;  // gravity, ground (plane or heightfield), springs
   Integrator integrator = Integrator::kThesis;  // kThesis or kSymplecticEuler
   double dt = 0.01;
-  BodyState3<double> start;            // t, orientation (normalized here), γ, v; contacts are found
+  BodyState<3, double> start;            // t, orientation (normalized here), γ, v; contacts are found
   Eigen::VectorXd stiffness, damping;  // K_d, c_d per mode (replace the body's own)
   Eigen::MatrixXd targets;             // modes × steps: γ0 during step n is column n
   int steps() const { return int(targets.cols()); }
@@ -50,7 +50,7 @@ int StateTangentSize3(const BodyModel3& body);
 
 // ℓ_n at state s: returns its value and adds ∂ℓ_n/∂z (tangent coordinates above) to *dz
 // (sized StateTangentSize3, zero on entry).
-using StageCost3 = std::function<double(int n, const BodyState3<double>& s, Eigen::VectorXd* dz)>;
+using StageCost3 = std::function<double(int n, const BodyState<3, double>& s, Eigen::VectorXd* dz)>;
 
 struct RolloutGradient3 {
   bool ok = false;

@@ -31,7 +31,7 @@
 
 #include "wobble/control/control.h"
 #include "wobble/dynamics/step.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 #include "wobble/fit/pose_fit.h"
 #include "wobble/fit/pose_fit3.h"
 
@@ -56,7 +56,7 @@ enum class FitGradient { kJets, kAdjoint };
 
 struct DynamicFitOptions {
   WorldParams world;    // gravity, ground, springs
-  WorldParams3 world3;  // the same for a 3D body
+  WorldParamsN<3> world3;  // the same for a 3D body
   double dt = 0.01;   // thesis integrator (Eq. 4.22/4.23), as `wobble simulate --integrator thesis`
   bool fit_q0 = true, fit_qd0 = true, fit_stiffness = true, fit_damping = true;
   bool fit_poses = false, fit_times = false;  // the controller's (needs a non-empty graph)

@@ -57,15 +57,15 @@ struct FrameCost3 {
   const Reference<3>* ref;
   std::vector<std::vector<int>> frames_at;
 
-  double operator()(int n, const BodyState3<double>& s, Eigen::VectorXd* dz) const {
+  double operator()(int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) const {
     if (n >= int(frames_at.size())) return 0.0;
-    const int D = int(s.gamma.size());
-    const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
+    const int D = int(s.gamma().size());
+    const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
     double cost = 0.0;
     for (int f : frames_at[n])
       for (const auto& p : ref->points[f]) {
-        const Eigen::Vector3d l = p.basis.b0 + p.basis.B * s.gamma;
-        const Eigen::Vector3d x = s.t + R * l;
+        const Eigen::Vector3d l = p.basis.b0 + p.basis.B * s.gamma();
+        const Eigen::Vector3d x = s.translation() + R * l;
         const double w = p.sqrt_weight * p.sqrt_weight;
         const Eigen::Vector3d r = w * (x - p.target), local = R.transpose() * r;
         cost += 0.5 * w * (x - p.target).squaredNorm();
@@ -153,15 +153,15 @@ template <> class FitRollout<3> {
     const int D = body.num_modes();
     const Eigen::Vector3d delta(b.q0[3], b.q0[4], b.q0[5]);
     // the start as Dimension<3>::Start makes it: t, chart · exp(δ̂), γ, v
-    rollout_.start = RestState3<double>(body);
-    rollout_.start.t = Eigen::Vector3d(b.q0[0], b.q0[1], b.q0[2]);
-    rollout_.start.orientation = (b.chart * ExpRotation<double>(delta)).normalized();
-    for (int d = 0; d < D; ++d) rollout_.start.gamma[d] = b.q0[size_t(kRigidDofs3 + d)];
-    rollout_.start.v = p.qd0;
+    rollout_.start = RestState<3, double>(body);
+    rollout_.start.translation() = Eigen::Vector3d(b.q0[0], b.q0[1], b.q0[2]);
+    Group<3>::SetOrientation(Eigen::Quaterniond(b.chart * ExpRotation<double>(delta)).normalized(), &rollout_.start.q);
+    for (int d = 0; d < D; ++d) rollout_.start.gamma()[d] = b.q0[size_t(Group<3>::kRigidDofs + d)];
+    rollout_.start.qd = p.qd0;
     rollout_.stiffness = p.stiffness;
     rollout_.damping = p.damping;
     rollout_.targets = std::move(targets);
-    const StageCost3 stage = [this](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) { return cost_(n, s, dz); };
+    const StageCost3 stage = [this](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) { return cost_(n, s, dz); };
     if (!gradient) {
       g->cost = RolloutCost3(body, rollout_, stage);
       return std::isfinite(g->cost);
@@ -170,11 +170,11 @@ template <> class FitRollout<3> {
     if (!r.ok) return false;
     TakeControls(&r, g);
     // z = (δt, ε, δγ, δv); the block's δ moves R = chart exp(δ̂) by ε = J_r(δ) δδ
-    g->q0.resize(kRigidDofs3 + D);
+    g->q0.resize(Group<3>::kRigidDofs + D);
     g->q0.head<3>() = r.start.head<3>();
     g->q0.segment<3>(3) = RightJacobianExp<double>(delta).transpose() * r.start.segment<3>(3);
     g->q0.tail(D) = r.start.segment(6, D);
-    g->qd0 = r.start.tail(kRigidDofs3 + D);
+    g->qd0 = r.start.tail(Group<3>::kRigidDofs + D);
     return true;
   }
 

@@ -29,7 +29,7 @@ namespace {
 
 template <class T> Vec3<T> Place(const PointBasis3& p, const Eigen::Matrix3d& R0, const T* x, int num_modes) {
   Vec3<T> l = p.b0.cast<T>();
-  for (int d = 0; d < num_modes; ++d) l += p.B.col(d).cast<T>() * x[kRigidDofs3 + d];
+  for (int d = 0; d < num_modes; ++d) l += p.B.col(d).cast<T>() * x[Group<3>::kRigidDofs + d];
   const Mat3<T> dR = ExpRotation<T>(Vec3<T>(x[3], x[4], x[5])).toRotationMatrix();
   return Vec3<T>(x[0], x[1], x[2]) + R0.cast<T>() * (dR * l);
 }
@@ -197,14 +197,14 @@ struct NearestSampleResidual3 {
   double sqrt_weight = 1.0;
   int num_modes = 0;
   template <class T> bool operator()(T const* const* x, T* r) const {
-    double xv[kMaxQ3];
-    for (int i = 0; i < kRigidDofs3 + num_modes; ++i) xv[i] = ScalarValue(x[0][i]);
+    double xv[kMaxQ];
+    for (int i = 0; i < Group<3>::kRigidDofs + num_modes; ++i) xv[i] = ScalarValue(x[0][i]);
     const Eigen::Matrix3d R = R0 * ExpRotation<double>(Eigen::Vector3d(xv[3], xv[4], xv[5])).toRotationMatrix();
     const Eigen::Vector3d t(xv[0], xv[1], xv[2]);
     int best = 0;
     double best_d2 = std::numeric_limits<double>::infinity();
     for (size_t k = 0; k < samples->size(); ++k) {
-      const double d2 = (PlaceValue((*samples)[k], R, t, xv + kRigidDofs3, num_modes) - y).squaredNorm();
+      const double d2 = (PlaceValue((*samples)[k], R, t, xv + Group<3>::kRigidDofs, num_modes) - y).squaredNorm();
       if (d2 < best_d2) best_d2 = d2, best = int(k);
     }
     const Vec3<T> e = (y.cast<T>() - Place((*samples)[best], R0, x[0], num_modes)) * T(sqrt_weight);
@@ -218,7 +218,7 @@ struct RestPrior3 {
   double sqrt_weight = 0;
   int num_modes = 0;
   template <class T> bool operator()(T const* const* x, T* r) const {
-    for (int d = 0; d < num_modes; ++d) r[d] = x[0][kRigidDofs3 + d] * T(sqrt_weight);
+    for (int d = 0; d < num_modes; ++d) r[d] = x[0][Group<3>::kRigidDofs + d] * T(sqrt_weight);
     return true;
   }
 };
@@ -232,13 +232,13 @@ template <class Functor> ceres::CostFunction* MakeCost(const Functor& f, int num
 
 // Adds the prior and the mode bounds of one pose's block.
 void AddPriorAndBounds(const PoseFitOptions& o, int num_modes, double* x, ceres::Problem* problem) {
-  const int n = kRigidDofs3 + num_modes;
+  const int n = Group<3>::kRigidDofs + num_modes;
   if (o.prior_weight > 0 && num_modes > 0)
     problem->AddResidualBlock(MakeCost(RestPrior3{std::sqrt(o.prior_weight), num_modes}, num_modes, 1, n), nullptr, x);
   if (!problem->HasParameterBlock(x)) return;
   for (int d = 0; d < num_modes; ++d) {
-    problem->SetParameterLowerBound(x, kRigidDofs3 + d, ModeLower(o, d));
-    problem->SetParameterUpperBound(x, kRigidDofs3 + d, ModeUpper(o, d));
+    problem->SetParameterLowerBound(x, Group<3>::kRigidDofs + d, ModeLower(o, d));
+    problem->SetParameterUpperBound(x, Group<3>::kRigidDofs + d, ModeUpper(o, d));
   }
 }
 
@@ -262,7 +262,7 @@ void SolvePose3(int num_modes, const PoseFitOptions& o, const AddTerms& add_term
                 FitReport* report) {
   Chart chart = Chart::At(*q);
   for (int d = 0; d < num_modes; ++d)
-    chart.x[kRigidDofs3 + d] = std::clamp(chart.x[kRigidDofs3 + d], ModeLower(o, d), ModeUpper(o, d));
+    chart.x[Group<3>::kRigidDofs + d] = std::clamp(chart.x[Group<3>::kRigidDofs + d], ModeLower(o, d), ModeUpper(o, d));
   constexpr int kMaxCharts = 8;
   for (int k = 0; k < kMaxCharts; ++k) {
     ceres::Problem problem;
@@ -286,7 +286,7 @@ Conditioning Conditioning3(const BodyModel3& body, const AddTerms& add_terms, co
   add_terms(chart, &problem);
   ceres::Problem::EvaluateOptions eval;
   problem.GetResidualBlocks(&eval.residual_blocks);
-  return ConditioningOfJacobian(DataJacobian(&problem, eval), CoordinateNames3(body), kRigidDofs3);
+  return ConditioningOfJacobian(DataJacobian(&problem, eval), CoordinateNames3(body), Group<3>::kRigidDofs);
 }
 
 
@@ -308,14 +308,14 @@ Eigen::VectorXd RigidStart3(int num_modes, const std::vector<Eigen::Vector3d>& r
   Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
   S(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;  // no reflection
   const Eigen::Matrix3d R = svd.matrixV() * S * svd.matrixU().transpose();
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(kRigidDofs3 + num_modes);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(Group<3>::kRigidDofs + num_modes);
   q.head<3>() = ys - R * ps;
   q.segment<3>(3) = LogRotation<double>(Eigen::Quaterniond(R));
   return q;
 }
 
 void CheckOptions3(const BodyModel3& body, const PoseFitOptions& o, const char* fit) {
-  const std::string error = ValidateOptions(o, body.num_modes(), kRigidDofs3);
+  const std::string error = ValidateOptions(o, body.num_modes(), Group<3>::kRigidDofs);
   if (!error.empty()) throw std::invalid_argument(std::string(fit) + ": " + error);
 }
 
@@ -346,7 +346,7 @@ PoseFitResult FitPose3(const BodyModel3& body, const std::vector<Correspondence3
     goal.push_back(t.position);
     weights.push_back(t.weight);
   }
-  const int D = body.num_modes(), n = kRigidDofs3 + D;
+  const int D = body.num_modes(), n = Group<3>::kRigidDofs + D;
   auto add_terms = [&](Chart& chart, ceres::Problem* problem) {
     ceres::LossFunction* loss = MakeLoss(o.loss, o.loss_scale);
     for (PointResidual3 r : data) {
@@ -449,7 +449,7 @@ PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& ta
   const std::vector<PointBasis3> samples = SurfaceSamples3(body, o);
   if (samples.empty()) throw std::invalid_argument("surface fit: the body has no samples (no mass points used, no mesh)");
   const SurfaceIndex surface(target);
-  const int D = body.num_modes(), n = kRigidDofs3 + D, ns = int(samples.size());
+  const int D = body.num_modes(), n = Group<3>::kRigidDofs + D, ns = int(samples.size());
   // the target's points for the reverse direction (mesh vertices and cloud), evenly spread
   std::vector<Eigen::Vector3d> reverse_points;
   if (o.two_sided) {
@@ -565,7 +565,7 @@ struct SecondDifference3 {
   template <class T> bool operator()(T const* const* x, T* r) const {
     for (int i = 0; i < 3; ++i) r[i] = (T(c0) * x[0][i] + T(c1) * x[1][i] + T(c2) * x[2][i]) * T(scale[i]);
     for (int d = 0; d < num_modes; ++d) {
-      const int i = kRigidDofs3 + d;
+      const int i = Group<3>::kRigidDofs + d;
       r[i] = (T(c0) * x[0][i] + T(c1) * x[1][i] + T(c2) * x[2][i]) * T(scale[i]);
     }
     Eigen::Quaternion<T> R[3];
@@ -585,7 +585,7 @@ TrajectoryFitResult FitKinematicTrajectory3(const BodyModel3& body, const std::v
   if (!(o.smoothness >= 0) || !std::isfinite(o.smoothness))
     throw std::invalid_argument("trajectory fit: smoothness must be >= 0");
   if (frames.empty()) throw std::invalid_argument("trajectory fit: no frames");
-  const int F = int(frames.size()), D = body.num_modes(), n = kRigidDofs3 + D;
+  const int F = int(frames.size()), D = body.num_modes(), n = Group<3>::kRigidDofs + D;
   for (int f = 1; f < F; ++f)
     if (!(frames[f].time > frames[f - 1].time))
       throw std::invalid_argument("trajectory fit: frame times must strictly increase");
@@ -606,9 +606,9 @@ TrajectoryFitResult FitKinematicTrajectory3(const BodyModel3& body, const std::v
     }
     charts[f] = Chart::At(po.initial_q.size() ? po.initial_q : RigidStart3(D, rest, goal, w));
     for (int d = 0; d < D; ++d)
-      charts[f].x[kRigidDofs3 + d] = std::clamp(charts[f].x[kRigidDofs3 + d], ModeLower(po, d), ModeUpper(po, d));
+      charts[f].x[Group<3>::kRigidDofs + d] = std::clamp(charts[f].x[Group<3>::kRigidDofs + d], ModeLower(po, d), ModeUpper(po, d));
   }
-  const VecQ3<double> L = SmoothnessScales3(body) * std::sqrt(o.smoothness);
+  const VecQ<double> L = SmoothnessScales3(body) * std::sqrt(o.smoothness);
   // one problem; re-centred (all charts) while some frame turned far from its chart's centre
   constexpr int kMaxCharts = 8;
   for (int k = 0; k < kMaxCharts; ++k) {

@@ -63,7 +63,7 @@ PoseFitResult FitPoseToSurface3(const BodyModel3& body, const SurfaceTarget3& ta
 
 // Length scales of the smoothness term, as SmoothnessScales in 2D: 1 for t, the rms radius
 // of the mass points for the rotation, the rms mass point displacement of each mode.
-VecQ3<double> SmoothnessScales3(const BodyModel3& body);
+VecQ<double> SmoothnessScales3(const BodyModel3& body);
 
 // q(t) for every frame, as FitKinematicTrajectory in 2D. The smoothness of the orientation
 // is the second difference on the group, c2 log(R_fᵀ R_f+1) − c0 log(R_f−1ᵀ R_f) (body-frame

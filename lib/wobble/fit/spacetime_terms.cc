@@ -127,12 +127,12 @@ StageCost3 CentreOfMassAt3(const BodyModel3& body, int step, const Eigen::Vector
   CheckTerm(step, weight, "CentreOfMassAt3");
   if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassAt3: the goal must be finite");
   const MassMoments3 mm = body.moments();
-  return [mm, step, goal, weight, axes](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) {
+  return [mm, step, goal, weight, axes](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
-    const Tangent3 z{int(s.gamma.size())};
-    const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
-    const Eigen::Vector3d c = (mm.c0 + mm.C * s.gamma) / mm.m;  // body frame
-    const Eigen::Vector3d miss = Masked(s.t + R * c - goal, axes);
+    const Tangent3 z{int(s.gamma().size())};
+    const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
+    const Eigen::Vector3d c = (mm.c0 + mm.C * s.gamma()) / mm.m;  // body frame
+    const Eigen::Vector3d miss = Masked(s.translation() + R * c - goal, axes);
     const Eigen::Vector3d r = weight * miss, r_body = R.transpose() * r;
     dz->segment<3>(z.t()) += r;                                   // ∂x/∂t = I
     dz->segment<3>(z.eps()) += c.cross(r_body);                   // R exp(ε̂) c ≈ R (c + ε × c)
@@ -146,14 +146,14 @@ StageCost3 CentreOfMassVelocityAt3(const BodyModel3& body, int step, const Eigen
   CheckTerm(step, weight, "CentreOfMassVelocityAt3");
   if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassVelocityAt3: the goal must be finite");
   const MassMoments3 mm = body.moments();
-  return [mm, step, goal, weight, axes](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) {
+  return [mm, step, goal, weight, axes](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
-    const Tangent3 z{int(s.gamma.size())};
-    const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
-    const Eigen::Vector3d c = (mm.c0 + mm.C * s.gamma) / mm.m;
-    const Eigen::Vector3d omega = s.v.segment<3>(3);
-    const Eigen::Vector3d w = omega.cross(c) + mm.C * s.v.tail(z.D) / mm.m;  // body-frame rate of R c
-    const Eigen::Vector3d miss = Masked(s.v.head<3>() + R * w - goal, axes);
+    const Tangent3 z{int(s.gamma().size())};
+    const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
+    const Eigen::Vector3d c = (mm.c0 + mm.C * s.gamma()) / mm.m;
+    const Eigen::Vector3d omega = s.qd.segment<3>(3);
+    const Eigen::Vector3d w = omega.cross(c) + mm.C * s.qd.tail(z.D) / mm.m;  // body-frame rate of R c
+    const Eigen::Vector3d miss = Masked(s.qd.head<3>() + R * w - goal, axes);
     const Eigen::Vector3d r = weight * miss, r_body = R.transpose() * r;
     // v_c = ṫ + R w: ∂/∂ṫ = I; ∂/∂ω: r·R(ω × c) = ω·(c × Rᵀr); ∂/∂γ̇ = R C/m;
     // ∂/∂ε: R exp(ε̂) w ≈ R (w + ε × w); ∂/∂γ: r·R(ω × C δγ/m) = δγ·Cᵀ(Rᵀr × ω)/m
@@ -170,12 +170,12 @@ StageCost3 UprightAt3(int step, double weight, double time_scale) {
   CheckTerm(step, weight, "UprightAt3");
   if (!(time_scale >= 0.0) || !std::isfinite(time_scale))
     throw std::invalid_argument("UprightAt3: the time scale must be >= 0");
-  return [step, weight, time_scale](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) {
+  return [step, weight, time_scale](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
-    const Tangent3 z{int(s.gamma.size())};
-    const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
+    const Tangent3 z{int(s.gamma().size())};
+    const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
     const Eigen::Vector3d up = Eigen::Vector3d::UnitY(), up_body = R.transpose() * up;
-    const Eigen::Vector3d omega = s.v.segment<3>(3);
+    const Eigen::Vector3d omega = s.qd.segment<3>(3);
     const double s2 = time_scale * time_scale;
     // |R e_y − e_y|² = 2 − 2 u_y with u_y = e_yᵀ R e_y; under R exp(ε̂), δu_y = ε·(e_y × Rᵀe_y)
     dz->segment<3>(z.eps()) += -weight * up.cross(up_body);
@@ -186,17 +186,17 @@ StageCost3 UprightAt3(int step, double weight, double time_scale) {
 
 StageCost3 StillAt3(int step, double weight) {
   CheckTerm(step, weight, "StillAt3");
-  return [step, weight](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) {
+  return [step, weight](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
-    dz->tail(s.v.size()) += weight * s.v;
-    return 0.5 * weight * s.v.squaredNorm();
+    dz->tail(s.qd.size()) += weight * s.qd;
+    return 0.5 * weight * s.qd.squaredNorm();
   };
 }
 
 StageCost3 SumOf3(std::vector<StageCost3> terms) {
   for (const StageCost3& t : terms)
     if (!t) throw std::invalid_argument("SumOf3: an empty term");
-  return [terms = std::move(terms)](int n, const BodyState3<double>& s, Eigen::VectorXd* dz) {
+  return [terms = std::move(terms)](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     double total = 0.0;
     for (const StageCost3& t : terms) total += t(n, s, dz);
     return total;

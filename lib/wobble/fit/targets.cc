@@ -55,7 +55,7 @@ PointBasis3 BasisOf3(const BodyModel3& body, int mass_point, const Eigen::Vector
 }
 
 Eigen::Vector3d PointPosition3(const PointBasis3& p, const Eigen::VectorXd& q) {
-  const Eigen::Vector3d local = p.b0 + p.B * q.tail(q.size() - kRigidDofs3);
+  const Eigen::Vector3d local = p.b0 + p.B * q.tail(q.size() - Group<3>::kRigidDofs);
   return q.head<3>() + ExpRotation<double>(q.segment<3>(3)) * local;
 }
 

@@ -59,7 +59,7 @@ std::vector<Frame> FramesOf(const BodyModelN<Dim>& body, const std::vector<doubl
 }  // namespace
 
 VecQ<double> SmoothnessScales(const BodyModel& body) { return ScalesOf(body); }
-VecQ3<double> SmoothnessScales3(const BodyModel3& body) { return ScalesOf(body); }
+VecQ<double> SmoothnessScales3(const BodyModel3& body) { return ScalesOf(body); }
 
 std::vector<ReferenceFrame> FramesFromStates(const BodyModel& body, const std::vector<double>& times,
                                              const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,

@@ -105,19 +105,19 @@ int Trajectory::Append(const World& world, double control_energy, int pose) {
     const Layout& l = layout_[b];
     const int nq = bodies_[b].num_q;
     if (bodies_[b].kind == BodyKind::kFfd) {
-      const BodyState<double>& s = world.state(b);
+      const BodyState<2, double>& s = world.state(b);
       Eigen::Map<Eigen::VectorXd>(row + l.q, nq) = s.q;
       Eigen::Map<Eigen::VectorXd>(row + l.qd, nq) = s.qd;
       if (s.mode_target.size() == l.num_targets) Eigen::Map<Eigen::VectorXd>(row + l.targets, l.num_targets) = s.mode_target;
       row[l.contacts] = double(s.contacts.size());
       row[l.contacts + 1] = s.penetration;
     } else if (bodies_[b].kind == BodyKind::kFfd3) {
-      const BodyState3<double>& s = world.state3(b);
-      Eigen::Map<Eigen::Vector3d>(row + l.q) = s.t;
-      const Eigen::Quaterniond& o = s.orientation;
+      const BodyState<3, double>& s = world.state3(b);
+      Eigen::Map<Eigen::Vector3d>(row + l.q) = s.translation();
+      const Eigen::Quaterniond& o = s.orientation();
       row[l.q + 3] = o.w(), row[l.q + 4] = o.x(), row[l.q + 5] = o.y(), row[l.q + 6] = o.z();
-      Eigen::Map<Eigen::VectorXd>(row + l.q + 7, s.gamma.size()) = s.gamma;
-      Eigen::Map<Eigen::VectorXd>(row + l.qd, bodies_[b].num_v) = s.v;
+      Eigen::Map<Eigen::VectorXd>(row + l.q + 7, s.gamma().size()) = s.gamma();
+      Eigen::Map<Eigen::VectorXd>(row + l.qd, bodies_[b].num_v) = s.qd;
       if (s.mode_target.size() == l.num_targets) Eigen::Map<Eigen::VectorXd>(row + l.targets, l.num_targets) = s.mode_target;
       row[l.contacts] = double(s.contacts.size());
       row[l.contacts + 1] = world.Penetration(b);

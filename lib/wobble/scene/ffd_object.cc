@@ -44,7 +44,7 @@ void FfdObject::Load(const std::string& path, const formats::MeshReader& read_me
   modes_.clear();
   modes3_.clear();
   mode_paths_.clear();
-  const int rigid = def3_ ? kRigidDofs3 : kRigidDofs;
+  const int rigid = def3_ ? Group<3>::kRigidDofs : kRigidDofs;
   q_.setZero(rigid);
   qd_.setZero(rigid);
   Place(dim(), placement_, &q_, &qd_);  // at rest where `trans` put it
@@ -54,7 +54,7 @@ void FfdObject::Load(const std::string& path, const formats::MeshReader& read_me
 
 // A new mode set (§4.10): amplitudes of modes with the same name carry over, others start at 0.
 template <class Modes> void FfdObject::Remember(Modes modes, std::vector<std::string> paths) {
-  const int rigid = def3_ ? kRigidDofs3 : kRigidDofs, n = rigid + int(modes.size());
+  const int rigid = def3_ ? Group<3>::kRigidDofs : kRigidDofs, n = rigid + int(modes.size());
   Eigen::VectorXd q = Eigen::VectorXd::Zero(n), qd = Eigen::VectorXd::Zero(n);
   q.head(rigid) = q_.head(rigid);
   qd.head(rigid) = qd_.head(rigid);
@@ -187,14 +187,14 @@ std::shared_ptr<const BodyModel3> FfdObject::Body3() const {
 }
 
 void SetState3FromQ(World* world, int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  const BodyState3<double> s = State3FromQ(q, qd);
-  world->SetState3(body, s.t, s.orientation, s.gamma, s.v);
+  const BodyState<3, double> s = StateFromCoordinates<3>(q, qd);
+  world->SetState3(body, s.translation(), s.orientation(), s.gamma(), s.qd);
 }
 
 void QFromState3(const World& world, int body, Eigen::VectorXd* q, Eigen::VectorXd* qd) {
-  const BodyState3<double>& s = world.state3(body);
-  *q = QOfState3(s);
-  *qd = s.v;
+  const BodyState<3, double>& s = world.state3(body);
+  *q = CoordinatesOf(s);
+  *qd = s.qd;
 }
 
 }  // namespace wobble::scene

@@ -64,7 +64,7 @@ class FfdObject {
   // The state in world coordinates (tx ty θ γ1..γD; 3D: tx ty tz rx ry rz γ1..γD).
   const Eigen::VectorXd& q() const { return q_; }
   const Eigen::VectorXd& qd() const { return qd_; }
-  int num_q() const { return (def3_ ? kRigidDofs3 : kRigidDofs) + num_modes(); }
+  int num_q() const { return (def3_ ? Group<3>::kRigidDofs : kRigidDofs) + num_modes(); }
   void SetState(const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
 
   // The body the runs step: the modes with codamA in the active modes' damping. Built once

@@ -65,7 +65,7 @@ WorldOptions Scene::ObjectWorldOptions3() const {
   o.springs_3d.clear();
   if (springs_.enabled && object_.dim() == 3)
     for (const LatticeSpring3& sp : springs_.list3)
-      o.springs_3d.push_back(MakeSpring3(*object_.Body3(), sp.lattice_coords, sp.anchor, sp.stiffness, sp.damping,
+      o.springs_3d.push_back(MakeSpring(*object_.Body3(), sp.lattice_coords, sp.anchor, sp.stiffness, sp.damping,
                                          sp.rest_length));
   return o;
 }

@@ -80,11 +80,11 @@ void CenterOfMassX(const BodyModel& body, const Eigen::VectorXd& q, const Eigen:
 void CenterOfMassX(const World& world, double* x, double* v) {
   if (world.kind(0) == BodyKind::kFfd) return CenterOfMassX(world.body(0), world.state(0).q, world.state(0).qd, x, v);
   const MassMoments3& mm = world.body3(0).moments();
-  const BodyState3<double>& s = world.state3(0);
-  const int D = int(s.gamma.size());
-  const Eigen::Vector3d l = (mm.c0 + mm.C * s.gamma) / mm.m;
-  const Eigen::Vector3d vel = s.v.head<3>() + s.orientation * (s.v.segment<3>(3).cross(l) + mm.C * s.v.tail(D) / mm.m);
-  *x = (s.t + s.orientation * l).x();
+  const BodyState<3, double>& s = world.state3(0);
+  const int D = int(s.gamma().size());
+  const Eigen::Vector3d l = (mm.c0 + mm.C * s.gamma()) / mm.m;
+  const Eigen::Vector3d vel = s.qd.head<3>() + s.orientation() * (s.qd.segment<3>(3).cross(l) + mm.C * s.qd.tail(D) / mm.m);
+  *x = (s.translation() + s.orientation() * l).x();
   *v = vel.x();
 }
 

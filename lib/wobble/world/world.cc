@@ -158,8 +158,8 @@ void World::AddSpring(Spring spring) {
   options_.params.springs.push_back(std::move(spring));
 }
 
-ForceBreakdown<double> World::Forces(int i) const {
-  ForceBreakdown<double> f;
+ForceBreakdown<2, double> World::Forces(int i) const {
+  ForceBreakdown<2, double> f;
   EvaluateForces(body(i), options_.params, i, state(i), &f);
   return f;
 }
@@ -173,9 +173,9 @@ Eigen::VectorXd World::Accelerations(int i) const {
 
 std::vector<Eigen::Vector2d> World::PointPositions(int i) const {
   const BodyModel& b = body(i);
-  const BodyState<double>& s = state(i);
+  const BodyState<2, double>& s = state(i);
   std::vector<Eigen::Vector2d> x(b.num_points());
-  const Frame<double> frame(s.q);
+  const Frame<2, double> frame(s.q);
   for (int k = 0; k < b.num_points(); ++k) x[k] = WorldFromLocal(frame, LocalPosition<double>(b.rest_local(k), b.mode_matrix(k), s.q));
   return x;
 }
@@ -390,8 +390,8 @@ Energies World::FfdEnergies(int i, ContactSet contacts, bool per_mode) const {
   Energies e;
   const WorldParams& p = options_.params;
   const BodyModel& b = body(i);
-  const BodyState<double>& s = state(i);
-  const Frame<double> frame(s.q);
+  const BodyState<2, double>& s = state(i);
+  const Frame<2, double> frame(s.q);
   e.kinetic = wobble::KineticEnergy(b.moments(), s.q, s.qd, frame.R);  // Eq. 4.9
   if (p.gravity_on) e.gravity = GravityEnergy(b.moments(), s.q, p.gravity);
   // K (γ − γ0)²: the potential whose gradient is the mode force, PD target γ0 included
@@ -450,14 +450,14 @@ bool World::EnergyFinite(int body) const {
 // normal step passes; one that does not has its energies computed (EnergyFinite).
 bool World::EnergySurelyFinite(const FfdEntry& e) const {
   constexpr double kScreen = 1e30;
-  const BodyState<double>& s = e.state;
+  const BodyState<2, double>& s = e.state;
   const WorldParams& p = options_.params;
   if (!(e.scale <= kScreen && s.q.cwiseAbs().maxCoeff() <= kScreen && s.qd.cwiseAbs().maxCoeff() <= kScreen))
     return false;
   if (s.mode_target.size() > 0 && !(s.mode_target.cwiseAbs().maxCoeff() <= kScreen)) return false;
   // a terrain's own stiffnesses are at most 1e30 (Terrain::Make)
   if (!(p.gravity.cwiseAbs().maxCoeff() <= kScreen && std::abs(p.ground.stiffness) <= kScreen)) return false;
-  for (const Contact<double>& c : s.contacts)
+  for (const Contact<2, double>& c : s.contacts)
     if (!(c.anchor.cwiseAbs().maxCoeff() <= kScreen)) return false;
   for (const Spring& sp : p.springs)
     if (!(std::abs(sp.stiffness) <= kScreen && std::abs(sp.rest_length) <= kScreen &&

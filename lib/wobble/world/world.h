@@ -41,7 +41,7 @@
 #include "wobble/body/linear_body.h"
 #include "wobble/dynamics/linear_ground.h"
 #include "wobble/dynamics/step.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 #include "wobble/world/controller.h"
 #include "wobble/world/multiplier_solver.h"
 #include "wobble/world/point_path.h"
@@ -83,9 +83,9 @@ struct WorldOptions {
   WorldParams params;
   Eigen::Vector3d gravity_3d = Eigen::Vector3d(0.0, -9.81, 0.0);
   // The ground plane of the 3D FFD bodies (off by default) and their springs to world
-  // anchors (each made for its body by MakeSpring3; they act on every 3D FFD body).
+  // anchors (each made for its body by MakeSpring; they act on every 3D FFD body).
   GroundPlane ground_3d;
-  std::vector<Spring3> springs_3d;
+  std::vector<SpringN<3>> springs_3d;
   // The FFD bodies' integrator while no constraint is enabled.
   Integrator integrator = Integrator::kThesis;
   double dt = 0.01;
@@ -101,7 +101,7 @@ struct WorldOptions {
 // The 3D FFD bodies' world from the options: gravity_3d (off with params.gravity_on),
 // ground_3d, springs_3d and params.max_condition. What World steps them in, and the world of
 // a 3D rollout (fit/adjoint3.h) built from the same options.
-WorldParams3 Params3Of(const WorldOptions& options);
+WorldParamsN<3> Params3Of(const WorldOptions& options);
 
 // A material point of a body. Linear bodies: u in undeformed coordinates (any point, inside
 // or outside the mass points). FFD bodies: u = lattice coordinates (s, t) in [0, 1]². Or
@@ -155,7 +155,7 @@ class World {
   // How deep the body's deepest contact point is below the ground now (0 without contacts):
   // BodyState::penetration in 2D, computed from the contacts in 3D, the linear contacts'.
   double Penetration(int body) const;
-  const BodyState3<double>& state3(int i) const;
+  const BodyState<3, double>& state3(int i) const;
   void SetState3(int body, const Eigen::Vector3d& t, const Eigen::Quaterniond& orientation,
                  const Eigen::VectorXd& gamma, const Eigen::VectorXd& v);
 
@@ -163,12 +163,12 @@ class World {
   // not enforce constraints: follow with ProjectVelocities() or let the feedback pull it in.
   const BodyModel& body(int i) const;
   const std::shared_ptr<const BodyModel>& shared_body(int i) const;  // for whoever outlives the world
-  const BodyState<double>& state(int i) const;
+  const BodyState<2, double>& state(int i) const;
   void SetState(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
   // PD targets γ0 of the body's modes (one per mode; empty: all zero), 2D and 3D FFD bodies.
   // See wobble/control.
   void SetModeTargets(int body, const Eigen::VectorXd& targets);
-  ForceBreakdown<double> Forces(int body) const;
+  ForceBreakdown<2, double> Forces(int body) const;
   Eigen::VectorXd Accelerations(int body) const;     // free q̈ (no constraint forces)
   std::vector<Eigen::Vector2d> PointPositions(int body) const;  // world positions of its mass points
 
@@ -313,13 +313,13 @@ class World {
   using PointVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
   struct FfdEntry {
     std::shared_ptr<const BodyModel> model;
-    BodyState<double> state;
+    BodyState<2, double> state;
     Eigen::VectorXd applied;  // Σ Jᵀ f of ApplyPointForce for the next step
     double scale = 0.0;       // the largest |number| of the model (ModelScale), for EnergyFinite
   };
   struct Ffd3Entry {
     std::shared_ptr<const BodyModel3> model;
-    BodyState3<double> state;
+    BodyState<3, double> state;
     Eigen::VectorXd applied;  // Σ Jᵀ f of ApplyPointForce for the next step
   };
   struct LinearEntry {
@@ -458,6 +458,6 @@ inline const World::FfdEntry& World::Ffd(int body) const {
 }
 inline World::FfdEntry& World::Ffd(int body) { return const_cast<FfdEntry&>(static_cast<const World*>(this)->Ffd(body)); }
 inline const BodyModel& World::body(int i) const { return *Ffd(i).model; }
-inline const BodyState<double>& World::state(int i) const { return Ffd(i).state; }
+inline const BodyState<2, double>& World::state(int i) const { return Ffd(i).state; }
 
 }  // namespace wobble

@@ -95,8 +95,8 @@ World::PointVec World::EndPosition(const End& e) const {
   if (b.kind == BodyKind::kLinear) {
     return TimesBasis(linear_[b.index].R, e.p);
   }
-  const BodyState<double>& s = ffd_[b.index].state;
-  return WorldFromLocal(Frame<double>(s.q), LocalPosition<double>(e.b0, e.B, s.q));
+  const BodyState<2, double>& s = ffd_[b.index].state;
+  return WorldFromLocal(Frame<2, double>(s.q), LocalPosition<double>(e.b0, e.B, s.q));
 }
 
 World::PointVec World::EndVelocity(const End& e) const {
@@ -105,8 +105,8 @@ World::PointVec World::EndVelocity(const End& e) const {
   if (b.kind == BodyKind::kLinear) {
     return TimesBasis(linear_[b.index].R_dot, e.p);
   }
-  const BodyState<double>& s = ffd_[b.index].state;
-  const Frame<double> frame(s.q);
+  const BodyState<2, double>& s = ffd_[b.index].state;
+  const Frame<2, double> frame(s.q);
   return wobble::PointVelocity(frame, s.qd, LocalPosition<double>(e.b0, e.B, s.q), e.B);
 }
 
@@ -122,8 +122,8 @@ void World::AddEndForce(const End& e, const Eigen::VectorXd& f, std::vector<Eige
     const int d = int(f.size()), n = int(e.p.size());
     AsMatrix(out, d, n) += f * e.p.transpose();  // Q = f pᵀ (§2.2)
   } else {
-    const BodyState<double>& s = ffd_[b.index].state;
-    const Frame<double> frame(s.q);
+    const BodyState<2, double>& s = ffd_[b.index].state;
+    const Frame<2, double> frame(s.q);
     VecQ<double> q = out;
     AddGeneralizedForce(frame, LocalPosition<double>(e.b0, e.B, s.q), e.B, Vec2<double>(f), &q);  // Jᵀ f (Eq. 4.20)
     out = q;
@@ -153,8 +153,8 @@ World::PointVec World::EndJdotQdot(const End& e) const {
   if (b.kind == BodyKind::kFfd3) return Ffd3EndJdotQdot(e);
   if (b.kind == BodyKind::kLinear) return PointVec::Zero(linear_[b.index].model->dim());  // J constant
   // J̇ q̇ = R(−θ̇² l + 2 θ̇ S B γ̇) (ARCHITECTURE.md, from Eq. 4.21's velocity terms)
-  const BodyState<double>& s = ffd_[b.index].state;
-  const Frame<double> frame(s.q);
+  const BodyState<2, double>& s = ffd_[b.index].state;
+  const Frame<2, double> frame(s.q);
   const Vec2<double> l = LocalPosition<double>(e.b0, e.B, s.q);
   const double thd = s.qd[2];
   Vec2<double> Bgd = Vec2<double>::Zero();
@@ -171,8 +171,8 @@ Eigen::MatrixXd World::EndJacobian(const End& e) const {
     for (int i = 0; i < d; ++i) J.block(i, i * n, 1, n) = e.p.transpose();
     return J;
   }
-  const BodyState<double>& s = ffd_[b.index].state;
-  const Frame<double> frame(s.q);
+  const BodyState<2, double>& s = ffd_[b.index].state;
+  const Frame<2, double> frame(s.q);
   const Vec2<double> l = LocalPosition<double>(e.b0, e.B, s.q);
   Eigen::MatrixXd J(2, s.q.size());  // [I | R S l | R B] (Eq. 4.6–4.8)
   J.leftCols(2).setIdentity();
@@ -208,7 +208,7 @@ void World::ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd
     return;
   }
   const BodyModel& m = (*ffd_[b.index].model);
-  const BodyState<double>& s = ffd_[b.index].state;
+  const BodyState<2, double>& s = ffd_[b.index].state;
   VecQ<double> x;
   double cond = 0;
   if (!SolveMassSystem(m.moments(), s.q, Rotation(s.q[2]), VecQ<double>(Q), &x, &cond)) {
@@ -706,8 +706,8 @@ bool World::ApplyImpulse(const std::vector<VelocityGoal>& goals, std::string* er
       const Slot& b = slots_[body];
       if (b.kind == BodyKind::kFfd3) {
         Ffd3Entry& e = ffd3_[b.index];
-        e.state.v += dv[body];
-        UpdateContacts3(*e.model, options_.ground_3d, &e.state);
+        e.state.qd += dv[body];
+        UpdateContacts(*e.model, options_.ground_3d, &e.state);
       } else if (b.kind == BodyKind::kLinear) {
         LinearEntry& e = linear_[b.index];
         e.R_dot += AsMatrix(dv[body], e.model->dim(), e.model->basis_size());

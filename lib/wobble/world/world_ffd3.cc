@@ -1,4 +1,4 @@
-// The 3D FFD bodies of the World: added, set and stepped with StepBody3 (dynamics/step3.h) on
+// The 3D FFD bodies of the World: added, set and stepped with StepBody (dynamics/step.h) on
 // the world's 3D gravity and ground plane, and the 3D FFD ends of nails, attachments,
 // trajectories and impulses: x = t + R l, J = [1 | −R[l]× | R B], J̇v = R(ω×(ω×l) + 2ω×Bγ̇)
 // (kinematics3.h). A constrained world steps them by semi-implicit Euler, velocity first, on
@@ -14,12 +14,12 @@ namespace wobble {
 int World::AddBody(std::shared_ptr<const BodyModel3> model) {
   if (!model) throw std::invalid_argument("AddBody: no model");
   Ffd3Entry e;
-  e.state = RestState3<double>(*model);
+  e.state = RestState<3, double>(*model);
   e.applied = Eigen::VectorXd::Zero(model->num_q());
   e.model = std::move(model);
   ffd3_.push_back(std::move(e));
   slots_.push_back({BodyKind::kFfd3, int(ffd3_.size()) - 1});
-  UpdateContacts3(*ffd3_.back().model, options_.ground_3d, &ffd3_.back().state);
+  UpdateContacts(*ffd3_.back().model, options_.ground_3d, &ffd3_.back().state);
   return num_bodies() - 1;
 }
 
@@ -49,19 +49,19 @@ double World::Penetration(int body) const {
   if (kind(body) == BodyKind::kFfd) return state(body).penetration;
   if (kind(body) == BodyKind::kLinear) return Linear(body).contacts.penetration;
   const BodyModel3& m = body3(body);
-  const BodyState3<double>& s = state3(body);
-  const Eigen::Matrix3d R = s.orientation.toRotationMatrix();
+  const BodyState<3, double>& s = state3(body);
+  const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
   double deepest = 0.0;
-  for (const Contact3<double>& c : s.contacts) {
-    const Eigen::Vector3d x = s.t + R * (m.rest_local(c.point) + m.mode_matrix(c.point) * s.gamma);
+  for (const Contact<3, double>& c : s.contacts) {
+    const Eigen::Vector3d x = s.translation() + R * (m.rest_local(c.point) + m.mode_matrix(c.point) * s.gamma());
     deepest = std::max(deepest, -options_.ground_3d.Face(c.face, x).Height(x));
   }
   return deepest;
 }
-const BodyState3<double>& World::state3(int i) const { return Ffd3(i).state; }
+const BodyState<3, double>& World::state3(int i) const { return Ffd3(i).state; }
 
-WorldParams3 Params3Of(const WorldOptions& options) {
-  WorldParams3 p;
+WorldParamsN<3> Params3Of(const WorldOptions& options) {
+  WorldParamsN<3> p;
   p.gravity_on = options.params.gravity_on;
   p.gravity = options.gravity_3d;
   p.ground = options.ground_3d;
@@ -82,13 +82,14 @@ void World::SetState3(int body, const Eigen::Vector3d& t, const Eigen::Quaternio
   if (!t.allFinite() || !orientation.coeffs().allFinite() || !gamma.allFinite() || !v.allFinite())
     throw InputError("body '" + m.name() + "': the state must be finite");
   if (!(orientation.norm() > 1e-12)) throw InputError("body '" + m.name() + "': the orientation quaternion is zero");
-  const BodyState3<double> before = e.state;
-  e.state.t = t;
-  e.state.orientation = orientation.normalized();
-  e.state.gamma = gamma;
-  e.state.v = v;
+  const BodyState<3, double> before = e.state;
+  e.state = RestState<3, double>(m);
+  e.state.translation() = t;
+  Group<3>::SetOrientation(orientation.normalized(), &e.state.q);
+  e.state.gamma() = gamma;
+  e.state.qd = v;
   e.state.contacts.clear();
-  UpdateContacts3(m, options_.ground_3d, &e.state);
+  UpdateContacts(m, options_.ground_3d, &e.state);
   const Energies energies = Ffd3Energies(body);
   if (std::isfinite(energies.total())) return;
   e.state = before;
@@ -96,11 +97,11 @@ void World::SetState3(int body, const Eigen::Vector3d& t, const Eigen::Quaternio
 }
 
 namespace {
-// The point forces of ApplyPointForce as StepBody3's extra generalized force; none (null) on
+// The point forces of ApplyPointForce as StepBody's extra generalized force; none (null) on
 // almost every step. One functor type for both cases: one instantiation of the step.
 struct AppliedForce3 {
   const Eigen::VectorXd* force = nullptr;
-  void operator()(const BodyState3<double>&, VecQ3<double>* Q) const {
+  void operator()(const BodyState<3, double>&, VecQ<double>* Q) const {
     if (force) *Q += *force;
   }
 };
@@ -108,9 +109,9 @@ struct AppliedForce3 {
 
 bool World::StepFfd3Body(int body) {
   Ffd3Entry& e = ffd3_[slots_[body].index];
-  const BodyState3<double> before = e.state;
+  const BodyState<3, double> before = e.state;
   const bool pushed = !e.applied.isZero(0.0);
-  const StepStatus st = StepBody3(*e.model, Params3Of(options_), options_.integrator, options_.dt, &e.state,
+  const StepStatus st = StepBody(*e.model, Params3Of(options_), 0, options_.integrator, options_.dt, &e.state,
                                   AppliedForce3{pushed ? &e.applied : nullptr});
   if (pushed) e.applied.setZero();
   if (st.ok() && std::isfinite(Ffd3Energies(body).total())) return true;
@@ -125,24 +126,24 @@ bool World::StepFfd3Body(int body) {
 Energies World::Ffd3Energies(int body) const {
   const Ffd3Entry& e = Ffd3(body);
   const BodyModel3& m = *e.model;
-  const BodyState3<double>& s = e.state;
-  const ShapeMoments3<double> sm(m.moments(), s.gamma);
-  const Frame3<double> frame(s.t, s.orientation);
+  const BodyState<3, double>& s = e.state;
+  const ShapeMoments<double> sm(m.moments(), s.gamma());
+  const Frame<3, double> frame(s.q);
   Energies out;
-  out.kinetic = KineticEnergy3(m.moments(), sm, frame.R, s.v);
-  if (options_.params.gravity_on) out.gravity = GravityEnergy3(m.moments(), sm, frame, options_.gravity_3d);
+  out.kinetic = wobble::KineticEnergy(m.moments(), sm, frame.R, s.qd);
+  if (options_.params.gravity_on) out.gravity = GravityEnergy(m.moments(), sm, frame, options_.gravity_3d);
   for (int d = 0; d < m.num_modes(); ++d) {
-    const double offset = s.gamma[d] - (s.mode_target.size() == m.num_modes() ? s.mode_target[d] : 0.0);
+    const double offset = s.gamma()[d] - (s.mode_target.size() == m.num_modes() ? s.mode_target[d] : 0.0);
     out.per_mode.push_back(m.modes()[d].stiffness * offset * offset);
     out.modes += out.per_mode.back();
   }
-  for (const Contact3<double>& c : s.contacts) {
-    const Eigen::Vector3d x = frame.t + frame.R * LocalPosition3<double>(m.rest_local(c.point), m.mode_matrix(c.point), s.gamma);
+  for (const Contact<3, double>& c : s.contacts) {
+    const Eigen::Vector3d x = frame.t + frame.R * LocalPosition<double>(m.rest_local(c.point), m.mode_matrix(c.point), s.q);
     out.ground += 0.5 * options_.ground_3d.Face(c.face, x).stiffness * (x - c.anchor).squaredNorm();
   }
   // springs: ½ K (|x − anchor| − L)², the potential of step3.h's force
-  for (const Spring3& sp : options_.springs_3d) {
-    const Eigen::Vector3d x = frame.t + frame.R * LocalPosition3<double>(sp.rest_local, sp.mode_matrix, s.gamma);
+  for (const SpringN<3>& sp : options_.springs_3d) {
+    const Eigen::Vector3d x = frame.t + frame.R * LocalPosition<double>(sp.rest_local, sp.mode_matrix, s.q);
     const double stretch = (x - sp.anchor).norm() - sp.rest_length;
     out.springs += 0.5 * sp.stiffness * stretch * stretch;
   }
@@ -171,31 +172,31 @@ void World::Ffd3Resolve(const MaterialPoint& point, End* e) const {
 }
 
 World::PointVec World::Ffd3EndPosition(const End& e) const {
-  const BodyState3<double>& s = Ffd3(e.body).state;
-  const Frame3<double> frame(s.t, s.orientation);
-  return frame.t + frame.R * LocalPosition3<double>(e.b0_3, e.B3, s.gamma);
+  const BodyState<3, double>& s = Ffd3(e.body).state;
+  const Frame<3, double> frame(s.q);
+  return frame.t + frame.R * LocalPosition<double>(e.b0_3, e.B3, s.q);
 }
 
 World::PointVec World::Ffd3EndVelocity(const End& e) const {
-  const BodyState3<double>& s = Ffd3(e.body).state;
-  const Frame3<double> frame(s.t, s.orientation);
-  return PointVelocity3(frame, s.v, LocalPosition3<double>(e.b0_3, e.B3, s.gamma), e.B3);
+  const BodyState<3, double>& s = Ffd3(e.body).state;
+  const Frame<3, double> frame(s.q);
+  return wobble::PointVelocity(frame, s.qd, LocalPosition<double>(e.b0_3, e.B3, s.q), e.B3);
 }
 
 World::PointVec World::Ffd3EndJdotQdot(const End& e) const {
-  const BodyState3<double>& s = Ffd3(e.body).state;
-  const Frame3<double> frame(s.t, s.orientation);
-  const Eigen::Vector3d l = LocalPosition3<double>(e.b0_3, e.B3, s.gamma);
-  const Eigen::Vector3d omega = s.v.segment<3>(3);
-  const Eigen::Vector3d Bgd = e.B3 * s.v.tail(e.B3.cols());
+  const BodyState<3, double>& s = Ffd3(e.body).state;
+  const Frame<3, double> frame(s.q);
+  const Eigen::Vector3d l = LocalPosition<double>(e.b0_3, e.B3, s.q);
+  const Eigen::Vector3d omega = s.qd.segment<3>(3);
+  const Eigen::Vector3d Bgd = e.B3 * s.qd.tail(e.B3.cols());
   return frame.R * (omega.cross(omega.cross(l)) + 2.0 * omega.cross(Bgd));
 }
 
 Eigen::MatrixXd World::Ffd3EndJacobian(const End& e) const {
-  const BodyState3<double>& s = Ffd3(e.body).state;
-  const Frame3<double> frame(s.t, s.orientation);
-  const Eigen::Vector3d l = LocalPosition3<double>(e.b0_3, e.B3, s.gamma);
-  Eigen::MatrixXd J(3, s.v.size());
+  const BodyState<3, double>& s = Ffd3(e.body).state;
+  const Frame<3, double> frame(s.q);
+  const Eigen::Vector3d l = LocalPosition<double>(e.b0_3, e.B3, s.q);
+  Eigen::MatrixXd J(3, s.qd.size());
   J.leftCols(3).setIdentity();
   J.block<3, 3>(0, 3) = -frame.R * Skew<double>(l);
   if (e.B3.cols() > 0) J.rightCols(e.B3.cols()) = frame.R * e.B3;
@@ -203,30 +204,30 @@ Eigen::MatrixXd World::Ffd3EndJacobian(const End& e) const {
 }
 
 void World::Ffd3AddEndForce(const End& e, const Eigen::VectorXd& f, Eigen::VectorXd* Q) const {
-  const BodyState3<double>& s = Ffd3(e.body).state;
-  const Frame3<double> frame(s.t, s.orientation);
-  VecQ3<double> q = *Q;
-  AddGeneralizedForce3(frame, LocalPosition3<double>(e.b0_3, e.B3, s.gamma), e.B3, Eigen::Vector3d(f), &q);
+  const BodyState<3, double>& s = Ffd3(e.body).state;
+  const Frame<3, double> frame(s.q);
+  VecQ<double> q = *Q;
+  AddGeneralizedForce(frame, LocalPosition<double>(e.b0_3, e.B3, s.q), e.B3, Eigen::Vector3d(f), &q);
   *Q = q;
 }
 
 void World::Ffd3ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const {
   const Ffd3Entry& e = Ffd3(body);
-  const ShapeMoments3<double> sm(e.model->moments(), e.state.gamma);
-  MatQ3<double> M;
-  MassMatrix3(e.model->moments(), sm, Mat3<double>(e.state.orientation.toRotationMatrix()), &M);
+  const ShapeMoments<double> sm(e.model->moments(), e.state.gamma());
+  MatQ<double> M;
+  MassMatrix(e.model->moments(), sm, Mat3<double>(e.state.orientation().toRotationMatrix()), &M);
   if (!CholeskyInPlace(&M)) {
     *acc = Eigen::VectorXd::Constant(acc->size(), std::nan(""));  // caught by the finite checks
     return;
   }
-  VecQ3<double> x = Q;
+  VecQ<double> x = Q;
   CholeskySolveInPlace(M, &x);
   *acc += x;
 }
 
 bool World::Ffd3FreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st) const {
-  VecQ3<double> a;
-  *st = Accelerations3(*Ffd3(body).model, Params3Of(options_), Ffd3(body).state, &a);
+  VecQ<double> a;
+  *st = wobble::Accelerations(*Ffd3(body).model, Params3Of(options_), 0, Ffd3(body).state, &a);
   if (!st->ok()) return false;
   *acc = a;
   if (!Ffd3(body).applied.isZero(0.0)) Ffd3ApplyGeneralized(body, Ffd3(body).applied, acc);
@@ -235,12 +236,12 @@ bool World::Ffd3FreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st)
 
 bool World::Ffd3AcceptConstrainedStep(int body, const Eigen::VectorXd& acc) {
   Ffd3Entry& e = ffd3_[slots_[body].index];
-  const BodyState3<double> before = e.state;
+  const BodyState<3, double> before = e.state;
   e.applied.setZero();  // acc holds it
-  e.state.v += options_.dt * acc;
-  AdvanceConfiguration3<double>(e.state.v, options_.dt, &e.state);
-  UpdateContacts3(*e.model, options_.ground_3d, &e.state);
-  if (e.state.v.allFinite() && e.state.t.allFinite() && e.state.gamma.allFinite() &&
+  e.state.qd += options_.dt * acc;
+  Group<3>::Advance(e.state.qd, options_.dt, &e.state.q);
+  UpdateContacts(*e.model, options_.ground_3d, &e.state);
+  if (e.state.qd.allFinite() && e.state.translation().allFinite() && e.state.gamma().allFinite() &&
       std::isfinite(Ffd3Energies(body).total()))
     return true;
   e.state = before;

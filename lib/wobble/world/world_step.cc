@@ -38,7 +38,7 @@ namespace {
 // almost every step. One functor type for both cases: one instantiation of the step.
 struct AppliedForce {
   const Eigen::VectorXd* force = nullptr;
-  void operator()(const BodyState<double>&, VecQ<double>* Q) const {
+  void operator()(const BodyState<2, double>&, VecQ<double>* Q) const {
     if (force) *Q += *force;
   }
 };
@@ -46,7 +46,7 @@ struct AppliedForce {
 
 bool World::StepFfdBody(int body) {
   FfdEntry& e = ffd_[slots_[body].index];
-  BodyState<double>& s = e.state;
+  BodyState<2, double>& s = e.state;
   const VecQ<double> q_before = s.q, qd_before = s.qd;
   const bool pushed = !e.applied.isZero(0.0);
   const StepStatus st = StepBody(*e.model, options_.params, body, options_.integrator, options_.dt, &s,
@@ -63,7 +63,7 @@ bool World::StepFfdBody(int body) {
 // body keeps its state before the step for whoever reports the failure.
 bool World::RefuseFfdStep(int body, const VecQ<double>& q_before, const VecQ<double>& qd_before, StepStatus st) {
   FfdEntry& e = ffd_[slots_[body].index];
-  BodyState<double>& s = e.state;
+  BodyState<2, double>& s = e.state;
   const bool finite = s.q.allFinite() && s.qd.allFinite();
   const double limit = PenetrationLimit(*e.model);
   const double depth = s.penetration;
@@ -72,8 +72,9 @@ bool World::RefuseFfdStep(int body, const VecQ<double>& q_before, const VecQ<dou
   s.q = q_before;
   s.qd = qd_before;
   UpdateContacts(*e.model, options_.params.ground, &s);
-  if (!st.ok()) return Fail(st.code, body, "", st.value);
-  // a state that overflowed because its forces did: the force is the cause to name
+  // a state that overflowed because its forces did: the force is the cause to name (the step
+  // reports only that its state is not finite)
+  if (!st.ok() && st.code != StatusCode::kNonFinite) return Fail(st.code, body, "", st.value);
   if (!finite) return ForcesFinite(body) ? Fail(StatusCode::kNonFinite, body) : Fail(StatusCode::kOverflowingForce, body);
   if (!too_deep)
     return Fail(StatusCode::kNonFiniteEnergy, body, EnergyTerms(energies) + " after the step (refused: the state is the one before it)");
@@ -85,8 +86,8 @@ bool World::RefuseFfdStep(int body, const VecQ<double>& q_before, const VecQ<dou
 
 bool World::ForcesFinite(int body) const {
   const FfdEntry& e = ffd_[slots_[body].index];
-  ForceBreakdown<double> f;
-  EvaluateForces(*e.model, options_.params, body, e.state, Frame<double>(e.state.q), &f, ContactSet::kDetect);
+  ForceBreakdown<2, double> f;
+  EvaluateForces(*e.model, options_.params, body, e.state, Frame<2, double>(e.state.q), &f, ContactSet::kDetect);
   return f.total.allFinite();
 }
 

@@ -29,7 +29,7 @@ template <> struct Dimension<2> {
   using Target = Correspondence;
   using Basis = PointBasis;
   using Vec = Eigen::Vector2d;
-  template <class T> using State = BodyState<T>;
+  template <class T> using State = BodyState<2, T>;
   static const WorldParams& World(const DynamicFitOptions& o) { return o.world; }
   static Basis BasisOf(const Body& body, const Target& t) { return SegmentResidual::ToPoint(body, t, "dynamic fit").point; }
   template <class T> static State<T> Start(const Body& body, const WorldParams& w, const T* q0, const T* qd0,
@@ -69,36 +69,37 @@ template <> struct Dimension<3> {
   using Target = Correspondence3;
   using Basis = PointBasis3;
   using Vec = Eigen::Vector3d;
-  template <class T> using State = BodyState3<T>;
-  static const WorldParams3& World(const DynamicFitOptions& o) { return o.world3; }
+  template <class T> using State = BodyState<3, T>;
+  static const WorldParamsN<3>& World(const DynamicFitOptions& o) { return o.world3; }
   static Basis BasisOf(const Body& body, const Target& t) {
     if (t.mass_point >= body.num_points())
       throw std::invalid_argument("dynamic fit: mass point " + std::to_string(t.mass_point) + " does not exist");
     return BasisOf3(body, t.mass_point, t.lattice_coords);
   }
-  template <class T> static State<T> Start(const Body& body, const WorldParams3& w, const T* q0, const T* qd0,
+  template <class T> static State<T> Start(const Body& body, const WorldParamsN<3>& w, const T* q0, const T* qd0,
                                            const Eigen::Quaterniond& chart) {
     const int D = body.num_modes();
-    State<T> s = RestState3<T>(body);
-    s.t = Vec3<T>(q0[0], q0[1], q0[2]);
-    s.orientation = (chart.cast<T>() * ExpRotation<T>(Vec3<T>(q0[3], q0[4], q0[5]))).normalized();
-    for (int d = 0; d < D; ++d) s.gamma[d] = q0[kRigidDofs3 + d];
-    s.v = Eigen::Map<const VecQ3<T>>(qd0, body.num_q());
-    UpdateContacts3(body, w.ground, &s);
+    State<T> s = RestState<3, T>(body);
+    s.translation() = Vec3<T>(q0[0], q0[1], q0[2]);
+    Group<3>::SetOrientation(
+        Eigen::Quaternion<T>(chart.cast<T>() * ExpRotation<T>(Vec3<T>(q0[3], q0[4], q0[5]))).normalized(), &s.q);
+    for (int d = 0; d < D; ++d) s.gamma()[d] = q0[Group<3>::kRigidDofs + d];
+    s.qd = Eigen::Map<const VecQ<T>>(qd0, body.num_q());
+    UpdateContacts(body, w.ground, &s);
     return s;
   }
-  template <class T, class Extra> static bool Step(const Body& body, const WorldParams3& w, double dt, State<T>* s,
+  template <class T, class Extra> static bool Step(const Body& body, const WorldParamsN<3>& w, double dt, State<T>* s,
                                                    const Extra& extra) {
-    return StepBody3(body, w, Integrator::kThesis, dt, s, extra).ok();  // non-finite states fail inside
+    return StepBody(body, w, 0, Integrator::kThesis, dt, s, extra).ok();  // non-finite states fail inside
   }
   template <class T> static Vec3<T> Position(const Basis& p, const State<T>& s) {
     Vec3<T> l = p.b0.cast<T>();
-    for (int d = 0; d < s.gamma.size(); ++d) l += p.B.col(d).cast<T>() * s.gamma[d];
-    return s.t + s.orientation.toRotationMatrix() * l;
+    for (int d = 0; d < s.gamma().size(); ++d) l += p.B.col(d).cast<T>() * s.gamma()[d];
+    return s.translation() + s.orientation().toRotationMatrix() * l;
   }
   static Eigen::VectorXd Q(const State<double>& s) {
-    Eigen::VectorXd q(kRigidDofs3 + s.gamma.size());
-    q << s.t, LogRotation<double>(s.orientation), s.gamma;
+    Eigen::VectorXd q(Group<3>::kRigidDofs + s.gamma().size());
+    q << s.translation(), LogRotation<double>(s.orientation()), s.gamma();
     return q;
   }
   static Eigen::Quaterniond Chart(const Eigen::VectorXd& q) { return ExpRotation<double>(q.segment<3>(3)); }
@@ -122,7 +123,7 @@ template <> struct Dimension<3> {
                                                              ExpRotation<double>(b.segment<3>(3)))) / h;
     return v;
   }
-  static VecQ3<double> Scales(const Body& body) { return SmoothnessScales3(body); }
+  static VecQ<double> Scales(const Body& body) { return SmoothnessScales3(body); }
 };
 
 // The thesis integrator (Eq. 4.22/4.23), exactly as World runs it: the body's step with the mode

@@ -7,7 +7,7 @@
 
 #include "wobble/body/body_model.h"
 #include "wobble/dynamics/forces.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/step.h"
 
 namespace wobble::fit {
 
@@ -20,13 +20,10 @@ template <class T> struct ModeParams {
 template <class T> struct ModeForce {
   const ModeParams<T>* p;
   const VecD<T>* target;
-  void operator()(const BodyState<T>& s, VecQ<T>* Q) const {
+  template <int Dim> void operator()(const BodyState<Dim, T>& s, VecQ<T>* Q) const {
+    constexpr int kRigid = Group<Dim>::kRigidDofs, kRigidParams = Group<Dim>::kRigidParams;
     for (int d = 0; d < p->K.size(); ++d)
-      (*Q)[kRigidDofs + d] += -T(2.0) * p->K[d] * (s.q[kRigidDofs + d] - (*target)[d]) - p->c[d] * s.qd[kRigidDofs + d];
-  }
-  void operator()(const BodyState3<T>& s, VecQ3<T>* Q) const {
-    for (int d = 0; d < p->K.size(); ++d)
-      (*Q)[kRigidDofs3 + d] += -T(2.0) * p->K[d] * (s.gamma[d] - (*target)[d]) - p->c[d] * s.v[kRigidDofs3 + d];
+      (*Q)[kRigid + d] += -T(2.0) * p->K[d] * (s.q[kRigidParams + d] - (*target)[d]) - p->c[d] * s.qd[kRigid + d];
   }
 };
 

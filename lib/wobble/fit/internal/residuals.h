@@ -166,10 +166,10 @@ struct SecondDifference {
   VecQ<double> scale;  // per coordinate, times sqrt(w)
 };
 
-// Calls make(std::integral_constant<int, N>) with N = num_q, for num_q in [kRigidDofs, kMaxQ]:
+// Calls make(std::integral_constant<int, N>) with N = num_q, for a 2D body (3 to 3 + kMaxModes):
 // Ceres' AutoDiffCostFunction wants block sizes at compile time.
 template <int N = kRigidDofs, class Make> ceres::CostFunction* WithNumQ(int num_q, Make&& make) {
-  if constexpr (N > kMaxQ) {
+  if constexpr (N > kRigidDofs + kMaxModes) {
     return nullptr;
   } else {
     if (num_q == N) return make(std::integral_constant<int, N>{});

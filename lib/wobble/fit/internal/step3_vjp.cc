@@ -41,7 +41,7 @@ void PullPosition(const Matrix3d& R, const Vector3d& l, const ModeMatrix& B, con
 
 // ẋ = ṫ + R y with y = ω × l + B γ̇:  z += (∂ẋ/∂z)ᵀ λ_ẋ.
 template <class ModeMatrix>
-void PullVelocity(const Matrix3d& R, const VecQ3<double>& v, const Vector3d& l, const ModeMatrix& B,
+void PullVelocity(const Matrix3d& R, const VecQ<double>& v, const Vector3d& l, const ModeMatrix& B,
                   const Vector3d& lambda_v, const Tangent& ix, Eigen::VectorXd* z) {
   const Vector3d mu = R.transpose() * lambda_v, omega = v.segment<3>(3);
   const Vector3d y = omega.cross(l) + B * v.tail(ix.D);
@@ -57,10 +57,10 @@ struct PointPullback {
   Vector3d dx, dv, danchor;
 };
 
-// y = the ground force f = f_n n + f_t of GroundForcePartsOf3: f_n = −K n·Δ − C_n n·ẋ (held at 0
+// y = the ground force f = f_n n + f_t of GroundForcePartsOf: f_n = −K n·Δ − C_n n·ẋ (held at 0
 // when negative), the uncapped f_t = −K P Δ − C_f P ẋ with P = 1 − n nᵀ and Δ = x − anchor,
 // scaled to μ f_n f_t/|f_t| when it slips. Without `normal`, y is the capped f_t alone.
-PointPullback PullGroundForce(const GroundPlane& g, const GroundForceParts3<double>& p, const Vector3d& w,
+PointPullback PullGroundForce(const GroundPlane& g, const GroundForceParts<double>& p, const Vector3d& w,
                               bool normal = true) {
   const Vector3d n = g.normal;
   double w_fn = normal ? w.dot(n) : 0.0;  // weights of f_n and of the uncapped f_t
@@ -80,9 +80,9 @@ PointPullback PullGroundForce(const GroundPlane& g, const GroundForceParts3<doub
   return r;
 }
 
-// y = the anchor after UpdateContacts3: kept, or moved by SlipAnchor3 to P x + n n·p +
+// y = the anchor after UpdateContacts: kept, or moved by SlipAnchor to P x + n n·p +
 // (f_t + C_f P ẋ)/K (f_t capped) when the friction slips.
-PointPullback PullAnchorUpdate(const GroundPlane& g, const GroundForceParts3<double>& p, const Vector3d& w) {
+PointPullback PullAnchorUpdate(const GroundPlane& g, const GroundForceParts<double>& p, const Vector3d& w) {
   if (!p.slipping || !(g.stiffness > 0.0)) return {Vector3d::Zero(), Vector3d::Zero(), w};
   PointPullback r = PullGroundForce(g, p, w / g.stiffness, false);
   const Vector3d w_t = w - g.normal * g.normal.dot(w);
@@ -93,7 +93,7 @@ PointPullback PullAnchorUpdate(const GroundPlane& g, const GroundForceParts3<dou
 
 // y = SpringForce3's f = −s d with s = K (|Δ| − L) + C d·ẋ, d = Δ/|Δ|, Δ = x − anchor
 // (∂d/∂x = (1 − d dᵀ)/|Δ|); the anchor is fixed.
-PointPullback PullSpringForce(const Spring3& sp, const Vector3d& x, const Vector3d& v, const Vector3d& w) {
+PointPullback PullSpringForce(const SpringN<3>& sp, const Vector3d& x, const Vector3d& v, const Vector3d& w) {
   const Vector3d delta = x - sp.anchor;
   const double len = std::sqrt(delta.squaredNorm() + 1e-300);
   const Vector3d d = delta / len;
@@ -105,14 +105,14 @@ PointPullback PullSpringForce(const Spring3& sp, const Vector3d& x, const Vector
   return r;
 }
 
-// Where ForEachFaceFelt3 (step3.h) took the anchor of (point k, face) from, among the contacts
+// Where ForEachFaceFelt (step3.h) took the anchor of (point k, face) from, among the contacts
 // of the state it scanned: the contact on the same face, the first contact of k projected onto
 // the face (a − n n·(a − p)), or the point's foot on the face (x − n n·(x − p)). The adjoint of
 // the anchor goes back the same way.
-void PullAnchor(const std::vector<Contact3<double>>& contacts, int k, int face, const Vector3d& normal,
+void PullAnchor(const std::vector<Contact<3, double>>& contacts, int k, int face, const Vector3d& normal,
                 const Vector3d& lambda_anchor, AnchorAdjoints* anchors, Vector3d* lambda_x) {
   const Vector3d along_face = lambda_anchor - normal * normal.dot(lambda_anchor);
-  const auto [first, last] = ContactsOfPoint3(contacts, k);
+  const auto [first, last] = ContactsOfPoint(contacts, k);
   if (first == last) {
     *lambda_x += along_face;
     return;
@@ -126,10 +126,10 @@ void PullAnchor(const std::vector<Contact3<double>>& contacts, int k, int face, 
   AddTo(anchors, {k, first->face}, along_face);
 }
 
-// The configuration after g·exp(h u) (AdvanceConfiguration3): z's configuration part holds
+// The configuration after g·exp(h u) (Group<3>::Advance): z's configuration part holds
 // λ there and becomes λ before; λ_u += h (λ_t, J_r(h ω)ᵀ λ_ε, λ_γ). The turn R' = R exp(φ̂),
 // φ = h ω, moves a body-frame ε to exp(−φ̂) ε and ω by h J_r(φ) δω.
-void PullAdvance(const VecQ3<double>& u, double h, const Tangent& ix, Eigen::VectorXd* z, VecQ3<double>* lambda_u) {
+void PullAdvance(const VecQ<double>& u, double h, const Tangent& ix, Eigen::VectorXd* z, VecQ<double>* lambda_u) {
   const Vector3d phi = h * u.segment<3>(3);
   const Vector3d lambda_eps = z->segment<3>(Tangent::kEpsilon);
   lambda_u->head<3>() += h * z->segment<3>(Tangent::kT);
@@ -138,25 +138,25 @@ void PullAdvance(const VecQ3<double>& u, double h, const Tangent& ix, Eigen::Vec
   z->segment<3>(Tangent::kEpsilon) = ExpRotation<double>(phi).toRotationMatrix() * lambda_eps;
 }
 
-// The part of λ_A' (the anchors after a step) that goes back through UpdateContacts3 at `after`
+// The part of λ_A' (the anchors after a step) that goes back through UpdateContacts at `after`
 // (the state after the step, still with the contacts before it): into z (λ at `after`) and into
 // the adjoint of the anchors before.
-void PullContactUpdate(const BodyModel3& body, const GroundPlane& ground, const BodyState3<double>& after,
+void PullContactUpdate(const BodyModel3& body, const GroundPlane& ground, const BodyState<3, double>& after,
                        const AnchorAdjoints& lambda_new, const Tangent& ix, Eigen::VectorXd* z,
                        AnchorAdjoints* lambda_old) {
   if (lambda_new.empty()) return;
-  const Frame3<double> frame(after.t, after.orientation);
-  ForEachPointInContact3(
+  const Frame<3, double> frame(after.q);
+  ForEachPointInContact(
       body, ground, after, frame,
-      [&](int k, int face, const GroundPlane& plane, const Vector3d& l, const Vector3d& x, const Vector3d& v,
-          const Vector3d& anchor) {
+      [&](int k, const Vector3d& l, const Vector3d& x, const Vector3d& v, const Vector3d& anchor,
+          const GroundPlane& plane, int face) {
         const auto it = lambda_new.find({k, face});
         if (it == lambda_new.end()) return;
-        PointPullback r = PullAnchorUpdate(plane, GroundForcePartsOf3(plane, x, v, anchor), it->second);
+        PointPullback r = PullAnchorUpdate(plane, GroundForcePartsOf(plane, x, v, anchor), it->second);
         PullAnchor(after.contacts, k, face, plane.normal, r.danchor, lambda_old, &r.dx);
         const auto B = body.mode_matrix(k);
         PullPosition(frame.R, l, B, r.dx, ix, z);
-        PullVelocity(frame.R, after.v, l, B, r.dv, ix, z);
+        PullVelocity(frame.R, after.qd, l, B, r.dv, ix, z);
       },
       ContactSet::kDetect);
 }
@@ -165,7 +165,7 @@ void PullContactUpdate(const BodyModel3& body, const GroundPlane& ground, const 
 // u·f with u = J λ_r = p + R (q × l + B s) (λ_r = (p, q, s)). Adds ∂ψ/∂z at fixed f (J moves
 // with ε and, through l, with γ) and returns u, which the caller pulls through f.
 template <class ModeMatrix>
-Vector3d PullGeneralizedForce(const Matrix3d& R, const Vector3d& l, const ModeMatrix& B, const VecQ3<double>& lr,
+Vector3d PullGeneralizedForce(const Matrix3d& R, const Vector3d& l, const ModeMatrix& B, const VecQ<double>& lr,
                               const Vector3d& f, const Tangent& ix, Eigen::VectorXd* z) {
   const Vector3d q = lr.segment<3>(3), f_local = R.transpose() * f;
   const Vector3d y = q.cross(l) + B * lr.tail(ix.D);
@@ -175,7 +175,7 @@ Vector3d PullGeneralizedForce(const Matrix3d& R, const Vector3d& l, const ModeMa
 }
 
 // ∂K/∂γ_j of K(γ) = S0 + Σ_d γ_d (E_d + E_dᵀ) + Σ_de γ_d γ_e F_de: E_j + L_j + Σ_d γ_d F_dj.
-Matrix3d SecondMomentRate(const MassMoments3& mm, const ShapeMoments3<double>& sm, const VecD<double>& gamma, int j) {
+Matrix3d SecondMomentRate(const MassMoments3& mm, const ShapeMoments<double>& sm, const VecD<double>& gamma, int j) {
   const int D = int(gamma.size());
   Matrix3d dK = mm.E[size_t(j)] + sm.L[size_t(j)];
   for (int d = 0; d < D; ++d) dK += gamma[d] * mm.F[size_t(d) * D + j];
@@ -185,13 +185,13 @@ Matrix3d SecondMomentRate(const MassMoments3& mm, const ShapeMoments3<double>& s
 // z += ∂ψ/∂z of the mass-moment terms of ψ = λ_rᵀ (Q_gravity − w − M a) at `e` (kinematics3.h's
 // formulas; ∂I/∂γ_j = tr(K_j) 1 − K_j with K_j = ∂K/∂γ_j, ∂N_d/∂γ_g = X_gd, ∂L_d/∂γ_g = F_dg,
 // ∂e/∂γ = G, ∂c/∂γ = C; a rotated vector Rᵀy moves by (Rᵀy) × ε).
-void PullMomentTerms(const MassMoments3& mm, const WorldParams3& world, const BodyState3<double>& e,
-                     const Matrix3d& R, const ShapeMoments3<double>& sm, const VecQ3<double>& a,
-                     const VecQ3<double>& lr, const Tangent& ix, Eigen::VectorXd* z) {
+void PullMomentTerms(const MassMoments3& mm, const WorldParamsN<3>& world, const BodyState<3, double>& e,
+                     const Matrix3d& R, const ShapeMoments<double>& sm, const VecQ<double>& a,
+                     const VecQ<double>& lr, const Tangent& ix, Eigen::VectorXd* z) {
   const int D = ix.D;
   const Vector3d p = lr.head<3>(), q = lr.segment<3>(3), alpha = a.head<3>(), beta = a.segment<3>(3);
-  const VecD<double> s = lr.tail(D), eta = a.tail(D), gdot = e.v.tail(D);
-  const Vector3d omega = e.v.segment<3>(3);
+  const VecD<double> s = lr.tail(D), eta = a.tail(D), gdot = e.qd.tail(D);
+  const Vector3d omega = e.qd.segment<3>(3);
   const Vector3d P = R.transpose() * p, A = R.transpose() * alpha;
   const Vector3d Cs = mm.C * s, C_eta = mm.C * eta, C_gdot = mm.C * gdot;
   const double omega2 = omega.squaredNorm();
@@ -231,7 +231,7 @@ void PullMomentTerms(const MassMoments3& mm, const WorldParams3& world, const Bo
   }
   const VecD<double> G_gdot = mm.G.transpose() * gdot;
   for (int j = 0; j < D; ++j) {
-    const Matrix3d dK = SecondMomentRate(mm, sm, e.gamma, j);
+    const Matrix3d dK = SecondMomentRate(mm, sm, e.gamma(), j);
     double dj = dK.trace() * q.dot(beta) - q.dot(dK * beta);  // q·(∂I/∂γ_j) β
     for (int d = 0; d < D; ++d) {
       const Matrix3d& F = mm.F[size_t(d) * D + j];
@@ -249,9 +249,9 @@ void PullMomentTerms(const MassMoments3& mm, const WorldParams3& world, const Bo
 
 // z, the anchors and the controls += ∇ψ, ψ = λ_rᵀ (Q − w − M a) at `e` with a and λ_r fixed:
 // the pull-back of λ_a through a = M⁻¹ (Q − w), with λ_r = M⁻¹ λ_a.
-void PullAccelerations(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& e,
-                       const Frame3<double>& frame, const ShapeMoments3<double>& sm, const VecQ3<double>& a,
-                       const VecQ3<double>& lr, const Tangent& ix, StateAdjoint3* in, ControlAdjoint3* controls) {
+void PullAccelerations(const StepModel3& m, const VecD<double>& target, const BodyState<3, double>& e,
+                       const Frame<3, double>& frame, const ShapeMoments<double>& sm, const VecQ<double>& a,
+                       const VecQ<double>& lr, const Tangent& ix, StateAdjoint3* in, ControlAdjoint3* controls) {
   const BodyModel3& body = m.passive;
   const int D = ix.D;
   Eigen::VectorXd& z = in->z;
@@ -260,58 +260,58 @@ void PullAccelerations(const StepModel3& m, const VecD<double>& target, const Bo
   const VecD<double> s = lr.tail(D);
   for (int d = 0; d < D; ++d) {
     const DeformationMode3& mode = body.modes()[size_t(d)];
-    const double offset = e.gamma[d] - target[d];
+    const double offset = e.gamma()[d] - target[d];
     z[Tangent::kGamma + d] -= 2.0 * (mode.stiffness + m.gains.K[d]) * s[d];
     z[ix.gamma_dot() + d] -= (mode.damping + m.gains.c[d]) * s[d];
     controls->target[d] = 2.0 * m.gains.K[d] * s[d];
     (*controls->stiffness)[d] -= 2.0 * offset * s[d];
-    (*controls->damping)[d] -= e.v[kRigidDofs3 + d] * s[d];
+    (*controls->damping)[d] -= e.qd[Group<3>::kRigidDofs + d] * s[d];
   }
   // ground and springs, point by point
-  ForEachPointInContact3(
+  ForEachPointInContact(
       body, m.world.ground, e, frame,
-      [&](int k, int face, const GroundPlane& plane, const Vector3d& l, const Vector3d& x, const Vector3d& v,
-          const Vector3d& anchor) {
+      [&](int k, const Vector3d& l, const Vector3d& x, const Vector3d& v, const Vector3d& anchor,
+          const GroundPlane& plane, int face) {
         const auto B = body.mode_matrix(k);
-        const GroundForceParts3<double> parts = GroundForcePartsOf3(plane, x, v, anchor);
+        const GroundForceParts<double> parts = GroundForcePartsOf(plane, x, v, anchor);
         const Vector3d u = PullGeneralizedForce(frame.R, l, B, lr, parts.f, ix, &z);
         PointPullback r = PullGroundForce(plane, parts, u);
         PullAnchor(e.contacts, k, face, plane.normal, r.danchor, &in->anchor, &r.dx);
         PullPosition(frame.R, l, B, r.dx, ix, &z);
-        PullVelocity(frame.R, e.v, l, B, r.dv, ix, &z);
+        PullVelocity(frame.R, e.qd, l, B, r.dv, ix, &z);
       },
       ContactSet::kDetect);
-  for (const Spring3& sp : m.world.springs) {
-    const Vector3d l = LocalPosition3<double>(sp.rest_local, sp.mode_matrix, e.gamma);
-    const Vector3d x = frame.t + frame.R * l, v = PointVelocity3(frame, e.v, l, sp.mode_matrix);
-    const Vector3d u = PullGeneralizedForce(frame.R, l, sp.mode_matrix, lr, SpringForce3(sp, x, v), ix, &z);
+  for (const SpringN<3>& sp : m.world.springs) {
+    const Vector3d l = LocalPosition<double>(sp.rest_local, sp.mode_matrix, e.q);
+    const Vector3d x = frame.t + frame.R * l, v = PointVelocity(frame, e.qd, l, sp.mode_matrix);
+    const Vector3d u = PullGeneralizedForce(frame.R, l, sp.mode_matrix, lr, SpringForce(sp, x, v), ix, &z);
     const PointPullback r = PullSpringForce(sp, x, v, u);
     PullPosition(frame.R, l, sp.mode_matrix, r.dx, ix, &z);
-    PullVelocity(frame.R, e.v, l, sp.mode_matrix, r.dv, ix, &z);
+    PullVelocity(frame.R, e.qd, l, sp.mode_matrix, r.dv, ix, &z);
   }
 }
 
 }  // namespace
 
-StepStatus RecordStep3(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& s,
-                       StepTape3* tape, BodyState3<double>* next) {
+StepStatus RecordStep3(const StepModel3& m, const VecD<double>& target, const BodyState<3, double>& s,
+                       StepTape3* tape, BodyState<3, double>* next) {
   const BodyModel3& body = m.passive;
   const MassMoments3& mm = body.moments();
   const double h = m.dt;
   const bool thesis = m.integrator == Integrator::kThesis;
   // accelerations at `eval`: the start for the thesis integrator, the advanced configuration
-  // for the symplectic one (StepBody3 and Accelerations3, operation for operation)
+  // for the symplectic one (StepBody and Accelerations, operation for operation)
   tape->eval = s;
-  if (!thesis) AdvanceConfiguration3(s.v, h, &tape->eval);
-  const BodyState3<double>& eval = tape->eval;
-  const Frame3<double>& frame = tape->frame.emplace(eval.t, eval.orientation);
-  const ShapeMoments3<double>& sm = tape->moments.emplace(mm, eval.gamma);
-  VecQ3<double> w;
-  VelocityTerms3(mm, sm, frame.R, eval.v, &w);
-  ForceBreakdown3<double> forces;
-  EvaluateForces3(body, m.world, eval, frame, sm, &forces);
+  if (!thesis) Group<3>::Advance(s.qd, h, &tape->eval.q);
+  const BodyState<3, double>& eval = tape->eval;
+  const Frame<3, double>& frame = tape->frame.emplace(eval.q);
+  const ShapeMoments<double>& sm = tape->moments.emplace(mm, eval.gamma());
+  VecQ<double> w;
+  VelocityTerms(mm, sm, frame.R, eval.qd, &w);
+  ForceBreakdown<3, double> forces;
+  EvaluateForces(body, m.world, 0, eval, frame, &forces);
   ModeForce<double>{&m.gains, &target}(eval, &forces.total);
-  MassMatrix3(mm, sm, frame.R, &tape->mass_factor);
+  MassMatrix(mm, sm, frame.R, &tape->mass_factor);
   if (!CholeskyInPlace(&tape->mass_factor)) {
     if (!forces.total.allFinite()) return {StatusCode::kOverflowingForce, 0.0};
     return {StatusCode::kSingularMass, 0.0};
@@ -322,20 +322,20 @@ StepStatus RecordStep3(const StepModel3& m, const VecD<double>& target, const Bo
   CholeskySolveInPlace(tape->mass_factor, &tape->a);
   if (hi / lo > m.world.max_condition) return {StatusCode::kIllConditioned, hi / lo};
   tape->after = eval;  // the state after the step, with the contacts before it
-  tape->after.v += h * tape->a;
-  if (thesis) AdvanceConfiguration3(tape->after.v, h, &tape->after);
-  const BodyState3<double>& after = tape->after;
-  if (!after.v.allFinite() || !after.t.allFinite() || !after.gamma.allFinite() ||
-      !after.orientation.coeffs().allFinite())
+  tape->after.qd += h * tape->a;
+  if (thesis) Group<3>::Advance(tape->after.qd, h, &tape->after.q);
+  const BodyState<3, double>& after = tape->after;
+  if (!after.qd.allFinite() || !after.translation().allFinite() || !after.gamma().allFinite() ||
+      !after.orientation().coeffs().allFinite())
     return {StatusCode::kNonFinite, 0.0};
   *next = after;
-  UpdateContacts3(body, m.world.ground, next);
+  UpdateContacts(body, m.world.ground, next);
   return {};
 }
 
-void StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& s, const StepTape3& tape,
+void StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState<3, double>& s, const StepTape3& tape,
               const StateAdjoint3& out, StateAdjoint3* in, ControlAdjoint3* controls) {
-  const int D = m.passive.num_modes(), nv = kRigidDofs3 + D;
+  const int D = m.passive.num_modes(), nv = Group<3>::kRigidDofs + D;
   const Tangent ix(D);
   const double h = m.dt;
   const bool thesis = m.integrator == Integrator::kThesis;
@@ -344,21 +344,21 @@ void StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState3<
   in->anchor.clear();
   in->z = out.z;
   PullContactUpdate(m.passive, m.world.ground, tape.after, out.anchor, ix, &in->z, &in->anchor);
-  VecQ3<double> lambda_v = in->z.tail(nv);
-  if (thesis) PullAdvance(tape.after.v, h, ix, &in->z, &lambda_v);
-  VecQ3<double> lr = h * lambda_v;
+  VecQ<double> lambda_v = in->z.tail(nv);
+  if (thesis) PullAdvance(tape.after.qd, h, ix, &in->z, &lambda_v);
+  VecQ<double> lr = h * lambda_v;
   CholeskySolveInPlace(tape.mass_factor, &lr);
   in->z.tail(nv) = lambda_v;
   controls->target = VecD<double>::Zero(D);
   PullAccelerations(m, target, tape.eval, *tape.frame, *tape.moments, tape.a, lr, ix, in, controls);
   if (!thesis) {
-    VecQ3<double> lambda_u = VecQ3<double>::Zero(nv);
-    PullAdvance(s.v, h, ix, &in->z, &lambda_u);
+    VecQ<double> lambda_u = VecQ<double>::Zero(nv);
+    PullAdvance(s.qd, h, ix, &in->z, &lambda_u);
     in->z.tail(nv) += lambda_u;
   }
 }
 
-void StartContactsVjp3(const BodyModel3& passive, const GroundPlane& ground, BodyState3<double> s,
+void StartContactsVjp3(const BodyModel3& passive, const GroundPlane& ground, BodyState<3, double> s,
                        const AnchorAdjoints& anchor, Eigen::VectorXd* dz) {
   s.contacts.clear();
   AnchorAdjoints none;  // without contacts before, every anchor comes from its point's foot

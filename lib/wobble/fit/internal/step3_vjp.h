@@ -9,8 +9,8 @@
 //  - ψ's mass-moment terms (M, w, gravity: kinematics3.h) are differentiated by hand, in O(D²)
 //    whatever the number of mass points;
 //  - a contact's force (Eq. 4.24/4.25: its one-sided normal force and capped friction) and its
-//    anchor's update (SlipAnchor3) by their partials in the point's x, ẋ and anchor, from the
-//    parts the forward force keeps (GroundForcePartsOf3), and a spring's the same way; x and ẋ
+//    anchor's update (SlipAnchor) by their partials in the point's x, ẋ and anchor, from the
+//    parts the forward force keeps (GroundForcePartsOf), and a spring's the same way; x and ẋ
 //    are pulled back to the state by x = t + R l, ẋ = ṫ + R (ω × l + B γ̇);
 //  - the turn R' = R exp(Δt ω̂) moves ε by exp(−Δt ω̂) and ω by Δt J_r(Δt ω) (rotation3.h).
 // tests/adjoint3_test.cc checks whole runs against forward-mode Jets and central differences.
@@ -22,8 +22,8 @@
 #include <utility>
 
 #include "wobble/body/body_model.h"
-#include "wobble/dynamics/kinematics3.h"
-#include "wobble/dynamics/step3.h"
+#include "wobble/dynamics/spatial_inertia.h"
+#include "wobble/dynamics/step.h"
 #include "wobble/fit/internal/mode_force.h"
 
 namespace wobble::fit::internal {
@@ -41,7 +41,7 @@ struct StateAdjoint3 {
 // the mode forces' gains.
 struct StepModel3 {
   const BodyModel3& passive;
-  const WorldParams3& world;
+  const WorldParamsN<3>& world;
   Integrator integrator;  // kThesis or kSymplecticEuler
   double dt;
   const ModeParams<double>& gains;
@@ -59,27 +59,27 @@ struct ControlAdjoint3 {
 // contact update. The adjoint's recompute keeps one per step of an interval, so the product
 // does not factor M a second time.
 struct StepTape3 {
-  BodyState3<double> eval, after;
-  std::optional<Frame3<double>> frame;
-  std::optional<ShapeMoments3<double>> moments;
-  MatQ3<double> mass_factor;
-  VecQ3<double> a;
+  BodyState<3, double> eval, after;
+  std::optional<Frame<3, double>> frame;
+  std::optional<ShapeMoments<double>> moments;
+  MatQ<double> mass_factor;
+  VecQ<double> a;
 };
 
 // One step from s with PD targets `target`, as StepBody3 takes it, keeping its tape: *next is
 // StepBody3's result (contacts updated). Fails as StepBody3 does.
-StepStatus RecordStep3(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& s,
-                       StepTape3* tape, BodyState3<double>* next);
+StepStatus RecordStep3(const StepModel3& m, const VecD<double>& target, const BodyState<3, double>& s,
+                       StepTape3* tape, BodyState<3, double>* next);
 
 // in = λ of state s from out = λ of the state after the step taken from s with PD targets
 // `target` (whose tape RecordStep3 kept); adds the gains' part to controls->stiffness/damping
 // and sets controls->target.
-void StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState3<double>& s, const StepTape3& tape,
+void StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState<3, double>& s, const StepTape3& tape,
               const StateAdjoint3& out, StateAdjoint3* in, ControlAdjoint3* controls);
 
-// The start's contact update (UpdateContacts3 on `s`, whose contacts are ignored): adds the
+// The start's contact update (UpdateContacts on `s`, whose contacts are ignored): adds the
 // part of ∂cost/∂z that reaches s through the anchors it gives.
-void StartContactsVjp3(const BodyModel3& passive, const GroundPlane& ground, BodyState3<double> s,
+void StartContactsVjp3(const BodyModel3& passive, const GroundPlane& ground, BodyState<3, double> s,
                        const std::map<ContactKey3, Eigen::Vector3d>& anchor, Eigen::VectorXd* dz);
 
 }  // namespace wobble::fit::internal

@@ -25,14 +25,17 @@
 #include <array>
 
 #include "wobble/body/body_model.h"
+#include "wobble/body/group.h"
+#include "wobble/core/cholesky.h"
 #include "wobble/core/rotation3.h"
+#include "wobble/dynamics/kinematics.h"
 #include "wobble/core/types.h"
 
 namespace wobble {
 
 // The γ-dependent moments at one shape γ, computed once per evaluation.
-template <class T> struct ShapeMoments3 {
-  ShapeMoments3(const MassMoments3& mm, const VecD<T>& gamma) {
+template <class T> struct ShapeMoments {
+  ShapeMoments(const MassMoments3& mm, const VecD<T>& gamma) {
     const int D = int(gamma.size());
     c = mm.c0.cast<T>() + mm.C.cast<T>() * gamma;
     e = mm.e0.cast<T>() + mm.G.cast<T>() * gamma;
@@ -58,51 +61,10 @@ template <class T> struct ShapeMoments3 {
   std::array<Mat3<T>, kMaxModes> L;  // L_d = Σ m B^d lᵀ
 };
 
-// The rigid part of a 3D state: translation and rotation matrix.
-template <class T> struct Frame3 {
-  Frame3(const Vec3<T>& t_in, const Eigen::Quaternion<T>& orientation) : t(t_in), R(orientation.toRotationMatrix()) {}
-  Vec3<T> t;
-  Mat3<T> R;
-};
-
-// Body-frame position l = b0 + B γ.
-// A plain loop over B's contiguous columns: this runs for every point of every contact scan,
-// and Eigen's per-column expressions over a dynamic-width map cost three times as much.
-template <class T, class Derived>
-Vec3<T> LocalPosition3(const Eigen::Vector3d& b0, const Eigen::MatrixBase<Derived>& B, const VecD<T>& gamma) {
-  T x(b0.x()), y(b0.y()), z(b0.z());
-  const int D = int(B.cols());
-  for (int d = 0; d < D; ++d) {
-    const T& g = gamma[d];
-    x += T(B(0, d)) * g;
-    y += T(B(1, d)) * g;
-    z += T(B(2, d)) * g;
-  }
-  return Vec3<T>(x, y, z);
-}
-
-// World velocity J v = ṫ + R (ω × l + B γ̇).
-template <class T, class Derived>
-Vec3<T> PointVelocity3(const Frame3<T>& frame, const VecQ3<T>& v, const Vec3<T>& l, const Eigen::MatrixBase<Derived>& B) {
-  Vec3<T> local = v.template segment<3>(3).cross(l);
-  for (int d = 0; d < B.cols(); ++d) local += B.col(d).template cast<T>() * v[kRigidDofs3 + d];
-  return v.template head<3>() + frame.R * local;
-}
-
-// Adds Jᵀ f for a world force f at a point with local position l and mode matrix B.
-template <class T, class Derived>
-void AddGeneralizedForce3(const Frame3<T>& frame, const Vec3<T>& l, const Eigen::MatrixBase<Derived>& B,
-                          const Vec3<T>& f, VecQ3<T>* Q) {
-  const Vec3<T> f_local = frame.R.transpose() * f;
-  Q->template head<3>() += f;
-  Q->template segment<3>(3) += l.cross(f_local);
-  for (int d = 0; d < B.cols(); ++d) (*Q)[kRigidDofs3 + d] += B.col(d).template cast<T>().dot(f_local);
-}
-
 // M of the header comment.
-template <class T> void MassMatrix3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const Mat3<T>& R, MatQ3<T>* M) {
+template <class T> void MassMatrix(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, MatQ<T>* M) {
   const int D = int(sm.e.size());
-  M->setZero(kRigidDofs3 + D, kRigidDofs3 + D);
+  M->setZero(Group<3>::kRigidDofs + D, Group<3>::kRigidDofs + D);
   M->template block<3, 3>(0, 0) = Mat3<T>::Identity() * T(mm.m);
   const Mat3<T> t_omega = -R * Skew(sm.c);
   M->template block<3, 3>(0, 3) = t_omega;
@@ -110,30 +72,30 @@ template <class T> void MassMatrix3(const MassMoments3& mm, const ShapeMoments3<
   M->template block<3, 3>(3, 3) = sm.I;
   if (D == 0) return;
   const Mat3D<T> RC = R * mm.C.cast<T>();
-  M->block(0, kRigidDofs3, 3, D) = RC;
-  M->block(kRigidDofs3, 0, D, 3) = RC.transpose();
-  M->block(3, kRigidDofs3, 3, D) = sm.N;
-  M->block(kRigidDofs3, 3, D, 3) = sm.N.transpose();
-  M->block(kRigidDofs3, kRigidDofs3, D, D) = mm.G.cast<T>();
+  M->block(0, Group<3>::kRigidDofs, 3, D) = RC;
+  M->block(Group<3>::kRigidDofs, 0, D, 3) = RC.transpose();
+  M->block(3, Group<3>::kRigidDofs, 3, D) = sm.N;
+  M->block(Group<3>::kRigidDofs, 3, D, 3) = sm.N.transpose();
+  M->block(Group<3>::kRigidDofs, Group<3>::kRigidDofs, D, D) = mm.G.cast<T>();
 }
 
 // ½ vᵀ M v.
 template <class T>
-T KineticEnergy3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const Mat3<T>& R, const VecQ3<T>& v) {
-  MatQ3<T> M;
-  MassMatrix3(mm, sm, R, &M);
+T KineticEnergy(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& v) {
+  MatQ<T> M;
+  MassMatrix(mm, sm, R, &M);
   return T(0.5) * v.dot(M * v);
 }
 
 // w of the header comment.
 template <class T>
-void VelocityTerms3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const Mat3<T>& R, const VecQ3<T>& v,
-                    VecQ3<T>* w) {
+void VelocityTerms(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& v,
+                    VecQ<T>* w) {
   const int D = int(sm.e.size());
   const Vec3<T> omega = v.template segment<3>(3);
   const auto gamma_dot = v.tail(D);
   const Vec3<T> C_gd = mm.C.cast<T>() * gamma_dot;
-  w->resize(kRigidDofs3 + D);
+  w->resize(Group<3>::kRigidDofs + D);
   w->template head<3>() = R * (omega.cross(omega.cross(sm.c)) + T(2.0) * omega.cross(C_gd));
   Mat3<T> L_gd = Mat3<T>::Zero();
   for (int d = 0; d < D; ++d) L_gd += sm.L[d] * gamma_dot[d];
@@ -142,17 +104,17 @@ void VelocityTerms3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const Ma
   for (int d = 0; d < D; ++d) {
     Vec3<T> X_gd = Vec3<T>::Zero();
     for (int e = 0; e < D; ++e) X_gd += mm.X[size_t(e) * D + d].cast<T>() * gamma_dot[e];
-    (*w)[kRigidDofs3 + d] = omega.dot(sm.L[d] * omega) - omega2 * sm.e[d] + T(2.0) * omega.dot(X_gd);
+    (*w)[Group<3>::kRigidDofs + d] = omega.dot(sm.L[d] * omega) - omega2 * sm.e[d] + T(2.0) * omega.dot(X_gd);
   }
 }
 
 // Generalized gravity Σ m_k J_kᵀ g = [m g ; c × Rᵀg ; Cᵀ Rᵀ g].
 template <class T>
-void GravityForce3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const Mat3<T>& R, const Eigen::Vector3d& g,
-                   VecQ3<T>* Q) {
+void GravityForce(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const Eigen::Vector3d& g,
+                   VecQ<T>* Q) {
   const int D = int(sm.e.size());
   const Vec3<T> g_local = R.transpose() * g.cast<T>();
-  Q->resize(kRigidDofs3 + D);
+  Q->resize(Group<3>::kRigidDofs + D);
   Q->template head<3>() = T(mm.m) * g.cast<T>();
   Q->template segment<3>(3) = sm.c.cross(g_local);
   if (D > 0) Q->tail(D) = mm.C.cast<T>().transpose() * g_local;
@@ -160,7 +122,7 @@ void GravityForce3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const Mat
 
 // Potential energy of gravity, −Σ m_k g·x_k = −g·(m t + R c).
 template <class T>
-T GravityEnergy3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const Frame3<T>& frame, const Eigen::Vector3d& g) {
+T GravityEnergy(const MassMoments3& mm, const ShapeMoments<T>& sm, const Frame<3, T>& frame, const Eigen::Vector3d& g) {
   return -(T(mm.m) * frame.t + frame.R * sm.c).dot(g.cast<T>());
 }
 
@@ -169,7 +131,7 @@ T GravityEnergy3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const Frame
 //   L = Σ m x × ẋ = t × P + R (Σ m l × ẋ_local) with Σ m l × (ω × l + B γ̇) = I ω + N γ̇
 //   (plus the cross term R c × ṫ from l × Rᵀṫ).
 template <class T>
-void Momentum3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const Frame3<T>& frame, const VecQ3<T>& v,
+void Momentum(const MassMoments3& mm, const ShapeMoments<T>& sm, const Frame<3, T>& frame, const VecQ<T>& v,
                Vec3<T>* linear, Vec3<T>* angular) {
   const int D = int(sm.e.size());
   const Vec3<T> t_dot = v.template head<3>(), omega = v.template segment<3>(3);
@@ -177,6 +139,63 @@ void Momentum3(const MassMoments3& mm, const ShapeMoments3<T>& sm, const Frame3<
   *linear = T(mm.m) * t_dot + frame.R * (omega.cross(sm.c) + mm.C.cast<T>() * gamma_dot);
   const Vec3<T> spin = sm.I * omega + sm.N * gamma_dot;  // Σ m l × ẋ_local, body frame
   *angular = frame.t.cross(*linear) + frame.R * (spin + sm.c.cross(frame.R.transpose() * t_dot));
+}
+
+// Kinetic-energy gradient ∂T/∂g at fixed ξ, left-trivialized on SO(3) (δR = R ε̂), for the
+// variational integrator. With a = ω × c + C γ̇ (so that M_tω ω + M_tγ γ̇ = R a):
+//   ∂T/∂t = 0,  ∂T/∂R = a × Rᵀṫ,
+//   ∂T/∂γ_d = ṫ·R(ω × C_d) + e_d|ω|² − ωᵀ L_d ω + ω·Σ_e γ̇_e X_de
+// (∂K/∂γ_d = L_d + L_dᵀ, ∂I/∂γ_d = 2 e_d 1 − L_d − L_dᵀ, ∂N_e/∂γ_d = X_de).
+template <class T>
+void KineticGradient(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& xi,
+                      VecQ<T>* out) {
+  const int D = int(sm.e.size());
+  const Vec3<T> t_dot = xi.template head<3>(), omega = xi.template segment<3>(3);
+  const auto gamma_dot = xi.tail(D);
+  const Vec3<T> a = omega.cross(sm.c) + mm.C.cast<T>() * gamma_dot;
+  const Vec3<T> t_local = R.transpose() * t_dot;
+  out->setZero(Group<3>::kRigidDofs + D);
+  out->template segment<3>(3) = a.cross(t_local);
+  const T omega2 = omega.squaredNorm();
+  for (int d = 0; d < D; ++d) {
+    Vec3<T> X_gd = Vec3<T>::Zero();
+    for (int e = 0; e < D; ++e) X_gd += mm.X[size_t(d) * D + e].cast<T>() * gamma_dot[e];
+    (*out)[Group<3>::kRigidDofs + d] = t_local.dot(omega.cross(mm.C.col(d).cast<T>())) + sm.e[d] * omega2 -
+                              omega.dot(sm.L[d] * omega) + omega.dot(X_gd);
+  }
+}
+
+// Gravity's generalized force at positions q (group.h's layout), without the other moments.
+template <class T>
+void GravityForce(const MassMoments3& mm, const VecQ<T>& q, const Mat3<T>& R, const Eigen::Vector3d& g, VecQ<T>* Q) {
+  const int D = int(mm.e0.size());
+  const Vec3<T> g_local = R.transpose() * g.cast<T>();
+  const Vec3<T> c = mm.c0.cast<T>() + mm.C.cast<T>() * q.tail(D);
+  Q->resize(Group<3>::kRigidDofs + D);
+  Q->template head<3>() = T(mm.m) * g.cast<T>();
+  Q->template segment<3>(3) = c.cross(g_local);
+  if (D > 0) Q->tail(D) = mm.C.cast<T>().transpose() * g_local;
+}
+
+// q̈ of M q̈ = Q − w at positions q and velocities q̇ (the 3D Eq. 4.21 of the header), by a
+// Cholesky factorization of M. *cond_estimate: the ratio of its largest to smallest pivot, a
+// lower bound of cond₂(M). False when M is singular.
+template <class T>
+bool SolveAccelerations(const MassMoments3& mm, const VecQ<T>& q, const VecQ<T>& qd, const Mat3<T>& R,
+                        const VecQ<T>& Q, VecQ<T>* qdd, double* cond_estimate) {
+  const int D = int(mm.e0.size());
+  const ShapeMoments<T> sm(mm, VecD<T>(q.tail(D)));
+  VecQ<T> w;
+  VelocityTerms(mm, sm, R, qd, &w);
+  MatQ<T> M;
+  MassMatrix(mm, sm, R, &M);
+  if (!CholeskyInPlace(&M)) return false;
+  double lo = HUGE_VAL, hi = 0.0;
+  CholeskyPivotRange(M, &lo, &hi);
+  *qdd = Q - w;
+  CholeskySolveInPlace(M, qdd);
+  *cond_estimate = hi / lo;
+  return true;
 }
 
 }  // namespace wobble
