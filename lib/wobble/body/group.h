@@ -26,9 +26,6 @@ template <> struct Group<2> {
   static constexpr int kRotationDofs = 1;    // ω
   static constexpr int kRigidParams = 2 + kRotationParams;
   static constexpr int kRigidDofs = 2 + kRotationDofs;
-  template <class T> using Vector = Vec2<T>;
-  template <class T> using Matrix = Mat2<T>;
-  template <class T> using Angular = Eigen::Matrix<T, 1, 1>;  // ω as a vector of one
 
   // R of the rotation parameters at q[2].
   template <class T> static Mat2<T> RotationOf(const VecQ<T>& q) { return Rotation(q[2]); }
@@ -44,8 +41,6 @@ template <> struct Group<2> {
   template <class T> static void Retract(const VecQ<T>& q0, const VecQ<T>& dy, VecQ<T>* q) { *q = q0 + dy; }
   // Θ̇ of the stage coordinates for the velocity v at the stage offset dy: dexp⁻¹ is 1 on SO(2).
   template <class T> static VecQ<T> StageRate(const VecQ<T>&, const VecQ<T>& v) { return v; }
-  template <class T> static bool Finite(const VecQ<T>&) { return true; }
-  template <class T> static void Normalize(VecQ<T>*) {}
 };
 
 template <> struct Group<3> {
@@ -53,9 +48,6 @@ template <> struct Group<3> {
   static constexpr int kRotationDofs = 3;    // ω in the body frame
   static constexpr int kRigidParams = 3 + kRotationParams;
   static constexpr int kRigidDofs = 3 + kRotationDofs;
-  template <class T> using Vector = Vec3<T>;
-  template <class T> using Matrix = Mat3<T>;
-  template <class T> using Angular = Vec3<T>;
 
   template <class T> static Eigen::Quaternion<T> OrientationOf(const VecQ<T>& q) {
     return Eigen::Quaternion<T>(q[6], q[3], q[4], q[5]);
