@@ -86,25 +86,31 @@ def function_kind(statement, match):
     return None
 
 
+def layered_sources(root):
+    """(rel, top, folder, text) of every source file under lib/, pipelines/ and app/; folder is
+    the lib/wobble/<folder> a library file sits in, None elsewhere."""
+    for top in ("lib", "pipelines", "app"):
+        for path in source_files(root, top):
+            rel = os.path.relpath(path, root)
+            parts = rel.split(os.sep)
+            with open(path, encoding="utf-8") as f:
+                yield rel, top, parts[2] if top == "lib" and len(parts) > 3 else None, f.read()
+
+
 def misplaced_definitions(root):
     """Functions declared in a lib/wobble/<folder> header and defined outside that folder but
     not inside it. By name: an overload defined in the right folder hides one defined elsewhere,
     which is enough to keep a layer's declarations and definitions together."""
     declared, defined = [], {}
-    for top in ("lib", "pipelines", "app"):
-        for path in source_files(root, top):
-            rel = os.path.relpath(path, root)
-            parts = rel.split(os.sep)
-            place = parts[2] if top == "lib" and len(parts) > 3 else top
-            with open(path, encoding="utf-8") as f:
-                text = f.read()
-            for number, statement in column0_statements(text):
-                m = FUNCTION.match(statement)
-                kind = function_kind(statement, m) if m else None
-                if kind == "definition":
-                    defined.setdefault(m.group(1), set()).add(place)
-                elif kind == "declaration" and top == "lib" and rel.endswith(".h"):
-                    declared.append((m.group(1), place, f"{rel}:{number}"))
+    for rel, top, folder, text in layered_sources(root):
+        place = folder or top
+        for number, statement in column0_statements(text):
+            m = FUNCTION.match(statement)
+            kind = function_kind(statement, m) if m else None
+            if kind == "definition":
+                defined.setdefault(m.group(1), set()).add(place)
+            elif kind == "declaration" and top == "lib" and rel.endswith(".h"):
+                declared.append((m.group(1), place, f"{rel}:{number}"))
     problems = []
     for name, place, where in declared:
         elsewhere = defined.get(name, set())
@@ -129,51 +135,47 @@ def main():
         if d not in allowed:
             problems.append(f"lib/wobble/{d}: a folder that is not in the documented layers")
 
-    for top in ("lib", "pipelines", "app"):
-        for path in source_files(root, top):
-            rel = os.path.relpath(path, root)
-            parts = rel.split(os.sep)
-            folder = parts[2] if top == "lib" and len(parts) > 3 else None
-            with open(path, encoding="utf-8") as f:
-                lines = f.read().split("\n")
-            if len(lines) > MAX_LINES:
-                problems.append(f"{rel}: {len(lines)} lines, more than {MAX_LINES}; split it by what its parts do")
-            for number, line in enumerate(lines, 1):
-                m = INCLUDE.match(line)
-                if m:
-                    inc = m.group(1)
-                    where = f"{rel}:{number}"
-                    if top == "lib" and re.match(r"(vtk|Imf|Imath|OpenEXR)", inc):
-                        problems.append(f"{where}: lib/ includes {inc}; VTK and OpenEXR belong in pipelines/")
-                    if top == "pipelines" and inc.startswith("wobble/script/"):
-                        problems.append(f"{where}: pipelines/ includes the interpreter ({inc}); use wobble/scene")
-                    if inc.startswith("wobble/"):
-                        target = inc.split("/")
-                        if len(target) < 3:
-                            continue
-                        if "internal" in target[:-1]:
-                            inner = os.path.join("lib", *target[:target.index("internal")])
-                            if not rel.startswith(inner + os.sep):
-                                problems.append(f"{where}: {inc} is internal to lib/{'/'.join(target[:target.index('internal')])}")
-                            elif rel.endswith(".h") and "internal" not in parts:
-                                problems.append(f"{where}: the public header includes {inc}, which is not "
-                                                "installed; include it from the .cc files")
-                        if folder and target[1] != folder and target[1] not in allowed.get(folder, []):
-                            problems.append(f"{where}: lib/wobble/{folder} may not include {inc} "
-                                            f"(it may include: {', '.join(allowed.get(folder, [])) or 'nothing of wobble'})")
-                    if top != "app" and "internal" not in parts and rel.endswith(".h") and inc.startswith("ceres/"):
-                        problems.append(f"{where}: a public header includes Ceres ({inc}); move what needs it to an "
-                                        "internal/ header or a .cc")
-                m = NAMESPACE.match(line)
-                if m and folder:
-                    ns = m.group(1)
-                    want = "wobble" if folder in GROUND_FLOOR else f"wobble::{folder}"
-                    upper = ns.split("::")[1] if ns.count("::") else ""
-                    wrong = not (ns == want or ns.startswith(want + "::"))
-                    if folder in GROUND_FLOOR:  # wobble or wobble::detail, never an upper layer's
-                        wrong = wrong or upper in order
-                    if ns.startswith("wobble") and wrong:
-                        problems.append(f"{rel}:{number}: namespace {ns} in lib/wobble/{folder}; expected {want}")
+    for rel, top, folder, text in layered_sources(root):
+        parts = rel.split(os.sep)
+        lines = text.split("\n")
+        if len(lines) > MAX_LINES:
+            problems.append(f"{rel}: {len(lines)} lines, more than {MAX_LINES}; split it by what its parts do")
+        for number, line in enumerate(lines, 1):
+            m = INCLUDE.match(line)
+            if m:
+                inc = m.group(1)
+                where = f"{rel}:{number}"
+                if top == "lib" and re.match(r"(vtk|Imf|Imath|OpenEXR)", inc):
+                    problems.append(f"{where}: lib/ includes {inc}; VTK and OpenEXR belong in pipelines/")
+                if top == "pipelines" and inc.startswith("wobble/script/"):
+                    problems.append(f"{where}: pipelines/ includes the interpreter ({inc}); use wobble/scene")
+                if inc.startswith("wobble/"):
+                    target = inc.split("/")
+                    if len(target) < 3:
+                        continue
+                    if "internal" in target[:-1]:
+                        inner = os.path.join("lib", *target[:target.index("internal")])
+                        if not rel.startswith(inner + os.sep):
+                            problems.append(f"{where}: {inc} is internal to lib/{'/'.join(target[:target.index('internal')])}")
+                        elif rel.endswith(".h") and "internal" not in parts:
+                            problems.append(f"{where}: the public header includes {inc}, which is not "
+                                            "installed; include it from the .cc files")
+                    if folder and target[1] != folder and target[1] not in allowed.get(folder, []):
+                        problems.append(f"{where}: lib/wobble/{folder} may not include {inc} "
+                                        f"(it may include: {', '.join(allowed.get(folder, [])) or 'nothing of wobble'})")
+                if top != "app" and "internal" not in parts and rel.endswith(".h") and inc.startswith("ceres/"):
+                    problems.append(f"{where}: a public header includes Ceres ({inc}); move what needs it to an "
+                                    "internal/ header or a .cc")
+            m = NAMESPACE.match(line)
+            if m and folder:
+                ns = m.group(1)
+                want = "wobble" if folder in GROUND_FLOOR else f"wobble::{folder}"
+                upper = ns.split("::")[1] if ns.count("::") else ""
+                wrong = not (ns == want or ns.startswith(want + "::"))
+                if folder in GROUND_FLOOR:  # wobble or wobble::detail, never an upper layer's
+                    wrong = wrong or upper in order
+                if ns.startswith("wobble") and wrong:
+                    problems.append(f"{rel}:{number}: namespace {ns} in lib/wobble/{folder}; expected {want}")
     problems += misplaced_definitions(root)
     for p in problems:
         print(p)
