@@ -260,7 +260,7 @@ World StartingWorld::MakeWorld() const {
   if (body3) {
     // q = (t, rotation vector r, γ): R = exp([r]×), the turn by |r| radians about r
     world.AddBody(body3);
-    scene::SetState3FromQ(&world, 0, q0, qd0);
+    world.SetCoordinates(0, q0, qd0);
     return world;
   }
   world.AddBody(body);

@@ -60,7 +60,7 @@ int RunInspect(const InspectArgs& a) {
   if (setup.body3) throw UsageError("inspect takes 2D objects only so far; for a 3D object use condition check or simulate");
   const std::shared_ptr<const BodyModel>& body = setup.body;
   const World world = setup.MakeWorld();
-  const BodyState<2, double>& s = world.state(0);
+  const BodyState<2, double>& s = world.state<2>(0);
   const Lattice& lat = body->lattice();
 
   json out = json::object();
@@ -79,7 +79,7 @@ int RunInspect(const InspectArgs& a) {
 
   // the state: world positions, inertia, velocity terms, forces, accelerations
   json x = json::array();
-  for (const Eigen::Vector2d& p : world.PointPositions(0)) x.push_back(Point(p));
+  for (const Eigen::Vector2d& p : world.PointPositions<2>(0)) x.push_back(Point(p));
   out["x"] = std::move(x);
   MatQ<double> M;
   MassMatrix(body->moments(), s.q, &M);
@@ -87,7 +87,7 @@ int RunInspect(const InspectArgs& a) {
   VecQ<double> w;
   VelocityTerms(body->moments(), s.q, s.qd, &w);
   out["velocity_terms"] = Vector(-w);
-  const ForceBreakdown<2, double> f = world.Forces(0);
+  const ForceBreakdown<2, double> f = world.Forces<2>(0);
   out["forces"] = {{"gravity", Vector(f.gravity)}, {"modes", Vector(f.modes)}, {"ground", Vector(f.ground)},
                    {"total", Vector(f.total)}};
   VecQ<double> qdd;

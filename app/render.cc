@@ -144,7 +144,7 @@ void RenderRun(const RenderArgs& a, const RenderRequest& request, World& world, 
             << (wall > 0 ? Num(report.frames / wall) : std::string("-")) << " frames/s).\n";
   for (const pl::RenderReport::File& f : report.files) std::cout << "  " << f.Line() << "\n";
   bool ffd = false;
-  for (const record::BodyInfo& b : run.bodies()) ffd = ffd || b.kind == BodyKind::kFfd || b.kind == BodyKind::kFfd3;
+  for (const record::BodyInfo& b : run.bodies()) ffd = ffd || b.kind == BodyKind::kFfd;
   if (out.disp && !ffd) std::cout << "  no displacement images: they are drawn for FFD bodies only\n";
   std::cout << std::flush;
 }

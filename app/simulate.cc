@@ -139,14 +139,14 @@ int RunSimulate(const SimulateArgs& a) {
       << " steps/s.\n";
   int contacts = 0;
   if (three) {
-    const BodyState<3, double>& s = final_world.state3(0);
+    const BodyState<3, double>& s = final_world.state<3>(0);
     const Eigen::Quaterniond& o = s.orientation();
     out << "Final state at t = " << Num(world.time()) << ": t = " << VectorText(s.translation()) << ", orientation (w x y z) = "
         << VectorText(Eigen::Vector4d(o.w(), o.x(), o.y(), o.z())) << ", modes = " << VectorText(s.gamma()) << ",\n"
         << "  v (t-dot, body omega, modes-dot) = " << VectorText(s.qd) << ".\n";
     contacts = int(s.contacts.size());
   } else {
-    const BodyState<2, double>& s = final_world.state(0);
+    const BodyState<2, double>& s = final_world.state<2>(0);
     out << "Final state at t = " << Num(world.time()) << ": q = " << VectorText(s.q) << ",\n"
         << "  qdot = " << VectorText(s.qd) << ".\n";
     contacts = int(s.contacts.size());

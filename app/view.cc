@@ -240,9 +240,7 @@ int RunView(const ViewArgs& a) {
     for (const std::string& f : view.SaveSession(a.save_session)) std::cout << "wrote " << f << "\n";
   if (a.report_fps) ReportFps(view.stats(), a, view.world().options().dt);
   if (view.character() || object3) {
-    Eigen::VectorXd q, qd;
-    if (object3) scene::QFromState3(view.world(), 0, &q, &qd);  // rotation vector, as the script's q
-    else q = view.world().state(0).q;
+    const Eigen::VectorXd q = view.world().coordinates(0);  // 3D: rotation vector, as the script's q
     std::printf("t = %.6g, q =", view.time());
     for (int i = 0; i < q.size(); ++i) std::printf(" %.17g", q[i]);
     std::printf("\n");

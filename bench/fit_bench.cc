@@ -113,7 +113,7 @@ std::vector<fit::ReferenceFrame> ThrownFrames(const std::shared_ptr<const BodyMo
   for (int i = 1; i < frames; ++i) {
     world.Step();
     t.push_back(world.time());
-    q.push_back(world.state(0).q);
+    q.push_back(world.q(0));
   }
   return fit::FramesFromStates(*body, t, q, {});
 }
@@ -218,7 +218,7 @@ struct PoseGraphProblem {
       world.SetModeTargets(0, control::SmoothPoseTargets(*body, truth.graph, n * o.dt, o.switch_width));
       world.Step();
       t.push_back(world.time());
-      q.push_back(world.state(0).q);
+      q.push_back(world.q(0));
     }
     frames = fit::FramesFromStates(*body, t, q, {}, 2);
     start = truth;

@@ -135,7 +135,7 @@ void TimeSteps(benchmark::State& state, World& world) {
     }
   }
   state.SetItemsProcessed(state.iterations());
-  state.counters["contacts"] = double(world.state(0).contacts.size());
+  state.counters["contacts"] = double(world.state<2>(0).contacts.size());
 }
 
 // ---- benchmarks --------------------------------------------------------------------------

@@ -42,9 +42,9 @@ bool Finite(const Energies& e) {
                g.friction_damping, g.friction_cap, e.kinetic, e.gravity, e.modes, e.ground, e.springs);
   if (world.kind(body) == BodyKind::kFfd) {
     std::fprintf(stderr, "  q:");
-    for (int i = 0; i < world.state(body).q.size(); ++i) std::fprintf(stderr, " %g", world.state(body).q[i]);
+    for (int i = 0; i < world.q(body).size(); ++i) std::fprintf(stderr, " %g", world.q(body)[i]);
     std::fprintf(stderr, "\n  qd:");
-    for (int i = 0; i < world.state(body).qd.size(); ++i) std::fprintf(stderr, " %g", world.state(body).qd[i]);
+    for (int i = 0; i < world.qd(body).size(); ++i) std::fprintf(stderr, " %g", world.qd(body)[i]);
   } else {
     std::fprintf(stderr, "  R:");
     for (int i = 0; i < world.linear_R(body).size(); ++i) std::fprintf(stderr, " %g", world.linear_R(body)(i));
@@ -58,8 +58,8 @@ bool Finite(const Energies& e) {
 // Everything a step leaves behind must be finite (the step loop's promise, world.h).
 void CheckFinite(const World& world, int body) {
   if (world.kind(body) == BodyKind::kFfd) {
-    if (!world.state(body).q.allFinite() || !world.state(body).qd.allFinite()) Finding(world, body, "q or q-dot not finite after an ok step");
-    for (const Eigen::Vector2d& p : world.PointPositions(body))
+    if (!world.q(body).allFinite() || !world.qd(body).allFinite()) Finding(world, body, "q or q-dot not finite after an ok step");
+    for (const Eigen::Vector2d& p : world.PointPositions<2>(body))
       if (!p.allFinite()) Finding(world, body, "a mass point position not finite after an ok step");
   } else if (!world.linear_R(body).allFinite() || !world.linear_R_dot(body).allFinite()) {
     Finding(world, body, "R or R-dot not finite after an ok step");
@@ -106,7 +106,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       world.SetLinearState(body, R, R_dot);
     } else {
       body = world.AddBody(fuzz::TableBody());
-      const int n = int(world.state(body).q.size());
+      const int n = int(world.q(body).size());
       Eigen::VectorXd q(n), qd(n), targets(n - kRigidDofs);
       q[0] = in.Value(-500, 500);
       q[1] = in.Value(-100, 500);

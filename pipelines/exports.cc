@@ -115,9 +115,9 @@ void PvdCollection::Write(const std::string& pvd_path) const {
 
 std::vector<ExrChannel> DisplacementImage(const World& world, int body_index, int width, int height) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("displacement image size must be positive");
-  const BodyModel& body = world.body(body_index);
+  const BodyModel& body = world.body<2>(body_index);
   const Lattice& lat = body.lattice();
-  const VecQ<double>& q = world.state(body_index).q;
+  const VecQ<double>& q = world.q(body_index);
   const Frame<2, double> frame(q);
   // deformed control points in the world, W_ij = t + R (L_ij + Σ γ_d d^d_ij); the weights are
   // a partition of unity, so x(s, t) = Σ_ij W_ij B_i(s) B_j(t) is Eq. 4.2 with the rigid motion
@@ -157,9 +157,9 @@ std::vector<ExrChannel> DisplacementImage(const World& world, int body_index, in
 
 vtkSmartPointer<vtkImageData> DisplacementVolume(const World& world, int body_index, int nx, int ny, int nz) {
   if (nx <= 0 || ny <= 0 || nz <= 0) throw std::invalid_argument("displacement volume size must be positive");
-  const BodyModel3& body = world.body3(body_index);
+  const BodyModel3& body = world.body<3>(body_index);
   const Lattice3& lat = body.lattice();
-  const BodyState<3, double>& s = world.state3(body_index);
+  const BodyState<3, double>& s = world.state<3>(body_index);
   // deformed control points in the world, W_c = t + R (L_c + Σ γ_d d^d_c): the weights are a
   // partition of unity, so x(s, t, u) = Σ_c W_c B_c(s, t, u) is Eq. 4.2 with the rigid motion
   std::vector<Eigen::Vector3d> W(size_t(lat.size()));

@@ -34,10 +34,9 @@ constexpr double kPickRadius = 30.0;  // pixels
 int NumMassPoints(const World& w, int b) {
   switch (w.kind(b)) {
     case BodyKind::kLinear: return w.linear_model(b).num_points();
-    case BodyKind::kFfd3: return w.body3(b).num_points();
     case BodyKind::kFfd: break;
   }
-  return w.body(b).num_points();
+  return w.dim(b) == 3 ? w.body<3>(b).num_points() : w.body<2>(b).num_points();
 }
 
 }  // namespace

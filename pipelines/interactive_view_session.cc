@@ -230,7 +230,7 @@ void InteractiveView::Impl::BeginSessionRun(scene::RunKind kind) {
 
 void InteractiveView::Impl::RecordFrame() {
   if (history.size() >= size_t(std::max(1L, options.max_history))) history.erase(history.begin());
-  history.push_back({world->time(), world->state(0).q, world->state(0).qd});
+  history.push_back({world->time(), world->q(0), world->qd(0)});
   recorder->Sample(*world);
 }
 
@@ -351,7 +351,7 @@ void InteractiveView::RecordPose() {
   if (D == 0) return;
   const double t = m.world->time();
   // the pose is held from the last record (or the start) until now; at least one step
-  m.recorded_poses.push_back(m.world->state(0).q.tail(D));
+  m.recorded_poses.push_back(m.world->q(0).tail(D));
   m.recorded_durations.push_back(std::max(t - m.last_pose_time, m.setup.world.dt));
   m.last_pose_time = t;
   m.message = "recorded pose " + std::to_string(m.recorded_poses.size());

@@ -62,8 +62,8 @@ bool HasDisplay() {
 }
 
 Eigen::AlignedBox2d BodyBounds(const World& world, int body_index) {
-  const BodyModel& body = world.body(body_index);
-  const VecQ<double>& q = world.state(body_index).q;
+  const BodyModel& body = world.body<2>(body_index);
+  const VecQ<double>& q = world.q(body_index);
   const Eigen::Matrix2d R = Rotation(q[2]);
   Eigen::AlignedBox2d box;
   for (int c = 0; c < body.lattice().size(); ++c) {
@@ -80,7 +80,7 @@ Eigen::AlignedBox3d SceneBounds(const World& world, const SceneSpec& spec) {
     if (world.kind(b) == BodyKind::kLinear) {
       const LinearDrawing* d = b < int(spec.drawings.size()) ? &spec.drawings[b] : nullptr;
       box.extend(LinearBodyBounds(world, b, d));
-    } else if (world.kind(b) == BodyKind::kFfd3) {
+    } else if (world.dim(b) == 3) {
       box.extend(BodyBounds3(world, b));
     } else {
       const Eigen::AlignedBox2d flat = BodyBounds(world, b);
@@ -174,8 +174,8 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
   // the world's layers, where FFD bodies live: ground, trails, springs
   int first_ffd = -1, first_ffd3 = -1, ground_dim = 0;  // ground_dim: GroundDimensionOf the bodies
   for (int b = world->num_bodies() - 1; b >= 0; --b) {
-    if (world->kind(b) == BodyKind::kFfd) first_ffd = b;
-    if (world->kind(b) == BodyKind::kFfd3) first_ffd3 = b;
+    if (world->IsFfd(b, 2)) first_ffd = b;
+    if (world->IsFfd(b, 3)) first_ffd3 = b;
     ground_dim = std::max(ground_dim, GroundDimensionOf(*world, b));
   }
   if (first_ffd3 >= 0 || ground_dim == 3) {
@@ -219,7 +219,7 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
     m.points.push_back(Ptr<MassPointSource>::New());
     lattice_mappers.push_back(vtkPolyDataMapper::SafeDownCast(
         m.Add(SceneLayer::kLattice, on(m.lattices[b], b), lattice_rgb, 1.0, options_.point_size * 0.75, 1)->GetMapper()));
-    if (world->kind(b) == BodyKind::kFfd) {
+    if (world->IsFfd(b, 2)) {
       if (clean) {  // closed outlines filled under the lines; VTK fans polygons, so triangulated
         auto fill = Ptr<ShapeSource>::New();
         fill->SetSamplesPerSegment(options_.shape_samples);
@@ -232,7 +232,7 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
       auto shape = Ptr<ShapeSource>::New();
       shape->SetSamplesPerSegment(options_.shape_samples);
       m.Add(SceneLayer::kShape, on(shape, b), shape_rgb, clean ? 2.0 * options_.line_width : options_.line_width, 1.0, 2);
-    } else if (world->kind(b) == BodyKind::kFfd3) {
+    } else if (world->IsFfd(b, 3)) {
       // the mesh as a lit surface (flat-shaded facets), and the polylines over it
       auto surface = Ptr<ShapeSource>::New();
       surface->SetLines(false);
@@ -257,8 +257,8 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
     }
     // a mesh's sampled mass (hundreds of points) would cover its surface at the usual size
     double point_size = options_.point_size;
-    if (world->kind(b) == BodyKind::kFfd3)
-      point_size = std::max(2.0, point_size * std::min(1.0, std::sqrt(27.0 / world->body3(b).num_points())));
+    if (world->IsFfd(b, 3))
+      point_size = std::max(2.0, point_size * std::min(1.0, std::sqrt(27.0 / world->body<3>(b).num_points())));
     point_mappers.push_back(vtkPolyDataMapper::SafeDownCast(
         m.Add(SceneLayer::kPoints, on(m.points[b], b), points_rgb, 1.0, point_size, 3)->GetMapper()));
   }

@@ -156,12 +156,12 @@ struct DispTarget {
 std::vector<DispTarget> DispTargets(const World& world, const RenderOutputs& out) {
   std::vector<int> ffd;
   for (int b = 0; b < world.num_bodies(); ++b)
-    if (world.kind(b) == BodyKind::kFfd || world.kind(b) == BodyKind::kFfd3) ffd.push_back(b);
+    if (world.kind(b) == BodyKind::kFfd) ffd.push_back(b);
   std::vector<DispTarget> targets;
   for (int b : ffd) {
     const std::string stem = ffd.size() == 1 ? "disp" : "disp_" + world.body_name(b);
-    if (world.kind(b) == BodyKind::kFfd3) {  // disp_volume voxels along the longest axis
-      const Lattice3& lat = world.body3(b).lattice();
+    if (world.dim(b) == 3) {  // disp_volume voxels along the longest axis
+      const Lattice3& lat = world.body<3>(b).lattice();
       double longest = 0;
       for (const auto& axis : lat.axes()) longest = std::max(longest, axis.norm());
       int n[3];
@@ -169,7 +169,7 @@ std::vector<DispTarget> DispTargets(const World& world, const RenderOutputs& out
       targets.push_back({b, stem, n[0], n[1], n[2]});
       continue;
     }
-    const Lattice& lat = world.body(b).lattice();
+    const Lattice& lat = world.body<2>(b).lattice();
     const int h = out.disp_height > 0 ? out.disp_height
                                       : std::max(1, int(std::lround(out.disp_width * lat.axis_t().norm() / lat.axis_s().norm())));
     targets.push_back({b, stem, out.disp_width, h, 0});
@@ -188,7 +188,7 @@ void WriteCharts(const record::Trajectory& run, const RenderOutputs& out, Render
   if (b < 0 || b >= run.num_bodies()) throw std::invalid_argument("charts: the run has no body " + std::to_string(b));
   const std::string& name = run.bodies()[b].name;
   std::vector<std::pair<ChartSpec, std::string>> charts = {{EnergyChart(run, b, name + ": energy"), "energy"}};
-  if (run.bodies()[b].kind == BodyKind::kFfd)
+  if (run.bodies()[b].IsFfd(2))
     charts.push_back({ConditionChart(run, b, name + ": condition number of M (Fig. 4.9)"), "condition"});
   for (auto& [spec, stem] : charts) {
     spec.width = out.chart_width;
@@ -286,8 +286,8 @@ RenderOutputs SceneRenderOutputs(const std::string& folder, const std::string& n
 World WorldFor(const record::Trajectory& run, const WorldOptions& options) {
   World world(options);
   for (const record::BodyInfo& b : run.bodies()) {
-    if (b.kind == BodyKind::kFfd) world.AddBody(b.ffd);
-    else if (b.kind == BodyKind::kFfd3) world.AddBody(b.ffd3);
+    if (b.IsFfd(2)) world.AddBody(b.ffd);
+    else if (b.IsFfd(3)) world.AddBody(b.ffd3);
     else world.SetGroundContact(world.AddLinearBody(b.linear), b.ground_contact);
   }
   return world;

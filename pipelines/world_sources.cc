@@ -72,8 +72,8 @@ Eigen::Vector3d To3(const Eigen::VectorXd& x) { return Eigen::Vector3d(x[0], x[1
 Eigen::Vector2d WorldPositionOf(const World& world, int body, const Eigen::Vector2d& st) {
   Eigen::Vector2d b0;
   Mat2D<double> B;
-  world.body(body).LocalBasis(st, &b0, &B);
-  const VecQ<double>& q = world.state(body).q;
+  world.body<2>(body).LocalBasis(st, &b0, &B);
+  const VecQ<double>& q = world.q(body);
   return WorldFromLocal(Frame<2, double>(q), LocalPosition<double>(b0, B, q));
 }
 
@@ -110,7 +110,7 @@ bool WorldSourceBase::Check(Needs needs) {
     return false;
   }
   const BodyKind kind = world_->kind(Body);
-  if (needs == Needs::kFfdBody && kind != BodyKind::kFfd) {
+  if (needs == Needs::kFfdBody && !world_->IsFfd(Body, 2)) {
     vtkErrorMacro("body " << Body << " is not an FFD body of the world");
     return false;
   }
@@ -125,7 +125,8 @@ int BodyPartSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInfo
   if (!Check(Needs::kAnyBody)) return 0;
   vtkPolyData* out = OutputOf(out_vec);
   const BodyKind kind = world_->kind(Body);
-  if (!(kind == BodyKind::kFfd ? DrawFfd(out) : kind == BodyKind::kFfd3 ? DrawFfd3(out) : DrawLinear(out))) return 0;
+  const bool drawn = kind == BodyKind::kLinear ? DrawLinear(out) : world_->dim(Body) == 3 ? DrawFfd3(out) : DrawFfd(out);
+  if (!drawn) return 0;
   AddTimeValue(out, world_->time());
   return 1;
 }
@@ -134,8 +135,8 @@ int BodyPartSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInfo
 vtkStandardNewMacro(LatticeSource);
 
 bool LatticeSource::DrawFfd(vtkPolyData* out) {
-  const BodyModel& body = world_->body(Body);
-  const VecQ<double>& q = world_->state(Body).q;
+  const BodyModel& body = world_->body<2>(Body);
+  const VecQ<double>& q = world_->q(Body);
   const Lattice& lat = body.lattice();
   const Frame<2, double> frame(q);
   const int n = lat.size();
@@ -229,8 +230,8 @@ bool LatticeSource::DrawLinear(vtkPolyData* out) {
 vtkStandardNewMacro(MassPointSource);
 
 bool MassPointSource::DrawFfd(vtkPolyData* out) {
-  const BodyModel& body = world_->body(Body);
-  const BodyState<2, double>& s = world_->state(Body);
+  const BodyModel& body = world_->body<2>(Body);
+  const BodyState<2, double>& s = world_->state<2>(Body);
   const WorldParams& params = world_->options().params;
   const Frame<2, double> frame(s.q);
   const int n = body.num_points();
@@ -311,7 +312,7 @@ void ShapeSource::PrintSelf(ostream& os, vtkIndent indent) {
 }
 
 void ShapeSource::UpdateCache() {
-  const BodyModel& body = world_->body(Body);
+  const BodyModel& body = world_->body<2>(Body);
   if (cached_body_ == &body && cached_samples_ == SamplesPerSegment) return;
   sample_st_.clear();
   sample_b0_.clear();
@@ -346,7 +347,7 @@ std::vector<Eigen::Vector2d> ShapeSource::SampleLatticeCoords() const { return s
 
 bool ShapeSource::DrawFfd(vtkPolyData* out) {
   UpdateCache();
-  const VecQ<double>& q = world_->state(Body).q;
+  const VecQ<double>& q = world_->q(Body);
   const Frame<2, double> frame(q);
   const vtkIdType n = vtkIdType(sample_st_.size());
   auto points = DoublePoints();
@@ -463,8 +464,7 @@ int GroundSource::DrawTerrain(const Terrain& terrain, vtkPoints* points, vtkPoly
 
 int GroundDimensionOf(const World& world, int body) {
   switch (world.kind(body)) {
-    case BodyKind::kFfd: return 2;
-    case BodyKind::kFfd3: return 3;
+    case BodyKind::kFfd: return world.dim(body);
     case BodyKind::kLinear: return world.ground_contact(body) ? world.dim(body) : 0;
   }
   return 0;
@@ -506,7 +506,7 @@ int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
   Eigen::AlignedBox3d bodies3;
   for (int b = 0; b < world_->num_bodies(); ++b) {
     if (GroundDimensionOf(*world_, b) != 3) continue;
-    bodies3.extend(world_->kind(b) == BodyKind::kFfd3 ? BodyBounds3(*world_, b) : LinearBodyBounds(*world_, b));
+    bodies3.extend(world_->kind(b) == BodyKind::kFfd ? BodyBounds3(*world_, b) : LinearBodyBounds(*world_, b));
   }
   if (!bodies3.isEmpty()) {
     const GroundPlane& plane = world_->options().ground_3d;
@@ -563,19 +563,18 @@ int SpringSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
   auto stretch = Ptr<vtkDoubleArray>::New();
   stretch->SetName("stretch");  // length minus rest length, per line
   for (const Spring& sp : world_->options().params.springs) {
-    if (sp.body < 0 || sp.body >= world_->num_bodies() || world_->kind(sp.body) != BodyKind::kFfd) continue;
-    const VecQ<double>& q = world_->state(sp.body).q;
+    if (sp.body < 0 || sp.body >= world_->num_bodies() || !world_->IsFfd(sp.body, 2)) continue;
+    const VecQ<double>& q = world_->q(sp.body);
     const Eigen::Vector2d x = WorldFromLocal(Frame<2, double>(q), LocalPosition<double>(sp.rest_local, sp.mode_matrix, q));
     const vtkIdType ids[2] = {points->InsertNextPoint(sp.anchor.x(), sp.anchor.y(), 0.0),
                               points->InsertNextPoint(x.x(), x.y(), 0.0)};
     lines->InsertNextCell(2, ids);
     stretch->InsertNextValue((x - sp.anchor).norm() - sp.rest_length);
   }
-  // 3D FFD bodies: every spring of springs_3d acts on every such body (world.h)
-  for (int b = 0; b < world_->num_bodies(); ++b) {
-    if (world_->kind(b) != BodyKind::kFfd3) continue;
-    const BodyState<3, double>& s = world_->state3(b);
-    for (const SpringN<3>& sp : world_->options().springs_3d) {
+  for (const SpringN<3>& sp : world_->options().springs_3d) {
+    if (sp.body < 0 || sp.body >= world_->num_bodies() || !world_->IsFfd(sp.body, 3)) continue;
+    const BodyState<3, double>& s = world_->state<3>(sp.body);
+    {
       const Eigen::Vector3d x = s.translation() + s.orientation() * LocalPosition<double>(sp.rest_local, sp.mode_matrix, s.q);
       const vtkIdType ids[2] = {points->InsertNextPoint(sp.anchor.data()), points->InsertNextPoint(x.data())};
       lines->InsertNextCell(2, ids);

@@ -34,13 +34,13 @@ Ptr<vtkPoints> DoublePoints(vtkIdType n) {
 }  // namespace
 
 Eigen::Vector3d WorldPosition3(const World& world, int body, const Eigen::Vector3d& b0, const Mat3D<double>& B) {
-  const BodyState<3, double>& s = world.state3(body);
+  const BodyState<3, double>& s = world.state<3>(body);
   return s.translation() + s.orientation() * (b0 + B * s.gamma());
 }
 
 Eigen::AlignedBox3d BodyBounds3(const World& world, int body) {
-  const BodyModel3& m = world.body3(body);
-  const BodyState<3, double>& s = world.state3(body);
+  const BodyModel3& m = world.body<3>(body);
+  const BodyState<3, double>& s = world.state<3>(body);
   Eigen::AlignedBox3d box;
   for (int c = 0; c < m.lattice().size(); ++c) {
     Eigen::Vector3d l = m.rest_control()[size_t(c)];
@@ -51,8 +51,8 @@ Eigen::AlignedBox3d BodyBounds3(const World& world, int body) {
 }
 
 bool LatticeSource::DrawFfd3(vtkPolyData* out) {
-  const BodyModel3& body = world_->body3(Body);
-  const BodyState<3, double>& s = world_->state3(Body);
+  const BodyModel3& body = world_->body<3>(Body);
+  const BodyState<3, double>& s = world_->state<3>(Body);
   const Lattice3& lat = body.lattice();
   const int n = lat.size();
   auto points = DoublePoints(n);
@@ -93,8 +93,8 @@ bool LatticeSource::DrawFfd3(vtkPolyData* out) {
 }
 
 bool MassPointSource::DrawFfd3(vtkPolyData* out) {
-  const BodyModel3& body = world_->body3(Body);
-  const BodyState<3, double>& s = world_->state3(Body);
+  const BodyModel3& body = world_->body<3>(Body);
+  const BodyState<3, double>& s = world_->state<3>(Body);
   const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
   const WorldOptions& o = world_->options();
   const int n = body.num_points();
@@ -143,8 +143,8 @@ bool MassPointSource::DrawFfd3(vtkPolyData* out) {
 }
 
 bool ShapeSource::DrawFfd3(vtkPolyData* out) {
-  const BodyModel3& body = world_->body3(Body);
-  const BodyState<3, double>& s = world_->state3(Body);
+  const BodyModel3& body = world_->body<3>(Body);
+  const BodyState<3, double>& s = world_->state<3>(Body);
   const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
   const SurfaceMesh& mesh = body.def().mesh;
   auto points = Ptr<vtkPoints>::New();

@@ -597,24 +597,24 @@ TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
   World world(o);
   world.AddBody(std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(4e6, 1e6)));
   const int b3 = world.AddBody(table3);
-  EXPECT_EQ(world.kind(b3), BodyKind::kFfd3);
+  EXPECT_EQ(world.kind(b3), BodyKind::kFfd);
   EXPECT_EQ(world.dim(b3), 3);
-  EXPECT_EQ(world.body3(b3).num_q(), 10);
+  EXPECT_EQ(world.body<3>(b3).num_q(), 10);
   Eigen::VectorXd gamma(4), v(10);
   gamma << 0.05, 0.0, -0.02, 0.01;
   v << 10, -20, 5, 0.1, 0.3, -0.2, 0, 0, 0, 0;
-  world.SetState3(b3, Vector3d(0, 30, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Vector3d::UnitX())), gamma, v);
+  world.SetState(b3, PositionsOf(Vector3d(0, 30, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Vector3d::UnitX())), gamma), v);
   // the same body alone, by StepBody3
   WorldParamsN<3> p;
   p.ground = o.ground_3d;
-  BodyState<3, double> alone = world.state3(b3);
+  BodyState<3, double> alone = world.state<3>(b3);
   for (int step = 0; step < 2000; ++step) {
     ASSERT_TRUE(world.Step()) << world.status().message;
     ASSERT_TRUE(StepBody(*table3, p, 0, o.integrator, o.dt, &alone).ok());
   }
-  EXPECT_EQ(world.state3(b3).translation(), alone.translation());
-  EXPECT_EQ(world.state3(b3).qd, alone.qd);
-  EXPECT_FALSE(world.state3(b3).contacts.empty());  // it landed
+  EXPECT_EQ(world.state<3>(b3).translation(), alone.translation());
+  EXPECT_EQ(world.state<3>(b3).qd, alone.qd);
+  EXPECT_FALSE(world.state<3>(b3).contacts.empty());  // it landed
   EXPECT_TRUE(std::isfinite(world.ComputeEnergies(b3).total()));
 }
 
@@ -622,18 +622,18 @@ TEST(Body3InWorld, RefusesBadStatesAndPoints) {
   const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
   World world;
   const int b = world.AddBody(std::make_shared<const BodyModel3>(def, std::vector<DeformationMode3>{}));
-  EXPECT_THROW(world.body(b), std::invalid_argument);  // not a 2D FFD body
+  EXPECT_THROW(world.body<2>(b), std::invalid_argument);  // not a 2D FFD body
   EXPECT_THROW(world.AddNail(At(b, Eigen::Vector2d(0.5, 0.5))), std::invalid_argument);  // (s, t, u) needed
   EXPECT_THROW(world.AddNail(At(b, Eigen::Vector3d(0.5, 1.5, 0.5))), std::invalid_argument);
   EXPECT_THROW(world.ApplyPointForce(MassPointOf(b, 0), Eigen::Vector2d(1, 0)), std::invalid_argument);  // 3 components
   Eigen::VectorXd none(0), v = Eigen::VectorXd::Zero(6);
-  EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, Eigen::VectorXd::Zero(5)),
+  EXPECT_THROW(world.SetState(b, PositionsOf(Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none), Eigen::VectorXd::Zero(5)),
                std::invalid_argument);
   v[0] = NAN;
-  EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, v), std::invalid_argument);
+  EXPECT_THROW(world.SetState(b, PositionsOf(Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none), v), std::invalid_argument);
   v[0] = 1e160;  // finite, but its kinetic energy is not
-  EXPECT_THROW(world.SetState3(b, Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none, v), std::invalid_argument);
-  EXPECT_EQ(world.state3(b).qd[0], 0.0);  // the refused states left it as it was
+  EXPECT_THROW(world.SetState(b, PositionsOf(Vector3d(0, 0, 0), Eigen::Quaterniond::Identity(), none), v), std::invalid_argument);
+  EXPECT_EQ(world.state<3>(b).qd[0], 0.0);  // the refused states left it as it was
 }
 
 // A point force for one step from rest gives the body exactly its impulse. The explicit step
@@ -657,13 +657,13 @@ TEST(Body3InWorld, APointForceGivesTheBodyItsImpulse) {
     const Vector3d t0(1, 2, 3);
     const Eigen::Quaterniond R0(Eigen::AngleAxisd(0.7, Vector3d(1, 2, 0.5).normalized()));
     const Eigen::VectorXd gamma0 = Eigen::VectorXd::Constant(4, 0.05);
-    world.SetState3(b, t0, R0, gamma0, Eigen::VectorXd::Zero(10));
+    world.SetState(b, PositionsOf(t0, R0, gamma0), Eigen::VectorXd::Zero(10));
     if (constrained) world.AddNail(MassPointOf(world.AddBody(table3), 0));
     const MaterialPoint p = MassPointOf(b, 7);
     const Vector3d f(30, -50, 20), x_p = world.PointPosition(p);
     world.ApplyPointForce(p, f);
     ASSERT_TRUE(world.Step()) << world.status().message;
-    const Eigen::VectorXd v = world.state3(b).qd;
+    const Eigen::VectorXd v = world.state<3>(b).qd;
     auto momenta = [&](const Eigen::VectorXd& vel, Vector3d* P, Vector3d* L) {
       P->setZero();
       L->setZero();
@@ -683,11 +683,11 @@ TEST(Body3InWorld, APointForceGivesTheBodyItsImpulse) {
     World twin(o);
     const int tb = twin.AddBody(table3);
     if (constrained) twin.AddNail(MassPointOf(twin.AddBody(table3), 0));
-    const BodyState<3, double>& s1 = world.state3(b);
-    twin.SetState3(tb, s1.translation(), s1.orientation(), s1.gamma(), s1.qd);
+    const BodyState<3, double>& s1 = world.state<3>(b);
+    twin.SetState(tb, PositionsOf(s1.translation(), s1.orientation(), s1.gamma()), s1.qd);
     ASSERT_TRUE(world.Step());
     ASSERT_TRUE(twin.Step());
-    EXPECT_EQ(world.state3(b).qd, twin.state3(tb).qd) << path;
+    EXPECT_EQ(world.state<3>(b).qd, twin.state<3>(tb).qd) << path;
   }
 }
 
@@ -704,15 +704,15 @@ TEST(Body3InWorld, NailedBoxSwingsWithThePhysicalPendulumPeriod) {
   // turned by θ0 about the nail (a/2, b, c/2): t = pivot − R pivot
   const Vector3d pivot(a / 2, b, c / 2);
   const Eigen::Quaterniond turn(Eigen::AngleAxisd(theta0, Vector3d::UnitZ()));
-  world.SetState3(body, pivot - turn * pivot, turn, Eigen::VectorXd(0), Eigen::VectorXd::Zero(6));
+  world.SetState(body, PositionsOf(pivot - turn * pivot, turn, Eigen::VectorXd(0)), Eigen::VectorXd::Zero(6));
   world.AddNail(At(body, Vector3d(0.5, 1.0, 0.5)));
   const double M = 8 * m, d = b / 2, I_pivot = 8 * m * (a * a + b * b) / 4 + M * d * d;
   const double period = 2 * M_PI * std::sqrt(I_pivot / (M * g * d)) * (1 + theta0 * theta0 / 16);
   std::vector<double> crossings;
-  double previous = world.state3(body).qd[5], worst_violation = 0.0;
+  double previous = world.state<3>(body).qd[5], worst_violation = 0.0;
   while (world.time() < 2.2 * period) {
     ASSERT_TRUE(world.Step()) << world.status().message;
-    const double now = world.state3(body).qd[5];
+    const double now = world.state<3>(body).qd[5];
     if (previous > 0 && now <= 0) crossings.push_back(world.time() - o.dt * now / (now - previous));
     previous = now;
     worst_violation = std::max(worst_violation, world.MaxViolation());
@@ -743,12 +743,12 @@ AttachedRun RunAttached(double dt) {
   World world(o);
   const int a = world.AddBody(body_a), b = world.AddBody(body_b), s = world.AddLinearBody(slab);
   BodyState<3, double> sa = RandomState3(rng, *body_a, 0.2), sb = RandomState3(rng, *body_b, 0.2);
-  world.SetState3(a, Vector3d::Zero(), Eigen::Quaterniond::Identity(), sa.gamma(), sa.qd);
+  world.SetState(a, PositionsOf(Vector3d::Zero(), Eigen::Quaterniond::Identity(), sa.gamma()), sa.qd);
   // b and the slab placed so that their joint points coincide with a's
   const Vector3d joint_ab = world.PointPosition(At(a, Vector3d(1, 0.5, 0.5)));
-  world.SetState3(b, Vector3d::Zero(), Eigen::Quaterniond::Identity(), sb.gamma(), sb.qd);
+  world.SetState(b, PositionsOf(Vector3d::Zero(), Eigen::Quaterniond::Identity(), sb.gamma()), sb.qd);
   const Vector3d b_local = world.PointPosition(At(b, Vector3d(0, 0.5, 0.5)));
-  world.SetState3(b, joint_ab - b_local, Eigen::Quaterniond::Identity(), sb.gamma(), sb.qd);
+  world.SetState(b, PositionsOf(joint_ab - b_local, Eigen::Quaterniond::Identity(), sb.gamma()), sb.qd);
   const Vector3d joint_as = world.PointPosition(At(a, Vector3d(0.5, 1, 0.5)));
   Eigen::MatrixXd R = slab->RestState();
   R.col(3) = joint_as - Vector3d(0, -15, 0);  // x = u + R.col(3): the slab point (0, −15, 0) at the joint
@@ -761,7 +761,7 @@ AttachedRun RunAttached(double dt) {
     P->setZero();
     for (int i : {a, b}) {
       Vector3d Pi;
-      L += AngularMomentum(world.body3(i), world.state3(i), &Pi);
+      L += AngularMomentum(world.body<3>(i), world.state<3>(i), &Pi);
       *P += Pi;
     }
     // the linear body, from its mass points: P = Σ m ẋ, L = Σ m x × ẋ

@@ -61,7 +61,7 @@ TEST_P(PdControl, DrivesAFreeModeToTargetWithTheDampingRatioItsGainsImply) {
   const double duration = 4 * 2 * M_PI / wd;
   while (world.time() < duration) {
     ASSERT_TRUE(world.Step());
-    const double t = world.time(), g = world.state(0).q[kRigidDofs];
+    const double t = world.time(), g = world.q(0)[kRigidDofs];
     const double exact =
         target * (1 - std::exp(-zeta * omega * t) * (std::cos(wd * t) + zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * t)));
     max_err = std::max(max_err, std::abs(g - exact));
@@ -98,7 +98,7 @@ TEST(ControlEnergy, CountsTheAbsoluteWorkOfTheModeForces) {
   control::ControlEnergy energy;
   for (int n = 0; n < 20000; ++n) {
     ASSERT_TRUE(world.Step());
-    energy.Accumulate(*body, world.state(0), dt);
+    energy.Accumulate(*body, world.state<2>(0), dt);
   }
   EXPECT_NEAR(energy.consumed, 4 * K * a * a, 2e-3 * 4 * K * a * a);
   EXPECT_NEAR(energy.work, 0.0, 2e-3 * K * a * a);
@@ -149,7 +149,7 @@ TEST(PoseGraph, DrivenModeBecomesPeriodicWithTheGraphsPeriod) {
   for (long n = 0; n < 40 * per_period; ++n) {
     world.SetModeTargets(0, control::TargetsFromPose(*body, g.poses[g.PoseAt(n * dt)]));
     ASSERT_TRUE(world.Step());
-    gamma.push_back(world.state(0).q[kRigidDofs]);
+    gamma.push_back(world.q(0)[kRigidDofs]);
   }
   double diff = 0, range = 0;
   for (long n = 38 * per_period; n < 39 * per_period; ++n) {
@@ -246,7 +246,7 @@ TEST(Controllers, PoseGraphControllerIsThePoseAtRuleAndTheTargetLogHasItsSwitche
     ASSERT_TRUE(by_hand.Step());
     ASSERT_TRUE(driven.Step());
   }
-  EXPECT_EQ((driven.state(0).q - by_hand.state(0).q).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((driven.q(0) - by_hand.q(0)).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(log->steps(), steps);
   ASSERT_EQ(log->segments().size(), expected.size());
   EXPECT_GE(expected.size(), 5u);  // 2.6 s of a 1.2 s cycle: switches at about 0, 0.7, 1.2, 1.9, 2.4
@@ -272,10 +272,10 @@ TEST(Controllers, ModeTargetSetActsAtTheNextStep) {
   sliders->Set(a);
   sliders->Set(b);
   EXPECT_EQ(sliders->targets(), b);
-  EXPECT_EQ(world.state(0).mode_target.size() == 0 ? 0.0 : world.state(0).mode_target.cwiseAbs().maxCoeff(), 0.0)
+  EXPECT_EQ(world.mode_targets(0).size() == 0 ? 0.0 : world.mode_targets(0).cwiseAbs().maxCoeff(), 0.0)
       << "the world's targets changed between steps";
   ASSERT_TRUE(world.Step());
-  EXPECT_EQ(world.state(0).mode_target, b);
+  EXPECT_EQ(world.mode_targets(0), b);
   ASSERT_EQ(sliders->segments().size(), 2u);
   EXPECT_EQ(sliders->segments()[0].step, 0);
   EXPECT_EQ(sliders->segments()[0].targets, Eigen::VectorXd::Zero(D));

@@ -55,7 +55,7 @@ struct Case {
     for (int i = 0; i < steps; ++i) {
       EXPECT_TRUE(world.Step());
       t.push_back(world.time());
-      q.push_back(world.state(0).q);
+      q.push_back(world.q(0));
     }
   }
 };

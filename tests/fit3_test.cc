@@ -342,11 +342,11 @@ std::vector<fit::ReferenceFrame3> WorldFrames(const std::shared_ptr<const BodyMo
   o.integrator = Integrator::kThesis;
   World world(o);
   const int b = world.AddBody(body);
-  world.SetState3(b, q0.head<3>(), ExpRotation<double>(q0.segment<3>(3)), q0.tail(3), v0);
+  world.SetState(b, PositionsOf(q0.head<3>(), ExpRotation<double>(q0.segment<3>(3)), q0.tail(3)), v0);
   std::vector<fit::ReferenceFrame3> frames;
   for (int k = 0; k <= steps; ++k) {
     if (k % every == 0) {
-      const BodyState<3, double>& s = world.state3(b);
+      const BodyState<3, double>& s = world.state<3>(b);
       Eigen::VectorXd q(9);
       q << s.translation(), LogRotation<double>(s.orientation()), s.gamma();
       fit::ReferenceFrame3 f;

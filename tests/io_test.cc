@@ -607,8 +607,7 @@ TEST(io3DFiles, BodyOriginIsTheFileOriginNotTheLatticeCorner) {
 
   World world{WorldOptions{}};
   world.AddBody(body);
-  world.SetState3(0, Eigen::Vector3d(1, 2, 3), Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())),
-                  Eigen::VectorXd(), Eigen::VectorXd::Zero(6));
+  world.SetState(0, PositionsOf(Eigen::Vector3d(1, 2, 3), Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())), Eigen::VectorXd()), Eigen::VectorXd::Zero(6));
   const Eigen::Vector3d placed[3] = {{-19, 12, 33}, {-69, 52, 93}, {-44, 22, 63}};
   for (int k = 0; k < 3; ++k) {
     const Eigen::VectorXd x = world.PointPosition(MassPointOf(0, k));

@@ -40,8 +40,8 @@ Eigen::VectorXd State(std::initializer_list<double> v) {
 
 // Linear momentum Σ m ẋ and angular momentum Σ m x × ẋ about the world origin, point by point.
 std::pair<Eigen::Vector2d, double> Momenta(const World& w) {
-  const BodyModel& b = w.body(0);
-  const BodyState<2, double>& s = w.state(0);
+  const BodyModel& b = w.body<2>(0);
+  const BodyState<2, double>& s = w.state<2>(0);
   const Frame<2, double> frame(s.q);
   Eigen::Vector2d p = Eigen::Vector2d::Zero();
   double L = 0;
@@ -73,12 +73,12 @@ TEST(FreeFall, MatchesClosedFormsWithAndWithoutModes) {
       const double y_expected = integrator == Integrator::kThesis ? 1000 + n * 0.01 * 20 - kG * 0.01 * 0.01 * n * (n + 1) / 2
                                                                   : 1000 + 20 * t - 0.5 * kG * t * t;
       SCOPED_TRACE(IntegratorName(integrator) + (with_modes ? " with modes" : " rigid"));
-      EXPECT_NEAR(w.state(0).q[1], y_expected, 1e-9 * 1000);
-      EXPECT_NEAR(w.state(0).q[0], 10 + 3 * t, 1e-9 * 100);
-      EXPECT_NEAR(w.state(0).qd[1], 20 - kG * t, 1e-10 * 100);
+      EXPECT_NEAR(w.q(0)[1], y_expected, 1e-9 * 1000);
+      EXPECT_NEAR(w.q(0)[0], 10 + 3 * t, 1e-9 * 100);
+      EXPECT_NEAR(w.qd(0)[1], 20 - kG * t, 1e-10 * 100);
       // uniform gravity neither turns nor deforms the body
-      EXPECT_NEAR(w.state(0).q[2], 0.4, 1e-12);
-      for (int d = 0; d < body->num_modes(); ++d) EXPECT_NEAR(w.state(0).q[3 + d], 0.0, 1e-12);
+      EXPECT_NEAR(w.q(0)[2], 0.4, 1e-12);
+      for (int d = 0; d < body->num_modes(); ++d) EXPECT_NEAR(w.q(0)[3 + d], 0.0, 1e-12);
     }
   }
 }
@@ -96,12 +96,12 @@ TEST(Rod, OscillatesAtTheFrequencyItsStiffnessAndMassPredict) {
   for (int i = 1; i <= 10000; ++i) {
     ASSERT_TRUE(w.Step());
     const double t = w.time();
-    max_err = std::max(max_err, std::abs(w.state(0).q[3] - 0.1 * std::cos(omega * t)));
-    max_ty_err = std::max(max_ty_err, std::abs(w.state(0).q[1] + 1.5 * C * (w.state(0).q[3] - 0.1)));
+    max_err = std::max(max_err, std::abs(w.q(0)[3] - 0.1 * std::cos(omega * t)));
+    max_ty_err = std::max(max_ty_err, std::abs(w.q(0)[1] + 1.5 * C * (w.q(0)[3] - 0.1)));
   }
   EXPECT_LT(max_err, 1e-9);
   EXPECT_LT(max_ty_err, 1e-7);
-  EXPECT_NEAR(w.state(0).q[2], 0.0, 1e-12);
+  EXPECT_NEAR(w.q(0)[2], 0.0, 1e-12);
 }
 
 // Error against the rod's closed form at Δt and Δt/2: first order for the Euler family,
@@ -113,7 +113,7 @@ TEST(Integrators, ConvergeAtTheirOrder) {
     w.AddBody(std::make_shared<BodyModel>(Rod(K, C)));
     w.SetState(0, State({0, 0, 0, 0.1}), State({0, 0, 0, 0}));
     w.RunUntil(2.0, [](const World&) {});
-    return std::abs(w.state(0).q[3] - 0.1 * std::cos(2.0 * w.time()));
+    return std::abs(w.q(0)[3] - 0.1 * std::cos(2.0 * w.time()));
   };
   for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler, Integrator::kImplicitEuler}) {
     const double ratio = error(integrator, 0.002) / error(integrator, 0.001);
@@ -198,13 +198,13 @@ TEST(Ground, DroppedTableComesToRestWithBoundedPenetration) {
   double deepest = 0;
   for (int i = 0; i < 4000; ++i) {
     ASSERT_TRUE(w.Step()) << w.status().message;
-    deepest = std::max(deepest, w.state(0).penetration);
+    deepest = std::max(deepest, w.Penetration(0));
   }
   const double weight = body->moments().m * kG, Kd = o.params.ground.stiffness;
   const Energies e = w.ComputeEnergies(0);
   EXPECT_LT(e.kinetic, 1e-3 * weight);  // at rest
-  EXPECT_EQ(w.state(0).contacts.size(), 2u);
-  EXPECT_NEAR(w.state(0).penetration, weight / (2 * Kd), 0.05 * weight / (2 * Kd));
+  EXPECT_EQ(w.state<2>(0).contacts.size(), 2u);
+  EXPECT_NEAR(w.Penetration(0), weight / (2 * Kd), 0.05 * weight / (2 * Kd));
   // the impact cannot store more than the drop's energy m g h in the two ground springs
   EXPECT_LT(deepest, std::sqrt(weight * 50 / Kd));
 }
@@ -261,9 +261,9 @@ TEST(Ground, SticksBelowFrictionCapAndSlidesAbove) {
     const Eigen::Vector2d n(-std::sin(alpha), std::cos(alpha)), tau(std::cos(alpha), std::sin(alpha));
     const Eigen::Vector2d t0 = 0.01 * n;
     w.SetState(0, State({t0.x(), t0.y(), alpha}), State({0, 0, 0}));
-    auto along = [&] { return tau.dot(Eigen::Vector2d(w.state(0).q[0], w.state(0).q[1])); };
+    auto along = [&] { return tau.dot(Eigen::Vector2d(w.q(0)[0], w.q(0)[1])); };
     w.RunUntil(6.0, [](const World&) {});
-    const double s1 = along(), v1 = tau.dot(Eigen::Vector2d(w.state(0).qd[0], w.state(0).qd[1]));
+    const double s1 = along(), v1 = tau.dot(Eigen::Vector2d(w.qd(0)[0], w.qd(0)[1]));
     ASSERT_TRUE(w.RunUntil(10.0, [](const World&) {})) << w.status().message;
     const double s2 = along();
     SCOPED_TRACE(alpha_deg);
@@ -300,8 +300,8 @@ TEST(Ground, ImplicitEulerHandlesStiffContact) {
       EXPECT_TRUE(!ok || w.ComputeEnergies(0).kinetic > 1.0);
     } else {
       ASSERT_TRUE(ok) << w.status().message;
-      EXPECT_LT(std::abs(w.state(0).qd[1]), 1e-3);
-      EXPECT_NEAR(w.state(0).penetration, 550 * kG / (2 * 9e7), 1e-6);
+      EXPECT_LT(std::abs(w.qd(0)[1]), 1e-3);
+      EXPECT_NEAR(w.Penetration(0), 550 * kG / (2 * 9e7), 1e-6);
     }
   }
 }
@@ -324,10 +324,10 @@ TEST(Spring, HoldsTheTableAtTheStaticStretch) {
   w.SetState(0, State({-com.x(), 300 - com.y(), 0}), State({0, 0, 0}));
   ASSERT_TRUE(w.RunUntil(60.0, [](const World&) {})) << w.status().message;
   const double m = body->moments().m;
-  const Eigen::Vector2d held(w.state(0).q[0] + com.x(), w.state(0).q[1] + com.y());
+  const Eigen::Vector2d held(w.q(0)[0] + com.x(), w.q(0)[1] + com.y());
   EXPECT_NEAR((sp.anchor - held).norm(), 100 + m * kG / 2000, 1e-6);
   EXPECT_NEAR(held.x(), 0.0, 1e-9);
-  EXPECT_NEAR(w.state(0).q[2], 0.0, 1e-9);
+  EXPECT_NEAR(w.q(0)[2], 0.0, 1e-9);
   EXPECT_NEAR(w.ComputeEnergies(0).springs, 0.5 * 2000 * std::pow(m * kG / 2000, 2), 1e-3);
 }
 
@@ -356,9 +356,9 @@ TEST(Status, RunawayPenetrationIsNamedWithStepAndTime) {
   EXPECT_NE(w.status().message.find("below the ground"), std::string::npos);
   // the last good state is kept: finite, and within the automatic limit (half the lattice's
   // shorter side, 50)
-  EXPECT_TRUE(w.state(0).q.allFinite());
-  EXPECT_LE(w.state(0).penetration, 50.0);
-  EXPECT_GT(w.state(0).penetration, 40.0);
+  EXPECT_TRUE(w.q(0).allFinite());
+  EXPECT_LE(w.Penetration(0), 50.0);
+  EXPECT_GT(w.Penetration(0), 40.0);
 }
 
 // A state is finite with finite energies, or refused: SetState refuses inf, and a finite q̇ of
@@ -373,7 +373,7 @@ TEST(Status, StatesWithoutAFiniteEnergyAreRefused) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("kinetic inf"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(w.state(0).qd, State({0, 0, 0}));
+  EXPECT_EQ(w.qd(0), State({0, 0, 0}));
   EXPECT_TRUE(std::isfinite(w.ComputeEnergies(0).total()));
 }
 
@@ -388,8 +388,8 @@ TEST(Status, AStepToAnInfiniteEnergyIsRefusedWithThatCause) {
   EXPECT_FALSE(w.Step());
   EXPECT_EQ(w.status().code, StepStatus::Code::kNonFiniteEnergy) << w.status().message;
   EXPECT_NE(w.status().message.find("kinetic"), std::string::npos) << w.status().message;
-  EXPECT_EQ(w.state(0).q, State({0, 0, 0}));
-  EXPECT_EQ(w.state(0).qd, State({0, 0, 0}));
+  EXPECT_EQ(w.q(0), State({0, 0, 0}));
+  EXPECT_EQ(w.qd(0), State({0, 0, 0}));
 }
 
 // A force past the largest double is named as such, not as a singular mass matrix (a ground
@@ -406,7 +406,7 @@ TEST(Status, AnOverflowingForceIsNotASingularMassMatrix) {
   EXPECT_TRUE(w.status().code == StepStatus::Code::kOverflowingForce ||
               w.status().code == StepStatus::Code::kNonFiniteEnergy)
       << w.status().message;
-  EXPECT_TRUE(w.state(0).q.allFinite() && w.state(0).qd.allFinite());
+  EXPECT_TRUE(w.q(0).allFinite() && w.qd(0).allFinite());
   EXPECT_TRUE(std::isfinite(w.ComputeEnergies(0).total()));
 }
 

@@ -226,8 +226,8 @@ TEST(ExrIo, NamedChannelsRoundTripExactly) {
 TEST(DisplacementExr, ValuesAtKnownPixelsMatchTheFfdEvaluatedIndependently) {
   const std::string dir = TempDir("disp");
   auto world = AirborneWorld();
-  const BodyModel& body = world->body(0);
-  const Eigen::VectorXd q = world->state(0).q;
+  const BodyModel& body = world->body<2>(0);
+  const Eigen::VectorXd q = world->q(0);
   const int w = 64, h = 24;
   WriteDisplacementExr(dir + "/disp.exr", *world, 0, w, h);
   const ExrImage img = ReadExrChannels(dir + "/disp.exr");
@@ -278,7 +278,7 @@ TEST(RenderedExr, CameraAndTimeInTheHeaderAtKnownPixels) {
       r[j] = p.x() * m[size_t(j)] + p.y() * m[size_t(4 + j)] + p.z() * m[size_t(8 + j)] + m[size_t(12 + j)];
     return Eigen::Vector3d(r[0] / r[3], r[1] / r[3], r[2] / r[3]);
   };
-  const std::vector<Eigen::Vector2d> points = world->PointPositions(0);
+  const std::vector<Eigen::Vector2d> points = world->PointPositions<2>(0);
   int checked = 0;
   for (const Eigen::Vector2d& x : points) {
     // (drawn 3 above the plane, their layer's z offset: the parallel camera looks down z, so
@@ -365,7 +365,7 @@ TEST(RenderedExr, CharactersAlphaAndMotionOfARigidMotionAtEveryPixel) {
   const std::string data = wobble::test_env::DataDir();
   world.AddBody(std::make_shared<const BodyModel>(formats::ReadObjectFile(data + "/pot.obj"),
                                                   formats::ReadDeformationFile(data + "/def_pot")));
-  const int dofs = world.body(0).num_q();
+  const int dofs = world.body<2>(0).num_q();
   Eigen::VectorXd qa = Eigen::VectorXd::Zero(dofs), qb = qa;
   qa.head(3) << 12, 140, 0.3;
   qb.head(3) << 31, 128, 0.42;
@@ -467,8 +467,7 @@ TEST(RenderedExr, A3dHeightfieldIsTheTerrainLayer) {
   o.ground_3d.heightfield = Heightfield::Make(origin, spacing, nx, nz, heights);
   World world(o);
   world.AddBody(std::make_shared<const BodyModel3>(testing::Chair3()));
-  world.SetState3(0, Eigen::Vector3d(-50, 200, -30), Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())),
-                  Eigen::VectorXd::Zero(3), Eigen::VectorXd::Zero(9));
+  world.SetState(0, PositionsOf(Eigen::Vector3d(-50, 200, -30), Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())), Eigen::VectorXd::Zero(3)), Eigen::VectorXd::Zero(9));
   SceneOptions opt;
   opt.width = 320;
   opt.height = 240;
@@ -676,10 +675,10 @@ TEST(TrajectoryCharts, EnergiesConditionAndContactEventsAgreeWithIndependentSums
   double first_contact = -1;
   std::vector<double> reference_cond = {NAN};  // after every step (the start is not checked)
   world.RunUntil(4.0, [&](const World& w) {
-    if (first_contact < 0 && !w.state(0).contacts.empty()) first_contact = w.time();
+    if (first_contact < 0 && !w.state<2>(0).contacts.empty()) first_contact = w.time();
     // cond₂ of the per-point reference M (Eq. 4.10), by eigenvalues: M is symmetric positive definite
     const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
-        reference::MassMatrix(w.body(0), w.state(0).q)).eigenvalues();
+        reference::MassMatrix(w.body<2>(0), w.q(0))).eigenvalues();
     reference_cond.push_back(ev.maxCoeff() / ev.minCoeff());
   });
   const std::vector<double> cond = ConditionNumbers(*run, 0);
@@ -705,7 +704,7 @@ TEST(TrajectoryCharts, EnergiesConditionAndContactEventsAgreeWithIndependentSums
     EXPECT_NEAR(total[i], sum, 1e-9 * std::abs(total[i]));
   }
   // at the start: at rest, 50 up: gravity m g h = 550 · 9.81 · (50 + 50) (centre of mass 50 above the lattice's foot)
-  EXPECT_NEAR(series("gravity")[0], world.body(0).moments().m * 9.81 * (50 + world.body(0).moments().c0.y() / world.body(0).moments().m), 1e-6);
+  EXPECT_NEAR(series("gravity")[0], world.body<2>(0).moments().m * 9.81 * (50 + world.body<2>(0).moments().c0.y() / world.body<2>(0).moments().m), 1e-6);
 
   // the CSV beside the chart holds the same numbers
   const std::string dir = TempDir("chart_csv");

@@ -130,16 +130,15 @@ World MovingPot() {
   w.AddBody(std::make_shared<const BodyModel3>(std::move(def), std::move(modes)));
   Eigen::VectorXd v(9);
   v << 3, -2, 1, 0.4, -0.7, 0.25, 0.5, -0.3, 0.8;
-  w.SetState3(0, Vec3(10, 40, -5), Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Vec3(1, 2, -1).normalized())),
-              Eigen::Vector3d(0.3, -0.2, 0.15), v);
+  w.SetState(0, PositionsOf(Vec3(10, 40, -5), Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Vec3(1, 2, -1).normalized())), Eigen::Vector3d(0.3, -0.2, 0.15)), v);
   return w;
 }
 
 // Eq. 4.1/4.2 at a body-frame point: the deformed control points L + Σ γ_d d^d weighted at
 // the point's lattice coordinates, then into the world.
 Vec3 DirectWorldPoint(const World& w, const Vec3& body_point) {
-  const BodyModel3& m = w.body3(0);
-  const BodyState<3, double>& s = w.state3(0);
+  const BodyModel3& m = w.body<3>(0);
+  const BodyState<3, double>& s = w.state<3>(0);
   std::vector<Vec3> control = m.lattice().RestPoints();
   for (size_t c = 0; c < control.size(); ++c)
     for (int d = 0; d < m.num_modes(); ++d) control[c] += s.gamma()[d] * m.modes()[size_t(d)].displacement[c];
@@ -155,8 +154,7 @@ TEST(Mesh3Sources, SpringsOfA3dBodyRunFromTheAnchorToTheHeldPoint) {
   options.springs_3d.push_back(MakeSpring(*body, coords, anchor, 100.0, 1.0, 20.0));
   World w(options);
   w.AddBody(body);
-  w.SetState3(0, Vec3(10, 40, -5), Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Vec3(1, 2, -1).normalized())),
-              Eigen::Vector3d(0.3, -0.2, 0.15), Eigen::VectorXd::Zero(9));
+  w.SetState(0, PositionsOf(Vec3(10, 40, -5), Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Vec3(1, 2, -1).normalized())), Eigen::Vector3d(0.3, -0.2, 0.15)), Eigen::VectorXd::Zero(9));
   const auto springs = Source<SpringSource>(w);
   vtkPolyData* out = springs->GetOutput();
   ASSERT_EQ(out->GetNumberOfLines(), 1);
@@ -174,8 +172,8 @@ TEST(Mesh3Sources, SpringsOfA3dBodyRunFromTheAnchorToTheHeldPoint) {
 // the voxel's place from the image's origin, spacing and direction is that rest point.
 TEST(Mesh3Sources, DisplacementVolumeHoldsEachVoxelsMotion) {
   const World w = MovingPot();
-  const BodyModel3& body = w.body3(0);
-  const BodyState<3, double>& s = w.state3(0);
+  const BodyModel3& body = w.body<3>(0);
+  const BodyState<3, double>& s = w.state<3>(0);
   const int nx = 8, ny = 6, nz = 5;
   const vtkSmartPointer<vtkImageData> image = pipelines::DisplacementVolume(w, 0, nx, ny, nz);
   int dims[3];
@@ -205,7 +203,7 @@ TEST(Mesh3Sources, TheMeshIsMovedByTheFfdOfItsLattice) {
   const World w = MovingPot();
   const auto shape = Source<ShapeSource>(w);
   vtkPolyData* out = shape->GetOutput();
-  const SurfaceMesh& mesh = w.body3(0).def().mesh;
+  const SurfaceMesh& mesh = w.body<3>(0).def().mesh;
   ASSERT_EQ(out->GetNumberOfPolys(), vtkIdType(mesh.triangles.size()));
   ASSERT_GE(out->GetNumberOfPoints(), vtkIdType(mesh.points.size()));
   double worst = 0;
@@ -225,17 +223,17 @@ TEST(Mesh3Sources, LatticeAndMassPointsOfA3dBody) {
   EXPECT_EQ(lattice->GetOutput()->GetNumberOfLines(), 3 * 16);  // 4 x 4 rows along each axis
   const auto points = Source<MassPointSource>(w);
   vtkPolyData* pd = points->GetOutput();
-  const BodyModel3& m = w.body3(0);
+  const BodyModel3& m = w.body<3>(0);
   ASSERT_EQ(pd->GetNumberOfPoints(), m.num_points());
   // velocities against a central difference of the positions: t + h ṫ, R exp(h ω̂) (ω in the
   // body frame), γ + h γ̇
-  const BodyState<3, double>& s = w.state3(0);
+  const BodyState<3, double>& s = w.state<3>(0);
   const double h = 1e-6;
   auto moved = [&](double sign) {
     World copy = w;
     const Vec3 omega = s.qd.segment<3>(3);
     const Eigen::Quaterniond turn(Eigen::AngleAxisd(sign * h * omega.norm(), omega.normalized()));
-    copy.SetState3(0, s.translation() + sign * h * s.qd.head<3>(), s.orientation() * turn, s.gamma() + sign * h * s.qd.tail(3), s.qd);
+    copy.SetState(0, PositionsOf(s.translation() + sign * h * s.qd.head<3>(), s.orientation() * turn, s.gamma() + sign * h * s.qd.tail(3)), s.qd);
     return copy;
   };
   const World ahead = moved(1), behind = moved(-1);
@@ -261,10 +259,9 @@ TEST(Mesh3Sources, AppliedForcesSumToTheGeneralizedForcesTranslationRows) {
   options.ground_3d.enabled = true;
   World w(options);
   w.AddBody(std::make_shared<const BodyModel3>(std::move(def), std::vector<DeformationMode3>()));
-  w.SetState3(0, Vec3(0, -2, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Vec3::UnitX())), Eigen::VectorXd(),
-              (Eigen::VectorXd(6) << 30, -5, 10, 0, 0.4, 0).finished());
+  w.SetState(0, PositionsOf(Vec3(0, -2, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Vec3::UnitX())), Eigen::VectorXd()), (Eigen::VectorXd(6) << 30, -5, 10, 0, 0.4, 0).finished());
   ASSERT_TRUE(w.Step());
-  ASSERT_GT(w.state3(0).contacts.size(), 10u);
+  ASSERT_GT(w.state<3>(0).contacts.size(), 10u);
   const auto points = Source<MassPointSource>(w);
   vtkDataArray* applied = points->GetOutput()->GetPointData()->GetArray("applied_force");
   Vec3 sum = Vec3::Zero();
@@ -273,12 +270,12 @@ TEST(Mesh3Sources, AppliedForcesSumToTheGeneralizedForcesTranslationRows) {
     applied->GetTuple(k, f.data());
     sum += f;
   }
-  const BodyState<3, double>& s = w.state3(0);
+  const BodyState<3, double>& s = w.state<3>(0);
   WorldParamsN<3> params;
   params.gravity = options.gravity_3d;
   params.ground = options.ground_3d;
   ForceBreakdown<3, double> Q;
-  EvaluateForces(w.body3(0), params, 0, s, Frame<3, double>(s.q), &Q, ContactSet::kFrozen);
+  EvaluateForces(w.body<3>(0), params, 0, s, Frame<3, double>(s.q), &Q, ContactSet::kFrozen);
   const Vec3 expected = (Q.gravity + Q.ground).head<3>();
   EXPECT_LT((sum - expected).norm(), 1e-9 * expected.norm()) << sum.transpose() << " vs " << expected.transpose();
 }
@@ -294,7 +291,7 @@ TEST(Mesh3Record, ConditionNumberOverA3dRunIsThePerPointMassMatrixs) {
   }
   const std::vector<double> cond = pipelines::ConditionNumbers(run, 0);
   ASSERT_EQ(int(cond.size()), run.size());
-  const BodyModel3& body = w.body3(0);
+  const BodyModel3& body = w.body<3>(0);
   const int n = body.num_q();
   double lo = HUGE_VAL, hi = 0;
   for (int k = 0; k < run.size(); k += 13) {
@@ -330,10 +327,10 @@ TEST(Mesh3Record, A3dBodyRecordsAndRestoresExactly) {
   EXPECT_EQ(run.Column("dqw"), -1);  // velocities are ṫ, ω, γ̇: 6 + D, not 7 + D
   ASSERT_EQ(run.Append(w), -1);
   World fresh = MovingPot();
-  fresh.SetState3(0, Vec3::Zero(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero(), Eigen::VectorXd::Zero(9));
+  fresh.SetState(0, PositionsOf(Vec3::Zero(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()), Eigen::VectorXd::Zero(9));
   run.Restore(0, fresh);
-  const BodyState<3, double>& a = w.state3(0);
-  const BodyState<3, double>& b = fresh.state3(0);
+  const BodyState<3, double>& a = w.state<3>(0);
+  const BodyState<3, double>& b = fresh.state<3>(0);
   EXPECT_EQ(a.translation(), b.translation());
   EXPECT_LT((a.orientation().coeffs() - b.orientation().coeffs()).norm(), 1e-15);
   EXPECT_EQ(a.gamma(), b.gamma());

@@ -265,8 +265,7 @@ TEST(RenderRegression, MeshCharacter3d) {
   options.ground_3d.enabled = true;
   World world(options);
   world.AddBody(std::make_shared<const BodyModel3>(std::move(def), std::move(modes)));
-  world.SetState3(0, Eigen::Vector3d(0, 40, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 0, 0.5).normalized())),
-                  Eigen::Vector3d(-0.3, 0.4, 0.5), Eigen::VectorXd::Zero(9));
+  world.SetState(0, PositionsOf(Eigen::Vector3d(0, 40, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 0, 0.5).normalized())), Eigen::Vector3d(-0.3, 0.4, 0.5)), Eigen::VectorXd::Zero(9));
   SceneOptions o;
   o.width = 240;
   o.height = 180;

@@ -366,7 +366,7 @@ TEST(SceneRun, FramesAtAnFpsAreAtTheirExactTimes) {
     const double alpha = a + 1 < run.size() ? (t - run.time(a)) / (run.time(a + 1) - run.time(a)) : 0.0;
     const int b = std::min(a + 1, run.size() - 1);
     blended.SetState(0, (1 - alpha) * run.q(a, 0) + alpha * run.q(b, 0), (1 - alpha) * run.qd(a, 0) + alpha * run.qd(b, 0));
-    const std::vector<Eigen::Vector2d> expected = blended.PointPositions(0);
+    const std::vector<Eigen::Vector2d> expected = blended.PointPositions<2>(0);
     auto reader = Ptr<vtkXMLPolyDataReader>::New();
     reader->SetFileName(vtp.c_str());
     reader->Update();

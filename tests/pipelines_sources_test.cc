@@ -45,8 +45,8 @@ double TimeValue(vtkPolyData* pd) {
 
 TEST(LatticeSource, ControlPointsAreTheDeformedLatticeMovedIntoTheWorld) {
   auto world = AirborneWorld();
-  const BodyModel& body = world->body(0);
-  const Eigen::VectorXd q = world->state(0).q;
+  const BodyModel& body = world->body<2>(0);
+  const Eigen::VectorXd q = world->q(0);
   auto src = Source<LatticeSource>(*world);
   vtkPolyData* out = src->GetOutput();
   const Lattice& lat = body.lattice();
@@ -74,8 +74,8 @@ TEST(LatticeSource, ControlPointsAreTheDeformedLatticeMovedIntoTheWorld) {
 
 TEST(MassPointSource, PositionsVelocitiesAndMassesMatchIndependentEvaluation) {
   auto world = AirborneWorld();
-  const BodyModel& body = world->body(0);
-  const Eigen::VectorXd q = world->state(0).q, qd = world->state(0).qd;
+  const BodyModel& body = world->body<2>(0);
+  const Eigen::VectorXd q = world->q(0), qd = world->qd(0);
   auto src = Source<MassPointSource>(*world);
   vtkPolyData* out = src->GetOutput();
   ASSERT_EQ(out->GetNumberOfPoints(), body.num_points());
@@ -97,12 +97,12 @@ TEST(MassPointSource, PositionsVelocitiesAndMassesMatchIndependentEvaluation) {
 
 TEST(MassPointSource, ContactFlagsAndForcesAgreeWithTheGeneralizedForce) {
   auto world = TouchingWorld();
-  const BodyModel& body = world->body(0);
-  ASSERT_GE(world->state(0).contacts.size(), 2u);
+  const BodyModel& body = world->body<2>(0);
+  ASSERT_GE(world->state<2>(0).contacts.size(), 2u);
   auto src = Source<MassPointSource>(*world);
   vtkPolyData* out = src->GetOutput();
   std::vector<bool> touching(body.num_points(), false);
-  for (const auto& c : world->state(0).contacts) touching[c.point] = true;
+  for (const auto& c : world->state<2>(0).contacts) touching[c.point] = true;
   // the translation rows of Q = Σ Jᵀ f are Σ f (J's translation block is the identity), so
   // the point forces must add up to Q_t of gravity plus ground (Eq. 4.20)
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
@@ -110,13 +110,13 @@ TEST(MassPointSource, ContactFlagsAndForcesAgreeWithTheGeneralizedForce) {
     EXPECT_EQ(out->GetPointData()->GetArray("in_contact")->GetTuple1(k), touching[k] ? 1.0 : 0.0) << k;
     sum += Tuple2(out, "applied_force", k);
   }
-  const ForceBreakdown<2, double> f = world->Forces(0);
+  const ForceBreakdown<2, double> f = world->Forces<2>(0);
   const Eigen::Vector2d expected(f.gravity[0] + f.ground[0], f.gravity[1] + f.ground[1]);
   EXPECT_GT((expected - f.gravity.head<2>()).norm(), 1.0);  // the ground does push
   EXPECT_NEAR((sum - expected).norm(), 0.0, 1e-9 * expected.norm());
   // and the θ row: Σ (x_k − t) × f_k equals Q_θ
   double torque = 0;
-  const Eigen::Vector2d t = world->state(0).q.head<2>();
+  const Eigen::Vector2d t = world->q(0).head<2>();
   for (int k = 0; k < body.num_points(); ++k) {
     const Eigen::Vector2d r = Point(out, k) - t, fk = Tuple2(out, "applied_force", k);
     torque += r.x() * fk.y() - r.y() * fk.x();
@@ -126,8 +126,8 @@ TEST(MassPointSource, ContactFlagsAndForcesAgreeWithTheGeneralizedForce) {
 
 TEST(ShapeSource, SamplesAreTheFfdOfTheDrawingResampledFiner) {
   auto world = AirborneWorld();
-  const BodyModel& body = world->body(0);
-  const Eigen::VectorXd q = world->state(0).q;
+  const BodyModel& body = world->body<2>(0);
+  const Eigen::VectorXd q = world->q(0);
   auto src = vtkSmartPointer<ShapeSource>::New();
   src->SetWorld(world.get());
   src->SetSamplesPerSegment(10);
@@ -190,7 +190,7 @@ TEST(SpringSource, LinesRunFromAnchorToTheHeldPoint) {
   auto src = Source<SpringSource>(*world);
   vtkPolyData* out = src->GetOutput();
   ASSERT_EQ(out->GetNumberOfLines(), 1);
-  const Eigen::Vector2d held = IndependentWorldPoint(world->body(0), world->state(0).q, sp.lattice_coords);
+  const Eigen::Vector2d held = IndependentWorldPoint(world->body<2>(0), world->q(0), sp.lattice_coords);
   EXPECT_NEAR((Point(out, 0) - sp.anchor).norm(), 0.0, 1e-12);
   EXPECT_NEAR((Point(out, 1) - held).norm(), 0.0, 1e-9);
   EXPECT_NEAR(out->GetCellData()->GetArray("stretch")->GetTuple1(0), (held - sp.anchor).norm() - 10, 1e-9);
@@ -205,7 +205,7 @@ TEST(TrailSource, RecordsTheTrackedPointsEachFrame) {
   for (int k = 0; k < 5; ++k) {
     if (k) world->Step();
     src->Record();
-    expected.push_back(IndependentWorldPoint(world->body(0), world->state(0).q, {0, 0}));
+    expected.push_back(IndependentWorldPoint(world->body<2>(0), world->q(0), {0, 0}));
   }
   src->Update();
   vtkPolyData* out = src->GetOutput();
@@ -231,7 +231,7 @@ TEST(WorldSources, OneSourceDrawsEitherKindAndRefusesWhatItCannotDraw) {
       MakeBoxBody("box", 2, LinearOrder::kAffine, testing::Vec({50, 30}), 3, 9.0)));
   // the same MassPointSource draws the FFD table (with its force arrays) and the linear box
   auto ffd = Source<MassPointSource>(*world);
-  EXPECT_EQ(ffd->GetOutput()->GetNumberOfPoints(), world->body(0).num_points());
+  EXPECT_EQ(ffd->GetOutput()->GetNumberOfPoints(), world->body<2>(0).num_points());
   EXPECT_NE(ffd->GetOutput()->GetPointData()->GetArray("applied_force"), nullptr);
   auto linear = vtkSmartPointer<MassPointSource>::New();
   linear->SetWorld(world.get());

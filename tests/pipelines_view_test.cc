@@ -178,9 +178,9 @@ TEST(InteractiveView, DragInTheAirMatchesAWorldWithASpring) {
   Play(&view, frames);
   for (long n = 0; n < view.session_steps(); ++n) ASSERT_TRUE(ref.Step());
   EXPECT_EQ(ref.steps(), view.world().steps());
-  const Eigen::VectorXd dq = view.world().state(0).q - ref.state(0).q;
-  EXPECT_LT(dq.cwiseAbs().maxCoeff(), 1e-9) << "viewer " << view.world().state(0).q.transpose() << "\nreference "
-                                           << ref.state(0).q.transpose();
+  const Eigen::VectorXd dq = view.world().q(0) - ref.q(0);
+  EXPECT_LT(dq.cwiseAbs().maxCoeff(), 1e-9) << "viewer " << view.world().q(0).transpose() << "\nreference "
+                                           << ref.q(0).transpose();
   const double after = (WorldPositionOf(view.world(), 0, st) - cursor).norm();
   EXPECT_LT(after, before);
   // the match with the independent World (gravity, modes, the spring) is the check that the
@@ -205,7 +205,7 @@ TEST(InteractiveView, SliderClickSetsTheModeTargetAndTheAmplitudeFollows) {
   std::string frames;
   for (int k = 0; k < 60; ++k) frames += Event("TimerEvent", 10, 10);
   Play(&view, frames);
-  const double gamma = view.world().state(0).q[3 + bend];
+  const double gamma = view.world().q(0)[3 + bend];
   EXPECT_GT(gamma, 0.6 * target) << "the bend amplitude did not follow its target";
   EXPECT_LT(gamma, 1.4 * target);
 }
@@ -269,9 +269,9 @@ void ExpectReplayMatches(InteractiveView& view, const std::string& name) {
   script::Interpreter interp(out);
   interp.RunFile(path);
   const Eigen::VectorXd& q = interp.q();
-  ASSERT_EQ(q.size(), view.world().state(0).q.size());
-  const Eigen::VectorXd d = q - view.world().state(0).q;
-  EXPECT_LT(d.cwiseAbs().maxCoeff(), 1e-9) << "replay " << q.transpose() << "\nviewer " << view.world().state(0).q.transpose()
+  ASSERT_EQ(q.size(), view.world().q(0).size());
+  const Eigen::VectorXd d = q - view.world().q(0);
+  EXPECT_LT(d.cwiseAbs().maxCoeff(), 1e-9) << "replay " << q.transpose() << "\nviewer " << view.world().q(0).transpose()
                                           << "\nscript:\n" << view.SessionScriptText();
   EXPECT_NEAR(interp.time(), view.time(), 1e-9);
 }
@@ -348,7 +348,7 @@ TEST(InteractiveView, CharacterSessionIsTheScenesRunAsSimulRunsIt) {
     view.Initialize();
     for (int k = 0; k < 30; ++k) view.Frame();  // 1 s: 100 steps
     EXPECT_EQ(view.session_steps(), 100);
-    q = view.world().state(0).q;
+    q = view.world().q(0);
   }
   script::Interpreter ref(out);
   ref.RunFile(script);
@@ -385,10 +385,10 @@ TEST(InteractiveView, KeysPlayFirstThenTheSimulationGoesOn) {
     view.Initialize();
     for (int k = 0; k < 15; ++k) view.Frame();  // 0.5 s: the keys
     EXPECT_NEAR(view.world().time(), 0.5, 1e-12);
-    at_keys_end = view.world().state(0).q;
+    at_keys_end = view.world().q(0);
     for (int k = 0; k < 15; ++k) view.Frame();  // 0.5 s more, simulated
     EXPECT_EQ(view.session_steps(), 100);
-    q = view.world().state(0).q;
+    q = view.world().q(0);
   }
   script::Interpreter ref(out);
   ref.RunFile(script);
@@ -445,23 +445,23 @@ TEST(InteractiveViewOfAScene, A3DObjectsKeysPlayFirstThenItSimulatesOn) {
   interp.RunFile(script);
   ViewerOptions options = TestOptions();
   options.keys_first = true;
-  Eigen::VectorXd at_key2, at_keys_end, q, qd;
+  Eigen::VectorXd at_key2, at_keys_end, q;
   {
     InteractiveView view(interp.scene(), options);
     EXPECT_FALSE(view.character());
     view.Initialize();
     for (int k = 0; k < 9; ++k) view.Frame();  // 0.3 s: the second key
-    scene::QFromState3(view.world(), 0, &at_key2, &qd);
+    at_key2 = view.world().coordinates(0);
     EXPECT_NEAR(at_key2[bend], 0.2, 1e-12);
     // right on a mass point: a keyframed body is placed, not pulled
     const Eigen::Vector3d on_point = view.WorldToDisplay(view.world().PointPosition(MassPointOf(0, 0)));
     EXPECT_FALSE(view.BeginDrag(int(std::lround(on_point[0])), int(std::lround(on_point[1]))));
     for (int k = 0; k < 6; ++k) view.Frame();  // 0.5 s: the keys' end
     EXPECT_NEAR(view.world().time(), 0.5, 1e-12);
-    scene::QFromState3(view.world(), 0, &at_keys_end, &qd);
+    at_keys_end = view.world().coordinates(0);
     for (int k = 0; k < 15; ++k) view.Frame();  // 0.5 s more, simulated
     EXPECT_EQ(view.stats().steps, 100);
-    scene::QFromState3(view.world(), 0, &q, &qd);
+    q = view.world().coordinates(0);
     // once the body simulates, a press on a mass point picks it (so the refusal above meant something)
     const Eigen::Vector3d now = view.WorldToDisplay(view.world().PointPosition(MassPointOf(0, 0)));
     EXPECT_TRUE(view.BeginDrag(int(std::lround(now[0])), int(std::lround(now[1]))));
@@ -505,11 +505,11 @@ TEST(InteractiveView, RecordedPosesBecomeACyclicPoseGraphScript) {
   std::vector<Eigen::VectorXd> amplitudes;
   view.SetModeTarget(0, 0.1);
   for (int k = 0; k < 60; ++k) view.Frame();
-  amplitudes.push_back(view.world().state(0).q.tail(4));
+  amplitudes.push_back(view.world().q(0).tail(4));
   PressKey(&view, 'k');
   view.SetModeTarget(0, -0.1);
   for (int k = 0; k < 60; ++k) view.Frame();
-  amplitudes.push_back(view.world().state(0).q.tail(4));
+  amplitudes.push_back(view.world().q(0).tail(4));
   PressKey(&view, 'k');
   const std::string dir = testing::TempDir("view_poses");
   const std::vector<std::string> files = view.SaveSession(dir + "/s.wob");

@@ -71,7 +71,7 @@ struct Case {
       world.SetModeTargets(0, control::SmoothPoseTargets(*body, truth.graph, n * options.dt, kWidth));
       EXPECT_TRUE(world.Step()) << world.status().message;
       t.push_back(world.time());
-      q.push_back(world.state(0).q);
+      q.push_back(world.q(0));
     }
     frames = fit::FramesFromStates(*body, t, q, {}, 2);  // every 2nd step, all 11 mass points
   }

@@ -55,8 +55,8 @@ TEST(Trajectory, ColumnsNameTheModes) {
 TEST(Recorder, KeepsEveryNthStepAndTheEnd) {
   DroppedTable d(7);
   World reference(WorldOptions{});
-  reference.AddBody(d.world.shared_body(0));
-  reference.SetState(0, d.world.state(0).q, d.world.state(0).qd);
+  reference.AddBody(d.world.shared_body<2>(0));
+  reference.SetState(0, d.world.q(0), d.world.qd(0));
   for (int n = 1; n <= 100; ++n) {
     ASSERT_TRUE(d.world.Step()) << d.world.status().message;
     ASSERT_TRUE(reference.Step());
@@ -64,10 +64,10 @@ TEST(Recorder, KeepsEveryNthStepAndTheEnd) {
       const record::Trajectory& t = *d.trajectory;
       const int k = t.size() - 1;
       EXPECT_EQ(t.time(k), reference.time());
-      EXPECT_EQ((t.q(k, 0) - reference.state(0).q).norm(), 0.0);
-      EXPECT_EQ((t.qd(k, 0) - reference.state(0).qd).norm(), 0.0);
+      EXPECT_EQ((t.q(k, 0) - reference.q(0)).norm(), 0.0);
+      EXPECT_EQ((t.qd(k, 0) - reference.qd(0)).norm(), 0.0);
       EXPECT_EQ(t.energies(k, 0).total(), reference.ComputeEnergies(0).total());
-      EXPECT_EQ(t.contacts(k, 0), int(reference.state(0).contacts.size()));
+      EXPECT_EQ(t.contacts(k, 0), int(reference.state<2>(0).contacts.size()));
     }
   }
   d.recorder->Finish(d.world);
@@ -83,7 +83,7 @@ TEST(TrajectoryCsv, RoundTripsExactly) {
   for (int n = 0; n < 60; ++n) ASSERT_TRUE(d.world.Step());
   const std::string path = (std::filesystem::temp_directory_path() / "wobble_record_test.csv").string();
   record::WriteTrajectoryCsv(path, *d.trajectory);
-  const record::ReadTrajectory back = record::ReadTrajectoryCsv(path, {record::DescribeFfdBody(d.world.shared_body(0))});
+  const record::ReadTrajectory back = record::ReadTrajectoryCsv(path, {record::DescribeFfdBody(d.world.shared_body<2>(0))});
   std::remove(path.c_str());
   ASSERT_TRUE(back.has_velocities);
   ASSERT_EQ(back.trajectory.size(), d.trajectory->size());
@@ -97,12 +97,12 @@ TEST(Trajectory, RestoreReplaysTheRun) {
   DroppedTable d(1);
   for (int n = 0; n < 80; ++n) ASSERT_TRUE(d.world.Step());
   World again(WorldOptions{});
-  again.AddBody(d.world.shared_body(0));
+  again.AddBody(d.world.shared_body<2>(0));
   d.trajectory->Restore(30, again);
   EXPECT_EQ(again.time(), d.trajectory->time(30));
   for (int n = 31; n <= 80; ++n) {
     ASSERT_TRUE(again.Step());
-    EXPECT_EQ((again.state(0).q - d.trajectory->q(n, 0)).norm(), 0.0) << "step " << n;
+    EXPECT_EQ((again.q(0) - d.trajectory->q(n, 0)).norm(), 0.0) << "step " << n;
   }
 }
 
@@ -114,28 +114,27 @@ TEST(Trajectory, RestoreAtInterpolatesBetweenSamples) {
   for (int n = 0; n < 80; ++n) ASSERT_TRUE(d.world.Step());
   const record::Trajectory& run = *d.trajectory;
   World at(WorldOptions{}), exact(WorldOptions{});
-  at.AddBody(d.world.shared_body(0));
-  exact.AddBody(d.world.shared_body(0));
+  at.AddBody(d.world.shared_body<2>(0));
+  exact.AddBody(d.world.shared_body<2>(0));
   run.RestoreAt(run.time(7), at);
   run.Restore(7, exact);
-  EXPECT_EQ(at.state(0).q, exact.state(0).q);
-  EXPECT_EQ(at.state(0).qd, exact.state(0).qd);
+  EXPECT_EQ(at.q(0), exact.q(0));
+  EXPECT_EQ(at.qd(0), exact.qd(0));
   const double t = run.time(7) + 0.3 * (run.time(8) - run.time(7));
   run.RestoreAt(t, at);
   EXPECT_EQ(at.time(), t);
   const Eigen::VectorXd q = 0.7 * run.q(7, 0) + 0.3 * run.q(8, 0), qd = 0.7 * run.qd(7, 0) + 0.3 * run.qd(8, 0);
-  EXPECT_LT((at.state(0).q - q).norm(), 1e-12 * (1 + q.norm()));
-  EXPECT_LT((at.state(0).qd - qd).norm(), 1e-12 * (1 + qd.norm()));
+  EXPECT_LT((at.q(0) - q).norm(), 1e-12 * (1 + q.norm()));
+  EXPECT_LT((at.qd(0) - qd).norm(), 1e-12 * (1 + qd.norm()));
   run.RestoreAt(run.time(run.size() - 1) + 1.0, at);
-  EXPECT_EQ(at.state(0).q, run.q(run.size() - 1, 0));
+  EXPECT_EQ(at.q(0), run.q(run.size() - 1, 0));
 
   // a 3D body turning: the orientation between two samples is the normalised blend
   World w3(WorldOptions{});
   w3.mutable_options().ground_3d.enabled = false;
   const int b = w3.AddBody(std::make_shared<const BodyModel3>(testing::Chair3()));
-  const Eigen::VectorXd g0 = Eigen::VectorXd::Zero(w3.body3(b).num_modes());
-  w3.SetState3(b, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), g0,
-               (Eigen::VectorXd(6 + g0.size()) << Eigen::VectorXd::Zero(3), 0.5, 2.0, -1.0, g0).finished());
+  const Eigen::VectorXd g0 = Eigen::VectorXd::Zero(w3.body<3>(b).num_modes());
+  w3.SetState(b, PositionsOf(Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), g0), (Eigen::VectorXd(6 + g0.size()) << Eigen::VectorXd::Zero(3), 0.5, 2.0, -1.0, g0).finished());
   auto run3 = std::make_shared<record::Trajectory>(w3);
   auto rec3 = std::make_shared<record::Recorder>(run3, 10);
   rec3->Start(w3);
@@ -143,14 +142,14 @@ TEST(Trajectory, RestoreAtInterpolatesBetweenSamples) {
   for (int n = 0; n < 40; ++n) ASSERT_TRUE(w3.Step()) << w3.status().message;
   World at3(WorldOptions{});
   at3.mutable_options().ground_3d.enabled = false;
-  at3.AddBody(w3.shared_body3(b));
+  at3.AddBody(w3.shared_body<3>(b));
   const double t3 = 0.5 * (run3->time(2) + run3->time(3));
   run3->RestoreAt(t3, at3);
   const Eigen::Map<const Eigen::VectorXd> qa = run3->q(2, b), qb = run3->q(3, b);
   const Eigen::Vector4d wxyz = 0.5 * (qa.segment<4>(3) + qb.segment<4>(3));  // recorded as qw qx qy qz
   const Eigen::Quaterniond mid = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).normalized();
-  EXPECT_LT(std::abs(std::abs(at3.state3(b).orientation().dot(mid)) - 1.0), 1e-12);
-  EXPECT_LT((at3.state3(b).translation() - 0.5 * (qa.head<3>() + qb.head<3>())).norm(), 1e-12);
+  EXPECT_LT(std::abs(std::abs(at3.state<3>(b).orientation().dot(mid)) - 1.0), 1e-12);
+  EXPECT_LT((at3.state<3>(b).translation() - 0.5 * (qa.head<3>() + qb.head<3>())).norm(), 1e-12);
   EXPECT_EQ(at3.time(), t3);
 }
 

@@ -228,11 +228,11 @@ TEST(Scene, RunsWithoutARecordAndAStoppedPoseGraph) {
   // pose 1 holds 0.3 s (30 steps): stopped at step 10, the targets stay those of pose 1
   s.BeginRun(scene::RunKind::kSimulate, false);
   for (int n = 0; n < 10; ++n) ASSERT_TRUE(s.Step());
-  const Eigen::VectorXd held = s.run_world()->state(0).mode_target;
+  const Eigen::VectorXd held = s.run_world()->mode_targets(0);
   ASSERT_GT(held.cwiseAbs().maxCoeff(), 0.0);
   s.StopPoseGraph();
   for (int n = 0; n < 60; ++n) ASSERT_TRUE(s.Step());  // past the switch to pose 2 at step 30
-  EXPECT_EQ(s.run_world()->state(0).mode_target, held);
+  EXPECT_EQ(s.run_world()->mode_targets(0), held);
   s.EndRun();
 }
 

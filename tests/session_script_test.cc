@@ -42,7 +42,7 @@ Session RunByHand(const WorldOptions& options, const Eigen::VectorXd& q0, long s
     }
     EXPECT_TRUE(world.Step());
   }
-  s.q = world.state(0).q;
+  s.q = world.q(0);
   s.record.object_path = kData + "/table.obj";
   s.record.mode_paths = {kData + "/table_modes.def"};
   s.record.body = s.body.get();

@@ -270,7 +270,7 @@ TEST(Synthesis3d, ATrialMeasuresTheUniformTravelOfAFreeBodysCentre) {
   // the centre's x velocity at the start, from the same state in a world
   World w(p.world);
   w.AddBody(p.body3);
-  scene::SetState3FromQ(&w, 0, p.q0, p.qd0);
+  w.SetCoordinates(0, p.q0, p.qd0);
   double x0, v0;
   synth::CenterOfMassX(w, &x0, &v0);
   const synth::TrialOutcome o = synth::RunTrial(p, {});

@@ -59,8 +59,8 @@ BodyDef BallDef() {
 // The ground's force on body 0 through each face, summed over the body's contacts.
 std::vector<Eigen::Vector2d> ForcePerFace(const World& w) {
   const Ground& g = w.options().params.ground;
-  const BodyModel& body = w.body(0);
-  const BodyState<2, double>& s = w.state(0);
+  const BodyModel& body = w.body<2>(0);
+  const BodyState<2, double>& s = w.state<2>(0);
   const Frame<2, double> frame(s.q);
   std::vector<Eigen::Vector2d> per_face(g.terrain->num_faces(), Eigen::Vector2d::Zero());
   for (const Contact<2, double>& c : s.contacts) {
@@ -73,14 +73,14 @@ std::vector<Eigen::Vector2d> ForcePerFace(const World& w) {
 }
 
 Eigen::Vector2d CentreOfMass(const World& w) {
-  const MassMoments& mm = w.body(0).moments();
-  const Frame<2, double> frame(w.state(0).q);
+  const MassMoments& mm = w.body<2>(0).moments();
+  const Frame<2, double> frame(w.q(0));
   return frame.t + frame.R * (mm.c0 / mm.m);
 }
 
 Eigen::Vector2d CentreOfMassVelocity(const World& w) {
-  const MassMoments& mm = w.body(0).moments();
-  const BodyState<2, double>& s = w.state(0);
+  const MassMoments& mm = w.body<2>(0).moments();
+  const BodyState<2, double>& s = w.state<2>(0);
   const Frame<2, double> frame(s.q);
   return Eigen::Vector2d(s.qd[0], s.qd[1]) + s.qd[2] * (frame.R * Perp(Vec2<double>(mm.c0 / mm.m)));
 }
@@ -169,12 +169,12 @@ TEST(Terrain, BlockAtRestOnEachFaceOfAValley) {
     const Eigen::Vector2d t0 = foot + 0.01 * n;
     w.SetState(0, State({t0.x(), t0.y(), side * alpha}), State({0, 0, 0}));
     ASSERT_TRUE(w.RunUntil(6.0, [](const World&) {})) << w.status().message;
-    const double s1 = tau.dot(Eigen::Vector2d(w.state(0).q[0], w.state(0).q[1]));
+    const double s1 = tau.dot(Eigen::Vector2d(w.q(0)[0], w.q(0)[1]));
     ASSERT_TRUE(w.RunUntil(10.0, [](const World&) {})) << w.status().message;
-    const double s2 = tau.dot(Eigen::Vector2d(w.state(0).q[0], w.state(0).q[1]));
+    const double s2 = tau.dot(Eigen::Vector2d(w.q(0)[0], w.q(0)[1]));
     EXPECT_LT(std::abs(s2 - s1), 1e-3);  // a slide would move tens of units in 4 s
     const std::vector<Eigen::Vector2d> f = ForcePerFace(w);
-    const double weight = w.body(0).moments().m * kG;
+    const double weight = w.body<2>(0).moments().m * kG;
     for (int i = 0; i < int(f.size()); ++i) {
       if (i == face) continue;
       EXPECT_EQ(f[i], Eigen::Vector2d::Zero()) << "face " << i;
@@ -197,7 +197,7 @@ TEST(Terrain, BlockInAValleyCornerFeelsBothFaces) {
   w.SetState(0, State({0, 0.5, kPi / 4}), State({0, 0, 0}));
   ASSERT_TRUE(w.RunUntil(5.0, [](const World&) {})) << w.status().message;
   const std::vector<Eigen::Vector2d> f = ForcePerFace(w);
-  const double weight = w.body(0).moments().m * kG;
+  const double weight = w.body<2>(0).moments().m * kG;
   EXPECT_LT(w.ComputeEnergies(0).kinetic, 1e-6 * weight);
   for (int face : {1, 2}) {
     SCOPED_TRACE(face);
@@ -206,7 +206,7 @@ TEST(Terrain, BlockInAValleyCornerFeelsBothFaces) {
     EXPECT_NEAR(f[face].dot(o.params.ground.Face(face).tau), 0.0, 1e-9 * weight);  // no friction
   }
   int corner_contacts = 0;
-  for (const Contact<2, double>& c : w.state(0).contacts) corner_contacts += c.point == 0;
+  for (const Contact<2, double>& c : w.state<2>(0).contacts) corner_contacts += c.point == 0;
   EXPECT_EQ(corner_contacts, 2);
 }
 
@@ -227,9 +227,9 @@ TEST(Terrain, SlidesDownASlopeFaceWithItsOwnFrictionCap) {
   const GroundFace face = o.params.ground.Face(1);
   const Eigen::Vector2d t0 = Eigen::Vector2d(-1500, 1500 * std::tan(alpha)) + 0.01 * face.n;
   w.SetState(0, State({t0.x(), t0.y(), -alpha}), State({0, 0, 0}));
-  auto along = [&] { return face.tau.dot(Eigen::Vector2d(w.state(0).q[0], w.state(0).q[1])); };
+  auto along = [&] { return face.tau.dot(Eigen::Vector2d(w.q(0)[0], w.q(0)[1])); };
   ASSERT_TRUE(w.RunUntil(6.0, [](const World&) {})) << w.status().message;
-  const double s1 = along(), v1 = face.tau.dot(Eigen::Vector2d(w.state(0).qd[0], w.state(0).qd[1]));
+  const double s1 = along(), v1 = face.tau.dot(Eigen::Vector2d(w.qd(0)[0], w.qd(0)[1]));
   ASSERT_TRUE(w.RunUntil(10.0, [](const World&) {})) << w.status().message;
   const double a = kG * (std::sin(alpha) - mu * std::cos(alpha));  // down the face is +τ here
   EXPECT_NEAR(v1, a * 6.0, 0.01 * a * 6.0);
@@ -262,10 +262,10 @@ TEST(Terrain, BallRollingOffACliffEdgeFollowsTheFreeFallParabola) {
   double wall_depth = 0;  // how far below the edge a point touched the cliff face
   while (w.time() < 12.0 && (samples.empty() || !samples.back().on_floor)) {
     ASSERT_TRUE(w.Step()) << w.status().message;
-    const BodyState<2, double>& s = w.state(0);
+    const BodyState<2, double>& s = w.state<2>(0);
     const Frame<2, double> frame(s.q);
-    for (int k = 0; k < w.body(0).num_points(); ++k) {
-      const Eigen::Vector2d x = WorldFromLocal(frame, Vec2<double>(w.body(0).rest_local(k)));
+    for (int k = 0; k < w.body<2>(0).num_points(); ++k) {
+      const Eigen::Vector2d x = WorldFromLocal(frame, Vec2<double>(w.body<2>(0).rest_local(k)));
       const bool has_contact =
           std::any_of(s.contacts.begin(), s.contacts.end(), [k](const Contact<2, double>& c) { return c.point == k; });
       ASSERT_EQ(terrain.Inside(x), has_contact) << "point " << k << " at t = " << w.time();
@@ -273,7 +273,7 @@ TEST(Terrain, BallRollingOffACliffEdgeFollowsTheFreeFallParabola) {
     Sample sample{w.time(), CentreOfMass(w), CentreOfMassVelocity(w), false, false};
     for (const Contact<2, double>& c : s.contacts) {
       if (c.face == 1)  // the cliff face: only where the ball pivots over the edge
-        wall_depth = std::max(wall_depth, 100 - WorldFromLocal(frame, Vec2<double>(w.body(0).rest_local(c.point))).y());
+        wall_depth = std::max(wall_depth, 100 - WorldFromLocal(frame, Vec2<double>(w.body<2>(0).rest_local(c.point))).y());
       (c.face == 2 ? sample.on_floor : sample.on_cliff) = true;
     }
     samples.push_back(sample);
@@ -340,7 +340,7 @@ TEST(Terrain, LevelTerrainStepsExactlyAsTheGroundLine) {
     w.SetState(0, State({0, 50, 0.1, 0, 0, 0, 0}), State({5, 0, 0, 0, 0, 0, 0}));
     for (int i = 0; i < 800; ++i) {
       ASSERT_TRUE(w.Step()) << w.status().message;
-      runs[with_terrain].push_back(w.state(0).q);
+      runs[with_terrain].push_back(w.q(0));
     }
   }
   for (size_t i = 0; i < runs[0].size(); ++i) ASSERT_EQ(runs[0][i], runs[1][i]) << "step " << i;

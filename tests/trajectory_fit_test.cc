@@ -35,7 +35,7 @@ Reference Simulated(const std::shared_ptr<const BodyModel>& body, int steps = 15
   for (int i = 0; i < steps; ++i) {
     EXPECT_TRUE(world.Step());
     r.t.push_back(world.time());
-    r.q.push_back(world.state(0).q);
+    r.q.push_back(world.q(0));
   }
   return r;
 }

@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "hello_wobble: %s\n", world.status().message.c_str());
         return 3;
       }
-      const Eigen::VectorXd& s = world.state(body).q;
+      const Eigen::VectorXd& s = world.q(body);
       const double kinetic = world.KineticEnergy(body);
       calm_seconds = kinetic < 1.0 ? calm_seconds + 1 : 0;
       if (second % 5 == 0 || calm_seconds == 3)

@@ -13,6 +13,9 @@
 #include "wobble/core/limits.h"
 #include "wobble/core/types.h"
 #include "wobble/scene/ffd_object.h"
+#ifdef WOBBLE_PYTHON_RENDER
+#include "pipelines/mesh_io.h"
+#endif
 
 namespace wobble::python {
 namespace {
@@ -20,13 +23,24 @@ namespace {
 // The object file and its modes, read as a script's load_obj and load_def would (one loader:
 // scene::FfdObject), then the mode set checked as `wobble simulate` does.
 // (pybind11 holds bodies as shared_ptr<BodyModel>; Python never changes one.)
-std::shared_ptr<BodyModel> LoadBody(const std::string& object, const std::vector<std::string>& modes, bool check) {
+// A 2D or 3D body, as the object file's `dimension` says (a 3D file's `mesh` is read by VTK's
+// readers when the module has the pipelines).
+py::object LoadBody(const std::string& object, const std::vector<std::string>& modes, bool check) {
   scene::FfdObject o;
-  o.Load(object);
+#ifdef WOBBLE_PYTHON_RENDER
+  o.Load(object, pipelines::ReadSurfaceMesh);
+#else
+  o.Load(object);  // a `mesh` line is refused: this module was built without VTK
+#endif
   o.LoadModes(modes);
+  if (o.dim() == 3) {
+    std::shared_ptr<const BodyModel3> body = o.Body3();
+    if (check) CheckLoadedModeSet(*body, object);
+    return py::cast(std::const_pointer_cast<BodyModel3>(body));
+  }
   std::shared_ptr<const BodyModel> body = o.Body();
   if (check) CheckLoadedModeSet(*body, object);
-  return std::const_pointer_cast<BodyModel>(body);
+  return py::cast(std::const_pointer_cast<BodyModel>(body));
 }
 
 py::array_t<double> Points(const std::vector<Eigen::Vector2d>& points) {
@@ -240,8 +254,9 @@ void BindBodies(py::module_& m) {
 
   m.def("load_body", &LoadBody, py::arg("object"), py::arg("modes") = std::vector<std::string>(),
         py::arg("check") = true,
-        "Reads an object file (.obj: lattice, mass points, drawing) and deformation files (.def),\n"
-        "the modes of all files in order. check: refuse a mode set that cannot be simulated\n"
+        "Reads an object file (.obj: lattice, mass points, drawing; 'dimension 3': a 3D lattice or\n"
+        "'lattice fit', 'sample', a 'mesh') and its deformation files, the modes of all files in\n"
+        "order; returns a BodyModel or a BodyModel3. check: refuse a mode set that cannot be simulated\n"
         "(InputError, as `wobble simulate`), and warn about a poorly conditioned one.\n"
         "Errors name FILE:LINE (wobble.ParseError).");
 }

@@ -9,32 +9,9 @@
 #include "wobble/core/errors.h"
 #include "wobble/core/rotation3.h"
 #include "wobble/fit/pose_fit3.h"
-#include "wobble/scene/ffd_object.h"
-#ifdef WOBBLE_PYTHON_RENDER
-#include "pipelines/mesh_io.h"
-#endif
 
 namespace wobble::python {
 namespace {
-
-std::shared_ptr<BodyModel3> LoadBody3(const std::string& object, const std::vector<std::string>& modes, bool check) {
-  scene::FfdObject o;
-#ifdef WOBBLE_PYTHON_RENDER
-  o.Load(object, pipelines::ReadSurfaceMesh);
-#else
-  o.Load(object);  // a `mesh` line is refused: this module was built without VTK
-#endif
-  if (o.dim() != 3) throw InputError(object + ": a 2D object file (use wobble.load_body)");
-  o.LoadModes(modes);
-  std::shared_ptr<const BodyModel3> body = o.Body3();
-  if (check) CheckLoadedModeSet(*body, object);
-  return std::const_pointer_cast<BodyModel3>(body);
-}
-
-void Check3(const World& w, int body) {
-  if (body < 0 || body >= w.num_bodies() || w.kind(body) != BodyKind::kFfd3)
-    throw InputError("body " + std::to_string(body) + " is not a 3D FFD body of the world");
-}
 
 py::array_t<double> Rows3(const std::vector<Eigen::Vector3d>& points) {
   py::array_t<double> out({py::ssize_t(points.size()), py::ssize_t(3)});
@@ -52,7 +29,7 @@ void BindBodies3(py::module_& m) {
       "A 3D FFD character (issue 15): a trivariate lattice, mass points, modes made by generators,\n"
       "and optionally a user's mesh. Immutable. In a World its q is [tx, ty, tz, rx, ry, rz,\n"
       "γ1..γD] (r the rotation vector) and q̇ [vx, vy, vz, ωx, ωy, ωz (body frame), γ̇1..γ̇D].\n"
-      "Make one with wobble.load_body3.")
+      "Make one with wobble.load_body (a 'dimension 3' object file).")
       .def_property_readonly("name", &BodyModel3::name)
       .def_property_readonly("num_modes", &BodyModel3::num_modes)
       .def_property_readonly("num_q", [](const BodyModel3& b) { return Group<3>::kRigidDofs + b.num_modes(); },
@@ -113,48 +90,6 @@ void BindBodies3(py::module_& m) {
                std::to_string(b.num_modes()) + " modes, " + std::to_string(b.def().mesh.points.size()) + " mesh vertices>";
       });
 
-  m.def("load_body3", &LoadBody3, py::arg("object"), py::arg("modes") = std::vector<std::string>(),
-        py::arg("check") = true,
-        "Reads a 3D object file ('dimension 3': a lattice or 'lattice fit', mass points or 'sample',\n"
-        "a 'mesh' read by VTK's readers) and its .def3 mode files, as a script's load_obj and\n"
-        "load_def do. Errors name FILE:LINE (wobble.ParseError).");
-
-  // the 3D body in the World: the methods live on World (bound in world.cc)
-  auto world = py::reinterpret_borrow<py::class_<World>>(m.attr("World"));
-  world
-      .def("add_body3", [](World& w, std::shared_ptr<BodyModel3> body) { return w.AddBody(body); }, py::arg("body"),
-           "Adds a 3D FFD body at q = 0 (its lattice's pose), at rest; returns its index.")
-      .def(
-          "q3",
-          [](const World& w, int body) {
-            Check3(w, body);
-            Eigen::VectorXd q, qd;
-            scene::QFromState3(w, body, &q, &qd);
-            return q;
-          },
-          py::arg("body") = 0, "a copy of the 3D body's q = [t, rotation vector, γ]")
-      .def(
-          "qd3",
-          [](const World& w, int body) {
-            Check3(w, body);
-            return Eigen::VectorXd(w.state3(body).qd);
-          },
-          py::arg("body") = 0, "a copy of the 3D body's q̇ = [ṫ, body ω, γ̇]")
-      .def(
-          "set_state3",
-          [](World& w, int body, const py::object& q, const py::object& qd) {
-            Check3(w, body);
-            const long n = Group<3>::kRigidDofs + w.body3(body).num_modes();
-            scene::SetState3FromQ(&w, body, AsVector(q, n, "q"), qd.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(qd, n, "qd"));
-          },
-          py::arg("body"), py::arg("q"), py::arg("qd") = py::none(),
-          "Sets a 3D body's state (InputError for a state that is not finite)")
-      .def(
-          "body3", [](const World& w, int body) {
-            Check3(w, body);
-            return std::const_pointer_cast<BodyModel3>(w.shared_body3(body));
-          },
-          py::arg("body"));
 }
 
 }  // namespace wobble::python

@@ -37,16 +37,15 @@ py::array_t<double, py::array::c_style> Rows(const py::handle& h, long n, const 
 // (World.q3 / set_state3).
 void SetStart(World* w, const BodyModel&, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) { w->SetState(0, q, qd); }
 void SetStart(World* w, const BodyModel3&, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  scene::SetState3FromQ(w, 0, q, qd);
+  w->SetCoordinates(0, q, qd);
 }
 void ReadState(const World& w, const BodyModel&, double* q, double* qd) {
-  const BodyState<2, double>& s = w.state(0);
+  const BodyState<2, double>& s = w.state<2>(0);
   std::copy(s.q.data(), s.q.data() + s.q.size(), q);
   std::copy(s.qd.data(), s.qd.data() + s.qd.size(), qd);
 }
 void ReadState(const World& w, const BodyModel3&, double* q, double* qd) {
-  Eigen::VectorXd q3, qd3;
-  scene::QFromState3(w, 0, &q3, &qd3);
+  const Eigen::VectorXd q3 = w.coordinates(0), qd3 = w.qd(0);
   std::copy(q3.data(), q3.data() + q3.size(), q);
   std::copy(qd3.data(), qd3.data() + qd3.size(), qd);
 }

@@ -18,12 +18,18 @@ void CheckBody(const World& w, int body) {
   if (w.kind(body) != BodyKind::kFfd) throw InputError("body " + std::to_string(body) + " is not an FFD body");
 }
 
+// A 2D-only call (keyframes, the 2D controllers' lattice coordinates) on a 2D FFD body.
+void Check2D(const World& w, int body, const char* what) {
+  CheckBody(w, body);
+  if (w.dim(body) != 2) throw InputError(std::string(what) + ": body " + std::to_string(body) + " is a 3D body (2D only)");
+}
+
 void CheckLinear(const World& w, int body) {
   CheckIndex(w, body);
   if (w.kind(body) != BodyKind::kLinear) throw InputError("body " + std::to_string(body) + " is not a linear body");
 }
 
-py::dict ForcesDict(const ForceBreakdown<2, double>& f) {
+template <int Dim> py::dict ForcesDict(const ForceBreakdown<Dim, double>& f) {
   py::dict d;
   d["gravity"] = Eigen::VectorXd(f.gravity);
   d["modes"] = Eigen::VectorXd(f.modes);
@@ -193,13 +199,13 @@ void BindWorld(py::module_& m) {
       "simulation with its keyframed q and q̇.")
       .def(py::init([](World& w, int body, const std::vector<double>& times, const Eigen::MatrixXd& amplitudes,
                        const std::string& interpolation, const py::object& hold) {
-             CheckBody(w, body);
+             Check2D(w, body, "KeyframeController");
              control::Keyframes keys;
              keys.times = times;
              for (int k = 0; k < amplitudes.rows(); ++k) keys.amplitudes.push_back(amplitudes.row(k).transpose());
              if (interpolation == "smooth") keys.interpolation = control::Interpolation::kSmooth;
              else if (interpolation != "linear") throw InputError("interpolation: '" + interpolation + "' is not linear or smooth");
-             const std::string error = keys.Validate(w.body(body).num_modes());
+             const std::string error = keys.Validate(w.body<2>(body).num_modes());
              if (!error.empty()) throw InputError("keyframes: " + error);
              control::HeldPoint held;
              if (!hold.is_none()) {
@@ -215,13 +221,16 @@ void BindWorld(py::module_& m) {
       .def("release", &control::KeyframeController::Release, py::arg("world"));
 
   py::class_<World>(m, "World",
-                    "THE world: FFD bodies (q = [tx, ty, θ, γ1..γD], Eq. 4.4), the ground, springs, constraints,\n"
+                    "THE world: FFD bodies of either dimension (2D q = [tx, ty, θ, γ1..γD], Eq. 4.4; 3D q =\n"
+                    "[tx, ty, tz, rx, ry, rz, γ1..γD], r the rotation vector, q̇ = [ṫ, body ω, γ̇]), linear\n"
+                    "bodies, the ground, springs, constraints,\n"
                     "one clock and one status. Every accepted state is finite, or the world stops and\n"
                     "step() raises SimulationStopped. Not thread-safe: one World per thread (steps\n"
                     "release the GIL).")
       .def(py::init<WorldOptions>(), py::arg("options") = WorldOptions())
       .def("add_body", [](World& w, std::shared_ptr<BodyModel> body) { return w.AddBody(body); }, py::arg("body"),
-           "Adds an FFD body at q = 0, at rest; returns its index.")
+           "Adds an FFD body (2D or 3D) at q = 0 (its lattice's pose), at rest; returns its index.")
+      .def("add_body", [](World& w, std::shared_ptr<BodyModel3> body) { return w.AddBody(body); }, py::arg("body"))
       .def_property_readonly("num_bodies", &World::num_bodies)
       .def_property_readonly("time", &World::time)
       .def_property_readonly("steps", &World::steps)
@@ -231,23 +240,25 @@ void BindWorld(py::module_& m) {
           "a copy; assign a changed one to change dt, gravity, the ground or the integrator between steps")
       .def_property_readonly("status", &World::status)
       .def(
-          "body", [](const World& w, int body) {
+          "body",
+          [](const World& w, int body) -> py::object {
             CheckBody(w, body);
-            return std::const_pointer_cast<BodyModel>(w.shared_body(body));
+            if (w.dim(body) == 3) return py::cast(std::const_pointer_cast<BodyModel3>(w.shared_body<3>(body)));
+            return py::cast(std::const_pointer_cast<BodyModel>(w.shared_body<2>(body)));
           },
-          py::arg("body"))
+          py::arg("body"), "the FFD body's model (BodyModel or BodyModel3)")
       .def(
-          "q", [](const World& w, int body) { CheckBody(w, body); return Eigen::VectorXd(w.state(body).q); },
-          py::arg("body") = 0, "a copy of the body's q")
+          "q", [](const World& w, int body) { CheckBody(w, body); return w.coordinates(body); },
+          py::arg("body") = 0, "a copy of the body's q (3D: [t, rotation vector, γ])")
       .def(
-          "qd", [](const World& w, int body) { CheckBody(w, body); return Eigen::VectorXd(w.state(body).qd); },
-          py::arg("body") = 0, "a copy of the body's q̇")
+          "qd", [](const World& w, int body) { CheckBody(w, body); return Eigen::VectorXd(w.qd(body)); },
+          py::arg("body") = 0, "a copy of the body's q̇ (3D: [ṫ, body ω, γ̇])")
       .def(
           "set_state",
           [](World& w, int body, const py::object& q, const py::object& qd) {
             CheckBody(w, body);
-            const long n = w.body(body).num_q();
-            w.SetState(body, AsVector(q, n, "q"), qd.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(qd, n, "qd"));
+            const long n = w.dim(body) == 3 ? w.body<3>(body).num_q() : w.body<2>(body).num_q();
+            w.SetCoordinates(body, AsVector(q, n, "q"), qd.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(qd, n, "qd"));
           },
           py::arg("body"), py::arg("q"), py::arg("qd") = py::none(),
           "Sets q and q̇ (zero when not given); InputError for a wrong shape or a non-finite value.")
@@ -256,7 +267,7 @@ void BindWorld(py::module_& m) {
           [](World& w, int body, const py::object& targets) {
             CheckIndex(w, body);
             if (w.kind(body) == BodyKind::kLinear) throw InputError("body " + std::to_string(body) + " is not an FFD body");
-            const int D = w.kind(body) == BodyKind::kFfd3 ? w.body3(body).num_modes() : w.body(body).num_modes();
+            const int D = w.num_modes(body);
             w.SetModeTargets(body, AsVector(targets, D, "targets"));
           },
           py::arg("body"), py::arg("targets"), "PD targets γ0 of the body's modes (chapter 5), 2D or 3D FFD bodies")
@@ -292,8 +303,8 @@ void BindWorld(py::module_& m) {
               }
               return py::make_tuple(points, anchors);
             };
-            if (w.kind(body) == BodyKind::kFfd3) return table(w.state3(body).contacts, 3);
-            return table(w.state(body).contacts, 2);
+            if (w.dim(body) == 3) return table(w.state<3>(body).contacts, 3);
+            return table(w.state<2>(body).contacts, 2);
           },
           py::arg("body") = 0,
           "(points, anchors): the mass points below the ground and their entry points (Fig. 4.5); anchors\n"
@@ -310,14 +321,20 @@ void BindWorld(py::module_& m) {
           "point_positions",
           [](const World& w, int body) {
             CheckBody(w, body);
-            const std::vector<Eigen::Vector2d> x = w.PointPositions(body);
-            Eigen::MatrixXd out(x.size(), 2);
-            for (size_t k = 0; k < x.size(); ++k) out.row(k) = x[k].transpose();
-            return out;
+            auto rows = [](const auto& x) {
+              Eigen::MatrixXd out(x.size(), x.empty() ? 0 : x[0].size());
+              for (size_t k = 0; k < x.size(); ++k) out.row(long(k)) = x[k].transpose();
+              return out;
+            };
+            return w.dim(body) == 3 ? rows(w.PointPositions<3>(body)) : rows(w.PointPositions<2>(body));
           },
-          py::arg("body") = 0, "(num_points, 2) world positions of the mass points")
+          py::arg("body") = 0, "(num_points, 2 or 3) world positions of the mass points")
       .def(
-          "forces", [](const World& w, int body) { CheckBody(w, body); return ForcesDict(w.Forces(body)); },
+          "forces",
+          [](const World& w, int body) {
+            CheckBody(w, body);
+            return w.dim(body) == 3 ? ForcesDict(w.Forces<3>(body)) : ForcesDict(w.Forces<2>(body));
+          },
           py::arg("body") = 0, "generalized forces by source: gravity, modes, ground, springs, total")
       .def(
           "accelerations", [](const World& w, int body) { CheckBody(w, body); return w.Accelerations(body); },

@@ -12,7 +12,7 @@ G = 9.81
 
 @pytest.fixture(scope="module")
 def pot3():
-    return wobble.load_body3(str(DATA / "pot3.obj"), [str(DATA / "pot3_modes.def3")])
+    return wobble.load_body(str(DATA / "pot3.obj"), [str(DATA / "pot3_modes.def3")])
 
 
 def test_the_mesh_pot_loads_with_its_mass_and_mesh(pot3):
@@ -26,10 +26,10 @@ def test_the_mesh_pot_loads_with_its_mass_and_mesh(pot3):
 
 def test_a_turned_state_reads_back_and_moves_the_mesh_rigidly(pot3):
     world = wobble.World(no_ground("rk4", 0.001))
-    world.add_body3(pot3)
+    world.add_body(pot3)
     q = np.array([5.0, 100.0, -3.0, 0.1, 0.7, -0.2, 0.0, 0.0, 0.0])
-    world.set_state3(0, q)
-    assert world.q3(0) == pytest.approx(q, abs=1e-14)
+    world.set_state(0, q)
+    assert world.q(0) == pytest.approx(q, abs=1e-14)
     # the mesh at a rigid q: rotated by the rotation vector's turn (Rodrigues) and moved by t
     r = q[3:6]
     angle = np.linalg.norm(r)
@@ -43,11 +43,11 @@ def test_a_turned_state_reads_back_and_moves_the_mesh_rigidly(pot3):
 def test_free_fall_follows_the_parabola_and_is_recorded(pot3):
     # uniform gravity neither turns nor deforms a body: t_y(t) = y0 + v t - g t²/2 (RK4 is exact)
     world = wobble.World(no_ground("rk4", 0.01))
-    world.add_body3(pot3)
-    world.set_state3(0, [0, 500, 0, 0.2, 0, 0.1, 0, 0, 0], [1, 20, 0, 0, 0, 0, 0, 0, 0])
+    world.add_body(pot3)
+    world.set_state(0, [0, 500, 0, 0.2, 0, 0.1, 0, 0, 0], [1, 20, 0, 0, 0, 0, 0, 0, 0])
     run = wobble.simulate(world, 2.0, every=10)
     t = 2.0
-    q = world.q3(0)
+    q = world.q(0)
     assert q[1] == pytest.approx(500 + 20 * t - 0.5 * G * t * t, abs=1e-9 * 500)
     assert q[0] == pytest.approx(t, abs=1e-9 * 500)
     assert q[3:6] == pytest.approx([0.2, 0, 0.1], abs=1e-12)
@@ -59,16 +59,45 @@ def test_free_fall_follows_the_parabola_and_is_recorded(pot3):
     assert np.allclose(np.linalg.norm(run.q(0)[:, 3:7], axis=1), 1.0, atol=1e-14)
 
 
+def test_one_loader_and_one_world_api_for_both_dimensions(pot3):
+    assert isinstance(wobble.load_body(str(DATA / "table.obj")), wobble.BodyModel)
+    assert isinstance(pot3, wobble.BodyModel3)
+    world = wobble.World(no_ground("rk4", 0.001))
+    assert world.add_body(wobble.load_body(str(DATA / "table.obj"))) == 0
+    assert world.add_body(pot3) == 1
+    assert isinstance(world.body(0), wobble.BodyModel) and isinstance(world.body(1), wobble.BodyModel3)
+    assert world.q(0).shape == (3,) and world.q(1).shape == (9,)
+    assert world.point_positions(0).shape[1] == 2 and world.point_positions(1).shape[1] == 3
+    assert world.forces(1)["total"].shape == (9,)
+
+
+def test_the_old_3d_names_warn_and_do_the_same(pot3):
+    q = [1.0, 2.0, 3.0, 0.1, -0.2, 0.3, 0.01, 0.0, -0.02]
+    with pytest.warns(DeprecationWarning, match="load_body3 is deprecated: use load_body"):
+        old_pot = wobble.load_body3(str(DATA / "pot3.obj"), [str(DATA / "pot3_modes.def3")])
+    assert old_pot.num_q == pot3.num_q and old_pot.total_mass == pot3.total_mass
+    world = wobble.World()
+    with pytest.warns(DeprecationWarning, match="World.add_body3"):
+        body = world.add_body3(pot3)
+    with pytest.warns(DeprecationWarning, match="World.set_state3"):
+        world.set_state3(body, q)
+    with pytest.warns(DeprecationWarning, match="World.q3"):
+        assert np.array_equal(world.q3(body), world.q(body))
+    with pytest.warns(DeprecationWarning, match="World.qd3"):
+        assert np.array_equal(world.qd3(body), world.qd(body))
+    with pytest.warns(DeprecationWarning, match="World.body3"):
+        assert world.body3(body).num_q == pot3.num_q
+    assert world.q(body) == pytest.approx(q, abs=1e-14)
+
+
 def test_errors_name_the_file_and_line(tmp_path):
-    with pytest.raises(wobble.InputError, match="2D object file"):
-        wobble.load_body3(str(DATA / "table.obj"))
     bad = tmp_path / "bad3.obj"
     bad.write_text("dimension 3\n# a mesh that is not there\nmesh missing.stl\nsample volume 10 1\n")
     with pytest.raises(wobble.ParseError, match=r"bad3.obj:3: mesh: .*missing.stl"):
-        wobble.load_body3(str(bad))
+        wobble.load_body(str(bad))
     world = wobble.World()
-    with pytest.raises(wobble.InputError, match="not a 3D FFD body"):
-        world.q3(0)
+    with pytest.raises(wobble.InputError, match="body 0: the world has 0 bodies"):
+        world.q(0)
 
 
 def test_batched_rollout_of_the_3d_pot_equals_worlds_stepped_alone(pot3):
@@ -83,13 +112,13 @@ def test_batched_rollout_of_the_3d_pot_equals_worlds_stepped_alone(pot3):
     assert r.q.shape == (3, 4, 9) and r.status == ["ok"] * 3
     for i in range(3):
         world = wobble.World(options)
-        world.add_body3(pot3)
-        world.set_state3(0, q0[i], qd0[i])
+        world.add_body(pot3)
+        world.set_state(0, q0[i], qd0[i])
         world.set_mode_targets(0, targets[i])
-        assert np.array_equal(r.q[i, 0], world.q3(0))
+        assert np.array_equal(r.q[i, 0], world.q(0))
         for k in range(1, 4):
             world.step(100)
-            assert np.array_equal(r.q[i, k], world.q3(0)) and np.array_equal(r.qd[i, k], world.qd3(0))
+            assert np.array_equal(r.q[i, k], world.q(0)) and np.array_equal(r.qd[i, k], world.qd(0))
     # the modes were driven: γ moved toward the targets
     assert np.abs(r.q[:, -1, 6:] - q0[:, 6:]).max() > 1e-3
 
@@ -124,8 +153,8 @@ def test_contacts_and_penetration_of_a_3d_body_on_the_ground(pot3):
     options.ground_3d.enabled = True
     options.ground_3d.stiffness = 20000
     world = wobble.World(options)
-    world.add_body3(pot3)
-    world.set_state3(0, [0, 0.5, 0, 0.1, 0, 0.05, 0, 0, 0])  # its foot 0.5 above the plane, tilted
+    world.add_body(pot3)
+    world.set_state(0, [0, 0.5, 0, 0.1, 0, 0.05, 0, 0, 0])  # its foot 0.5 above the plane, tilted
     for _ in range(4000):  # until it touches (it bounces: contacts come and go)
         world.step(1)
         points, anchors = world.contacts(0)
@@ -133,7 +162,7 @@ def test_contacts_and_penetration_of_a_3d_body_on_the_ground(pot3):
             break
     assert len(points) > 0 and anchors.shape == (len(points), 3)
     # the contact points are below the plane y = 0; the deepest is the penetration
-    y = pot3.mass_points_at(world.q3(0))[points, 1]
+    y = pot3.mass_points_at(world.q(0))[points, 1]
     assert np.all(y < 0)
     assert world.penetration(0) == pytest.approx(-y.min(), rel=1e-12)
 
@@ -142,14 +171,14 @@ def test_a_point_force_on_a_3d_body_gives_its_impulse(pot3):
     # one explicit step from rest solves M(q0) v1 = dt Jᵀ f, so the linear momentum Σ m_k ẋ_k,
     # with ẋ_k = ṫ + (R ω) × (x_k − t) + R B_k γ̇ at the start's configuration, is f dt
     world = wobble.World(no_ground("thesis", 0.01, gravity=False))
-    world.add_body3(pot3)
+    world.add_body(pot3)
     q0 = np.array([1.0, 2.0, 3.0, 0.3, -0.2, 0.5, 0, 0, 0])
-    world.set_state3(0, q0)
+    world.set_state(0, q0)
     x = pot3.mass_points_at(q0)
     f = np.array([30.0, -50.0, 20.0])
     world.apply_point_force(0, 7, force=f)
     world.step(1)
-    v = world.qd3(0)
+    v = world.qd(0)
     r = q0[3:6]
     angle = np.linalg.norm(r)
     k = r / angle

@@ -11,7 +11,7 @@ from conftest import DATA, no_ground
 
 @pytest.fixture(scope="module")
 def pot3():
-    return wobble.load_body3(str(DATA / "pot3.obj"), [str(DATA / "pot3_modes.def3")])
+    return wobble.load_body(str(DATA / "pot3.obj"), [str(DATA / "pot3_modes.def3")])
 
 
 def rotation(r):
@@ -94,14 +94,14 @@ def test_dynamic_fit_finds_the_worlds_mode_constants(pot3, tmp_path, gradient):
     # the reference: a World run of the pot tumbling in the air (its modes: K 2e6, c 2e4)
     options = no_ground("thesis", 0.005)
     world = wobble.World(options)
-    world.add_body3(pot3)
-    world.set_state3(0, [0, 150, 0, 0.3, 0.2, 0.1, 0.2, -0.1, 0.1], [20, 40, 0, 1, 2, -1, 0, 0, 0])
+    world.add_body(pot3)
+    world.set_state(0, [0, 150, 0, 0.3, 0.2, 0.1, 0.2, -0.1, 0.1], [20, 40, 0, 1, 2, -1, 0, 0, 0])
     which = np.arange(pot3.num_points)[EVERY]
     times, points = [], []
     for step in range(61):
         if step % 5 == 0:
             times.append(step * 0.005)
-            points.append(pot3.mass_points_at(world.q3(0))[which])
+            points.append(pot3.mass_points_at(world.q(0))[which])
         if step < 60:
             world.step()
     r = wobble.fit_dynamic(pot3, np.array(times), np.stack(points), list(which), stiffness=[3e6] * 3,

@@ -10,7 +10,7 @@ from conftest import DATA, no_ground
 
 @pytest.fixture(scope="module")
 def pot3():
-    return wobble.load_body3(str(DATA / "pot3.obj"), [str(DATA / "pot3_modes.def3")])
+    return wobble.load_body(str(DATA / "pot3.obj"), [str(DATA / "pot3_modes.def3")])
 
 
 def air_problem(pot3, integrator="thesis"):

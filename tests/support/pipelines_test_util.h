@@ -71,7 +71,7 @@ inline std::unique_ptr<World> TouchingWorld() {
   auto w = std::make_unique<World>(o);
   w->AddBody(Table());
   w->SetState(0, Vec({0, 50, 0, 0, 0, 0, 0}), Eigen::VectorXd::Zero(7));
-  while (w->state(0).contacts.size() < 2 && w->time() < 10) w->Step();
+  while (w->state<2>(0).contacts.size() < 2 && w->time() < 10) w->Step();
   for (int k = 0; k < 3; ++k) w->Step();  // a little deeper, with anchors that have moved
   return w;
 }

@@ -10,18 +10,18 @@ namespace wobble::control {
 namespace {
 // The pose graph's targets at t of a 2D or 3D FFD body (the graph drives either the same way).
 Eigen::VectorXd Targets(const World& world, int body, const PoseGraph& graph, double t, double width, int pose) {
-  if (world.kind(body) == BodyKind::kFfd3)
-    return width > 0 ? SmoothPoseTargets(world.body3(body), graph, t, width)
-                     : TargetsFromPose(world.body3(body), graph.poses[size_t(pose)]);
-  return width > 0 ? SmoothPoseTargets(world.body(body), graph, t, width)
-                   : TargetsFromPose(world.body(body), graph.poses[size_t(pose)]);
+  if (world.dim(body) == 3)
+    return width > 0 ? SmoothPoseTargets(world.body<3>(body), graph, t, width)
+                     : TargetsFromPose(world.body<3>(body), graph.poses[size_t(pose)]);
+  return width > 0 ? SmoothPoseTargets(world.body<2>(body), graph, t, width)
+                   : TargetsFromPose(world.body<2>(body), graph.poses[size_t(pose)]);
 }
 }  // namespace
 
 PoseGraphController::PoseGraphController(const World& world, int body, PoseGraph graph, double switch_width)
     : body_(body), graph_(std::move(graph)), width_(switch_width) {
-  const int active = int(world.kind(body) == BodyKind::kFfd3 ? ActiveModes(world.body3(body)).size()
-                                                             : ActiveModes(world.body(body)).size());
+  const int active = int(world.dim(body) == 3 ? ActiveModes(world.body<3>(body)).size()
+                                                             : ActiveModes(world.body<2>(body)).size());
   const std::string invalid = graph_.Validate(active);
   if (!invalid.empty()) throw std::invalid_argument("pose graph: " + invalid);
   if (!(width_ >= 0.0)) throw std::invalid_argument("pose graph: the switch width must be 0 or positive");
@@ -43,9 +43,8 @@ void PoseGraphController::BeforeStep(World& world) {
 
 TargetScheduleController::TargetScheduleController(const World& world, int body, Eigen::MatrixXd targets)
     : body_(body), targets_(std::move(targets)) {
-  const BodyKind kind = world.kind(body);
-  if (kind != BodyKind::kFfd && kind != BodyKind::kFfd3) throw std::invalid_argument("target schedule: an FFD body only");
-  const int modes = kind == BodyKind::kFfd3 ? world.body3(body).num_modes() : world.body(body).num_modes();
+  if (world.kind(body) != BodyKind::kFfd) throw std::invalid_argument("target schedule: an FFD body only");
+  const int modes = world.num_modes(body);
   if (targets_.rows() != modes || targets_.cols() < 1)
     throw std::invalid_argument("target schedule: one row per mode and at least one column needed");
 }
@@ -57,11 +56,11 @@ void TargetScheduleController::BeforeStep(World& world) {
 
 KeyframeController::KeyframeController(World& world, int body, Keyframes keys, HeldPoint hold)
     : body_(body), keys_(std::move(keys)), hold_(hold), dt_(world.options().dt) {
-  if (world.kind(body) == BodyKind::kFfd3) {  // the same on a 3D body: its orientation is kept
-    const BodyModel3& model = world.body3(body);
+  if (world.IsFfd(body, 3)) {  // the same on a 3D body: its orientation is kept
+    const BodyModel3& model = world.body<3>(body);
     const std::string invalid = keys_.Validate(model.num_modes());
     if (!invalid.empty()) throw std::invalid_argument("keyframe: " + invalid);
-    const BodyState<3, double>& s = world.state3(body);
+    const BodyState<3, double>& s = world.state<3>(body);
     translation3_ = s.translation();
     orientation_ = s.orientation();
     if (hold_.enabled) {
@@ -74,10 +73,10 @@ KeyframeController::KeyframeController(World& world, int body, Keyframes keys, H
     Place(world, 0.0);
     return;
   }
-  const BodyModel& model = world.body(body);
+  const BodyModel& model = world.body<2>(body);
   const std::string invalid = keys_.Validate(model.num_modes());
   if (!invalid.empty()) throw std::invalid_argument("keyframe: " + invalid);
-  const Eigen::VectorXd q = world.state(body).q;
+  const Eigen::VectorXd q = world.q(body);
   // the held point stays where it is at the start; θ and, without a hold, t stay as they are
   anchor_ = hold_.enabled ? PointAt(model, hold_.lattice_coords, q) : Eigen::Vector2d::Zero();
   translation_ = q.head<2>();
@@ -98,19 +97,19 @@ void KeyframeController::AfterStep(World& world) {
 void KeyframeController::Place(World& world, double t) const {
   Eigen::VectorXd gamma, gamma_dot, q, qd;
   keys_.Evaluate(t, &gamma, &gamma_dot);
-  if (world.kind(body_) == BodyKind::kFfd3) {
+  if (world.IsFfd(body_, 3)) {
     Eigen::Vector3d translation;
-    KeyframedState3(world.body3(body_), hold_, anchor3_, translation3_, orientation_, gamma, gamma_dot, &translation, &qd);
-    world.SetState3(body_, translation, orientation_, gamma, qd);
+    KeyframedState3(world.body<3>(body_), hold_, anchor3_, translation3_, orientation_, gamma, gamma_dot, &translation, &qd);
+    world.SetState(body_, PositionsOf(translation, orientation_, gamma), qd);
     return;
   }
-  KeyframedState(world.body(body_), hold_, anchor_, translation_, theta_, gamma, gamma_dot, &q, &qd);
+  KeyframedState(world.body<2>(body_), hold_, anchor_, translation_, theta_, gamma, gamma_dot, &q, &qd);
   world.SetState(body_, q, qd);
 }
 
 ModeTargetController::ModeTargetController(const World& world, int body) : body_(body) {
-  const BodyModel& model = world.body(body);
-  Eigen::VectorXd now = world.state(body).mode_target;
+  const BodyModel& model = world.body<2>(body);
+  Eigen::VectorXd now = world.mode_targets(body);
   if (now.size() == 0) now = Eigen::VectorXd::Zero(model.num_modes());  // empty means all zero
   segments_.push_back({0, now});
 }
@@ -129,7 +128,7 @@ void ModeTargetController::BeforeStep(World& world) {
     pending_ = false;
   }
   // compared in place: this runs every step, and the targets rarely change
-  const Eigen::VectorXd& now = world.state(body_).mode_target;
+  const VecD<double>& now = world.mode_targets(body_);
   TargetSegment& last = segments_.back();
   if (now.size() == 0 ? last.targets.isZero(0.0) : now == last.targets) return;
   const Eigen::VectorXd logged = now.size() == 0 ? Eigen::VectorXd::Zero(last.targets.size()) : now;

@@ -121,6 +121,22 @@ template <int Dim, class T> struct ForceBreakdown {
   VecQ<T> gravity, modes, ground, springs, total;
 };
 
+// Positions q (group.h's layout) from a translation, a rotation and the amplitudes γ: the
+// angle θ in 2D; a quaternion (or anything Eigen makes one of: an angle-axis) in 3D.
+inline VecQ<double> PositionsOf(const Eigen::Vector2d& t, double theta, const Eigen::VectorXd& gamma) {
+  VecQ<double> q(Group<2>::kRigidParams + gamma.size());
+  q << t, theta, gamma;
+  return q;
+}
+template <class Rotation>
+VecQ<double> PositionsOf(const Eigen::Vector3d& t, const Rotation& rotation, const Eigen::VectorXd& gamma) {
+  VecQ<double> q(Group<3>::kRigidParams + gamma.size());
+  q.head<3>() = t;
+  Group<3>::SetOrientation(Eigen::Quaterniond(rotation).normalized(), &q);
+  q.tail(gamma.size()) = gamma;
+  return q;
+}
+
 // The cached ground force of s, when it was computed at s's current state on ground g.
 template <int Dim, class T> const VecQ<T>* CachedGroundForce(const BodyState<Dim, T>& s, const GroundOf<Dim>& g) {
   if constexpr (!std::is_same_v<T, double>) {

@@ -20,13 +20,13 @@ BodyInfo DescribeBody(const World& world, int body) {
   info.name = world.body_name(body);
   info.kind = world.kind(body);
   info.dim = world.dim(body);
-  if (info.kind == BodyKind::kFfd) {
-    const BodyModel& m = world.body(body);
-    info.ffd = world.shared_body(body);  // drawing after the world is gone
+  if (world.IsFfd(body, 2)) {
+    const BodyModel& m = world.body<2>(body);
+    info.ffd = world.shared_body<2>(body);  // drawing after the world is gone
     info.coordinate_names = {"tx", "ty", "theta"};
     for (const DeformationMode& mode : m.modes()) info.coordinate_names.push_back(mode.name);
-  } else if (info.kind == BodyKind::kFfd3) {
-    info.ffd3 = world.shared_body3(body);
+  } else if (world.IsFfd(body, 3)) {
+    info.ffd3 = world.shared_body<3>(body);
     info.coordinate_names = {"tx", "ty", "tz", "qw", "qx", "qy", "qz"};
     info.velocity_names = {"dtx", "dty", "dtz", "wx", "wy", "wz"};
     for (const DeformationMode3& mode : info.ffd3->modes()) {
@@ -104,15 +104,15 @@ int Trajectory::Append(const World& world, double control_energy, int pose) {
   for (int b = 0; b < num_bodies(); ++b) {
     const Layout& l = layout_[b];
     const int nq = bodies_[b].num_q;
-    if (bodies_[b].kind == BodyKind::kFfd) {
-      const BodyState<2, double>& s = world.state(b);
+    if (bodies_[b].IsFfd(2)) {
+      const BodyState<2, double>& s = world.state<2>(b);
       Eigen::Map<Eigen::VectorXd>(row + l.q, nq) = s.q;
       Eigen::Map<Eigen::VectorXd>(row + l.qd, nq) = s.qd;
       if (s.mode_target.size() == l.num_targets) Eigen::Map<Eigen::VectorXd>(row + l.targets, l.num_targets) = s.mode_target;
       row[l.contacts] = double(s.contacts.size());
       row[l.contacts + 1] = s.penetration;
-    } else if (bodies_[b].kind == BodyKind::kFfd3) {
-      const BodyState<3, double>& s = world.state3(b);
+    } else if (bodies_[b].IsFfd(3)) {
+      const BodyState<3, double>& s = world.state<3>(b);
       Eigen::Map<Eigen::Vector3d>(row + l.q) = s.translation();
       const Eigen::Quaterniond& o = s.orientation();
       row[l.q + 3] = o.w(), row[l.q + 4] = o.x(), row[l.q + 5] = o.y(), row[l.q + 6] = o.z();
@@ -120,7 +120,7 @@ int Trajectory::Append(const World& world, double control_energy, int pose) {
       Eigen::Map<Eigen::VectorXd>(row + l.qd, bodies_[b].num_v) = s.qd;
       if (s.mode_target.size() == l.num_targets) Eigen::Map<Eigen::VectorXd>(row + l.targets, l.num_targets) = s.mode_target;
       row[l.contacts] = double(s.contacts.size());
-      row[l.contacts + 1] = world.Penetration(b);
+      row[l.contacts + 1] = s.penetration;
     } else {
       const Eigen::MatrixXd& R = world.linear_R(b);
       const Eigen::MatrixXd& Rd = world.linear_R_dot(b);
@@ -195,12 +195,12 @@ void Trajectory::RestoreRow(const double* row, World& world) const {
   for (int b = 0; b < num_bodies(); ++b) {
     const Eigen::Map<const Eigen::VectorXd> qb(row + layout_[b].q, bodies_[b].num_q),
         qdb(row + layout_[b].qd, bodies_[b].num_v), targets(row + layout_[b].targets, layout_[b].num_targets);
-    if (bodies_[b].kind == BodyKind::kFfd) {
+    if (bodies_[b].IsFfd(2)) {
       world.SetState(b, qb, qdb);
       world.SetModeTargets(b, targets.isZero(0.0) ? Eigen::VectorXd() : Eigen::VectorXd(targets));
-    } else if (bodies_[b].kind == BodyKind::kFfd3) {
+    } else if (bodies_[b].IsFfd(3)) {
       const Eigen::Quaterniond o(qb[3], qb[4], qb[5], qb[6]);  // unit as recorded, to rounding
-      world.SetState3(b, qb.head<3>(), o.normalized(), qb.tail(bodies_[b].num_modes()), qdb);
+      world.SetState(b, PositionsOf(qb.head<3>(), o.normalized(), qb.tail(bodies_[b].num_modes())), qdb);
       world.SetModeTargets(b, targets.isZero(0.0) ? Eigen::VectorXd() : Eigen::VectorXd(targets));
     } else {
       const int d = bodies_[b].dim, n = bodies_[b].num_q / d;
@@ -228,7 +228,7 @@ void Trajectory::RestoreAt(double t, World& world) const {
   std::vector<double> row(static_cast<size_t>(width_));
   for (int i = 0; i < width_; ++i) row[size_t(i)] = a[i] + alpha * (b[i] - a[i]);
   for (int body = 0; body < num_bodies(); ++body) {  // a quaternion and its negative are one turn
-    if (bodies_[body].kind != BodyKind::kFfd3) continue;
+    if (!bodies_[body].IsFfd(3)) continue;
     const int o = layout_[body].q + 3;
     double dot = 0;
     for (int i = 0; i < 4; ++i) dot += a[o + i] * b[o + i];
@@ -280,8 +280,8 @@ void Recorder::AfterStep(World& world) {
   const double dt = world.options().dt;
   for (int b = 0; b < world.num_bodies(); ++b) {
     if (world.kind(b) == BodyKind::kLinear || world.kinematic(b)) continue;
-    if (world.kind(b) == BodyKind::kFfd) energy_.Accumulate(world.body(b), world.state(b), dt);
-    else energy_.Accumulate(world.body3(b), world.state3(b), dt);
+    if (world.IsFfd(b, 2)) energy_.Accumulate(world.body<2>(b), world.state<2>(b), dt);
+    else energy_.Accumulate(world.body<3>(b), world.state<3>(b), dt);
   }
   int bad = -1;
   if (period_ > 0.0) bad = SampleFrame(world);

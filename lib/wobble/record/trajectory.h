@@ -42,6 +42,7 @@ struct BodyInfo {
   std::vector<std::string> coordinate_names;      // one per q entry
   std::vector<std::string> velocity_names;        // one per q̇ (v) entry
   int num_modes() const { return ffd ? ffd->num_modes() : ffd3 ? ffd3->num_modes() : 0; }
+  bool IsFfd(int d) const { return kind == BodyKind::kFfd && dim == d; }
 };
 
 class Trajectory {

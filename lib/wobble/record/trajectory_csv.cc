@@ -27,7 +27,7 @@ std::vector<std::string> SplitCommas(const std::string& text) {
 // " (a body with D modes)" for one FFD body, the bodies' names otherwise.
 std::string BodiesText(const Trajectory& t) {
   if (t.num_bodies() == 1 && t.bodies()[0].kind == BodyKind::kFfd)
-    return " (a body with " + std::to_string(t.bodies()[0].num_q - kRigidDofs) + " modes)";
+    return " (a body with " + std::to_string(t.bodies()[0].num_modes()) + " modes)";
   std::string names;
   for (const BodyInfo& b : t.bodies()) names += (names.empty() ? "" : ", ") + b.name;
   return " (bodies " + names + ")";

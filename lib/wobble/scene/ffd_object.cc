@@ -186,15 +186,4 @@ std::shared_ptr<const BodyModel3> FfdObject::Body3() const {
   return body3_;
 }
 
-void SetState3FromQ(World* world, int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  const BodyState<3, double> s = StateFromCoordinates<3>(q, qd);
-  world->SetState3(body, s.translation(), s.orientation(), s.gamma(), s.qd);
-}
-
-void QFromState3(const World& world, int body, Eigen::VectorXd* q, Eigen::VectorXd* qd) {
-  const BodyState<3, double>& s = world.state3(body);
-  *q = CoordinatesOf(s);
-  *qd = s.qd;
-}
-
 }  // namespace wobble::scene

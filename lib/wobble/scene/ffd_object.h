@@ -88,9 +88,4 @@ class FfdObject {
   mutable std::shared_ptr<const BodyModel3> body3_;
 };
 
-// A 3D state (t, r, γ) as `World::SetState3` takes it, and back (the rotation vector of the
-// orientation, |r| ≤ π).
-void SetState3FromQ(World* world, int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
-void QFromState3(const World& world, int body, Eigen::VectorXd* q, Eigen::VectorXd* qd);
-
 }  // namespace wobble::scene

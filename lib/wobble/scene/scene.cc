@@ -118,7 +118,7 @@ int Scene::AddObjectBody(const std::string& name) {
   int b = 0;
   if (object_.dim() == 3) {
     b = w.AddBody(object_.Body3());
-    SetState3FromQ(&w, b, object_.q(), object_.qd());
+    w.SetCoordinates(b, object_.q(), object_.qd());
   } else {
     b = w.AddBody(object_.Body());
     w.SetState(b, object_.q(), object_.qd());
@@ -204,7 +204,7 @@ void Scene::BeginObjectRun(RunKind kind, bool keep_steps) {
     // the 3D object stands on the plane of the ground line (GroundPlaneOf), under the same gravity
     w = std::make_unique<World>(ObjectWorldOptions3());
     w->AddBody(object_.Body3());
-    SetState3FromQ(w.get(), 0, object_.q(), object_.qd());
+    w->SetCoordinates(0, object_.q(), object_.qd());
   } else {
     const std::shared_ptr<const BodyModel> body = object_.Body();
     w = std::make_unique<World>(ObjectWorldOptions(*body));
@@ -265,13 +265,7 @@ void Scene::Finish(bool act_due_behaviours) {
     return;
   }
   // the hand-over: the object goes on from the run's last state
-  if (w.kind(0) == BodyKind::kFfd3) {
-    Eigen::VectorXd q, qd;
-    QFromState3(w, 0, &q, &qd);
-    object_.SetState(q, qd);
-  } else {
-    object_.SetState(w.state(0).q, w.state(0).qd);
-  }
+  object_.SetState(w.coordinates(0), w.qd(0));
   time_ = run->kind == RunKind::kKeyframes ? run->start_time + control_.keys.Duration() : w.time();
   if (run->recorder) {
     energy_ = run->recorder->control_energy();

@@ -65,9 +65,7 @@ scene::StepCallback StepObserver(State& s, bool object) {
   if (!s.progress && !(object && s.debug)) return nullptr;
   return [&s, object](long n, long steps, const World& world) {
     if (object && s.debug) {
-      Eigen::VectorXd q, qd;
-      if (world.kind(0) == BodyKind::kFfd3) scene::QFromState3(world, 0, &q, &qd);
-      else q = world.state(0).q;
+      const Eigen::VectorXd q = world.coordinates(0);
       s.out << "t " << Num(world.time()) << " q";
       for (int i = 0; i < q.size(); ++i) s.out << " " << Num(q[i]);
       s.out << "\n";

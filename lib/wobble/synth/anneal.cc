@@ -78,9 +78,9 @@ void CenterOfMassX(const BodyModel& body, const Eigen::VectorXd& q, const Eigen:
 }
 
 void CenterOfMassX(const World& world, double* x, double* v) {
-  if (world.kind(0) == BodyKind::kFfd) return CenterOfMassX(world.body(0), world.state(0).q, world.state(0).qd, x, v);
-  const MassMoments3& mm = world.body3(0).moments();
-  const BodyState<3, double>& s = world.state3(0);
+  if (world.IsFfd(0, 2)) return CenterOfMassX(world.body<2>(0), world.q(0), world.qd(0), x, v);
+  const MassMoments3& mm = world.body<3>(0).moments();
+  const BodyState<3, double>& s = world.state<3>(0);
   const int D = int(s.gamma().size());
   const Eigen::Vector3d l = (mm.c0 + mm.C * s.gamma()) / mm.m;
   const Eigen::Vector3d vel = s.qd.head<3>() + s.orientation() * (s.qd.segment<3>(3).cross(l) + mm.C * s.qd.tail(D) / mm.m);
@@ -100,7 +100,7 @@ TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
   World world(p.world);
   if (p.body3) {
     world.AddBody(p.body3);
-    scene::SetState3FromQ(&world, 0, p.q0, p.qd0);
+    world.SetCoordinates(0, p.q0, p.qd0);
   } else {
     world.AddBody(p.body);
     world.SetState(0, p.q0, p.qd0);
@@ -124,8 +124,8 @@ TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
       out.cost = p.cost.high;
       return out;
     }
-    if (p.body3) energy.Accumulate(*p.body3, world.state3(0), dt);
-    else energy.Accumulate(*p.body, world.state(0), dt);
+    if (p.body3) energy.Accumulate(*p.body3, world.state<3>(0), dt);
+    else energy.Accumulate(*p.body, world.state<2>(0), dt);
     if (on_step) on_step(world);
   }
   out.ok = true;

@@ -19,22 +19,10 @@ World::World(WorldOptions options) : options_(std::move(options)) {
 
 // ---------------------------------------------------------------- bodies
 
-int World::AddBody(std::shared_ptr<const BodyModel> model) {
-  if (!model) throw std::invalid_argument("AddBody: no model");
-  FfdEntry e;
-  e.state.q.setZero(model->num_q());
-  e.state.qd.setZero(model->num_q());
-  e.applied = Eigen::VectorXd::Zero(model->num_q());
-  e.scale = ModelScale(*model);
-  e.model = std::move(model);
-  ffd_.push_back(std::move(e));
-  slots_.push_back({BodyKind::kFfd, int(ffd_.size()) - 1});
-  return num_bodies() - 1;
-}
-
 int World::AddLinearBody(std::shared_ptr<const LinearBodyModel> model, AffineMaterial material) {
   if (!model) throw std::invalid_argument("AddLinearBody: no model");
   LinearEntry e;
+  const int model_dim = model->dim();
   e.R = model->RestState();
   e.R_dot = Eigen::MatrixXd::Zero(e.R.rows(), e.R.cols());
   e.applied = e.R_dot;
@@ -42,62 +30,38 @@ int World::AddLinearBody(std::shared_ptr<const LinearBodyModel> model, AffineMat
   e.material = material;
   e.scale = LinearScale(*e.model, material);
   linear_.push_back(std::move(e));
-  slots_.push_back({BodyKind::kLinear, int(linear_.size()) - 1});
+  slots_.push_back({BodyKind::kLinear, model_dim, int(linear_.size()) - 1});
   return num_bodies() - 1;
 }
 
-void World::ThrowBadBody(int body, BodyKind wanted) const {
+void World::ThrowBadBody(int body, BodyKind wanted, int wanted_dim) const {
   if (body < 0 || body >= num_bodies())
     throw std::invalid_argument("unknown body " + std::to_string(body) + " (the world has " +
                                 std::to_string(num_bodies()) + " bodies)");
   throw std::invalid_argument("body " + std::to_string(body) + " is not " +
-                              (wanted == BodyKind::kFfd    ? "a 2D FFD body"
-                               : wanted == BodyKind::kFfd3 ? "a 3D FFD body"
-                                                           : "a linear body"));
+                              (wanted == BodyKind::kLinear ? std::string("a linear body")
+                               : wanted_dim == 0           ? std::string("an FFD body")
+                                                           : "a " + std::to_string(wanted_dim) + "D FFD body"));
 }
 
 int World::dim(int body) const {
-  switch (kind(body)) {
-    case BodyKind::kLinear: return Linear(body).model->dim();
-    case BodyKind::kFfd3: return 3;
-    case BodyKind::kFfd: break;
-  }
-  return 2;
+  CheckBody(body);
+  return slots_[size_t(body)].dim;
 }
 
 int World::num_q(int body) const {
-  switch (kind(body)) {
-    case BodyKind::kLinear: return Linear(body).model->num_q();
-    case BodyKind::kFfd3: return Ffd3(body).model->num_q();
-    case BodyKind::kFfd: break;
-  }
-  return Ffd(body).model->num_q();
+  if (kind(body) == BodyKind::kLinear) return Linear(body).model->num_q();
+  return dim(body) == 3 ? Ffd<3>(body).model->num_q() : Ffd<2>(body).model->num_q();
 }
 
 const std::string& World::body_name(int body) const {
-  switch (kind(body)) {
-    case BodyKind::kLinear: return Linear(body).model->name();
-    case BodyKind::kFfd3: return Ffd3(body).model->name();
-    case BodyKind::kFfd: break;
-  }
-  return Ffd(body).model->name();
+  if (kind(body) == BodyKind::kLinear) return Linear(body).model->name();
+  return dim(body) == 3 ? Ffd<3>(body).model->name() : Ffd<2>(body).model->name();
 }
 
 const World::LinearEntry& World::Linear(int body) const {
   if (kind(body) != BodyKind::kLinear) ThrowBadBody(body, BodyKind::kLinear);
   return linear_[slots_[body].index];
-}
-
-const std::shared_ptr<const BodyModel>& World::shared_body(int i) const { return Ffd(i).model; }
-
-void World::SetModeTargets(int i, const Eigen::VectorXd& targets) {
-  const bool three = kind(i) == BodyKind::kFfd3;
-  const int D = three ? body3(i).num_modes() : body(i).num_modes();
-  if (targets.size() != 0 && targets.size() != D)
-    throw std::invalid_argument("body '" + body_name(i) + "' has " + std::to_string(D) + " modes, got " +
-                                std::to_string(targets.size()) + " targets");
-  if (three) ffd3_[slots_[size_t(i)].index].state.mode_target = targets;
-  else Ffd(i).state.mode_target = targets;
 }
 
 const LinearBodyModel& World::linear_model(int body) const { return *Linear(body).model; }
@@ -152,32 +116,14 @@ void World::RefreshLinearContacts(LinearEntry& e) const {
   if (e.ground_contact) UpdateLinearContacts(*e.model, linear_ground(), e.R, e.R_dot, &e.contacts);
 }
 
-void World::AddSpring(Spring spring) {
-  const BodyModel& b = body(spring.body);
-  b.LocalBasis(spring.lattice_coords, &spring.rest_local, &spring.mode_matrix);
+void World::AddSpring(SpringN<2> spring) {
+  body<2>(spring.body).LocalBasis(spring.lattice_coords, &spring.rest_local, &spring.mode_matrix);
   options_.params.springs.push_back(std::move(spring));
 }
 
-ForceBreakdown<2, double> World::Forces(int i) const {
-  ForceBreakdown<2, double> f;
-  EvaluateForces(body(i), options_.params, i, state(i), &f);
-  return f;
-}
-
-Eigen::VectorXd World::Accelerations(int i) const {
-  VecQ<double> a;
-  const StepStatus st = wobble::Accelerations(body(i), options_.params, i, state(i), &a);
-  if (!st.ok()) return Eigen::VectorXd::Constant(body(i).num_q(), std::nan(""));
-  return a;
-}
-
-std::vector<Eigen::Vector2d> World::PointPositions(int i) const {
-  const BodyModel& b = body(i);
-  const BodyState<2, double>& s = state(i);
-  std::vector<Eigen::Vector2d> x(b.num_points());
-  const Frame<2, double> frame(s.q);
-  for (int k = 0; k < b.num_points(); ++k) x[k] = WorldFromLocal(frame, LocalPosition<double>(b.rest_local(k), b.mode_matrix(k), s.q));
-  return x;
+void World::AddSpring(SpringN<3> spring) {
+  body<3>(spring.body).LocalBasis(spring.lattice_coords, &spring.rest_local, &spring.mode_matrix);
+  options_.springs_3d.push_back(std::move(spring));
 }
 
 // ---------------------------------------------------------------- stepping
@@ -257,11 +203,7 @@ bool World::StepEachBody() {
   for (int body = 0; body < num_bodies(); ++body) {
     if (slots_[body].kinematic) continue;
     if (slots_[body].kind == BodyKind::kFfd) {
-      if (!StepFfdBody(body)) return false;
-      continue;
-    }
-    if (slots_[body].kind == BodyKind::kFfd3) {
-      if (!StepFfd3Body(body)) return false;
+      if (!(slots_[body].dim == 3 ? StepFfdBody<3>(body) : StepFfdBody<2>(body))) return false;
       continue;
     }
     LinearEntry& e = linear_[slots_[body].index];
@@ -368,7 +310,6 @@ bool World::Fail(StatusCode code, int body, const std::string& detail, double va
 Energies World::ComputeEnergies(int i) const {
   Energies e;
   const WorldParams& p = options_.params;
-  if (kind(i) == BodyKind::kFfd3) return Ffd3Energies(i);
   if (kind(i) == BodyKind::kLinear) {
     const LinearEntry& l = Linear(i);
     e.kinetic = 0.5 * (l.R_dot * l.model->mass_matrix() * l.R_dot.transpose()).trace();  // ½ Ṙ_ij Ṙ_ik M_jk
@@ -380,39 +321,7 @@ Energies World::ComputeEnergies(int i) const {
     }
     return e;
   }
-  return FfdEnergies(i, ContactSet::kDetect, true);
-}
-
-// The FFD body's energies: Eq. 4.9's kinetic, gravity, K (γ − γ0)², the ground's penalty and
-// the springs. The step's finiteness check takes the contacts the step left (kFrozen: no scan
-// of every point) and no per-mode breakdown (no heap).
-Energies World::FfdEnergies(int i, ContactSet contacts, bool per_mode) const {
-  Energies e;
-  const WorldParams& p = options_.params;
-  const BodyModel& b = body(i);
-  const BodyState<2, double>& s = state(i);
-  const Frame<2, double> frame(s.q);
-  e.kinetic = wobble::KineticEnergy(b.moments(), s.q, s.qd, frame.R);  // Eq. 4.9
-  if (p.gravity_on) e.gravity = GravityEnergy(b.moments(), s.q, p.gravity);
-  // K (γ − γ0)²: the potential whose gradient is the mode force, PD target γ0 included
-  const bool targeted = s.mode_target.size() == b.num_modes();
-  for (int d = 0; d < b.num_modes(); ++d) {
-    const double offset = s.q[kRigidDofs + d] - (targeted ? s.mode_target[d] : 0.0);
-    const double term = b.modes()[d].stiffness * offset * offset;
-    if (per_mode) e.per_mode.push_back(term);
-    e.modes += term;
-  }
-  ForEachPointInContact(b, p.ground, s, frame,
-                        [&](int, const Vec2<double>&, const Vec2<double>& x, const Vec2<double>&, const Vec2<double>& anchor,
-                            const GroundFace& face, int) { e.ground += 0.5 * face.stiffness * (x - anchor).squaredNorm(); },
-                        contacts);
-  for (const Spring& sp : p.springs) {
-    if (sp.body != i) continue;
-    const Vec2<double> x = WorldFromLocal(frame, LocalPosition<double>(sp.rest_local, sp.mode_matrix, s.q));
-    const double stretch = (x - sp.anchor).norm() - sp.rest_length;
-    e.springs += 0.5 * sp.stiffness * stretch * stretch;
-  }
-  return e;
+  return dim(i) == 3 ? FfdEnergies<3>(i, ContactSet::kDetect, true) : FfdEnergies<2>(i, ContactSet::kDetect, true);
 }
 
 // A finite acceleration can still overflow R, Ṙ or the energy: the step is refused then, and
@@ -435,62 +344,20 @@ bool World::AcceptLinearStep(int body, bool screened) {
 
 bool World::EnergyFinite(int body) const {
   if (kind(body) == BodyKind::kFfd) {
-    const FfdEntry& e = Ffd(body);
-    if (EnergySurelyFinite(e)) return true;
-    return std::isfinite(FfdEnergies(body, ContactSet::kFrozen, false).total());
+    if (dim(body) == 3) {
+      if (EnergySurelyFinite(Ffd<3>(body))) return true;
+      return std::isfinite(FfdEnergies<3>(body, ContactSet::kFrozen, false).total());
+    }
+    if (EnergySurelyFinite(Ffd<2>(body))) return true;
+    return std::isfinite(FfdEnergies<2>(body, ContactSet::kFrozen, false).total());
   }
   return std::isfinite(ComputeEnergies(body).total());
-}
-
-// A screen with a proof, so that the step need not compute its energies (a quarter of a step's
-// work): when every factor is at most kScreen (the state, the PD targets, the contact anchors,
-// the model's moments, points and stiffnesses, the world's gravity, ground and springs), each
-// energy term is a sum of at most ~10^6 products of at most five factors (γᵀGγ θ̇², k |x − a|²
-// with x = t + R(b0 + Bγ)), so below 10^6 · 15^4 · kScreen^5, far from the largest double. A
-// normal step passes; one that does not has its energies computed (EnergyFinite).
-bool World::EnergySurelyFinite(const FfdEntry& e) const {
-  constexpr double kScreen = 1e30;
-  const BodyState<2, double>& s = e.state;
-  const WorldParams& p = options_.params;
-  if (!(e.scale <= kScreen && s.q.cwiseAbs().maxCoeff() <= kScreen && s.qd.cwiseAbs().maxCoeff() <= kScreen))
-    return false;
-  if (s.mode_target.size() > 0 && !(s.mode_target.cwiseAbs().maxCoeff() <= kScreen)) return false;
-  // a terrain's own stiffnesses are at most 1e30 (Terrain::Make)
-  if (!(p.gravity.cwiseAbs().maxCoeff() <= kScreen && std::abs(p.ground.stiffness) <= kScreen)) return false;
-  for (const Contact<2, double>& c : s.contacts)
-    if (!(c.anchor.cwiseAbs().maxCoeff() <= kScreen)) return false;
-  for (const Spring& sp : p.springs)
-    if (!(std::abs(sp.stiffness) <= kScreen && std::abs(sp.rest_length) <= kScreen &&
-          sp.anchor.cwiseAbs().maxCoeff() <= kScreen && sp.rest_local.cwiseAbs().maxCoeff() <= kScreen &&
-          (sp.mode_matrix.size() == 0 || sp.mode_matrix.cwiseAbs().maxCoeff() <= kScreen)))
-      return false;
-  return true;
 }
 
 double LinearScale(const LinearBodyModel& m, const AffineMaterial& material) {
   const double scale = std::max({m.mass_matrix().cwiseAbs().maxCoeff(), m.first_moment().cwiseAbs().maxCoeff(),
                                  std::abs(material.rigidity), std::abs(material.volume), std::abs(material.bending),
                                  std::abs(material.damping)});
-  return std::isfinite(scale) ? scale : std::numeric_limits<double>::infinity();
-}
-
-double ModelScale(const BodyModel& b) {
-  const MassMoments& m = b.moments();
-  double scale = std::max({std::abs(m.m), std::abs(m.I0), m.c0.cwiseAbs().maxCoeff()});
-  auto take = [&scale](const auto& x) {
-    if (x.size() > 0) scale = std::max(scale, double(x.cwiseAbs().maxCoeff()));
-  };
-  take(m.C);
-  take(m.e0);
-  take(m.h0);
-  take(m.G);
-  take(m.P);
-  for (int k = 0; k < b.num_points(); ++k) {
-    take(b.rest_local(k));
-    take(b.mode_matrix(k));
-  }
-  for (const DeformationMode& d : b.modes()) scale = std::max(scale, std::abs(d.stiffness));
-  // NaN anywhere fails every comparison with the screen
   return std::isfinite(scale) ? scale : std::numeric_limits<double>::infinity();
 }
 

@@ -9,8 +9,9 @@
 //   while (w.time() < 5) if (!w.Step()) report(w.status().message);
 //   w.SetEnabled(nail, false);                            // the link falls; refactors once
 //
-// One body numbering for both kinds. FFD bodies have q = [tx, ty, θ, γ1..γD] (Eq. 4.4) and
-// their accessors (body, state, SetState, SetModeTargets, ComputeEnergies, Forces, ...);
+// One body numbering for both kinds. FFD bodies of either dimension (2D: q = [tx, ty, θ,
+// γ1..γD], Eq. 4.4; 3D: q = [t, unit quaternion, γ]) share their accessors (q, qd, SetState,
+// SetModeTargets, ComputeEnergies, ...; body<Dim>, state<Dim> for the typed model and state);
 // linear bodies x = R p(u) have R and Ṙ (linear_model, linear_R, SetLinearState).
 //
 // Stepping. While no constraint is enabled, every FFD body is advanced on its own by the
@@ -41,14 +42,13 @@
 #include "wobble/body/linear_body.h"
 #include "wobble/dynamics/linear_ground.h"
 #include "wobble/dynamics/step.h"
-#include "wobble/dynamics/step.h"
 #include "wobble/world/controller.h"
 #include "wobble/world/multiplier_solver.h"
 #include "wobble/world/point_path.h"
 
 namespace wobble {
 
-enum class BodyKind { kLinear, kFfd, kFfd3 };  // kFfd3: the 3D FFD body (step3.h)
+enum class BodyKind { kLinear, kFfd };  // an FFD body of either dimension: World::dim
 enum class ConstraintKind { kNail, kAttachment, kTrajectory };
 const char* ConstraintKindName(ConstraintKind kind);
 
@@ -71,7 +71,7 @@ struct WorldStatus {
 };
 
 // The largest |number| of a model's moments, points and mode stiffnesses (inf for a NaN).
-double ModelScale(const BodyModel& b);
+template <int Dim> double ModelScale(const BodyModelN<Dim>& b);
 double LinearScale(const LinearBodyModel& m, const AffineMaterial& material);  // the same, linear
 
 // "kinetic K, gravity G, ..." of a refused step, for its status message.
@@ -83,7 +83,7 @@ struct WorldOptions {
   WorldParams params;
   Eigen::Vector3d gravity_3d = Eigen::Vector3d(0.0, -9.81, 0.0);
   // The ground plane of the 3D FFD bodies (off by default) and their springs to world
-  // anchors (each made for its body by MakeSpring; they act on every 3D FFD body).
+  // anchors (each made for its body by MakeSpring; SpringN::body is the world's body index).
   GroundPlane ground_3d;
   std::vector<SpringN<3>> springs_3d;
   // The FFD bodies' integrator while no constraint is enabled.
@@ -136,41 +136,50 @@ class World {
   explicit World(WorldOptions options = {});
 
   // ---- bodies (one numbering for both kinds) ----
-  // An FFD body starts at q = 0 (the body frame), at rest.
-  int AddBody(std::shared_ptr<const BodyModel> model);
-  // A 3D FFD body starts in its lattice's pose (t = 0, no turn, γ = 0), at rest. It steps with
-  // options().integrator on options().ground_3d and gravity_3d; constraints on it: not yet.
-  int AddBody(std::shared_ptr<const BodyModel3> model);
+  // An FFD body of either dimension starts in its lattice's pose (t = 0, no turn, γ = 0), at
+  // rest. 2D bodies step on options().params, 3D bodies on gravity_3d, ground_3d and
+  // springs_3d (Params3Of), both with options().integrator.
+  int AddBody(std::shared_ptr<const BodyModelN<2>> model) { return AddFfdBody<2>(std::move(model)); }
+  int AddBody(std::shared_ptr<const BodyModelN<3>> model) { return AddFfdBody<3>(std::move(model)); }
   // A linear body starts at its rest state R = [I | 0 | 0], at rest.
   int AddLinearBody(std::shared_ptr<const LinearBodyModel> model, AffineMaterial material = {});
   int num_bodies() const { return int(slots_.size()); }
   BodyKind kind(int body) const;
   int dim(int body) const;  // 2 or 3
+  bool IsFfd(int body, int dim) const { return kind(body) == BodyKind::kFfd && slots_[size_t(body)].dim == dim; }
   const std::string& body_name(int body) const;
 
-  // 3D FFD bodies (std::invalid_argument for another kind or a wrong size; InputError for a
-  // state that is not finite or whose energy is not).
-  const BodyModel3& body3(int i) const;
-  const std::shared_ptr<const BodyModel3>& shared_body3(int i) const;  // for whoever outlives the world
-  // How deep the body's deepest contact point is below the ground now (0 without contacts):
-  // BodyState::penetration in 2D, computed from the contacts in 3D, the linear contacts'.
+  // FFD bodies of either dimension (std::invalid_argument for another kind, the other
+  // dimension or a wrong size; InputError for a state that is not finite or whose energy is
+  // not). The model and state of dimension Dim: body<2>(i), state<3>(i), ...
+  template <int Dim> const BodyModelN<Dim>& body(int i) const { return *Ffd<Dim>(i).model; }
+  // for whoever outlives the world
+  template <int Dim> const std::shared_ptr<const BodyModelN<Dim>>& shared_body(int i) const { return Ffd<Dim>(i).model; }
+  template <int Dim> const BodyState<Dim, double>& state(int i) const { return Ffd<Dim>(i).state; }
+  // Either dimension: positions q (2D [t, θ, γ]; 3D [t, unit quaternion x y z w, γ]) and
+  // velocities q̇ (2D dq/dt; 3D [ṫ, body ω, γ̇]), as body_state.h lays them out.
+  const VecQ<double>& q(int i) const;
+  const VecQ<double>& qd(int i) const;
+  int num_modes(int i) const;
+  // The PD targets γ0 of its modes (empty: all zero).
+  const VecD<double>& mode_targets(int i) const;
+  // How deep the body's deepest contact point is below the ground now (0 without contacts).
   double Penetration(int body) const;
-  const BodyState<3, double>& state3(int i) const;
-  void SetState3(int body, const Eigen::Vector3d& t, const Eigen::Quaterniond& orientation,
-                 const Eigen::VectorXd& gamma, const Eigen::VectorXd& v);
-
-  // FFD bodies (std::invalid_argument for a linear one or a wrong size). Setting a state does
-  // not enforce constraints: follow with ProjectVelocities() or let the feedback pull it in.
-  const BodyModel& body(int i) const;
-  const std::shared_ptr<const BodyModel>& shared_body(int i) const;  // for whoever outlives the world
-  const BodyState<2, double>& state(int i) const;
+  // Sets positions and velocities in the layout of q() and qd(); a 3D quaternion is
+  // normalized (a zero one is refused). Does not enforce constraints: follow with
+  // ProjectVelocities() or let the feedback pull it in.
   void SetState(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
-  // PD targets γ0 of the body's modes (one per mode; empty: all zero), 2D and 3D FFD bodies.
-  // See wobble/control.
+  // The coordinates people read and write (files, the command line's --q, Python's World.q):
+  // the positions in 2D; [t, Θ, γ] in 3D with Θ the orientation's rotation vector
+  // (StateFromCoordinates, body_state.h). Velocities as qd().
+  Eigen::VectorXd coordinates(int body) const;
+  void SetCoordinates(int body, const Eigen::VectorXd& coordinates, const Eigen::VectorXd& qd);
+  // PD targets γ0 of the body's modes (one per mode; empty: all zero). See wobble/control.
   void SetModeTargets(int body, const Eigen::VectorXd& targets);
-  ForceBreakdown<2, double> Forces(int body) const;
-  Eigen::VectorXd Accelerations(int body) const;     // free q̈ (no constraint forces)
-  std::vector<Eigen::Vector2d> PointPositions(int body) const;  // world positions of its mass points
+  template <int Dim> ForceBreakdown<Dim, double> Forces(int body) const;
+  Eigen::VectorXd Accelerations(int body) const;  // free q̈ (no constraint forces)
+  // world positions of its mass points
+  template <int Dim> std::vector<Eigen::Matrix<double, Dim, 1>> PointPositions(int body) const;
 
   // Linear bodies: R and Ṙ (d×n).
   const LinearBodyModel& linear_model(int body) const;
@@ -190,8 +199,10 @@ class World {
   // The ground of a linear body, for the linear_ground.h functions.
   LinearGround linear_ground() const { return {options_.params.ground, options_.ground_3d}; }
 
-  // Springs hold a point of an FFD body given by lattice coordinates (Fig. 4.4).
-  void AddSpring(Spring spring);
+  // Springs hold a point of an FFD body (spring.body) given by lattice coordinates (Fig. 4.4);
+  // into options().params.springs or springs_3d.
+  void AddSpring(SpringN<2> spring);
+  void AddSpring(SpringN<3> spring);
 
   // ---- material points ----
   // Throws std::invalid_argument: unknown body, wrong size, lattice coordinates outside
@@ -306,21 +317,18 @@ class World {
  private:
   struct Slot {
     BodyKind kind;
-    int index;  // into ffd_ or linear_
+    int dim;    // 2 or 3
+    int index;  // into ffd2_, ffd3_ (by dim) or linear_
     bool kinematic = false;
   };
   // A point or constraint value (d ≤ 3) on the stack: the per-step loops allocate nothing.
   using PointVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
-  struct FfdEntry {
-    std::shared_ptr<const BodyModel> model;
-    BodyState<2, double> state;
+  // An FFD body of dimension Dim: its model and what a run changes.
+  template <int Dim> struct FfdEntry {
+    std::shared_ptr<const BodyModelN<Dim>> model;
+    BodyState<Dim, double> state;
     Eigen::VectorXd applied;  // Σ Jᵀ f of ApplyPointForce for the next step
-    double scale = 0.0;       // the largest |number| of the model (ModelScale), for EnergyFinite
-  };
-  struct Ffd3Entry {
-    std::shared_ptr<const BodyModel3> model;
-    BodyState<3, double> state;
-    Eigen::VectorXd applied;  // Σ Jᵀ f of ApplyPointForce for the next step
+    double scale = 0.0;       // the largest |number| of the model (ModelScale), for EnergySurelyFinite
   };
   struct LinearEntry {
     std::shared_ptr<const LinearBodyModel> model;
@@ -332,14 +340,13 @@ class World {
     bool ground_contact = false;
     LinearContacts contacts, contacts_before;  // contacts_before: per-step work, as R_before
   };
-  // A resolved material point: linear bodies keep p(u) and W p; FFD bodies b0 and B.
+  // A resolved material point: linear bodies keep p(u) and W p; FFD bodies b0 and B (their
+  // first dim(body) rows: one layout for both dimensions).
   struct End {
     int body = -1;
     Eigen::VectorXd p, Wp;  // linear
-    Eigen::Vector2d b0;     // FFD
-    Mat2D<double> B;        // FFD
-    Eigen::Vector3d b0_3 = Eigen::Vector3d::Zero();  // 3D FFD
-    Mat3D<double> B3;                                // 3D FFD
+    Eigen::Vector3d b0 = Eigen::Vector3d::Zero();  // FFD
+    Mat3D<double> B;                               // FFD
   };
   struct Constraint {
     ConstraintKind kind;
@@ -352,44 +359,57 @@ class World {
     int row = -1;  // first row in A while enabled
   };
 
-  // world.cc: bodies, controllers, energies; world_step.cc: the per-body step and its checks
-  // inline (below the class): the per-step loops of controllers call body() and state()
+  // world.cc: bodies, controllers, linear bodies, energies; world_ffd.cc: the FFD bodies of
+  // either dimension (added, set, stepped, checked; their ends of constraints)
   void CheckBody(int body) const;
-  FfdEntry& Ffd(int body);
-  const FfdEntry& Ffd(int body) const;
-  [[noreturn]] void ThrowBadBody(int body, BodyKind wanted) const;
+  template <int Dim> std::vector<FfdEntry<Dim>>& FfdEntries();
+  template <int Dim> const std::vector<FfdEntry<Dim>>& FfdEntries() const;
+  template <int Dim> const FfdEntry<Dim>& Ffd(int body) const;
+  template <int Dim> FfdEntry<Dim>& Ffd(int body) {
+    return const_cast<FfdEntry<Dim>&>(static_cast<const World*>(this)->Ffd<Dim>(body));
+  }
+  template <int Dim> int AddFfdBody(std::shared_ptr<const BodyModelN<Dim>> model);
+  // The world of a Dim-dimensional FFD body: options_.params, or Params3Of(options_).
+  template <int Dim> decltype(auto) ParamsOf() const {
+    if constexpr (Dim == 2) return (options_.params);
+    else return Params3Of(options_);
+  }
+  template <int Dim> const GroundOf<Dim>& GroundFor() const {
+    if constexpr (Dim == 2) return options_.params.ground;
+    else return options_.ground_3d;
+  }
+  [[noreturn]] void ThrowBadBody(int body, BodyKind wanted, int wanted_dim = 0) const;
   const LinearEntry& Linear(int body) const;
-  const Ffd3Entry& Ffd3(int body) const;
   bool StepEachBody();
-  // world_ffd3.cc: the 3D FFD bodies; their ends of constraints (the kFfd3 branches of the
-  // End functions in world_constraints.cc)
-  void Ffd3Resolve(const MaterialPoint& point, End* e) const;
-  PointVec Ffd3EndPosition(const End& e) const;
-  PointVec Ffd3EndVelocity(const End& e) const;
-  PointVec Ffd3EndJdotQdot(const End& e) const;
-  Eigen::MatrixXd Ffd3EndJacobian(const End& e) const;
-  void Ffd3AddEndForce(const End& e, const Eigen::VectorXd& f, Eigen::VectorXd* Q) const;
-  void Ffd3ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const;
-  bool Ffd3FreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st) const;
-  bool Ffd3AcceptConstrainedStep(int body, const Eigen::VectorXd& acc);
-  bool StepFfd3Body(int body);
-  Energies Ffd3Energies(int body) const;
-  bool StepFfdBody(int body);
-  void LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const;
-  void RefreshLinearContacts(LinearEntry& e) const;  // the contacts of its state now
-  double PenetrationLimit(const BodyModel& model) const;
-  // The ground contacts of an FFD body at its state now (world_step.cc).
-  void RefreshContacts(FfdEntry& e) const;
+  template <int Dim> void SetFfdState(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  template <int Dim> bool StepFfdBody(int body);
+  // Refuses a step that failed, left a non-finite state or energy, or sank a point too deep;
+  // the body gets `before` back.
+  template <int Dim>
   bool RefuseFfdStep(int body, const VecQ<double>& q_before, const VecQ<double>& qd_before, StepStatus st);
-  bool Fail(StatusCode code, int body, const std::string& detail = "", double value = 0.0);
-  Energies FfdEnergies(int body, ContactSet contacts, bool per_mode) const;
+  template <int Dim> bool AcceptFfdState(int body);  // the checks of StepFfdBody
+  template <int Dim> bool ForcesFinite(int body) const;
+  template <int Dim> double PenetrationLimit(const BodyModelN<Dim>& model) const;
+  template <int Dim> Energies FfdEnergies(int body, ContactSet contacts, bool per_mode) const;
   // Every energy term of the body is finite: a finite state can hold an infinite energy (a
   // q̇ of 1e160 squares past the largest double), and no accepted step leaves one.
   bool EnergyFinite(int body) const;
-  bool EnergySurelyFinite(const FfdEntry& e) const;
+  template <int Dim> bool EnergySurelyFinite(const FfdEntry<Dim>& e) const;
+  template <int Dim> void ResolveFfd(const MaterialPoint& point, End* e) const;
+  template <int Dim> PointVec FfdEndPosition(const End& e) const;
+  template <int Dim> PointVec FfdEndVelocity(const End& e) const;
+  template <int Dim> PointVec FfdEndJdotQdot(const End& e) const;
+  template <int Dim> Eigen::MatrixXd FfdEndJacobian(const End& e) const;
+  template <int Dim> void FfdAddEndForce(const End& e, const Eigen::VectorXd& f, Eigen::VectorXd* Q) const;
+  template <int Dim> void FfdApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const;
+  template <int Dim> bool FfdFreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st) const;
+  template <int Dim> bool FfdAcceptConstrainedStep(int body, const Eigen::VectorXd& acc);
+  template <int Dim> void FfdAddVelocity(int body, const Eigen::VectorXd& dv);
+  void LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const;
+  void RefreshLinearContacts(LinearEntry& e) const;  // the contacts of its state now
+  bool Fail(StatusCode code, int body, const std::string& detail = "", double value = 0.0);
   bool StepLinearBody(int body, const Eigen::VectorXd& acc);
   bool AcceptLinearStep(int body, bool screened);
-  bool ForcesFinite(int body) const;  // an FFD body's generalized forces at its state now
   void FinishStep();
 
   // world_constraints.cc: points, constraints, the multiplier step, impulses
@@ -427,8 +447,8 @@ class World {
   std::shared_ptr<Controller> recorder_;
   bool stepping_ = false;
   bool removed_while_stepping_ = false;  // controllers_ has null entries to erase
-  std::vector<FfdEntry> ffd_;
-  std::vector<Ffd3Entry> ffd3_;
+  std::vector<FfdEntry<2>> ffd2_;
+  std::vector<FfdEntry<3>> ffd3_;
   std::vector<LinearEntry> linear_;
   std::vector<Constraint> constraints_;
   int enabled_count_ = 0;
@@ -452,12 +472,15 @@ inline BodyKind World::kind(int body) const {
   CheckBody(body);
   return slots_[size_t(body)].kind;
 }
-inline const World::FfdEntry& World::Ffd(int body) const {
-  if (unsigned(body) >= slots_.size() || slots_[size_t(body)].kind != BodyKind::kFfd) ThrowBadBody(body, BodyKind::kFfd);
-  return ffd_[size_t(slots_[size_t(body)].index)];
+template <> inline std::vector<World::FfdEntry<2>>& World::FfdEntries<2>() { return ffd2_; }
+template <> inline std::vector<World::FfdEntry<3>>& World::FfdEntries<3>() { return ffd3_; }
+template <> inline const std::vector<World::FfdEntry<2>>& World::FfdEntries<2>() const { return ffd2_; }
+template <> inline const std::vector<World::FfdEntry<3>>& World::FfdEntries<3>() const { return ffd3_; }
+// inline: the per-step loops of controllers call body() and state()
+template <int Dim> const World::FfdEntry<Dim>& World::Ffd(int body) const {
+  if (unsigned(body) >= slots_.size() || slots_[size_t(body)].kind != BodyKind::kFfd || slots_[size_t(body)].dim != Dim)
+    ThrowBadBody(body, BodyKind::kFfd, Dim);
+  return FfdEntries<Dim>()[size_t(slots_[size_t(body)].index)];
 }
-inline World::FfdEntry& World::Ffd(int body) { return const_cast<FfdEntry&>(static_cast<const World*>(this)->Ffd(body)); }
-inline const BodyModel& World::body(int i) const { return *Ffd(i).model; }
-inline const BodyState<2, double>& World::state(int i) const { return Ffd(i).state; }
 
 }  // namespace wobble

@@ -51,9 +51,10 @@ World::End World::Resolve(const MaterialPoint& point) const {
   CheckBody(point.body);
   End e;
   e.body = point.body;
-  if (slots_[point.body].kind == BodyKind::kFfd3) {
-    Ffd3Resolve(point, &e);
-  } else if (slots_[point.body].kind == BodyKind::kLinear) {
+  if (slots_[point.body].kind == BodyKind::kFfd) {
+    if (slots_[point.body].dim == 3) ResolveFfd<3>(point, &e);
+    else ResolveFfd<2>(point, &e);
+  } else {
     const LinearBodyModel& m = *linear_[slots_[point.body].index].model;
     Eigen::VectorXd u = point.u;
     if (point.mass_point >= 0) {
@@ -67,47 +68,20 @@ World::End World::Resolve(const MaterialPoint& point) const {
                                   " finite undeformed coordinates, got " + std::to_string(u.size()));
     e.p = m.Basis(u);
     e.Wp = m.inverse_mass_matrix() * e.p;
-  } else {
-    const BodyModel& m = (*ffd_[slots_[point.body].index].model);
-    Eigen::Vector2d st;
-    if (point.mass_point >= 0) {
-      if (point.mass_point >= m.num_points())
-        throw std::invalid_argument("body '" + m.name() + "' has " + std::to_string(m.num_points()) +
-                                    " mass points, no point " + std::to_string(point.mass_point));
-      st = m.lattice_coords(point.mass_point);
-    } else {
-      if (point.u.size() != 2 || !point.u.allFinite())
-        throw std::invalid_argument("a point of FFD body '" + m.name() + "' needs 2 lattice coordinates (s, t)");
-      st = point.u;
-      const double tol = 1e-9;
-      if (st.minCoeff() < -tol || st.maxCoeff() > 1.0 + tol)
-        throw std::invalid_argument("lattice coordinates (" + std::to_string(st[0]) + ", " + std::to_string(st[1]) +
-                                    ") of FFD body '" + m.name() + "' are outside [0, 1]^2");
-    }
-    m.LocalBasis(st, &e.b0, &e.B);
   }
   return e;
 }
 
 World::PointVec World::EndPosition(const End& e) const {
   const Slot& b = slots_[e.body];
-  if (b.kind == BodyKind::kFfd3) return Ffd3EndPosition(e);
-  if (b.kind == BodyKind::kLinear) {
-    return TimesBasis(linear_[b.index].R, e.p);
-  }
-  const BodyState<2, double>& s = ffd_[b.index].state;
-  return WorldFromLocal(Frame<2, double>(s.q), LocalPosition<double>(e.b0, e.B, s.q));
+  if (b.kind == BodyKind::kLinear) return TimesBasis(linear_[b.index].R, e.p);
+  return b.dim == 3 ? FfdEndPosition<3>(e) : FfdEndPosition<2>(e);
 }
 
 World::PointVec World::EndVelocity(const End& e) const {
   const Slot& b = slots_[e.body];
-  if (b.kind == BodyKind::kFfd3) return Ffd3EndVelocity(e);
-  if (b.kind == BodyKind::kLinear) {
-    return TimesBasis(linear_[b.index].R_dot, e.p);
-  }
-  const BodyState<2, double>& s = ffd_[b.index].state;
-  const Frame<2, double> frame(s.q);
-  return wobble::PointVelocity(frame, s.qd, LocalPosition<double>(e.b0, e.B, s.q), e.B);
+  if (b.kind == BodyKind::kLinear) return TimesBasis(linear_[b.index].R_dot, e.p);
+  return b.dim == 3 ? FfdEndVelocity<3>(e) : FfdEndVelocity<2>(e);
 }
 
 Eigen::VectorXd World::PointPosition(const MaterialPoint& point) const { return EndPosition(Resolve(point)); }
@@ -116,17 +90,13 @@ Eigen::VectorXd World::PointVelocity(const MaterialPoint& point) const { return 
 void World::AddEndForce(const End& e, const Eigen::VectorXd& f, std::vector<Eigen::VectorXd>* Q) const {
   const Slot& b = slots_[e.body];
   Eigen::VectorXd& out = (*Q)[e.body];
-  if (b.kind == BodyKind::kFfd3) {
-    Ffd3AddEndForce(e, f, &out);
-  } else if (b.kind == BodyKind::kLinear) {
+  if (b.kind == BodyKind::kLinear) {
     const int d = int(f.size()), n = int(e.p.size());
     AsMatrix(out, d, n) += f * e.p.transpose();  // Q = f pᵀ (§2.2)
+  } else if (b.dim == 3) {
+    FfdAddEndForce<3>(e, f, &out);
   } else {
-    const BodyState<2, double>& s = ffd_[b.index].state;
-    const Frame<2, double> frame(s.q);
-    VecQ<double> q = out;
-    AddGeneralizedForce(frame, LocalPosition<double>(e.b0, e.B, s.q), e.B, Vec2<double>(f), &q);  // Jᵀ f (Eq. 4.20)
-    out = q;
+    FfdAddEndForce<2>(e, f, &out);
   }
 }
 
@@ -141,7 +111,7 @@ void World::ApplyPointForce(const MaterialPoint& point, const Eigen::VectorXd& f
     return;
   }
   // FFD bodies of either dimension: Jᵀ f (Eq. 4.20), as a constraint's force enters
-  Eigen::VectorXd& applied = b.kind == BodyKind::kFfd3 ? ffd3_[b.index].applied : ffd_[b.index].applied;
+  Eigen::VectorXd& applied = b.dim == 3 ? ffd3_[size_t(b.index)].applied : ffd2_[size_t(b.index)].applied;
   std::vector<Eigen::VectorXd> Q(num_bodies());
   Q[e.body] = Eigen::VectorXd::Zero(applied.size());
   AddEndForce(e, f, &Q);
@@ -150,35 +120,19 @@ void World::ApplyPointForce(const MaterialPoint& point, const Eigen::VectorXd& f
 
 World::PointVec World::EndJdotQdot(const End& e) const {
   const Slot& b = slots_[e.body];
-  if (b.kind == BodyKind::kFfd3) return Ffd3EndJdotQdot(e);
   if (b.kind == BodyKind::kLinear) return PointVec::Zero(linear_[b.index].model->dim());  // J constant
-  // J̇ q̇ = R(−θ̇² l + 2 θ̇ S B γ̇) (ARCHITECTURE.md, from Eq. 4.21's velocity terms)
-  const BodyState<2, double>& s = ffd_[b.index].state;
-  const Frame<2, double> frame(s.q);
-  const Vec2<double> l = LocalPosition<double>(e.b0, e.B, s.q);
-  const double thd = s.qd[2];
-  Vec2<double> Bgd = Vec2<double>::Zero();
-  for (int d = 0; d < e.B.cols(); ++d) Bgd += e.B.col(d) * s.qd[kRigidDofs + d];
-  return frame.R * (-thd * thd * l + 2.0 * thd * Perp(Bgd));
+  return b.dim == 3 ? FfdEndJdotQdot<3>(e) : FfdEndJdotQdot<2>(e);
 }
 
 Eigen::MatrixXd World::EndJacobian(const End& e) const {
   const Slot& b = slots_[e.body];
-  if (b.kind == BodyKind::kFfd3) return Ffd3EndJacobian(e);
   if (b.kind == BodyKind::kLinear) {
     const int d = linear_[b.index].model->dim(), n = int(e.p.size());
     Eigen::MatrixXd J = Eigen::MatrixXd::Zero(d, d * n);  // ∂x_i/∂R_rs = δ_ir p_s (§3.3)
     for (int i = 0; i < d; ++i) J.block(i, i * n, 1, n) = e.p.transpose();
     return J;
   }
-  const BodyState<2, double>& s = ffd_[b.index].state;
-  const Frame<2, double> frame(s.q);
-  const Vec2<double> l = LocalPosition<double>(e.b0, e.B, s.q);
-  Eigen::MatrixXd J(2, s.q.size());  // [I | R S l | R B] (Eq. 4.6–4.8)
-  J.leftCols(2).setIdentity();
-  J.col(2) = frame.R * Perp(l);
-  if (e.B.cols() > 0) J.rightCols(e.B.cols()) = frame.R * e.B;
-  return J;
+  return b.dim == 3 ? FfdEndJacobian<3>(e) : FfdEndJacobian<2>(e);
 }
 
 Eigen::MatrixXd World::EndWJt(const End& e) const {
@@ -201,21 +155,13 @@ Eigen::MatrixXd World::EndWJt(const End& e) const {
 
 void World::ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const {
   const Slot& b = slots_[body];
-  if (b.kind == BodyKind::kFfd3) return Ffd3ApplyGeneralized(body, Q, acc);
   if (b.kind == BodyKind::kLinear) {
     const LinearBodyModel& m = *linear_[b.index].model;
     AsMatrix(*acc, m.dim(), m.basis_size()) += AsMatrix(Q, m.dim(), m.basis_size()) * m.inverse_mass_matrix();  // Eq. 5
     return;
   }
-  const BodyModel& m = (*ffd_[b.index].model);
-  const BodyState<2, double>& s = ffd_[b.index].state;
-  VecQ<double> x;
-  double cond = 0;
-  if (!SolveMassSystem(m.moments(), s.q, Rotation(s.q[2]), VecQ<double>(Q), &x, &cond)) {
-    *acc = Eigen::VectorXd::Constant(acc->size(), std::nan(""));  // caught by the finite checks
-    return;
-  }
-  *acc += x;
+  if (b.dim == 3) FfdApplyGeneralized<3>(body, Q, acc);
+  else FfdApplyGeneralized<2>(body, Q, acc);
 }
 
 // ---------------------------------------------------------------- constraints
@@ -473,26 +419,14 @@ bool World::EnsureFactored(std::string* why, const MultiplierSolver** factored) 
 
 bool World::FreeAccelerations(std::vector<Eigen::VectorXd>* acc, int* failed_body, StepStatus* st) {
   acc->resize(num_bodies());
-  const WorldParams& params = options_.params;
   for (int body = 0; body < num_bodies(); ++body) {
     const Slot& b = slots_[body];
     Eigen::VectorXd& a = (*acc)[body];
-    if (b.kind == BodyKind::kFfd3) {
-      if (!Ffd3FreeAcceleration(body, &a, st)) {
-        *failed_body = body;
-        return false;
-      }
-    } else if (b.kind == BodyKind::kLinear) {
+    if (b.kind == BodyKind::kLinear) {
       LinearFreeAcceleration(linear_[b.index], &a);
-    } else {
-      VecQ<double> qdd;
-      *st = wobble::Accelerations(*ffd_[b.index].model, params, body, ffd_[b.index].state, &qdd);
-      if (!st->ok()) {
-        *failed_body = body;
-        return false;
-      }
-      a = qdd;
-      if (!ffd_[b.index].applied.isZero(0.0)) ApplyGeneralized(body, ffd_[b.index].applied, &a);
+    } else if (!(b.dim == 3 ? FfdFreeAcceleration<3>(body, &a, st) : FfdFreeAcceleration<2>(body, &a, st))) {
+      *failed_body = body;
+      return false;
     }
   }
   return true;
@@ -601,20 +535,11 @@ bool World::StepConstrained() {
   for (int body = 0; body < num_bodies(); ++body) {
     const Slot& b = slots_[body];
     if (b.kinematic) continue;
-    if (b.kind == BodyKind::kFfd3) {
-      if (!Ffd3AcceptConstrainedStep(body, acc[body])) return false;
-    } else if (b.kind == BodyKind::kLinear) {
+    if (b.kind == BodyKind::kLinear) {
       if (!StepLinearBody(body, acc[body])) return false;
-    } else {
-      FfdEntry& e = ffd_[b.index];
-      const VecQ<double> q_before = e.state.q, qd_before = e.state.qd;
-      e.state.qd += h * acc[body];
-      e.state.q += h * e.state.qd;
-      RefreshContacts(e);
-      e.applied.setZero();
-      if (!e.state.q.allFinite() || !e.state.qd.allFinite() || e.state.penetration > PenetrationLimit(*e.model) ||
-          !EnergyFinite(body))
-        return RefuseFfdStep(body, q_before, qd_before, StepStatus{});
+    } else if (!(b.dim == 3 ? FfdAcceptConstrainedStep<3>(body, acc[body])
+                            : FfdAcceptConstrainedStep<2>(body, acc[body]))) {
+      return false;
     }
   }
   return true;
@@ -704,17 +629,13 @@ bool World::ApplyImpulse(const std::vector<VelocityGoal>& goals, std::string* er
     for (int body = 0; body < num_bodies(); ++body) {
       if (dv[body].size() == 0) continue;
       const Slot& b = slots_[body];
-      if (b.kind == BodyKind::kFfd3) {
-        Ffd3Entry& e = ffd3_[b.index];
-        e.state.qd += dv[body];
-        UpdateContacts(*e.model, options_.ground_3d, &e.state);
-      } else if (b.kind == BodyKind::kLinear) {
+      if (b.kind == BodyKind::kLinear) {
         LinearEntry& e = linear_[b.index];
         e.R_dot += AsMatrix(dv[body], e.model->dim(), e.model->basis_size());
+      } else if (b.dim == 3) {
+        FfdAddVelocity<3>(body, dv[body]);
       } else {
-        FfdEntry& e = ffd_[b.index];
-        e.state.qd += dv[body];
-        RefreshContacts(e);
+        FfdAddVelocity<2>(body, dv[body]);
       }
     }
   } catch (const std::invalid_argument& e) {
