@@ -10,7 +10,6 @@
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/core/rotation3.h"
 #include "wobble/fit/pose_fit.h"
-#include "wobble/fit/pose_fit3.h"
 #include "wobble/fit/trajectory_fit.h"
 
 namespace wobble {
@@ -266,15 +265,15 @@ Eigen::VectorXd KnownQ3() {
 // Pose with correspondences: every 10th mass point (~30). Baseline: the 2D table's 11-point fit.
 void BM_PoseFit3_Chair(benchmark::State& state) {
   const BodyModel3 body = testing::Chair3();
-  std::vector<fit::Correspondence3> targets;
+  std::vector<fit::CorrespondenceN<3>> targets;
   for (int k = 0; k < body.num_points(); k += 10) {
-    fit::Correspondence3 t;
+    fit::CorrespondenceN<3> t;
     t.mass_point = k;
-    t.position = fit::PointPosition3(fit::BasisOf3(body, k, {}), KnownQ3());
+    t.position = fit::PointPosition(fit::BasisOf(body, k, {}), KnownQ3());
     targets.push_back(t);
   }
   int iterations = 0;
-  for (auto _ : state) iterations = fit::FitPose3(body, targets, {}).report.iterations;
+  for (auto _ : state) iterations = fit::FitPose(body, targets, {}).report.iterations;
   state.counters["iterations"] = iterations;
   state.counters["points"] = double(targets.size());
 }
@@ -287,11 +286,11 @@ void BM_SurfaceFit3_Chair(benchmark::State& state) {
   SurfaceMesh target_mesh = body.def().mesh;
   const Eigen::VectorXd q = KnownQ3();
   for (size_t v = 0; v < target_mesh.points.size(); ++v)
-    target_mesh.points[v] = fit::PointPosition3({body.mesh_rest_local(int(v)), body.mesh_mode_matrix(int(v))}, q);
-  fit::SurfaceTarget3 target;
+    target_mesh.points[v] = fit::PointPosition(fit::PointBasisN<3>{body.mesh_rest_local(int(v)), body.mesh_mode_matrix(int(v))}, q);
+  fit::SurfaceTarget target;
   target.AddMesh(target_mesh);
   double rms = 0;
-  for (auto _ : state) rms = fit::FitPoseToSurface3(body, target, {}).rms_residual;
+  for (auto _ : state) rms = fit::FitPoseToSurface(body, target, {}).rms_residual;
   state.counters["rms"] = rms;
 }
 BENCHMARK(BM_SurfaceFit3_Chair)->Unit(benchmark::kMillisecond);
@@ -311,16 +310,16 @@ void BM_DynamicFit3_100Steps(benchmark::State& state) {
   truth.qd0 << 20, 40, -10, 1.5, -2, 3, 0, 1, -0.5;
   truth.stiffness = Eigen::VectorXd::Constant(3, 3e5);
   truth.damping = Eigen::VectorXd::Constant(3, 2e3);
-  std::vector<fit::ReferenceFrame3> frames;
+  std::vector<fit::ReferenceFrameN<3>> frames;
   std::vector<int> steps;
   for (int f = 0; f <= 50; ++f) steps.push_back(2 * f);
   fit::SimulateWithParameters(body, o, truth, steps, [&](int f, const Eigen::VectorXd& q) {
-    fit::ReferenceFrame3 frame;
+    fit::ReferenceFrameN<3> frame;
     frame.time = steps[size_t(f)] * o.dt;
     for (int k = 0; k < body.num_points(); k += 10) {
-      fit::Correspondence3 p;
+      fit::CorrespondenceN<3> p;
       p.mass_point = k;
-      p.position = fit::PointPosition3(fit::BasisOf3(body, k, {}), q);
+      p.position = fit::PointPosition(fit::BasisOf(body, k, {}), q);
       frame.points.push_back(p);
     }
     frames.push_back(frame);
