@@ -606,14 +606,15 @@ std::vector<fit::ReferenceFrameN<Dim>> LoadFrames(const FitTrajectoryArgs& a,
   formats::CheckMassPointIndices(file, body->num_points());
   return ReferenceFrames(file.frames);
 }
-void SetWorld(const WorldFlags& flags, fit::DynamicFitOptions* o, const BodyModel&) { o->world = MakeWorldParams(flags); }
-void SetWorld(const WorldFlags& flags, fit::DynamicFitOptions* o, const BodyModel3&) {
-  // the 3D world of the flags, as simulate's (cli_common.h: StartingWorld)
+// The world of the flags for a body of each dimension (3D: as simulate's, cli_common.h:
+// StartingWorld).
+void SetWorld(const WorldFlags& flags, fit::DynamicFitOptionsN<2>* o) { o->world = MakeWorldParams(flags); }
+void SetWorld(const WorldFlags& flags, fit::DynamicFitOptionsN<3>* o) {
   const WorldParams w = MakeWorldParams(flags);
-  o->world3.gravity_on = w.gravity_on;
-  o->world3.gravity = Eigen::Vector3d(w.gravity.x(), w.gravity.y(), 0.0);
-  o->world3.ground = GroundPlaneOf(w.ground);
-  o->world3.max_condition = w.max_condition;
+  o->world.gravity_on = w.gravity_on;
+  o->world.gravity = Eigen::Vector3d(w.gravity.x(), w.gravity.y(), 0.0);
+  o->world.ground = GroundPlaneOf(w.ground);
+  o->world.max_condition = w.max_condition;
 }
 
 template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shared_ptr<const BodyModelN<Dim>>& body) {
@@ -654,8 +655,8 @@ template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shar
         << " s.\ncost " << Num(r.report.initial_cost) << " -> " << Num(r.report.final_cost) << ", rms residual "
         << Num(r.rms_residual) << ".";
   } else {
-    fit::DynamicFitOptions o;
-    SetWorld(a.world, &o, *body);
+    fit::DynamicFitOptionsN<Dim> o;
+    SetWorld(a.world, &o);
     RequirePositive(a.dt, "--dt");
     o.dt = a.dt;
     o.max_iterations = po.max_iterations;

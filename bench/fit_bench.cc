@@ -256,7 +256,7 @@ BENCHMARK(BM_PoseGraphFit_Annealing)->Arg(24)->Arg(240)->Arg(2400)->ArgName("sim
 
 // ---- 3D bodies (issue 15): the chair of tests/support (3 modes, ~300 mass points, 24-vertex mesh) ----
 
-Eigen::VectorXd KnownQ3() {
+Eigen::VectorXd KnownQChair() {
   Eigen::VectorXd q(9);
   q << 30, -12, 20, 0.9, -0.6, 1.2, 0.3, -0.2, 0.15;
   return q;
@@ -269,7 +269,7 @@ void BM_PoseFit3_Chair(benchmark::State& state) {
   for (int k = 0; k < body.num_points(); k += 10) {
     fit::CorrespondenceN<3> t;
     t.mass_point = k;
-    t.position = fit::PointPosition(fit::BasisOf(body, k, {}), KnownQ3());
+    t.position = fit::PointPosition(fit::BasisOf(body, k, {}), KnownQChair());
     targets.push_back(t);
   }
   int iterations = 0;
@@ -279,12 +279,12 @@ void BM_PoseFit3_Chair(benchmark::State& state) {
 }
 BENCHMARK(BM_PoseFit3_Chair)->Unit(benchmark::kMicrosecond);
 
-// Surface without correspondences: the chair's mesh deformed and placed at KnownQ3 (36
+// Surface without correspondences: the chair's mesh deformed and placed at KnownQChair (36
 // triangles); samples: the body mesh's 24 vertices; 24 axis matchings ranked, 4 solved.
 void BM_SurfaceFit3_Chair(benchmark::State& state) {
   const BodyModel3 body = testing::Chair3();
   SurfaceMesh target_mesh = body.def().mesh;
-  const Eigen::VectorXd q = KnownQ3();
+  const Eigen::VectorXd q = KnownQChair();
   for (size_t v = 0; v < target_mesh.points.size(); ++v)
     target_mesh.points[v] = fit::PointPosition(fit::PointBasisN<3>{body.mesh_rest_local(int(v)), body.mesh_mode_matrix(int(v))}, q);
   fit::SurfaceTarget target;
@@ -302,10 +302,10 @@ void BM_DynamicFit3_100Steps(benchmark::State& state) {
   std::vector<DeformationMode3> modes = passive.modes();
   for (DeformationMode3& m : modes) m.stiffness = 3e5, m.damping = 2e3;
   const BodyModel3 body(passive.def(), modes);
-  fit::DynamicFitOptions o;
+  fit::DynamicFitOptionsN<3> o;
   o.dt = 0.005;
   fit::DynamicParameters truth;
-  truth.q0 = KnownQ3();
+  truth.q0 = KnownQChair();
   truth.qd0.resize(9);
   truth.qd0 << 20, 40, -10, 1.5, -2, 3, 0, 1, -0.5;
   truth.stiffness = Eigen::VectorXd::Constant(3, 3e5);

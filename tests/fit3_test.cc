@@ -362,9 +362,9 @@ void ExpectTheVibratingChairRecovered(fit::FitGradient gradient) {
   v0 << 20, 40, -10, 1.5, -2.0, 3.0, 0, 1.0, -0.5;  // body ω of a few rad/s
   const double dt = 0.004;
   const std::vector<fit::ReferenceFrameN<3>> frames = WorldFrames(v.body, q0, v0, dt, 150, 5);
-  fit::DynamicFitOptions o;
+  fit::DynamicFitOptionsN<3> o;
   o.dt = dt;
-  o.world3.gravity_on = true;
+  o.world.gravity_on = true;
   fit::DynamicParameters start;  // q0 and q̇0 from pose fits of the first two frames
   start.stiffness = v.K * 1.4;
   start.damping = v.c * 0.5;
@@ -401,7 +401,7 @@ TEST(DynamicFit3, CostIsTheWorldsRunAtTheTrueParameters) {
   q0 << 0, 0, 0, 2.0, 1.0, -0.5, 0.3, 0.2, -0.1;
   v0 << 1, 2, 3, -4, 2, 1, 0.5, 0, 0;
   const std::vector<fit::ReferenceFrameN<3>> frames = WorldFrames(v.body, q0, v0, 0.005, 200, 10);
-  fit::DynamicFitOptions o;
+  fit::DynamicFitOptionsN<3> o;
   o.dt = 0.005;
   fit::DynamicParameters truth{q0, v0, v.K, v.c, {}};
   EXPECT_LT(fit::DynamicCost(*v.body, frames, truth, o), 1e-16);

@@ -152,6 +152,10 @@ template <int Dim> void BindTrajectoryFit(py::module_& m) {
                : "A 3D body: points (F, K, 3); q rows [t, r, γ], the orientation's smoothness on SO(3).");
 }
 
+// The world of a body of each dimension, as World steps it.
+WorldParams FitWorld(const WorldOptions& w, std::integral_constant<int, 2>) { return w.params; }
+WorldParamsN<3> FitWorld(const WorldOptions& w, std::integral_constant<int, 3>) { return Params3Of(w); }
+
 template <int Dim> void BindDynamicFit(py::module_& m) {
   m.def(
       "fit_dynamic",
@@ -169,9 +173,8 @@ template <int Dim> void BindDynamicFit(py::module_& m) {
         if (!graph.is_none()) start.graph = graph.cast<control::PoseGraph>();
         if (world.integrator != Integrator::kThesis)
           throw InputError("fit_dynamic simulates with the thesis integrator (options.integrator = 'thesis')");
-        fit::DynamicFitOptions o;
-        o.world = world.params;
-        o.world3 = Params3Of(world);  // a 3D body's world, as World steps it
+        fit::DynamicFitOptionsN<Dim> o;
+        o.world = FitWorld(world, std::integral_constant<int, Dim>{});
         o.dt = world.dt;
         o.fit_q0 = fit_q0;
         o.fit_qd0 = fit_qd0;

@@ -27,7 +27,7 @@ constexpr int kStride = 32;
 // Residuals sqrt(w)(x_i(q_f) − target) of every frame, from the raw blocks.
 template <int Dim> struct DynamicResidual {
   const BodyModelN<Dim>* passive;
-  const DynamicFitOptions* options;
+  const DynamicFitOptionsN<Dim>* options;
   Eigen::Quaterniond chart;
   int num_poses, pose_size;  // the controller's blocks follow q0, q̇0, log K, ζ when num_poses > 0
   bool cyclic;
@@ -89,7 +89,7 @@ template <int Dim> std::vector<int> FrameSteps(const std::vector<ReferenceFrameN
 }
 
 template <int Dim>
-bool SimulateWithParameters(const BodyModelN<Dim>& body, const DynamicFitOptions& o, const DynamicParameters& p,
+bool SimulateWithParameters(const BodyModelN<Dim>& body, const DynamicFitOptionsN<Dim>& o, const DynamicParameters& p,
                             const std::vector<int>& frame_steps,
                             const std::function<void(int, const Eigen::VectorXd&)>& on_frame) {
   return SimulatePlain(body, o, p, frame_steps,
@@ -100,7 +100,7 @@ namespace {
 
 template <int Dim>
 DynamicFitResult FitDynamic(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
-                            const DynamicParameters& initial, const DynamicFitOptions& o) {
+                            const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o) {
   if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
@@ -170,20 +170,20 @@ DynamicFitResult FitDynamic(const BodyModelN<Dim>& body, const std::vector<Refer
 
 template <int Dim>
 double DynamicCost(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames, const DynamicParameters& p,
-                   const DynamicFitOptions& o) {
+                   const DynamicFitOptionsN<Dim>& o) {
   return CostOf(body, frames, p, o);
 }
 
 template <int Dim>
 DynamicFitResult FitDynamicTrajectory(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
-                                      const DynamicParameters& initial, const DynamicFitOptions& o) {
+                                      const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o) {
   if (o.gradient == FitGradient::kAdjoint) return FitDynamicByAdjoint(body, frames, initial, o);
   return FitDynamic(body, frames, initial, o);
 }
 
 template <int Dim>
 AnnealingResult AnnealPoseGraph(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
-                                const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
+                                const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o, long budget,
                                 std::uint64_t seed) {
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
@@ -223,7 +223,7 @@ AnnealingResult AnnealPoseGraph(const BodyModelN<Dim>& body, const std::vector<R
 
 template <int Dim>
 AnnealingResult AnnealDynamicTrajectory(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
-                                        const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
+                                        const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o, long budget,
                                         unsigned seed) {
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
@@ -291,27 +291,27 @@ AnnealingResult AnnealDynamicTrajectory(const BodyModelN<Dim>& body, const std::
 }
 
 template std::vector<int> FrameSteps(const std::vector<ReferenceFrameN<2>>&, double);
-template bool SimulateWithParameters(const BodyModelN<2>&, const DynamicFitOptions&, const DynamicParameters&,
+template bool SimulateWithParameters(const BodyModelN<2>&, const DynamicFitOptionsN<2>&, const DynamicParameters&,
                                      const std::vector<int>&, const std::function<void(int, const Eigen::VectorXd&)>&);
 template DynamicFitResult FitDynamicTrajectory(const BodyModelN<2>&, const std::vector<ReferenceFrameN<2>>&,
-                                               const DynamicParameters&, const DynamicFitOptions&);
+                                               const DynamicParameters&, const DynamicFitOptionsN<2>&);
 template AnnealingResult AnnealPoseGraph(const BodyModelN<2>&, const std::vector<ReferenceFrameN<2>>&,
-                                         const DynamicParameters&, const DynamicFitOptions&, long, std::uint64_t);
+                                         const DynamicParameters&, const DynamicFitOptionsN<2>&, long, std::uint64_t);
 template AnnealingResult AnnealDynamicTrajectory(const BodyModelN<2>&, const std::vector<ReferenceFrameN<2>>&,
-                                                 const DynamicParameters&, const DynamicFitOptions&, long, unsigned);
+                                                 const DynamicParameters&, const DynamicFitOptionsN<2>&, long, unsigned);
 template double DynamicCost(const BodyModelN<2>&, const std::vector<ReferenceFrameN<2>>&, const DynamicParameters&,
-                            const DynamicFitOptions&);
+                            const DynamicFitOptionsN<2>&);
 template std::vector<int> FrameSteps(const std::vector<ReferenceFrameN<3>>&, double);
-template bool SimulateWithParameters(const BodyModelN<3>&, const DynamicFitOptions&, const DynamicParameters&,
+template bool SimulateWithParameters(const BodyModelN<3>&, const DynamicFitOptionsN<3>&, const DynamicParameters&,
                                      const std::vector<int>&, const std::function<void(int, const Eigen::VectorXd&)>&);
 template DynamicFitResult FitDynamicTrajectory(const BodyModelN<3>&, const std::vector<ReferenceFrameN<3>>&,
-                                               const DynamicParameters&, const DynamicFitOptions&);
+                                               const DynamicParameters&, const DynamicFitOptionsN<3>&);
 template AnnealingResult AnnealPoseGraph(const BodyModelN<3>&, const std::vector<ReferenceFrameN<3>>&,
-                                         const DynamicParameters&, const DynamicFitOptions&, long, std::uint64_t);
+                                         const DynamicParameters&, const DynamicFitOptionsN<3>&, long, std::uint64_t);
 template AnnealingResult AnnealDynamicTrajectory(const BodyModelN<3>&, const std::vector<ReferenceFrameN<3>>&,
-                                                 const DynamicParameters&, const DynamicFitOptions&, long, unsigned);
+                                                 const DynamicParameters&, const DynamicFitOptionsN<3>&, long, unsigned);
 template double DynamicCost(const BodyModelN<3>&, const std::vector<ReferenceFrameN<3>>&, const DynamicParameters&,
-                            const DynamicFitOptions&);
+                            const DynamicFitOptionsN<3>&);
 
 }  // namespace wobble::fit
 

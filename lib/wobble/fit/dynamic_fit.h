@@ -13,11 +13,11 @@
 // Every function takes a 2D or a 3D body (one template over the dimension): in 3D q0 = [t, r, γ]
 // with r a rotation vector and q̇0 = [ṫ, body ω, γ̇], as the 3D CLI; the solver holds q0's
 // orientation as chart · exp(δ̂) (as the pose fits, pose_fit.h), the world is
-// DynamicFitOptions::world3.
+// DynamicFitOptionsN<3>::world.
 //
 // Transition times are made differentiable by a smoothed pose switch: the targets are
 //     γ0(t) = P_0 + Σ_k (P_{k mod n} − P_{(k−1) mod n}) σ((t − S_k)/w),  S_k = τ_0 + … + τ_{k−1},
-// σ the logistic function and w the switch width (DynamicFitOptions::switch_width). A hard switch
+// σ the logistic function and w the switch width (DynamicFitOptionsN::switch_width). A hard switch
 // (the pose graph of lib/wobble/control) has a cost that is piecewise constant in the times
 // between steps, with zero gradient almost everywhere; the smoothed one is a controller in its
 // own right (a PD servo whose set point moves in about 4w) and tends to the hard one as w → 0.
@@ -52,9 +52,8 @@ struct DynamicParameters {
 //             logistic map. 2D and 3D bodies (3D: fit/adjoint3.h, q0's δ through J_r).
 enum class FitGradient { kJets, kAdjoint };
 
-struct DynamicFitOptions {
-  WorldParams world;    // gravity, ground, springs
-  WorldParamsN<3> world3;  // the same for a 3D body
+template <int Dim> struct DynamicFitOptionsN {
+  WorldParamsN<Dim> world;  // gravity, ground, springs (of the body's dimension)
   double dt = 0.01;   // thesis integrator (Eq. 4.22/4.23), as `wobble simulate --integrator thesis`
   bool fit_q0 = true, fit_qd0 = true, fit_stiffness = true, fit_damping = true;
   bool fit_poses = false, fit_times = false;  // the controller's (needs a non-empty graph)
@@ -65,6 +64,7 @@ struct DynamicFitOptions {
   bool full_report = false;
   std::function<void(int iteration, double cost)> on_iteration;  // progress display
 };
+using DynamicFitOptions = DynamicFitOptionsN<2>;
 
 struct DynamicFitResult {
   DynamicParameters params;
@@ -81,7 +81,7 @@ template <int Dim> std::vector<int> FrameSteps(const std::vector<ReferenceFrameN
 // on_frame(f, q) at every frame step (q as the fits' q). Returns false on numerical trouble
 // (singular M, non-finite state).
 template <int Dim>
-bool SimulateWithParameters(const BodyModelN<Dim>& body, const DynamicFitOptions& options, const DynamicParameters& p,
+bool SimulateWithParameters(const BodyModelN<Dim>& body, const DynamicFitOptionsN<Dim>& options, const DynamicParameters& p,
                             const std::vector<int>& frame_steps,
                             const std::function<void(int, const Eigen::VectorXd&)>& on_frame);
 
@@ -91,7 +91,7 @@ bool SimulateWithParameters(const BodyModelN<Dim>& body, const DynamicFitOptions
 // generalized mass), bounded below by 0.
 template <int Dim>
 DynamicFitResult FitDynamicTrajectory(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
-                                      const DynamicParameters& initial, const DynamicFitOptions& options);
+                                      const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& options);
 
 // Baseline: simulated annealing on the same parameters and the same cost (½ Σ |x − target|²),
 // given a budget of simulations. Returns the best parameters and cost found.
@@ -105,17 +105,17 @@ struct AnnealingResult {
 // fixed, with `simulation_budget` simulations (batch 1). The best graph is in result.params.
 template <int Dim>
 AnnealingResult AnnealPoseGraph(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
-                                const DynamicParameters& initial, const DynamicFitOptions& options,
+                                const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& options,
                                 long simulation_budget, std::uint64_t seed = 1);
 template <int Dim>
 AnnealingResult AnnealDynamicTrajectory(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
-                                        const DynamicParameters& initial, const DynamicFitOptions& options,
+                                        const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& options,
                                         long simulation_budget, unsigned seed = 1);
 
 // ½ Σ w |x − target|² of a parameter set (one plain simulation); +inf on numerical trouble.
 template <int Dim>
 double DynamicCost(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
-                   const DynamicParameters& p, const DynamicFitOptions& options);
+                   const DynamicParameters& p, const DynamicFitOptionsN<Dim>& options);
 
 // (Each is instantiated for Dim = 2 and 3 in dynamic_fit.cc.)
 

@@ -106,7 +106,7 @@ template <int Dim> class FitRollout;
 
 template <> class FitRollout<2> {
  public:
-  FitRollout(const Reference<2>& ref, const DynamicFitOptions& o) {
+  FitRollout(const Reference<2>& ref, const DynamicFitOptionsN<2>& o) {
     cost_.ref = &ref;
     cost_.frames_at = FramesAt(ref.steps);
     rollout_.world = o.world;
@@ -141,10 +141,10 @@ template <> class FitRollout<2> {
 
 template <> class FitRollout<3> {
  public:
-  FitRollout(const Reference<3>& ref, const DynamicFitOptions& o) {
+  FitRollout(const Reference<3>& ref, const DynamicFitOptionsN<3>& o) {
     cost_.ref = &ref;
     cost_.frames_at = FramesAt(ref.steps);
-    rollout_.world = o.world3;
+    rollout_.world = o.world;
     rollout_.integrator = Integrator::kThesis;
     rollout_.dt = o.dt;
   }
@@ -193,7 +193,7 @@ template <> class FitRollout<3> {
 template <int Dim> class AdjointDynamicCost final : public ceres::FirstOrderFunction {
  public:
   AdjointDynamicCost(const BodyModelN<Dim>& body, const Reference<Dim>& ref, const Blocks<Dim>& start,
-                     const VecD<double>& G, const DynamicFitOptions& o, long* simulations)
+                     const VecD<double>& G, const DynamicFitOptionsN<Dim>& o, long* simulations)
       : body_(body), ref_(ref), start_(start), G_(G), o_(o), simulations_(simulations), rollout_(ref, o) {
     log_lo_ = std::log(o.min_time);
     log_hi_ = std::log(o.max_time);
@@ -301,7 +301,7 @@ template <int Dim> class AdjointDynamicCost final : public ceres::FirstOrderFunc
   const Reference<Dim>& ref_;
   const Blocks<Dim> start_;
   const VecD<double> G_;
-  const DynamicFitOptions& o_;
+  const DynamicFitOptionsN<Dim>& o_;
   long* simulations_;
   double log_lo_ = 0, log_hi_ = 0;
   std::vector<double> scale_;  // of each x
@@ -312,7 +312,7 @@ template <int Dim> class AdjointDynamicCost final : public ceres::FirstOrderFunc
 
 template <int Dim>
 DynamicFitResult FitDynamicByAdjoint(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
-                              const DynamicParameters& initial, const DynamicFitOptions& o) {
+                              const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o) {
   if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
@@ -379,8 +379,8 @@ DynamicFitResult FitDynamicByAdjoint(const BodyModelN<Dim>& body, const std::vec
 }
 
 template DynamicFitResult FitDynamicByAdjoint(const BodyModelN<2>&, const std::vector<ReferenceFrameN<2>>&,
-                                              const DynamicParameters&, const DynamicFitOptions&);
+                                              const DynamicParameters&, const DynamicFitOptionsN<2>&);
 template DynamicFitResult FitDynamicByAdjoint(const BodyModelN<3>&, const std::vector<ReferenceFrameN<3>>&,
-                                              const DynamicParameters&, const DynamicFitOptions&);
+                                              const DynamicParameters&, const DynamicFitOptionsN<3>&);
 
 }  // namespace wobble::fit::internal

@@ -27,7 +27,6 @@ template <int Dim> struct Dimension;
 template <> struct Dimension<2> {
   using Body = BodyModel;
   template <class T> using State = BodyState<2, T>;
-  static const WorldParams& World(const DynamicFitOptions& o) { return o.world; }
   template <class T> static State<T> Start(const Body& body, const WorldParams& w, const T* q0, const T* qd0,
                                            const Eigen::Quaterniond&) {
     State<T> s;
@@ -58,7 +57,6 @@ template <> struct Dimension<2> {
 template <> struct Dimension<3> {
   using Body = BodyModel3;
   template <class T> using State = BodyState<3, T>;
-  static const WorldParamsN<3>& World(const DynamicFitOptions& o) { return o.world3; }
   template <class T> static State<T> Start(const Body& body, const WorldParamsN<3>& w, const T* q0, const T* qd0,
                                            const Eigen::Quaterniond& chart) {
     const int D = body.num_modes();
@@ -109,11 +107,11 @@ template <> struct Dimension<3> {
 // forces from `p` and the controller's targets at the start of every step (as the World's pose
 // graph sets them). Calls on_frame(f, state) at every frame step.
 template <int Dim, class T, class F>
-bool Simulate(const BodyModelN<Dim>& passive, const DynamicFitOptions& o, const T* q0, const T* qd0,
+bool Simulate(const BodyModelN<Dim>& passive, const DynamicFitOptionsN<Dim>& o, const T* q0, const T* qd0,
               const Eigen::Quaterniond& chart, const ModeParams<T>& p, const control::PoseGraphOf<T>& control,
               const std::vector<int>& steps, F&& on_frame) {
   using Dims = Dimension<Dim>;
-  const auto& w = Dims::World(o);
+  const auto& w = o.world;
   typename Dims::template State<T> s = Dims::template Start<T>(passive, w, q0, qd0, chart);
   VecD<T> target = VecD<T>::Zero(passive.num_modes());
   int step = 0;
@@ -257,7 +255,7 @@ DynamicParameters Completed(const BodyModelN<Dim>& body, const std::vector<Refer
 
 // The plain simulation with parameters p: on_frame(f, state) at every frame step.
 template <int Dim, class F>
-bool SimulatePlain(const BodyModelN<Dim>& body, const DynamicFitOptions& o, const DynamicParameters& p,
+bool SimulatePlain(const BodyModelN<Dim>& body, const DynamicFitOptionsN<Dim>& o, const DynamicParameters& p,
                    const std::vector<int>& frame_steps, F&& on_frame) {
   using Dims = Dimension<Dim>;
   CheckParameters(body, p);
@@ -273,7 +271,7 @@ bool SimulatePlain(const BodyModelN<Dim>& body, const DynamicFitOptions& o, cons
 
 template <int Dim>
 double CostOf(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
-              const DynamicParameters& p, const DynamicFitOptions& o) {
+              const DynamicParameters& p, const DynamicFitOptionsN<Dim>& o) {
   using Dims = Dimension<Dim>;
   const Reference<Dim> ref = MakeReference(body, frames, o.dt);
   double cost = 0;
@@ -285,10 +283,10 @@ double CostOf(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim
 }
 
 
-// The fit with the adjoint gradient and Ceres' line search (DynamicFitOptions::gradient ==
+// The fit with the adjoint gradient and Ceres' line search (DynamicFitOptionsN::gradient ==
 // kAdjoint): dynamic_fit_adjoint.cc.
 template <int Dim>
 DynamicFitResult FitDynamicByAdjoint(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
-                                     const DynamicParameters& initial, const DynamicFitOptions& o);
+                                     const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o);
 
 }  // namespace wobble::fit::internal
