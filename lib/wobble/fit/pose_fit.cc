@@ -64,46 +64,49 @@ template <int Dim> std::vector<std::string> CoordinateNames(const BodyModelN<Dim
 template std::vector<std::string> CoordinateNames(const BodyModelN<2>&);
 template std::vector<std::string> CoordinateNames(const BodyModelN<3>&);
 
+namespace {
+
+// The weighted centroids of the rest positions and of their targets, and the cross-covariance
+// H = Σ w (p − p̄)(y − ȳ)ᵀ the best rotation is found from (Procrustes, Kabsch).
+template <int Dim> struct CrossCovariance {
+  using Vec = Eigen::Matrix<double, Dim, 1>;
+  Vec ps = Vec::Zero(), ys = Vec::Zero();
+  Eigen::Matrix<double, Dim, Dim> H = Eigen::Matrix<double, Dim, Dim>::Zero();
+  CrossCovariance(const std::vector<Vec>& rest, const std::vector<Vec>& target, const std::vector<double>& w) {
+    double wsum = 0;
+    for (size_t i = 0; i < rest.size(); ++i) {
+      ps += w[i] * rest[i];
+      ys += w[i] * target[i];
+      wsum += w[i];
+    }
+    ps /= wsum;
+    ys /= wsum;
+    for (size_t i = 0; i < rest.size(); ++i) H += w[i] * (rest[i] - ps) * (target[i] - ys).transpose();
+  }
+};
+
+}  // namespace
+
 Eigen::VectorXd PoseChart<2>::RigidStart(int num_modes, const std::vector<Vec>& rest, const std::vector<Vec>& target,
                                          const std::vector<double>& w) {
-  Eigen::Vector2d ps = Eigen::Vector2d::Zero(), ys = Eigen::Vector2d::Zero();
-  double wsum = 0;
-  for (size_t i = 0; i < rest.size(); ++i) {
-    ps += w[i] * rest[i];
-    ys += w[i] * target[i];
-    wsum += w[i];
-  }
-  ps /= wsum;
-  ys /= wsum;
-  Eigen::Matrix2d H = Eigen::Matrix2d::Zero();
-  for (size_t i = 0; i < rest.size(); ++i) H += w[i] * (rest[i] - ps) * (target[i] - ys).transpose();
+  const CrossCovariance<2> c(rest, target, w);
   // maximise Σ w yᵀ R p: θ = atan2(H01 − H10, H00 + H11) (0 when the points are all one point)
-  const double theta = std::atan2(H(0, 1) - H(1, 0), H(0, 0) + H(1, 1));
+  const double theta = std::atan2(c.H(0, 1) - c.H(1, 0), c.H(0, 0) + c.H(1, 1));
   Eigen::VectorXd q = Eigen::VectorXd::Zero(FitPoseQ<2>::kRigid + num_modes);
-  const Eigen::Vector2d t = ys - Rotation(theta) * ps;
+  const Eigen::Vector2d t = c.ys - Rotation(theta) * c.ps;
   q << t.x(), t.y(), theta, Eigen::VectorXd::Zero(num_modes);
   return q;
 }
 
 Eigen::VectorXd PoseChart<3>::RigidStart(int num_modes, const std::vector<Vec>& rest, const std::vector<Vec>& target,
                                          const std::vector<double>& w) {
-  Eigen::Vector3d ps = Eigen::Vector3d::Zero(), ys = Eigen::Vector3d::Zero();
-  double wsum = 0;
-  for (size_t i = 0; i < rest.size(); ++i) {
-    ps += w[i] * rest[i];
-    ys += w[i] * target[i];
-    wsum += w[i];
-  }
-  ps /= wsum;
-  ys /= wsum;
-  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-  for (size_t i = 0; i < rest.size(); ++i) H += w[i] * (rest[i] - ps) * (target[i] - ys).transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const CrossCovariance<3> c(rest, target, w);
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(c.H, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
   S(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;  // no reflection
   const Eigen::Matrix3d R = svd.matrixV() * S * svd.matrixU().transpose();
   Eigen::VectorXd q = Eigen::VectorXd::Zero(FitPoseQ<3>::kRigid + num_modes);
-  q.head<3>() = ys - R * ps;
+  q.head<3>() = c.ys - R * c.ps;
   q.segment<3>(3) = LogRotation<double>(Eigen::Quaterniond(R));
   return q;
 }

@@ -11,14 +11,12 @@
 
 namespace wobble::fit {
 
-namespace {
-
-// SmoothnessScales of either dimension: 1 for the translation, the rms radius of the mass
-// points about their centroid for every rotation coordinate, each mode's rms displacement of
-// the mass points (1 where there is nothing to measure).
-template <int Dim> Eigen::VectorXd ScalesOf(const BodyModelN<Dim>& body) {
+// 1 for the translation, the rms radius of the mass points about their centroid for every
+// rotation coordinate, each mode's rms displacement of the mass points (1 where there is
+// nothing to measure).
+template <int Dim> VecQ<double> SmoothnessScales(const BodyModelN<Dim>& body) {
   const int n = body.num_q(), N = body.num_points(), rigid = n - body.num_modes();
-  Eigen::VectorXd L = Eigen::VectorXd::Ones(n);
+  VecQ<double> L = VecQ<double>::Ones(n);
   Eigen::Matrix<double, Dim, 1> c = Eigen::Matrix<double, Dim, 1>::Zero();
   for (int k = 0; k < N; ++k) c += body.rest_local(k);
   c /= N;
@@ -34,29 +32,33 @@ template <int Dim> Eigen::VectorXd ScalesOf(const BodyModelN<Dim>& body) {
   return L;
 }
 
-// FramesFromStates of either dimension; place(k, q) is mass point k's world position at q.
-template <class Frame, int Dim, class Place>
-std::vector<Frame> FramesOf(const BodyModelN<Dim>& body, const std::vector<double>& times,
-                            const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points, int every,
-                            const Place& place) {
+template VecQ<double> SmoothnessScales(const BodyModelN<2>&);
+template VecQ<double> SmoothnessScales(const BodyModelN<3>&);
+
+template <int Dim>
+std::vector<ReferenceFrameN<Dim>> FramesFromStates(const BodyModelN<Dim>& body, const std::vector<double>& times,
+                                                   const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
+                                                   int every) {
   std::vector<int> which = points;
   if (which.empty())
     for (int k = 0; k < body.num_points(); ++k) which.push_back(k);
-  std::vector<Frame> frames;
+  std::vector<ReferenceFrameN<Dim>> frames;
   for (size_t f = 0; f < q.size(); f += size_t(std::max(1, every))) {
-    Frame frame;
+    ReferenceFrameN<Dim> frame;
     frame.time = times[f];
     for (int k : which) {
       if (k < 0 || k >= body.num_points()) throw std::invalid_argument("mass point " + std::to_string(k) + " does not exist");
-      typename decltype(frame.points)::value_type p;
+      CorrespondenceN<Dim> p;
       p.mass_point = k;
-      p.position = place(k, q[f]);
+      p.position = PointPosition(BasisOf(body, k, {}), q[f]);
       frame.points.push_back(p);
     }
     frames.push_back(frame);
   }
   return frames;
 }
+
+namespace {
 
 // Smoothness between frames f−1, f, f+1 of a 3D body (blocks x0, x1, x2 in their charts): the
 // divided second difference of t and γ, and c2 log(R1ᵀR2) − c0 log(R0ᵀR1) for the orientation,
@@ -98,18 +100,6 @@ ceres::CostFunction* PoseChart<3>::Smoothness(const double c[3], const PoseChart
   return cost;
 }
 
-template <int Dim> VecQ<double> SmoothnessScales(const BodyModelN<Dim>& body) { return ScalesOf(body); }
-template VecQ<double> SmoothnessScales(const BodyModelN<2>&);
-template VecQ<double> SmoothnessScales(const BodyModelN<3>&);
-
-template <int Dim>
-std::vector<ReferenceFrameN<Dim>> FramesFromStates(const BodyModelN<Dim>& body, const std::vector<double>& times,
-                                                   const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
-                                                   int every) {
-  return FramesOf<ReferenceFrameN<Dim>>(body, times, q, points, every, [&](int k, const Eigen::VectorXd& qf) {
-    return Eigen::Matrix<double, Dim, 1>(PointPosition(BasisOf(body, k, {}), qf));
-  });
-}
 template std::vector<ReferenceFrameN<2>> FramesFromStates(const BodyModelN<2>&, const std::vector<double>&,
                                                           const std::vector<Eigen::VectorXd>&, const std::vector<int>&, int);
 template std::vector<ReferenceFrameN<3>> FramesFromStates(const BodyModelN<3>&, const std::vector<double>&,
