@@ -18,8 +18,8 @@
 
 namespace wobble::fit::internal {
 
-// What differs between the dimensions: the world, the state, its step, where a body point is
-// in a state, and how q0 is held as a parameter block. In 3D the block is [t, δ, γ] with the
+// What differs between the dimensions: the state, its step, where a body point is in a state,
+// the fits' q of a state, and how q0 is held as a parameter block. In 3D the block is [t, δ, γ] with the
 // orientation chart · exp(δ̂) (as the pose fits, pose_fit.h), so the solver never meets a
 // rotation-vector singularity.
 template <int Dim> struct Dimension;

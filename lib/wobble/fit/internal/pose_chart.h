@@ -74,13 +74,12 @@ template <> struct PoseChart<2> {
   }
   // The divided second difference c0 q0 + c1 q1 + c2 q2 of three frames, times `scale`
   // (SecondDifference: linear, its Jacobian written out).
-  static ceres::CostFunction* Smoothness(const double c[3], const PoseChart* charts[3], const VecQ<double>& scale) {
+  static ceres::CostFunction* Smoothness(const double c[3], const PoseChart* /*charts*/[3], const VecQ<double>& scale) {
     SecondDifference s;
     s.c0 = c[0];
     s.c1 = c[1];
     s.c2 = c[2];
     s.scale = scale;
-    (void)charts;
     return MakeSecondDifferenceCost(s);
   }
 };
