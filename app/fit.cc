@@ -15,7 +15,6 @@
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/core/rotation3.h"
 #include "wobble/fit/pose_fit.h"
-#include "wobble/fit/pose_fit3.h"
 #include "wobble/fit/trajectory_fit.h"
 #include "wobble/formats/object_file.h"
 #include "wobble/record/trajectory_csv.h"
@@ -212,24 +211,16 @@ std::string List(const std::vector<std::string>& names) {
 }
 
 // The file records as fit's input types (lib/wobble/fit does not read files).
-std::vector<fit::Correspondence> Correspondences(const std::vector<formats::PointTarget>& points) {
-  std::vector<fit::Correspondence> out;
-  for (const formats::PointTarget& p : points) out.push_back({p.mass_point, p.lattice_coords, p.position, p.weight});
+template <int Dim>
+std::vector<fit::CorrespondenceN<Dim>> Correspondences(const std::vector<formats::PointTargetN<Dim>>& points) {
+  std::vector<fit::CorrespondenceN<Dim>> out;
+  for (const formats::PointTargetN<Dim>& p : points) out.push_back({p.mass_point, p.lattice_coords, p.position, p.weight});
   return out;
 }
-std::vector<fit::ReferenceFrame> ReferenceFrames(const std::vector<formats::TargetFrame>& frames) {
-  std::vector<fit::ReferenceFrame> out;
-  for (const formats::TargetFrame& f : frames) out.push_back({f.time, Correspondences(f.points)});
-  return out;
-}
-std::vector<fit::Correspondence3> Correspondences(const std::vector<formats::PointTarget3>& points) {
-  std::vector<fit::Correspondence3> out;
-  for (const formats::PointTarget3& p : points) out.push_back({p.mass_point, p.lattice_coords, p.position, p.weight});
-  return out;
-}
-std::vector<fit::ReferenceFrame3> ReferenceFrames(const std::vector<formats::TargetFrame3>& frames) {
-  std::vector<fit::ReferenceFrame3> out;
-  for (const formats::TargetFrame3& f : frames) out.push_back({f.time, Correspondences(f.points)});
+template <int Dim>
+std::vector<fit::ReferenceFrameN<Dim>> ReferenceFrames(const std::vector<formats::TargetFrameN<Dim>>& frames) {
+  std::vector<fit::ReferenceFrameN<Dim>> out;
+  for (const formats::TargetFrameN<Dim>& f : frames) out.push_back({f.time, Correspondences(f.points)});
   return out;
 }
 // What reads a 3D target file's 'mesh' line: VTK's readers, when the pipelines are built.
@@ -377,127 +368,141 @@ FitCommands AddFitCommand(CLI::App* app, FitPoseArgs* pose, FitTrajectoryArgs* t
 
 namespace {
 
-// A 3D object: correspondences, or a surface (mesh and/or cloud) without them.
-int RunFitPose3(const FitPoseArgs& a) {
-  const std::shared_ptr<const BodyModel3> body = LoadBody3(a.files);
-  fit::PoseFitOptions o = PoseOptions(a.fit, *body);
+// What a pose fit does differently in 2D and 3D: the target file it reads and what it fits
+// without correspondences (not twins: a 2D body is fitted to curves, a 3D body to a surface).
+// The correspondence fit, the JSON and the summary are one code path (RunPose).
+struct ShapeFit {
+  fit::PoseFitResult r;
+  std::string kind, after_iterations;
+};
+
+void SetShapeOptions(const FitPoseArgs& a, const BodyModel&, fit::PoseFitOptions* o) {
+  if (a.samples_per_segment < 0) throw UsageError("--samples-per-segment must be >= 0");
+  if (a.max_rounds < 1) throw UsageError("--max-rounds must be at least 1");
+  o->samples_per_segment = a.samples_per_segment;
+  o->max_rounds = a.max_rounds;
+  o->joint_closest_points = !a.alternate;
+}
+void SetShapeOptions(const FitPoseArgs& a, const BodyModel3&, fit::PoseFitOptions* o) {
   if (a.alternate) throw UsageError("--alternate: 3D surface fits find the nearest points jointly (2D curves only)");
   if (a.mesh_samples < 0) throw UsageError("--mesh-samples must be >= 0");
-  o.max_mesh_samples = a.mesh_samples;
+  o->max_mesh_samples = a.mesh_samples;
+}
+
+formats::TargetFile ReadTargets(const std::string& path, const BodyModel&) { return formats::ReadTargetFile(path); }
+formats::TargetFile3 ReadTargets(const std::string& path, const BodyModel3&) {
+  return formats::ReadTargetFile3(path, AppMeshReader());
+}
+
+// The fitted body's drawing (2D: segments between its curve samples); a 3D body has none here.
+void AddBodyDrawing(const BodyModel& body, const fit::PoseFitOptions& o, const Eigen::VectorXd& q, json* overlay) {
+  (*overlay)["body"] = json::array();
+  const fit::CurveSamples drawing = fit::CurveSamples::Of(body, o);
+  std::vector<Eigen::Vector2d> drawn;
+  for (const fit::PointBasis& p : drawing.points) drawn.push_back(fit::PointPosition(p, q));
+  for (const auto& [a, b] : drawing.segments) (*overlay)["body"].push_back({Point(drawn[size_t(a)]), Point(drawn[size_t(b)])});
+}
+void AddBodyDrawing(const BodyModel3&, const fit::PoseFitOptions&, const Eigen::VectorXd&, json*) {}
+
+// 2D: the body's outline fitted to the file's polylines and cloud; the overlay joins every
+// drawn sample to the nearest target point.
+ShapeFit FitShape(const FitPoseArgs& a, const BodyModel& body, const formats::TargetFile& targets,
+                  const fit::PoseFitOptions& o, json* overlay) {
+  ShapeFit s;
+  s.kind = "curve";
+  s.r = fit::FitPoseToCurve(body, CurveTargetOf(targets), o);
+  EndIterationLine();
+  if (a.alternate) s.after_iterations = " in " + std::to_string(s.r.rounds) + " closest-point rounds";
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> target_segments;
+  for (const formats::TargetCurve& line : targets.polylines) {
+    json pl = json::array();
+    for (const Eigen::Vector2d& p : line.points) pl.push_back(Point(p));
+    (*overlay)["targets"].push_back({{"polyline", pl}, {"closed", line.closed}});
+    for (size_t k = 0; k + 1 < line.points.size(); ++k) target_segments.push_back({line.points[k], line.points[k + 1]});
+    if (line.closed && line.points.size() > 2) target_segments.push_back({line.points.back(), line.points.front()});
+  }
+  for (const Eigen::Vector2d& p : targets.cloud) (*overlay)["targets"].push_back({{"point", Point(p)}});
+  for (const fit::PointBasis& p : fit::CurveSamples::Of(body, o).points) {
+    const Eigen::Vector2d x = fit::PointPosition(p, s.r.q);
+    (*overlay)["fitted"].push_back(Point(x));
+    double best = INFINITY;
+    Eigen::Vector2d nearest = x;
+    for (const auto& [a, b] : target_segments) {
+      const Eigen::Vector2d d = b - a;
+      const double t = d.squaredNorm() > 0 ? std::clamp((x - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+      if ((a + t * d - x).norm() < best) best = (a + t * d - x).norm(), nearest = a + t * d;
+    }
+    for (const Eigen::Vector2d& p : targets.cloud)
+      if ((p - x).norm() < best) best = (p - x).norm(), nearest = p;
+    (*overlay)["joins"].push_back({Point(x), Point(nearest)});
+  }
+  return s;
+}
+
+// 3D: the body's samples fitted to the file's mesh and cloud (the overlay's targets: the cloud).
+ShapeFit FitShape(const FitPoseArgs&, const BodyModel3& body, const formats::TargetFile3& targets,
+                  const fit::PoseFitOptions& o, json* overlay) {
+  ShapeFit s;
+  s.kind = "surface";
+  fit::SurfaceTarget target;
+  if (!targets.mesh.empty()) target.AddMesh(targets.mesh);
+  for (const Eigen::Vector3d& p : targets.cloud) target.AddPoint(p);
+  s.r = fit::FitPoseToSurface(body, target, o);
+  EndIterationLine();
+  for (const fit::PointBasisN<3>& p : fit::SurfaceSamples(body, o)) (*overlay)["fitted"].push_back(Point(fit::PointPosition(p, s.r.q)));
+  for (const Eigen::Vector3d& p : targets.cloud) (*overlay)["targets"].push_back({{"point", Point(p)}});
+  return s;
+}
+
+// `wobble fit pose` on a body of either dimension: correspondences, or a shape without them.
+template <int Dim> int RunPose(const FitPoseArgs& a, const std::shared_ptr<const BodyModelN<Dim>>& body) {
+  fit::PoseFitOptions o = PoseOptions(a.fit, *body);
+  SetShapeOptions(a, *body, &o);
   o.two_sided = !a.one_sided;
   o.on_iteration = IterationLine();
-  const formats::TargetFile3 targets = formats::ReadTargetFile3(a.targets, AppMeshReader());
+  const auto targets = ReadTargets(a.targets, *body);
   formats::CheckMassPointIndices(targets, body->num_points());
   if (targets.is_trajectory())
     throw formats::ParseError(a.targets, targets.frames[0].line, "this file has frames: use `wobble fit trajectory`");
-  const bool surface = targets.has_curve();
-  const std::vector<fit::Correspondence3> points = Correspondences(targets.points);
-  fit::SurfaceTarget3 target;
-  if (!targets.mesh.empty()) target.AddMesh(targets.mesh);
-  for (const Eigen::Vector3d& p : targets.cloud) target.AddPoint(p);
-  const fit::PoseFitResult r = surface ? fit::FitPoseToSurface3(*body, target, o) : fit::FitPose3(*body, points, o);
-  EndIterationLine();
-  const std::vector<std::string> names = fit::CoordinateNames3(*body);
-
-  json j = PoseJson(surface ? "surface" : "correspondences", 3, body->name(), a.targets, names, r);
-  // fitted body points next to their targets (surface fits: the body samples; the target is
-  // the file's mesh and cloud)
+  // the overlay hook, world frame: fitted body points and their targets, each fitted point
+  // joined to its target (a 2D curve fit: to the nearest point of the target's polylines), and
+  // in 2D the fitted body's drawing
   json overlay;
   overlay["fitted"] = json::array();
   overlay["targets"] = json::array();
-  if (surface) {
-    for (const fit::PointBasis3& p : fit::SurfaceSamples3(*body, o)) overlay["fitted"].push_back(Point(fit::PointPosition3(p, r.q)));
-    for (const Eigen::Vector3d& p : targets.cloud) overlay["targets"].push_back({{"point", Point(p)}});
+  ShapeFit s;
+  s.kind = "correspondences";
+  if (targets.has_curve()) {
+    s = FitShape(a, *body, targets, o, &overlay);
   } else {
-    for (const fit::Correspondence3& t : points) {
-      overlay["fitted"].push_back(Point(fit::PointPosition3(fit::BasisOf3(*body, t.mass_point, t.lattice_coords), r.q)));
+    const std::vector<fit::CorrespondenceN<Dim>> points = Correspondences(targets.points);
+    s.r = fit::FitPose(*body, points, o);
+    EndIterationLine();
+    for (const fit::CorrespondenceN<Dim>& t : points) {
+      const Eigen::Matrix<double, Dim, 1> x = fit::PointPosition(fit::BasisOf(*body, t.mass_point, t.lattice_coords), s.r.q);
+      overlay["fitted"].push_back(Point(x));
       overlay["targets"].push_back({{"point", Point(t.position)}});
+      overlay["joins"].push_back({Point(x), Point(t.position)});
     }
   }
+  const fit::PoseFitResult& r = s.r;
+  AddBodyDrawing(*body, o, r.q, &overlay);
+  const std::vector<std::string> names = fit::CoordinateNames(*body);
+  json j = PoseJson(s.kind, Dim, body->name(), a.targets, names, r);
+  if (s.kind == "curve") j["rounds"] = r.rounds;
   j["overlay"] = overlay;
   WriteOutputs(a.fit, j, r.report);
-  return PrintPoseSummary(body->name() + ": " + (surface ? "surface" : "correspondence") + " fit to " + a.targets + ": ",
-                          names, r, a.fit.full_report);
+  const std::string fit_kind = s.kind == "correspondences" ? "correspondence" : s.kind;
+  return PrintPoseSummary(body->name() + ": " + fit_kind + " fit to " + a.targets + ": ", names, r, a.fit.full_report,
+                          s.after_iterations);
 }
 
 }  // namespace
 
 int RunFitPose(const FitPoseArgs& a) {
   CheckOutputs(a.fit);
-  if (formats::ObjectFileDimension(a.files.object) == 3) return RunFitPose3(a);
-  const std::shared_ptr<const BodyModel> body = LoadBody(a.files);
-  fit::PoseFitOptions o = PoseOptions(a.fit, *body);
-  if (a.samples_per_segment < 0) throw UsageError("--samples-per-segment must be >= 0");
-  if (a.max_rounds < 1) throw UsageError("--max-rounds must be at least 1");
-  o.samples_per_segment = a.samples_per_segment;
-  o.max_rounds = a.max_rounds;
-  o.two_sided = !a.one_sided;
-  o.joint_closest_points = !a.alternate;
-  o.on_iteration = IterationLine();
-  const formats::TargetFile targets = formats::ReadTargetFile(a.targets);
-  formats::CheckMassPointIndices(targets, body->num_points());
-  if (targets.is_trajectory())
-    throw formats::ParseError(a.targets, targets.frames[0].line, "this file has frames: use `wobble fit trajectory`");
-
-  const bool curve = targets.has_curve();
-  const std::vector<fit::Correspondence> points = Correspondences(targets.points);
-  const fit::PoseFitResult r =
-      curve ? fit::FitPoseToCurve(*body, CurveTargetOf(targets), o) : fit::FitPose(*body, points, o);
-  EndIterationLine();
-  const std::vector<std::string> names = fit::CoordinateNames(*body);
-
-  json j = PoseJson(curve ? "curve" : "correspondences", 2, body->name(), a.targets, names, r);
-  if (curve) j["rounds"] = r.rounds;
-  // the overlay hook, world frame: fitted body points and their targets, the fitted body's
-  // drawing (segments between its samples) and each fitted point joined to its target (a
-  // curve fit: to the nearest point of the target's polylines)
-  json overlay;
-  overlay["fitted"] = json::array();
-  overlay["targets"] = json::array();
-  overlay["body"] = json::array();
-  overlay["joins"] = json::array();
-  const fit::CurveSamples drawing = fit::CurveSamples::Of(*body, o);
-  std::vector<Eigen::Vector2d> drawn;
-  for (const fit::PointBasis& p : drawing.points) drawn.push_back(fit::PointPosition(p, r.q.data(), body->num_q()));
-  for (const auto& [a, b] : drawing.segments) overlay["body"].push_back({Point(drawn[size_t(a)]), Point(drawn[size_t(b)])});
-  if (curve) {
-    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> target_segments;
-    for (const formats::TargetCurve& line : targets.polylines) {
-      json pl = json::array();
-      for (const Eigen::Vector2d& p : line.points) pl.push_back(Point(p));
-      overlay["targets"].push_back({{"polyline", pl}, {"closed", line.closed}});
-      for (size_t k = 0; k + 1 < line.points.size(); ++k) target_segments.push_back({line.points[k], line.points[k + 1]});
-      if (line.closed && line.points.size() > 2) target_segments.push_back({line.points.back(), line.points.front()});
-    }
-    for (const Eigen::Vector2d& p : targets.cloud) overlay["targets"].push_back({{"point", Point(p)}});
-    for (const Eigen::Vector2d& x : drawn) {
-      overlay["fitted"].push_back(Point(x));
-      double best = INFINITY;
-      Eigen::Vector2d nearest = x;
-      for (const auto& [a, b] : target_segments) {
-        const Eigen::Vector2d d = b - a;
-        const double t = d.squaredNorm() > 0 ? std::clamp((x - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
-        if ((a + t * d - x).norm() < best) best = (a + t * d - x).norm(), nearest = a + t * d;
-      }
-      for (const Eigen::Vector2d& p : targets.cloud)
-        if ((p - x).norm() < best) best = (p - x).norm(), nearest = p;
-      overlay["joins"].push_back({Point(x), Point(nearest)});
-    }
-  } else {
-    for (const fit::Correspondence& t : points) {
-      const Eigen::Vector2d x = fit::PointPosition(fit::BasisOf(*body, t.mass_point, t.lattice_coords), r.q.data(), body->num_q());
-      overlay["fitted"].push_back(Point(x));
-      overlay["targets"].push_back({{"point", Point(t.position)}});
-      overlay["joins"].push_back({Point(x), Point(t.position)});
-    }
-  }
-  j["overlay"] = overlay;
-  WriteOutputs(a.fit, j, r.report);
-
-  const std::string rounds =
-      curve && a.alternate ? " in " + std::to_string(r.rounds) + " closest-point rounds" : std::string();
-  return PrintPoseSummary(body->name() + ": " + (curve ? "curve" : "correspondence") + " fit to " + a.targets + ": ",
-                          names, r, a.fit.full_report, rounds);
+  if (formats::ObjectFileDimension(a.files.object) == 3) return RunPose<3>(a, LoadBody3(a.files));
+  return RunPose<2>(a, LoadBody(a.files));
 }
 
 namespace {
@@ -562,62 +567,54 @@ control::PoseGraph ParsePoseGraph(const std::string& text, int num_active, bool 
   return g;
 }
 
-// What the trajectory fit does differently in 2D and 3D: the reference's frames, the kinematic
-// fit and the coordinate names.
-// The reference's frames: a `wobble simulate` CSV (its q rows; a 3D run's hold the orientation
-// as a quaternion, tx ty tz qw qx qy qz γ.., turned into the fit's rotation vector) or a
+// What the trajectory fit reads differently in 2D and 3D: a `wobble simulate` CSV's q rows as
+// the fits' q (a 3D run's hold the orientation as a quaternion, tx ty tz qw qx qy qz γ..,
+// turned into the fit's rotation vector).
+void ReadStates(const std::string& path, const std::shared_ptr<const BodyModel>& body, std::vector<double>* t,
+                std::vector<Eigen::VectorXd>* q) {
+  const record::Trajectory sim = record::ReadTrajectoryCsv(path, {record::DescribeFfdBody(body)}).trajectory;
+  for (int k = 0; k < sim.size(); ++k) t->push_back(sim.time(k)), q->push_back(sim.q(k, 0));
+}
+void ReadStates(const std::string& path, const std::shared_ptr<const BodyModel3>& body, std::vector<double>* t,
+                std::vector<Eigen::VectorXd>* q) {
+  const record::Trajectory sim = record::ReadTrajectoryCsv(path, {record::DescribeFfd3Body(body)}).trajectory;
+  for (int k = 0; k < sim.size(); ++k) {
+    const Eigen::VectorXd row = sim.q(k, 0);
+    const Eigen::Quaterniond orientation(row[3], row[4], row[5], row[6]);
+    Eigen::VectorXd qk(body->num_q());
+    qk << row.head<3>(), LogRotation<double>(orientation.normalized()), row.tail(body->num_modes());
+    t->push_back(sim.time(k));
+    q->push_back(qk);
+  }
+}
+
+// The reference's frames: a `wobble simulate` CSV (the listed mass points at its states) or a
 // target file with frames.
 template <int Dim>
-auto LoadFrames(const FitTrajectoryArgs& a, const std::shared_ptr<const BodyModelN<Dim>>& body) {
+std::vector<fit::ReferenceFrameN<Dim>> LoadFrames(const FitTrajectoryArgs& a,
+                                                  const std::shared_ptr<const BodyModelN<Dim>>& body) {
   if (EndsWith(a.reference, ".csv")) {
     std::vector<double> t;
     std::vector<Eigen::VectorXd> q;
-    const record::Trajectory sim = [&] {
-      if constexpr (Dim == 2) return record::ReadTrajectoryCsv(a.reference, {record::DescribeFfdBody(body)}).trajectory;
-      else return record::ReadTrajectoryCsv(a.reference, {record::DescribeFfd3Body(body)}).trajectory;
-    }();
-    for (int k = 0; k < sim.size(); ++k) {
-      Eigen::VectorXd row = sim.q(k, 0);
-      if constexpr (Dim == 3) {
-        const Eigen::Quaterniond orientation(row[3], row[4], row[5], row[6]);
-        Eigen::VectorXd qk(body->num_q());
-        qk << row.head<3>(), LogRotation<double>(orientation.normalized()), row.tail(body->num_modes());
-        row = qk;
-      }
-      t.push_back(sim.time(k));
-      q.push_back(row);
-    }
+    ReadStates(a.reference, body, &t, &q);
     const std::vector<int> points = ParsePointList(a.points, body->num_points());
-    if constexpr (Dim == 2) return fit::FramesFromStates(*body, t, q, points, a.every);
-    else return fit::FramesFromStates3(*body, t, q, points, a.every);
+    return fit::FramesFromStates(*body, t, q, points, a.every);
   }
-  const auto file = [&] {
-    if constexpr (Dim == 2) return formats::ReadTargetFile(a.reference);
-    else return formats::ReadTargetFile3(a.reference, AppMeshReader());
-  }();
+  const auto file = ReadTargets(a.reference, *body);
   if (!file.is_trajectory())
     throw formats::ParseError(a.reference, 0, "no 'frame' lines: a trajectory needs frames (for one pose use `wobble fit pose`)");
   formats::CheckMassPointIndices(file, body->num_points());
   return ReferenceFrames(file.frames);
 }
-fit::TrajectoryFitResult FitKinematic(const BodyModel& body, const std::vector<fit::ReferenceFrame>& frames,
-                                      const fit::TrajectoryFitOptions& o) {
-  return fit::FitKinematicTrajectory(body, frames, o);
-}
-fit::TrajectoryFitResult FitKinematic(const BodyModel3& body, const std::vector<fit::ReferenceFrame3>& frames,
-                                      const fit::TrajectoryFitOptions& o) {
-  return fit::FitKinematicTrajectory3(body, frames, o);
-}
-std::vector<std::string> NamesOf(const BodyModel& body) { return fit::CoordinateNames(body); }
-std::vector<std::string> NamesOf(const BodyModel3& body) { return fit::CoordinateNames3(body); }
-void SetWorld(const WorldFlags& flags, fit::DynamicFitOptions* o, const BodyModel&) { o->world = MakeWorldParams(flags); }
-void SetWorld(const WorldFlags& flags, fit::DynamicFitOptions* o, const BodyModel3&) {
-  // the 3D world of the flags, as simulate's (cli_common.h: StartingWorld)
+// The world of the flags for a body of each dimension (3D: as simulate's, cli_common.h:
+// StartingWorld).
+void SetWorld(const WorldFlags& flags, fit::DynamicFitOptionsN<2>* o) { o->world = MakeWorldParams(flags); }
+void SetWorld(const WorldFlags& flags, fit::DynamicFitOptionsN<3>* o) {
   const WorldParams w = MakeWorldParams(flags);
-  o->world3.gravity_on = w.gravity_on;
-  o->world3.gravity = Eigen::Vector3d(w.gravity.x(), w.gravity.y(), 0.0);
-  o->world3.ground = GroundPlaneOf(w.ground);
-  o->world3.max_condition = w.max_condition;
+  o->world.gravity_on = w.gravity_on;
+  o->world.gravity = Eigen::Vector3d(w.gravity.x(), w.gravity.y(), 0.0);
+  o->world.ground = GroundPlaneOf(w.ground);
+  o->world.max_condition = w.max_condition;
 }
 
 template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shared_ptr<const BodyModelN<Dim>>& body) {
@@ -633,7 +630,7 @@ template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shar
   j["body"] = body->name();
   j["dimension"] = Dim;
   j["reference"] = a.reference;
-  j["coordinates"] = NamesOf(*body);
+  j["coordinates"] = fit::CoordinateNames(*body);
   std::ostringstream out;
   fit::FitReport report;
   if (!a.dynamic) {
@@ -641,7 +638,7 @@ template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shar
     o.pose = po;
     o.pose.on_iteration = IterationLine();
     o.smoothness = a.smoothness;
-    const fit::TrajectoryFitResult r = FitKinematic(*body, frames, o);
+    const fit::TrajectoryFitResult r = fit::FitKinematicTrajectory(*body, frames, o);
     EndIterationLine();
     report = r.report;
     j["kind"] = "kinematic";
@@ -658,8 +655,8 @@ template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shar
         << " s.\ncost " << Num(r.report.initial_cost) << " -> " << Num(r.report.final_cost) << ", rms residual "
         << Num(r.rms_residual) << ".";
   } else {
-    fit::DynamicFitOptions o;
-    SetWorld(a.world, &o, *body);
+    fit::DynamicFitOptionsN<Dim> o;
+    SetWorld(a.world, &o);
     RequirePositive(a.dt, "--dt");
     o.dt = a.dt;
     o.max_iterations = po.max_iterations;

@@ -4,7 +4,7 @@
 // the cost per iteration as CSV (--costs), and a short summary on stdout. With a display the
 // pictures go beside them: the cost chart (FILE.png beside --costs) and, for 2D bodies, the
 // fitted points over their targets (FILE_overlay.png beside --out). A 3D object (`dimension 3`)
-// takes 3D target files and the fits of lib/wobble/fit/pose_fit3.h and dynamic_fit.h.
+// takes 3D target files; the fits of lib/wobble/fit are the same functions for both.
 #pragma once
 
 #include <CLI/CLI.hpp>

@@ -10,7 +10,6 @@
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/core/rotation3.h"
 #include "wobble/fit/pose_fit.h"
-#include "wobble/fit/pose_fit3.h"
 #include "wobble/fit/trajectory_fit.h"
 
 namespace wobble {
@@ -257,7 +256,7 @@ BENCHMARK(BM_PoseGraphFit_Annealing)->Arg(24)->Arg(240)->Arg(2400)->ArgName("sim
 
 // ---- 3D bodies (issue 15): the chair of tests/support (3 modes, ~300 mass points, 24-vertex mesh) ----
 
-Eigen::VectorXd KnownQ3() {
+Eigen::VectorXd KnownQChair() {
   Eigen::VectorXd q(9);
   q << 30, -12, 20, 0.9, -0.6, 1.2, 0.3, -0.2, 0.15;
   return q;
@@ -266,32 +265,32 @@ Eigen::VectorXd KnownQ3() {
 // Pose with correspondences: every 10th mass point (~30). Baseline: the 2D table's 11-point fit.
 void BM_PoseFit3_Chair(benchmark::State& state) {
   const BodyModel3 body = testing::Chair3();
-  std::vector<fit::Correspondence3> targets;
+  std::vector<fit::CorrespondenceN<3>> targets;
   for (int k = 0; k < body.num_points(); k += 10) {
-    fit::Correspondence3 t;
+    fit::CorrespondenceN<3> t;
     t.mass_point = k;
-    t.position = fit::PointPosition3(fit::BasisOf3(body, k, {}), KnownQ3());
+    t.position = fit::PointPosition(fit::BasisOf(body, k, {}), KnownQChair());
     targets.push_back(t);
   }
   int iterations = 0;
-  for (auto _ : state) iterations = fit::FitPose3(body, targets, {}).report.iterations;
+  for (auto _ : state) iterations = fit::FitPose(body, targets, {}).report.iterations;
   state.counters["iterations"] = iterations;
   state.counters["points"] = double(targets.size());
 }
 BENCHMARK(BM_PoseFit3_Chair)->Unit(benchmark::kMicrosecond);
 
-// Surface without correspondences: the chair's mesh deformed and placed at KnownQ3 (36
+// Surface without correspondences: the chair's mesh deformed and placed at KnownQChair (36
 // triangles); samples: the body mesh's 24 vertices; 24 axis matchings ranked, 4 solved.
 void BM_SurfaceFit3_Chair(benchmark::State& state) {
   const BodyModel3 body = testing::Chair3();
   SurfaceMesh target_mesh = body.def().mesh;
-  const Eigen::VectorXd q = KnownQ3();
+  const Eigen::VectorXd q = KnownQChair();
   for (size_t v = 0; v < target_mesh.points.size(); ++v)
-    target_mesh.points[v] = fit::PointPosition3({body.mesh_rest_local(int(v)), body.mesh_mode_matrix(int(v))}, q);
-  fit::SurfaceTarget3 target;
+    target_mesh.points[v] = fit::PointPosition(fit::PointBasisN<3>{body.mesh_rest_local(int(v)), body.mesh_mode_matrix(int(v))}, q);
+  fit::SurfaceTarget target;
   target.AddMesh(target_mesh);
   double rms = 0;
-  for (auto _ : state) rms = fit::FitPoseToSurface3(body, target, {}).rms_residual;
+  for (auto _ : state) rms = fit::FitPoseToSurface(body, target, {}).rms_residual;
   state.counters["rms"] = rms;
 }
 BENCHMARK(BM_SurfaceFit3_Chair)->Unit(benchmark::kMillisecond);
@@ -303,24 +302,24 @@ void BM_DynamicFit3_100Steps(benchmark::State& state) {
   std::vector<DeformationMode3> modes = passive.modes();
   for (DeformationMode3& m : modes) m.stiffness = 3e5, m.damping = 2e3;
   const BodyModel3 body(passive.def(), modes);
-  fit::DynamicFitOptions o;
+  fit::DynamicFitOptionsN<3> o;
   o.dt = 0.005;
   fit::DynamicParameters truth;
-  truth.q0 = KnownQ3();
+  truth.q0 = KnownQChair();
   truth.qd0.resize(9);
   truth.qd0 << 20, 40, -10, 1.5, -2, 3, 0, 1, -0.5;
   truth.stiffness = Eigen::VectorXd::Constant(3, 3e5);
   truth.damping = Eigen::VectorXd::Constant(3, 2e3);
-  std::vector<fit::ReferenceFrame3> frames;
+  std::vector<fit::ReferenceFrameN<3>> frames;
   std::vector<int> steps;
   for (int f = 0; f <= 50; ++f) steps.push_back(2 * f);
   fit::SimulateWithParameters(body, o, truth, steps, [&](int f, const Eigen::VectorXd& q) {
-    fit::ReferenceFrame3 frame;
+    fit::ReferenceFrameN<3> frame;
     frame.time = steps[size_t(f)] * o.dt;
     for (int k = 0; k < body.num_points(); k += 10) {
-      fit::Correspondence3 p;
+      fit::CorrespondenceN<3> p;
       p.mass_point = k;
-      p.position = fit::PointPosition3(fit::BasisOf3(body, k, {}), q);
+      p.position = fit::PointPosition(fit::BasisOf(body, k, {}), q);
       frame.points.push_back(p);
     }
     frames.push_back(frame);

@@ -42,7 +42,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       if (!(targets.frames[f].time > targets.frames[f - 1].time)) std::abort();
     const BodyModel3& table = *fuzz::Table3Body();
     formats::CheckMassPointIndices(targets, table.num_points());
-    fit::SurfaceTarget3 surface;
+    fit::SurfaceTarget surface;
     if (!targets.mesh.empty()) surface.AddMesh(targets.mesh);
     for (const Eigen::Vector3d& p : targets.cloud) surface.AddPoint(p);
     for (const auto& t : surface.triangles)
@@ -50,8 +50,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (i < 0 || i >= int(surface.points.size())) std::abort();
     const Eigen::VectorXd q = Eigen::VectorXd::Zero(table.num_q());
     auto basis = [&](const formats::PointTarget3& t) {
-      const fit::PointBasis3 b = fit::BasisOf3(table, t.mass_point, t.lattice_coords);
-      if (!b.b0.allFinite() || !b.B.allFinite() || !fit::PointPosition3(b, q).allFinite()) std::abort();
+      const fit::PointBasisN<3> b = fit::BasisOf(table, t.mass_point, t.lattice_coords);
+      if (!b.b0.allFinite() || !b.B.allFinite() || !fit::PointPosition(b, q).allFinite()) std::abort();
     };
     for (const formats::PointTarget3& t : targets.points) basis(t);
     for (const formats::TargetFrame3& f : targets.frames)

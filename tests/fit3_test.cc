@@ -14,7 +14,8 @@
 #include "wobble/body/body_model.h"
 #include "wobble/core/rotation3.h"
 #include "wobble/fit/dynamic_fit.h"
-#include "wobble/fit/pose_fit3.h"
+#include "wobble/fit/pose_fit.h"
+#include "wobble/fit/trajectory_fit.h"
 #include "support/test_bodies.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
@@ -64,10 +65,10 @@ QError Compare(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return {(a.head<3>() - b.head<3>()).norm(), std::abs(turn.angle()), (a.tail(a.size() - 6) - b.tail(b.size() - 6)).cwiseAbs().maxCoeff()};
 }
 
-std::vector<fit::Correspondence3> MassPointTargets(const Character& c, const Eigen::VectorXd& q) {
-  std::vector<fit::Correspondence3> targets;
+std::vector<fit::CorrespondenceN<3>> MassPointTargets(const Character& c, const Eigen::VectorXd& q) {
+  std::vector<fit::CorrespondenceN<3>> targets;
   for (int k = 0; k < c.body.num_points(); k += 3) {
-    fit::Correspondence3 t;
+    fit::CorrespondenceN<3> t;
     t.mass_point = k;
     t.position = Direct(c, q, c.body.lattice_coords(k));
     targets.push_back(t);
@@ -79,14 +80,14 @@ TEST(PoseFit3, CorrespondencesGiveBackTheQTheyWereMadeWith) {
   const Character c = MakeChair();
   const Eigen::VectorXd truth = Q(Vec3(30, -12, 250), 2.5, Vec3(1, 2, -0.7), Vec3(0.4, -0.3, 0.2));
   // mass points, and lattice points given by (s, t, u)
-  std::vector<fit::Correspondence3> targets = MassPointTargets(c, truth);
+  std::vector<fit::CorrespondenceN<3>> targets = MassPointTargets(c, truth);
   for (const Vec3& u : {Vec3(0.1, 0.9, 0.5), Vec3(0.95, 0.05, 0.3), Vec3(0.5, 0.5, 0.99)}) {
-    fit::Correspondence3 t;
+    fit::CorrespondenceN<3> t;
     t.lattice_coords = u;
     t.position = Direct(c, truth, u);
     targets.push_back(t);
   }
-  const fit::PoseFitResult r = fit::FitPose3(c.body, targets, {});
+  const fit::PoseFitResult r = fit::FitPose(c.body, targets, {});
   EXPECT_TRUE(r.report.usable) << r.report.brief_report;
   const QError e = Compare(r.q, truth);
   EXPECT_LT(e.translation, 1e-7);
@@ -107,7 +108,7 @@ TEST(PoseFit3, FarStartTurnsOnTheGroupToTheAnswer) {
   fit::PoseFitOptions o;
   o.initial_q = Eigen::VectorXd::Zero(9);
   o.initial_q.head<3>() = truth.head<3>();
-  const fit::PoseFitResult r = fit::FitPose3(c.body, MassPointTargets(c, truth), o);
+  const fit::PoseFitResult r = fit::FitPose(c.body, MassPointTargets(c, truth), o);
   const QError e = Compare(r.q, truth);
   EXPECT_LT(e.angle, 1e-8) << r.report.brief_report;
   EXPECT_LT(e.gamma, 1e-8);
@@ -117,13 +118,13 @@ TEST(PoseFit3, FarStartTurnsOnTheGroupToTheAnswer) {
 TEST(PoseFit3, RobustLossShrugsOffOutliers) {
   const Character c = MakeChair();
   const Eigen::VectorXd truth = Q(Vec3(5, 40, -3), 0.8, Vec3(0, 1, 1), Vec3(-0.3, 0.35, 0.1));
-  std::vector<fit::Correspondence3> targets = MassPointTargets(c, truth);
+  std::vector<fit::CorrespondenceN<3>> targets = MassPointTargets(c, truth);
   for (size_t i = 0; i < targets.size(); i += 10) targets[i].position += Vec3(60, -40, 30);  // 10% outliers
   fit::PoseFitOptions squared, cauchy;
   cauchy.loss = fit::Loss::kCauchy;
   cauchy.loss_scale = 1.0;
-  const QError bad = Compare(fit::FitPose3(c.body, targets, squared).q, truth);
-  const QError good = Compare(fit::FitPose3(c.body, targets, cauchy).q, truth);
+  const QError bad = Compare(fit::FitPose(c.body, targets, squared).q, truth);
+  const QError good = Compare(fit::FitPose(c.body, targets, cauchy).q, truth);
   EXPECT_GT(bad.translation, 1.0);  // the outliers drag a least-squares fit
   EXPECT_LT(good.translation, 1e-2);
   EXPECT_LT(good.angle, 1e-4);
@@ -136,26 +137,14 @@ TEST(PoseFit3, BoundsHoldAndAreReported) {
   fit::PoseFitOptions o;
   o.gamma_lower = -0.5;
   o.gamma_upper = 0.5;
-  const fit::PoseFitResult r = fit::FitPose3(c.body, MassPointTargets(c, truth), o);
+  const fit::PoseFitResult r = fit::FitPose(c.body, MassPointTargets(c, truth), o);
   EXPECT_NEAR(r.q[6], 0.5, 1e-12);
   EXPECT_EQ(r.at_bound, std::vector<std::string>{"bend"});
 }
 
-TEST(PoseFit3, BadInputIsRefusedByName) {
+TEST(PoseFit3, SurfaceFitRefusesAnEmptyTarget) {
   const Character c = MakeChair();
-  EXPECT_THROW(fit::FitPose3(c.body, {}, {}), std::invalid_argument);
-  fit::Correspondence3 missing;
-  missing.mass_point = c.body.num_points();
-  EXPECT_THROW(fit::FitPose3(c.body, {missing}, {}), std::invalid_argument);
-  fit::PoseFitOptions o;
-  o.initial_q = Eigen::VectorXd::Zero(6);  // 3 + 3 modes is 9
-  try {
-    fit::FitPose3(c.body, MassPointTargets(c, Eigen::VectorXd::Zero(9)), o);
-    FAIL();
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("the body has 9 coordinates"), std::string::npos) << e.what();
-  }
-  EXPECT_THROW(fit::FitPoseToSurface3(c.body, fit::SurfaceTarget3{}, {}), std::invalid_argument);
+  EXPECT_THROW(fit::FitPoseToSurface(c.body, fit::SurfaceTarget{}, {}), std::invalid_argument);
 }
 
 // The deformed mesh of the character at q, vertex by vertex from the direct formula.
@@ -169,9 +158,9 @@ TEST(PoseFit3, SurfaceWithoutCorrespondencesFindsThePoseAndTheShape) {
   const Character c = MakeChair();
   const Eigen::VectorXd truth = Q(Vec3(-20, 35, 10), 0.6, Vec3(0.2, 1, -0.4), Vec3(0.3, -0.25, 0.15));
   const SurfaceMesh target_mesh = DeformedMesh(c, truth);
-  fit::SurfaceTarget3 target;
+  fit::SurfaceTarget target;
   target.AddMesh(target_mesh);
-  const fit::PoseFitResult r = fit::FitPoseToSurface3(c.body, target, {});  // samples: the mesh's vertices
+  const fit::PoseFitResult r = fit::FitPoseToSurface(c.body, target, {});  // samples: the mesh's vertices
   const QError e = Compare(r.q, truth);
   EXPECT_LT(e.translation, 1e-5) << r.report.brief_report;
   EXPECT_LT(e.angle, 1e-7);
@@ -187,11 +176,11 @@ TEST(PoseFit3, PointCloudWithoutCorrespondences) {
   std::vector<Vec3> cloud;
   for (int k = 0; k < c.body.num_points(); ++k) cloud.push_back(Direct(c, truth, c.body.lattice_coords(k)));
   std::shuffle(cloud.begin(), cloud.end(), std::mt19937(7));
-  fit::SurfaceTarget3 target;
+  fit::SurfaceTarget target;
   for (const Vec3& p : cloud) target.AddPoint(p);
   fit::PoseFitOptions o;
   o.max_mesh_samples = 0;  // the samples are the mass points
-  const fit::PoseFitResult r = fit::FitPoseToSurface3(c.body, target, o);
+  const fit::PoseFitResult r = fit::FitPoseToSurface(c.body, target, o);
   const QError e = Compare(r.q, truth);
   EXPECT_LT(e.translation, 1e-6) << r.report.brief_report;
   EXPECT_LT(e.angle, 1e-8);
@@ -204,14 +193,14 @@ Eigen::VectorXd Motion(double t) {
            Vec3(0.3 * std::sin(3 * t), 0.2 * std::cos(2 * t), 0.1 * t));
 }
 
-std::vector<fit::ReferenceFrame3> Frames(const Character& c, int count, double noise, unsigned seed) {
+std::vector<fit::ReferenceFrameN<3>> Frames(const Character& c, int count, double noise, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> n(0.0, noise);
-  std::vector<fit::ReferenceFrame3> frames;
+  std::vector<fit::ReferenceFrameN<3>> frames;
   for (int f = 0; f < count; ++f) {
-    fit::ReferenceFrame3 frame;
+    fit::ReferenceFrameN<3> frame;
     frame.time = 2.0 * f / (count - 1);
-    for (fit::Correspondence3 p : MassPointTargets(c, Motion(frame.time))) {
+    for (fit::CorrespondenceN<3> p : MassPointTargets(c, Motion(frame.time))) {
       if (noise > 0) p.position += Vec3(n(rng), n(rng), n(rng));
       frame.points.push_back(p);
     }
@@ -224,7 +213,7 @@ TEST(TrajectoryFit3, ExactFramesGiveBackTheMotion) {
   const Character c = MakeChair();
   fit::TrajectoryFitOptions o;
   o.smoothness = 0;
-  const fit::TrajectoryFitResult r = fit::FitKinematicTrajectory3(c.body, Frames(c, 21, 0, 1), o);
+  const fit::TrajectoryFitResult r = fit::FitKinematicTrajectory(c.body, Frames(c, 21, 0, 1), o);
   ASSERT_EQ(r.q.size(), 21u);
   for (size_t f = 0; f < r.q.size(); ++f) {
     const QError e = Compare(r.q[f], Motion(r.times[f]));
@@ -238,16 +227,16 @@ TEST(TrajectoryFit3, ExactFramesGiveBackTheMotion) {
 TEST(TrajectoryFit3, SmoothnessOnTheGroupFiltersNoise) {
   // noisy markers: the smoothed fit lies nearer the true motion than frame-by-frame fits
   const Character c = MakeChair();
-  const std::vector<fit::ReferenceFrame3> frames = Frames(c, 41, 2.0, 5);
+  const std::vector<fit::ReferenceFrameN<3>> frames = Frames(c, 41, 2.0, 5);
   auto error = [&](double smoothness) {
     fit::TrajectoryFitOptions o;
     o.smoothness = smoothness;
-    const fit::TrajectoryFitResult r = fit::FitKinematicTrajectory3(c.body, frames, o);
+    const fit::TrajectoryFitResult r = fit::FitKinematicTrajectory(c.body, frames, o);
     double sum = 0;
     int count = 0;
     for (size_t f = 0; f < r.q.size(); ++f)
       for (int k = 0; k < c.body.num_points(); k += 5, ++count)
-        sum += (fit::PointPosition3(fit::BasisOf3(c.body, k, {}), r.q[f]) -
+        sum += (fit::PointPosition(fit::BasisOf(c.body, k, {}), r.q[f]) -
                 Direct(c, Motion(r.times[f]), c.body.lattice_coords(k))).squaredNorm();
     return std::sqrt(sum / count);
   };
@@ -335,7 +324,7 @@ struct Vibrating {
 };
 
 // Frames of a World run (the world's own mode forces, not the fit's), every `every` steps.
-std::vector<fit::ReferenceFrame3> WorldFrames(const std::shared_ptr<const BodyModel3>& body, const Eigen::VectorXd& q0,
+std::vector<fit::ReferenceFrameN<3>> WorldFrames(const std::shared_ptr<const BodyModel3>& body, const Eigen::VectorXd& q0,
                                               const Eigen::VectorXd& v0, double dt, int steps, int every) {
   WorldOptions o;
   o.dt = dt;
@@ -343,18 +332,18 @@ std::vector<fit::ReferenceFrame3> WorldFrames(const std::shared_ptr<const BodyMo
   World world(o);
   const int b = world.AddBody(body);
   world.SetState(b, PositionsOf(q0.head<3>(), ExpRotation<double>(q0.segment<3>(3)), q0.tail(3)), v0);
-  std::vector<fit::ReferenceFrame3> frames;
+  std::vector<fit::ReferenceFrameN<3>> frames;
   for (int k = 0; k <= steps; ++k) {
     if (k % every == 0) {
       const BodyState<3, double>& s = world.state<3>(b);
       Eigen::VectorXd q(9);
       q << s.translation(), LogRotation<double>(s.orientation()), s.gamma();
-      fit::ReferenceFrame3 f;
+      fit::ReferenceFrameN<3> f;
       f.time = k * dt;
       for (int i = 0; i < body->num_points(); i += 4) {
-        fit::Correspondence3 p;
+        fit::CorrespondenceN<3> p;
         p.mass_point = i;
-        p.position = fit::PointPosition3(fit::BasisOf3(*body, i, {}), q);
+        p.position = fit::PointPosition(fit::BasisOf(*body, i, {}), q);
         f.points.push_back(p);
       }
       frames.push_back(f);
@@ -372,10 +361,10 @@ void ExpectTheVibratingChairRecovered(fit::FitGradient gradient) {
   q0 << 10, 50, -5, 0.3, -0.2, 0.5, 0.2, -0.15, 0.1;
   v0 << 20, 40, -10, 1.5, -2.0, 3.0, 0, 1.0, -0.5;  // body ω of a few rad/s
   const double dt = 0.004;
-  const std::vector<fit::ReferenceFrame3> frames = WorldFrames(v.body, q0, v0, dt, 150, 5);
-  fit::DynamicFitOptions o;
+  const std::vector<fit::ReferenceFrameN<3>> frames = WorldFrames(v.body, q0, v0, dt, 150, 5);
+  fit::DynamicFitOptionsN<3> o;
   o.dt = dt;
-  o.world3.gravity_on = true;
+  o.world.gravity_on = true;
   fit::DynamicParameters start;  // q0 and q̇0 from pose fits of the first two frames
   start.stiffness = v.K * 1.4;
   start.damping = v.c * 0.5;
@@ -411,8 +400,8 @@ TEST(DynamicFit3, CostIsTheWorldsRunAtTheTrueParameters) {
   Eigen::VectorXd q0(9), v0(9);
   q0 << 0, 0, 0, 2.0, 1.0, -0.5, 0.3, 0.2, -0.1;
   v0 << 1, 2, 3, -4, 2, 1, 0.5, 0, 0;
-  const std::vector<fit::ReferenceFrame3> frames = WorldFrames(v.body, q0, v0, 0.005, 200, 10);
-  fit::DynamicFitOptions o;
+  const std::vector<fit::ReferenceFrameN<3>> frames = WorldFrames(v.body, q0, v0, 0.005, 200, 10);
+  fit::DynamicFitOptionsN<3> o;
   o.dt = 0.005;
   fit::DynamicParameters truth{q0, v0, v.K, v.c, {}};
   EXPECT_LT(fit::DynamicCost(*v.body, frames, truth, o), 1e-16);

@@ -1,6 +1,7 @@
 // Pose fits (lib/wobble/fit): synthetic targets made from a known q are recovered; bounds
 // hold; unreachable targets end with an honest residual; a mode the data cannot see is
-// reported as undetermined; target files are parsed strictly.
+// reported as undetermined; target files are parsed strictly; bad input is refused by name
+// by the same code in both dimensions (typed over the dimension).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include "wobble/core/errors.h"
 #include "wobble/core/interrupt.h"
 #include "wobble/fit/pose_fit.h"
+#include "wobble/fit/trajectory_fit.h"
 #include "wobble/formats/parse_error.h"
 #include "wobble/formats/target_file.h"
 
@@ -352,6 +354,82 @@ TEST(TargetFile, RejectsMalformedInputWithFileAndLine) {
   } catch (const formats::ParseError& e) {
     EXPECT_STREQ(e.what(), "t.tgt:3: mass point 11 does not exist: the body has 11 (numbered from 0)");
   }
+}
+
+// ---- both dimensions: one fit, one set of checks (the 2D table, fit3_test's 3D chair) ----
+
+template <class Body> class FitOverDimension : public ::testing::Test {};
+using Bodies = ::testing::Types<BodyModel, BodyModel3>;
+TYPED_TEST_SUITE(FitOverDimension, Bodies);
+
+BodyModel MakeBody(BodyModel*) { return Table(); }
+BodyModel3 MakeBody(BodyModel3*) { return testing::Chair3(); }
+
+// Every third mass point where the rest pose (q = 0) has it.
+template <int Dim> std::vector<fit::CorrespondenceN<Dim>> RestTargets(const BodyModelN<Dim>& body) {
+  std::vector<fit::CorrespondenceN<Dim>> targets;
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(body.num_q());
+  for (int k = 0; k < body.num_points(); k += 3) {
+    fit::CorrespondenceN<Dim> t;
+    t.mass_point = k;
+    t.position = fit::PointPosition(fit::BasisOf(body, k, {}), q);
+    targets.push_back(t);
+  }
+  return targets;
+}
+
+TYPED_TEST(FitOverDimension, BadInputIsRefusedByName) {
+  const TypeParam body = MakeBody(static_cast<TypeParam*>(nullptr));
+  constexpr int Dim = TypeParam::dim();
+  EXPECT_THROW(fit::FitPose(body, {}, {}), std::invalid_argument);
+  fit::CorrespondenceN<Dim> missing;
+  missing.mass_point = body.num_points();
+  EXPECT_THROW(fit::FitPose(body, {missing}, {}), std::invalid_argument);
+  PoseFitOptions o;
+  o.initial_q = Eigen::VectorXd::Zero(body.num_q() - 3);  // too short by 3
+  try {
+    fit::FitPose(body, RestTargets(body), o);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    const std::string expected = "the body has " + std::to_string(body.num_q()) + " coordinates";
+    EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+  }
+  // a weight that is not > 0, in a pose and in a trajectory; a frame without points
+  std::vector<fit::CorrespondenceN<Dim>> weightless = RestTargets(body);
+  weightless[1].weight = 0.0;
+  try {
+    fit::FitPose(body, weightless, {});
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "pose fit: weights must be > 0");
+  }
+  fit::ReferenceFrameN<Dim> a{0.0, RestTargets(body)}, b{0.1, weightless}, empty{0.2, {}};
+  try {
+    fit::FitKinematicTrajectory(body, {a, b}, {});
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "trajectory fit: weights must be > 0");
+  }
+  try {
+    fit::FitKinematicTrajectory(body, {a, empty}, {});
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "trajectory fit: a frame has no points");
+  }
+  // the names of q: the rigid coordinates, then the modes
+  const std::vector<std::string> names = fit::CoordinateNames(body);
+  ASSERT_EQ(int(names.size()), body.num_q());
+  EXPECT_EQ(names[Dim == 2 ? 2 : 5], Dim == 2 ? "theta" : "rz");
+  EXPECT_EQ(names.back(), body.modes().back().name);
+}
+
+// The rest pose's own points are met exactly at q = 0, from the rigid start, in both dimensions.
+TYPED_TEST(FitOverDimension, RestTargetsGiveBackTheRestPose) {
+  const TypeParam body = MakeBody(static_cast<TypeParam*>(nullptr));
+  const PoseFitResult r = fit::FitPose(body, RestTargets(body), {});
+  ASSERT_TRUE(r.report.usable) << r.report.brief_report;
+  EXPECT_LT(r.q.cwiseAbs().maxCoeff(), 1e-7) << r.q.transpose();
+  EXPECT_LT(r.rms_residual, 1e-7);
 }
 
 }  // namespace

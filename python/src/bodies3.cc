@@ -8,7 +8,7 @@
 #include "wobble/body/body_model.h"
 #include "wobble/core/errors.h"
 #include "wobble/core/rotation3.h"
-#include "wobble/fit/pose_fit3.h"
+#include "wobble/fit/pose_fit.h"
 
 namespace wobble::python {
 namespace {
@@ -79,7 +79,7 @@ void BindBodies3(py::module_& m) {
             const int n = Group<3>::kRigidDofs + b.num_modes();
             const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
             std::vector<Eigen::Vector3d> x;
-            for (int k = 0; k < b.num_points(); ++k) x.push_back(fit::PointPosition3(fit::BasisOf3(b, k, {}), q));
+            for (int k = 0; k < b.num_points(); ++k) x.push_back(fit::PointPosition(fit::BasisOf(b, k, {}), q));
             return Rows3(x);
           },
           py::arg("q") = py::none(),

@@ -1,8 +1,8 @@
 // Fits from Python (fit/pose_fit.h, Ceres): mode amplitudes and placement from target points
 // (mass points or lattice points matched to world positions) or from target curves, with the
 // report and the conditioning of the fit (which modes the data cannot see). Every fit takes a
-// 3D body too (fit/pose_fit3.h: points (K, 3), q = [t, r, γ]); 3D surfaces without
-// correspondences go to fit_pose_to_surface.
+// 2D or a 3D body (one C++ template per fit; points (K, 3) and q = [t, r, γ] in 3D); 2D curves
+// without correspondences go to fit_pose_to_curves, 3D surfaces to fit_pose_to_surface.
 #include "support.h"
 
 #include <cmath>
@@ -11,7 +11,6 @@
 #include "wobble/core/errors.h"
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/pose_fit.h"
-#include "wobble/fit/pose_fit3.h"
 #include "wobble/fit/trajectory_fit.h"
 
 namespace wobble::python {
@@ -37,14 +36,10 @@ fit::PoseFitOptions Options(const BodyModelN<Dim>& body, const py::object& initi
   return o;
 }
 
-// The correspondence and frame types of a dimension.
-template <int Dim> using CorrespondenceOf = std::conditional_t<Dim == 2, fit::Correspondence, fit::Correspondence3>;
-template <int Dim> using FrameOf = std::conditional_t<Dim == 2, fit::ReferenceFrame, fit::ReferenceFrame3>;
-
 // Target points: positions (K, Dim), each on a mass point (mass_points, K ints) or at lattice
 // coordinates (lattice_coords, K x Dim); weights > 0.
 template <int Dim>
-std::vector<CorrespondenceOf<Dim>> Targets(const BodyModelN<Dim>& body, const py::object& positions_in,
+std::vector<fit::CorrespondenceN<Dim>> Targets(const BodyModelN<Dim>& body, const py::object& positions_in,
                                            const py::object& mass_points, const py::object& lattice_coords,
                                            const py::object& weights_in) {
   auto probe = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(positions_in);
@@ -54,7 +49,7 @@ std::vector<CorrespondenceOf<Dim>> Targets(const BodyModelN<Dim>& body, const py
   auto positions = AsMatrix(probe, K, Dim, "points");
   if (mass_points.is_none() == lattice_coords.is_none())
     throw InputError("give the body's points as exactly one of mass_points (K,) or lattice_coords (K, " + dim + ")");
-  std::vector<CorrespondenceOf<Dim>> out(K);
+  std::vector<fit::CorrespondenceN<Dim>> out(K);
   std::vector<long> which;
   if (!mass_points.is_none()) which = mass_points.cast<std::vector<long>>();
   py::array_t<double, py::array::c_style> st;
@@ -67,7 +62,7 @@ std::vector<CorrespondenceOf<Dim>> Targets(const BodyModelN<Dim>& body, const py
     weights.assign(w.data(), w.data() + K);
   }
   for (long k = 0; k < K; ++k) {
-    CorrespondenceOf<Dim>& c = out[k];
+    fit::CorrespondenceN<Dim>& c = out[k];
     for (int i = 0; i < Dim; ++i) c.position[i] = positions.at(k, i);
     if (!c.position.allFinite()) throw InputError("points[" + std::to_string(k) + "] is not finite");
     if (!(weights[k] > 0) || !std::isfinite(weights[k]))
@@ -88,7 +83,7 @@ std::vector<CorrespondenceOf<Dim>> Targets(const BodyModelN<Dim>& body, const py
 
 // Reference frames: times (F,), world positions (F, K, Dim) of the mass points mass_points (K,).
 template <int Dim>
-std::vector<FrameOf<Dim>> Frames(const BodyModelN<Dim>& body, const py::object& times_in, const py::object& points_in,
+std::vector<fit::ReferenceFrameN<Dim>> Frames(const BodyModelN<Dim>& body, const py::object& times_in, const py::object& points_in,
                                  const std::vector<long>& mass_points) {
   auto probe = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(times_in);
   if (!probe || probe.ndim() != 1 || probe.shape(0) < 1) throw InputError("times: expected (F,) frame times, F >= 1");
@@ -97,12 +92,12 @@ std::vector<FrameOf<Dim>> Frames(const BodyModelN<Dim>& body, const py::object& 
   if (!points || points.ndim() != 3 || points.shape(0) != F || points.shape(1) != K || points.shape(2) != Dim)
     throw InputError("points: expected shape (" + std::to_string(F) + ", " + std::to_string(K) + ", " + std::to_string(Dim) +
                      "): frames x mass_points x coordinates");
-  std::vector<FrameOf<Dim>> frames(F);
+  std::vector<fit::ReferenceFrameN<Dim>> frames(F);
   for (long f = 0; f < F; ++f) {
     frames[f].time = probe.at(f);
     if (!std::isfinite(frames[f].time)) throw InputError("times[" + std::to_string(f) + "] is not finite");
     for (long k = 0; k < K; ++k) {
-      CorrespondenceOf<Dim> c;
+      fit::CorrespondenceN<Dim> c;
       if (mass_points[k] < 0 || mass_points[k] >= body.num_points())
         throw InputError("mass_points[" + std::to_string(k) + "]: the body has " + std::to_string(body.num_points()) + " mass points");
       c.mass_point = int(mass_points[k]);
@@ -123,13 +118,7 @@ template <int Dim> void BindPoseFit(py::module_& m) {
          double loss_scale, double prior_weight, std::pair<double, double> bounds, int max_iterations) {
         const auto targets = Targets(*body, points, mass_points, lattice_coords, weights);
         const auto o = Options(*body, initial_q, loss, loss_scale, prior_weight, bounds, max_iterations);
-        return WithCtrlC([&] {
-          if constexpr (Dim == 2) {
-            return fit::FitPose(*body, targets, o);
-          } else {
-            return fit::FitPose3(*body, targets, o);
-          }
-        });
+        return WithCtrlC([&] { return fit::FitPose(*body, targets, o); });
       },
       py::arg("body"), py::arg("points"), py::kw_only(), py::arg("mass_points") = py::none(),
       py::arg("lattice_coords") = py::none(), py::arg("weights") = py::none(), py::arg("initial_q") = py::none(),
@@ -139,7 +128,7 @@ template <int Dim> void BindPoseFit(py::module_& m) {
                  "point mass_points[k], or the lattice point lattice_coords[k] = (s, t). Like `wobble fit pose`.\n"
                  "loss: squared, huber or cauchy (robust, scale loss_scale); prior_weight pulls γ to 0."
                : "A 3D body: points (K, 3), lattice_coords (s, t, u), q = [tx, ty, tz, rx, ry, rz, γ...] with r\n"
-                 "the rotation vector (fit/pose_fit3.h: Kabsch start, the turn solved on SO(3)).");
+                 "the rotation vector (fit/pose_fit.h: Kabsch start, the turn solved on SO(3)).");
 }
 
 template <int Dim> void BindTrajectoryFit(py::module_& m) {
@@ -153,13 +142,7 @@ template <int Dim> void BindTrajectoryFit(py::module_& m) {
         fit::TrajectoryFitOptions o;
         o.pose = Options(*body, py::none(), loss, loss_scale, prior_weight, bounds, max_iterations);
         o.smoothness = smoothness;
-        return WithCtrlC([&] {
-          if constexpr (Dim == 2) {
-            return fit::FitKinematicTrajectory(*body, frames, o);
-          } else {
-            return fit::FitKinematicTrajectory3(*body, frames, o);
-          }
-        });
+        return WithCtrlC([&] { return fit::FitKinematicTrajectory(*body, frames, o); });
       },
       py::arg("body"), py::arg("times"), py::arg("points"), py::arg("mass_points"), py::kw_only(),
       py::arg("smoothness") = 1.0, py::arg("loss") = "squared", py::arg("loss_scale") = 1.0,
@@ -168,6 +151,10 @@ template <int Dim> void BindTrajectoryFit(py::module_& m) {
                  "in one problem with ½ w Σ |L Δ²q|² (w = smoothness) tying neighbours. Like `wobble fit trajectory`."
                : "A 3D body: points (F, K, 3); q rows [t, r, γ], the orientation's smoothness on SO(3).");
 }
+
+// The world of a body of each dimension, as World steps it.
+WorldParams FitWorld(const WorldOptions& w, std::integral_constant<int, 2>) { return w.params; }
+WorldParamsN<3> FitWorld(const WorldOptions& w, std::integral_constant<int, 3>) { return Params3Of(w); }
 
 template <int Dim> void BindDynamicFit(py::module_& m) {
   m.def(
@@ -186,9 +173,8 @@ template <int Dim> void BindDynamicFit(py::module_& m) {
         if (!graph.is_none()) start.graph = graph.cast<control::PoseGraph>();
         if (world.integrator != Integrator::kThesis)
           throw InputError("fit_dynamic simulates with the thesis integrator (options.integrator = 'thesis')");
-        fit::DynamicFitOptions o;
-        o.world = world.params;
-        o.world3 = Params3Of(world);  // a 3D body's world, as World steps it
+        fit::DynamicFitOptionsN<Dim> o;
+        o.world = FitWorld(world, std::integral_constant<int, Dim>{});
         o.dt = world.dt;
         o.fit_q0 = fit_q0;
         o.fit_qd0 = fit_qd0;
@@ -311,7 +297,7 @@ void BindFit(py::module_& m) {
       [](std::shared_ptr<BodyModel3> body, const py::object& vertices, const py::object& triangles,
          const py::object& cloud, const py::object& initial_q, const std::string& loss, double loss_scale,
          double prior_weight, std::pair<double, double> bounds, int max_iterations, int mesh_samples, bool two_sided) {
-        fit::SurfaceTarget3 target;
+        fit::SurfaceTarget target;
         if (vertices.is_none() != triangles.is_none()) throw InputError("give vertices (V, 3) and triangles (T, 3) together");
         if (!vertices.is_none()) {
           const Eigen::MatrixXd v = vertices.cast<Eigen::MatrixXd>();
@@ -334,7 +320,7 @@ void BindFit(py::module_& m) {
         fit::PoseFitOptions o = Options(*body, initial_q, loss, loss_scale, prior_weight, bounds, max_iterations);
         o.max_mesh_samples = mesh_samples;
         o.two_sided = two_sided;
-        return WithCtrlC([&] { return fit::FitPoseToSurface3(*body, target, o); });
+        return WithCtrlC([&] { return fit::FitPoseToSurface(*body, target, o); });
       },
       py::arg("body"), py::kw_only(), py::arg("vertices") = py::none(), py::arg("triangles") = py::none(),
       py::arg("cloud") = py::none(), py::arg("initial_q") = py::none(), py::arg("loss") = "squared",

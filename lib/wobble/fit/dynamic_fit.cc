@@ -12,7 +12,6 @@
 #include "wobble/fit/internal/solve_common.h"
 #include "wobble/synth/anneal.h"
 #include "wobble/core/rotation3.h"
-#include "wobble/fit/pose_fit3.h"
 #include "wobble/fit/trajectory_fit.h"
 
 namespace wobble::fit {
@@ -28,7 +27,7 @@ constexpr int kStride = 32;
 // Residuals sqrt(w)(x_i(q_f) − target) of every frame, from the raw blocks.
 template <int Dim> struct DynamicResidual {
   const BodyModelN<Dim>* passive;
-  const DynamicFitOptions* options;
+  const DynamicFitOptionsN<Dim>* options;
   Eigen::Quaterniond chart;
   int num_poses, pose_size;  // the controller's blocks follow q0, q̇0, log K, ζ when num_poses > 0
   bool cyclic;
@@ -72,11 +71,13 @@ template <int Dim> struct DynamicResidual {
   }
 };
 
-template <class Frame> std::vector<int> FrameStepsOf(const std::vector<Frame>& frames, double dt) {
+}  // namespace
+
+template <int Dim> std::vector<int> FrameSteps(const std::vector<ReferenceFrameN<Dim>>& frames, double dt) {
   if (!(dt > 0)) throw std::invalid_argument("dynamic fit: dt must be positive");
   if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
   std::vector<int> steps;
-  for (const Frame& f : frames) {
+  for (const ReferenceFrameN<Dim>& f : frames) {
     const double n = (f.time - frames[0].time) / dt;
     const double rounded = std::round(n);
     if (std::abs(n - rounded) > 1e-6 * std::max(1.0, n))
@@ -88,15 +89,18 @@ template <class Frame> std::vector<int> FrameStepsOf(const std::vector<Frame>& f
 }
 
 template <int Dim>
-bool SimulateWith(const BodyModelN<Dim>& body, const DynamicFitOptions& o, const DynamicParameters& p,
-                  const std::vector<int>& frame_steps, const std::function<void(int, const Eigen::VectorXd&)>& on_frame) {
+bool SimulateWithParameters(const BodyModelN<Dim>& body, const DynamicFitOptionsN<Dim>& o, const DynamicParameters& p,
+                            const std::vector<int>& frame_steps,
+                            const std::function<void(int, const Eigen::VectorXd&)>& on_frame) {
   return SimulatePlain(body, o, p, frame_steps,
                        [&](int f, const auto& state) { on_frame(f, Dimension<Dim>::Q(state)); });
 }
 
+namespace {
+
 template <int Dim>
-DynamicFitResult FitDynamic(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
-                            const DynamicParameters& initial, const DynamicFitOptions& o) {
+DynamicFitResult FitDynamic(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
+                            const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o) {
   if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
@@ -164,46 +168,23 @@ DynamicFitResult FitDynamic(const BodyModelN<Dim>& body, const std::vector<typen
 
 }  // namespace
 
-std::vector<int> FrameSteps(const std::vector<ReferenceFrame>& frames, double dt) { return FrameStepsOf(frames, dt); }
-std::vector<int> FrameSteps(const std::vector<ReferenceFrame3>& frames, double dt) { return FrameStepsOf(frames, dt); }
-
-bool SimulateWithParameters(const BodyModel& body, const DynamicFitOptions& o, const DynamicParameters& p,
-                            const std::vector<int>& frame_steps,
-                            const std::function<void(int, const Eigen::VectorXd&)>& on_frame) {
-  return SimulateWith(body, o, p, frame_steps, on_frame);
-}
-bool SimulateWithParameters(const BodyModel3& body, const DynamicFitOptions& o, const DynamicParameters& p,
-                            const std::vector<int>& frame_steps,
-                            const std::function<void(int, const Eigen::VectorXd&)>& on_frame) {
-  return SimulateWith(body, o, p, frame_steps, on_frame);
-}
-
-double DynamicCost(const BodyModel& body, const std::vector<ReferenceFrame>& frames, const DynamicParameters& p,
-                   const DynamicFitOptions& o) {
+template <int Dim>
+double DynamicCost(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames, const DynamicParameters& p,
+                   const DynamicFitOptionsN<Dim>& o) {
   return CostOf(body, frames, p, o);
 }
-double DynamicCost(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames, const DynamicParameters& p,
-                   const DynamicFitOptions& o) {
-  return CostOf(body, frames, p, o);
-}
-
-DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
-                                      const DynamicParameters& initial, const DynamicFitOptions& o) {
-  if (o.gradient == FitGradient::kAdjoint) return FitDynamicByAdjoint(body, frames, initial, o);
-  return FitDynamic(body, frames, initial, o);
-}
-DynamicFitResult FitDynamicTrajectory(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
-                                      const DynamicParameters& initial, const DynamicFitOptions& o) {
-  if (o.gradient == FitGradient::kAdjoint) return FitDynamicByAdjoint(body, frames, initial, o);
-  return FitDynamic(body, frames, initial, o);
-}
-
-namespace {
 
 template <int Dim>
-AnnealingResult AnnealGraph(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
-                            const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
-                            std::uint64_t seed) {
+DynamicFitResult FitDynamicTrajectory(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
+                                      const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o) {
+  if (o.gradient == FitGradient::kAdjoint) return FitDynamicByAdjoint(body, frames, initial, o);
+  return FitDynamic(body, frames, initial, o);
+}
+
+template <int Dim>
+AnnealingResult AnnealPoseGraph(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
+                                const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o, long budget,
+                                std::uint64_t seed) {
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
   if (start.graph.empty()) throw std::invalid_argument("anneal: needs a pose graph to start from");
@@ -241,15 +222,16 @@ AnnealingResult AnnealGraph(const BodyModelN<Dim>& body, const std::vector<typen
 }
 
 template <int Dim>
-AnnealingResult AnnealDynamic(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
-                              const DynamicParameters& initial, const DynamicFitOptions& o, long budget, unsigned seed) {
+AnnealingResult AnnealDynamicTrajectory(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
+                                        const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o, long budget,
+                                        unsigned seed) {
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
   const VecD<double> G = ModeMasses(body);
   const int nq = body.num_q(), D = body.num_modes();
   const double duration = std::max(o.dt, frames.back().time - frames.front().time);
   // step sizes that move the points by about one length unit (SmoothnessScales)
-  const auto L = Dimension<Dim>::Scales(body);
+  const auto L = SmoothnessScales(body);
   struct Coordinate {
     double* value;
     double step;
@@ -308,28 +290,28 @@ AnnealingResult AnnealDynamic(const BodyModelN<Dim>& body, const std::vector<typ
   return best;
 }
 
-}  // namespace
-
-AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
-                                const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
-                                std::uint64_t seed) {
-  return AnnealGraph(body, frames, initial, o, budget, seed);
-}
-AnnealingResult AnnealPoseGraph(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
-                                const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
-                                std::uint64_t seed) {
-  return AnnealGraph(body, frames, initial, o, budget, seed);
-}
-AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
-                                        const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
-                                        unsigned seed) {
-  return AnnealDynamic(body, frames, initial, o, budget, seed);
-}
-AnnealingResult AnnealDynamicTrajectory(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
-                                        const DynamicParameters& initial, const DynamicFitOptions& o, long budget,
-                                        unsigned seed) {
-  return AnnealDynamic(body, frames, initial, o, budget, seed);
-}
+template std::vector<int> FrameSteps(const std::vector<ReferenceFrameN<2>>&, double);
+template bool SimulateWithParameters(const BodyModelN<2>&, const DynamicFitOptionsN<2>&, const DynamicParameters&,
+                                     const std::vector<int>&, const std::function<void(int, const Eigen::VectorXd&)>&);
+template DynamicFitResult FitDynamicTrajectory(const BodyModelN<2>&, const std::vector<ReferenceFrameN<2>>&,
+                                               const DynamicParameters&, const DynamicFitOptionsN<2>&);
+template AnnealingResult AnnealPoseGraph(const BodyModelN<2>&, const std::vector<ReferenceFrameN<2>>&,
+                                         const DynamicParameters&, const DynamicFitOptionsN<2>&, long, std::uint64_t);
+template AnnealingResult AnnealDynamicTrajectory(const BodyModelN<2>&, const std::vector<ReferenceFrameN<2>>&,
+                                                 const DynamicParameters&, const DynamicFitOptionsN<2>&, long, unsigned);
+template double DynamicCost(const BodyModelN<2>&, const std::vector<ReferenceFrameN<2>>&, const DynamicParameters&,
+                            const DynamicFitOptionsN<2>&);
+template std::vector<int> FrameSteps(const std::vector<ReferenceFrameN<3>>&, double);
+template bool SimulateWithParameters(const BodyModelN<3>&, const DynamicFitOptionsN<3>&, const DynamicParameters&,
+                                     const std::vector<int>&, const std::function<void(int, const Eigen::VectorXd&)>&);
+template DynamicFitResult FitDynamicTrajectory(const BodyModelN<3>&, const std::vector<ReferenceFrameN<3>>&,
+                                               const DynamicParameters&, const DynamicFitOptionsN<3>&);
+template AnnealingResult AnnealPoseGraph(const BodyModelN<3>&, const std::vector<ReferenceFrameN<3>>&,
+                                         const DynamicParameters&, const DynamicFitOptionsN<3>&, long, std::uint64_t);
+template AnnealingResult AnnealDynamicTrajectory(const BodyModelN<3>&, const std::vector<ReferenceFrameN<3>>&,
+                                                 const DynamicParameters&, const DynamicFitOptionsN<3>&, long, unsigned);
+template double DynamicCost(const BodyModelN<3>&, const std::vector<ReferenceFrameN<3>>&, const DynamicParameters&,
+                            const DynamicFitOptionsN<3>&);
 
 }  // namespace wobble::fit
 

@@ -10,14 +10,14 @@
 // forces switched off; the mode and PD forces −2K(γ − γ0(t)) − c γ̇, whose K, c and γ0 are Jets,
 // enter as StepBody's extra generalized force.
 //
-// 3D bodies (issue 15) take the same fits through StepBody3 (every function has a BodyModel3
-// overload): q0 = [t, r, γ] with r a rotation vector and q̇0 = [ṫ, body ω, γ̇], as the 3D CLI;
-// the solver holds q0's orientation as chart · exp(δ̂) (pose_fit3.h), the world is
-// DynamicFitOptions::world3.
+// Every function takes a 2D or a 3D body (one template over the dimension): in 3D q0 = [t, r, γ]
+// with r a rotation vector and q̇0 = [ṫ, body ω, γ̇], as the 3D CLI; the solver holds q0's
+// orientation as chart · exp(δ̂) (as the pose fits, pose_fit.h), the world is
+// DynamicFitOptionsN<3>::world.
 //
 // Transition times are made differentiable by a smoothed pose switch: the targets are
 //     γ0(t) = P_0 + Σ_k (P_{k mod n} − P_{(k−1) mod n}) σ((t − S_k)/w),  S_k = τ_0 + … + τ_{k−1},
-// σ the logistic function and w the switch width (DynamicFitOptions::switch_width). A hard switch
+// σ the logistic function and w the switch width (DynamicFitOptionsN::switch_width). A hard switch
 // (the pose graph of lib/wobble/control) has a cost that is piecewise constant in the times
 // between steps, with zero gradient almost everywhere; the smoothed one is a controller in its
 // own right (a PD servo whose set point moves in about 4w) and tends to the hard one as w → 0.
@@ -31,9 +31,7 @@
 
 #include "wobble/control/control.h"
 #include "wobble/dynamics/step.h"
-#include "wobble/dynamics/step.h"
 #include "wobble/fit/pose_fit.h"
-#include "wobble/fit/pose_fit3.h"
 
 namespace wobble::fit {
 
@@ -54,9 +52,8 @@ struct DynamicParameters {
 //             logistic map. 2D and 3D bodies (3D: fit/adjoint3.h, q0's δ through J_r).
 enum class FitGradient { kJets, kAdjoint };
 
-struct DynamicFitOptions {
-  WorldParams world;    // gravity, ground, springs
-  WorldParamsN<3> world3;  // the same for a 3D body
+template <int Dim> struct DynamicFitOptionsN {
+  WorldParamsN<Dim> world;  // gravity, ground, springs (of the body's dimension)
   double dt = 0.01;   // thesis integrator (Eq. 4.22/4.23), as `wobble simulate --integrator thesis`
   bool fit_q0 = true, fit_qd0 = true, fit_stiffness = true, fit_damping = true;
   bool fit_poses = false, fit_times = false;  // the controller's (needs a non-empty graph)
@@ -67,6 +64,7 @@ struct DynamicFitOptions {
   bool full_report = false;
   std::function<void(int iteration, double cost)> on_iteration;  // progress display
 };
+using DynamicFitOptions = DynamicFitOptionsN<2>;
 
 struct DynamicFitResult {
   DynamicParameters params;
@@ -77,16 +75,13 @@ struct DynamicFitResult {
 
 // The reference's frame times as step counts from its first frame; throws
 // std::invalid_argument when a time is not a whole number of steps of dt.
-std::vector<int> FrameSteps(const std::vector<ReferenceFrame>& frames, double dt);
-std::vector<int> FrameSteps(const std::vector<ReferenceFrame3>& frames, double dt);
+template <int Dim> std::vector<int> FrameSteps(const std::vector<ReferenceFrameN<Dim>>& frames, double dt);
 
 // Runs the simulation with `p` (the body's own K and c are replaced by p's) and calls
-// on_frame(f, q) at every frame step. Returns false on numerical trouble (singular M,
-// non-finite state).
-bool SimulateWithParameters(const BodyModel& body, const DynamicFitOptions& options, const DynamicParameters& p,
-                            const std::vector<int>& frame_steps,
-                            const std::function<void(int, const Eigen::VectorXd&)>& on_frame);
-bool SimulateWithParameters(const BodyModel3& body, const DynamicFitOptions& options, const DynamicParameters& p,
+// on_frame(f, q) at every frame step (q as the fits' q). Returns false on numerical trouble
+// (singular M, non-finite state).
+template <int Dim>
+bool SimulateWithParameters(const BodyModelN<Dim>& body, const DynamicFitOptionsN<Dim>& options, const DynamicParameters& p,
                             const std::vector<int>& frame_steps,
                             const std::function<void(int, const Eigen::VectorXd&)>& on_frame);
 
@@ -94,10 +89,9 @@ bool SimulateWithParameters(const BodyModel3& body, const DynamicFitOptions& opt
 // pose fits of the first two frames. Stiffness starts must be > 0 (it is fitted as log K);
 // damping is fitted as the ratio ζ_d = c_d / (2 sqrt(2 K_d G_dd)) (G_dd the mode's
 // generalized mass), bounded below by 0.
-DynamicFitResult FitDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
-                                      const DynamicParameters& initial, const DynamicFitOptions& options);
-DynamicFitResult FitDynamicTrajectory(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
-                                      const DynamicParameters& initial, const DynamicFitOptions& options);
+template <int Dim>
+DynamicFitResult FitDynamicTrajectory(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
+                                      const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& options);
 
 // Baseline: simulated annealing on the same parameters and the same cost (½ Σ |x − target|²),
 // given a budget of simulations. Returns the best parameters and cost found.
@@ -109,23 +103,20 @@ struct AnnealingResult {
 // Simulated annealing of the controller (lib/wobble/synth, Fig. 5.2) on the same cost: the
 // poses and/or times (options.fit_poses/fit_times) of initial.graph, the rest of `initial`
 // fixed, with `simulation_budget` simulations (batch 1). The best graph is in result.params.
-AnnealingResult AnnealPoseGraph(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
-                                const DynamicParameters& initial, const DynamicFitOptions& options,
+template <int Dim>
+AnnealingResult AnnealPoseGraph(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
+                                const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& options,
                                 long simulation_budget, std::uint64_t seed = 1);
-AnnealingResult AnnealPoseGraph(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
-                                const DynamicParameters& initial, const DynamicFitOptions& options,
-                                long simulation_budget, std::uint64_t seed = 1);
-AnnealingResult AnnealDynamicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
-                                        const DynamicParameters& initial, const DynamicFitOptions& options,
-                                        long simulation_budget, unsigned seed = 1);
-AnnealingResult AnnealDynamicTrajectory(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
-                                        const DynamicParameters& initial, const DynamicFitOptions& options,
+template <int Dim>
+AnnealingResult AnnealDynamicTrajectory(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
+                                        const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& options,
                                         long simulation_budget, unsigned seed = 1);
 
 // ½ Σ w |x − target|² of a parameter set (one plain simulation); +inf on numerical trouble.
-double DynamicCost(const BodyModel& body, const std::vector<ReferenceFrame>& frames, const DynamicParameters& p,
-                   const DynamicFitOptions& options);
-double DynamicCost(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames, const DynamicParameters& p,
-                   const DynamicFitOptions& options);
+template <int Dim>
+double DynamicCost(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
+                   const DynamicParameters& p, const DynamicFitOptionsN<Dim>& options);
+
+// (Each is instantiated for Dim = 2 and 3 in dynamic_fit.cc.)
 
 }  // namespace wobble::fit

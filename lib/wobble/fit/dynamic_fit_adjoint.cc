@@ -106,7 +106,7 @@ template <int Dim> class FitRollout;
 
 template <> class FitRollout<2> {
  public:
-  FitRollout(const Reference<2>& ref, const DynamicFitOptions& o) {
+  FitRollout(const Reference<2>& ref, const DynamicFitOptionsN<2>& o) {
     cost_.ref = &ref;
     cost_.frames_at = FramesAt(ref.steps);
     rollout_.world = o.world;
@@ -141,10 +141,10 @@ template <> class FitRollout<2> {
 
 template <> class FitRollout<3> {
  public:
-  FitRollout(const Reference<3>& ref, const DynamicFitOptions& o) {
+  FitRollout(const Reference<3>& ref, const DynamicFitOptionsN<3>& o) {
     cost_.ref = &ref;
     cost_.frames_at = FramesAt(ref.steps);
-    rollout_.world = o.world3;
+    rollout_.world = o.world;
     rollout_.integrator = Integrator::kThesis;
     rollout_.dt = o.dt;
   }
@@ -193,11 +193,11 @@ template <> class FitRollout<3> {
 template <int Dim> class AdjointDynamicCost final : public ceres::FirstOrderFunction {
  public:
   AdjointDynamicCost(const BodyModelN<Dim>& body, const Reference<Dim>& ref, const Blocks<Dim>& start,
-                     const VecD<double>& G, const DynamicFitOptions& o, long* simulations)
+                     const VecD<double>& G, const DynamicFitOptionsN<Dim>& o, long* simulations)
       : body_(body), ref_(ref), start_(start), G_(G), o_(o), simulations_(simulations), rollout_(ref, o) {
     log_lo_ = std::log(o.min_time);
     log_hi_ = std::log(o.max_time);
-    const auto L = Dimension<Dim>::Scales(body);
+    const auto L = SmoothnessScales(body);
     const double duration = ref.steps.back() * o.dt;
     const std::vector<int> active = control::ActiveModes(body);
     const int nq = body.num_q(), D = body.num_modes();
@@ -301,7 +301,7 @@ template <int Dim> class AdjointDynamicCost final : public ceres::FirstOrderFunc
   const Reference<Dim>& ref_;
   const Blocks<Dim> start_;
   const VecD<double> G_;
-  const DynamicFitOptions& o_;
+  const DynamicFitOptionsN<Dim>& o_;
   long* simulations_;
   double log_lo_ = 0, log_hi_ = 0;
   std::vector<double> scale_;  // of each x
@@ -311,8 +311,8 @@ template <int Dim> class AdjointDynamicCost final : public ceres::FirstOrderFunc
 }  // namespace
 
 template <int Dim>
-DynamicFitResult FitByAdjoint(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
-                              const DynamicParameters& initial, const DynamicFitOptions& o) {
+DynamicFitResult FitDynamicByAdjoint(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
+                              const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o) {
   if (frames.empty()) throw std::invalid_argument("dynamic fit: no frames");
   const DynamicParameters start = Completed(body, frames, initial);
   CheckParameters(body, start);
@@ -341,7 +341,7 @@ DynamicFitResult FitByAdjoint(const BodyModelN<Dim>& body, const std::vector<typ
   int iterations = 0;
   double seconds = 0.0;
   for (size_t m : horizons) {
-    const std::vector<typename Dimension<Dim>::Frame> part(frames.begin(), frames.begin() + std::ptrdiff_t(m));
+    const std::vector<ReferenceFrameN<Dim>> part(frames.begin(), frames.begin() + std::ptrdiff_t(m));
     const Reference<Dim> part_ref = MakeReference(body, part, o.dt);
     if (part_ref.steps.back() < 1) continue;  // frames at one time: nothing to simulate yet
     auto* cost = new AdjointDynamicCost<Dim>(body, part_ref, Blocks<Dim>::From(current, G), G, o, &result.simulations);
@@ -378,13 +378,9 @@ DynamicFitResult FitByAdjoint(const BodyModelN<Dim>& body, const std::vector<typ
   return result;
 }
 
-DynamicFitResult FitDynamicByAdjoint(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
-                                     const DynamicParameters& initial, const DynamicFitOptions& o) {
-  return FitByAdjoint(body, frames, initial, o);
-}
-DynamicFitResult FitDynamicByAdjoint(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
-                                     const DynamicParameters& initial, const DynamicFitOptions& o) {
-  return FitByAdjoint(body, frames, initial, o);
-}
+template DynamicFitResult FitDynamicByAdjoint(const BodyModelN<2>&, const std::vector<ReferenceFrameN<2>>&,
+                                              const DynamicParameters&, const DynamicFitOptionsN<2>&);
+template DynamicFitResult FitDynamicByAdjoint(const BodyModelN<3>&, const std::vector<ReferenceFrameN<3>>&,
+                                              const DynamicParameters&, const DynamicFitOptionsN<3>&);
 
 }  // namespace wobble::fit::internal

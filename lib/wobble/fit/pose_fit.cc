@@ -11,6 +11,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include "wobble/core/rotation3.h"
+#include "wobble/fit/internal/pose_chart.h"
 #include "wobble/fit/internal/solve_common.h"
 
 namespace wobble::fit {
@@ -54,33 +56,87 @@ std::string ValidateOptions(const PoseFitOptions& o, int num_modes, int num_rigi
   return "";
 }
 
-std::vector<std::string> CoordinateNames(const BodyModel& body) {
-  std::vector<std::string> names = {"tx", "ty", "theta"};
-  for (const DeformationMode& m : body.modes()) names.push_back(m.name);
+template <int Dim> std::vector<std::string> CoordinateNames(const BodyModelN<Dim>& body) {
+  std::vector<std::string> names = FitPoseQ<Dim>::RigidNames();
+  for (const DeformationModeN<Dim>& m : body.modes()) names.push_back(m.name);
   return names;
 }
+template std::vector<std::string> CoordinateNames(const BodyModelN<2>&);
+template std::vector<std::string> CoordinateNames(const BodyModelN<3>&);
 
-// Weighted Procrustes: the rotation and translation that best carry the rest positions b0_i
-// onto the targets y_i (least squares), with γ = 0.
-Eigen::VectorXd RigidStart(const BodyModel& body, const std::vector<Eigen::Vector2d>& rest,
-                           const std::vector<Eigen::Vector2d>& target, const std::vector<double>& w) {
-  Eigen::Vector2d ps = Eigen::Vector2d::Zero(), ys = Eigen::Vector2d::Zero();
-  double wsum = 0;
-  for (size_t i = 0; i < rest.size(); ++i) {
-    ps += w[i] * rest[i];
-    ys += w[i] * target[i];
-    wsum += w[i];
+namespace {
+
+// The weighted centroids of the rest positions and of their targets, and the cross-covariance
+// H = Σ w (p − p̄)(y − ȳ)ᵀ the best rotation is found from (Procrustes, Kabsch).
+template <int Dim> struct CrossCovariance {
+  using Vec = Eigen::Matrix<double, Dim, 1>;
+  Vec ps = Vec::Zero(), ys = Vec::Zero();
+  Eigen::Matrix<double, Dim, Dim> H = Eigen::Matrix<double, Dim, Dim>::Zero();
+  CrossCovariance(const std::vector<Vec>& rest, const std::vector<Vec>& target, const std::vector<double>& w) {
+    double wsum = 0;
+    for (size_t i = 0; i < rest.size(); ++i) {
+      ps += w[i] * rest[i];
+      ys += w[i] * target[i];
+      wsum += w[i];
+    }
+    ps /= wsum;
+    ys /= wsum;
+    for (size_t i = 0; i < rest.size(); ++i) H += w[i] * (rest[i] - ps) * (target[i] - ys).transpose();
   }
-  ps /= wsum;
-  ys /= wsum;
-  Eigen::Matrix2d H = Eigen::Matrix2d::Zero();
-  for (size_t i = 0; i < rest.size(); ++i) H += w[i] * (rest[i] - ps) * (target[i] - ys).transpose();
+};
+
+}  // namespace
+
+Eigen::VectorXd PoseChart<2>::RigidStart(int num_modes, const std::vector<Vec>& rest, const std::vector<Vec>& target,
+                                         const std::vector<double>& w) {
+  const CrossCovariance<2> c(rest, target, w);
   // maximise Σ w yᵀ R p: θ = atan2(H01 − H10, H00 + H11) (0 when the points are all one point)
-  const double theta = std::atan2(H(0, 1) - H(1, 0), H(0, 0) + H(1, 1));
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(body.num_q());
-  const Eigen::Vector2d t = ys - Rotation(theta) * ps;
-  q << t.x(), t.y(), theta, Eigen::VectorXd::Zero(body.num_modes());
+  const double theta = std::atan2(c.H(0, 1) - c.H(1, 0), c.H(0, 0) + c.H(1, 1));
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(FitPoseQ<2>::kRigid + num_modes);
+  const Eigen::Vector2d t = c.ys - Rotation(theta) * c.ps;
+  q << t.x(), t.y(), theta, Eigen::VectorXd::Zero(num_modes);
   return q;
+}
+
+Eigen::VectorXd PoseChart<3>::RigidStart(int num_modes, const std::vector<Vec>& rest, const std::vector<Vec>& target,
+                                         const std::vector<double>& w) {
+  const CrossCovariance<3> c(rest, target, w);
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(c.H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
+  S(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;  // no reflection
+  const Eigen::Matrix3d R = svd.matrixV() * S * svd.matrixU().transpose();
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(FitPoseQ<3>::kRigid + num_modes);
+  q.head<3>() = c.ys - R * c.ps;
+  q.segment<3>(3) = LogRotation<double>(Eigen::Quaterniond(R));
+  return q;
+}
+
+void AddPriorAndBounds(const PoseFitOptions& o, int num_rigid, int num_modes, double* x, ceres::Problem* problem) {
+  const int n = num_rigid + num_modes;
+  if (o.prior_weight > 0 && num_modes > 0) {
+    RestPrior prior;
+    prior.sqrt_weight = std::sqrt(o.prior_weight);
+    prior.num_rigid = num_rigid;
+    prior.num_q = n;
+    problem->AddResidualBlock(MakeRestPriorCost(prior), nullptr, x);
+  }
+  if (!problem->HasParameterBlock(x)) problem->AddParameterBlock(x, n);
+  for (int d = 0; d < num_modes; ++d) {
+    problem->SetParameterLowerBound(x, num_rigid + d, ModeLower(o, d));
+    problem->SetParameterUpperBound(x, num_rigid + d, ModeUpper(o, d));
+  }
+}
+
+void AppendReport(const FitReport& next, bool first, FitReport* report) {
+  const std::vector<double> before = report->cost_per_iteration;
+  const int iterations = report->iterations;
+  const double initial = first ? next.initial_cost : report->initial_cost;
+  const double seconds = report->solve_seconds;
+  *report = next;
+  report->initial_cost = initial;
+  report->cost_per_iteration.insert(report->cost_per_iteration.begin(), before.begin(), before.end());
+  report->iterations += iterations;
+  report->solve_seconds += seconds;
 }
 
 namespace {
@@ -97,34 +153,47 @@ void FillResiduals(const std::vector<SegmentResidual>& data, const Eigen::Vector
   r->rms_residual = data.empty() ? 0.0 : std::sqrt(sum / double(data.size()));
 }
 
-
 }  // namespace
 
-PoseFitResult FitPose(const BodyModel& body, const std::vector<Correspondence>& targets, const PoseFitOptions& o) {
-  const std::string error = ValidateOptions(o, body.num_modes());
-  if (!error.empty()) throw std::invalid_argument("pose fit: " + error);
+template <int Dim>
+PoseFitResult FitPose(const BodyModelN<Dim>& body, const std::vector<CorrespondenceN<Dim>>& targets,
+                      const PoseFitOptions& o) {
+  CheckOptions(body, o, "pose fit");
   if (targets.empty()) throw std::invalid_argument("pose fit: no target points");
-  std::vector<SegmentResidual> data;
-  std::vector<Eigen::Vector2d> rest, goal;
+  std::vector<PointResidual<Dim>> data;
+  std::vector<typename PoseChart<Dim>::Vec> rest, goal;
   std::vector<double> weights;
-  for (const Correspondence& t : targets) {
-    const SegmentResidual r = SegmentResidual::ToPoint(body, t, "pose fit");
-    data.push_back(r);
-    rest.push_back(r.point.b0);
+  for (const CorrespondenceN<Dim>& t : targets) {
+    data.push_back(ToPoint(body, t, "pose fit"));
+    rest.push_back(data.back().point.b0);
     goal.push_back(t.position);
     weights.push_back(t.weight);
   }
+  const int D = body.num_modes(), n = body.num_q();
+  auto add_terms = [&](PoseChart<Dim>& chart, ceres::Problem* problem) {
+    // one loss object shared by every data term (Ceres deletes it once)
+    ceres::LossFunction* loss = MakeLoss(o.loss, o.loss_scale);
+    for (PointResidual<Dim> r : data) {
+      r.centre = chart.centre;
+      problem->AddResidualBlock(PoseChart<Dim>::Cost(r, n), loss, chart.x.data());
+    }
+  };
   PoseFitResult result;
-  result.q = o.initial_q.size() ? o.initial_q : RigidStart(body, rest, goal, weights);
-  // the start must lie inside the bounds
-  for (int d = 0; d < body.num_modes(); ++d)
-    result.q[kRigidDofs + d] = std::clamp(result.q[kRigidDofs + d], ModeLower(o, d), ModeUpper(o, d));
-  SolvePose(body, data, {}, o, &result.q, &result.report);
-  FillResiduals(data, result.q, &result);
+  result.q = o.initial_q.size() ? o.initial_q : PoseChart<Dim>::RigidStart(D, rest, goal, weights);
+  SolvePoseInChart<Dim>(D, o, add_terms, &result.q, &result.report);
+  double sum = 0;
+  for (const PointResidual<Dim>& d : data) {
+    const double dist = (PointPosition(d.point, result.q) - d.y).norm();
+    result.point_residuals.push_back(dist);
+    sum += dist * dist;
+  }
+  result.rms_residual = std::sqrt(sum / double(data.size()));
   FillAtBound(body, o, &result);
-  if (o.analyze_conditioning) result.conditioning = ComputeConditioning(body, data, {}, o, result.q);
+  if (o.analyze_conditioning) result.conditioning = ConditioningAt(body, add_terms, result.q);
   return result;
 }
+template PoseFitResult FitPose(const BodyModelN<2>&, const std::vector<CorrespondenceN<2>>&, const PoseFitOptions&);
+template PoseFitResult FitPose(const BodyModelN<3>&, const std::vector<CorrespondenceN<3>>&, const PoseFitOptions&);
 
 CurveSamples CurveSamples::Of(const BodyModel& body, const PoseFitOptions& o) {
   CurveSamples s;

@@ -1,14 +1,21 @@
-// Pose fits: q = [tx, ty, θ, γ1..γD] (Eq. 4.4) so that the body matches a target shape.
+// Pose fits: q so that the body matches a target shape, for 2D and 3D bodies alike (q as in
+// targets.h: [tx, ty, θ, γ] in 2D (Eq. 4.4), [t, r, γ] in 3D with r the rotation vector).
 //
-//   FitPose         with correspondences: body points (mass points or lattice points, e.g. of
-//                   the drawing) and where each should be.
-//   FitPoseToCurve  without correspondences: the target is a set of polylines and/or an
-//                   unordered point cloud; the residual of each body sample is its distance
-//                   to the nearest target segment (ICP-like, see the function).
+//   FitPose           with correspondences: body points (mass points or lattice points, e.g. of
+//                     the drawing) and where each should be. Either dimension.
+//   FitPoseToCurve    2D, without correspondences: the target is a set of polylines and/or an
+//                     unordered point cloud; the residual of each body sample is its distance
+//                     to the nearest target segment (ICP-like, see the function).
+//   FitPoseToSurface  3D, without correspondences: the target is a triangle mesh and/or an
+//                     unordered point cloud (e.g. a scan); every body sample is pulled to the
+//                     nearest target triangle or point.
 //
-// Both minimise Σ ρ(w_i |x_i(q) − target_i|²) + w_prior |γ|² with Ceres (automatic
+// All minimise Σ ρ(w_i |x_i(q) − target_i|²) + w_prior |γ|² with Ceres (automatic
 // derivatives through the templated kinematics), γ_d bounded to [lower_d, upper_d]. The
-// result says how well the targets determine q: see Conditioning.
+// result says how well the targets determine q: see Conditioning. A 3D orientation is solved
+// on SO(3) (R = R0 exp(δ̂) about the start, re-centred when δ grows past a radian), so there
+// is no Euler-angle singularity; the conditioning's rotation coordinates are then body-frame
+// turns rx ry rz (radians).
 #pragma once
 
 #include <Eigen/Core>
@@ -58,7 +65,7 @@ struct PoseFitOptions {
   // start) instead of alternating closest-point rounds and solves.
   bool joint_closest_points = true;
   // 3D surface fits: at most this many of the body mesh's vertices are the body samples
-  // (0: the mass points are; see SurfaceSamples3). use_mass_points is for 2D curve fits.
+  // (0: the mass points are; see SurfaceSamples). use_mass_points is for 2D curve fits.
   int max_mesh_samples = 400;
   // Compute PoseFitResult::conditioning (an SVD of the data Jacobian at the solution).
   bool analyze_conditioning = true;
@@ -113,15 +120,21 @@ struct PoseFitResult {
   int rounds = 0;  // curve fits: closest-point rounds of the best start
 };
 
-// The names of q's coordinates: tx, ty, theta, then the mode names.
-std::vector<std::string> CoordinateNames(const BodyModel& body);
+// The names of q's coordinates: tx, ty, theta (2D) or tx ty tz, rx ry rz (3D), then the mode
+// names.
+template <int Dim> std::vector<std::string> CoordinateNames(const BodyModelN<Dim>& body);
+extern template std::vector<std::string> CoordinateNames(const BodyModelN<2>&);
+extern template std::vector<std::string> CoordinateNames(const BodyModelN<3>&);
 
 // Fits q to point correspondences. Without options.initial_q the start is the best rigid
-// placement of the rest shape onto the targets (weighted Procrustes), γ = 0.
-// Throws std::invalid_argument for invalid options, no targets or a mass point index the body
-// does not have.
-PoseFitResult FitPose(const BodyModel& body, const std::vector<Correspondence>& targets,
+// placement of the rest shape onto the targets (weighted Procrustes in 2D, Kabsch in 3D: SVD,
+// no reflection), γ = 0. Throws std::invalid_argument for invalid options, no targets, a
+// weight that is not > 0 or a mass point index the body does not have.
+template <int Dim>
+PoseFitResult FitPose(const BodyModelN<Dim>& body, const std::vector<CorrespondenceN<Dim>>& targets,
                       const PoseFitOptions& options);
+extern template PoseFitResult FitPose(const BodyModelN<2>&, const std::vector<CorrespondenceN<2>>&, const PoseFitOptions&);
+extern template PoseFitResult FitPose(const BodyModelN<3>&, const std::vector<CorrespondenceN<3>>&, const PoseFitOptions&);
 
 // Body samples of a curve fit: the mass points (if options.use_mass_points) and
 // options.samples_per_segment + 1 points along every segment of the drawing; `segments`
@@ -146,5 +159,24 @@ struct CurveSamples {
 // of the axis are tried (four quarter turns when either shape is nearly isotropic) and the
 // lowest final cost wins; γ = 0. point_residuals are those of the body samples.
 PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, const PoseFitOptions& options);
+
+// Body samples of a 3D surface fit: up to options.max_mesh_samples of the body mesh's vertices,
+// evenly spread over its vertex list; the mass points when there are none (no mesh, or
+// max_mesh_samples = 0). Not both: mass points sampled in the volume lie inside the skin,
+// and pulling them onto the target's surface would squeeze the body.
+std::vector<PointBasisN<3>> SurfaceSamples(const BodyModel3& body, const PoseFitOptions& options);
+
+// Fits a 3D body to a surface target without correspondences: the residual of every body
+// sample is its distance to the nearest target triangle or cloud point, chosen anew at every
+// evaluation (the distance is continuous in q; inside a face it moves the point along the
+// normal, as point-to-plane ICP). Two-sided (options.two_sided): up to
+// options.max_reverse_points target points (evenly spread) are also pulled to the nearest body
+// sample, weighted so that both directions weigh the same.
+// Starts (without options.initial_q): the samples' centroid onto the target's (area-weighted)
+// centroid with the principal axes aligned (area-weighted on meshes, on both sides), in any
+// order and with any signs (24 rotations); the four that fit best before solving are solved,
+// best first, until one meets the target exactly (cost down by 1e12); the lowest cost wins.
+// point_residuals are those of the body samples.
+PoseFitResult FitPoseToSurface(const BodyModel3& body, const SurfaceTarget& target, const PoseFitOptions& options);
 
 }  // namespace wobble::fit

@@ -1,7 +1,5 @@
 #include "wobble/fit/targets.h"
 
-#include "wobble/core/rotation3.h"
-
 namespace wobble::fit {
 
 void CurveTarget::AddPolyline(const std::vector<Eigen::Vector2d>& points, bool closed) {
@@ -19,8 +17,20 @@ void CurveTarget::AddPoint(const Eigen::Vector2d& p) {
   vertices.push_back(p);
 }
 
-PointBasis BasisOf(const BodyModel& body, int mass_point, const Eigen::Vector2d& lattice_coords) {
-  PointBasis p;
+void SurfaceTarget::AddMesh(const SurfaceMesh& mesh) {
+  const int first = int(points.size());
+  points.insert(points.end(), mesh.points.begin(), mesh.points.end());
+  for (const std::array<int, 3>& t : mesh.triangles) triangles.push_back({first + t[0], first + t[1], first + t[2]});
+}
+
+void SurfaceTarget::AddPoint(const Eigen::Vector3d& p) {
+  cloud.push_back(int(points.size()));
+  points.push_back(p);
+}
+
+template <int Dim>
+PointBasisN<Dim> BasisOf(const BodyModelN<Dim>& body, int mass_point, const Eigen::Matrix<double, Dim, 1>& lattice_coords) {
+  PointBasisN<Dim> p;
   if (mass_point >= 0) {
     p.b0 = body.rest_local(mass_point);
     p.B = body.mode_matrix(mass_point);
@@ -30,33 +40,7 @@ PointBasis BasisOf(const BodyModel& body, int mass_point, const Eigen::Vector2d&
   return p;
 }
 
-void SurfaceTarget3::AddMesh(const SurfaceMesh& mesh) {
-  const int first = int(points.size());
-  points.insert(points.end(), mesh.points.begin(), mesh.points.end());
-  for (const std::array<int, 3>& t : mesh.triangles) triangles.push_back({first + t[0], first + t[1], first + t[2]});
-}
-
-void SurfaceTarget3::AddPoint(const Eigen::Vector3d& p) {
-  cloud.push_back(int(points.size()));
-  points.push_back(p);
-}
-
-PointBasis3 BasisOf3(const BodyModel3& body, int mass_point, const Eigen::Vector3d& lattice_coords) {
-  PointBasis3 p;
-  if (mass_point >= 0) {
-    p.b0 = body.rest_local(mass_point);
-    p.B = body.mode_matrix(mass_point);
-  } else {
-    BodyModel3::ModeMatrix B;
-    body.LocalBasis(lattice_coords, &p.b0, &B);
-    p.B = B;
-  }
-  return p;
-}
-
-Eigen::Vector3d PointPosition3(const PointBasis3& p, const Eigen::VectorXd& q) {
-  const Eigen::Vector3d local = p.b0 + p.B * q.tail(q.size() - Group<3>::kRigidDofs);
-  return q.head<3>() + ExpRotation<double>(q.segment<3>(3)) * local;
-}
+template PointBasisN<2> BasisOf(const BodyModelN<2>&, int, const Eigen::Vector2d&);
+template PointBasisN<3> BasisOf(const BodyModelN<3>&, int, const Eigen::Vector3d&);
 
 }  // namespace wobble::fit

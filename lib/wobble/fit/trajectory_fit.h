@@ -1,7 +1,10 @@
 // Kinematic trajectory fit: reference positions of some body points over frames (a recorded
 // simulation, keyframes, motion drawn by hand) → q(t) for every frame, as ONE sparse Ceres
 // problem: the pose residuals of every frame plus a temporal smoothness term coupling each
-// frame to its neighbours (the divided second difference of q, see SecondDifference).
+// frame to its neighbours (the divided second difference of q). 2D and 3D bodies alike (q as
+// in targets.h); a 3D orientation's smoothness is the second difference on the group,
+// c2 log(R_fᵀ R_f+1) − c0 log(R_f−1ᵀ R_f) (body-frame turns), solved in charts about the
+// frames' orientations as the pose fits do (pose_fit.h).
 #pragma once
 
 #include <vector>
@@ -25,21 +28,38 @@ struct TrajectoryFitResult {
   std::string linear_solver;       // what Ceres used
 };
 
-// Length scales L that weigh the coordinates in the smoothness term: 1 for tx, ty; the rms
-// distance of the mass points from their centroid for θ; the rms displacement of the mass
-// points under a unit amplitude for each γ_d (1 when a mode moves no mass point).
-VecQ<double> SmoothnessScales(const BodyModel& body);
+// Length scales L that weigh the coordinates in the smoothness term: 1 for the translation;
+// the rms distance of the mass points from their centroid for every rotation coordinate; the
+// rms displacement of the mass points under a unit amplitude for each γ_d (1 when a mode moves
+// no mass point).
+template <int Dim> VecQ<double> SmoothnessScales(const BodyModelN<Dim>& body);
+extern template VecQ<double> SmoothnessScales(const BodyModelN<2>&);
+extern template VecQ<double> SmoothnessScales(const BodyModelN<3>&);
 
 // Fits q(t). Frames need not be evenly spaced. Without options.pose.initial_q each frame
-// starts from its rigid Procrustes placement (angles unwrapped across frames), γ = 0.
-// Throws std::invalid_argument for invalid options, no frames or unknown mass points.
-TrajectoryFitResult FitKinematicTrajectory(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
+// starts from its rigid placement (FitPose's; 2D angles unwrapped across frames), γ = 0.
+// Throws std::invalid_argument for invalid options, no frames, a frame without points,
+// weights that are not > 0 or unknown mass points.
+template <int Dim>
+TrajectoryFitResult FitKinematicTrajectory(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
                                            const TrajectoryFitOptions& options);
+extern template TrajectoryFitResult FitKinematicTrajectory(const BodyModelN<2>&, const std::vector<ReferenceFrameN<2>>&,
+                                                           const TrajectoryFitOptions&);
+extern template TrajectoryFitResult FitKinematicTrajectory(const BodyModelN<3>&, const std::vector<ReferenceFrameN<3>>&,
+                                                           const TrajectoryFitOptions&);
 
-// Reference frames from recorded states (a simulation, e.g. `wobble simulate`'s CSV): the
-// positions of the listed mass points (all when empty) at every `every`-th state, weight 1.
-std::vector<ReferenceFrame> FramesFromStates(const BodyModel& body, const std::vector<double>& times,
-                                             const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
-                                             int every = 1);
+// Reference frames from recorded states (a simulation, e.g. `wobble simulate`'s CSV; q rows as
+// the fits' q): the positions of the listed mass points (all when empty) at every `every`-th
+// state, weight 1.
+template <int Dim>
+std::vector<ReferenceFrameN<Dim>> FramesFromStates(const BodyModelN<Dim>& body, const std::vector<double>& times,
+                                                   const std::vector<Eigen::VectorXd>& q, const std::vector<int>& points,
+                                                   int every = 1);
+extern template std::vector<ReferenceFrameN<2>> FramesFromStates(const BodyModelN<2>&, const std::vector<double>&,
+                                                                 const std::vector<Eigen::VectorXd>&,
+                                                                 const std::vector<int>&, int);
+extern template std::vector<ReferenceFrameN<3>> FramesFromStates(const BodyModelN<3>&, const std::vector<double>&,
+                                                                 const std::vector<Eigen::VectorXd>&,
+                                                                 const std::vector<int>&, int);
 
 }  // namespace wobble::fit

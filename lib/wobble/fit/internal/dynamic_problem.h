@@ -13,25 +13,20 @@
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/fit/internal/mode_force.h"
 #include "wobble/fit/internal/residuals.h"
-#include "wobble/fit/pose_fit3.h"
+#include "wobble/fit/pose_fit.h"
 #include "wobble/fit/trajectory_fit.h"
 
 namespace wobble::fit::internal {
 
-// What differs between the dimensions: the state, its step, where a body point is, and how
-// q0 is held as a parameter block. In 3D the block is [t, δ, γ] with the orientation
-// chart · exp(δ̂) (pose_fit3.h), so the solver never meets a rotation-vector singularity.
+// What differs between the dimensions: the state, its step, where a body point is in a state,
+// the fits' q of a state, and how q0 is held as a parameter block. In 3D the block is [t, δ, γ] with the
+// orientation chart · exp(δ̂) (as the pose fits, pose_fit.h), so the solver never meets a
+// rotation-vector singularity.
 template <int Dim> struct Dimension;
 
 template <> struct Dimension<2> {
   using Body = BodyModel;
-  using Frame = ReferenceFrame;
-  using Target = Correspondence;
-  using Basis = PointBasis;
-  using Vec = Eigen::Vector2d;
   template <class T> using State = BodyState<2, T>;
-  static const WorldParams& World(const DynamicFitOptions& o) { return o.world; }
-  static Basis BasisOf(const Body& body, const Target& t) { return SegmentResidual::ToPoint(body, t, "dynamic fit").point; }
   template <class T> static State<T> Start(const Body& body, const WorldParams& w, const T* q0, const T* qd0,
                                            const Eigen::Quaterniond&) {
     State<T> s;
@@ -47,7 +42,7 @@ template <> struct Dimension<2> {
       if (!std::isfinite(ScalarValue(s->q[i])) || !std::isfinite(ScalarValue(s->qd[i]))) return false;
     return true;
   }
-  template <class T> static Vec2<T> Position(const Basis& p, const State<T>& s) {
+  template <class T> static Vec2<T> Position(const PointBasisN<2>& p, const State<T>& s) {
     return PointPosition(p, s.q.data(), int(s.q.size()));
   }
   static Eigen::VectorXd Q(const State<double>& s) { return s.q; }
@@ -55,27 +50,13 @@ template <> struct Dimension<2> {
   static Eigen::Quaterniond Chart(const Eigen::VectorXd&) { return Eigen::Quaterniond::Identity(); }
   static Eigen::VectorXd ToBlock(const Eigen::VectorXd& q, const Eigen::Quaterniond&) { return q; }
   static Eigen::VectorXd FromBlock(const Eigen::VectorXd& b, const Eigen::Quaterniond&) { return b; }
-  // a pose fit of one frame, and the velocity between two poses h apart
-  static Eigen::VectorXd FitFrame(const Body& body, const Frame& f, const PoseFitOptions& o) {
-    return FitPose(body, f.points, o).q;
-  }
+  // the velocity between two poses h apart
   static Eigen::VectorXd Velocity(const Eigen::VectorXd& a, const Eigen::VectorXd& b, double h) { return (b - a) / h; }
-  static VecQ<double> Scales(const Body& body) { return SmoothnessScales(body); }
 };
 
 template <> struct Dimension<3> {
   using Body = BodyModel3;
-  using Frame = ReferenceFrame3;
-  using Target = Correspondence3;
-  using Basis = PointBasis3;
-  using Vec = Eigen::Vector3d;
   template <class T> using State = BodyState<3, T>;
-  static const WorldParamsN<3>& World(const DynamicFitOptions& o) { return o.world3; }
-  static Basis BasisOf(const Body& body, const Target& t) {
-    if (t.mass_point >= body.num_points())
-      throw std::invalid_argument("dynamic fit: mass point " + std::to_string(t.mass_point) + " does not exist");
-    return BasisOf3(body, t.mass_point, t.lattice_coords);
-  }
   template <class T> static State<T> Start(const Body& body, const WorldParamsN<3>& w, const T* q0, const T* qd0,
                                            const Eigen::Quaterniond& chart) {
     const int D = body.num_modes();
@@ -92,7 +73,7 @@ template <> struct Dimension<3> {
                                                    const Extra& extra) {
     return StepBody(body, w, 0, Integrator::kThesis, dt, s, extra).ok();  // non-finite states fail inside
   }
-  template <class T> static Vec3<T> Position(const Basis& p, const State<T>& s) {
+  template <class T> static Vec3<T> Position(const PointBasisN<3>& p, const State<T>& s) {
     Vec3<T> l = p.b0.cast<T>();
     for (int d = 0; d < s.gamma().size(); ++d) l += p.B.col(d).cast<T>() * s.gamma()[d];
     return s.translation() + s.orientation().toRotationMatrix() * l;
@@ -113,9 +94,6 @@ template <> struct Dimension<3> {
     q.segment<3>(3) = LogRotation<double>(Eigen::Quaterniond(chart * ExpRotation<double>(b.segment<3>(3))));
     return q;
   }
-  static Eigen::VectorXd FitFrame(const Body& body, const Frame& f, const PoseFitOptions& o) {
-    return FitPose3(body, f.points, o).q;
-  }
   // v = [ṫ, body ω, γ̇] with ω = log(R_aᵀ R_b)/h
   static Eigen::VectorXd Velocity(const Eigen::VectorXd& a, const Eigen::VectorXd& b, double h) {
     Eigen::VectorXd v = (b - a) / h;
@@ -123,18 +101,17 @@ template <> struct Dimension<3> {
                                                              ExpRotation<double>(b.segment<3>(3)))) / h;
     return v;
   }
-  static VecQ<double> Scales(const Body& body) { return SmoothnessScales3(body); }
 };
 
 // The thesis integrator (Eq. 4.22/4.23), exactly as World runs it: the body's step with the mode
 // forces from `p` and the controller's targets at the start of every step (as the World's pose
 // graph sets them). Calls on_frame(f, state) at every frame step.
 template <int Dim, class T, class F>
-bool Simulate(const BodyModelN<Dim>& passive, const DynamicFitOptions& o, const T* q0, const T* qd0,
+bool Simulate(const BodyModelN<Dim>& passive, const DynamicFitOptionsN<Dim>& o, const T* q0, const T* qd0,
               const Eigen::Quaterniond& chart, const ModeParams<T>& p, const control::PoseGraphOf<T>& control,
               const std::vector<int>& steps, F&& on_frame) {
   using Dims = Dimension<Dim>;
-  const auto& w = Dims::World(o);
+  const auto& w = o.world;
   typename Dims::template State<T> s = Dims::template Start<T>(passive, w, q0, qd0, chart);
   VecD<T> target = VecD<T>::Zero(passive.num_modes());
   int step = 0;
@@ -204,7 +181,7 @@ template <int Dim> struct Blocks {
 // The reference: body points (bases) and their targets, per frame.
 template <int Dim> struct Reference {
   struct Point {
-    typename Dimension<Dim>::Basis basis;
+    PointBasisN<Dim> basis;
     Eigen::Matrix<double, Dim, 1> target;
     double sqrt_weight = 1.0;
   };
@@ -213,7 +190,7 @@ template <int Dim> struct Reference {
   int num_residuals = 0;
 };
 template <int Dim>
-Reference<Dim> MakeReference(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
+Reference<Dim> MakeReference(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
                              double dt) {
   Reference<Dim> r;
   r.steps = FrameSteps(frames, dt);
@@ -221,7 +198,9 @@ Reference<Dim> MakeReference(const BodyModelN<Dim>& body, const std::vector<type
     std::vector<typename Reference<Dim>::Point> pts;
     for (const auto& t : f.points) {
       if (!(t.weight > 0) || !std::isfinite(t.weight)) throw std::invalid_argument("dynamic fit: weights must be > 0");
-      pts.push_back({Dimension<Dim>::BasisOf(body, t), t.position, std::sqrt(t.weight)});
+      if (t.mass_point >= body.num_points())
+        throw std::invalid_argument("dynamic fit: mass point " + std::to_string(t.mass_point) + " does not exist");
+      pts.push_back({BasisOf(body, t.mass_point, t.lattice_coords), t.position, std::sqrt(t.weight)});
       r.num_residuals += Dim;
     }
     r.points.push_back(pts);
@@ -251,7 +230,7 @@ template <int Dim> void CheckParameters(const BodyModelN<Dim>& body, const Dynam
 
 // Fills an empty q0 / q̇0 from pose fits of the first two frames.
 template <int Dim>
-DynamicParameters Completed(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
+DynamicParameters Completed(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
                             DynamicParameters p) {
   using Dims = Dimension<Dim>;
   if (p.stiffness.size() == 0 && p.damping.size() == 0) body.ModeGains(&p.stiffness, &p.damping);
@@ -260,14 +239,14 @@ DynamicParameters Completed(const BodyModelN<Dim>& body, const std::vector<typen
   o.gamma_lower = -10;
   o.gamma_upper = 10;
   o.analyze_conditioning = false;
-  const Eigen::VectorXd a = Dims::FitFrame(body, frames[0], o);
+  const Eigen::VectorXd a = FitPose(body, frames[0].points, o).q;
   if (!p.q0.size()) p.q0 = a;
   if (!p.qd0.size()) {
     if (frames.size() < 2) {
       p.qd0 = Eigen::VectorXd::Zero(body.num_q());
     } else {
       o.initial_q = a;
-      const Eigen::VectorXd b = Dims::FitFrame(body, frames[1], o);
+      const Eigen::VectorXd b = FitPose(body, frames[1].points, o).q;
       p.qd0 = Dims::Velocity(a, b, frames[1].time - frames[0].time);
     }
   }
@@ -276,7 +255,7 @@ DynamicParameters Completed(const BodyModelN<Dim>& body, const std::vector<typen
 
 // The plain simulation with parameters p: on_frame(f, state) at every frame step.
 template <int Dim, class F>
-bool SimulatePlain(const BodyModelN<Dim>& body, const DynamicFitOptions& o, const DynamicParameters& p,
+bool SimulatePlain(const BodyModelN<Dim>& body, const DynamicFitOptionsN<Dim>& o, const DynamicParameters& p,
                    const std::vector<int>& frame_steps, F&& on_frame) {
   using Dims = Dimension<Dim>;
   CheckParameters(body, p);
@@ -291,8 +270,8 @@ bool SimulatePlain(const BodyModelN<Dim>& body, const DynamicFitOptions& o, cons
 }
 
 template <int Dim>
-double CostOf(const BodyModelN<Dim>& body, const std::vector<typename Dimension<Dim>::Frame>& frames,
-              const DynamicParameters& p, const DynamicFitOptions& o) {
+double CostOf(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
+              const DynamicParameters& p, const DynamicFitOptionsN<Dim>& o) {
   using Dims = Dimension<Dim>;
   const Reference<Dim> ref = MakeReference(body, frames, o.dt);
   double cost = 0;
@@ -304,11 +283,10 @@ double CostOf(const BodyModelN<Dim>& body, const std::vector<typename Dimension<
 }
 
 
-// The fit with the adjoint gradient and Ceres' line search (DynamicFitOptions::gradient ==
+// The fit with the adjoint gradient and Ceres' line search (DynamicFitOptionsN::gradient ==
 // kAdjoint): dynamic_fit_adjoint.cc.
-DynamicFitResult FitDynamicByAdjoint(const BodyModel& body, const std::vector<ReferenceFrame>& frames,
-                                     const DynamicParameters& initial, const DynamicFitOptions& o);
-DynamicFitResult FitDynamicByAdjoint(const BodyModel3& body, const std::vector<ReferenceFrame3>& frames,
-                                     const DynamicParameters& initial, const DynamicFitOptions& o);
+template <int Dim>
+DynamicFitResult FitDynamicByAdjoint(const BodyModelN<Dim>& body, const std::vector<ReferenceFrameN<Dim>>& frames,
+                                     const DynamicParameters& initial, const DynamicFitOptionsN<Dim>& o);
 
 }  // namespace wobble::fit::internal

@@ -58,15 +58,15 @@ namespace {
 class RestPriorCost : public ceres::CostFunction {
  public:
   explicit RestPriorCost(const RestPrior& r) : r_(r) {
-    set_num_residuals(r.num_q - kRigidDofs);
+    set_num_residuals(r.num_q - r.num_rigid);
     mutable_parameter_block_sizes()->push_back(r.num_q);
   }
   bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
-    const int n = r_.num_q, D = n - kRigidDofs;
-    for (int d = 0; d < D; ++d) residuals[d] = r_.sqrt_weight * p[0][kRigidDofs + d];
+    const int n = r_.num_q, rigid = r_.num_rigid, D = n - rigid;
+    for (int d = 0; d < D; ++d) residuals[d] = r_.sqrt_weight * p[0][rigid + d];
     if (jacobians && jacobians[0]) {
       std::fill(jacobians[0], jacobians[0] + D * n, 0.0);
-      for (int d = 0; d < D; ++d) jacobians[0][d * n + kRigidDofs + d] = r_.sqrt_weight;
+      for (int d = 0; d < D; ++d) jacobians[0][d * n + rigid + d] = r_.sqrt_weight;
     }
     return true;
   }
@@ -102,20 +102,9 @@ class SecondDifferenceCost : public ceres::CostFunction {
 }  // namespace
 
 ceres::CostFunction* MakeRestPriorCost(const RestPrior& r) {
-  return r.num_q > kRigidDofs ? new RestPriorCost(r) : nullptr;
+  return r.num_q > r.num_rigid ? new RestPriorCost(r) : nullptr;
 }
 
 ceres::CostFunction* MakeSecondDifferenceCost(const SecondDifference& r) { return new SecondDifferenceCost(r); }
-
-SegmentResidual SegmentResidual::ToPoint(const BodyModel& body, const Correspondence& target, const char* fit) {
-  if (target.mass_point >= body.num_points())
-    throw std::invalid_argument(std::string(fit) + ": mass point " + std::to_string(target.mass_point) + " does not exist");
-  SegmentResidual s;
-  s.point = BasisOf(body, target.mass_point, target.lattice_coords);
-  s.a = s.b = target.position;
-  s.sqrt_weight = std::sqrt(target.weight);
-  s.num_q = body.num_q();
-  return s;
-}
 
 }  // namespace wobble::fit

@@ -1,4 +1,5 @@
-// Ceres cost functors shared by the pose and trajectory fits, and the helper that turns a
+// Ceres cost functors of the 2D curve fits and the linear terms of every pose and trajectory
+// fit (internal/pose_chart.h has the ones written once over the dimension), and the helper that turns a
 // run-time number of coordinates into Ceres' compile-time block sizes.
 //
 // Every functor follows Ceres' pattern (examples/snavely_reprojection_error.h): it stores its
@@ -39,9 +40,6 @@ struct SegmentResidual {
   Eigen::Vector2d a, b;
   double sqrt_weight = 1.0;
   int num_q = kRigidDofs;
-  // A point target (a = b): the body point of `target` pulled to its position. Throws
-  // std::invalid_argument naming `fit` when the mass point does not exist.
-  static SegmentResidual ToPoint(const BodyModel& body, const Correspondence& target, const char* fit);
   template <class T> bool operator()(const T* q, T* r) const {
     const Vec2<T> x = PointPosition(point, q, num_q);
     const Vec2<T> e = (x - ClosestOnSegment(x, a, b)) * T(sqrt_weight);
@@ -150,10 +148,12 @@ struct NearestBodySegmentResidual {
   }
 };
 
-// Prior toward rest: sqrt(w) γ_d for every mode d (one residual per mode). Linear, so its
-// Jacobian is written out (an autodiff instance per size would only cost compile time).
+// Prior toward rest: sqrt(w) γ_d for every mode d (one residual per mode), γ_d = q[num_rigid + d]
+// (2D and 3D). Linear, so its Jacobian is written out (an autodiff instance per size would only
+// cost compile time).
 struct RestPrior {
   double sqrt_weight = 0.0;
+  int num_rigid = kRigidDofs;
   int num_q = kRigidDofs;
 };
 

@@ -17,11 +17,6 @@ namespace wobble::fit {
 inline double ModeLower(const PoseFitOptions& o, int d) { return o.mode_lower.empty() ? o.gamma_lower : o.mode_lower[d]; }
 inline double ModeUpper(const PoseFitOptions& o, int d) { return o.mode_upper.empty() ? o.gamma_upper : o.mode_upper[d]; }
 
-// Weighted Procrustes: q (γ = 0) whose rigid motion best carries the rest positions onto the
-// targets in the least-squares sense.
-Eigen::VectorXd RigidStart(const BodyModel& body, const std::vector<Eigen::Vector2d>& rest,
-                           const std::vector<Eigen::Vector2d>& target, const std::vector<double>& weights);
-
 // Fills r->at_bound: the modes whose fitted amplitude r->q[rigid + d] (rigid: 3 in 2D, 6 in 3D)
 // ended on one of its bounds.
 template <int Dim> void FillAtBound(const BodyModelN<Dim>& body, const PoseFitOptions& o, PoseFitResult* r) {
@@ -37,8 +32,8 @@ template <int Dim> void FillAtBound(const BodyModelN<Dim>& body, const PoseFitOp
 // A new loss function for Problem (which takes ownership); nullptr for squared.
 ceres::LossFunction* MakeLoss(Loss loss, double scale);
 
-// Adds the data terms (and the rest prior) of one pose to `problem` over q, with the mode
-// bounds. Returns the data residual blocks.
+// Adds the data terms (and the rest prior) of one pose of a 2D curve fit to `problem` over q,
+// with the mode bounds. Returns the data residual blocks.
 // `reverse` holds the target-to-body terms of a two-sided curve fit.
 std::vector<ceres::ResidualBlockId> AddPoseTerms(const BodyModel& body, const std::vector<SegmentResidual>& data,
                                                  const std::vector<ReverseSegmentResidual>& reverse,
@@ -91,12 +86,12 @@ ceres::Solver::Options TrajectorySolverOptions(const PoseFitOptions& o, std::str
 // Solves a pose problem built by the caller (dense normal equations, the fit's tolerances).
 void SolvePoseProblem(const PoseFitOptions& o, ceres::Problem* problem, FitReport* report);
 
-// Solves one pose (dense: a handful of unknowns), q in and out.
+// Solves one pose of a 2D curve fit (dense: a handful of unknowns), q in and out.
 void SolvePose(const BodyModel& body, const std::vector<SegmentResidual>& data,
                const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o, Eigen::VectorXd* q,
                FitReport* report);
 
-// Conditioning of the data terms at q (see Conditioning in pose_fit.h).
+// Conditioning of a 2D curve fit's data terms at q (see Conditioning in pose_fit.h).
 Conditioning ComputeConditioning(const BodyModel& body, const std::vector<SegmentResidual>& data,
                                  const std::vector<ReverseSegmentResidual>& reverse, const PoseFitOptions& o,
                                  const Eigen::VectorXd& q);
