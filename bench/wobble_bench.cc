@@ -271,9 +271,9 @@ std::shared_ptr<const BodyModel3> Table3(int points = 0, int mesh_vertices = 0) 
 }
 
 void TimeSteps3(benchmark::State& state, const BodyModel3& body, const WorldParamsN<3>& w, double dt,
-                BodyState<3, double>* s) {
+                BodyState<3, double>* s, Integrator integrator = Integrator::kThesis) {
   for (auto _ : state) {
-    const StepStatus st = StepBody(body, w, 0, Integrator::kThesis, dt, s);
+    const StepStatus st = StepBody(body, w, 0, integrator, dt, s);
     if (!st.ok()) {
       state.SkipWithError(StatusCodeName(st.code).c_str());
       break;
@@ -330,6 +330,29 @@ void BM_Table3kRestingOnGround(benchmark::State& state) {
   TimeSteps3(state, *body, w, 0.01, &s);
 }
 BENCHMARK(BM_Table3kRestingOnGround);
+
+// The variational integrator (variational.h) on the 3D table: tumbling and vibrating with no
+// ground (ground 0), and resting on its feet after a drop (ground 1).
+void BM_Table3Variational(benchmark::State& state) {
+  const std::shared_ptr<const BodyModel3> body = Table3();
+  WorldParamsN<3> w;
+  BodyState<3, double> s = RestState<3, double>(*body);
+  if (state.range(0) != 0) {
+    w.ground.enabled = true;
+    s.translation().y() = 10.0;
+    for (int i = 0; i < 3000; ++i)
+      if (!StepBody(*body, w, 0, Integrator::kVariational, 0.01, &s).ok()) {
+        state.SkipWithError("the table did not settle");
+        return;
+      }
+  } else {
+    w.gravity_on = false;
+    s.qd.segment<3>(3) = Eigen::Vector3d(0.8, 1.5, -0.6);
+    for (int d = 0; d < body->num_modes(); ++d) s.qd[Group<3>::kRigidDofs + d] = 0.5;
+  }
+  TimeSteps3(state, *body, w, 0.01, &s, Integrator::kVariational);
+}
+BENCHMARK(BM_Table3Variational)->ArgName("ground")->Arg(0)->Arg(1);
 
 }  // namespace
 }  // namespace wobble

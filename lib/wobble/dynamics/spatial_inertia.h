@@ -177,9 +177,73 @@ void GravityForce(const MassMoments3& mm, const VecQ<T>& q, const Mat3<T>& R, co
   if (D > 0) Q->tail(D) = mm.C.cast<T>().transpose() * g_local;
 }
 
-// q̈ of M q̈ = Q − w at positions q and velocities q̇ (the 3D Eq. 4.21 of the header), by a
-// Cholesky factorization of M. *cond_estimate: the ratio of its largest to smallest pivot, a
-// lower bound of cond₂(M). False when M is singular.
+// Solves M a = r (M of the header comment at shape moments sm and rotation R) by block
+// elimination about the centre of mass, without forming M, as SolveMassSystem does in 2D
+// (kinematics.h). With c = c0 + Cγ, r̂ = Rᵀ r_t and â = Rᵀ a_t, the translation rows give
+//   â = (r̂ + c × a_ω − C a_γ)/m,
+// and eliminating them leaves
+//   [ I_com   U     ] [a_ω]   [ r_ω − c × r̂/m ]      I_com = I − (|c|² 1 − c cᵀ)/m
+//   [ Uᵀ      G_com ] [a_γ] = [ r_γ − Cᵀ r̂/m  ],     U = N − [c]× C/m,
+// whose mode block G_com = G − CᵀC/m is constant and factored once (MassMoments3, as in 2D).
+// Then G_com y = ρ_γ, G_com Z = Uᵀ (three solves), the 3x3 Schur complement
+// S = I_com − U Z (factored by Cholesky), S a_ω = ρ_ω − U y, a_γ = y − Z a_ω and
+// a_t = (r_t − R(C a_γ − c × a_ω))/m. Returns false when M is singular. *cond_estimate receives
+// the ratio of the largest to the smallest elimination pivot (m, G_com's pivots, S's pivots):
+// each pivot is a 1x1 Schur complement of a principal submatrix P of M, so lies in
+// [λ_min(P), λ_max(P)] ⊂ [λ_min(M), λ_max(M)] (Cauchy interlacing), and the ratio is a lower
+// bound of cond₂(M).
+template <class T>
+bool SolveMassSystem(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& r,
+                     VecQ<T>* a, double* cond_estimate) {
+  constexpr int kRigid = Group<3>::kRigidDofs;
+  const int D = int(sm.e.size());
+  if (D > 0 && !mm.G_com_positive) return false;
+  const T inv_m = T(1.0 / mm.m);
+  const Vec3<T>& c = sm.c;
+  const Vec3<T> r_hat = R.transpose() * r.template head<3>();
+  Mat3<T> S = sm.I - (Mat3<T>::Identity() * c.squaredNorm() - c * c.transpose()) * inv_m;
+  Vec3<T> rho = r.template segment<3>(3) - c.cross(r_hat) * inv_m;
+  a->resize(kRigid + D);
+  MatND<T, 3> U;
+  Eigen::Matrix<T, Eigen::Dynamic, 3, 0, kMaxModes, 3> Z;
+  VecD<T> y;
+  if (D > 0) {
+    U.resize(3, D);
+    Z.resize(D, 3);
+    y = r.tail(D);
+    for (int d = 0; d < D; ++d) {
+      const Vec3<T> C_d = mm.C.col(d).cast<T>();
+      U.col(d) = sm.N.col(d) - c.cross(C_d) * inv_m;
+      y[d] -= C_d.dot(r_hat) * inv_m;
+    }
+    CholeskySolveInPlace(mm.G_com_factor, &y);
+    for (int i = 0; i < 3; ++i) {
+      VecD<T> z = U.row(i).transpose();
+      CholeskySolveInPlace(mm.G_com_factor, &z);
+      Z.col(i) = z;
+    }
+    S -= U * Z;
+    rho -= U * y;
+  }
+  if (!CholeskyInPlace(&S)) return false;
+  Vec3<T> a_omega = rho;
+  CholeskySolveInPlace(S, &a_omega);
+  Vec3<T> local = -c.cross(a_omega);
+  if (D > 0) {
+    a->tail(D) = y - Z * a_omega;
+    local += mm.C.cast<T>() * a->tail(D);
+  }
+  a->template segment<3>(3) = a_omega;
+  a->template head<3>() = (r.template head<3>() - R * local) * inv_m;
+  double lo = mm.m, hi = mm.m;
+  CholeskyPivotRange(S, &lo, &hi);
+  if (D > 0) CholeskyPivotRange(mm.G_com_factor, &lo, &hi);
+  *cond_estimate = hi / lo;
+  return true;
+}
+
+// q̈ of M q̈ = Q − w at positions q and velocities q̇ (the 3D Eq. 4.21 of the header), by
+// SolveMassSystem above (about the centre of mass, M never formed).
 template <class T>
 bool SolveAccelerations(const MassMoments3& mm, const VecQ<T>& q, const VecQ<T>& qd, const Mat3<T>& R,
                         const VecQ<T>& Q, VecQ<T>* qdd, double* cond_estimate) {
@@ -187,15 +251,7 @@ bool SolveAccelerations(const MassMoments3& mm, const VecQ<T>& q, const VecQ<T>&
   const ShapeMoments<T> sm(mm, VecD<T>(q.tail(D)));
   VecQ<T> w;
   VelocityTerms(mm, sm, R, qd, &w);
-  MatQ<T> M;
-  MassMatrix(mm, sm, R, &M);
-  if (!CholeskyInPlace(&M)) return false;
-  double lo = HUGE_VAL, hi = 0.0;
-  CholeskyPivotRange(M, &lo, &hi);
-  *qdd = Q - w;
-  CholeskySolveInPlace(M, qdd);
-  *cond_estimate = hi / lo;
-  return true;
+  return SolveMassSystem(mm, sm, R, VecQ<T>(Q - w), qdd, cond_estimate);
 }
 
 }  // namespace wobble
