@@ -40,85 +40,74 @@ template <class Problem> void SetBounds(const FitSpacetimeArgs& a, int D, Proble
   p->control_weight = a.effort;
 }
 
-// The 2D body's problem from the flags: --reach "X Y T".
-fit::SpacetimeResult Fit2(const FitSpacetimeArgs& a, const StartingWorld& start, const Eigen::MatrixXd& first_guess,
-                          const fit::SpacetimeOptions& o, nlohmann::json* task) {
-  const BodyModel& body = *start.body;
-  const int steps = int(first_guess.cols()), D = body.num_modes();
-  fit::SpacetimeProblem p;
-  p.rollout.world = start.options.params;
-  p.rollout.integrator = Integrator::kThesis;
-  p.rollout.dt = a.dt;
-  p.rollout.q0 = start.q0;
-  p.rollout.qd0 = start.qd0;
-  body.ModeGains(&p.rollout.stiffness, &p.rollout.damping);
-  p.rollout.targets = first_guess;
-  SetBounds(a, D, &p);
-  std::vector<fit::StageCost> terms;
-  const MassMoments& mm = body.moments();
-  const Eigen::Vector2d com0 =
-      start.q0.head<2>() + Eigen::Rotation2Dd(start.q0[2]) * ((mm.c0 + mm.C * start.q0.tail(D)) / mm.m);
-  if (!a.rise.empty()) {
-    const std::vector<double> v = ParseNumbers(a.rise, "--rise");
-    if (v.size() != 2) throw UsageError("--rise takes \"DY T\"");
-    fit::Axes y_only;
-    y_only.x = false;
-    const int top = StepAt(v[1], a.dt, steps, "--rise");
-    terms.push_back(fit::CentreOfMassAt(body, top, {0.0, com0.y() + v[0]}, a.weight, y_only));
-    // at the top: not rising any more (a velocity of 1 weighs as a height of 0.1)
-    terms.push_back(fit::CentreOfMassVelocityAt(body, top, {0.0, 0.0}, 0.01 * a.weight, y_only));
-    (*task)["rise"] = {{"dy", v[0]}, {"t", v[1]}};
+// What the command's problem takes of each dimension's object: its body, its world, where its
+// centre of mass starts and how --reach reads.
+template <int Dim> struct SpacetimeObject;
+template <> struct SpacetimeObject<2> {
+  static const BodyModel& Body(const StartingWorld& start) { return *start.body; }
+  static WorldParamsN<2> World(const StartingWorld& start) { return start.options.params; }
+  static Eigen::Vector2d CentreOfMass(const BodyModel& body, const BodyState<2, double>& s) {
+    const MassMoments& mm = body.moments();
+    const Eigen::VectorXd q0 = s.q;
+    const int D = body.num_modes();
+    return q0.head<2>() + Eigen::Rotation2Dd(q0[2]) * ((mm.c0 + mm.C * q0.tail(D)) / mm.m);
   }
-  if (!a.reach.empty()) {
-    const std::vector<double> v = ParseNumbers(a.reach, "--reach");
-    if (v.size() != 3) throw UsageError("--reach takes \"X Y T\" for a 2D object");
-    terms.push_back(fit::CentreOfMassAt(body, StepAt(v[2], a.dt, steps, "--reach"), {v[0], v[1]}, a.weight));
-    (*task)["reach"] = {{"x", v[0]}, {"y", v[1]}, {"t", v[2]}};
+  static constexpr const char* kReach = "--reach takes \"X Y T\" for a 2D object";
+};
+template <> struct SpacetimeObject<3> {
+  static const BodyModel3& Body(const StartingWorld& start) { return *start.body3; }
+  static WorldParamsN<3> World(const StartingWorld& start) { return Params3Of(start.options); }
+  static Eigen::Vector3d CentreOfMass(const BodyModel3& body, const BodyState<3, double>& s) {
+    const MassMoments3& mm = body.moments();
+    return s.translation() + s.orientation() * ((mm.c0 + mm.C * s.gamma()) / mm.m);
   }
-  if (a.upright) terms.push_back(fit::UprightAt(steps, a.weight, 0.1)), (*task)["upright"] = true;
-  if (a.still) terms.push_back(fit::StillAt(steps, a.weight)), (*task)["still"] = true;
-  p.task = fit::SumOf(terms);
-  return fit::FitSpacetime(body, p, o);
-}
+  static constexpr const char* kReach = "--reach takes \"X Y Z T\" for a 3D object";
+};
 
-// The 3D body's problem from the same flags: --reach "X Y Z T"; --upright leaves the heading free.
-fit::SpacetimeResult Fit3(const FitSpacetimeArgs& a, const StartingWorld& start, const Eigen::MatrixXd& first_guess,
-                          const fit::SpacetimeOptions& o, nlohmann::json* task) {
-  const BodyModel3& body = *start.body3;
+// The object's problem from the flags: --reach "X Y T" (3D "X Y Z T"); in 3D --upright leaves
+// the heading free.
+template <int Dim>
+fit::SpacetimeResult FitOf(const FitSpacetimeArgs& a, const StartingWorld& start, const Eigen::MatrixXd& first_guess,
+                           const fit::SpacetimeOptions& o, nlohmann::json* task) {
+  using Object = SpacetimeObject<Dim>;
+  using Vec = Eigen::Matrix<double, Dim, 1>;
+  const BodyModelN<Dim>& body = Object::Body(start);
   const int steps = int(first_guess.cols()), D = body.num_modes();
-  fit::SpacetimeProblem3 p;
-  p.rollout.world = Params3Of(start.options);
+  fit::SpacetimeProblemN<Dim> p;
+  p.rollout.world = Object::World(start);
   p.rollout.integrator = Integrator::kThesis;
   p.rollout.dt = a.dt;
-  p.rollout.start = StateFromCoordinates<3>(start.q0, start.qd0);
+  p.rollout.start = StateFromCoordinates<Dim>(start.q0, start.qd0);
   body.ModeGains(&p.rollout.stiffness, &p.rollout.damping);
   p.rollout.targets = first_guess;
   SetBounds(a, D, &p);
-  std::vector<fit::StageCost3> terms;
-  const MassMoments3& mm = body.moments();
-  const Eigen::Vector3d com0 =
-      p.rollout.start.translation() + p.rollout.start.orientation() * ((mm.c0 + mm.C * p.rollout.start.gamma()) / mm.m);
+  std::vector<fit::StageCostN<Dim>> terms;
+  const Vec com0 = Object::CentreOfMass(body, p.rollout.start);
   if (!a.rise.empty()) {
     const std::vector<double> v = ParseNumbers(a.rise, "--rise");
     if (v.size() != 2) throw UsageError("--rise takes \"DY T\"");
     fit::Axes y_only;
     y_only.x = y_only.z = false;
     const int top = StepAt(v[1], a.dt, steps, "--rise");
-    terms.push_back(fit::CentreOfMassAt3(body, top, {0.0, com0.y() + v[0], 0.0}, a.weight, y_only));
-    terms.push_back(fit::CentreOfMassVelocityAt3(body, top, Eigen::Vector3d::Zero(), 0.01 * a.weight, y_only));
+    Vec height = Vec::Zero();
+    height.y() = com0.y() + v[0];
+    terms.push_back(fit::CentreOfMassAt(body, top, height, a.weight, y_only));
+    // at the top: not rising any more (a velocity of 1 weighs as a height of 0.1)
+    terms.push_back(fit::CentreOfMassVelocityAt(body, top, Vec::Zero(), 0.01 * a.weight, y_only));
     (*task)["rise"] = {{"dy", v[0]}, {"t", v[1]}};
   }
   if (!a.reach.empty()) {
     const std::vector<double> v = ParseNumbers(a.reach, "--reach");
-    if (v.size() != 4) throw UsageError("--reach takes \"X Y Z T\" for a 3D object");
-    terms.push_back(
-        fit::CentreOfMassAt3(body, StepAt(v[3], a.dt, steps, "--reach"), {v[0], v[1], v[2]}, a.weight));
-    (*task)["reach"] = {{"x", v[0]}, {"y", v[1]}, {"z", v[2]}, {"t", v[3]}};
+    if (v.size() != size_t(Dim + 1)) throw UsageError(Object::kReach);
+    const Vec goal = Eigen::Map<const Vec>(v.data());
+    terms.push_back(fit::CentreOfMassAt(body, StepAt(v[Dim], a.dt, steps, "--reach"), goal, a.weight));
+    (*task)["reach"] = {{"x", v[0]}, {"y", v[1]}, {"t", v[Dim]}};
+    if (Dim == 3) (*task)["reach"]["z"] = v[2];
   }
-  if (a.upright) terms.push_back(fit::UprightAt3(steps, a.weight, 0.1)), (*task)["upright"] = true;
-  if (a.still) terms.push_back(fit::StillAt3(steps, a.weight)), (*task)["still"] = true;
-  p.task = fit::SumOf3(terms);
-  return fit::FitSpacetime3(body, p, o);
+  if (a.upright) terms.push_back(fit::UprightAt<Dim>(steps, a.weight, 0.1)), (*task)["upright"] = true;
+  if (a.still) terms.push_back(fit::StillAt<Dim>(steps, a.weight)), (*task)["still"] = true;
+  p.task = fit::SumOf(terms);
+  return fit::FitSpacetime(body, p, o);
 }
 
 }  // namespace
@@ -209,7 +198,7 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
     o.on_start = [&bar](int done, int starts, double best) { bar.Update(double(done) / starts, best); };
   }
   nlohmann::json task;
-  const fit::SpacetimeResult r = start.body3 ? Fit3(a, start, first_guess, o, &task) : Fit2(a, start, first_guess, o, &task);
+  const fit::SpacetimeResult r = start.body3 ? FitOf<3>(a, start, first_guess, o, &task) : FitOf<2>(a, start, first_guess, o, &task);
   if (a.starts == 1) EndIterationLine();
   bar.Finish();
   const std::string body_name = start.body3 ? start.body3->name() : start.body->name();

@@ -6,9 +6,9 @@
 // to every parameter) in the same run: the gradient's cost is the ratio of the two rows with
 // the same arguments. In the air (second argument 0) and falling onto the ground (1; contacts
 // add 2 inputs per point to each step's differentiation).
-// The 3D rows (Simulation3, Gradient3) do the same for the chair of tests/support (about 300
+// The chair rows (SimulationChair, GradientChair) do the same for the chair of tests/support (about 300
 // mass points, 3 modes; 12 + 2·3 state coordinates), controls/3 steps of 0.002 s, falling onto
-// a plane in the grounded case; Gradient3's third argument is its checkpoint interval (0: the
+// a plane in the grounded case; GradientChair's third argument is its checkpoint interval (0: the
 // default, the whole run kept within the budget; -1: ⌈√steps⌉ checkpoints), to compare the two.
 // Run: build/bench/adjoint_bench --benchmark_min_time=0.5
 #include <benchmark/benchmark.h>
@@ -17,7 +17,6 @@
 
 #include "support/test_bodies.h"
 #include "wobble/fit/adjoint.h"
-#include "wobble/fit/adjoint3.h"
 
 namespace wobble {
 namespace {
@@ -32,10 +31,10 @@ fit::ControlledRollout Rollout(int controls, bool grounded) {
   r.integrator = Integrator::kThesis;
   r.dt = 0.005;
   r.world.ground.enabled = grounded;
-  r.q0 = Eigen::VectorXd::Zero(7);
-  r.q0[1] = grounded ? 5.0 : 200.0;
-  r.qd0 = Eigen::VectorXd::Zero(7);
-  r.qd0[0] = 30.0;
+  r.start.q = Eigen::VectorXd::Zero(7);
+  r.start.q[1] = grounded ? 5.0 : 200.0;
+  r.start.qd = Eigen::VectorXd::Zero(7);
+  r.start.qd[0] = 30.0;
   r.stiffness = Eigen::VectorXd::Constant(4, 4e5);
   r.damping = Eigen::VectorXd::Constant(4, 2e3);
   const int steps = controls / 4;
@@ -46,16 +45,16 @@ fit::ControlledRollout Rollout(int controls, bool grounded) {
 }
 
 // ½ |x − y|² of the table's top middle point against a fixed goal, every step.
-double Stage(int, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq, Eigen::VectorXd*) {
+double Stage(int, const BodyState<2, double>& state, Eigen::VectorXd* dz) {
+  const VecQ<double>& q = state.q;
   const Eigen::Vector2d goal(400.0, 120.0);
   // the cost of a rigid point (150, 100) of the body frame: x = t + R l
   const double c = std::cos(q[2]), s = std::sin(q[2]);
   const Eigen::Vector2d l(150.0, 100.0), x(q[0] + c * l.x() - s * l.y(), q[1] + s * l.x() + c * l.y());
   const Eigen::Vector2d e = x - goal;
-  (*dq)[0] += e.x();
-  (*dq)[1] += e.y();
-  (*dq)[2] += e.x() * (-s * l.x() - c * l.y()) + e.y() * (c * l.x() - s * l.y());
-  (void)qd;
+  (*dz)[0] += e.x();
+  (*dz)[1] += e.y();
+  (*dz)[2] += e.x() * (-s * l.x() - c * l.y()) + e.y() * (c * l.x() - s * l.y());
   return 0.5 * e.squaredNorm();
 }
 
@@ -82,8 +81,8 @@ const BodyModel3& Chair() {
   return body;
 }
 
-fit::ControlledRollout3 Rollout3(int controls, bool grounded) {
-  fit::ControlledRollout3 r;
+fit::ControlledRolloutN<3> ChairRollout(int controls, bool grounded) {
+  fit::ControlledRolloutN<3> r;
   r.integrator = Integrator::kThesis;
   r.dt = 0.002;
   r.world.ground.enabled = grounded;
@@ -105,7 +104,7 @@ fit::ControlledRollout3 Rollout3(int controls, bool grounded) {
 
 // ½ |x − y|² of a rigid point l of the chair's frame against a fixed goal, every step:
 // x = t + R l, so ∂/∂δt = e and ∂/∂ε = l × Rᵀe.
-double Stage3(int, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
+double ChairStage(int, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
   const Eigen::Vector3d goal(400.0, 120.0, 50.0), l(50.0, 50.0, 30.0);
   const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
   const Eigen::Vector3d e = s.translation() + R * l - goal;
@@ -114,17 +113,17 @@ double Stage3(int, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
   return 0.5 * e.squaredNorm();
 }
 
-void BM_Simulation3(benchmark::State& state) {
-  const fit::ControlledRollout3 r = Rollout3(int(state.range(0)), state.range(1) != 0);
-  for (auto _ : state) benchmark::DoNotOptimize(fit::RolloutCost3(Chair(), r, Stage3));
+void BM_SimulationChair(benchmark::State& state) {
+  const fit::ControlledRolloutN<3> r = ChairRollout(int(state.range(0)), state.range(1) != 0);
+  for (auto _ : state) benchmark::DoNotOptimize(fit::RolloutCost(Chair(), r, ChairStage));
   state.counters["controls"] = double(3 * r.steps());
 }
 
-void BM_Gradient3(benchmark::State& state) {
-  const fit::ControlledRollout3 r = Rollout3(int(state.range(0)), state.range(1) != 0);
+void BM_GradientChair(benchmark::State& state) {
+  const fit::ControlledRolloutN<3> r = ChairRollout(int(state.range(0)), state.range(1) != 0);
   int held = 0;
   for (auto _ : state) {
-    const fit::RolloutGradient3 g = fit::RolloutCostGradient3(Chair(), r, Stage3, int(state.range(2)));
+    const fit::RolloutGradient g = fit::RolloutCostGradient(Chair(), r, ChairStage, int(state.range(2)));
     if (!g.ok) state.SkipWithError(g.message.c_str());
     held = g.states_held;
   }
@@ -134,8 +133,8 @@ void BM_Gradient3(benchmark::State& state) {
 
 BENCHMARK(BM_Simulation)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Gradient)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_Simulation3)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_Gradient3)
+BENCHMARK(BM_SimulationChair)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_GradientChair)
     ->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}, {fit::kCheckpointAuto, fit::kCheckpointSqrt}})
     ->Unit(benchmark::kMicrosecond);
 

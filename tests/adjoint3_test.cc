@@ -1,4 +1,4 @@
-// The adjoint gradient of a 3D rollout (lib/wobble/fit/adjoint3.h, issue 18), checked as the
+// The adjoint gradient of a 3D rollout (lib/wobble/fit/adjoint.h, issue 18), checked as the
 // 2D one is (adjoint_test.cc) against two independent derivatives of the same cost:
 //  - forward-mode Jets through the WHOLE simulation (written here, with its own PD force, its
 //    own passive body and its own perturbation of the orientation, R0 exp(ε̂)): single
@@ -18,7 +18,7 @@
 #include "support/test_bodies.h"
 #include "wobble/core/rotation3.h"
 #include "wobble/dynamics/step.h"
-#include "wobble/fit/adjoint3.h"
+#include "wobble/fit/adjoint.h"
 
 namespace wobble {
 namespace {
@@ -46,8 +46,8 @@ template <class T> T Stage(const BodyModel3& body, int n, const BodyState<3, T>&
   return cost;
 }
 
-// The stage cost's gradient in the tangent coordinates (δt, ε, δγ, δv) of adjoint3.h, by Jets.
-fit::StageCost3 StageOf(const BodyModel3& body) {
+// The stage cost's gradient in the tangent coordinates (δt, ε, δγ, δv) of adjoint.h, by Jets.
+fit::StageCostN<3> StageOf(const BodyModel3& body) {
   return [&body](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     using J = ceres::Jet<double, kNz>;
     BodyState<3, J> sj;
@@ -70,7 +70,7 @@ fit::StageCost3 StageOf(const BodyModel3& body) {
 }
 
 // The reference's mode forces −2K (γ − γ0(n)) − c γ̇, written out here.
-template <class T> struct PdForce3 {
+template <class T> struct PdForce {
   const std::vector<T>* K;
   const std::vector<T>* c;
   const std::vector<T>* target;
@@ -82,13 +82,13 @@ template <class T> struct PdForce3 {
 
 // Every parameter in one flat vector: the start's tangent coordinates (zero: the start
 // itself), K, c, then the targets step by step.
-Eigen::VectorXd Flatten(const fit::ControlledRollout3& r) {
+Eigen::VectorXd Flatten(const fit::ControlledRolloutN<3>& r) {
   const int N = r.steps();
   Eigen::VectorXd p(kNz + 2 * kModes + kModes * N);
   p << Eigen::VectorXd::Zero(kNz), r.stiffness, r.damping, Eigen::Map<const Eigen::VectorXd>(r.targets.data(), kModes * N);
   return p;
 }
-Eigen::VectorXd Flatten(const fit::RolloutGradient3& g) {
+Eigen::VectorXd Flatten(const fit::RolloutGradient& g) {
   const int N = int(g.targets.cols());
   Eigen::VectorXd p(kNz + 2 * kModes + kModes * N);
   p << g.start, g.stiffness, g.damping, Eigen::Map<const Eigen::VectorXd>(g.targets.data(), kModes * N);
@@ -98,7 +98,7 @@ Eigen::VectorXd Flatten(const fit::RolloutGradient3& g) {
 // The cost with parameters p + ε v (Flatten's order; the start moved along its tangent
 // coordinates), ε a Jet of one dimension (or double, v unused).
 template <class T>
-T ReferenceCost(const BodyModel3& passive, const fit::ControlledRollout3& r, const Eigen::VectorXd& p,
+T ReferenceCost(const BodyModel3& passive, const fit::ControlledRolloutN<3>& r, const Eigen::VectorXd& p,
                 const Eigen::VectorXd& v) {
   auto param = [&](int i) {
     T x(p[i]);
@@ -127,7 +127,7 @@ T ReferenceCost(const BodyModel3& passive, const fit::ControlledRollout3& r, con
   T total = Stage(passive, 0, s);
   for (int n = 0; n < r.steps(); ++n) {
     for (int d = 0; d < kModes; ++d) target[d] = param(kNz + 2 * kModes + kModes * n + d);
-    EXPECT_TRUE(StepBody(passive, r.world, 0, r.integrator, r.dt, &s, PdForce3<T>{&K, &c, &target}).ok());
+    EXPECT_TRUE(StepBody(passive, r.world, 0, r.integrator, r.dt, &s, PdForce<T>{&K, &c, &target}).ok());
     total += Stage(passive, n + 1, s);
   }
   return total;
@@ -136,7 +136,7 @@ T ReferenceCost(const BodyModel3& passive, const fit::ControlledRollout3& r, con
 struct Case {
   BodyModel3 body;     // the chair with its own mode gains, which the rollout's replace
   BodyModel3 passive;  // the same with none: the reference's
-  fit::ControlledRollout3 rollout;
+  fit::ControlledRolloutN<3> rollout;
 };
 
 // The chair with random gains, random PD targets every step and a random start; `grounded`:
@@ -145,7 +145,7 @@ Case MakeCase(Integrator integrator, bool grounded, int steps, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Case k{testing::Chair3(), PassiveChair(), {}};
-  fit::ControlledRollout3& r = k.rollout;
+  fit::ControlledRolloutN<3>& r = k.rollout;
   r.integrator = integrator;
   r.dt = 2e-3;
   if (grounded) {
@@ -191,7 +191,7 @@ void ContactEvents(const Case& k, int* onsets, int* ends, int* slips, std::set<i
     std::vector<double> target(k.rollout.targets.col(n).data(), k.rollout.targets.col(n).data() + kModes);
     const auto before = s.contacts;
     ASSERT_TRUE(StepBody(k.passive, k.rollout.world, 0, k.rollout.integrator, k.rollout.dt, &s,
-                          PdForce3<double>{&K, &c, &target}).ok());
+                          PdForce<double>{&K, &c, &target}).ok());
     for (const auto& x : s.contacts) {
       faces->insert(x.face);
       const Contact<3, double>* was = find(before, x);
@@ -203,7 +203,7 @@ void ContactEvents(const Case& k, int* onsets, int* ends, int* slips, std::set<i
 }
 
 void ExpectJetDirectionalDerivatives(const Case& k, unsigned seed) {
-  const fit::RolloutGradient3 g = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive));
+  const fit::RolloutGradient g = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive));
   ASSERT_TRUE(g.ok) << g.message;
   const Eigen::VectorXd p = Flatten(k.rollout), grad = Flatten(g);
   using J1 = ceres::Jet<double, 1>;
@@ -229,14 +229,14 @@ void ExpectJetDirectionalDerivatives(const Case& k, unsigned seed) {
   }
 }
 
-TEST(Adjoint3, MatchesJetsThroughTheWholeRunInTheAir) {
+TEST(AdjointSpace, MatchesJetsThroughTheWholeRunInTheAir) {
   for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler}) {
     SCOPED_TRACE(IntegratorName(integrator));
     ExpectJetDirectionalDerivatives(MakeCase(integrator, false, 60, 3), 11);
   }
 }
 
-TEST(Adjoint3, MatchesJetsThroughContactsThatBeginSlipAndEnd) {
+TEST(AdjointSpace, MatchesJetsThroughContactsThatBeginSlipAndEnd) {
   for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler}) {
     SCOPED_TRACE(IntegratorName(integrator));
     const Case k = MakeCase(integrator, true, 150, 5);
@@ -253,7 +253,7 @@ TEST(Adjoint3, MatchesJetsThroughContactsThatBeginSlipAndEnd) {
 
 // A V valley of heightfield triangles (contacts on both walls and carried across edges) and a
 // spring holding the chair's back.
-TEST(Adjoint3, MatchesJetsInAHeightfieldValleyWithASpring) {
+TEST(AdjointSpace, MatchesJetsInAHeightfieldValleyWithASpring) {
   for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler}) {
     SCOPED_TRACE(IntegratorName(integrator));
     Case k = MakeCase(integrator, true, 150, 41);
@@ -273,11 +273,11 @@ TEST(Adjoint3, MatchesJetsInAHeightfieldValleyWithASpring) {
 
 // Central differences of the plain cost, one parameter at a time (five-point stencil, its
 // rounding bound added as in adjoint_test.cc).
-TEST(Adjoint3, MatchesCentralDifferencesInTheAir) {
+TEST(AdjointSpace, MatchesCentralDifferencesInTheAir) {
   for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler}) {
     SCOPED_TRACE(IntegratorName(integrator));
     const Case k = MakeCase(integrator, false, 60, 7);
-    const fit::RolloutGradient3 g = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive));
+    const fit::RolloutGradient g = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive));
     ASSERT_TRUE(g.ok) << g.message;
     const Eigen::VectorXd p = Flatten(k.rollout), grad = Flatten(g);
     const int N = k.rollout.steps(), first_target = kNz + 2 * kModes;
@@ -297,12 +297,12 @@ TEST(Adjoint3, MatchesCentralDifferencesInTheAir) {
   }
 }
 
-TEST(Adjoint3, CheckpointIntervalDoesNotChangeTheGradient) {
+TEST(AdjointSpace, CheckpointIntervalDoesNotChangeTheGradient) {
   const Case k = MakeCase(Integrator::kThesis, true, 90, 17);
-  const fit::RolloutGradient3 a = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive), 1);
-  const fit::RolloutGradient3 b = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive), fit::kCheckpointSqrt);
-  const fit::RolloutGradient3 c = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive), 90);
-  const fit::RolloutGradient3 d = fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive));
+  const fit::RolloutGradient a = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive), 1);
+  const fit::RolloutGradient b = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive), fit::kCheckpointSqrt);
+  const fit::RolloutGradient c = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive), 90);
+  const fit::RolloutGradient d = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive));
   ASSERT_TRUE(a.ok && b.ok && c.ok && d.ok);
   EXPECT_EQ(Flatten(a), Flatten(b));
   EXPECT_EQ(Flatten(a), Flatten(c));
@@ -313,25 +313,25 @@ TEST(Adjoint3, CheckpointIntervalDoesNotChangeTheGradient) {
   EXPECT_EQ(d.states_held, 90 + 1) << "a 90-step run is kept whole by default";
 }
 
-TEST(Adjoint3, RefusesBadInputWithAMessage) {
+TEST(AdjointSpace, RefusesBadInputWithAMessage) {
   const Case good = MakeCase(Integrator::kThesis, false, 5, 1);
   auto refused = [&](auto&& edit, const std::string& words) {
     Case k = good;
     edit(&k.rollout);
     try {
-      fit::RolloutCostGradient3(k.body, k.rollout, StageOf(k.passive));
+      fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive));
       ADD_FAILURE() << "accepted: " << words;
     } catch (const std::invalid_argument& e) {
       EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
     }
   };
-  refused([](fit::ControlledRollout3* r) { r->integrator = Integrator::kRK4; }, "thesis and symplectic integrators");
-  refused([](fit::ControlledRollout3* r) { r->dt = 0.0; }, "dt must be positive");
-  refused([](fit::ControlledRollout3* r) { r->stiffness.resize(2); }, "one value per mode");
-  refused([](fit::ControlledRollout3* r) { r->targets.resize(2, 5); }, "one row per mode");
-  refused([](fit::ControlledRollout3* r) { r->start.qd[2] = std::nan(""); }, "finite");
-  refused([](fit::ControlledRollout3* r) { r->start.q.segment<4>(3).setZero(); }, "must not be zero");
-  refused([](fit::ControlledRollout3* r) { r->start.q.conservativeResize(Group<3>::kRigidParams + 1); }, "mode amplitudes");
+  refused([](fit::ControlledRolloutN<3>* r) { r->integrator = Integrator::kRK4; }, "thesis and symplectic integrators");
+  refused([](fit::ControlledRolloutN<3>* r) { r->dt = 0.0; }, "dt must be positive");
+  refused([](fit::ControlledRolloutN<3>* r) { r->stiffness.resize(2); }, "one value per mode");
+  refused([](fit::ControlledRolloutN<3>* r) { r->targets.resize(2, 5); }, "one row per mode");
+  refused([](fit::ControlledRolloutN<3>* r) { r->start.qd[2] = std::nan(""); }, "finite");
+  refused([](fit::ControlledRolloutN<3>* r) { r->start.q.segment<4>(3).setZero(); }, "must not be zero");
+  refused([](fit::ControlledRolloutN<3>* r) { r->start.q.conservativeResize(Group<3>::kRigidParams + 1); }, "mode amplitudes");
 }
 
 }  // namespace

@@ -40,7 +40,8 @@ template <class T> T Stage(const BodyModel& body, int n, const VecQ<T>& q, const
 }
 
 fit::StageCost StageOf(const BodyModel& body) {
-  return [&body](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq, Eigen::VectorXd* dqd) {
+  return [&body](int n, const BodyState<2, double>& s, Eigen::VectorXd* dz) {
+    const Eigen::VectorXd q = s.q, qd = s.qd;
     using J = ceres::Jet<double, 2 * kNq>;
     VecQ<J> qj(kNq), qdj(kNq);
     for (int i = 0; i < kNq; ++i) {
@@ -48,8 +49,8 @@ fit::StageCost StageOf(const BodyModel& body) {
       qdj[i] = J(qd[i], kNq + i);
     }
     const J c = Stage(body, n, qj, qdj);
-    *dq += c.v.head(kNq);
-    *dqd += c.v.tail(kNq);
+    dz->head(kNq) += c.v.head(kNq);  // z = (q, q̇)
+    dz->tail(kNq) += c.v.tail(kNq);
     return c.a;
   };
 }
@@ -70,13 +71,13 @@ template <class T> struct PdForce {
 Eigen::VectorXd Flatten(const fit::ControlledRollout& r) {
   const int N = r.steps();
   Eigen::VectorXd p(2 * kNq + 2 * kModes + kModes * N);
-  p << r.q0, r.qd0, r.stiffness, r.damping, Eigen::Map<const Eigen::VectorXd>(r.targets.data(), kModes * N);
+  p << r.start.q, r.start.qd, r.stiffness, r.damping, Eigen::Map<const Eigen::VectorXd>(r.targets.data(), kModes * N);
   return p;
 }
 Eigen::VectorXd Flatten(const fit::RolloutGradient& g) {
   const int N = int(g.targets.cols());
   Eigen::VectorXd p(2 * kNq + 2 * kModes + kModes * N);
-  p << g.q0, g.qd0, g.stiffness, g.damping, Eigen::Map<const Eigen::VectorXd>(g.targets.data(), kModes * N);
+  p << g.start, g.stiffness, g.damping, Eigen::Map<const Eigen::VectorXd>(g.targets.data(), kModes * N);
   return p;
 }
 
@@ -146,12 +147,12 @@ Case MakeCase(Integrator integrator, bool grounded, int steps, unsigned seed, bo
   r.integrator = integrator;
   r.dt = 0.005;
   r.world.ground.enabled = grounded;
-  r.q0.resize(kNq);
-  r.qd0.resize(kNq);
+  r.start.q.resize(kNq);
+  r.start.qd.resize(kNq);
   const double height = grounded ? 12.0 : 200.0;
   const double vx = grounded ? 80.0 : 20 * u(rng), vy = grounded ? -60.0 : 20 * u(rng);
-  r.q0 << 10 * u(rng), height, 0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng);
-  r.qd0 << vx, vy, 0.3 * u(rng), 0.2 * u(rng), 0.2 * u(rng), 0.2 * u(rng), 0.2 * u(rng);
+  r.start.q << 10 * u(rng), height, 0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng);
+  r.start.qd << vx, vy, 0.3 * u(rng), 0.2 * u(rng), 0.2 * u(rng), 0.2 * u(rng), 0.2 * u(rng);
   r.stiffness.resize(kModes);
   r.damping.resize(kModes);
   for (int d = 0; d < kModes; ++d) {
@@ -175,8 +176,8 @@ Eigen::VectorXd Direction(const Eigen::VectorXd& p, std::mt19937& rng) {
 // along the plain run: proof that a grounded case went through the branches it is meant to test.
 void ContactEvents(const Case& k, int* onsets, int* ends, int* slips, std::set<int>* faces = nullptr) {
   BodyState<2, double> s;
-  s.q = k.rollout.q0;
-  s.qd = k.rollout.qd0;
+  s.q = k.rollout.start.q;
+  s.qd = k.rollout.start.qd;
   UpdateContacts(k.passive, k.rollout.world.ground, &s);
   *onsets = *ends = *slips = 0;
   std::vector<double> K(k.rollout.stiffness.data(), k.rollout.stiffness.data() + kModes);
@@ -342,8 +343,8 @@ TEST(Adjoint, PoseGraphPosesAndSwitchTimesMatchJets) {
     }
     std::vector<J1> start(2 * kNq), K(kModes), damping(kModes);
     for (int i = 0; i < kNq; ++i) {
-      start[i] = J1(k.rollout.q0[i]);
-      start[kNq + i] = J1(k.rollout.qd0[i]);
+      start[i] = J1(k.rollout.start.q[i]);
+      start[kNq + i] = J1(k.rollout.start.qd[i]);
     }
     for (int d = 0; d < kModes; ++d) {
       K[d] = J1(k.rollout.stiffness[d]);
@@ -391,11 +392,11 @@ TEST(Adjoint, ZeroStepsIsTheGradientOfTheFirstStageCost) {
   Case k = MakeCase(Integrator::kThesis, false, 0, 19);
   const fit::RolloutGradient g = fit::RolloutCostGradient(k.body, k.rollout, StageOf(k.passive));
   ASSERT_TRUE(g.ok);
-  Eigen::VectorXd dq = Eigen::VectorXd::Zero(kNq), dqd = Eigen::VectorXd::Zero(kNq);
-  const double c = StageOf(k.passive)(0, k.rollout.q0, k.rollout.qd0, &dq, &dqd);
+  Eigen::VectorXd dz = Eigen::VectorXd::Zero(2 * kNq);
+  const double c = StageOf(k.passive)(0, k.rollout.start, &dz);
   EXPECT_EQ(g.cost, c);
-  EXPECT_EQ(g.q0, dq);
-  EXPECT_EQ(g.qd0, dqd);
+  EXPECT_EQ(Eigen::VectorXd(g.start.head(kNq)), Eigen::VectorXd(dz.head(kNq)));  // q0
+  EXPECT_EQ(Eigen::VectorXd(g.start.tail(kNq)), Eigen::VectorXd(dz.tail(kNq)));  // q̇0
   EXPECT_EQ(g.stiffness, Eigen::VectorXd::Zero(kModes));
 }
 
@@ -413,7 +414,7 @@ TEST(Adjoint, RefusesBadInputWithAMessage) {
   r.integrator = Integrator::kRK4;
   expect_refused(r, "thesis and symplectic integrators");
   r = k.rollout;
-  r.q0.resize(3);
+  r.start.q.resize(3);
   expect_refused(r, "q0 and qdot0 need 7 values");
   r = k.rollout;
   r.targets.resize(2, 5);

@@ -1,4 +1,4 @@
-// Spacetime fits of the 3D body (lib/wobble/fit/spacetime.h, FitSpacetime3, issue 18): the 3D
+// Spacetime fits of the 3D body (lib/wobble/fit/spacetime.h, FitSpacetime, issue 18): the 3D
 // task terms against the direct per-point formulas and central differences in tangent
 // coordinates, and the fit itself on a task whose answer is known.
 #include <gtest/gtest.h>
@@ -69,7 +69,7 @@ void PerPointCentre(const BodyModel3& body, const BodyState<3, double>& s, Eigen
   *v /= m;
 }
 
-TEST(Spacetime3, CentreOfMassTermsMeasureThePerPointCentre) {
+TEST(SpacetimeSpace, CentreOfMassTermsMeasureThePerPointCentre) {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 5; ++trial) {
     const BodyState<3, double> s = RandomState(&rng);
@@ -77,27 +77,27 @@ TEST(Spacetime3, CentreOfMassTermsMeasureThePerPointCentre) {
     PerPointCentre(Chair(), s, &x, &v);
     // with goal 0 and weight 1 the gradient in δt (δṫ) is the centre (its velocity) itself
     Eigen::VectorXd dz = Eigen::VectorXd::Zero(kNz);
-    const double at = fit::CentreOfMassAt3(Chair(), 4, Eigen::Vector3d::Zero(), 1.0)(4, s, &dz);
+    const double at = fit::CentreOfMassAt(Chair(), 4, Eigen::Vector3d::Zero(), 1.0)(4, s, &dz);
     EXPECT_LT((dz.head<3>() - x).norm(), 1e-10 * x.norm()) << "trial " << trial;
     EXPECT_NEAR(at, 0.5 * x.squaredNorm(), 1e-10 * x.squaredNorm());
     dz.setZero();
-    const double moving = fit::CentreOfMassVelocityAt3(Chair(), 4, Eigen::Vector3d::Zero(), 1.0)(4, s, &dz);
+    const double moving = fit::CentreOfMassVelocityAt(Chair(), 4, Eigen::Vector3d::Zero(), 1.0)(4, s, &dz);
     EXPECT_LT((dz.segment<3>(6 + kModes) - v).norm(), 1e-10 * v.norm()) << "trial " << trial;
     EXPECT_NEAR(moving, 0.5 * v.squaredNorm(), 1e-10 * v.squaredNorm());
   }
 }
 
-TEST(Spacetime3, TaskTermsHaveTheirExactGradients) {
+TEST(SpacetimeSpace, TaskTermsHaveTheirExactGradients) {
   const Eigen::Vector3d goal(30.0, -20.0, 45.0);
   fit::Axes xz;
   xz.y = false;
-  const std::vector<fit::StageCost3> terms = {
-      fit::CentreOfMassAt3(Chair(), 2, goal, 0.7),
-      fit::CentreOfMassAt3(Chair(), 2, goal, 0.7, xz),
-      fit::CentreOfMassVelocityAt3(Chair(), 2, goal, 0.3),
-      fit::UprightAt3(2, 2.0, 0.4),
-      fit::StillAt3(2, 0.5),
-      fit::SumOf3({fit::UprightAt3(2, 1.0), fit::CentreOfMassVelocityAt3(Chair(), 2, goal, 0.2, xz)}),
+  const std::vector<fit::StageCostN<3>> terms = {
+      fit::CentreOfMassAt(Chair(), 2, goal, 0.7),
+      fit::CentreOfMassAt(Chair(), 2, goal, 0.7, xz),
+      fit::CentreOfMassVelocityAt(Chair(), 2, goal, 0.3),
+      fit::UprightAt<3>(2, 2.0, 0.4),
+      fit::StillAt<3>(2, 0.5),
+      fit::SumOf({fit::UprightAt<3>(2, 1.0), fit::CentreOfMassVelocityAt(Chair(), 2, goal, 0.2, xz)}),
   };
   std::mt19937 rng(11);
   for (int trial = 0; trial < 3; ++trial) {
@@ -118,29 +118,29 @@ TEST(Spacetime3, TaskTermsHaveTheirExactGradients) {
       }
     }
   }
-  EXPECT_THROW(fit::UprightAt3(-1, 1.0), std::invalid_argument);
-  EXPECT_THROW(fit::StillAt3(1, -1.0), std::invalid_argument);
-  EXPECT_THROW(fit::CentreOfMassAt3(Chair(), 1, {NAN, 0.0, 0.0}, 1.0), std::invalid_argument);
-  EXPECT_THROW(fit::SumOf3({fit::StillAt3(1, 1.0), fit::StageCost3()}), std::invalid_argument);
+  EXPECT_THROW(fit::UprightAt<3>(-1, 1.0), std::invalid_argument);
+  EXPECT_THROW(fit::StillAt<3>(1, -1.0), std::invalid_argument);
+  EXPECT_THROW(fit::CentreOfMassAt(Chair(), 1, {NAN, 0.0, 0.0}, 1.0), std::invalid_argument);
+  EXPECT_THROW(fit::SumOf({fit::StillAt<3>(1, 1.0), fit::StageCostN<3>()}), std::invalid_argument);
 }
 
 // A tilted chair turned by a yaw stays upright; one tipped over does not.
-TEST(Spacetime3, UprightIgnoresHeadingOnly) {
+TEST(SpacetimeSpace, UprightIgnoresHeadingOnly) {
   BodyState<3, double> s = RestState<3, double>(Chair());
   s.gamma() = VecD<double>::Zero(kModes);
   s.qd = VecQ<double>::Zero(6 + kModes);
   Eigen::VectorXd dz = Eigen::VectorXd::Zero(kNz);
   s.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitY())));
-  EXPECT_NEAR(fit::UprightAt3(0, 1.0)(0, s, &dz), 0.0, 1e-15);
+  EXPECT_NEAR(fit::UprightAt<3>(0, 1.0)(0, s, &dz), 0.0, 1e-15);
   s.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())));
-  EXPECT_NEAR(fit::UprightAt3(0, 1.0)(0, s, &dz), 1.0, 1e-12);  // w (1 − cos 90°)
+  EXPECT_NEAR(fit::UprightAt<3>(0, 1.0)(0, s, &dz), 1.0, 1e-12);  // w (1 − cos 90°)
 }
 
 // The chair in the air without gravity: the task is to hold the squash at `goal` and be still
 // at the last step, from targets that start at zero (the 3D twin of spacetime_test's bend).
-fit::SpacetimeProblem3 SquashAtTheEnd(double goal, double bound, int steps, int knots) {
-  fit::SpacetimeProblem3 p;
-  fit::ControlledRollout3& r = p.rollout;
+fit::SpacetimeProblemN<3> SquashAtTheEnd(double goal, double bound, int steps, int knots) {
+  fit::SpacetimeProblemN<3> p;
+  fit::ControlledRolloutN<3>& r = p.rollout;
   r.world.gravity_on = false;
   r.world.ground.enabled = false;
   r.integrator = Integrator::kSymplecticEuler;
@@ -164,7 +164,7 @@ fit::SpacetimeProblem3 SquashAtTheEnd(double goal, double bound, int steps, int 
   p.lower = Eigen::VectorXd::Constant(kModes, -bound);
   p.upper = Eigen::VectorXd::Constant(kModes, bound);
   p.control_weight = 1e-3;
-  p.task = fit::SumOf3({fit::StillAt3(steps, 1e3), [goal, steps](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
+  p.task = fit::SumOf({fit::StillAt<3>(steps, 1e3), [goal, steps](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
                           if (n != steps) return 0.0;
                           const double miss = s.gamma()[2] - goal, w = 1e4;
                           (*dz)[6 + 2] += w * miss;
@@ -173,15 +173,15 @@ fit::SpacetimeProblem3 SquashAtTheEnd(double goal, double bound, int steps, int 
   return p;
 }
 
-TEST(Spacetime3, ReachesTheGoalAtTheEndWithinBounds) {
+TEST(SpacetimeSpace, ReachesTheGoalAtTheEndWithinBounds) {
   const int steps = 120;
-  const fit::SpacetimeProblem3 p = SquashAtTheEnd(0.2, 0.5, steps, 13);
-  const fit::SpacetimeResult r = fit::FitSpacetime3(Chair(), p);
+  const fit::SpacetimeProblemN<3> p = SquashAtTheEnd(0.2, 0.5, steps, 13);
+  const fit::SpacetimeResult r = fit::FitSpacetime(Chair(), p);
   ASSERT_TRUE(r.ok) << r.message;
-  fit::ControlledRollout3 run = p.rollout;
+  fit::ControlledRolloutN<3> run = p.rollout;
   run.targets = r.targets;
   double squash = 0.0, speed = 0.0;
-  fit::RolloutCost3(Chair(), run, [&](int n, const BodyState<3, double>& s, Eigen::VectorXd*) {
+  fit::RolloutCost(Chair(), run, [&](int n, const BodyState<3, double>& s, Eigen::VectorXd*) {
     if (n == steps) squash = s.gamma()[2], speed = s.qd.norm();
     return 0.0;
   });
@@ -190,20 +190,20 @@ TEST(Spacetime3, ReachesTheGoalAtTheEndWithinBounds) {
   EXPECT_LT(r.cost, 1e-2 * r.initial_cost);
   EXPECT_LE(r.targets.maxCoeff(), 0.5);
   EXPECT_GE(r.targets.minCoeff(), -0.5);
-  EXPECT_NEAR(fit::SpacetimeCostOf3(Chair(), p, r.knots), r.cost, 1e-9 * r.cost);
+  EXPECT_NEAR(fit::SpacetimeCostOf(Chair(), p, r.knots), r.cost, 1e-9 * r.cost);
 }
 
-TEST(Spacetime3, RefusesBadProblems) {
-  fit::SpacetimeProblem3 p = SquashAtTheEnd(0.2, 0.5, 20, 5);
+TEST(SpacetimeSpace, RefusesBadProblems) {
+  fit::SpacetimeProblemN<3> p = SquashAtTheEnd(0.2, 0.5, 20, 5);
   p.knots = 30;
-  EXPECT_THROW(fit::FitSpacetime3(Chair(), p), std::invalid_argument);
+  EXPECT_THROW(fit::FitSpacetime(Chair(), p), std::invalid_argument);
   p = SquashAtTheEnd(0.2, 0.5, 20, 5);
   p.lower[1] = 1.0;
-  EXPECT_THROW(fit::FitSpacetime3(Chair(), p), std::invalid_argument);
+  EXPECT_THROW(fit::FitSpacetime(Chair(), p), std::invalid_argument);
   p = SquashAtTheEnd(0.2, 0.5, 20, 5);
   p.task = nullptr;
-  EXPECT_THROW(fit::FitSpacetime3(Chair(), p), std::invalid_argument);
-  EXPECT_THROW(fit::FitSpacetime3(testing::Box(1, 2, 3), SquashAtTheEnd(0.2, 0.5, 20, 5)), std::invalid_argument);
+  EXPECT_THROW(fit::FitSpacetime(Chair(), p), std::invalid_argument);
+  EXPECT_THROW(fit::FitSpacetime(testing::Box(1, 2, 3), SquashAtTheEnd(0.2, 0.5, 20, 5)), std::invalid_argument);
 }
 
 }  // namespace

@@ -25,9 +25,9 @@ fit::SpacetimeProblem BendAtTheEnd(double goal, double upper, int steps, int kno
   r.world.ground.enabled = false;
   r.integrator = Integrator::kSymplecticEuler;
   r.dt = 0.005;
-  r.q0 = Eigen::VectorXd::Zero(kNq);
-  r.q0[1] = 100.0;
-  r.qd0 = Eigen::VectorXd::Zero(kNq);
+  r.start.q = Eigen::VectorXd::Zero(kNq);
+  r.start.q[1] = 100.0;
+  r.start.qd = Eigen::VectorXd::Zero(kNq);
   // the bend's generalized mass is ~1.2e7 (550 kg moving up to 150): K = 4e8 gives it a period
   // of ~0.8 s, damped at about a fifth of critical
   r.stiffness = Eigen::VectorXd::Constant(kModes, 4e8);
@@ -37,12 +37,12 @@ fit::SpacetimeProblem BendAtTheEnd(double goal, double upper, int steps, int kno
   p.lower = Eigen::VectorXd::Constant(kModes, -upper);
   p.upper = Eigen::VectorXd::Constant(kModes, upper);
   p.control_weight = 1e-2;  // small beside the task: the optimum misses the goal by ~1e-4
-  p.task = [goal, steps](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq,
-                         Eigen::VectorXd* dqd) {
+  p.task = [goal, steps](int n, const BodyState<2, double>& s, Eigen::VectorXd* dz) {
     if (n != steps) return 0.0;
+    const Eigen::VectorXd q = s.q, qd = s.qd;
     const double miss = q[3] - goal, w = 1e4;
-    (*dq)[3] += 2.0 * w * miss;
-    *dqd += 2.0 * w * qd;
+    (*dz)[3] += 2.0 * w * miss;        // z = (q, q̇)
+    dz->tail(kNq) += 2.0 * w * qd;
     return w * (miss * miss + qd.squaredNorm());
   };
   return p;
@@ -57,8 +57,8 @@ const BodyModel& Table() {
 void EndOf(const fit::SpacetimeProblem& p, const Eigen::MatrixXd& targets, double* bend, double* speed) {
   fit::ControlledRollout run = p.rollout;
   run.targets = targets;
-  fit::RolloutCost(Table(), run, [&](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd*,
-                                     Eigen::VectorXd*) {
+  fit::RolloutCost(Table(), run, [&](int n, const BodyState<2, double>& s, Eigen::VectorXd*) {
+    const Eigen::VectorXd q = s.q, qd = s.qd;
     if (n == run.steps()) {
       *bend = q[3];
       *speed = qd.norm();
@@ -120,6 +120,17 @@ TEST(Spacetime, BoundsHoldWhenTheGoalLiesBeyondThem) {
   EXPECT_GT(bend, 0.1) << "past the bound of its targets";
 }
 
+// A 2D stage cost at (q, q̇), its gradient added to *dq and *dqd (the halves of its z).
+double CallAt(const fit::StageCost& term, int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+              Eigen::VectorXd* dq, Eigen::VectorXd* dqd) {
+  Eigen::VectorXd dz(2 * q.size());
+  dz << *dq, *dqd;
+  const double value = term(n, StateFromCoordinates<2>(q, qd), &dz);
+  *dq = dz.head(q.size());
+  *dqd = dz.tail(q.size());
+  return value;
+}
+
 // The ready-made task terms' gradients against central differences of their values.
 TEST(Spacetime, TaskTermsHaveTheirExactGradients) {
   const BodyModel& body = testing::HopTable();
@@ -127,21 +138,21 @@ TEST(Spacetime, TaskTermsHaveTheirExactGradients) {
   only_y.x = false;
   const std::vector<fit::StageCost> terms = {
       fit::CentreOfMassAt(body, 3, {10.0, 80.0}, 2.0), fit::CentreOfMassAt(body, 3, {10.0, 80.0}, 2.0, only_y),
-      fit::UprightAt(3, 5.0, 0.3), fit::StillAt(3, 0.7), fit::CentreOfMassVelocityAt(body, 3, {1.0, -2.0}, 3.0),
+      fit::UprightAt<2>(3, 5.0, 0.3), fit::StillAt<2>(3, 0.7), fit::CentreOfMassVelocityAt(body, 3, {1.0, -2.0}, 3.0),
       fit::CentreOfMassVelocityAt(body, 3, {0.0, 0.0}, 3.0, only_y),
-      fit::SumOf({fit::UprightAt(3, 1.0), fit::CentreOfMassAt(body, 3, {0.0, 50.0}, 1.0)})};
+      fit::SumOf({fit::UprightAt<2>(3, 1.0), fit::CentreOfMassAt(body, 3, {0.0, 50.0}, 1.0)})};
   Eigen::VectorXd q(7), qd(7);
   q << 3.0, 70.0, 0.4, 0.1, -0.2, 0.15, 0.05;
   qd << 1.0, -2.0, 0.5, 0.3, 0.2, -0.1, 0.4;
   for (size_t t = 0; t < terms.size(); ++t) {
     Eigen::VectorXd dq = Eigen::VectorXd::Zero(7), dqd = Eigen::VectorXd::Zero(7), scratch = dq, scratch2 = dq;
-    EXPECT_EQ(terms[t](2, q, qd, &scratch, &scratch2), 0.0) << "another step adds nothing";
+    EXPECT_EQ(CallAt(terms[t], 2, q, qd, &scratch, &scratch2), 0.0) << "another step adds nothing";
     EXPECT_TRUE(scratch.isZero(0.0) && scratch2.isZero(0.0));
-    const double value = terms[t](3, q, qd, &dq, &dqd);
+    const double value = CallAt(terms[t], 3, q, qd, &dq, &dqd);
     EXPECT_GT(value, 0.0);
     auto at = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
       Eigen::VectorXd g1 = Eigen::VectorXd::Zero(7), g2 = g1;
-      return terms[t](3, a, b, &g1, &g2);
+      return CallAt(terms[t], 3, a, b, &g1, &g2);
     };
     for (int i = 0; i < 7; ++i) {
       const double h = 1e-6;
@@ -152,8 +163,8 @@ TEST(Spacetime, TaskTermsHaveTheirExactGradients) {
       EXPECT_NEAR(dqd[i], cd_qd, 1e-6 * (1.0 + std::abs(cd_qd))) << "term " << t << " qdot" << i;
     }
   }
-  EXPECT_THROW(fit::UprightAt(-1, 1.0), std::invalid_argument);
-  EXPECT_THROW(fit::StillAt(1, -1.0), std::invalid_argument);
+  EXPECT_THROW(fit::UprightAt<2>(-1, 1.0), std::invalid_argument);
+  EXPECT_THROW(fit::StillAt<2>(1, -1.0), std::invalid_argument);
   EXPECT_THROW(fit::CentreOfMassAt(body, 1, {NAN, 0.0}, 1.0), std::invalid_argument);
 }
 
@@ -175,8 +186,8 @@ TEST(Spacetime, FindsAHopFromAStandingStart) {
   double height = 0, lowest = 0, end_angle = 1;
   fit::ControlledRollout run = p.rollout;
   run.targets = r.targets;
-  fit::RolloutCost(body, run, [&](int n, const Eigen::VectorXd& q, const Eigen::VectorXd&, Eigen::VectorXd*,
-                                  Eigen::VectorXd*) {
+  fit::RolloutCost(body, run, [&](int n, const BodyState<2, double>& s, Eigen::VectorXd*) {
+    const Eigen::VectorXd q = s.q;
     if (n == testing::kHopPeak) {
       const Eigen::Vector2d c = (body.moments().c0 + body.moments().C * q.tail(4)) / body.moments().m;
       height = q[1] + (Eigen::Rotation2Dd(q[2]) * c).y();

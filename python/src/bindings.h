@@ -28,7 +28,6 @@ void BindScript(py::module_& m);   // Interpreter, scenes (script.cc)
 void BindSynth(py::module_& m);    // pose graphs, trials, annealing (synth.cc)
 void BindFit(py::module_& m);      // pose fits (fit.cc)
 void BindGradients(py::module_& m);  // rollout gradients, spacetime fits, schedules (gradients.cc)
-void BindGradients3(py::module_& m);  // the same for the 3D body (gradients3.cc)
 void BindAnalysis(py::module_& m); // condition numbers, mode-set checks (analysis.cc)
 void BindRender(py::module_& m);   // pictures and exports through pipelines/ (render.cc; with VTK)
 

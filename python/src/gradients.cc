@@ -1,63 +1,387 @@
 // Gradients through whole rollouts and spacetime control fits from Python (fit/adjoint.h,
-// fit/spacetime.h, issue 18), and the target schedule files that scripts play (`schedule`).
-// A stage cost is a StageCost: one of the task terms, a sum of them (`+`), or a Python callable
-// fn(n, q, qd) -> (value, dq, dqd) called with the GIL taken for each step.
-#include "gradients.h"
-
+// fit/spacetime.h, issue 18), for a 2D or a 3D body (the functions dispatch on the body's type),
+// and the target schedule files that scripts play (`schedule`).
+// A stage cost is one StageCost class for both bodies: a task term of a body serves its
+// dimension; upright_at, still_at and a Python fn(n, q, qd) -> (value, dq, dqd) (called with the
+// GIL taken for each step) serve both. Every gradient Python gives or gets is with respect to
+// the numbers it passes (q in World coordinates, 3D with its rotation vector); the library
+// works in the state's tangent coordinates (PyCoordinates converts). The 3D-suffixed names of
+// before are deprecated aliases.
 #include <cmath>
 #include <memory>
+#include <string>
 
+#include "support.h"
 #include "wobble/core/errors.h"
+#include "wobble/core/rotation3.h"
 #include "wobble/fit/adjoint.h"
 #include "wobble/fit/spacetime.h"
 #include "wobble/formats/target_schedule.h"
 
 namespace wobble::python {
+
+// A Python callable kept by C++ copies of a stage cost: dropped with the GIL taken, since the
+// library drops std::functions on threads that do not hold it.
+std::shared_ptr<py::function> HoldWithGil(py::function fn);
+// A Python stage cost's result (value, dq, dqd) at step n, each gradient `size` finite numbers or
+// None (zero); the value must be finite. InputError otherwise.
+double StageResult(const py::object& result, int n, long size, Eigen::VectorXd* dq, Eigen::VectorXd* dqd);
+// The rollout's integrator (thesis or symplectic) and targets (modes, steps).
+void CheckGradientIntegrator(Integrator integrator);
+Eigen::MatrixXd TargetsOf(const py::object& targets, int modes);
+
 namespace {
 
+// A StageCost as Python holds it: one cost for each dimension it serves. A task term of a body
+// serves that body's dimension; upright_at, still_at and a Python fn serve both (a 2D and a 3D
+// form of the same term); a sum serves the dimensions both terms do.
 struct StageCostHandle {
-  fit::StageCost cost;
+  fit::StageCostN<2> plane;  // empty: not for a 2D body
+  fit::StageCostN<3> space;  // empty: not for a 3D body
+  template <int Dim> const fit::StageCostN<Dim>& Of() const {
+    if constexpr (Dim == 2) {
+      if (!plane) throw InputError("this stage cost is a 3D body's; the rollout's body is 2D");
+      return plane;
+    } else {
+      if (!space) throw InputError("this stage cost is a 2D body's; the rollout's body is 3D");
+      return space;
+    }
+  }
 };
 
-// A Python fn(n, q, qd) -> (value, dq, dqd) as a stage cost (the GIL taken for each call).
-fit::StageCost FromPython(py::function fn) {
-  std::shared_ptr<py::function> held = HoldWithGil(std::move(fn));
-  return [held](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq,
-                Eigen::VectorXd* dqd) -> double {
+// How the numbers Python passes and gets (q: World coordinates, q̇) meet a state's tangent
+// coordinates z (fit/adjoint.h). 2D: z = (q, q̇), the same numbers. 3D: q = [t, rotation vector
+// Θ, γ] with R = exp(Θ̂), q̇ = [ṫ, body ω, γ̇], and z = (δt, ε, δγ, δv) with R exp(ε̂).
+//   AddTangentGradient(q, dq, dqd, &dz): dz += ∂ℓ/∂z from ∂ℓ/∂q, ∂ℓ/∂q̇ at q
+//   CoordinateGradients(q, dz, &dq, &dqd): ∂ℓ/∂q, ∂ℓ/∂q̇ from ∂ℓ/∂z at q
+template <int Dim> struct PyCoordinates;
+template <> struct PyCoordinates<2> {
+  static void AddTangentGradient(const Eigen::VectorXd& q, const Eigen::VectorXd& dq, const Eigen::VectorXd& dqd,
+                                 Eigen::VectorXd* dz) {
+    dz->head(q.size()) += dq;
+    dz->tail(q.size()) += dqd;
+  }
+  static void CoordinateGradients(const Eigen::VectorXd& q, const Eigen::VectorXd& dz, Eigen::VectorXd* dq,
+                                  Eigen::VectorXd* dqd) {
+    *dq = dz.head(q.size());
+    *dqd = dz.tail(q.size());
+  }
+};
+template <> struct PyCoordinates<3> {
+  static void AddTangentGradient(const Eigen::VectorXd& q, const Eigen::VectorXd& dq, const Eigen::VectorXd& dqd,
+                                 Eigen::VectorXd* dz);
+  static void CoordinateGradients(const Eigen::VectorXd& q, const Eigen::VectorXd& dz, Eigen::VectorXd* dq,
+                                  Eigen::VectorXd* dqd);
+};
+
+// The gains: the body's own when None.
+template <class Body>
+void GainsOf(const Body& body, const py::object& stiffness, const py::object& damping, Eigen::VectorXd* K,
+             Eigen::VectorXd* c) {
+  const int D = body.num_modes();
+  Eigen::VectorXd own_K, own_c;
+  body.ModeGains(&own_K, &own_c);
+  *K = VectorOr(stiffness, D, own_K, "stiffness");
+  *c = VectorOr(damping, D, own_c, "damping");
+}
+
+// std::invalid_argument from the library as InputError, prefixed with what was called.
+template <class F> auto Checked(const std::string& what, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(what + ": " + e.what());
+  }
+}
+
+
+// A = ∂Θ/∂ε at Θ: R exp(ε̂) = exp((Θ + A ε)^) to first order, A's columns dexp⁻¹_{−Θ}(e_i)
+// (the map RotationVectorRate takes ω through; rotation3.h).
+Eigen::Matrix3d RotationVectorPerTangent(const Eigen::Vector3d& theta) {
+  Eigen::Matrix3d A;
+  for (int i = 0; i < 3; ++i) A.col(i) = RotationVectorRate<double>(theta, Eigen::Vector3d::Unit(i));
+  return A;
+}
+
+// A Python fn(n, q, qd) -> (value, dq, dqd) in World coordinates as a stage cost of dimension
+// Dim (the GIL taken for each call).
+template <int Dim> fit::StageCostN<Dim> FromPython(std::shared_ptr<py::function> held) {
+  return [held](int n, const BodyState<Dim, double>& s, Eigen::VectorXd* dz) -> double {
     py::gil_scoped_acquire gil;
-    Eigen::VectorXd g_q, g_qd;
-    const double value = StageResult((*held)(n, q, qd), n, q.size(), &g_q, &g_qd);
-    *dq += g_q;
-    *dqd += g_qd;
+    const Eigen::VectorXd q = CoordinatesOf(s);
+    Eigen::VectorXd dq, dqd;
+    const double value = StageResult((*held)(n, q, Eigen::VectorXd(s.qd)), n, q.size(), &dq, &dqd);
+    PyCoordinates<Dim>::AddTangentGradient(q, dq, dqd, dz);
     return value;
   };
 }
 
-fit::Axes AxesOf(const std::string& axes) {
-  if (axes != "x" && axes != "y" && axes != "xy") throw InputError("axes: expected 'x', 'y' or 'xy', got '" + axes + "'");
+// The axes a centre-of-mass term measures: 2D 'x', 'y' or 'xy'; 3D some of 'x', 'y', 'z'.
+template <int Dim> fit::Axes AxesOf(const std::string& axes) {
   fit::Axes a;
   a.x = axes.find('x') != std::string::npos;
   a.y = axes.find('y') != std::string::npos;
+  a.z = axes.find('z') != std::string::npos;
+  if constexpr (Dim == 2) {
+    if (axes != "x" && axes != "y" && axes != "xy")
+      throw InputError("axes: expected 'x', 'y' or 'xy', got '" + axes + "'");
+  } else {
+    if (axes.empty() || axes.find_first_not_of("xyz") != std::string::npos)
+      throw InputError("axes: expected some of 'x', 'y', 'z' (such as 'xz'), got '" + axes + "'");
+  }
   return a;
 }
 
-// A rollout from the keyword arguments: the options' world, integrator and dt; the start (at
-// rest in the body frame by default); the gains (the body's own by default); the targets
-// (modes, steps).
-fit::ControlledRollout RolloutOf(const BodyModel& body, const WorldOptions& options, const py::object& targets,
-                                 const py::object& q0, const py::object& qd0, const py::object& stiffness,
-                                 const py::object& damping) {
+// (value, dq, dqd) of a cost of dimension Dim at (q, q̇) in World coordinates.
+template <int Dim>
+py::tuple CallAt(const fit::StageCostN<Dim>& cost, int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  constexpr int kRigid = Group<Dim>::kRigidDofs;
+  if (q.size() != qd.size() || q.size() < kRigid)
+    throw InputError("q and qd must have the same size, at least " + std::to_string(kRigid));
+  Eigen::VectorXd dz = Eigen::VectorXd::Zero(2 * q.size()), dq, dqd;
+  const double value = cost(n, StateFromCoordinates<Dim>(q, qd), &dz);
+  PyCoordinates<Dim>::CoordinateGradients(q, dz, &dq, &dqd);
+  return py::make_tuple(value, dq, dqd);
+}
+
+// A handle of a cost of one dimension.
+StageCostHandle HandleOf(fit::StageCostN<2> c) { return StageCostHandle{std::move(c), {}}; }
+StageCostHandle HandleOf(fit::StageCostN<3> c) { return StageCostHandle{{}, std::move(c)}; }
+
+template <int Dim> void BindBodyTerms(py::module_& m) {
+  using Body = BodyModelN<Dim>;
+  using Vec = Eigen::Matrix<double, Dim, 1>;
+  const char* all = Dim == 2 ? "xy" : "xyz";
+  m.def(
+      "centre_of_mass_at",
+      [](std::shared_ptr<Body> body, int step, const Vec& goal, double weight, const std::string& axes) {
+        return Checked("centre_of_mass_at",
+                       [&] { return HandleOf(fit::CentreOfMassAt(*body, step, goal, weight, AxesOf<Dim>(axes))); });
+      },
+      py::arg("body"), py::arg("step"), py::arg("goal"), py::kw_only(), py::arg("weight") = 1.0, py::arg("axes") = all,
+      "w/2 |centre of mass at step n - goal|^2 on the axes asked for (2D 'x', 'y', 'xy'; 3D 'xyz', 'xz',\n"
+      "'y', ...): be there then. A term of the body's dimension.");
+  m.def(
+      "centre_of_mass_velocity_at",
+      [](std::shared_ptr<Body> body, int step, const Vec& goal, double weight, const std::string& axes) {
+        return Checked("centre_of_mass_velocity_at", [&] {
+          return HandleOf(fit::CentreOfMassVelocityAt(*body, step, goal, weight, AxesOf<Dim>(axes)));
+        });
+      },
+      py::arg("body"), py::arg("step"), py::arg("goal"), py::kw_only(), py::arg("weight") = 1.0, py::arg("axes") = all,
+      "w/2 |centre-of-mass velocity at step n - goal|^2 (goal 0 on 'y': the top of a hop)");
+}
+
+
+void PyCoordinates<3>::AddTangentGradient(const Eigen::VectorXd& q, const Eigen::VectorXd& dq,
+                                          const Eigen::VectorXd& dqd, Eigen::VectorXd* dz) {
+  const int nq = int(dq.size());
+  const Eigen::Vector3d theta = q.segment<3>(3);
+  dz->head<3>() += dq.head<3>();
+  dz->segment<3>(3) += RotationVectorPerTangent(theta).transpose() * dq.segment<3>(3);
+  dz->segment(6, nq - 6) += dq.tail(nq - 6);
+  dz->tail(nq) += dqd;
+}
+
+void PyCoordinates<3>::CoordinateGradients(const Eigen::VectorXd& q, const Eigen::VectorXd& dz, Eigen::VectorXd* dq,
+                                           Eigen::VectorXd* dqd) {
+  const int nq = int(dz.size()) / 2;
+  const Eigen::Vector3d theta = q.segment<3>(3);
+  *dq = dz.head(nq);
+  dq->segment<3>(3) = RotationVectorPerTangent(theta).transpose().lu().solve(Eigen::Vector3d(dz.segment<3>(3)));
+  *dqd = dz.tail(nq);
+}
+
+void BindStageCosts(py::module_& m) {
+  py::class_<StageCostHandle>(
+      m, "StageCost",
+      "A cost l_n(q, qd) of one step of a rollout with its gradient, for a 2D or a 3D body: a task term\n"
+      "(centre_of_mass_at, upright_at, ...), a sum (a + b), or StageCost(fn) with a Python\n"
+      "fn(n, q, qd) -> (value, dq, dqd) in World coordinates (3D: q = [t, rotation vector, gamma],\n"
+      "qd = [t dot, body omega, gamma dot]; dq, dqd: num_q arrays or None).")
+      .def(py::init([](py::function fn) {
+             std::shared_ptr<py::function> held = HoldWithGil(std::move(fn));
+             return StageCostHandle{FromPython<2>(held), FromPython<3>(held)};
+           }),
+           py::arg("fn"))
+      .def(
+          "__call__",
+          [](const StageCostHandle& c, int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, int dim) {
+            if (dim != 0 && dim != 2 && dim != 3) throw InputError("dim: expected 2, 3 or 0 (the cost's own)");
+            if (dim == 0) dim = c.plane ? 2 : 3;
+            return dim == 2 ? CallAt<2>(c.Of<2>(), n, q, qd) : CallAt<3>(c.Of<3>(), n, q, qd);
+          },
+          py::arg("n"), py::arg("q"), py::arg("qd"), py::kw_only(), py::arg("dim") = 0,
+          "(value, dq, dqd) at step n in World coordinates; dim: which body's form (0: the cost's own,\n"
+          "2D when it serves both)")
+      .def("__add__", [](const StageCostHandle& a, const StageCostHandle& b) {
+        StageCostHandle sum;
+        if (a.plane && b.plane) sum.plane = fit::SumOf({a.plane, b.plane});
+        if (a.space && b.space) sum.space = fit::SumOf({a.space, b.space});
+        if (!sum.plane && !sum.space) throw InputError("a 2D body's stage cost and a 3D body's cannot be summed");
+        return sum;
+      });
+
+  BindBodyTerms<2>(m);
+  BindBodyTerms<3>(m);
+  m.def(
+      "upright_at",
+      [](int step, double weight, double time_scale) {
+        return Checked("upright_at", [&] {
+          return StageCostHandle{fit::UprightAt<2>(step, weight, time_scale), fit::UprightAt<3>(step, weight, time_scale)};
+        });
+      },
+      py::arg("step"), py::kw_only(), py::arg("weight") = 1.0, py::arg("time_scale") = 0.0,
+      "At step n: upright and not spinning. 2D w/2 (theta^2 + tau^2 thetadot^2); 3D\n"
+      "w/2 (|R e_y - e_y|^2 + tau^2 |omega|^2), the body's up axis up and not turning (any heading).");
+  m.def(
+      "still_at",
+      [](int step, double weight) {
+        return Checked("still_at",
+                       [&] { return StageCostHandle{fit::StillAt<2>(step, weight), fit::StillAt<3>(step, weight)}; });
+      },
+      py::arg("step"), py::kw_only(), py::arg("weight") = 1.0, "w/2 |qd|^2 at step n: at rest");
+}
+
+
+// The world of a body's dimension from the options: 2D the options' own, 3D ground_3d,
+// gravity_3d and springs_3d.
+WorldParamsN<2> WorldOf(const BodyModel&, const WorldOptions& options) { return options.params; }
+WorldParamsN<3> WorldOf(const BodyModel3&, const WorldOptions& options) { return Params3Of(options); }
+
+// A rollout from the keyword arguments: the options' world, integrator and dt; the start q0, qd0
+// in World coordinates (at rest at the lattice's pose by default); the gains (the body's own by
+// default); the targets (modes, steps).
+template <int Dim>
+fit::ControlledRolloutN<Dim> RolloutOf(const BodyModelN<Dim>& body, const WorldOptions& options,
+                                       const py::object& targets, const py::object& q0, const py::object& qd0,
+                                       const py::object& stiffness, const py::object& damping) {
   const int nq = body.num_q();
-  fit::ControlledRollout r;
-  r.world = options.params;
+  fit::ControlledRolloutN<Dim> r;
+  r.world = WorldOf(body, options);
   r.integrator = options.integrator;
   CheckGradientIntegrator(r.integrator);
   r.dt = options.dt;
-  r.q0 = VectorOr(q0, nq, Eigen::VectorXd::Zero(nq), "q0");
-  r.qd0 = VectorOr(qd0, nq, Eigen::VectorXd::Zero(nq), "qd0");
+  r.start = StateFromCoordinates<Dim>(VectorOr(q0, nq, Eigen::VectorXd::Zero(nq), "q0"),
+                                      VectorOr(qd0, nq, Eigen::VectorXd::Zero(nq), "qd0"));
   GainsOf(body, stiffness, damping, &r.stiffness, &r.damping);
   r.targets = TargetsOf(targets, body.num_modes());
   return r;
+}
+
+// A rollout's gradient as Python sees it: with respect to q0 and qd0 in World coordinates, not
+// the start's tangent coordinates (the same numbers in 2D).
+struct RolloutGradientPy {
+  fit::RolloutGradient g;
+  Eigen::VectorXd q0, qd0;
+};
+
+// fit_spacetime's bounds (every target within ±bound), control weight and options.
+template <class Problem> void SetSpacetimeBounds(int modes, double bound, double control_weight, Problem* p) {
+  if (!(bound > 0) || !std::isfinite(bound)) throw InputError("bound must be a finite number > 0");
+  if (!(control_weight >= 0) || !std::isfinite(control_weight)) throw InputError("control_weight must be >= 0");
+  p->lower = Eigen::VectorXd::Constant(modes, -bound);
+  p->upper = Eigen::VectorXd::Constant(modes, bound);
+  p->control_weight = control_weight;
+}
+fit::SpacetimeOptions SpacetimeOptionsOf(int max_iterations, int starts, double start_spread, unsigned seed,
+                                         int threads) {
+  fit::SpacetimeOptions o;
+  o.max_iterations = max_iterations;
+  o.starts = starts;
+  o.start_spread = start_spread;
+  o.seed = seed;
+  o.threads = threads;
+  return o;
+}
+
+template <int Dim> void BindRollouts(py::module_& m) {
+  using Body = BodyModelN<Dim>;
+  m.def(
+      "rollout_gradient",
+      [](std::shared_ptr<Body> body, const StageCostHandle& cost, const py::object& targets, const WorldOptions& options,
+         const py::object& q0, const py::object& qd0, const py::object& stiffness, const py::object& damping,
+         int checkpoint_interval) {
+        const fit::ControlledRolloutN<Dim> r = RolloutOf(*body, options, targets, q0, qd0, stiffness, damping);
+        const fit::StageCostN<Dim>& c = cost.Of<Dim>();
+        RolloutGradientPy out;
+        {
+          py::gil_scoped_release release;  // a Python stage cost takes it back for its own calls
+          out.g = Checked("rollout_gradient", [&] { return fit::RolloutCostGradient(*body, r, c, checkpoint_interval); });
+        }
+        if (out.g.start.size() > 0)
+          PyCoordinates<Dim>::CoordinateGradients(CoordinatesOf(r.start), out.g.start, &out.q0, &out.qd0);
+        return out;
+      },
+      py::arg("body"), py::arg("cost"), py::kw_only(), py::arg("targets"), py::arg("options") = WorldOptions(),
+      py::arg("q0") = py::none(), py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(),
+      py::arg("damping") = py::none(), py::arg("checkpoint_interval") = 0,
+      "The cost sum_n l_n(q_n, qd_n) of a rollout of the body, 2D or 3D (PD targets (modes, steps), one\n"
+      "per step; gains K, c per mode; the options' world of the body's dimension (3D: ground_3d,\n"
+      "gravity_3d, springs_3d), dt and integrator: thesis or symplectic) and its gradient with respect to\n"
+      "q0, qd0 (World coordinates; 3D q0 = [t, rotation vector, gamma]), K, c and every target, by one\n"
+      "adjoint sweep: its cost does not grow with the number of parameters (README: Gradients).\n"
+      "checkpoint_interval: 0 keeps the whole run when it fits in 64 MiB, else checkpoints every\n"
+      "ceil(sqrt(steps)) steps; -1 always does; N > 0 every N steps.");
+  m.def(
+      "rollout_cost",
+      [](std::shared_ptr<Body> body, const StageCostHandle& cost, const py::object& targets, const WorldOptions& options,
+         const py::object& q0, const py::object& qd0, const py::object& stiffness, const py::object& damping) {
+        const fit::ControlledRolloutN<Dim> r = RolloutOf(*body, options, targets, q0, qd0, stiffness, damping);
+        const fit::StageCostN<Dim>& c = cost.Of<Dim>();
+        py::gil_scoped_release release;
+        return Checked("rollout_cost", [&] { return fit::RolloutCost(*body, r, c); });
+      },
+      py::arg("body"), py::arg("cost"), py::kw_only(), py::arg("targets"), py::arg("options") = WorldOptions(),
+      py::arg("q0") = py::none(), py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(),
+      py::arg("damping") = py::none(), "The same rollout's cost alone (one plain simulation; inf when a step fails).");
+  m.def(
+      "fit_spacetime",
+      [](std::shared_ptr<Body> body, const StageCostHandle& task, const py::object& targets, int knots, double bound,
+         double control_weight, const WorldOptions& options, const py::object& q0, const py::object& qd0,
+         const py::object& stiffness, const py::object& damping, int max_iterations, int starts, double start_spread,
+         unsigned seed, int threads) {
+        fit::SpacetimeProblemN<Dim> p;
+        p.rollout = RolloutOf(*body, options, targets, q0, qd0, stiffness, damping);
+        p.knots = knots;
+        SetSpacetimeBounds(body->num_modes(), bound, control_weight, &p);
+        p.task = task.Of<Dim>();
+        const fit::SpacetimeOptions o = SpacetimeOptionsOf(max_iterations, starts, start_spread, seed, threads);
+        return Checked("fit_spacetime", [&] { return WithCtrlC([&] { return fit::FitSpacetime(*body, p, o); }); });
+      },
+      py::arg("body"), py::arg("task"), py::kw_only(), py::arg("targets"), py::arg("knots") = 21, py::arg("bound") = 0.3,
+      py::arg("control_weight") = 1.0, py::arg("options") = WorldOptions(), py::arg("q0") = py::none(),
+      py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(), py::arg("damping") = py::none(),
+      py::arg("max_iterations") = 100, py::arg("starts") = 1, py::arg("start_spread") = 1.0, py::arg("seed") = 1u,
+      py::arg("threads") = 0,
+      "Spacetime control (thesis 3.1 after Witkin & Kass) of a 2D or 3D body: every mode's PD targets over\n"
+      "the whole run, at `knots` evenly spaced knots within +-bound, minimising control_weight * sum\n"
+      "|target|^2 dt plus the task, by L-BFGS on the adjoint gradient; the options' world of the body's\n"
+      "dimension. targets (modes, steps): the first guess and the run's length. starts > 1: multi-start,\n"
+      "the further starts perturbed by a seeded Gaussian of start_spread on each knot's logistic\n"
+      "coordinate, run on `threads` (0: every core), the lowest cost wins (best_start, start_costs). Like\n"
+      "`wobble fit spacetime`; write_target_schedule(result.targets) for a script's schedule.");
+}
+
+// A deprecated name of before (one release): warns (DeprecationWarning), then calls `name`;
+// `keep_3d` drops a returned stage cost's 2D form, as the old 3D-only StageCost was.
+void BindDeprecated(py::module_& m, const char* old_name, const char* name, bool keep_3d = false) {
+  const std::string message = std::string("wobble.") + old_name + " is deprecated: use wobble." + name +
+                              ", which takes either body";
+  py::object module = m;
+  m.def(
+      old_name,
+      [module, name, message, keep_3d](py::args args, py::kwargs kwargs) -> py::object {
+        if (PyErr_WarnEx(PyExc_DeprecationWarning, message.c_str(), 1) < 0) throw py::error_already_set();
+        py::object result = module.attr(name)(*args, **kwargs);
+        if (keep_3d) {
+          StageCostHandle h = result.cast<StageCostHandle>();
+          h.plane = nullptr;
+          return py::cast(h);
+        }
+        return result;
+      },
+      (std::string("Deprecated (one release): ") + message + ".").c_str());
 }
 
 }  // namespace
@@ -103,119 +427,22 @@ Eigen::MatrixXd TargetsOf(const py::object& targets, int modes) {
   return t;
 }
 
-fit::SpacetimeOptions SpacetimeOptionsOf(int max_iterations, int starts, double start_spread, unsigned seed, int threads) {
-  fit::SpacetimeOptions o;
-  o.max_iterations = max_iterations;
-  o.starts = starts;
-  o.start_spread = start_spread;
-  o.seed = seed;
-  o.threads = threads;
-  return o;
-}
-
 void BindGradients(py::module_& m) {
-  py::class_<StageCostHandle>(m, "StageCost",
-                              "A cost l_n(q, qd) of one step of a rollout with its gradient: a task term\n"
-                              "(centre_of_mass_at, upright_at, ...), a sum (a + b), or StageCost(fn) with a\n"
-                              "Python fn(n, q, qd) -> (value, dq, dqd) (dq, dqd: num_q arrays or None).")
-      .def(py::init([](py::function fn) { return StageCostHandle{FromPython(std::move(fn))}; }), py::arg("fn"))
-      .def(
-          "__call__",
-          [](const StageCostHandle& c, int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-            if (q.size() != qd.size()) throw InputError("q and qd must have the same size");
-            Eigen::VectorXd dq = Eigen::VectorXd::Zero(q.size()), dqd = Eigen::VectorXd::Zero(q.size());
-            const double value = c.cost(n, q, qd, &dq, &dqd);
-            return py::make_tuple(value, dq, dqd);
-          },
-          py::arg("n"), py::arg("q"), py::arg("qd"), "(value, dq, dqd) at step n")
-      .def("__add__", [](const StageCostHandle& a, const StageCostHandle& b) {
-        return StageCostHandle{fit::SumOf({a.cost, b.cost})};
-      });
-
-  m.def(
-      "centre_of_mass_at",
-      [](std::shared_ptr<BodyModel> body, int step, const Eigen::Vector2d& goal, double weight, const std::string& axes) {
-        try {
-          return StageCostHandle{fit::CentreOfMassAt(*body, step, goal, weight, AxesOf(axes))};
-        } catch (const std::invalid_argument& e) {
-          throw InputError(e.what());
-        }
-      },
-      py::arg("body"), py::arg("step"), py::arg("goal"), py::kw_only(), py::arg("weight") = 1.0, py::arg("axes") = "xy",
-      "w/2 |centre of mass at step n - goal|^2 on the axes asked for ('x', 'y', 'xy'): be there then");
-  m.def(
-      "centre_of_mass_velocity_at",
-      [](std::shared_ptr<BodyModel> body, int step, const Eigen::Vector2d& goal, double weight, const std::string& axes) {
-        try {
-          return StageCostHandle{fit::CentreOfMassVelocityAt(*body, step, goal, weight, AxesOf(axes))};
-        } catch (const std::invalid_argument& e) {
-          throw InputError(e.what());
-        }
-      },
-      py::arg("body"), py::arg("step"), py::arg("goal"), py::kw_only(), py::arg("weight") = 1.0, py::arg("axes") = "xy",
-      "w/2 |centre-of-mass velocity at step n - goal|^2 (goal 0 on 'y': the top of a hop)");
-  m.def(
-      "upright_at",
-      [](int step, double weight, double time_scale) {
-        try {
-          return StageCostHandle{fit::UprightAt(step, weight, time_scale)};
-        } catch (const std::invalid_argument& e) {
-          throw InputError(e.what());
-        }
-      },
-      py::arg("step"), py::kw_only(), py::arg("weight") = 1.0, py::arg("time_scale") = 0.0,
-      "w/2 (theta^2 + tau^2 thetadot^2) at step n: upright and not spinning");
-  m.def(
-      "still_at",
-      [](int step, double weight) {
-        try {
-          return StageCostHandle{fit::StillAt(step, weight)};
-        } catch (const std::invalid_argument& e) {
-          throw InputError(e.what());
-        }
-      },
-      py::arg("step"), py::kw_only(), py::arg("weight") = 1.0, "w/2 |qd|^2 at step n: at rest");
-
-  py::class_<fit::RolloutGradient>(m, "RolloutGradient", "A rollout's cost and its gradient with respect to every parameter.")
-      .def_readonly("ok", &fit::RolloutGradient::ok)
-      .def_readonly("message", &fit::RolloutGradient::message)
-      .def_readonly("cost", &fit::RolloutGradient::cost)
-      .def_readonly("q0", &fit::RolloutGradient::q0)
-      .def_readonly("qd0", &fit::RolloutGradient::qd0)
-      .def_readonly("stiffness", &fit::RolloutGradient::stiffness)
-      .def_readonly("damping", &fit::RolloutGradient::damping)
-      .def_readonly("targets", &fit::RolloutGradient::targets, "(modes, steps): d cost / d target of each step")
-      .def_readonly("states_held", &fit::RolloutGradient::states_held, "the most states held at once (checkpoints)");
-
-  m.def(
-      "rollout_gradient",
-      [](std::shared_ptr<BodyModel> body, const StageCostHandle& cost, const py::object& targets, const WorldOptions& options,
-         const py::object& q0, const py::object& qd0, const py::object& stiffness, const py::object& damping,
-         int checkpoint_interval) {
-        const fit::ControlledRollout r = RolloutOf(*body, options, targets, q0, qd0, stiffness, damping);
-        py::gil_scoped_release release;  // a Python stage cost takes it back for its own calls
-        return fit::RolloutCostGradient(*body, r, cost.cost, checkpoint_interval);
-      },
-      py::arg("body"), py::arg("cost"), py::kw_only(), py::arg("targets"), py::arg("options") = WorldOptions(),
-      py::arg("q0") = py::none(), py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(),
-      py::arg("damping") = py::none(), py::arg("checkpoint_interval") = 0,
-      "The cost sum_n l_n(q_n, qd_n) of a rollout of the 2D body (PD targets (modes, steps), one per\n"
-      "step; gains K, c per mode; options' world, dt and integrator: thesis or symplectic) and its\n"
-      "gradient with respect to q0, qd0, K, c and every target, by one adjoint sweep (about 2-4\n"
-      "simulations whatever the number of parameters).\n"
-      "checkpoint_interval: 0 keeps the whole run when it fits in 64 MiB, else checkpoints every\n"
-      "ceil(sqrt(steps)) steps; -1 always does; N > 0 every N steps.");
-  m.def(
-      "rollout_cost",
-      [](std::shared_ptr<BodyModel> body, const StageCostHandle& cost, const py::object& targets, const WorldOptions& options,
-         const py::object& q0, const py::object& qd0, const py::object& stiffness, const py::object& damping) {
-        const fit::ControlledRollout r = RolloutOf(*body, options, targets, q0, qd0, stiffness, damping);
-        py::gil_scoped_release release;
-        return fit::RolloutCost(*body, r, cost.cost);
-      },
-      py::arg("body"), py::arg("cost"), py::kw_only(), py::arg("targets"), py::arg("options") = WorldOptions(),
-      py::arg("q0") = py::none(), py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(),
-      py::arg("damping") = py::none(), "The same rollout's cost alone (one plain simulation; inf when a step fails).");
+  BindStageCosts(m);
+  py::class_<RolloutGradientPy>(m, "RolloutGradient",
+                                "A rollout's cost and its gradient with respect to every parameter (q0, qd0 in World\n"
+                                "coordinates, as the rollout was given them).")
+      .def_property_readonly("ok", [](const RolloutGradientPy& r) { return r.g.ok; })
+      .def_property_readonly("message", [](const RolloutGradientPy& r) { return r.g.message; })
+      .def_property_readonly("cost", [](const RolloutGradientPy& r) { return r.g.cost; })
+      .def_readonly("q0", &RolloutGradientPy::q0, "d cost / d q0 (3D q0 = [t, rotation vector, gamma])")
+      .def_readonly("qd0", &RolloutGradientPy::qd0, "d cost / d qd0 (3D qd0 = [t dot, body omega, gamma dot])")
+      .def_property_readonly("stiffness", [](const RolloutGradientPy& r) { return r.g.stiffness; })
+      .def_property_readonly("damping", [](const RolloutGradientPy& r) { return r.g.damping; })
+      .def_property_readonly("targets", [](const RolloutGradientPy& r) { return r.g.targets; },
+                             "(modes, steps): d cost / d target of each step")
+      .def_property_readonly("states_held", [](const RolloutGradientPy& r) { return r.g.states_held; },
+                             "the most states held at once (checkpoints)");
 
   py::class_<fit::SpacetimeResult>(m, "SpacetimeResult", "A spacetime fit's targets and costs.")
       .def_readonly("ok", &fit::SpacetimeResult::ok)
@@ -230,35 +457,19 @@ void BindGradients(py::module_& m) {
       .def_readonly("best_start", &fit::SpacetimeResult::best_start)
       .def_readonly("start_costs", &fit::SpacetimeResult::start_costs, "every start's final cost (NaN: failed)");
 
-  m.def(
-      "fit_spacetime",
-      [](std::shared_ptr<BodyModel> body, const StageCostHandle& task, const py::object& targets, int knots, double bound,
-         double control_weight, const WorldOptions& options, const py::object& q0, const py::object& qd0,
-         const py::object& stiffness, const py::object& damping, int max_iterations, int starts, double start_spread,
-         unsigned seed, int threads) {
-        fit::SpacetimeProblem p;
-        p.rollout = RolloutOf(*body, options, targets, q0, qd0, stiffness, damping);
-        p.knots = knots;
-        SetSpacetimeBounds(body->num_modes(), bound, control_weight, &p);
-        p.task = task.cost;
-        const fit::SpacetimeOptions o = SpacetimeOptionsOf(max_iterations, starts, start_spread, seed, threads);
-        try {
-          return WithCtrlC([&] { return fit::FitSpacetime(*body, p, o); });
-        } catch (const std::invalid_argument& e) {
-          throw InputError(std::string("fit_spacetime: ") + e.what());
-        }
-      },
-      py::arg("body"), py::arg("task"), py::kw_only(), py::arg("targets"), py::arg("knots") = 21, py::arg("bound") = 0.3,
-      py::arg("control_weight") = 1.0, py::arg("options") = WorldOptions(), py::arg("q0") = py::none(),
-      py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(), py::arg("damping") = py::none(),
-      py::arg("max_iterations") = 100, py::arg("starts") = 1, py::arg("start_spread") = 1.0, py::arg("seed") = 1u,
-      py::arg("threads") = 0,
-      "Spacetime control (thesis 3.1 after Witkin & Kass): every mode's PD targets over the whole run,\n"
-      "at `knots` evenly spaced knots within +-bound, minimising control_weight * sum |target|^2 dt plus\n"
-      "the task, by L-BFGS on the adjoint gradient. targets (modes, steps): the first guess and the run's\n"
-      "length. starts > 1: multi-start, the further starts perturbed by a seeded Gaussian of start_spread on\n"
-      "each knot's logistic coordinate, run on `threads` (0: every core), the lowest cost wins (best_start,\n"
-      "start_costs). Like `wobble fit spacetime`; write_target_schedule(result.targets) for a script's schedule.");
+  BindRollouts<2>(m);
+  BindRollouts<3>(m);
+
+  // The 3D names of before, one release (python/wobble/__init__.pyi marks them deprecated).
+  m.attr("StageCost3") = m.attr("StageCost");
+  m.attr("RolloutGradient3") = m.attr("RolloutGradient");
+  BindDeprecated(m, "rollout_gradient3", "rollout_gradient");
+  BindDeprecated(m, "rollout_cost3", "rollout_cost");
+  BindDeprecated(m, "fit_spacetime3", "fit_spacetime");
+  BindDeprecated(m, "centre_of_mass_at3", "centre_of_mass_at");
+  BindDeprecated(m, "centre_of_mass_velocity_at3", "centre_of_mass_velocity_at");
+  BindDeprecated(m, "upright_at3", "upright_at", true);
+  BindDeprecated(m, "still_at3", "still_at", true);
 
   m.def(
       "write_target_schedule",

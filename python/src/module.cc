@@ -17,7 +17,6 @@ PYBIND11_MODULE(_wobble, m) {
   BindSynth(m);
   BindFit(m);
   BindGradients(m);
-  BindGradients3(m);
   BindAnalysis(m);
 #ifdef WOBBLE_PYTHON_RENDER
   BindRender(m);

@@ -414,19 +414,27 @@ def fit_dynamic(body: BodyModel | BodyModel3, times: ArrayLike, points: ArrayLik
                 max_iterations: int = 50, gradient: str = "jets") -> DynamicFitResult: ...
 
 class StageCost:
-    """l_n(q, qd) of one step with its gradient: a task term, a sum (a + b), or StageCost(fn) with
-    fn(n, q, qd) -> (value, dq, dqd)."""
+    """l_n(q, qd) of one step of a rollout of a 2D or a 3D body with its gradient: a task term, a sum
+    (a + b), or StageCost(fn) with fn(n, q, qd) -> (value, dq, dqd) in World coordinates (3D: q = [t,
+    rotation vector, gamma], qd = [t dot, body omega, gamma dot]). A term of a body serves that body's
+    dimension; upright_at, still_at and a Python fn serve both; a sum serves what both terms do."""
     def __init__(self, fn: Callable[[int, NDArray, NDArray], tuple[float, Optional[ArrayLike], Optional[ArrayLike]]]) -> None: ...
-    def __call__(self, n: int, q: ArrayLike, qd: ArrayLike) -> tuple[float, NDArray, NDArray]: ...
+    def __call__(self, n: int, q: ArrayLike, qd: ArrayLike, *, dim: int = 0) -> tuple[float, NDArray, NDArray]:
+        """(value, dq, dqd) at step n; dim 2 or 3 picks the body's form (0: the cost's own, 2D when both)."""
     def __add__(self, other: StageCost) -> StageCost: ...
 
-def centre_of_mass_at(body: BodyModel, step: int, goal: ArrayLike, *, weight: float = 1.0, axes: str = "xy") -> StageCost: ...
-def centre_of_mass_velocity_at(body: BodyModel, step: int, goal: ArrayLike, *, weight: float = 1.0,
-                               axes: str = "xy") -> StageCost: ...
-def upright_at(step: int, *, weight: float = 1.0, time_scale: float = 0.0) -> StageCost: ...
-def still_at(step: int, *, weight: float = 1.0) -> StageCost: ...
+def centre_of_mass_at(body: BodyModel | BodyModel3, step: int, goal: ArrayLike, *, weight: float = 1.0,
+                      axes: str = ...) -> StageCost:
+    """axes: 2D 'x', 'y', 'xy' (default 'xy'); 3D some of 'x', 'y', 'z' (default 'xyz')."""
+def centre_of_mass_velocity_at(body: BodyModel | BodyModel3, step: int, goal: ArrayLike, *, weight: float = 1.0,
+                               axes: str = ...) -> StageCost: ...
+def upright_at(step: int, *, weight: float = 1.0, time_scale: float = 0.0) -> StageCost:
+    """2D w/2 (theta^2 + tau^2 thetadot^2); 3D w/2 (|R e_y - e_y|^2 + tau^2 |omega|^2). Serves both bodies."""
+def still_at(step: int, *, weight: float = 1.0) -> StageCost:
+    """w/2 |qd|^2. Serves both bodies."""
 
 class RolloutGradient:
+    """d cost / d each parameter; q0, qd0 in World coordinates (3D q0 = [t, rotation vector, gamma])."""
     ok: bool
     message: str
     cost: float
@@ -437,11 +445,11 @@ class RolloutGradient:
     targets: NDArray
     states_held: int
 
-def rollout_gradient(body: BodyModel, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
-                     q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
+def rollout_gradient(body: BodyModel | BodyModel3, cost: StageCost, *, targets: ArrayLike,
+                     options: WorldOptions = ..., q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
                      stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None,
                      checkpoint_interval: int = 0) -> RolloutGradient: ...
-def rollout_cost(body: BodyModel, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
+def rollout_cost(body: BodyModel | BodyModel3, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
                  q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
                  stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None) -> float: ...
 
@@ -458,48 +466,45 @@ class SpacetimeResult:
     best_start: int
     start_costs: list[float]
 
-def fit_spacetime(body: BodyModel, task: StageCost, *, targets: ArrayLike, knots: int = 21, bound: float = 0.3,
-                  control_weight: float = 1.0, options: WorldOptions = ..., q0: Optional[ArrayLike] = None,
-                  qd0: Optional[ArrayLike] = None, stiffness: Optional[ArrayLike] = None,
-                  damping: Optional[ArrayLike] = None, max_iterations: int = 100, starts: int = 1,
-                  start_spread: float = 1.0, seed: int = 1, threads: int = 0) -> SpacetimeResult: ...
-class StageCost3:
-    """l_n(q, qd) of one step of a 3D rollout with its gradient, in World.q3 / qd3 coordinates
-    (q = [t, rotation vector, gamma], qd = [t dot, body omega, gamma dot])."""
-    def __init__(self, fn: Callable[[int, NDArray, NDArray], tuple[float, Optional[ArrayLike], Optional[ArrayLike]]]) -> None: ...
-    def __call__(self, n: int, q: ArrayLike, qd: ArrayLike) -> tuple[float, NDArray, NDArray]: ...
-    def __add__(self, other: StageCost3) -> StageCost3: ...
+def fit_spacetime(body: BodyModel | BodyModel3, task: StageCost, *, targets: ArrayLike, knots: int = 21,
+                  bound: float = 0.3, control_weight: float = 1.0, options: WorldOptions = ...,
+                  q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
+                  stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None,
+                  max_iterations: int = 100, starts: int = 1, start_spread: float = 1.0, seed: int = 1,
+                  threads: int = 0) -> SpacetimeResult: ...
 
+# Deprecated (one release; issue 45): the 3D body's names of before. The functions warn
+# (DeprecationWarning) and call the names above, which take either body; upright_at3 and still_at3
+# give the 3D form only (as their StageCost3 did). The classes are the same class objects.
+class StageCost3(StageCost):
+    """Deprecated: StageCost itself (it takes either body)."""
+class RolloutGradient3(RolloutGradient):
+    """Deprecated: RolloutGradient itself."""
 def centre_of_mass_at3(body: BodyModel3, step: int, goal: ArrayLike, *, weight: float = 1.0,
-                       axes: str = "xyz") -> StageCost3: ...
+                       axes: str = "xyz") -> StageCost:
+    """Deprecated: centre_of_mass_at."""
 def centre_of_mass_velocity_at3(body: BodyModel3, step: int, goal: ArrayLike, *, weight: float = 1.0,
-                                axes: str = "xyz") -> StageCost3: ...
-def upright_at3(step: int, *, weight: float = 1.0, time_scale: float = 0.0) -> StageCost3: ...
-def still_at3(step: int, *, weight: float = 1.0) -> StageCost3: ...
-
-class RolloutGradient3:
-    ok: bool
-    message: str
-    cost: float
-    q0: NDArray
-    qd0: NDArray
-    stiffness: NDArray
-    damping: NDArray
-    targets: NDArray
-    states_held: int
-
-def rollout_gradient3(body: BodyModel3, cost: StageCost3, *, targets: ArrayLike, options: WorldOptions = ...,
+                                axes: str = "xyz") -> StageCost:
+    """Deprecated: centre_of_mass_velocity_at."""
+def upright_at3(step: int, *, weight: float = 1.0, time_scale: float = 0.0) -> StageCost:
+    """Deprecated: upright_at (its 3D form)."""
+def still_at3(step: int, *, weight: float = 1.0) -> StageCost:
+    """Deprecated: still_at (its 3D form)."""
+def rollout_gradient3(body: BodyModel3, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
                       q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
                       stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None,
-                      checkpoint_interval: int = 0) -> RolloutGradient3: ...
-def rollout_cost3(body: BodyModel3, cost: StageCost3, *, targets: ArrayLike, options: WorldOptions = ...,
+                      checkpoint_interval: int = 0) -> RolloutGradient:
+    """Deprecated: rollout_gradient."""
+def rollout_cost3(body: BodyModel3, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
                   q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
-                  stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None) -> float: ...
-def fit_spacetime3(body: BodyModel3, task: StageCost3, *, targets: ArrayLike, knots: int = 21, bound: float = 0.3,
+                  stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None) -> float:
+    """Deprecated: rollout_cost."""
+def fit_spacetime3(body: BodyModel3, task: StageCost, *, targets: ArrayLike, knots: int = 21, bound: float = 0.3,
                    control_weight: float = 1.0, options: WorldOptions = ..., q0: Optional[ArrayLike] = None,
                    qd0: Optional[ArrayLike] = None, stiffness: Optional[ArrayLike] = None,
                    damping: Optional[ArrayLike] = None, max_iterations: int = 100, starts: int = 1,
-                   start_spread: float = 1.0, seed: int = 1, threads: int = 0) -> SpacetimeResult: ...
+                   start_spread: float = 1.0, seed: int = 1, threads: int = 0) -> SpacetimeResult:
+    """Deprecated: fit_spacetime."""
 def write_target_schedule(path: str, modes: Sequence[str], dt: float, targets: ArrayLike) -> None: ...
 def read_target_schedule(path: str, modes: Sequence[str], dt: float) -> NDArray: ...
 def fit_pose_to_curves(body: BodyModel, polylines: Sequence[ArrayLike], *, closed: bool = False,

@@ -1,4 +1,5 @@
-"""Gradients through whole 3D rollouts and 3D spacetime fits from Python (issue 18): the adjoint
+"""Gradients through whole 3D rollouts and 3D spacetime fits from Python (issue 18; the same
+functions as the 2D body's, given a BodyModel3): the adjoint
 gradient against central differences of the plain cost in the numbers Python passes (q0 with
 its rotation vector, qd0, targets, gains), stage costs written in Python, and a fit."""
 import numpy as np
@@ -20,8 +21,8 @@ def air_problem(pot3, integrator="thesis"):
     targets = 0.05 * rng.standard_normal((D, steps))
     q0 = np.concatenate([[10.0, 100.0, -5.0, 0.4, -0.3, 0.6], 0.03 * rng.standard_normal(D)])
     qd0 = np.concatenate([[30.0, 20.0, -10.0, 0.5, 1.0, -0.7], 0.2 * rng.standard_normal(D)])
-    cost = (wobble.centre_of_mass_at3(pot3, steps, [30.0, 110.0, 0.0], weight=1e-3)
-            + wobble.upright_at3(steps, weight=10.0, time_scale=0.1) + wobble.still_at3(12, weight=1e-3))
+    cost = (wobble.centre_of_mass_at(pot3, steps, [30.0, 110.0, 0.0], weight=1e-3)
+            + wobble.upright_at(steps, weight=10.0, time_scale=0.1) + wobble.still_at(12, weight=1e-3))
     return dict(targets=targets, options=options, q0=q0, qd0=qd0), cost
 
 
@@ -30,15 +31,15 @@ def central(pot3, cost, kw, name, index, h):
     minus = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in kw.items()}
     plus[name][index] += h
     minus[name][index] -= h
-    return (wobble.rollout_cost3(pot3, cost, **plus) - wobble.rollout_cost3(pot3, cost, **minus)) / (2 * h)
+    return (wobble.rollout_cost(pot3, cost, **plus) - wobble.rollout_cost(pot3, cost, **minus)) / (2 * h)
 
 
 @pytest.mark.parametrize("integrator", ["thesis", "symplectic"])
 def test_rollout_gradient3_matches_central_differences(pot3, integrator):
     kw, cost = air_problem(pot3, integrator)
-    g = wobble.rollout_gradient3(pot3, cost, **kw)
+    g = wobble.rollout_gradient(pot3, cost, **kw)
     assert g.ok, g.message
-    assert g.cost == pytest.approx(wobble.rollout_cost3(pot3, cost, **kw), rel=1e-14)
+    assert g.cost == pytest.approx(wobble.rollout_cost(pot3, cost, **kw), rel=1e-14)
     assert g.targets.shape == kw["targets"].shape
     # every start coordinate, the rotation vector's three included (q0[3:6])
     for i in range(len(kw["q0"])):
@@ -48,7 +49,7 @@ def test_rollout_gradient3_matches_central_differences(pot3, integrator):
         assert g.targets[d, n] == pytest.approx(central(pot3, cost, kw, "targets", (d, n), 1e-5), rel=1e-5, abs=1e-9)
     stiffness = np.array([2.5e6, 2.0e6, 1.5e6])  # given in place of the body's own
     kw["stiffness"] = stiffness
-    g_K = wobble.rollout_gradient3(pot3, cost, **kw)
+    g_K = wobble.rollout_gradient(pot3, cost, **kw)
     assert g_K.stiffness[1] == pytest.approx(central(pot3, cost, kw, "stiffness", 1, 1e-6 * stiffness[1]),
                                              rel=1e-4)
 
@@ -65,24 +66,24 @@ def test_stage_costs_written_in_python_meet_the_rotation_vector(pot3):
         dq[3:6] = w * (q[3:6] - theta_goal)
         return 0.5 * w * (q[3:6] - theta_goal) @ (q[3:6] - theta_goal), dq, None
 
-    cost = wobble.StageCost3(turned_to)
-    g = wobble.rollout_gradient3(pot3, cost, **kw)
+    cost = wobble.StageCost(turned_to)
+    g = wobble.rollout_gradient(pot3, cost, **kw)
     assert g.ok, g.message
     for i in [3, 4, 5, 6]:
         assert g.q0[i] == pytest.approx(central(pot3, cost, kw, "q0", i, 1e-5), rel=1e-5), f"q0[{i}]"
     # a built-in term called from Python gives its gradient in q coordinates too
     q, qd = kw["q0"], kw["qd0"]
-    value, dq, dqd = wobble.upright_at3(0, weight=3.0, time_scale=0.2)(0, q, qd)
+    value, dq, dqd = wobble.upright_at(0, weight=3.0, time_scale=0.2)(0, q, qd, dim=3)
     for i in range(3, 6):
         step = np.zeros_like(q)
         step[i] = 1e-6
-        cd = (wobble.upright_at3(0, weight=3.0, time_scale=0.2)(0, q + step, qd)[0]
-              - wobble.upright_at3(0, weight=3.0, time_scale=0.2)(0, q - step, qd)[0]) / 2e-6
+        cd = (wobble.upright_at(0, weight=3.0, time_scale=0.2)(0, q + step, qd, dim=3)[0]
+              - wobble.upright_at(0, weight=3.0, time_scale=0.2)(0, q - step, qd, dim=3)[0]) / 2e-6
         assert dq[i] == pytest.approx(cd, rel=1e-6)
     assert dqd[3:6] == pytest.approx(3.0 * 0.04 * qd[3:6], rel=1e-12)
 
     with pytest.raises(wobble.InputError, match="dq"):
-        wobble.rollout_cost3(pot3, wobble.StageCost3(lambda n, q, qd: (1.0, np.zeros(2), None)), **kw)
+        wobble.rollout_cost(pot3, wobble.StageCost(lambda n, q, qd: (1.0, np.zeros(2), None)), **kw)
 
 
 def test_fit_spacetime3_reaches_a_squash_in_the_air(pot3):
@@ -97,7 +98,7 @@ def test_fit_spacetime3_reaches_a_squash_in_the_air(pot3):
         dq[6] = 1e4 * (q[6] - goal)
         return 0.5e4 * (q[6] - goal) ** 2, dq, None
 
-    r = wobble.fit_spacetime3(pot3, wobble.StageCost3(squashed) + wobble.still_at3(steps, weight=1e2),
+    r = wobble.fit_spacetime(pot3, wobble.StageCost(squashed) + wobble.still_at(steps, weight=1e2),
                               targets=np.zeros((D, steps)), knots=7, bound=0.5, control_weight=1e-3,
                               options=options, max_iterations=60)
     assert r.ok, r.message
@@ -111,17 +112,17 @@ def test_fit_spacetime3_reaches_a_squash_in_the_air(pot3):
             end["squash"] = q[6]
         return 0.0, None, None
 
-    wobble.rollout_cost3(pot3, wobble.StageCost3(record), targets=r.targets, options=options)
+    wobble.rollout_cost(pot3, wobble.StageCost(record), targets=r.targets, options=options)
     assert end["squash"] == pytest.approx(goal, abs=5e-3)
 
 
 def test_bad_input_names_the_problem(pot3):
     kw, cost = air_problem(pot3)
     with pytest.raises(wobble.InputError, match="targets"):
-        wobble.rollout_gradient3(pot3, cost, **{**kw, "targets": np.zeros((2, 5))})
+        wobble.rollout_gradient(pot3, cost, **{**kw, "targets": np.zeros((2, 5))})
     with pytest.raises(wobble.InputError, match="axes"):
-        wobble.centre_of_mass_at3(pot3, 1, [0, 0, 0], axes="xw")
+        wobble.centre_of_mass_at(pot3, 1, [0, 0, 0], axes="xw")
     with pytest.raises(wobble.InputError, match="integrator"):
-        wobble.rollout_gradient3(pot3, cost, **{**kw, "options": no_ground(integrator="rk4")})
+        wobble.rollout_gradient(pot3, cost, **{**kw, "options": no_ground(integrator="rk4")})
     with pytest.raises(wobble.InputError, match="weight"):
-        wobble.still_at3(3, weight=-1.0)
+        wobble.still_at(3, weight=-1.0)

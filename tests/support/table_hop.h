@@ -29,8 +29,8 @@ inline fit::SpacetimeProblem TableHop(double rise = 2.0) {
   r.integrator = Integrator::kThesis;
   r.dt = 0.01;
   const int nq = body.num_q(), D = body.num_modes();
-  r.q0 = Eigen::VectorXd::Zero(nq);  // the legs' feet on the ground
-  r.qd0 = Eigen::VectorXd::Zero(nq);
+  r.start.q = Eigen::VectorXd::Zero(nq);  // the legs' feet on the ground
+  r.start.qd = Eigen::VectorXd::Zero(nq);
   r.stiffness = Eigen::VectorXd::Constant(D, 4e7);
   r.damping = Eigen::VectorXd::Constant(D, 4e6);
   r.targets = Eigen::MatrixXd::Zero(D, kHopSteps);
@@ -42,7 +42,7 @@ inline fit::SpacetimeProblem TableHop(double rise = 2.0) {
   fit::Axes height_only;
   height_only.x = false;
   p.task = fit::SumOf({fit::CentreOfMassAt(body, kHopPeak, {0.0, rest_height + rise}, 2e3, height_only),
-                       fit::UprightAt(kHopSteps, 2e3, 0.1)});
+                       fit::UprightAt<2>(kHopSteps, 2e3, 0.1)});
   return p;
 }
 

@@ -1,4 +1,4 @@
-// How a rollout gradient (adjoint.h, adjoint3.h) gets the forward run's states back in its
+// How a rollout gradient (adjoint.h) gets the forward run's states back in its
 // backward sweep: kept whole, or recomputed an interval at a time from checkpoints.
 #pragma once
 

@@ -49,7 +49,7 @@ struct DynamicParameters {
 //   kAdjoint: the adjoint (fit/adjoint.h) gives the cost's gradient for a few simulations
 //             whatever the number of parameters; Ceres' line search (BFGS, L-BFGS past 400
 //             unknowns). ζ ≥ 0 is held by ζ = u² and the transition times' bounds by a
-//             logistic map. 2D and 3D bodies (3D: fit/adjoint3.h, q0's δ through J_r).
+//             logistic map. 2D and 3D bodies (fit/adjoint.h; 3D q0's δ through J_r).
 enum class FitGradient { kJets, kAdjoint };
 
 template <int Dim> struct DynamicFitOptionsN {

@@ -1,5 +1,5 @@
 // The dynamic fit on the adjoint gradient (issue 18): the fit's cost as a rollout of
-// fit/adjoint.h (2D) or fit/adjoint3.h (3D) with a stage cost at every frame's step, minimised
+// fit/adjoint.h (either dimension) with a stage cost at every frame's step, minimised
 // by Ceres' BFGS line search.
 #include <ceres/gradient_problem.h>
 #include <ceres/gradient_problem_solver.h>
@@ -10,7 +10,6 @@
 #include "wobble/core/errors.h"
 #include "wobble/core/interrupt.h"
 #include "wobble/fit/adjoint.h"
-#include "wobble/fit/adjoint3.h"
 #include "wobble/fit/internal/dynamic_problem.h"
 #include "wobble/fit/internal/solve_common.h"
 #include "wobble/fit/trajectory_fit.h"
@@ -23,59 +22,59 @@ double Logistic(double x) { return 1.0 / (1.0 + std::exp(-x)); }
 
 constexpr double kLeastZeta = 1e-4;
 
-// ½ Σ w |x_i(q_n) − target|² over the frames at step n, and its gradient in q: with
-// x = t + R(θ) l (Eq. 4.2) and r = w (x − target), ∂/∂t = r, ∂/∂θ = rᵀ J (x − t) (J the
-// quarter turn) and ∂/∂γ = Bᵀ Rᵀ r.
-struct FrameCost {
-  const Reference<2>* ref;
+// ½ Σ w |x_i(state_n) − target|² over the frames observed at step n, and its gradient in the
+// state's tangent coordinates (adjoint.h); each dimension's formula below.
+template <int Dim> struct FrameCost {
+  const Reference<Dim>* ref;
   std::vector<std::vector<int>> frames_at;  // step → frames observed there
-
-  double operator()(int n, const Eigen::VectorXd& q, Eigen::VectorXd* dq) const {
-    if (n >= int(frames_at.size())) return 0.0;
-    const int D = int(q.size()) - 3;
-    const Eigen::Rotation2Dd R(q[2]);
-    const Eigen::Matrix2d Rm = R.toRotationMatrix();
-    double cost = 0.0;
-    for (int f : frames_at[n])
-      for (const auto& p : ref->points[f]) {
-        const Eigen::Vector2d x = PointPosition(p.basis, q.data(), int(q.size()));
-        const double w = p.sqrt_weight * p.sqrt_weight;
-        const Eigen::Vector2d r = w * (x - p.target);
-        cost += 0.5 * w * (x - p.target).squaredNorm();
-        const Eigen::Vector2d arm = x - q.head<2>();
-        dq->head<2>() += r;
-        (*dq)[2] += r.y() * arm.x() - r.x() * arm.y();
-        if (D > 0) dq->tail(D) += p.basis.B.transpose() * (Rm.transpose() * r);
-      }
-    return cost;
-  }
+  double operator()(int n, const BodyState<Dim, double>& s, Eigen::VectorXd* dz) const;
 };
 
-// The same in 3D at a state (tangent coordinates of adjoint3.h): x = t + R l, l = b0 + B γ,
-// so ∂/∂δt = r, ∂/∂ε = l × Rᵀ r (R moved to R exp(ε̂)) and ∂/∂γ = Bᵀ Rᵀ r.
-struct FrameCost3 {
-  const Reference<3>* ref;
-  std::vector<std::vector<int>> frames_at;
+// 2D: with x = t + R(θ) l (Eq. 4.2) and r = w (x − target), ∂/∂t = r, ∂/∂θ = rᵀ J (x − t) (J
+// the quarter turn) and ∂/∂γ = Bᵀ Rᵀ r; nothing on q̇.
+template <>
+double FrameCost<2>::operator()(int n, const BodyState<2, double>& s, Eigen::VectorXd* dz) const {
+  if (n >= int(frames_at.size())) return 0.0;
+  const Eigen::VectorXd q = s.q;
+  const int D = int(q.size()) - 3;
+  const Eigen::Rotation2Dd R(q[2]);
+  const Eigen::Matrix2d Rm = R.toRotationMatrix();
+  double cost = 0.0;
+  for (int f : frames_at[n])
+    for (const auto& p : ref->points[f]) {
+      const Eigen::Vector2d x = PointPosition(p.basis, q.data(), int(q.size()));
+      const double w = p.sqrt_weight * p.sqrt_weight;
+      const Eigen::Vector2d r = w * (x - p.target);
+      cost += 0.5 * w * (x - p.target).squaredNorm();
+      const Eigen::Vector2d arm = x - q.head<2>();
+      dz->head<2>() += r;
+      (*dz)[2] += r.y() * arm.x() - r.x() * arm.y();
+      if (D > 0) dz->segment(3, D) += p.basis.B.transpose() * (Rm.transpose() * r);
+    }
+  return cost;
+}
 
-  double operator()(int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) const {
-    if (n >= int(frames_at.size())) return 0.0;
-    const int D = int(s.gamma().size());
-    const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
-    double cost = 0.0;
-    for (int f : frames_at[n])
-      for (const auto& p : ref->points[f]) {
-        const Eigen::Vector3d l = p.basis.b0 + p.basis.B * s.gamma();
-        const Eigen::Vector3d x = s.translation() + R * l;
-        const double w = p.sqrt_weight * p.sqrt_weight;
-        const Eigen::Vector3d r = w * (x - p.target), local = R.transpose() * r;
-        cost += 0.5 * w * (x - p.target).squaredNorm();
-        dz->head<3>() += r;
-        dz->segment<3>(3) += l.cross(local);
-        if (D > 0) dz->segment(6, D) += p.basis.B.transpose() * local;
-      }
-    return cost;
-  }
-};
+// 3D: x = t + R l, l = b0 + B γ, so ∂/∂δt = r, ∂/∂ε = l × Rᵀ r (R moved to R exp(ε̂)) and
+// ∂/∂γ = Bᵀ Rᵀ r.
+template <>
+double FrameCost<3>::operator()(int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) const {
+  if (n >= int(frames_at.size())) return 0.0;
+  const int D = int(s.gamma().size());
+  const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
+  double cost = 0.0;
+  for (int f : frames_at[n])
+    for (const auto& p : ref->points[f]) {
+      const Eigen::Vector3d l = p.basis.b0 + p.basis.B * s.gamma();
+      const Eigen::Vector3d x = s.translation() + R * l;
+      const double w = p.sqrt_weight * p.sqrt_weight;
+      const Eigen::Vector3d r = w * (x - p.target), local = R.transpose() * r;
+      cost += 0.5 * w * (x - p.target).squaredNorm();
+      dz->head<3>() += r;
+      dz->segment<3>(3) += l.cross(local);
+      if (D > 0) dz->segment(6, D) += p.basis.B.transpose() * local;
+    }
+  return cost;
+}
 
 // One evaluation's cost and its gradient in the fit's blocks: q0 as Blocks holds it (3D: the
 // orientation chart · exp(δ̂)), q̇0, K, c and the per-step targets.
@@ -92,95 +91,76 @@ std::vector<std::vector<int>> FramesAt(const std::vector<int>& steps) {
   return at;
 }
 
-// The gains' and targets' parts of a rollout gradient (2D or 3D), moved into *g.
-template <class Gradient> void TakeControls(Gradient* r, BlockGradient* g) {
-  g->cost = r->cost;
-  g->stiffness = std::move(r->stiffness);
-  g->damping = std::move(r->damping);
-  g->targets = std::move(r->targets);
+// The rollout's start from the fit's blocks, and ∂cost/∂(q0's block) from ∂cost/∂z_0 (the
+// start's tangent coordinates), for each dimension. 2D: q0 and q̇0 themselves.
+void SetStart(const BodyModel&, const Blocks<2>&, const DynamicParameters& p, BodyState<2, double>* start) {
+  start->q = p.q0;
+  start->qd = p.qd0;
+}
+void TakeStartGradient(const BodyModel&, const Blocks<2>&, const Eigen::VectorXd& dz, BlockGradient* g) {
+  const Eigen::Index nq = dz.size() / 2;
+  g->q0 = dz.head(nq);
+  g->qd0 = dz.tail(nq);
 }
 
-// The rollout of each dimension: Run fills *g (with gradient) or only g->cost; false when the
-// simulation fails.
-template <int Dim> class FitRollout;
+// 3D: the start as Dimension<3>::Start makes it: t, chart · exp(δ̂), γ, v.
+void SetStart(const BodyModel3& body, const Blocks<3>& b, const DynamicParameters& p, BodyState<3, double>* start) {
+  const int D = body.num_modes();
+  const Eigen::Vector3d delta(b.q0[3], b.q0[4], b.q0[5]);
+  *start = RestState<3, double>(body);
+  start->translation() = Eigen::Vector3d(b.q0[0], b.q0[1], b.q0[2]);
+  Group<3>::SetOrientation(Eigen::Quaterniond(b.chart * ExpRotation<double>(delta)).normalized(), &start->q);
+  for (int d = 0; d < D; ++d) start->gamma()[d] = b.q0[size_t(Group<3>::kRigidDofs + d)];
+  start->qd = p.qd0;
+}
+// z = (δt, ε, δγ, δv); the block's δ moves R = chart exp(δ̂) by ε = J_r(δ) δδ
+void TakeStartGradient(const BodyModel3& body, const Blocks<3>& b, const Eigen::VectorXd& dz, BlockGradient* g) {
+  const int D = body.num_modes();
+  const Eigen::Vector3d delta(b.q0[3], b.q0[4], b.q0[5]);
+  g->q0.resize(Group<3>::kRigidDofs + D);
+  g->q0.head<3>() = dz.head<3>();
+  g->q0.segment<3>(3) = RightJacobianExp<double>(delta).transpose() * dz.segment<3>(3);
+  g->q0.tail(D) = dz.segment(6, D);
+  g->qd0 = dz.tail(Group<3>::kRigidDofs + D);
+}
 
-template <> class FitRollout<2> {
+// The fit's rollout: Run fills *g (with gradient) or only g->cost; false when the simulation
+// fails.
+template <int Dim> class FitRollout {
  public:
-  FitRollout(const Reference<2>& ref, const DynamicFitOptionsN<2>& o) {
+  FitRollout(const Reference<Dim>& ref, const DynamicFitOptionsN<Dim>& o) {
     cost_.ref = &ref;
     cost_.frames_at = FramesAt(ref.steps);
     rollout_.world = o.world;
     rollout_.integrator = Integrator::kThesis;
     rollout_.dt = o.dt;
   }
-  bool Run(const BodyModel& body, const Blocks<2>&, const DynamicParameters& p, Eigen::MatrixXd targets,
+  bool Run(const BodyModelN<Dim>& body, const Blocks<Dim>& b, const DynamicParameters& p, Eigen::MatrixXd targets,
            bool gradient, BlockGradient* g) {
-    rollout_.q0 = p.q0;
-    rollout_.qd0 = p.qd0;
+    SetStart(body, b, p, &rollout_.start);
     rollout_.stiffness = p.stiffness;
     rollout_.damping = p.damping;
     rollout_.targets = std::move(targets);
-    const StageCost stage = [this](int n, const Eigen::VectorXd& q, const Eigen::VectorXd&, Eigen::VectorXd* dq,
-                                   Eigen::VectorXd*) { return cost_(n, q, dq); };
+    const StageCostN<Dim> stage = [this](int n, const BodyState<Dim, double>& s, Eigen::VectorXd* dz) {
+      return cost_(n, s, dz);
+    };
     if (!gradient) {
       g->cost = RolloutCost(body, rollout_, stage);
       return std::isfinite(g->cost);
     }
     RolloutGradient r = RolloutCostGradient(body, rollout_, stage);
     if (!r.ok) return false;
-    TakeControls(&r, g);
-    g->q0 = std::move(r.q0);
-    g->qd0 = std::move(r.qd0);
+    g->cost = r.cost;
+    g->stiffness = std::move(r.stiffness);
+    g->damping = std::move(r.damping);
+    g->targets = std::move(r.targets);
+    TakeStartGradient(body, b, r.start, g);
     return true;
   }
 
  private:
-  FrameCost cost_;
-  ControlledRollout rollout_;
-};
-
-template <> class FitRollout<3> {
- public:
-  FitRollout(const Reference<3>& ref, const DynamicFitOptionsN<3>& o) {
-    cost_.ref = &ref;
-    cost_.frames_at = FramesAt(ref.steps);
-    rollout_.world = o.world;
-    rollout_.integrator = Integrator::kThesis;
-    rollout_.dt = o.dt;
-  }
-  bool Run(const BodyModel3& body, const Blocks<3>& b, const DynamicParameters& p, Eigen::MatrixXd targets,
-           bool gradient, BlockGradient* g) {
-    const int D = body.num_modes();
-    const Eigen::Vector3d delta(b.q0[3], b.q0[4], b.q0[5]);
-    // the start as Dimension<3>::Start makes it: t, chart · exp(δ̂), γ, v
-    rollout_.start = RestState<3, double>(body);
-    rollout_.start.translation() = Eigen::Vector3d(b.q0[0], b.q0[1], b.q0[2]);
-    Group<3>::SetOrientation(Eigen::Quaterniond(b.chart * ExpRotation<double>(delta)).normalized(), &rollout_.start.q);
-    for (int d = 0; d < D; ++d) rollout_.start.gamma()[d] = b.q0[size_t(Group<3>::kRigidDofs + d)];
-    rollout_.start.qd = p.qd0;
-    rollout_.stiffness = p.stiffness;
-    rollout_.damping = p.damping;
-    rollout_.targets = std::move(targets);
-    const StageCost3 stage = [this](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) { return cost_(n, s, dz); };
-    if (!gradient) {
-      g->cost = RolloutCost3(body, rollout_, stage);
-      return std::isfinite(g->cost);
-    }
-    RolloutGradient3 r = RolloutCostGradient3(body, rollout_, stage);
-    if (!r.ok) return false;
-    TakeControls(&r, g);
-    // z = (δt, ε, δγ, δv); the block's δ moves R = chart exp(δ̂) by ε = J_r(δ) δδ
-    g->q0.resize(Group<3>::kRigidDofs + D);
-    g->q0.head<3>() = r.start.head<3>();
-    g->q0.segment<3>(3) = RightJacobianExp<double>(delta).transpose() * r.start.segment<3>(3);
-    g->q0.tail(D) = r.start.segment(6, D);
-    g->qd0 = r.start.tail(Group<3>::kRigidDofs + D);
-    return true;
-  }
-
- private:
-  FrameCost3 cost_;
-  ControlledRollout3 rollout_;
+  FrameCost<Dim> cost_;
+  ControlledRolloutN<Dim> rollout_;
 };
 
 // The fit's free numbers as one vector x for Ceres' line search, in the order q0, q̇0, log K,

@@ -26,29 +26,15 @@ void KnotWeights(int n, int steps, int knots, int* j, double* f) {
 
 double Logistic(double x) { return 1.0 / (1.0 + std::exp(-x)); }
 
-// The rollout of either body: what the one templated fit below calls.
-double CostOf(const BodyModel& body, const ControlledRollout& r, const StageCost& cost) {
-  return RolloutCost(body, r, cost);
-}
-double CostOf(const BodyModel3& body, const ControlledRollout3& r, const StageCost3& cost) {
-  return RolloutCost3(body, r, cost);
-}
-RolloutGradient GradientOf(const BodyModel& body, const ControlledRollout& r, const StageCost& cost) {
-  return RolloutCostGradient(body, r, cost);
-}
-RolloutGradient3 GradientOf(const BodyModel3& body, const ControlledRollout3& r, const StageCost3& cost) {
-  return RolloutCostGradient3(body, r, cost);
-}
-
 // The problem's cost at these knots: one plain simulation, +inf when it fails.
-template <class Body, class Problem>
-double CostAtKnots(const Body& body, const Problem& problem, const Eigen::MatrixXd& knots) {
-  auto r = problem.rollout;
+template <int Dim>
+double CostAtKnots(const BodyModelN<Dim>& body, const SpacetimeProblemN<Dim>& problem, const Eigen::MatrixXd& knots) {
+  ControlledRolloutN<Dim> r = problem.rollout;
   r.targets = KnotTargets(knots, r.steps());
-  return CostOf(body, r, problem.task) + problem.control_weight * r.dt * r.targets.squaredNorm();
+  return RolloutCost(body, r, problem.task) + problem.control_weight * r.dt * r.targets.squaredNorm();
 }
 
-template <class Body, class Problem> void CheckProblem(const Body& body, const Problem& p) {
+template <int Dim> void CheckProblem(const BodyModelN<Dim>& body, const SpacetimeProblemN<Dim>& p) {
   const int D = body.num_modes(), steps = p.rollout.steps();
   auto fail = [](const std::string& what) { throw std::invalid_argument("spacetime fit: " + what); };
   if (D == 0) fail("the body has no modes to control");
@@ -63,9 +49,9 @@ template <class Body, class Problem> void CheckProblem(const Body& body, const P
 }
 
 // The cost as Ceres sees it: x (modes × knots, column-major) → knots → targets → rollout.
-template <class Body, class Problem> class SpacetimeCost final : public ceres::FirstOrderFunction {
+template <int Dim> class SpacetimeCost final : public ceres::FirstOrderFunction {
  public:
-  SpacetimeCost(const Body& body, const Problem& p, long* evaluations)
+  SpacetimeCost(const BodyModelN<Dim>& body, const SpacetimeProblemN<Dim>& p, long* evaluations)
       : body_(body), p_(p), rollout_(p.rollout), evaluations_(evaluations) {}
 
   int NumParameters() const override { return int(p_.lower.size()) * p_.knots; }
@@ -90,7 +76,7 @@ template <class Body, class Problem> class SpacetimeCost final : public ceres::F
       return std::isfinite(*cost);
     }
     rollout_.targets = KnotTargets(Knots(x), steps);
-    const auto g = GradientOf(body_, rollout_, p_.task);
+    const RolloutGradient g = RolloutCostGradient(body_, rollout_, p_.task);
     if (!g.ok) return false;  // the line search steps back
     *cost = g.cost + ControlEnergy(rollout_.targets);
     const Eigen::MatrixXd g_targets = g.targets + (2.0 * p_.control_weight * rollout_.dt) * rollout_.targets;
@@ -113,9 +99,9 @@ template <class Body, class Problem> class SpacetimeCost final : public ceres::F
   }
 
  private:
-  const Body& body_;
-  const Problem& p_;
-  mutable decltype(Problem::rollout) rollout_;  // its targets are each evaluation's
+  const BodyModelN<Dim>& body_;
+  const SpacetimeProblemN<Dim>& p_;
+  mutable ControlledRolloutN<Dim> rollout_;  // its targets are each evaluation's
   long* evaluations_;
 };
 
@@ -149,11 +135,11 @@ namespace {
 
 
 // One L-BFGS descent from x (the logistic coordinates of the knots); `progress` may be null.
-template <class Body, class Problem>
-SpacetimeResult DescendFrom(const Body& body, const Problem& problem, int max_iterations,
+template <int Dim>
+SpacetimeResult DescendFrom(const BodyModelN<Dim>& body, const SpacetimeProblemN<Dim>& problem, int max_iterations,
                             Eigen::VectorXd x, ceres::IterationCallback* progress) {
   SpacetimeResult r;
-  auto* cost = new SpacetimeCost<Body, Problem>(body, problem, &r.gradients);
+  auto* cost = new SpacetimeCost<Dim>(body, problem, &r.gradients);
   ceres::GradientProblem ceres_problem(cost);  // owns cost
   double first = 0.0;
   if (!cost->Evaluate(x.data(), &first, nullptr)) {
@@ -183,8 +169,11 @@ SpacetimeResult DescendFrom(const Body& body, const Problem& problem, int max_it
   return r;
 }
 
-template <class Body, class Problem>
-SpacetimeResult Fit(const Body& body, const Problem& problem, const SpacetimeOptions& options) {
+}  // namespace
+
+template <int Dim>
+SpacetimeResult FitSpacetime(const BodyModelN<Dim>& body, const SpacetimeProblemN<Dim>& problem,
+                             const SpacetimeOptions& options) {
   CheckProblem(body, problem);
   if (options.starts < 1) throw std::invalid_argument("spacetime fit: starts must be >= 1");
   if (!(options.start_spread >= 0.0) || !std::isfinite(options.start_spread))
@@ -240,19 +229,14 @@ SpacetimeResult Fit(const Body& body, const Problem& problem, const SpacetimeOpt
   return r;
 }
 
-}  // namespace
+template <int Dim>
+double SpacetimeCostOf(const BodyModelN<Dim>& body, const SpacetimeProblemN<Dim>& problem, const Eigen::MatrixXd& knots) {
+  return CostAtKnots(body, problem, knots);
+}
 
-double SpacetimeCostOf(const BodyModel& body, const SpacetimeProblem& problem, const Eigen::MatrixXd& knots) {
-  return CostAtKnots(body, problem, knots);
-}
-double SpacetimeCostOf3(const BodyModel3& body, const SpacetimeProblem3& problem, const Eigen::MatrixXd& knots) {
-  return CostAtKnots(body, problem, knots);
-}
-SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem, const SpacetimeOptions& options) {
-  return Fit(body, problem, options);
-}
-SpacetimeResult FitSpacetime3(const BodyModel3& body, const SpacetimeProblem3& problem, const SpacetimeOptions& options) {
-  return Fit(body, problem, options);
-}
+template double SpacetimeCostOf<2>(const BodyModelN<2>&, const SpacetimeProblemN<2>&, const Eigen::MatrixXd&);
+template double SpacetimeCostOf<3>(const BodyModelN<3>&, const SpacetimeProblemN<3>&, const Eigen::MatrixXd&);
+template SpacetimeResult FitSpacetime<2>(const BodyModelN<2>&, const SpacetimeProblemN<2>&, const SpacetimeOptions&);
+template SpacetimeResult FitSpacetime<3>(const BodyModelN<3>&, const SpacetimeProblemN<3>&, const SpacetimeOptions&);
 
 }  // namespace wobble::fit

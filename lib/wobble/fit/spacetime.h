@@ -6,10 +6,10 @@
 // (every step its own knot when knots == steps + 1 … any count ≥ 2). The cost is
 //     ρ Σ_n |γ0(n)|² Δt  +  Σ_n ℓ_n(q_n, q̇_n)
 // (control energy, then the task as a stage cost: reach a point at a time, land upright, …).
-// Its gradient with respect to every knot comes from one adjoint sweep (adjoint.h, adjoint3.h),
+// Its gradient with respect to every knot comes from one adjoint sweep (adjoint.h),
 // so the solver is Ceres' L-BFGS on the gradient alone; the bounds lo ≤ γ0 ≤ hi are kept by
 // solving for x with knot = lo + (hi − lo) σ(x), σ the logistic function. One fit serves the 2D
-// body (FitSpacetime) and the 3D body (FitSpacetime3); only their task terms differ.
+// and the 3D body (FitSpacetime<Dim>); only their task terms' formulas differ.
 #pragma once
 
 #include <Eigen/Core>
@@ -18,19 +18,17 @@
 #include <vector>
 
 #include "wobble/fit/adjoint.h"
-#include "wobble/fit/adjoint3.h"
 
 namespace wobble::fit {
 
-template <class Rollout, class Cost> struct SpacetimeProblemOf {
-  Rollout rollout;               // world, integrator, dt, start, gains; targets: the first guess
-  int knots = 2;                 // ≥ 2, at most steps + 1
-  Eigen::VectorXd lower, upper;  // per mode bounds of the targets, lower < upper
-  double control_weight = 0.0;   // ρ
-  Cost task;                     // ℓ_n, with its gradient
+template <int Dim> struct SpacetimeProblemN {
+  ControlledRolloutN<Dim> rollout;  // world, integrator, dt, start, gains; targets: the first guess
+  int knots = 2;                    // ≥ 2, at most steps + 1
+  Eigen::VectorXd lower, upper;     // per mode bounds of the targets, lower < upper
+  double control_weight = 0.0;      // ρ
+  StageCostN<Dim> task;             // ℓ_n, with its gradient
 };
-using SpacetimeProblem = SpacetimeProblemOf<ControlledRollout, StageCost>;
-using SpacetimeProblem3 = SpacetimeProblemOf<ControlledRollout3, StageCost3>;
+using SpacetimeProblem = SpacetimeProblemN<2>;
 
 struct SpacetimeOptions {
   int max_iterations = 100;  // per start
@@ -63,48 +61,42 @@ struct SpacetimeResult {
 // the first at step 0 and the last at step `steps`.
 Eigen::MatrixXd KnotTargets(const Eigen::MatrixXd& knots, int steps);
 
-// Ready-made task terms (each a StageCost with its exact gradient), and their sum.
-//   CentreOfMassAt: w/2 |x_c(q_n) − goal|² on the axes asked for, x_c = t + R c/m the centre
-//                   of mass (c = c0 + C γ, the mass moments of Eq. 4.9): "be there then".
-//   UprightAt:      w/2 (θ_n² + τ² θ̇_n²): "land upright and without spinning", τ a time scale.
-//   StillAt:        w/2 |q̇_n|² (every coordinate's rate): "be at rest".
+// Ready-made task terms (each a stage cost with its exact gradient in the state's tangent
+// coordinates, adjoint.h), and their sum; one name for both bodies (the 2D and 3D formulas):
+//   CentreOfMassAt: w/2 |x_c − goal|² on the axes asked for, x_c = t + R c/m the centre of mass
+//                   (c = c0 + C γ, the mass moments of Eq. 4.9; 3D kinematics3.h): "be there then".
+//   CentreOfMassVelocityAt: w/2 |v_c − goal|² on the axes asked for, v_c the velocity of the
+//                   centre of mass (2D ṫ + θ̇ S R c/m + R C γ̇/m; 3D ṫ + R (ω × c + C γ̇)/m, ω in
+//                   the body frame): with goal 0 on y, "at the top of a hop".
+//   UprightAt<Dim>: 2D w/2 (θ_n² + τ² θ̇_n²); 3D w/2 (|R e_y − e_y|² + τ² |ω|²), the body's up
+//                   axis up and not turning, any heading: "land upright and without spinning",
+//                   τ a time scale.
+//   StillAt<Dim>:   w/2 |q̇_n|² (every coordinate's rate; 3D v = (ṫ, ω, γ̇)): "be at rest".
 // n is a step index (0 … steps). Throws std::invalid_argument on a negative step or weight.
 struct Axes {
   bool x = true, y = true, z = true;  // z: 3D terms only
 };
-StageCost CentreOfMassAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight, Axes axes = {});
-//   CentreOfMassVelocityAt: w/2 |v_c − goal|² on the axes asked for, v_c the velocity of the
-//                   centre of mass ṫ + θ̇ S R c/m + R C γ̇/m: with goal 0 on y, "at the top of a hop".
-StageCost CentreOfMassVelocityAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight,
-                                 Axes axes = {});
-StageCost UprightAt(int step, double weight, double time_scale = 0.0);
-StageCost StillAt(int step, double weight);
-StageCost SumOf(std::vector<StageCost> terms);
-
-// The same for the 3D body, in the tangent coordinates z = (δt, ε, δγ, δv) of adjoint3.h, with
-// v = (ṫ, ω, γ̇) and ω in the body frame (y up, as in 2D):
-//   CentreOfMassAt3:         w/2 |x_c − goal|², x_c = t + R c/m, c = c0 + C γ (kinematics3.h).
-//   CentreOfMassVelocityAt3: w/2 |v_c − goal|², v_c = ṫ + R (ω × c + C γ̇)/m.
-//   UprightAt3:              w/2 (|R e_y − e_y|² + τ² |ω|²): the body's up axis up and not
-//                            turning; any heading (a turn about the vertical costs nothing).
-//   StillAt3:                w/2 |v|².
-StageCost3 CentreOfMassAt3(const BodyModel3& body, int step, const Eigen::Vector3d& goal, double weight, Axes axes = {});
-StageCost3 CentreOfMassVelocityAt3(const BodyModel3& body, int step, const Eigen::Vector3d& goal, double weight,
-                                   Axes axes = {});
-StageCost3 UprightAt3(int step, double weight, double time_scale = 0.0);
-StageCost3 StillAt3(int step, double weight);
-StageCost3 SumOf3(std::vector<StageCost3> terms);
+StageCostN<2> CentreOfMassAt(const BodyModelN<2>& body, int step, const Eigen::Vector2d& goal, double weight,
+                             Axes axes = {});
+StageCostN<3> CentreOfMassAt(const BodyModelN<3>& body, int step, const Eigen::Vector3d& goal, double weight,
+                             Axes axes = {});
+StageCostN<2> CentreOfMassVelocityAt(const BodyModelN<2>& body, int step, const Eigen::Vector2d& goal, double weight,
+                                     Axes axes = {});
+StageCostN<3> CentreOfMassVelocityAt(const BodyModelN<3>& body, int step, const Eigen::Vector3d& goal, double weight,
+                                     Axes axes = {});
+template <int Dim> StageCostN<Dim> UprightAt(int step, double weight, double time_scale = 0.0);
+template <int Dim> StageCostN<Dim> StillAt(int step, double weight);
+StageCostN<2> SumOf(std::vector<StageCostN<2>> terms);
+StageCostN<3> SumOf(std::vector<StageCostN<3>> terms);
 
 // The problem's cost at these knots (modes × knots, not bounded here): one plain simulation,
 // +inf when it fails. What FitSpacetime minimises, for other optimisers to compare on.
-double SpacetimeCostOf(const BodyModel& body, const SpacetimeProblem& problem, const Eigen::MatrixXd& knots);
+template <int Dim>
+double SpacetimeCostOf(const BodyModelN<Dim>& body, const SpacetimeProblemN<Dim>& problem, const Eigen::MatrixXd& knots);
 
-double SpacetimeCostOf3(const BodyModel3& body, const SpacetimeProblem3& problem, const Eigen::MatrixXd& knots);
-
-// Throws std::invalid_argument on inconsistent sizes, bounds or knot counts.
-SpacetimeResult FitSpacetime(const BodyModel& body, const SpacetimeProblem& problem,
+// Throws std::invalid_argument on inconsistent sizes, bounds or knot counts. Dim = 2 or 3.
+template <int Dim>
+SpacetimeResult FitSpacetime(const BodyModelN<Dim>& body, const SpacetimeProblemN<Dim>& problem,
                              const SpacetimeOptions& options = SpacetimeOptions());
-SpacetimeResult FitSpacetime3(const BodyModel3& body, const SpacetimeProblem3& problem,
-                              const SpacetimeOptions& options = SpacetimeOptions());
 
 }  // namespace wobble::fit

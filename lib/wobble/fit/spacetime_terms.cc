@@ -1,5 +1,5 @@
-// The task terms of spacetime fits (spacetime.h), each with its exact gradient: 2D in q and q̇,
-// 3D in the tangent coordinates of adjoint3.h.
+// The task terms of spacetime fits (spacetime.h), each with its exact gradient in the state's
+// tangent coordinates (adjoint.h): 2D z = (q, q̇), 3D z = (δt, ε, δγ, δv).
 #include <Eigen/Geometry>
 #include <cmath>
 #include <stdexcept>
@@ -19,13 +19,14 @@ void CheckTerm(int step, double weight, const char* what) {
 
 }  // namespace
 
-StageCost CentreOfMassAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight, Axes axes) {
+StageCostN<2> CentreOfMassAt(const BodyModelN<2>& body, int step, const Eigen::Vector2d& goal, double weight,
+                             Axes axes) {
   CheckTerm(step, weight, "CentreOfMassAt");
   if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassAt: the goal must be finite");
   const MassMoments mm = body.moments();
-  return [mm, step, goal, weight, axes](int n, const Eigen::VectorXd& q, const Eigen::VectorXd&, Eigen::VectorXd* dq,
-                                        Eigen::VectorXd*) {
+  return [mm, step, goal, weight, axes](int n, const BodyState<2, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
+    const Eigen::VectorXd q = s.q;
     const int D = int(q.size()) - kRigidDofs;
     const Eigen::Vector2d c = (mm.c0 + mm.C * q.tail(D)) / mm.m;  // body frame
     const Eigen::Rotation2Dd R(q[2]);
@@ -34,22 +35,22 @@ StageCost CentreOfMassAt(const BodyModel& body, int step, const Eigen::Vector2d&
     if (!axes.x) miss.x() = 0.0;
     if (!axes.y) miss.y() = 0.0;
     const Eigen::Vector2d r = weight * miss;
-    dq->head<2>() += r;                                 // ∂x/∂t = I
-    (*dq)[2] += r.y() * Rc.x() - r.x() * Rc.y();        // ∂x/∂θ = S R c
-    dq->tail(D) += mm.C.transpose() * (R.inverse() * r) / mm.m;  // ∂x/∂γ = R C / m
+    dz->head<2>() += r;                                 // ∂x/∂t = I
+    (*dz)[2] += r.y() * Rc.x() - r.x() * Rc.y();        // ∂x/∂θ = S R c
+    dz->segment(kRigidDofs, D) += mm.C.transpose() * (R.inverse() * r) / mm.m;  // ∂x/∂γ = R C / m
     return 0.5 * weight * miss.squaredNorm();
   };
 }
 
-StageCost CentreOfMassVelocityAt(const BodyModel& body, int step, const Eigen::Vector2d& goal, double weight,
-                                 Axes axes) {
+StageCostN<2> CentreOfMassVelocityAt(const BodyModelN<2>& body, int step, const Eigen::Vector2d& goal, double weight,
+                                     Axes axes) {
   CheckTerm(step, weight, "CentreOfMassVelocityAt");
   if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassVelocityAt: the goal must be finite");
   const MassMoments mm = body.moments();
-  return [mm, step, goal, weight, axes](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                                        Eigen::VectorXd* dq, Eigen::VectorXd* dqd) {
+  return [mm, step, goal, weight, axes](int n, const BodyState<2, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
-    const int D = int(q.size()) - kRigidDofs;
+    const Eigen::VectorXd q = s.q, qd = s.qd;
+    const int nq = int(q.size()), D = nq - kRigidDofs;
     Eigen::Matrix2d S;
     S << 0.0, -1.0, 1.0, 0.0;
     const Eigen::Matrix2d R = Eigen::Rotation2Dd(q[2]).toRotationMatrix();
@@ -61,51 +62,32 @@ StageCost CentreOfMassVelocityAt(const BodyModel& body, int step, const Eigen::V
     if (!axes.y) miss.y() = 0.0;
     const Eigen::Vector2d r = weight * miss;
     // ∂v/∂ṫ = I, ∂v/∂θ̇ = S R c, ∂v/∂γ̇ = R C/m; ∂v/∂θ = θ̇ S S R c + S R ċ, ∂v/∂γ = θ̇ S R C/m
-    dqd->head<2>() += r;
-    (*dqd)[2] += r.dot(S * R * c);
-    dqd->tail(D) += mm.C.transpose() * (R.transpose() * r) / mm.m;
-    (*dq)[2] += r.dot(thd * (S * S * R * c) + S * R * cd);
-    dq->tail(D) += thd * mm.C.transpose() * ((S * R).transpose() * r) / mm.m;
+    dz->segment<2>(nq) += r;
+    (*dz)[nq + 2] += r.dot(S * R * c);
+    dz->tail(D) += mm.C.transpose() * (R.transpose() * r) / mm.m;
+    (*dz)[2] += r.dot(thd * (S * S * R * c) + S * R * cd);
+    dz->segment(kRigidDofs, D) += thd * mm.C.transpose() * ((S * R).transpose() * r) / mm.m;
     return 0.5 * weight * miss.squaredNorm();
   };
 }
 
-StageCost UprightAt(int step, double weight, double time_scale) {
+template <> StageCostN<2> UprightAt<2>(int step, double weight, double time_scale) {
   CheckTerm(step, weight, "UprightAt");
   if (!(time_scale >= 0.0) || !std::isfinite(time_scale)) throw std::invalid_argument("UprightAt: the time scale must be >= 0");
-  return [step, weight, time_scale](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq,
-                                    Eigen::VectorXd* dqd) {
+  return [step, weight, time_scale](int n, const BodyState<2, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
+    const int nq = int(s.q.size());
+    const double q2 = s.q[2], qd2 = s.qd[2];
     const double s2 = time_scale * time_scale;
-    (*dq)[2] += weight * q[2];
-    (*dqd)[2] += weight * s2 * qd[2];
-    return 0.5 * weight * (q[2] * q[2] + s2 * qd[2] * qd[2]);
+    (*dz)[2] += weight * q2;
+    (*dz)[nq + 2] += weight * s2 * qd2;
+    return 0.5 * weight * (q2 * q2 + s2 * qd2 * qd2);
   };
 }
 
-StageCost StillAt(int step, double weight) {
-  CheckTerm(step, weight, "StillAt");
-  return [step, weight](int n, const Eigen::VectorXd&, const Eigen::VectorXd& qd, Eigen::VectorXd*, Eigen::VectorXd* dqd) {
-    if (n != step) return 0.0;
-    *dqd += weight * qd;
-    return 0.5 * weight * qd.squaredNorm();
-  };
-}
-
-StageCost SumOf(std::vector<StageCost> terms) {
-  for (const StageCost& t : terms)
-    if (!t) throw std::invalid_argument("SumOf: an empty term");
-  return [terms = std::move(terms)](int n, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd* dq,
-                                     Eigen::VectorXd* dqd) {
-    double total = 0.0;
-    for (const StageCost& t : terms) total += t(n, q, qd, dq, dqd);
-    return total;
-  };
-}
-
-// 3D: where each part of z = (δt, ε, δγ, δv) and of v = (ṫ, ω, γ̇) starts (adjoint3.h).
+// 3D: where each part of z = (δt, ε, δγ, δv) and of v = (ṫ, ω, γ̇) starts (adjoint.h).
 namespace {
-struct Tangent3 {
+struct SpaceTangent {
   int D;
   int t() const { return 0; }
   int eps() const { return 3; }
@@ -123,13 +105,14 @@ Eigen::Vector3d Masked(Eigen::Vector3d miss, Axes axes) {
 }
 }  // namespace
 
-StageCost3 CentreOfMassAt3(const BodyModel3& body, int step, const Eigen::Vector3d& goal, double weight, Axes axes) {
-  CheckTerm(step, weight, "CentreOfMassAt3");
-  if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassAt3: the goal must be finite");
+StageCostN<3> CentreOfMassAt(const BodyModelN<3>& body, int step, const Eigen::Vector3d& goal, double weight,
+                             Axes axes) {
+  CheckTerm(step, weight, "CentreOfMassAt");
+  if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassAt: the goal must be finite");
   const MassMoments3 mm = body.moments();
   return [mm, step, goal, weight, axes](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
-    const Tangent3 z{int(s.gamma().size())};
+    const SpaceTangent z{int(s.gamma().size())};
     const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
     const Eigen::Vector3d c = (mm.c0 + mm.C * s.gamma()) / mm.m;  // body frame
     const Eigen::Vector3d miss = Masked(s.translation() + R * c - goal, axes);
@@ -141,14 +124,14 @@ StageCost3 CentreOfMassAt3(const BodyModel3& body, int step, const Eigen::Vector
   };
 }
 
-StageCost3 CentreOfMassVelocityAt3(const BodyModel3& body, int step, const Eigen::Vector3d& goal, double weight,
+StageCostN<3> CentreOfMassVelocityAt(const BodyModelN<3>& body, int step, const Eigen::Vector3d& goal, double weight,
                                    Axes axes) {
-  CheckTerm(step, weight, "CentreOfMassVelocityAt3");
-  if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassVelocityAt3: the goal must be finite");
+  CheckTerm(step, weight, "CentreOfMassVelocityAt");
+  if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassVelocityAt: the goal must be finite");
   const MassMoments3 mm = body.moments();
   return [mm, step, goal, weight, axes](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
-    const Tangent3 z{int(s.gamma().size())};
+    const SpaceTangent z{int(s.gamma().size())};
     const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
     const Eigen::Vector3d c = (mm.c0 + mm.C * s.gamma()) / mm.m;
     const Eigen::Vector3d omega = s.qd.segment<3>(3);
@@ -166,13 +149,13 @@ StageCost3 CentreOfMassVelocityAt3(const BodyModel3& body, int step, const Eigen
   };
 }
 
-StageCost3 UprightAt3(int step, double weight, double time_scale) {
-  CheckTerm(step, weight, "UprightAt3");
+template <> StageCostN<3> UprightAt<3>(int step, double weight, double time_scale) {
+  CheckTerm(step, weight, "UprightAt");
   if (!(time_scale >= 0.0) || !std::isfinite(time_scale))
-    throw std::invalid_argument("UprightAt3: the time scale must be >= 0");
+    throw std::invalid_argument("UprightAt: the time scale must be >= 0");
   return [step, weight, time_scale](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
-    const Tangent3 z{int(s.gamma().size())};
+    const SpaceTangent z{int(s.gamma().size())};
     const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
     const Eigen::Vector3d up = Eigen::Vector3d::UnitY(), up_body = R.transpose() * up;
     const Eigen::Vector3d omega = s.qd.segment<3>(3);
@@ -184,23 +167,31 @@ StageCost3 UprightAt3(int step, double weight, double time_scale) {
   };
 }
 
-StageCost3 StillAt3(int step, double weight) {
-  CheckTerm(step, weight, "StillAt3");
-  return [step, weight](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
+// w/2 |q̇|², the same numbers in both dimensions: q̇ is the tangent's second half.
+template <int Dim> StageCostN<Dim> StillAt(int step, double weight) {
+  CheckTerm(step, weight, "StillAt");
+  return [step, weight](int n, const BodyState<Dim, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
     dz->tail(s.qd.size()) += weight * s.qd;
     return 0.5 * weight * s.qd.squaredNorm();
   };
 }
+template StageCostN<2> StillAt<2>(int, double);
+template StageCostN<3> StillAt<3>(int, double);
 
-StageCost3 SumOf3(std::vector<StageCost3> terms) {
-  for (const StageCost3& t : terms)
-    if (!t) throw std::invalid_argument("SumOf3: an empty term");
-  return [terms = std::move(terms)](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
+namespace {
+template <int Dim> StageCostN<Dim> Sum(std::vector<StageCostN<Dim>> terms) {
+  for (const StageCostN<Dim>& t : terms)
+    if (!t) throw std::invalid_argument("SumOf: an empty term");
+  return [terms = std::move(terms)](int n, const BodyState<Dim, double>& s, Eigen::VectorXd* dz) {
     double total = 0.0;
-    for (const StageCost3& t : terms) total += t(n, s, dz);
+    for (const StageCostN<Dim>& t : terms) total += t(n, s, dz);
     return total;
   };
 }
+}  // namespace
+
+StageCostN<2> SumOf(std::vector<StageCostN<2>> terms) { return Sum<2>(std::move(terms)); }
+StageCostN<3> SumOf(std::vector<StageCostN<3>> terms) { return Sum<3>(std::move(terms)); }
 
 }  // namespace wobble::fit

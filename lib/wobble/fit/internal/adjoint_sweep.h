@@ -1,5 +1,7 @@
-// What the 2D and 3D adjoints (adjoint.h, adjoint3.h) share (not public): the Jets of their
-// per-step products and the checkpointed forward run and backward sweep.
+// The adjoint of adjoint.h (not public): the Jets of the per-step products, the checkpointed
+// forward run and backward sweep, and the one gradient and cost of a rollout of either
+// dimension over the dimension's own step piece (AdjointStep<Dim>: adjoint_plane.cc in 2D,
+// adjoint_space.cc in 3D).
 #pragma once
 
 #include <ceres/jet.h>
@@ -8,8 +10,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "wobble/fit/adjoint.h"
 
 namespace wobble::fit::internal {
 
@@ -31,6 +38,15 @@ inline void Pull(const AdjointJet& y, double lambda, int offset, Eigen::VectorXd
   const int n = std::min(kAdjointChunk, int(g->size()) - offset);
   for (int k = 0; k < n; ++k) (*g)[offset + k] += lambda * y.v[k];
 }
+
+using ContactKey = std::pair<int, int>;  // (point, face): a contact's identity across steps
+
+// λ of one state: ∂cost/∂z in the state's tangent coordinates (adjoint.h), and ∂cost/∂(the
+// anchor of each contact).
+template <int Dim> struct StateAdjoint {
+  Eigen::VectorXd z;
+  std::map<ContactKey, Eigen::Matrix<double, Dim, 1>> anchor;
+};
 
 // Sets *why to which step failed and why; returns false.
 inline bool StepFailed(int n, const std::string& what, std::string* why) {
@@ -57,7 +73,7 @@ double PlainRolloutCost(int steps, State state, const Step& step, const Stage& s
 // no step is taken twice. On entry *lambda is the zero adjoint of a state; on return, λ_0.
 //   step(n, &state) → bool       advances state n to n + 1
 //   recompute(n, &state) → bool  the same, where the product can keep what the step computed
-//                                (3D: StepTape3): in the backward sweep's recompute of an
+//                                (3D: StepTape): in the backward sweep's recompute of an
 //                                interval (steps begin … end − 2 of it, in order), or for every
 //                                step, in order, when the interval is the whole run
 //   vjp(n, state, next, λ_{n+1}, &λ_n) → bool
@@ -109,6 +125,105 @@ bool CheckpointedAdjointSweep(int steps, int interval, const State& start, Adjoi
     }
   }
   return true;  // with no step, the start was the last state and its stage is in
+}
+
+// Each dimension's step piece: AdjointStep<2> (adjoint_plane.cc), AdjointStep<3> (adjoint_space.cc).
+template <int Dim> class AdjointStep;
+
+// The one rollout of either dimension over its step piece `Piece` (internal::AdjointStep<Dim>):
+//   Piece(body, rollout)                     the body with its own mode forces off, the gains
+//   kWhat                                    how its errors begin ("rollout", "3D rollout")
+//   CheckStartSizes(body, start, fail), StartFinite(start), CheckStartValid(start, fail)
+//   Start()                                  the start state, contacts found
+//   Advance(n, &s, &why) → bool              a plain step
+//   Tape, kTaped                             what Record keeps of a step for Vjp (3D), or not (2D)
+//   Record(n, &s, &tape, &why) → bool        a step keeping its tape (kTaped only)
+//   StepBytes(start)                         a kept step's memory (checkpoints.h's budget)
+//   Vjp(n, s, next, tape or null, λ', &λ, &g, &why) → bool   the step's product (sets g's
+//                                            targets column, adds the gains' part)
+//   StartVjp(λ_0, &dz0)                      the start's contact update pulled back
+template <class Piece, int Dim> void CheckRollout(const BodyModelN<Dim>& body, const ControlledRolloutN<Dim>& r) {
+  const int D = body.num_modes();
+  auto fail = [](const std::string& what) { throw std::invalid_argument(std::string(Piece::kWhat) + ": " + what); };
+  if (r.integrator != Integrator::kThesis && r.integrator != Integrator::kSymplecticEuler)
+    fail("the adjoint takes the thesis and symplectic integrators, not " + IntegratorName(r.integrator));
+  if (!(r.dt > 0.0) || !std::isfinite(r.dt)) fail("dt must be positive and finite");
+  Piece::CheckStartSizes(body, r.start, fail);
+  if (r.stiffness.size() != D || r.damping.size() != D) fail("stiffness and damping need one value per mode");
+  if (r.targets.rows() != D) fail("targets need one row per mode (" + std::to_string(D) + ")");
+  if (!Piece::StartFinite(r.start) || !r.stiffness.allFinite() || !r.damping.allFinite() || !r.targets.allFinite())
+    fail("every number must be finite");
+  Piece::CheckStartValid(r.start, fail);
+}
+
+template <class Piece, int Dim>
+double RolloutCostOf(const BodyModelN<Dim>& body, const ControlledRolloutN<Dim>& rollout, const StageCostN<Dim>& cost) {
+  CheckRollout<Piece>(body, rollout);
+  const Piece r(body, rollout);
+  Eigen::VectorXd dz(StateTangentSize(body));
+  std::string why;
+  return PlainRolloutCost(
+      rollout.steps(), r.Start(), [&](int n, BodyState<Dim, double>* s) { return r.Advance(n, s, &why); },
+      [&](int n, const BodyState<Dim, double>& s) {
+        dz.setZero();
+        return cost(n, s, &dz);
+      });
+}
+
+template <class Piece, int Dim>
+RolloutGradient RolloutGradientOf(const BodyModelN<Dim>& body, const ControlledRolloutN<Dim>& rollout,
+                                  const StageCostN<Dim>& cost, int checkpoint_interval) {
+  CheckRollout<Piece>(body, rollout);
+  const Piece r(body, rollout);
+  const int D = body.num_modes(), nz = StateTangentSize(body), N = rollout.steps();
+  const BodyState<Dim, double> start = r.Start();
+  const int interval = CheckpointInterval(N, checkpoint_interval, Piece::StepBytes(start));
+  RolloutGradient g;
+  g.stiffness = Eigen::VectorXd::Zero(D);
+  g.damping = Eigen::VectorXd::Zero(D);
+  g.targets = Eigen::MatrixXd::Zero(D, N);
+  Eigen::VectorXd dz(nz);
+  auto stage = [&](int n, const BodyState<Dim, double>& s, StateAdjoint<Dim>* lambda) {
+    dz.setZero();
+    g.cost += cost(n, s, &dz);
+    lambda->z += dz;
+  };
+  auto step = [&](int n, BodyState<Dim, double>* s) { return r.Advance(n, s, &g.message); };
+  // A taped piece's recompute of an interval keeps each step's tape (slot n mod interval;
+  // `taped` says which step a slot holds), so the product does not evaluate the step a third
+  // time: about one simulation less per gradient (the interval's last step has none and is
+  // taken again, except when the interval is the whole run, whose forward run keeps every tape).
+  using Tape = typename Piece::Tape;
+  std::vector<Tape> tapes(Piece::kTaped ? size_t(std::min(interval, std::max(N, 1))) : 0);
+  std::vector<int> taped(tapes.size(), -1);
+  auto recompute = [&](int n, BodyState<Dim, double>* s) {
+    if constexpr (Piece::kTaped) {
+      const size_t slot = size_t(n % int(tapes.size()));
+      taped[slot] = n;
+      return r.Record(n, s, &tapes[slot], &g.message);
+    } else {
+      return r.Advance(n, s, &g.message);
+    }
+  };
+  auto vjp = [&](int n, const BodyState<Dim, double>& state, const BodyState<Dim, double>& next,
+                 const StateAdjoint<Dim>& out, StateAdjoint<Dim>* in) {
+    const Tape* tape = nullptr;
+    if constexpr (Piece::kTaped) {
+      const size_t slot = size_t(n % int(tapes.size()));
+      if (taped[slot] == n) tape = &tapes[slot];
+    }
+    return r.Vjp(n, state, next, tape, out, in, &g, &g.message);
+  };
+  StateAdjoint<Dim> lambda{Eigen::VectorXd::Zero(nz), {}};
+  if (!CheckpointedAdjointSweep(N, interval, start, &lambda, step, recompute, vjp, stage, &g.states_held)) return g;
+  g.start = lambda.z;
+  r.StartVjp(lambda, &g.start);
+  if (!std::isfinite(g.cost)) {
+    g.message = "the cost is not finite";
+    return g;
+  }
+  g.ok = true;
+  return g;
 }
 
 }  // namespace wobble::fit::internal

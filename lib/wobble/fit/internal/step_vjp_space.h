@@ -1,8 +1,9 @@
-// The 3D adjoint's per-step vector–Jacobian product, derived by hand (not public; adjoint3.h).
+// The 3D body's piece of the adjoint (adjoint.h): its per-step vector–Jacobian product, derived
+// by hand (not public; adjoint_space.cc puts it behind internal::AdjointStep<3>).
 //
-// A step of StepBody3 (thesis or symplectic integrator) maps a state s, its contacts' anchors A
+// A step of StepBody<3> (thesis or symplectic integrator) maps a state s, its contacts' anchors A
 // and the step's controls u = (PD targets, K, c) to s' and A'. Given λ' = ∂cost/∂(s', A'), this
-// gives ∂cost/∂(s, A, u) = (∂(s', A')/∂(s, A, u))ᵀ λ' in the tangent coordinates of adjoint3.h,
+// gives ∂cost/∂(s, A, u) = (∂(s', A')/∂(s, A, u))ᵀ λ' in the tangent coordinates of adjoint.h,
 // for about the price of two plain steps, whatever the number of contacts:
 //  - the mass solve a = M⁻¹ (Q − w) is pulled back through one solve λ_r = M⁻¹ λ_a and the
 //    scalar ψ = λ_rᵀ (Q − w − M a) at fixed a and λ_r, whose gradient is that of λ_aᵀ a;
@@ -24,22 +25,14 @@
 #include "wobble/body/body_model.h"
 #include "wobble/dynamics/spatial_inertia.h"
 #include "wobble/dynamics/step.h"
+#include "wobble/fit/internal/adjoint_sweep.h"
 #include "wobble/fit/internal/mode_force.h"
 
 namespace wobble::fit::internal {
 
-using ContactKey3 = std::pair<int, int>;  // (point, face): a contact's identity across steps
-
-// λ of one 3D state: ∂cost/∂z in tangent coordinates (δt, ε, δγ, δv), and ∂cost/∂(the anchor
-// of each contact).
-struct StateAdjoint3 {
-  Eigen::VectorXd z;
-  std::map<ContactKey3, Eigen::Vector3d> anchor;
-};
-
 // What a step is: the body (its own mode gains off), the world, the integrator, the step and
 // the mode forces' gains.
-struct StepModel3 {
+struct StepModel {
   const BodyModel3& passive;
   const WorldParamsN<3>& world;
   Integrator integrator;  // kThesis or kSymplecticEuler
@@ -48,17 +41,17 @@ struct StepModel3 {
 };
 
 // ∂cost/∂(one step's controls).
-struct ControlAdjoint3 {
+struct ControlAdjoint {
   VecD<double> target;                  // this step's PD targets (set)
   Eigen::VectorXd *stiffness, *damping;  // the gains' (added to, across steps)
 };
 
-// What the product needs of the forward step from s (StepBody3's thesis or symplectic step,
+// What the product needs of the forward step from s (StepBody<3>'s thesis or symplectic step,
 // the same operations in the same order): where the accelerations were evaluated, the mass
 // matrix's Cholesky factor there, the accelerations, and the state after the step before its
 // contact update. The adjoint's recompute keeps one per step of an interval, so the product
 // does not factor M a second time.
-struct StepTape3 {
+struct StepTape {
   BodyState<3, double> eval, after;
   std::optional<Frame<3, double>> frame;
   std::optional<ShapeMoments<double>> moments;
@@ -66,20 +59,20 @@ struct StepTape3 {
   VecQ<double> a;
 };
 
-// One step from s with PD targets `target`, as StepBody3 takes it, keeping its tape: *next is
-// StepBody3's result (contacts updated). Fails as StepBody3 does.
-StepStatus RecordStep3(const StepModel3& m, const VecD<double>& target, const BodyState<3, double>& s,
-                       StepTape3* tape, BodyState<3, double>* next);
+// One step from s with PD targets `target`, as StepBody<3> takes it, keeping its tape: *next is
+// StepBody<3>'s result (contacts updated). Fails as StepBody<3> does.
+StepStatus RecordStep(const StepModel& m, const VecD<double>& target, const BodyState<3, double>& s,
+                       StepTape* tape, BodyState<3, double>* next);
 
 // in = λ of state s from out = λ of the state after the step taken from s with PD targets
-// `target` (whose tape RecordStep3 kept); adds the gains' part to controls->stiffness/damping
+// `target` (whose tape RecordStep kept); adds the gains' part to controls->stiffness/damping
 // and sets controls->target.
-void StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState<3, double>& s, const StepTape3& tape,
-              const StateAdjoint3& out, StateAdjoint3* in, ControlAdjoint3* controls);
+void StepVjp(const StepModel& m, const VecD<double>& target, const BodyState<3, double>& s, const StepTape& tape,
+              const StateAdjoint<3>& out, StateAdjoint<3>* in, ControlAdjoint* controls);
 
 // The start's contact update (UpdateContacts on `s`, whose contacts are ignored): adds the
 // part of ∂cost/∂z that reaches s through the anchors it gives.
-void StartContactsVjp3(const BodyModel3& passive, const GroundPlane& ground, BodyState<3, double> s,
-                       const std::map<ContactKey3, Eigen::Vector3d>& anchor, Eigen::VectorXd* dz);
+void StartContactsVjp(const BodyModel3& passive, const GroundPlane& ground, BodyState<3, double> s,
+                       const std::map<ContactKey, Eigen::Vector3d>& anchor, Eigen::VectorXd* dz);
 
 }  // namespace wobble::fit::internal

@@ -1,4 +1,4 @@
-#include "wobble/fit/internal/step3_vjp.h"
+#include "wobble/fit/internal/step_vjp_space.h"
 
 #include <cmath>
 #include <vector>
@@ -12,7 +12,7 @@ namespace {
 
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
-using AnchorAdjoints = std::map<ContactKey3, Eigen::Vector3d>;
+using AnchorAdjoints = std::map<ContactKey, Eigen::Vector3d>;
 
 // Where a state's tangent coordinates sit in z: δt, ε, δγ, then v = (ṫ, ω, γ̇).
 struct Tangent {
@@ -24,7 +24,7 @@ struct Tangent {
   int gamma_dot() const { return 12 + D; }
 };
 
-void AddTo(AnchorAdjoints* anchors, const ContactKey3& key, const Vector3d& value) {
+void AddTo(AnchorAdjoints* anchors, const ContactKey& key, const Vector3d& value) {
   const auto [it, inserted] = anchors->emplace(key, value);
   if (!inserted) it->second += value;
 }
@@ -91,7 +91,7 @@ PointPullback PullAnchorUpdate(const GroundPlane& g, const GroundForceParts<doub
   return r;
 }
 
-// y = SpringForce3's f = −s d with s = K (|Δ| − L) + C d·ẋ, d = Δ/|Δ|, Δ = x − anchor
+// y = SpringForce's f = −s d with s = K (|Δ| − L) + C d·ẋ, d = Δ/|Δ|, Δ = x − anchor
 // (∂d/∂x = (1 − d dᵀ)/|Δ|); the anchor is fixed.
 PointPullback PullSpringForce(const SpringN<3>& sp, const Vector3d& x, const Vector3d& v, const Vector3d& w) {
   const Vector3d delta = x - sp.anchor;
@@ -105,7 +105,7 @@ PointPullback PullSpringForce(const SpringN<3>& sp, const Vector3d& x, const Vec
   return r;
 }
 
-// Where ForEachFaceFelt (step3.h) took the anchor of (point k, face) from, among the contacts
+// Where ForEachFaceFelt (ground_plane.h) took the anchor of (point k, face) from, among the contacts
 // of the state it scanned: the contact on the same face, the first contact of k projected onto
 // the face (a − n n·(a − p)), or the point's foot on the face (x − n n·(x − p)). The adjoint of
 // the anchor goes back the same way.
@@ -249,9 +249,9 @@ void PullMomentTerms(const MassMoments3& mm, const WorldParamsN<3>& world, const
 
 // z, the anchors and the controls += ∇ψ, ψ = λ_rᵀ (Q − w − M a) at `e` with a and λ_r fixed:
 // the pull-back of λ_a through a = M⁻¹ (Q − w), with λ_r = M⁻¹ λ_a.
-void PullAccelerations(const StepModel3& m, const VecD<double>& target, const BodyState<3, double>& e,
+void PullAccelerations(const StepModel& m, const VecD<double>& target, const BodyState<3, double>& e,
                        const Frame<3, double>& frame, const ShapeMoments<double>& sm, const VecQ<double>& a,
-                       const VecQ<double>& lr, const Tangent& ix, StateAdjoint3* in, ControlAdjoint3* controls) {
+                       const VecQ<double>& lr, const Tangent& ix, StateAdjoint<3>* in, ControlAdjoint* controls) {
   const BodyModel3& body = m.passive;
   const int D = ix.D;
   Eigen::VectorXd& z = in->z;
@@ -293,8 +293,8 @@ void PullAccelerations(const StepModel3& m, const VecD<double>& target, const Bo
 
 }  // namespace
 
-StepStatus RecordStep3(const StepModel3& m, const VecD<double>& target, const BodyState<3, double>& s,
-                       StepTape3* tape, BodyState<3, double>* next) {
+StepStatus RecordStep(const StepModel& m, const VecD<double>& target, const BodyState<3, double>& s,
+                       StepTape* tape, BodyState<3, double>* next) {
   const BodyModel3& body = m.passive;
   const MassMoments3& mm = body.moments();
   const double h = m.dt;
@@ -333,8 +333,8 @@ StepStatus RecordStep3(const StepModel3& m, const VecD<double>& target, const Bo
   return {};
 }
 
-void StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState<3, double>& s, const StepTape3& tape,
-              const StateAdjoint3& out, StateAdjoint3* in, ControlAdjoint3* controls) {
+void StepVjp(const StepModel& m, const VecD<double>& target, const BodyState<3, double>& s, const StepTape& tape,
+              const StateAdjoint<3>& out, StateAdjoint<3>* in, ControlAdjoint* controls) {
   const int D = m.passive.num_modes(), nv = Group<3>::kRigidDofs + D;
   const Tangent ix(D);
   const double h = m.dt;
@@ -358,7 +358,7 @@ void StepVjp3(const StepModel3& m, const VecD<double>& target, const BodyState<3
   }
 }
 
-void StartContactsVjp3(const BodyModel3& passive, const GroundPlane& ground, BodyState<3, double> s,
+void StartContactsVjp(const BodyModel3& passive, const GroundPlane& ground, BodyState<3, double> s,
                        const AnchorAdjoints& anchor, Eigen::VectorXd* dz) {
   s.contacts.clear();
   AnchorAdjoints none;  // without contacts before, every anchor comes from its point's foot
