@@ -354,6 +354,41 @@ void BM_Table3Variational(benchmark::State& state) {
 }
 BENCHMARK(BM_Table3Variational)->ArgName("ground")->Arg(0)->Arg(1);
 
+// Issue 45: the resting table of either dimension stepped through World (what simulate, the
+// scene and Python run), thesis integrator, dt 0.01: dim 2 is BM_TableRestingOnGround's table,
+// dim 3 the 3D table (27 points, 3 modes). The ratio of the two rows is the 3D step's cost
+// against the 2D one in the same run.
+void BM_WorldTableResting(benchmark::State& state) {
+  const int dim = int(state.range(0));
+  WorldOptions options;
+  options.ground_3d.enabled = true;
+  World world(options);
+  if (dim == 2) {
+    world.AddBody(Table11());
+    world.SetState(0, TableQ(*Table11(), 10.0), Eigen::VectorXd::Zero(Table11()->num_q()));
+  } else {
+    const std::shared_ptr<const BodyModel3> body = Table3();
+    world.AddBody(body);
+    Eigen::VectorXd coordinates = Eigen::VectorXd::Zero(body->num_q());  // t, rotation vector, γ
+    coordinates[1] = 10.0;
+    world.SetCoordinates(0, coordinates, Eigen::VectorXd::Zero(coordinates.size()));
+  }
+  for (int i = 0; i < 3000; ++i)
+    if (!world.Step()) {
+      state.SkipWithError(world.status().message.c_str());
+      return;
+    }
+  for (auto _ : state) {
+    if (!world.Step()) {
+      state.SkipWithError(world.status().message.c_str());
+      break;
+    }
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["contacts"] = double(dim == 2 ? world.state<2>(0).contacts.size() : world.state<3>(0).contacts.size());
+}
+BENCHMARK(BM_WorldTableResting)->ArgName("dim")->Arg(2)->Arg(3);
+
 }  // namespace
 }  // namespace wobble
 

@@ -118,7 +118,7 @@ void ForEachPointInContact(const BodyModelN<3>& body, const GroundPlane& g, cons
 
 // Eq. 4.24/4.25 in the plane's frame: f_n = −K Δn − C_dam v_n (never pulling),
 // f_t = −K Δt − FR_dam v_t (tangent-plane vectors), scaled back onto |f_t| ≤ tan θ f_n. The
-// parts are kept for the 3D adjoint's partials (fit/internal/step3_vjp.cc).
+// parts are kept for the 3D adjoint's partials (fit/internal/step_vjp_space.cc).
 template <class T> struct GroundForceParts {
   T fn;             // the normal force, after the clamp at 0
   bool pressing;    // the spring-damper pushed (fn was not clamped)

@@ -100,7 +100,7 @@ struct WorldOptions {
 
 // The 3D FFD bodies' world from the options: gravity_3d (off with params.gravity_on),
 // ground_3d, springs_3d and params.max_condition. What World steps them in, and the world of
-// a 3D rollout (fit/adjoint3.h) built from the same options.
+// a 3D rollout (fit/adjoint.h) built from the same options.
 WorldParamsN<3> Params3Of(const WorldOptions& options);
 
 // A material point of a body. Linear bodies: u in undeformed coordinates (any point, inside

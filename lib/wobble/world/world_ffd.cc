@@ -38,19 +38,15 @@ double GravityEnergyOf(const BodyModelN<3>& m, const BodyState<3, double>& s, co
   return GravityEnergy(m.moments(), ShapeMoments<double>(m.moments(), s.gamma()), frame, g);
 }
 
-// x = M(q)⁻¹ Q: about the centre of mass in 2D (SolveMassSystem), by Cholesky of M in 3D.
+// x = M(q)⁻¹ Q, about the centre of mass in both (SolveMassSystem; M is never formed).
 bool SolveMass(const BodyModelN<2>& m, const BodyState<2, double>& s, const VecQ<double>& Q, VecQ<double>* x) {
   double cond = 0;
   return SolveMassSystem(m.moments(), s.q, Rotation(s.q[2]), Q, x, &cond);
 }
 bool SolveMass(const BodyModelN<3>& m, const BodyState<3, double>& s, const VecQ<double>& Q, VecQ<double>* x) {
-  MatQ<double> M;
-  MassMatrix(m.moments(), ShapeMoments<double>(m.moments(), s.gamma()), Mat3<double>(s.orientation().toRotationMatrix()),
-             &M);
-  if (!CholeskyInPlace(&M)) return false;
-  *x = Q;
-  CholeskySolveInPlace(M, x);
-  return true;
+  double cond = 0;
+  return SolveMassSystem(m.moments(), ShapeMoments<double>(m.moments(), s.gamma()),
+                         Mat3<double>(s.orientation().toRotationMatrix()), Q, x, &cond);
 }
 
 // The largest |number| of the moments (NaN fails every comparison with the screen).

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <vector>
 
-#include "wobble/core/cholesky.h"
 #include "wobble/core/rotation3.h"
 
 namespace wobble::fit::internal {
@@ -311,16 +310,14 @@ StepStatus RecordStep(const StepModel& m, const VecD<double>& target, const Body
   ForceBreakdown<3, double> forces;
   EvaluateForces(body, m.world, 0, eval, frame, &forces);
   ModeForce<double>{&m.gains, &target}(eval, &forces.total);
-  MassMatrix(mm, sm, frame.R, &tape->mass_factor);
-  if (!CholeskyInPlace(&tape->mass_factor)) {
+  // SolveAccelerations' solve, so the recorded step is StepBody's to the last bit (the
+  // checkpointed sweep mixes recorded and plain steps)
+  double cond_estimate = 0.0;
+  if (!SolveMassSystem(mm, sm, frame.R, VecQ<double>(forces.total - w), &tape->a, &cond_estimate)) {
     if (!forces.total.allFinite()) return {StatusCode::kOverflowingForce, 0.0};
     return {StatusCode::kSingularMass, 0.0};
   }
-  double lo = HUGE_VAL, hi = 0.0;
-  CholeskyPivotRange(tape->mass_factor, &lo, &hi);
-  tape->a = forces.total - w;
-  CholeskySolveInPlace(tape->mass_factor, &tape->a);
-  if (hi / lo > m.world.max_condition) return {StatusCode::kIllConditioned, hi / lo};
+  if (cond_estimate > m.world.max_condition) return {StatusCode::kIllConditioned, cond_estimate};
   tape->after = eval;  // the state after the step, with the contacts before it
   tape->after.qd += h * tape->a;
   if (thesis) Group<3>::Advance(tape->after.qd, h, &tape->after.q);
@@ -346,8 +343,9 @@ void StepVjp(const StepModel& m, const VecD<double>& target, const BodyState<3, 
   PullContactUpdate(m.passive, m.world.ground, tape.after, out.anchor, ix, &in->z, &in->anchor);
   VecQ<double> lambda_v = in->z.tail(nv);
   if (thesis) PullAdvance(tape.after.qd, h, ix, &in->z, &lambda_v);
-  VecQ<double> lr = h * lambda_v;
-  CholeskySolveInPlace(tape.mass_factor, &lr);
+  VecQ<double> lr;  // M⁻¹ h λ_v (M symmetric: the solve the step made, again)
+  double cond_estimate = 0.0;
+  SolveMassSystem(m.passive.moments(), *tape.moments, tape.frame->R, VecQ<double>(h * lambda_v), &lr, &cond_estimate);
   in->z.tail(nv) = lambda_v;
   controls->target = VecD<double>::Zero(D);
   PullAccelerations(m, target, tape.eval, *tape.frame, *tape.moments, tape.a, lr, ix, in, controls);

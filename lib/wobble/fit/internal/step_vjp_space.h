@@ -47,15 +47,14 @@ struct ControlAdjoint {
 };
 
 // What the product needs of the forward step from s (StepBody<3>'s thesis or symplectic step,
-// the same operations in the same order): where the accelerations were evaluated, the mass
-// matrix's Cholesky factor there, the accelerations, and the state after the step before its
-// contact update. The adjoint's recompute keeps one per step of an interval, so the product
-// does not factor M a second time.
+// the same operations in the same order): where the accelerations were evaluated, the frame and
+// shape moments there, the accelerations, and the state after the step before its contact
+// update. The adjoint's recompute keeps one per step of an interval, so the product does not
+// evaluate the step's forces a second time.
 struct StepTape {
   BodyState<3, double> eval, after;
   std::optional<Frame<3, double>> frame;
   std::optional<ShapeMoments<double>> moments;
-  MatQ<double> mass_factor;
   VecQ<double> a;
 };
 
