@@ -8,6 +8,7 @@
 #include <pybind11/stl.h>
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 
 #include "wobble/analysis/conditioning.h"
@@ -19,7 +20,7 @@ namespace py = pybind11;
 
 void BindErrors(py::module_& m);   // exceptions (errors.cc)
 void BindBodies(py::module_& m);   // BodyModel, modes, loading (bodies.cc)
-void BindBodies3(py::module_& m);  // BodyModel3, load_body3, the World's 3D methods (bodies3.cc)
+void BindBodies3(py::module_& m);  // BodyModel3, the deprecated 3D names of the bodies and the World (bodies3.cc)
 void BindWorld(py::module_& m);    // WorldOptions, Ground, World, Energies (world.cc)
 void BindBehaviours(py::module_& m);  // anchors and goal behaviours as a controller (behaviours.cc)
 void BindRecord(py::module_& m);   // Trajectory, simulate (record.cc)
@@ -33,6 +34,12 @@ void BindRender(py::module_& m);   // pictures and exports through pipelines/ (r
 
 // A C-contiguous float64 array of `rows` x `cols` (cols < 0: a vector of `rows`), or
 // InputError naming `what` and the shape expected.
+// A name of release 0.1 kept one release more (python/wobble/__init__.pyi marks it): warns
+// DeprecationWarning naming its replacement, then calls scope.name (scope: the module, or a
+// class whose method it becomes); `then`, when given, adjusts the result.
+void BindDeprecated(py::object scope, const char* old_name, const char* name,
+                    std::function<py::object(py::object)> then = nullptr);
+
 py::array_t<double, py::array::c_style> AsMatrix(const py::handle& a, long rows, long cols, const std::string& what);
 // An optional keyword vector: `otherwise` for None, else a finite vector of n (InputError naming
 // `what` otherwise).

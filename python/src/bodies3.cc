@@ -90,6 +90,13 @@ void BindBodies3(py::module_& m) {
                std::to_string(b.num_modes()) + " modes, " + std::to_string(b.def().mesh.points.size()) + " mesh vertices>";
       });
 
+  // release 0.1's 3D names: load_body and the World's methods take either body now
+  BindDeprecated(m, "load_body3", "load_body");
+  const py::object world = m.attr("World");
+  for (const auto& [old_name, name] : {std::pair{"add_body3", "add_body"}, {"body3", "body"}, {"q3", "q"},
+                                       {"qd3", "qd"}, {"set_state3", "set_state"}})
+    BindDeprecated(world, old_name, name);
+
 }
 
 }  // namespace wobble::python

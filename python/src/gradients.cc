@@ -363,27 +363,6 @@ template <int Dim> void BindRollouts(py::module_& m) {
       "`wobble fit spacetime`; write_target_schedule(result.targets) for a script's schedule.");
 }
 
-// A deprecated name of before (one release): warns (DeprecationWarning), then calls `name`;
-// `keep_3d` drops a returned stage cost's 2D form, as the old 3D-only StageCost was.
-void BindDeprecated(py::module_& m, const char* old_name, const char* name, bool keep_3d = false) {
-  const std::string message = std::string("wobble.") + old_name + " is deprecated: use wobble." + name +
-                              ", which takes either body";
-  py::object module = m;
-  m.def(
-      old_name,
-      [module, name, message, keep_3d](py::args args, py::kwargs kwargs) -> py::object {
-        if (PyErr_WarnEx(PyExc_DeprecationWarning, message.c_str(), 1) < 0) throw py::error_already_set();
-        py::object result = module.attr(name)(*args, **kwargs);
-        if (keep_3d) {
-          StageCostHandle h = result.cast<StageCostHandle>();
-          h.plane = nullptr;
-          return py::cast(h);
-        }
-        return result;
-      },
-      (std::string("Deprecated (one release): ") + message + ".").c_str());
-}
-
 }  // namespace
 
 std::shared_ptr<py::function> HoldWithGil(py::function fn) {
@@ -468,8 +447,14 @@ void BindGradients(py::module_& m) {
   BindDeprecated(m, "fit_spacetime3", "fit_spacetime");
   BindDeprecated(m, "centre_of_mass_at3", "centre_of_mass_at");
   BindDeprecated(m, "centre_of_mass_velocity_at3", "centre_of_mass_velocity_at");
-  BindDeprecated(m, "upright_at3", "upright_at", true);
-  BindDeprecated(m, "still_at3", "still_at", true);
+  // the old 3D-only StageCost: the 2D form dropped
+  auto only_3d = [](py::object cost) {
+    StageCostHandle h = cost.cast<StageCostHandle>();
+    h.plane = nullptr;
+    return py::cast(h);
+  };
+  BindDeprecated(m, "upright_at3", "upright_at", only_3d);
+  BindDeprecated(m, "still_at3", "still_at", only_3d);
 
   m.def(
       "write_target_schedule",

@@ -113,4 +113,28 @@ void BindErrors(py::module_& m) {
   });
 }
 
+void BindDeprecated(py::object scope, const char* old_name, const char* name,
+                    std::function<py::object(py::object)> then) {
+  const bool method = py::isinstance<py::type>(scope);
+  const std::string owner = method ? scope.attr("__name__").cast<std::string>() : "wobble";
+  const std::string message =
+      owner + "." + old_name + " is deprecated: use " + owner + "." + name + ", which takes a 2D or a 3D body";
+  const std::string doc = "Deprecated (one release): " + message + ".";
+  const std::string target = name;
+  auto call = [message, target, then](py::object on, py::args args, py::kwargs kwargs) -> py::object {
+    if (PyErr_WarnEx(PyExc_DeprecationWarning, message.c_str(), 1) < 0) throw py::error_already_set();
+    py::object result = on.attr(target.c_str())(*args, **kwargs);
+    return then ? then(std::move(result)) : result;
+  };
+  if (method) {
+    scope.attr(old_name) = py::cpp_function(
+        [call](py::object self, py::args args, py::kwargs kwargs) { return call(self, args, kwargs); },
+        py::name(old_name), py::is_method(scope), py::sibling(py::getattr(scope, old_name, py::none())),
+        py::doc(doc.c_str()));
+  } else {
+    py::reinterpret_borrow<py::module_>(scope).def(
+        old_name, [call, scope](py::args args, py::kwargs kwargs) { return call(scope, args, kwargs); }, doc.c_str());
+  }
+}
+
 }  // namespace wobble::python

@@ -15,8 +15,6 @@ records a Trajectory; rollout() runs many trials on every core; Interpreter runs
 from ._wobble import *  # noqa: F401,F403  (the extension's names are the package's)
 from ._wobble import Ground, WorldOptions, __doc__ as _extension_doc  # noqa: F401
 
-import warnings as _warnings
-
 __version__ = "0.2"
 
 
@@ -47,23 +45,6 @@ _keyword_init(Ground)
 _keyword_init(WorldOptions)
 _repr_fields(WorldOptions, ["dt", "integrator", "gravity_on", "max_condition", "feedback_rate"])
 _repr_fields(Ground, ["enabled", "slope", "stiffness", "normal_damping", "friction_damping", "friction_cap"])
-
-# The 3D names of release 0.1, one release more: every call and method takes either body now.
-def _deprecated(new, old_name, new_name):
-    def alias(*args, **kwargs):
-        _warnings.warn(f"{old_name} is deprecated: use {new_name}, which takes a 2D or a 3D body",
-                       DeprecationWarning, stacklevel=2)
-        return new(*args, **kwargs)
-
-    alias.__name__ = old_name.rsplit(".", 1)[-1]
-    alias.__doc__ = f"Deprecated: {new_name}."
-    return alias
-
-
-load_body3 = _deprecated(load_body, "load_body3", "load_body")  # noqa: F405
-for _old, _new in [("add_body3", "add_body"), ("body3", "body"), ("q3", "q"), ("qd3", "qd"),
-                   ("set_state3", "set_state")]:
-    setattr(World, _old, _deprecated(getattr(World, _new), f"World.{_old}", f"World.{_new}"))  # noqa: F405
 
 # Show the package, not the extension, in reprs and tracebacks (wobble.World, not wobble._wobble.World).
 for _name, _obj in list(globals().items()):

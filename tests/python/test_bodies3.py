@@ -73,7 +73,7 @@ def test_one_loader_and_one_world_api_for_both_dimensions(pot3):
 
 def test_the_old_3d_names_warn_and_do_the_same(pot3):
     q = [1.0, 2.0, 3.0, 0.1, -0.2, 0.3, 0.01, 0.0, -0.02]
-    with pytest.warns(DeprecationWarning, match="load_body3 is deprecated: use load_body"):
+    with pytest.warns(DeprecationWarning, match="load_body3 is deprecated: use wobble.load_body"):
         old_pot = wobble.load_body3(str(DATA / "pot3.obj"), [str(DATA / "pot3_modes.def3")])
     assert old_pot.num_q == pot3.num_q and old_pot.total_mass == pot3.total_mass
     world = wobble.World()
