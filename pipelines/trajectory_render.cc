@@ -415,9 +415,11 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     replay.At(v.sample, v.t);
     if (!follow_boxes.empty()) {  // an orbiting view frames its box below, at the frame's angle
       const Eigen::AlignedBox3d& box = follow_boxes[size_t(&v - visits.data())];
-      // 2D: the box is the picture, no margin; 3D: the cube with FrameBox3d's usual margin
-      for (SceneView* sv : {view.get(), strip_view.get()})
-        if (sv && !(orbit && sv == view.get())) sv->FrameBounds(box, flat ? 0.0 : 0.08);
+      for (SceneView* sv : {view.get(), strip_view.get()}) {
+        if (!sv || (orbit && sv == view.get())) continue;
+        if (flat) sv->FrameBounds(box, 0.0);  // 2D: the box is the picture
+        else sv->FrameBounds(box);            // 3D: the cube, with the usual margin
+      }
     }
     if (v.frame < 0) {
       if (out.filmstrip_cycle >= 0) strip_view->SetCaption("pose " + std::to_string(run.pose(v.sample)));

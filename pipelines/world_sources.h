@@ -93,7 +93,7 @@ class WorldSourceBase : public vtkPolyDataAlgorithm {
 
 // A part of one body of either kind: RequestData checks the body and draws it with the
 // kind's own function (false: nothing drawn, already reported). DrawFfd serves FFD bodies of
-// both dimensions: each source's calls its DrawFfdOf<Dim> for the body's.
+// both dimensions: each source's calls its own DrawFfdOf<Dim> with the body's dimension.
 class BodyPartSource : public WorldSourceBase {
  public:
   vtkTypeMacro(BodyPartSource, WorldSourceBase);
