@@ -38,48 +38,37 @@ double PlacedCentreY(double body_min_y, double body_max_y, const std::optional<d
 
 }  // namespace
 
-std::vector<Eigen::AlignedBox2d> FollowBoxes(const std::vector<FollowMoment>& moments, const FollowOptions& options) {
-  std::vector<Eigen::AlignedBox2d> boxes;
+template <int Dim>
+std::vector<Eigen::AlignedBox<double, Dim>> FollowBoxes(const std::vector<FollowMomentN<Dim>>& moments,
+                                                        const FollowOptions& options) {
+  using Vec = Eigen::Matrix<double, Dim, 1>;
+  std::vector<Eigen::AlignedBox<double, Dim>> boxes;
   if (moments.empty()) return boxes;
+  // the view's half-extents per unit of half-height: the picture's in 2D, a cube in 3D (the
+  // perspective camera fits the whole cube)
+  Vec shape = Vec::Ones();
+  if constexpr (Dim == 2) shape.x() = options.aspect;
   double reach = 1e-9;  // the largest half-extent of the body, as a half-height of the view
-  for (const FollowMoment& m : moments) {
-    const Eigen::Vector2d half = 0.5 * m.body.sizes();
-    reach = std::max({reach, half.y(), half.x() / options.aspect});
-  }
-  const double half_h = options.zoom * reach, half_w = half_h * options.aspect;
-  std::vector<double> t, cx, cy;
-  for (const FollowMoment& m : moments) {
+  for (const FollowMomentN<Dim>& m : moments) reach = std::max(reach, (0.5 * m.body.sizes()).cwiseQuotient(shape).maxCoeff());
+  const Vec half = options.zoom * reach * shape;
+  std::vector<double> t;
+  std::vector<std::vector<double>> centre(Dim);  // per axis
+  for (const FollowMomentN<Dim>& m : moments) {
     t.push_back(m.t);
-    cx.push_back(m.body.center().x());
-    cy.push_back(PlacedCentreY(m.body.min().y(), m.body.max().y(), m.ground_height, half_h));
+    for (int a = 0; a < Dim; ++a)
+      centre[size_t(a)].push_back(a == 1 ? PlacedCentreY(m.body.min().y(), m.body.max().y(), m.ground_height, half.y())
+                                         : m.body.center()[a]);
   }
   const double sigma = std::max(options.smoothing_s, 1e-9);
   for (size_t i = 0; i < moments.size(); ++i) {
-    const Eigen::Vector2d c(LocalLinearFit(t, cx, i, sigma), LocalLinearFit(t, cy, i, sigma));
-    boxes.emplace_back(c - Eigen::Vector2d(half_w, half_h), c + Eigen::Vector2d(half_w, half_h));
+    Vec c;
+    for (int a = 0; a < Dim; ++a) c[a] = LocalLinearFit(t, centre[size_t(a)], i, sigma);
+    boxes.emplace_back(c - half, c + half);
   }
   return boxes;
 }
 
-std::vector<Eigen::AlignedBox3d> FollowBoxes3(const std::vector<FollowMoment3>& moments, const FollowOptions& options) {
-  std::vector<Eigen::AlignedBox3d> boxes;
-  if (moments.empty()) return boxes;
-  double reach = 1e-9;
-  for (const FollowMoment3& m : moments) reach = std::max(reach, 0.5 * m.body.sizes().maxCoeff());
-  const double half = options.zoom * reach;
-  std::vector<double> t, cx, cy, cz;
-  for (const FollowMoment3& m : moments) {
-    t.push_back(m.t);
-    cx.push_back(m.body.center().x());
-    cy.push_back(PlacedCentreY(m.body.min().y(), m.body.max().y(), m.ground_height, half));
-    cz.push_back(m.body.center().z());
-  }
-  const double sigma = std::max(options.smoothing_s, 1e-9);
-  for (size_t i = 0; i < moments.size(); ++i) {
-    const Eigen::Vector3d c(LocalLinearFit(t, cx, i, sigma), LocalLinearFit(t, cy, i, sigma), LocalLinearFit(t, cz, i, sigma));
-    boxes.emplace_back(c - Eigen::Vector3d::Constant(half), c + Eigen::Vector3d::Constant(half));
-  }
-  return boxes;
-}
+template std::vector<Eigen::AlignedBox2d> FollowBoxes<2>(const std::vector<FollowMomentN<2>>&, const FollowOptions&);
+template std::vector<Eigen::AlignedBox3d> FollowBoxes<3>(const std::vector<FollowMomentN<3>>&, const FollowOptions&);
 
 }  // namespace wobble::pipelines

@@ -10,11 +10,14 @@
 
 namespace wobble::pipelines {
 
-struct FollowMoment {
+// The body's box at one moment and the ground's surface height under its centre, if any (2D:
+// the line or terrain under x; 3D: the plane or heightfield under x, z).
+template <int Dim> struct FollowMomentN {
   double t = 0;
-  Eigen::AlignedBox2d body;             // the body's box now
-  std::optional<double> ground_height;  // the ground's surface under the body's centre, if any
+  Eigen::AlignedBox<double, Dim> body;  // the body's box now
+  std::optional<double> ground_height;
 };
+using FollowMoment = FollowMomentN<2>;
 
 struct FollowOptions {
   double aspect = 4.0 / 3.0;  // width / height of the pictures
@@ -22,23 +25,17 @@ struct FollowOptions {
   double smoothing_s = 0.15;  // the camera path's smoothing, seconds (σ of its Gaussian weights)
 };
 
-// One box per moment (same order), all of one size: centred on the body in x; in y the ground
-// sits a fifth up from the bottom edge unless the body would leave the view (then the body is
-// kept in: 7.5 % above the bottom edge, and out of the top fifth, where the overlay's text is). Centres are smoothed by a Gaussian-weighted local linear fit
-// in time, so a body moving at constant velocity is followed exactly, to the first and last
-// moment, while jumps (the ground under the body at a cliff's edge) are eased over ~4σ.
-std::vector<Eigen::AlignedBox2d> FollowBoxes(const std::vector<FollowMoment>& moments, const FollowOptions& options);
-
-// 3D: the body's box and the ground's height under its centre (plane or heightfield).
-struct FollowMoment3 {
-  double t = 0;
-  Eigen::AlignedBox3d body;
-  std::optional<double> ground_height;
-};
-// One cube per moment, all of one size (zoom times the body's largest half-extent, as a half
-// side), for the perspective camera to frame (SceneView::FrameBox3d): centred on the body in x
-// and z, and in y placed as the 2D boxes are, so the ground under the body shows in the lower
-// part of the picture; smoothed in time as in 2D.
-std::vector<Eigen::AlignedBox3d> FollowBoxes3(const std::vector<FollowMoment3>& moments, const FollowOptions& options);
+// One box per moment (same order), all of one size: zoom times the body's largest
+// half-extent, as the view's half-height. 2D: a box of the picture's aspect for the parallel
+// camera; 3D: a cube for the perspective camera to frame (SceneView::FrameBox3d; the aspect is
+// not used). Centred on the body in x (and z); in y the ground sits a fifth up from the bottom
+// edge unless the body would leave the view (then the body is kept in: 7.5 % above the bottom
+// edge, and out of the top fifth, where the overlay's text is). Centres are smoothed by a
+// Gaussian-weighted local linear fit in time, so a body moving at constant velocity is
+// followed exactly, to the first and last moment, while jumps (the ground under the body at a
+// cliff's edge) are eased over ~4σ.
+template <int Dim>
+std::vector<Eigen::AlignedBox<double, Dim>> FollowBoxes(const std::vector<FollowMomentN<Dim>>& moments,
+                                                        const FollowOptions& options);
 
 }  // namespace wobble::pipelines

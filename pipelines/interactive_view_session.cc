@@ -268,7 +268,7 @@ void InteractiveView::Impl::UpdateCharts() {
 // when the ground is within a few body sizes below.
 void InteractiveView::Impl::FrameBody() {
   const World& w = scrubbing ? *scrub_world : *world;
-  Eigen::AlignedBox2d box = BodyBounds(w, 0);
+  Eigen::AlignedBox2d box = BodyBounds<2>(w, 0);
   const double size = box.sizes().maxCoeff();
   const Ground& g = setup.world.params.ground;
   if (g.enabled && std::abs(std::cos(g.slope)) > 1e-6) {

@@ -61,31 +61,14 @@ bool HasDisplay() {
   return has;
 }
 
-Eigen::AlignedBox2d BodyBounds(const World& world, int body_index) {
-  const BodyModel& body = world.body<2>(body_index);
-  const VecQ<double>& q = world.q(body_index);
-  const Eigen::Matrix2d R = Rotation(q[2]);
-  Eigen::AlignedBox2d box;
-  for (int c = 0; c < body.lattice().size(); ++c) {
-    Eigen::Vector2d l = body.rest_control()[c];
-    for (int m = 0; m < body.num_modes(); ++m) l += body.modes()[m].displacement[c] * q[kRigidDofs + m];
-    box.extend(Eigen::Vector2d(q[0], q[1]) + R * l);
-  }
-  return box;
-}
-
 Eigen::AlignedBox3d SceneBounds(const World& world, const SceneSpec& spec) {
   Eigen::AlignedBox3d box;
   for (int b = 0; b < world.num_bodies(); ++b) {
     if (world.kind(b) == BodyKind::kLinear) {
       const LinearDrawing* d = b < int(spec.drawings.size()) ? &spec.drawings[b] : nullptr;
       box.extend(LinearBodyBounds(world, b, d));
-    } else if (world.dim(b) == 3) {
-      box.extend(BodyBounds3(world, b));
     } else {
-      const Eigen::AlignedBox2d flat = BodyBounds(world, b);
-      box.extend(Eigen::Vector3d(flat.min().x(), flat.min().y(), 0.0));
-      box.extend(Eigen::Vector3d(flat.max().x(), flat.max().y(), 0.0));
+      box.extend(FfdBodyBounds(world, b));
     }
   }
   return box;
@@ -172,13 +155,12 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
     return s;
   };
   // the world's layers, where FFD bodies live: ground, trails, springs
-  int first_ffd = -1, first_ffd3 = -1, ground_dim = 0;  // ground_dim: GroundDimensionOf the bodies
+  int first_ffd[4] = {-1, -1, -1, -1}, ground_dim = 0;  // by dimension; ground_dim: GroundDimensionOf the bodies
   for (int b = world->num_bodies() - 1; b >= 0; --b) {
-    if (world->IsFfd(b, 2)) first_ffd = b;
-    if (world->IsFfd(b, 3)) first_ffd3 = b;
+    if (world->kind(b) == BodyKind::kFfd) first_ffd[world->dim(b)] = b;
     ground_dim = std::max(ground_dim, GroundDimensionOf(*world, b));
   }
-  if (first_ffd3 >= 0 || ground_dim == 3) {
+  if (first_ffd[3] >= 0 || ground_dim == 3) {
     // a light from above besides the camera's: the camera's alone leaves every upward face
     // (a table's top, the ground) dark at a low elevation
     auto head = Ptr<vtkLight>::New();
@@ -206,11 +188,11 @@ SceneView::SceneView(const World* world, SceneOptions options, SceneSpec spec) :
     m.ground = Ptr<GroundSource>::New();
     m.Add(SceneLayer::kGround, on(m.ground, 0), ground_rgb, 1.0, 1.0, 0.0);
   }
-  if (first_ffd >= 0) {
+  if (first_ffd[2] >= 0) {  // trails of lattice coordinates (s, t): 2D bodies
     m.trails = Ptr<TrailSource>::New();
-    m.Add(SceneLayer::kTrails, on(m.trails, first_ffd), trail_rgb, 1.5, 1.0, 0.5);
+    m.Add(SceneLayer::kTrails, on(m.trails, first_ffd[2]), trail_rgb, 1.5, 1.0, 0.5);
   }
-  if (first_ffd >= 0 || first_ffd3 >= 0)  // springs of either dimension (SpringSource)
+  if (first_ffd[2] >= 0 || first_ffd[3] >= 0)  // springs of either dimension (SpringSource)
     m.Add(SceneLayer::kSprings, on(Ptr<SpringSource>::New(), 0), spring_rgb, 1.5, 1.0, 1.5);
   // every body: lattice (or control box), shape, mass points
   std::vector<vtkPolyDataMapper*> point_mappers, lattice_mappers;

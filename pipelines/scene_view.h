@@ -82,11 +82,8 @@ SceneSpec SceneSpecOf(const std::vector<LinearDrawing>& drawings, const std::vec
 // when the world has an FFD body; kAnchors when the spec names points.
 enum class SceneLayer { kGround, kLattice, kPoints, kShape, kSprings, kTrails, kAnchors };
 
-// A box holding every point of the body now: its deformed control points (by the convex-hull
-// property of the Bernstein/B-spline weights no point of the body lies outside them).
-Eigen::AlignedBox2d BodyBounds(const World& world, int body);
-// A box holding every body of a World now (linear bodies with their drawings,
-// FFD bodies by their control points; z = 0 for 2D bodies).
+// A box holding every body of a World now (linear bodies with their drawings, FFD bodies by
+// their control points, BodyBounds in world_sources.h; z = 0 for 2D bodies).
 Eigen::AlignedBox3d SceneBounds(const World& world, const SceneSpec& spec = {});
 // True when every body of the world is 2D (the parallel 2D view suits it).
 bool IsFlat(const World& world);

@@ -85,19 +85,6 @@ struct Visit {
   }
 };
 
-// The 3D follow camera's view now: the bodies' box and the 3D ground's height under its centre.
-FollowMoment3 FollowMoment3Now(const World& world, const Eigen::AlignedBox3d& bodies) {
-  FollowMoment3 m;
-  m.t = world.time();
-  m.body = bodies;
-  const GroundPlane& g = world.options().ground_3d;
-  const Eigen::Vector3d c = bodies.center();
-  if (g.enabled && g.heightfield) m.ground_height = g.heightfield->HeightAt(c.x(), c.z());
-  else if (g.enabled && std::abs(g.normal.y()) > 1e-9)  // the plane n·(x − p) = 0 solved for y
-    m.ground_height = g.point.y() - (g.normal.x() * (c.x() - g.point.x()) + g.normal.z() * (c.z() - g.point.z())) / g.normal.y();
-  return m;
-}
-
 }  // namespace
 
 std::vector<double> FilmstripCycleTimes(const record::Trajectory& run, int k, int panels) {
@@ -198,16 +185,37 @@ void WriteCharts(const record::Trajectory& run, const RenderOutputs& out, Render
   }
 }
 
-// The follow camera's view of the world now: its bodies' box and the ground under its centre.
-FollowMoment FollowMomentNow(const World& world, const Eigen::AlignedBox3d& bodies) {
-  FollowMoment m;
-  m.t = world.time();
-  m.body = Eigen::AlignedBox2d(bodies.min().head<2>(), bodies.max().head<2>());
-  const Ground& g = world.options().params.ground;
-  const double x = m.body.center().x();
-  if (g.enabled && g.terrain) m.ground_height = g.terrain->HeightAt(x);
-  else if (g.enabled) m.ground_height = g.point.y() + std::tan(g.slope) * (x - g.point.x());
-  return m;
+// The ground's surface height under c, if any: 2D the line's or the terrain's under x; 3D the
+// heightfield's or the plane's (n·(x − p) = 0 solved for y) under (x, z).
+std::optional<double> GroundHeightUnder(const Ground& g, const Eigen::Vector2d& c) {
+  if (g.enabled && g.terrain) return g.terrain->HeightAt(c.x());
+  if (g.enabled) return g.point.y() + std::tan(g.slope) * (c.x() - g.point.x());
+  return std::nullopt;
+}
+std::optional<double> GroundHeightUnder(const GroundPlane& g, const Eigen::Vector3d& c) {
+  if (g.enabled && g.heightfield) return g.heightfield->HeightAt(c.x(), c.z());
+  if (g.enabled && std::abs(g.normal.y()) > 1e-9)
+    return g.point.y() - (g.normal.x() * (c.x() - g.point.x()) + g.normal.z() * (c.z() - g.point.z())) / g.normal.y();
+  return std::nullopt;
+}
+
+// The follow camera's boxes (issue 19) of a world of Dim, one per visit, from the time and the
+// bodies' box at each visit of the camera's pass, with the ground of Dim under them; as 3D
+// boxes (z = 0 in 2D).
+template <int Dim>
+std::vector<Eigen::AlignedBox3d> FollowBoxesOf(const World& world, const std::vector<std::pair<double, Eigen::AlignedBox3d>>& seen,
+                                               const FollowOptions& options) {
+  std::vector<FollowMomentN<Dim>> moments;
+  for (const auto& [t, bodies] : seen) {
+    FollowMomentN<Dim> m;
+    m.t = t;
+    m.body = Eigen::AlignedBox<double, Dim>(bodies.min().template head<Dim>(), bodies.max().template head<Dim>());
+    m.ground_height = GroundHeightUnder(FfdGround<Dim>(world), m.body.center());
+    moments.push_back(m);
+  }
+  std::vector<Eigen::AlignedBox3d> boxes;
+  for (const Eigen::AlignedBox<double, Dim>& box : FollowBoxes(moments, options)) boxes.emplace_back(To3(box.min()), To3(box.max()));
+  return boxes;
 }
 
 }  // namespace
@@ -319,13 +327,10 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
 
   // the camera's pass: the box of every drawn state (and the ground below it), the colour range
   Eigen::AlignedBox3d motion, cycle;  // cycle: the panels' states of a gait's filmstrip
-  const bool follow = out.camera == RenderOutputs::Camera::kFollow && IsFlat(world);
-  const bool follow3 = out.camera == RenderOutputs::Camera::kFollow && !IsFlat(world);
-  std::vector<FollowMoment> moments;
-  std::vector<FollowMoment3> moments3;
-  std::vector<Eigen::AlignedBox2d> follow_boxes;   // per visit
-  std::vector<Eigen::AlignedBox3d> follow_boxes3;  // per visit
-  const bool orbit = out.orbit_deg_per_s != 0.0 && !IsFlat(world);
+  const bool follow = out.camera == RenderOutputs::Camera::kFollow, flat = IsFlat(world);
+  std::vector<std::pair<double, Eigen::AlignedBox3d>> seen;  // the follow camera's: time, bodies' box
+  std::vector<Eigen::AlignedBox3d> follow_boxes;              // per visit (z = 0 in a flat world)
+  const bool orbit = out.orbit_deg_per_s != 0.0 && !flat;
   if (view || strip_view) {
     double lo = 1e300, hi = -1e300;
     const bool fixed_range = out.view.color_range[0] < out.view.color_range[1];
@@ -335,8 +340,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       const Eigen::AlignedBox3d bodies = SceneBounds(world, spec);
       motion.extend(bodies);
       if (v.frame < 0 && out.filmstrip_cycle >= 0) cycle.extend(bodies);
-      if (follow) moments.push_back(FollowMomentNow(world, bodies));
-      if (follow3) moments3.push_back(FollowMoment3Now(world, bodies));
+      if (follow) seen.push_back({world.time(), bodies});
       double r[2];
       if (!fixed_range && (view ? view : strip_view)->ColorRangeNow(r)) {
         lo = std::min(lo, r[0]);
@@ -367,8 +371,8 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       v->FrameBounds(v == strip_view.get() && !cycle.isEmpty() ? cycle : motion);
       if (lo < hi) v->SetColorRange(lo, hi);  // one colour scale for the whole run
     }
-    if (follow) follow_boxes = FollowBoxes(moments, {double(out.view.width) / out.view.height});
-    if (follow3) follow_boxes3 = FollowBoxes3(moments3, {});
+    const FollowOptions follow_options{double(out.view.width) / out.view.height};
+    if (follow) follow_boxes = flat ? FollowBoxesOf<2>(world, seen, follow_options) : FollowBoxesOf<3>(world, seen, follow_options);
     world = caller;  // the writing pass replays the run from the start again
   }
   for (SceneView* v : {view.get(), strip_view.get()})
@@ -409,15 +413,13 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       break;
     }
     replay.At(v.sample, v.t);
-    if (!follow_boxes.empty()) {
-      const Eigen::AlignedBox2d& box = follow_boxes[size_t(&v - visits.data())];
-      for (SceneView* sv : {view.get(), strip_view.get()})
-        if (sv) sv->FrameBox(box, 0.0);
-    }
-    if (!follow_boxes3.empty()) {  // an orbiting view frames its box below, at the frame's angle
-      const Eigen::AlignedBox3d& box3 = follow_boxes3[size_t(&v - visits.data())];
-      if (strip_view) strip_view->FrameBox3d(box3);
-      if (view && !orbit) view->FrameBox3d(box3);
+    if (!follow_boxes.empty()) {  // an orbiting view frames its box below, at the frame's angle
+      const Eigen::AlignedBox3d& box = follow_boxes[size_t(&v - visits.data())];
+      for (SceneView* sv : {view.get(), strip_view.get()}) {
+        if (!sv || (orbit && sv == view.get())) continue;
+        if (flat) sv->FrameBounds(box, 0.0);  // 2D: the box is the picture
+        else sv->FrameBounds(box);            // 3D: the cube, with the usual margin
+      }
     }
     if (v.frame < 0) {
       if (out.filmstrip_cycle >= 0) strip_view->SetCaption("pose " + std::to_string(run.pose(v.sample)));
@@ -429,7 +431,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       if (sv && !out.trail.empty() && sv->trails()) sv->trails()->Record();
     if (view && orbit) {  // the frame's angle of the orbit; the box framed is the whole motion's
       view->SetViewAngles(out.view.azimuth + out.orbit_deg_per_s * (world.time() - run.time(0)), out.view.elevation);
-      view->FrameBox3d(follow_boxes3.empty() ? motion : follow_boxes3[size_t(&v - visits.data())]);
+      view->FrameBox3d(follow_boxes.empty() ? motion : follow_boxes[size_t(&v - visits.data())]);
     }
     if (view) {
       view->Render();

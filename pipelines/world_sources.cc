@@ -1,5 +1,6 @@
 #include "pipelines/world_sources.h"
 
+#include <array>
 #include <cmath>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
@@ -69,12 +70,36 @@ void UndeformedBox(const LinearBodyModel& model, Eigen::VectorXd* lo, Eigen::Vec
 
 Eigen::Vector3d To3(const Eigen::VectorXd& x) { return Eigen::Vector3d(x[0], x[1], x.size() > 2 ? x[2] : 0.0); }
 
-Eigen::Vector2d WorldPositionOf(const World& world, int body, const Eigen::Vector2d& st) {
-  Eigen::Vector2d b0;
-  Mat2D<double> B;
-  world.body<2>(body).LocalBasis(st, &b0, &B);
+template <int Dim>
+Eigen::Matrix<double, Dim, 1> WorldPositionOf(const World& world, int body, const Eigen::Matrix<double, Dim, 1>& st) {
+  Eigen::Matrix<double, Dim, 1> b0;
+  MatND<double, Dim> B;
+  world.body<Dim>(body).LocalBasis(st, &b0, &B);
+  return WorldPosition(world, body, b0, B);
+}
+template Eigen::Vector2d WorldPositionOf<2>(const World&, int, const Eigen::Vector2d&);
+template Eigen::Vector3d WorldPositionOf<3>(const World&, int, const Eigen::Vector3d&);
+
+template <int Dim> Eigen::AlignedBox<double, Dim> BodyBounds(const World& world, int body) {
+  const BodyModelN<Dim>& m = world.body<Dim>(body);
   const VecQ<double>& q = world.q(body);
-  return WorldFromLocal(Frame<2, double>(q), LocalPosition<double>(b0, B, q));
+  const Frame<Dim, double> frame(q);
+  const double* gamma = q.data() + Group<Dim>::kRigidParams;
+  Eigen::AlignedBox<double, Dim> box;
+  for (int c = 0; c < m.lattice().size(); ++c) {
+    Eigen::Matrix<double, Dim, 1> l = m.rest_control()[size_t(c)];
+    for (int d = 0; d < m.num_modes(); ++d) l += m.modes()[size_t(d)].displacement[size_t(c)] * gamma[d];
+    box.extend(WorldFromLocal(frame, l));
+  }
+  return box;
+}
+template Eigen::AlignedBox2d BodyBounds<2>(const World&, int);
+template Eigen::AlignedBox3d BodyBounds<3>(const World&, int);
+
+Eigen::AlignedBox3d FfdBodyBounds(const World& world, int body) {
+  if (world.dim(body) == 3) return BodyBounds<3>(world, body);
+  const Eigen::AlignedBox2d flat = BodyBounds<2>(world, body);
+  return Eigen::AlignedBox3d(To3(flat.min()), To3(flat.max()));
 }
 
 Eigen::Vector3d LinearWorldPoint(const World& world, int body, const Eigen::VectorXd& u) {
@@ -125,7 +150,7 @@ int BodyPartSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInfo
   if (!Check(Needs::kAnyBody)) return 0;
   vtkPolyData* out = OutputOf(out_vec);
   const BodyKind kind = world_->kind(Body);
-  const bool drawn = kind == BodyKind::kLinear ? DrawLinear(out) : world_->dim(Body) == 3 ? DrawFfd3(out) : DrawFfd(out);
+  const bool drawn = kind == BodyKind::kLinear ? DrawLinear(out) : DrawFfd(out);
   if (!drawn) return 0;
   AddTimeValue(out, world_->time());
   return 1;
@@ -134,11 +159,15 @@ int BodyPartSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInfo
 // ---------------------------------------------------------------------------------------
 vtkStandardNewMacro(LatticeSource);
 
-bool LatticeSource::DrawFfd(vtkPolyData* out) {
-  const BodyModel& body = world_->body<2>(Body);
+bool LatticeSource::DrawFfd(vtkPolyData* out) { return world_->dim(Body) == 3 ? DrawFfdOf<3>(out) : DrawFfdOf<2>(out); }
+
+template <int Dim> bool LatticeSource::DrawFfdOf(vtkPolyData* out) {
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  const BodyModelN<Dim>& body = world_->body<Dim>(Body);
   const VecQ<double>& q = world_->q(Body);
-  const Lattice& lat = body.lattice();
-  const Frame<2, double> frame(q);
+  const double* gamma = q.data() + Group<Dim>::kRigidParams;
+  const LatticeN<Dim>& lat = body.lattice();
+  const Frame<Dim, double> frame(q);
   const int n = lat.size();
 
   // deformed control points: L_ij + Σ γ_d d^d_ij (Eq. 4.2), then into the world
@@ -147,27 +176,30 @@ bool LatticeSource::DrawFfd(vtkPolyData* out) {
   auto rest = Vectors("rest_position", n);
   auto disp = Vectors("displacement", n);
   for (int c = 0; c < n; ++c) {
-    Eigen::Vector2d d = Eigen::Vector2d::Zero();
-    for (int m = 0; m < body.num_modes(); ++m) d += body.modes()[m].displacement[c] * q[kRigidDofs + m];
-    const Eigen::Vector2d& r = body.rest_control()[c];
-    const Vec2<double> x = WorldFromLocal(frame, Vec2<double>(r + d));
-    points->SetPoint(c, x.x(), x.y(), 0.0);
-    rest->SetTuple3(c, r.x(), r.y(), 0.0);
-    disp->SetTuple3(c, d.x(), d.y(), 0.0);
+    Point d = Point::Zero();
+    for (int m = 0; m < body.num_modes(); ++m) d += body.modes()[size_t(m)].displacement[size_t(c)] * gamma[m];
+    const Point& r = body.rest_control()[size_t(c)];
+    points->SetPoint(c, To3(WorldFromLocal(frame, Point(r + d))).data());
+    rest->SetTuple(c, To3(r).data());
+    disp->SetTuple(c, To3(d).data());
   }
 
-  // a vertex per control point, a line per lattice row and column
+  // a vertex per control point, and a line along each axis through every row of control points
+  // (the last axis first: in 2D a line per lattice row, then per column)
   auto verts = Ptr<vtkCellArray>::New();
   for (vtkIdType c = 0; c < n; ++c) verts->InsertNextCell(1, &c);
   auto lines = Ptr<vtkCellArray>::New();
-  for (int i = 0; i < lat.num_s(); ++i) {
-    lines->InsertNextCell(lat.num_t());
-    for (int j = 0; j < lat.num_t(); ++j) lines->InsertCellPoint(lat.Index(i, j));
-  }
-  for (int j = 0; j < lat.num_t(); ++j) {
-    lines->InsertNextCell(lat.num_s());
-    for (int i = 0; i < lat.num_s(); ++i) lines->InsertCellPoint(lat.Index(i, j));
-  }
+  const typename LatticeN<Dim>::Sizes size = lat.sizes();
+  for (int axis = Dim - 1; axis >= 0; --axis)
+    for (int c = 0; c < n; ++c) {
+      typename LatticeN<Dim>::Cell cell = lat.CellOf(c);
+      if (cell[size_t(axis)] != 0) continue;  // a row starts at its first control point
+      lines->InsertNextCell(size[size_t(axis)]);
+      for (int k = 0; k < size[size_t(axis)]; ++k) {
+        cell[size_t(axis)] = k;
+        lines->InsertCellPoint(lat.FlatIndex(cell));
+      }
+    }
   out->SetPoints(points);
   out->SetVerts(verts);
   out->SetLines(lines);
@@ -229,12 +261,15 @@ bool LatticeSource::DrawLinear(vtkPolyData* out) {
 // ---------------------------------------------------------------------------------------
 vtkStandardNewMacro(MassPointSource);
 
-bool MassPointSource::DrawFfd(vtkPolyData* out) {
-  const BodyModel& body = world_->body<2>(Body);
-  const BodyState<2, double>& s = world_->state<2>(Body);
-  const WorldParams& params = world_->options().params;
-  const Frame<2, double> frame(s.q);
+bool MassPointSource::DrawFfd(vtkPolyData* out) { return world_->dim(Body) == 3 ? DrawFfdOf<3>(out) : DrawFfdOf<2>(out); }
+
+template <int Dim> bool MassPointSource::DrawFfdOf(vtkPolyData* out) {
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  const BodyModelN<Dim>& body = world_->body<Dim>(Body);
+  const BodyState<Dim, double>& s = world_->state<Dim>(Body);
+  const Frame<Dim, double> frame(s.q);
   const int n = body.num_points();
+  const Point gravity = world_->options().params.gravity_on ? FfdGravity<Dim>(*world_) : Point::Zero();
 
   auto points = DoublePoints();
   points->SetNumberOfPoints(n);
@@ -245,29 +280,29 @@ bool MassPointSource::DrawFfd(vtkPolyData* out) {
   contact->SetName("in_contact");
   contact->SetNumberOfTuples(n);
   contact->FillValue(0);
-  std::vector<Eigen::Vector2d> x(n), v(n), f(n);
+  std::vector<Point> x(static_cast<size_t>(n)), v(x), f(x);
   for (int k = 0; k < n; ++k) {
     const auto B = body.mode_matrix(k);
-    const Vec2<double> l = LocalPosition<double>(body.rest_local(k), B, s.q);
-    x[k] = WorldFromLocal(frame, l);
-    v[k] = PointVelocity(frame, s.qd, l, B);
-    f[k] = params.gravity_on ? Eigen::Vector2d(body.mass(k) * params.gravity) : Eigen::Vector2d::Zero();
+    const Point l = LocalPosition<double>(body.rest_local(k), B, s.q);
+    x[size_t(k)] = WorldFromLocal(frame, l);
+    v[size_t(k)] = PointVelocity(frame, s.qd, l, B);
+    f[size_t(k)] = body.mass(k) * gravity;
   }
-  // the ground's force on every point tied to it (Eq. 4.24, 4.25)
-  if (params.ground.enabled) {
-    for (const Contact<2, double>& c : s.contacts) {
-      bool slipping;
-      f[c.point] += GroundForce(params.ground.Face(c.face), Vec2<double>(x[c.point]), Vec2<double>(v[c.point]), c.anchor,
-                                &slipping);
-      contact->SetValue(c.point, 1);
-    }
-  }
+  // the ground's penalty and capped friction on every point tied to it (Eq. 4.24, 4.25), as
+  // the step's forces see them (ContactSet::kFrozen: the state's contacts)
+  ForEachPointInContact(body, FfdGround<Dim>(*world_), s, frame,
+                        [&](int k, const Point&, const Point& xk, const Point& vk, const Point& anchor, const auto& face, int) {
+                          bool slipping;
+                          f[size_t(k)] += GroundForce(face, xk, vk, anchor, &slipping);
+                          contact->SetValue(k, 1);
+                        },
+                        ContactSet::kFrozen);
   auto verts = Ptr<vtkCellArray>::New();
   for (vtkIdType k = 0; k < n; ++k) {
-    points->SetPoint(k, x[k].x(), x[k].y(), 0.0);
-    mass->SetValue(k, body.mass(k));
-    velocity->SetTuple3(k, v[k].x(), v[k].y(), 0.0);
-    force->SetTuple3(k, f[k].x(), f[k].y(), 0.0);
+    points->SetPoint(k, To3(x[size_t(k)]).data());
+    mass->SetValue(k, body.mass(int(k)));
+    velocity->SetTuple(k, To3(v[size_t(k)]).data());
+    force->SetTuple(k, To3(f[size_t(k)]).data());
     verts->InsertNextCell(1, &k);
   }
   out->SetPoints(points);
@@ -311,73 +346,92 @@ void ShapeSource::PrintSelf(ostream& os, vtkIndent indent) {
   os << indent << "SamplesPerSegment: " << SamplesPerSegment << "\n";
 }
 
-void ShapeSource::UpdateCache() {
-  const BodyModel& body = world_->body<2>(Body);
-  if (cached_body_ == &body && cached_samples_ == SamplesPerSegment) return;
-  sample_st_.clear();
-  sample_b0_.clear();
-  sample_B_.clear();
-  polyline_sizes_.clear();
-  const Lattice& lat = body.lattice();
-  for (const Polyline& pl : body.def().shapes) {
+template <int Dim> const DrawingSamples<Dim>& ShapeSource::SamplesOf(const BodyModelN<Dim>& body) {
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  DrawingSamples<Dim>& samples = std::get<Dim - 2>(samples_);
+  if (samples.body == &body && samples.per_segment == SamplesPerSegment) return samples;
+  samples = DrawingSamples<Dim>();
+  const LatticeN<Dim>& lat = body.lattice();
+  for (const PolylineN<Dim>& pl : body.def().shapes) {
     const int np = int(pl.points.size());
     if (np < 2) continue;  // nothing to draw
     // a closed polyline's last segment returns to its first point, which is not repeated
     const int segments = pl.closed ? np : np - 1;
     for (int seg = 0; seg < segments; ++seg) {
-      const Eigen::Vector2d a = pl.points[seg], b = pl.points[(seg + 1) % np];
+      const Point a = pl.points[size_t(seg)], b = pl.points[size_t((seg + 1) % np)];
       for (int k = 0; k < SamplesPerSegment; ++k)
-        sample_st_.push_back(lat.LocalCoords(a + (b - a) * (double(k) / SamplesPerSegment)));
+        samples.st.push_back(lat.LocalCoords(a + (b - a) * (double(k) / SamplesPerSegment)));
     }
-    if (!pl.closed) sample_st_.push_back(lat.LocalCoords(pl.points.back()));
-    polyline_sizes_.push_back({segments * SamplesPerSegment + (pl.closed ? 0 : 1), pl.closed});
+    if (!pl.closed) samples.st.push_back(lat.LocalCoords(pl.points.back()));
+    samples.polylines.push_back({segments * SamplesPerSegment + (pl.closed ? 0 : 1), pl.closed});
   }
-  for (const Eigen::Vector2d& st : sample_st_) {
-    Eigen::Vector2d b0;
-    Mat2D<double> B;
+  for (const Point& st : samples.st) {
+    Point b0;
+    MatND<double, Dim> B;
     body.LocalBasis(st, &b0, &B);
-    sample_b0_.push_back(b0);
-    sample_B_.push_back(B);
+    samples.b0.push_back(b0);
+    samples.B.push_back(B);
   }
-  cached_body_ = &body;
-  cached_samples_ = SamplesPerSegment;
+  samples.body = &body;
+  samples.per_segment = SamplesPerSegment;
+  return samples;
 }
 
-std::vector<Eigen::Vector2d> ShapeSource::SampleLatticeCoords() const { return sample_st_; }
+std::vector<Eigen::Vector2d> ShapeSource::SampleLatticeCoords() const { return std::get<0>(samples_).st; }
 
-bool ShapeSource::DrawFfd(vtkPolyData* out) {
-  UpdateCache();
+bool ShapeSource::DrawFfd(vtkPolyData* out) { return world_->dim(Body) == 3 ? DrawFfdOf<3>(out) : DrawFfdOf<2>(out); }
+
+template <int Dim> bool ShapeSource::DrawFfdOf(vtkPolyData* out) {
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  const BodyModelN<Dim>& body = world_->body<Dim>(Body);
+  const LatticeN<Dim>& lat = body.lattice();
   const VecQ<double>& q = world_->q(Body);
-  const Frame<2, double> frame(q);
-  const vtkIdType n = vtkIdType(sample_st_.size());
+  const Frame<Dim, double> frame(q);
   auto points = DoublePoints();
-  points->SetNumberOfPoints(n);
-  auto st_array = Ptr<vtkDoubleArray>::New();
-  st_array->SetName("lattice_coords");
-  st_array->SetNumberOfComponents(2);
-  st_array->SetNumberOfTuples(n);
-  for (vtkIdType k = 0; k < n; ++k) {
-    const Vec2<double> x = WorldFromLocal(frame, LocalPosition<double>(sample_b0_[k], sample_B_[k], q));
-    points->SetPoint(k, x.x(), x.y(), 0.0);
-    st_array->SetTuple2(k, sample_st_[k].x(), sample_st_[k].y());
-  }
-  auto cells = Ptr<vtkCellArray>::New();
-  vtkIdType first = 0;
-  for (const auto& [count, closed] : polyline_sizes_) {
-    if (FillClosed && closed) {
-      cells->InsertNextCell(count);
-      for (int k = 0; k < count; ++k) cells->InsertCellPoint(first + k);
-    } else if (!FillClosed) {
-      cells->InsertNextCell(count + (closed ? 1 : 0));
-      for (int k = 0; k < count; ++k) cells->InsertCellPoint(first + k);
-      if (closed) cells->InsertCellPoint(first);
+  // what a point carries besides its place: in 2D its lattice coordinates (the interactive view
+  // picks them), in 3D its displacement B γ (body frame), the deformation alone
+  auto carried = Ptr<vtkDoubleArray>::New();
+  carried->SetName(Dim == 2 ? "lattice_coords" : "displacement");
+  carried->SetNumberOfComponents(Dim == 2 ? 2 : 3);
+  auto add = [&](const Point& st, const Point& b0, const auto& B) {
+    if constexpr (Dim == 2) carried->InsertNextTuple(st.data());
+    else carried->InsertNextTuple(Point(LocalPosition<double>(Point(Point::Zero()), B, q)).data());
+    return points->InsertNextPoint(To3(WorldFromLocal(frame, LocalPosition<double>(b0, B, q))).data());
+  };
+  // the mesh (a 3D body's): its vertices' bases were made once, with the body (mesh_rest_local)
+  const TriangleMeshN<Dim>& mesh = body.def().mesh;
+  auto polys = Ptr<vtkCellArray>::New();
+  if (Surface && !mesh.empty()) {
+    const vtkIdType base = points->GetNumberOfPoints();
+    for (int v = 0; v < int(mesh.points.size()); ++v)
+      add(lat.LocalCoords(mesh.points[size_t(v)]), body.mesh_rest_local(v), body.mesh_mode_matrix(v));
+    for (const std::array<int, 3>& t : mesh.triangles) {
+      const vtkIdType ids[3] = {base + t[0], base + t[1], base + t[2]};
+      polys->InsertNextCell(3, ids);
     }
-    first += count;
+  }
+  // the polylines, resampled: as lines, or the closed ones as polygons (FillClosed)
+  auto lines = Ptr<vtkCellArray>::New();
+  const DrawingSamples<Dim>& samples = SamplesOf(body);
+  if (Lines) {
+    vtkIdType first = points->GetNumberOfPoints();
+    for (size_t k = 0; k < samples.st.size(); ++k) add(samples.st[k], samples.b0[k], samples.B[k]);
+    for (const auto& [count, closed] : samples.polylines) {
+      if (FillClosed && closed) {
+        polys->InsertNextCell(count);
+        for (int k = 0; k < count; ++k) polys->InsertCellPoint(first + k);
+      } else if (!FillClosed) {
+        lines->InsertNextCell(count + (closed ? 1 : 0));
+        for (int k = 0; k < count; ++k) lines->InsertCellPoint(first + k);
+        if (closed) lines->InsertCellPoint(first);
+      }
+      first += count;
+    }
   }
   out->SetPoints(points);
-  if (FillClosed) out->SetPolys(cells);
-  else out->SetLines(cells);
-  out->GetPointData()->AddArray(st_array);
+  out->SetPolys(polys);
+  out->SetLines(lines);
+  out->GetPointData()->AddArray(carried);
   return true;
 }
 
@@ -503,19 +557,19 @@ int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
   auto points = DoublePoints();
   AddTimeValue(out, world_->time());
   // a world of 3D bodies stands on the 3D ground plane
-  Eigen::AlignedBox3d bodies3;
+  Eigen::AlignedBox3d on_plane;
   for (int b = 0; b < world_->num_bodies(); ++b) {
     if (GroundDimensionOf(*world_, b) != 3) continue;
-    bodies3.extend(world_->kind(b) == BodyKind::kFfd ? BodyBounds3(*world_, b) : LinearBodyBounds(*world_, b));
+    on_plane.extend(world_->kind(b) == BodyKind::kFfd ? FfdBodyBounds(*world_, b) : LinearBodyBounds(*world_, b));
   }
-  if (!bodies3.isEmpty()) {
+  if (!on_plane.isEmpty()) {
     const GroundPlane& plane = world_->options().ground_3d;
     out->SetPoints(points);
     if (!plane.enabled) return 1;
     if (plane.heightfield) return DrawHeightfield(*plane.heightfield, points, out);
     const Eigen::Vector3d n = plane.normal.normalized();
     const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
-    const Eigen::Vector3d foot = bodies3.center() - n * plane.Height(Eigen::Vector3d(bodies3.center()));
+    const Eigen::Vector3d foot = on_plane.center() - n * plane.Height(Eigen::Vector3d(on_plane.center()));
     const double half = 0.5 * Length;
     const double corners[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
     for (const auto& c : corners) points->InsertNextPoint(Eigen::Vector3d(foot + half * (c[0] * u + c[1] * v)).data());
@@ -555,6 +609,22 @@ int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
 // ---------------------------------------------------------------------------------------
 vtkStandardNewMacro(SpringSource);
 
+namespace {
+
+// The springs of the FFD bodies of Dim as lines anchor → held point, with their stretch
+// (length minus rest length).
+template <int Dim> void AddSprings(const World& world, vtkPoints* points, vtkCellArray* lines, vtkDoubleArray* stretch) {
+  for (const SpringN<Dim>& sp : FfdSprings<Dim>(world)) {
+    if (sp.body < 0 || sp.body >= world.num_bodies() || !world.IsFfd(sp.body, Dim)) continue;
+    const Eigen::Matrix<double, Dim, 1> x = WorldPosition(world, sp.body, sp.rest_local, sp.mode_matrix);
+    const vtkIdType ids[2] = {points->InsertNextPoint(To3(sp.anchor).data()), points->InsertNextPoint(To3(x).data())};
+    lines->InsertNextCell(2, ids);
+    stretch->InsertNextValue((x - sp.anchor).norm() - sp.rest_length);
+  }
+}
+
+}  // namespace
+
 int SpringSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out_vec) {
   if (!Check(Needs::kWorld)) return 0;
   vtkPolyData* out = OutputOf(out_vec);
@@ -562,25 +632,8 @@ int SpringSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
   auto lines = Ptr<vtkCellArray>::New();
   auto stretch = Ptr<vtkDoubleArray>::New();
   stretch->SetName("stretch");  // length minus rest length, per line
-  for (const Spring& sp : world_->options().params.springs) {
-    if (sp.body < 0 || sp.body >= world_->num_bodies() || !world_->IsFfd(sp.body, 2)) continue;
-    const VecQ<double>& q = world_->q(sp.body);
-    const Eigen::Vector2d x = WorldFromLocal(Frame<2, double>(q), LocalPosition<double>(sp.rest_local, sp.mode_matrix, q));
-    const vtkIdType ids[2] = {points->InsertNextPoint(sp.anchor.x(), sp.anchor.y(), 0.0),
-                              points->InsertNextPoint(x.x(), x.y(), 0.0)};
-    lines->InsertNextCell(2, ids);
-    stretch->InsertNextValue((x - sp.anchor).norm() - sp.rest_length);
-  }
-  for (const SpringN<3>& sp : world_->options().springs_3d) {
-    if (sp.body < 0 || sp.body >= world_->num_bodies() || !world_->IsFfd(sp.body, 3)) continue;
-    const BodyState<3, double>& s = world_->state<3>(sp.body);
-    {
-      const Eigen::Vector3d x = s.translation() + s.orientation() * LocalPosition<double>(sp.rest_local, sp.mode_matrix, s.q);
-      const vtkIdType ids[2] = {points->InsertNextPoint(sp.anchor.data()), points->InsertNextPoint(x.data())};
-      lines->InsertNextCell(2, ids);
-      stretch->InsertNextValue((x - sp.anchor).norm() - sp.rest_length);
-    }
-  }
+  AddSprings<2>(*world_, points, lines, stretch);
+  AddSprings<3>(*world_, points, lines, stretch);
   out->SetPoints(points);
   out->SetLines(lines);
   out->GetCellData()->AddArray(stretch);

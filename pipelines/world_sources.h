@@ -1,43 +1,46 @@
 // VTK sources that turn a wobble::World into vtkPolyData, in world coordinates (2D bodies at
-// z = 0; 3D linear bodies in 3D). One hierarchy for every body kind: each source is a
+// z = 0; 3D bodies in 3D). One hierarchy for every body kind: each source is a
 // vtkPolyDataAlgorithm with no input over a World and a body index (WorldSourceBase); set the
 // world and the body, and call Modified() after the world has changed so that the next
 // Update() redraws. A source asked for a body of a kind it cannot draw (or for no world, or a
 // body the world does not have) reports it with vtkErrorMacro and outputs nothing.
 //
 // Per body, for both kinds (FFD bodies of the thesis, Witkin & Welch linear bodies; each a
-// BodyPartSource, which dispatches on the body's kind):
+// BodyPartSource, which dispatches on the body's kind). An FFD body of either dimension is drawn
+// by one code over Dim (issue 45: Frame, LocalPosition, PointVelocity and GroundForce of the
+// library); points and vectors always have 3 components, z = 0 in 2D.
 //   LatticeSource    the control structure, as vertices and grid lines.
-//                    FFD: the deformed control lattice; point arrays rest_position (body
-//                    frame) and displacement (body frame, Σ γ_d d^d_ij of Eq. 4.2: the
-//                    deformation alone, without the rigid motion).
+//                    FFD: the deformed control lattice, a line along each axis through every
+//                    row of control points; point arrays rest_position (body frame) and
+//                    displacement (body frame, Σ γ_d d^d_ij of Eq. 4.2: the deformation alone,
+//                    without the rigid motion).
 //                    Linear: the "control box", a grid of lines over the box the mass points
 //                    span (3 lines per direction and face), each cut into Pieces and carried
 //                    by x = R p(u), so a quadratic body's bend shows; the grid's nodes as
 //                    vertices; point array rest_position (u).
 //   MassPointSource  the mass points as vertices; arrays mass and velocity, and for FFD
 //                    bodies applied_force (gravity plus the ground's penalty force of
-//                    Eq. 4.24/4.25, world frame) and in_contact (1 for a point tied to the ground)
+//                    Eq. 4.24/4.25 on the points tied to it: the line or terrain in 2D, the
+//                    plane or heightfield in 3D; world frame) and in_contact (1 for a point
+//                    tied to the ground)
 //   ShapeSource      the body's drawing.
 //                    FFD: the drawing polylines of the body's file, resampled finer than the
 //                    mass points: each segment is cut into SamplesPerSegment pieces and every
 //                    sample is moved by the FFD (the thesis simulates few points and draws
-//                    many, §4.10); point array lattice_coords.
+//                    many, §4.10). 2D: point array lattice_coords. 3D adds the object's mesh
+//                    as triangles with every vertex moved by the FFD, and the point array
+//                    displacement (B γ, body frame) over mesh and polylines.
 //                    Linear: a LinearDrawing (SetDrawing: polylines and, in 3D, a triangle
 //                    surface) carried by x = R p(u).
-//   3D FFD bodies (world_sources_ffd3.cc): the lattice with lines along its three axes; the
-//                    mass points (mass, velocity, in_contact,
-//                    applied_force: gravity plus the ground plane's force on points in
-//                    contact); the shape: the object's mesh as triangles with every vertex moved by the FFD
-//                    (point array displacement = B γ, body frame) and its polylines resampled.
-//   TrailSource      (FFD bodies) trajectories of chosen points (lattice coordinates): call
+//   TrailSource      (2D FFD bodies) trajectories of chosen points (lattice coordinates): call
 //                    Record() after each frame; polylines with a point array time
 // Of the world (Body is not used):
 //   GroundSource     the ground line with its slope, or the terrain's profile, as a filled band of
 //                    given length and depth;
 //                    with a 3D FFD body, the 3D ground plane: a square of side Length under
 //                    the 3D bodies' centre
-//   SpringSource     the world's springs as lines anchor → held point; cell array stretch
+//   SpringSource     the world's springs (of FFD bodies of either dimension) as lines
+//                    anchor → held point; cell array stretch
 //   AnchorSource     named points (material points of any body, fixed places) as vertices,
 //                    e.g. the control points of a script
 // Every output has a TimeValue field array: the world's time.
@@ -46,16 +49,23 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <string>
+#include <tuple>
 #include <vector>
 #include <vtkPolyDataAlgorithm.h>
 
 #include "wobble/body/linear_shapes.h"
+#include "wobble/dynamics/kinematics.h"
 #include "wobble/world/world.h"
 
 namespace wobble::pipelines {
 
-// A point of a 2D or 3D world in VTK's three coordinates (z = 0 in 2D).
+// A point of a 2D or 3D world in VTK's three coordinates (z = 0 in 2D); for fixed sizes
+// without a temporary on the heap.
 Eigen::Vector3d To3(const Eigen::VectorXd& p);
+template <int Dim> Eigen::Vector3d To3(const Eigen::Matrix<double, Dim, 1>& p) {
+  if constexpr (Dim == 2) return Eigen::Vector3d(p.x(), p.y(), 0.0);
+  else return p;
+}
 
 // What every source shares: the world and which body of it.
 class WorldSourceBase : public vtkPolyDataAlgorithm {
@@ -82,7 +92,8 @@ class WorldSourceBase : public vtkPolyDataAlgorithm {
 };
 
 // A part of one body of either kind: RequestData checks the body and draws it with the
-// kind's own function (false: nothing drawn, already reported).
+// kind's own function (false: nothing drawn, already reported). DrawFfd serves FFD bodies of
+// both dimensions: each source's calls its own DrawFfdOf<Dim> with the body's dimension.
 class BodyPartSource : public WorldSourceBase {
  public:
   vtkTypeMacro(BodyPartSource, WorldSourceBase);
@@ -92,7 +103,6 @@ class BodyPartSource : public WorldSourceBase {
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) final;
   virtual bool DrawFfd(vtkPolyData* out) = 0;
   virtual bool DrawLinear(vtkPolyData* out) = 0;
-  virtual bool DrawFfd3(vtkPolyData* out) = 0;  // world_sources_ffd3.cc
 };
 
 class LatticeSource : public BodyPartSource {
@@ -107,8 +117,10 @@ class LatticeSource : public BodyPartSource {
   LatticeSource() = default;
   bool DrawFfd(vtkPolyData* out) override;
   bool DrawLinear(vtkPolyData* out) override;
-  bool DrawFfd3(vtkPolyData* out) override;
   int Pieces = 12;
+
+ private:
+  template <int Dim> bool DrawFfdOf(vtkPolyData* out);
 };
 
 class MassPointSource : public BodyPartSource {
@@ -120,7 +132,20 @@ class MassPointSource : public BodyPartSource {
   MassPointSource() = default;
   bool DrawFfd(vtkPolyData* out) override;
   bool DrawLinear(vtkPolyData* out) override;
-  bool DrawFfd3(vtkPolyData* out) override;
+
+ private:
+  template <int Dim> bool DrawFfdOf(vtkPolyData* out);
+};
+
+// ShapeSource's drawing polylines of an FFD body of Dim, resampled: every sample's lattice
+// coordinates and its b0 and B (BodyModelN::LocalBasis), made once per body and sample
+// count: the lattice weights of a sample never change, only q does.
+template <int Dim> struct DrawingSamples {
+  const BodyModelN<Dim>* body = nullptr;
+  int per_segment = -1;
+  std::vector<Eigen::Matrix<double, Dim, 1>> st, b0;
+  std::vector<MatND<double, Dim>> B;
+  std::vector<std::pair<int, bool>> polylines;  // samples per polyline, closed
 };
 
 class ShapeSource : public BodyPartSource {
@@ -131,19 +156,20 @@ class ShapeSource : public BodyPartSource {
   // FFD bodies: pieces each drawing segment is cut into (>= 1).
   vtkSetClampMacro(SamplesPerSegment, int, 1, 100000);
   vtkGetMacro(SamplesPerSegment, int);
-  // FFD bodies: lattice coordinates of every sample, in output order (one polyline after the
-  // other), as of the last update.
+  // 2D FFD bodies: lattice coordinates of every sample, in output order (one polyline after
+  // the other), as of the last update.
   std::vector<Eigen::Vector2d> SampleLatticeCoords() const;
 
-  // Linear bodies: the drawing (in the body's undeformed coordinates), and which part of it:
-  // lines (polylines), surface (triangles) or both (default).
+  // Which part of the drawing: lines (polylines), surface (triangles: a linear body's drawing,
+  // a 3D FFD body's mesh) or both (default).
+  vtkSetMacro(Lines, bool);
+  vtkSetMacro(Surface, bool);
+  // Linear bodies: the drawing (in the body's undeformed coordinates).
   void SetDrawing(const LinearDrawing& drawing) {
     drawing_ = drawing;
     Modified();
   }
-  vtkSetMacro(Lines, bool);
-  vtkSetMacro(Surface, bool);
-  // 2D FFD bodies: the closed polylines of the drawing as polygons (the clean style's fill)
+  // FFD bodies: the closed polylines of the drawing as polygons (the clean style's fill)
   // instead of every polyline as lines.
   vtkSetMacro(FillClosed, bool);
 
@@ -151,20 +177,14 @@ class ShapeSource : public BodyPartSource {
   ShapeSource() = default;
   bool DrawFfd(vtkPolyData* out) override;
   bool DrawLinear(vtkPolyData* out) override;
-  bool DrawFfd3(vtkPolyData* out) override;
   int SamplesPerSegment = 16;
   LinearDrawing drawing_;
   bool Lines = true, Surface = true, FillClosed = false;
 
  private:
-  // b0 and B of every sample (BodyModel::LocalBasis), cached per body and sample count:
-  // the lattice weights of a sample never change, only q does.
-  void UpdateCache();
-  const BodyModel* cached_body_ = nullptr;
-  int cached_samples_ = -1;
-  std::vector<Eigen::Vector2d> sample_st_, sample_b0_;
-  std::vector<Mat2D<double>> sample_B_;
-  std::vector<std::pair<int, bool>> polyline_sizes_;  // samples per polyline, closed
+  template <int Dim> const DrawingSamples<Dim>& SamplesOf(const BodyModelN<Dim>& body);  // made if stale
+  template <int Dim> bool DrawFfdOf(vtkPolyData* out);
+  std::tuple<DrawingSamples<2>, DrawingSamples<3>> samples_;  // by Dim - 2
 };
 
 class GroundSource : public WorldSourceBase {
@@ -241,14 +261,40 @@ class AnchorSource : public WorldSourceBase {
   std::vector<Anchor> anchors_;
 };
 
-// World position of lattice coordinates st of FFD body `body` at the world's current state
-// (Eq. 4.2 through BodyModel::LocalBasis).
-Eigen::Vector2d WorldPositionOf(const World& world, int body, const Eigen::Vector2d& st);
+// The world position x = t + R (b0 + B γ) (Eq. 4.2) of a point of FFD body `body` of Dim with
+// rest position b0 and mode matrix B, at the world's current state.
+template <int Dim, class Derived>
+Eigen::Matrix<double, Dim, 1> WorldPosition(const World& world, int body, const Eigen::Matrix<double, Dim, 1>& b0,
+                                            const Eigen::MatrixBase<Derived>& B) {
+  const VecQ<double>& q = world.q(body);
+  return WorldFromLocal(Frame<Dim, double>(q), LocalPosition<double>(b0, B, q));
+}
 
-// A 3D FFD body: the world position t + R (b0 + B γ) of a point with this basis, and a box
-// holding its deformed control points (so every point of the body, by the convex hull).
-Eigen::Vector3d WorldPosition3(const World& world, int body, const Eigen::Vector3d& b0, const Mat3D<double>& B);
-Eigen::AlignedBox3d BodyBounds3(const World& world, int body);
+// World position of lattice coordinates st of FFD body `body` (of st's dimension) at the
+// world's current state (through BodyModelN::LocalBasis).
+template <int Dim>
+Eigen::Matrix<double, Dim, 1> WorldPositionOf(const World& world, int body, const Eigen::Matrix<double, Dim, 1>& st);
+
+// A box holding the deformed control points of FFD body `body` of Dim, so every point of the
+// body (by the convex hull).
+template <int Dim> Eigen::AlignedBox<double, Dim> BodyBounds(const World& world, int body);
+// The same for an FFD body of either dimension, in 3 coordinates (z = 0 in 2D).
+Eigen::AlignedBox3d FfdBodyBounds(const World& world, int body);
+
+// The ground, gravity and springs of this world's FFD bodies of Dim (2D: options().params;
+// 3D: ground_3d, gravity_3d, springs_3d).
+template <int Dim> const GroundOf<Dim>& FfdGround(const World& world) {
+  if constexpr (Dim == 2) return world.options().params.ground;
+  else return world.options().ground_3d;
+}
+template <int Dim> Eigen::Matrix<double, Dim, 1> FfdGravity(const World& world) {
+  if constexpr (Dim == 2) return world.options().params.gravity;
+  else return world.options().gravity_3d;
+}
+template <int Dim> const std::vector<SpringN<Dim>>& FfdSprings(const World& world) {
+  if constexpr (Dim == 2) return world.options().params.springs;
+  else return world.options().springs_3d;
+}
 
 // The ground a body stands on, as drawn: 2 for the 2D ground (line or terrain), 3 for the 3D
 // plane, 0 for none. FFD bodies always stand on theirs; a linear body only when it touches it

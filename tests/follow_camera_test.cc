@@ -58,7 +58,7 @@ TEST(FollowCamera, EasesAJumpOfTheGroundUnderTheBody) {
 // 3D: cubes of one size, centred on a body moving at constant velocity in x and z (exactly,
 // first and last too), with the ground under it a fifth up when the body stands on it.
 TEST(FollowCamera, FollowsA3DBodyInCubesOfOneSizeWithTheGroundInView) {
-  std::vector<FollowMoment3> moments;
+  std::vector<FollowMomentN<3>> moments;
   auto pot = [](double x, double y, double z) {
     return Eigen::AlignedBox3d(Eigen::Vector3d(x - 40, y, z - 40), Eigen::Vector3d(x + 40, y + 100, z + 40));
   };
@@ -66,7 +66,7 @@ TEST(FollowCamera, FollowsA3DBodyInCubesOfOneSizeWithTheGroundInView) {
     const double t = i / 30.0;
     moments.push_back({t, pot(-100 + 60 * t, 20 - 5 * t, 30 * t), 20 - 5 * t});  // on a ground going down
   }
-  const std::vector<Eigen::AlignedBox3d> boxes = FollowBoxes3(moments, {});
+  const std::vector<Eigen::AlignedBox3d> boxes = FollowBoxes(moments, {});
   ASSERT_EQ(boxes.size(), moments.size());
   for (size_t i = 0; i < boxes.size(); ++i) {
     EXPECT_NEAR(boxes[i].center().x(), moments[i].body.center().x(), 1e-9) << i;

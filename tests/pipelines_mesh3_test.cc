@@ -240,7 +240,7 @@ TEST(Mesh3Sources, LatticeAndMassPointsOfA3dBody) {
   vtkDataArray* velocity = pd->GetPointData()->GetArray("velocity");
   double worst = 0, scale = 0;
   for (int k = 0; k < m.num_points(); k += 7) {
-    auto at = [&](const World& world) { return WorldPosition3(world, 0, m.rest_local(k), m.mode_matrix(k)); };
+    auto at = [&](const World& world) { return WorldPosition(world, 0, m.rest_local(k), m.mode_matrix(k)); };
     const Vec3 fd = (at(ahead) - at(behind)) / (2 * h);
     Vec3 v;
     velocity->GetTuple(k, v.data());
