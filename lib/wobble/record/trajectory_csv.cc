@@ -47,7 +47,7 @@ BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel> body) {
   info.coordinate_names = {"tx", "ty", "theta"};
   for (const DeformationMode& mode : body->modes()) info.coordinate_names.push_back(mode.name);
   info.num_q = int(info.coordinate_names.size());
-  info.ffd = std::move(body);
+  info.set_ffd(std::move(body));
   return info;
 }
 
