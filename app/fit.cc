@@ -577,7 +577,7 @@ void ReadStates(const std::string& path, const std::shared_ptr<const BodyModel>&
 }
 void ReadStates(const std::string& path, const std::shared_ptr<const BodyModel3>& body, std::vector<double>* t,
                 std::vector<Eigen::VectorXd>* q) {
-  const record::Trajectory sim = record::ReadTrajectoryCsv(path, {record::DescribeFfd3Body(body)}).trajectory;
+  const record::Trajectory sim = record::ReadTrajectoryCsv(path, {record::DescribeFfdBody(body)}).trajectory;
   for (int k = 0; k < sim.size(); ++k) {
     const Eigen::VectorXd row = sim.q(k, 0);
     const Eigen::Quaterniond orientation(row[3], row[4], row[5], row[6]);

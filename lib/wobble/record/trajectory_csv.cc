@@ -51,7 +51,7 @@ BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel> body) {
   return info;
 }
 
-BodyInfo DescribeFfd3Body(std::shared_ptr<const BodyModel3> body) {
+BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel3> body) {  // as a world describes it
   World w;
   w.AddBody(body);
   return DescribeBody(w, 0);
