@@ -45,37 +45,34 @@ template <class Body> void CheckLoadedModes(const Body& body, const std::string&
   }
   for (const std::string& m : report.messages) std::cerr << "wobble: warning: " << m << "\n";
 }
+
+// The object file: a 3D one's `mesh` line is read by VTK when the CLI has the pipelines.
+template <int Dim> BodyDefN<Dim> ReadObject(const std::string& path) {
+  if constexpr (Dim == 2) return formats::ReadObjectFile(path);
+#ifdef WOBBLE_HAVE_PIPELINES
+  else return pipelines::ReadObject3(path);
+#else
+  else return formats::ReadObjectFile3(path);
+#endif
+}
 }  // namespace
 
-std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_modes) {
-  BodyDef def = formats::ReadObjectFile(files.object);
-  std::vector<DeformationMode> modes;
+template <int Dim> std::shared_ptr<const BodyModelN<Dim>> LoadBody(const BodyFiles& files, bool check_modes) {
+  BodyDefN<Dim> def = ReadObject<Dim>(files.object);
+  std::vector<DeformationModeN<Dim>> modes;
   for (const std::string& path : files.modes) {
     if (path.empty()) throw UsageError("--modes: empty file name in the list");
-    std::vector<DeformationMode> more = formats::ReadDeformationFile(path, def.lattice);  // generators need it
+    std::vector<DeformationModeN<Dim>> more;
+    if constexpr (Dim == 2) more = formats::ReadDeformationFile(path, def.lattice);  // generators need it
+    else more = formats::ReadDeformationFile3(path, def.lattice);
     modes.insert(modes.end(), more.begin(), more.end());
   }
-  auto body = std::make_shared<const BodyModel>(std::move(def), std::move(modes));
+  auto body = std::make_shared<const BodyModelN<Dim>>(std::move(def), std::move(modes));
   if (check_modes) CheckLoadedModes(*body, files.object);
   return body;
 }
-
-std::shared_ptr<const BodyModel3> LoadBody3(const BodyFiles& files, bool check_modes) {
-#ifdef WOBBLE_HAVE_PIPELINES
-  BodyDef3 def = pipelines::ReadObject3(files.object);  // a `mesh` line is read by VTK
-#else
-  BodyDef3 def = formats::ReadObjectFile3(files.object);
-#endif
-  std::vector<DeformationMode3> modes;
-  for (const std::string& path : files.modes) {
-    if (path.empty()) throw UsageError("--modes: empty file name in the list");
-    std::vector<DeformationMode3> more = formats::ReadDeformationFile3(path, def.lattice);
-    modes.insert(modes.end(), more.begin(), more.end());
-  }
-  auto body = std::make_shared<const BodyModel3>(std::move(def), std::move(modes));
-  if (check_modes) CheckLoadedModes(*body, files.object);
-  return body;
-}
+template std::shared_ptr<const BodyModel> LoadBody<2>(const BodyFiles&, bool);
+template std::shared_ptr<const BodyModel3> LoadBody<3>(const BodyFiles&, bool);
 
 void CheckOutputFolder(const std::string& folder) {
   try {
@@ -228,11 +225,14 @@ WorldParams MakeWorldParams(const WorldFlags& f) {
   return p;
 }
 
-std::string CoordinateNames(const BodyModel& body) {
-  std::string names = "tx ty theta";
-  for (int d = 1; d <= body.num_modes(); ++d) names += " g" + std::to_string(d);
-  return names;
+namespace {
+template <int Dim> void LoadStartingBody(const BodyFiles& files, const std::string& q, const std::string& qdot, StartingWorld* s) {
+  const std::shared_ptr<const BodyModelN<Dim>> body = LoadBody<Dim>(files);
+  s->q0 = ParseCoordinates(q, "--q", *body);
+  s->qd0 = ParseVelocities(qdot, "--qdot", *body);
+  std::get<Dim - 2>(s->bodies) = body;
 }
+}  // namespace
 
 StartingWorld LoadStartingWorld(const BodyFiles& files, const std::string& q, const std::string& qdot,
                                 const WorldFlags& flags, Integrator integrator, double dt) {
@@ -243,46 +243,53 @@ StartingWorld LoadStartingWorld(const BodyFiles& files, const std::string& q, co
   if (formats::ObjectFileDimension(files.object) == 3) {
     // the 3D ground: the plane through y = height, tilted by the slope about z as the 2D line
     s.options.ground_3d = GroundPlaneOf(s.options.params.ground);
-    s.body3 = LoadBody3(files);
-    const int n = Group<3>::kRigidDofs + s.body3->num_modes();
-    s.q0 = ParseNumbers(q, "--q", n, CoordinateNames3(*s.body3), s.body3->name());
-    s.qd0 = ParseNumbers(qdot, "--qdot", n, VelocityNames3(*s.body3), s.body3->name());
-    return s;
+    LoadStartingBody<3>(files, q, qdot, &s);
+  } else {
+    LoadStartingBody<2>(files, q, qdot, &s);
   }
-  s.body = LoadBody(files);
-  s.q0 = ParseCoordinates(q, "--q", *s.body);
-  s.qd0 = ParseCoordinates(qdot, "--qdot", *s.body);
   return s;
 }
 
 World StartingWorld::MakeWorld() const {
   World world(options);
-  if (body3) {
-    // q = (t, rotation vector r, γ): R = exp([r]×), the turn by |r| radians about r
-    world.AddBody(body3);
-    world.SetCoordinates(0, q0, qd0);
-    return world;
-  }
-  world.AddBody(body);
-  world.SetState(0, q0, qd0);
+  if (dim() == 3) world.AddBody(body<3>());
+  else world.AddBody(body<2>());
+  // 3D: q = (t, rotation vector r, γ), R = exp([r]×) the turn by |r| radians about r; 2D: the state
+  world.SetCoordinates(0, q0, qd0);
   return world;
 }
 
-std::string CoordinateNames3(const BodyModel3& body) {
-  std::string names = "tx ty tz rx ry rz";
+template <int Dim> std::string CoordinateNames(const BodyModelN<Dim>& body) {
+  std::string names = Dim == 3 ? "tx ty tz rx ry rz" : "tx ty theta";
   for (int d = 1; d <= body.num_modes(); ++d) names += " g" + std::to_string(d);
   return names;
 }
 
-std::string VelocityNames3(const BodyModel3& body) {
+template <int Dim> std::string VelocityNames(const BodyModelN<Dim>& body) {
+  if constexpr (Dim == 2) return CoordinateNames(body);  // q̇ = dq/dt
   std::string names = "vx vy vz wx wy wz";
   for (int d = 1; d <= body.num_modes(); ++d) names += " dg" + std::to_string(d);
   return names;
 }
 
-Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& what, const BodyModel& body) {
+template <int Dim>
+Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& what, const BodyModelN<Dim>& body) {
   return ParseNumbers(text, what, body.num_q(), CoordinateNames(body), body.name());
 }
+
+template <int Dim>
+Eigen::VectorXd ParseVelocities(const std::string& text, const std::string& what, const BodyModelN<Dim>& body) {
+  return ParseNumbers(text, what, body.num_q(), VelocityNames(body), body.name());
+}
+
+template std::string CoordinateNames(const BodyModel&);
+template std::string CoordinateNames(const BodyModel3&);
+template std::string VelocityNames(const BodyModel&);
+template std::string VelocityNames(const BodyModel3&);
+template Eigen::VectorXd ParseCoordinates(const std::string&, const std::string&, const BodyModel&);
+template Eigen::VectorXd ParseCoordinates(const std::string&, const std::string&, const BodyModel3&);
+template Eigen::VectorXd ParseVelocities(const std::string&, const std::string&, const BodyModel&);
+template Eigen::VectorXd ParseVelocities(const std::string&, const std::string&, const BodyModel3&);
 
 Eigen::VectorXd ParseNumbers(const std::string& text, const std::string& what, int expected_size,
                              const std::string& names, const std::string& body_name) {

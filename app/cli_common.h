@@ -12,6 +12,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "wobble/body/body_model.h"
@@ -44,10 +45,9 @@ void AddBodyFlags(CLI::App* cmd, BodyFiles* files);
 // file and std::invalid_argument when the modes do not fit the object.
 // With check_modes, the mode set is checked as it loads (analysis::CheckModeSet): warnings
 // (nearly dependent modes, modes the mass cannot see) go to stderr, and a dependent set — M
-// singular — is refused with std::invalid_argument.
-std::shared_ptr<const BodyModel> LoadBody(const BodyFiles& files, bool check_modes = true);
-// The same for a 3D object file ('dimension 3') and its 3D deformation files.
-std::shared_ptr<const BodyModel3> LoadBody3(const BodyFiles& files, bool check_modes = true);
+// singular — is refused with std::invalid_argument. Dim is the object file's dimension
+// (formats::ObjectFileDimension: 3 for 'dimension 3' and 3D deformation files).
+template <int Dim> std::shared_ptr<const BodyModelN<Dim>> LoadBody(const BodyFiles& files, bool check_modes = true);
 
 // Gravity and ground flags, shared by simulate and inspect.
 struct WorldFlags {
@@ -82,9 +82,13 @@ void CheckLimitFlags(const Limits& limits);
 long CheckRunLimits(double duration, double dt, long every, int columns, const Limits& limits);
 
 // Parses a generalized-coordinate vector given as "1 2.5 -3" (spaces and/or commas) with
-// one number per coordinate of the body. `what` names the flag in messages. An empty text
-// gives zeros. Throws UsageError on a non-number, a non-finite number or a wrong count.
-Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& what, const BodyModel& body);
+// one number per coordinate of the body (CoordinateNames). `what` names the flag in messages.
+// An empty text gives zeros. Throws UsageError on a non-number, a non-finite number or a
+// wrong count. ParseVelocities: the same for a velocity (VelocityNames).
+template <int Dim>
+Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& what, const BodyModelN<Dim>& body);
+template <int Dim>
+Eigen::VectorXd ParseVelocities(const std::string& text, const std::string& what, const BodyModelN<Dim>& body);
 
 // What simulate, render, inspect and condition time start from: the body of the files, its
 // start state (--q, --qdot; empty texts give rest) and the world options of the flags.
@@ -93,8 +97,12 @@ Eigen::VectorXd ParseCoordinates(const std::string& text, const std::string& wha
 // dgD" (ω in the body frame), and the ground is the plane through y = --ground-height tilted
 // by --ground-slope about z.
 struct StartingWorld {
-  std::shared_ptr<const BodyModel> body;     // a 2D object file's
-  std::shared_ptr<const BodyModel3> body3;   // a 3D object file's
+  // The body, of the object file's dimension (null for the other one).
+  template <int Dim> const std::shared_ptr<const BodyModelN<Dim>>& body() const { return std::get<Dim - 2>(bodies); }
+  int dim() const { return body<3>() ? 3 : 2; }
+  // f(body) on the body of either dimension.
+  template <class F> decltype(auto) OnBody(F&& f) const { return dim() == 3 ? f(*body<3>()) : f(*body<2>()); }
+  std::tuple<std::shared_ptr<const BodyModel>, std::shared_ptr<const BodyModel3>> bodies;  // one is set
   Eigen::VectorXd q0, qd0;
   WorldOptions options;
   World MakeWorld() const;  // the body alone in a world, at (q0, q̇0)
@@ -113,11 +121,10 @@ std::string StateFlagHelp(const std::string& default_text);
 std::string VelocityFlagHelp(const std::string& default_text);
 std::string IntegratorFlagHelp();
 
-// "tx ty theta g1 .. gD" for a body; "tx ty tz rx ry rz g1 .." and "vx vy vz wx wy wz dg1 .."
-// for a 3D body's --q and --qdot.
-std::string CoordinateNames(const BodyModel& body);
-std::string CoordinateNames3(const BodyModel3& body);
-std::string VelocityNames3(const BodyModel3& body);
+// The names of --q and --qdot in messages: "tx ty theta g1 .. gD" for both of a 2D body (q̇ is
+// dq/dt); "tx ty tz rx ry rz g1 .." and "vx vy vz wx wy wz dg1 .." for a 3D body.
+template <int Dim> std::string CoordinateNames(const BodyModelN<Dim>& body);
+template <int Dim> std::string VelocityNames(const BodyModelN<Dim>& body);
 // The words of a list separated by commas and/or white space.
 std::vector<std::string> ListWords(const std::string& text);
 // Every word of such a list as a finite number (a UsageError naming `flag` otherwise).

@@ -267,7 +267,7 @@ int RunConditionTime(const ConditionTimeArgs& a) {
   if (!(a.duration / a.dt <= 1e7)) throw UsageError("--duration / --dt asks for more than 10^7 steps");
   CheckOutputFolder(a.out);
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, "", a.world, Integrator::kThesis, a.dt);
-  const std::string name = setup.body3 ? setup.body3->name() : setup.body->name();
+  const std::string name = setup.OnBody([](const auto& body) { return body.name(); });
   World world = setup.MakeWorld();
 
   // the run's trajectory: cond₂(M) and the contact events come from it, as for wobble render
@@ -307,10 +307,10 @@ int RunConditionCheck(const ConditionCheckArgs& a) {
   options.warn_visibility = a.warn_visibility;
   if (formats::ObjectFileDimension(a.files.object) == 3) {
     if (!a.q.empty()) throw UsageError("--q: a 3D body is checked at rest (its orientation is no coordinate)");
-    const std::shared_ptr<const BodyModel3> body = LoadBody3(a.files, /*check_modes=*/false);
+    const std::shared_ptr<const BodyModel3> body = LoadBody<3>(a.files, /*check_modes=*/false);
     return PrintModeSetReport(analysis::CheckModeSet(*body, options), body->name(), a);
   }
-  const std::shared_ptr<const BodyModel> body = LoadBody(a.files, /*check_modes=*/false);
+  const std::shared_ptr<const BodyModel> body = LoadBody<2>(a.files, /*check_modes=*/false);
   return PrintModeSetReport(analysis::CheckModeSet(*body, ParseCoordinates(a.q, "--q", *body), options), body->name(), a);
 }
 

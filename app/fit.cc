@@ -57,24 +57,9 @@ void AddFitFlags(CLI::App* cmd, FitFlags* f) {
   cmd->add_option("--costs", f->costs, "Cost per iteration as CSV (written atomically)")->type_name("FILE.csv");
 }
 
-// --q0 (and --qdot0) of a 2D body: "tx ty theta g.."; of a 3D body "tx ty tz rx ry rz g.."
-// (r a rotation vector) and "vx vy vz wx wy wz dg.." (ω in the body frame).
-Eigen::VectorXd StartQ(const std::string& text, const std::string& flag, const BodyModel& body) {
-  return ParseCoordinates(text, flag, body);
-}
-Eigen::VectorXd StartQ(const std::string& text, const std::string& flag, const BodyModel3& body) {
-  return ParseNumbers(text, flag, body.num_q(), CoordinateNames3(body), body.name());
-}
-Eigen::VectorXd StartVelocity(const std::string& text, const std::string& flag, const BodyModel& body) {
-  return ParseCoordinates(text, flag, body);
-}
-Eigen::VectorXd StartVelocity(const std::string& text, const std::string& flag, const BodyModel3& body) {
-  return ParseNumbers(text, flag, body.num_q(), VelocityNames3(body), body.name());
-}
-
 template <int Dim> fit::PoseFitOptions PoseOptions(const FitFlags& f, const BodyModelN<Dim>& body) {
   fit::PoseFitOptions o;
-  if (!f.q0.empty()) o.initial_q = StartQ(f.q0, "--q0", body);
+  if (!f.q0.empty()) o.initial_q = ParseCoordinates(f.q0, "--q0", body);  // 3D: t, rotation vector, γ
   RequireFinite(f.gamma_min, "--gamma-min");
   RequireFinite(f.gamma_max, "--gamma-max");
   if (!(f.gamma_min < f.gamma_max)) throw UsageError("--gamma-min must be below --gamma-max");
@@ -501,8 +486,8 @@ template <int Dim> int RunPose(const FitPoseArgs& a, const std::shared_ptr<const
 
 int RunFitPose(const FitPoseArgs& a) {
   CheckOutputs(a.fit);
-  if (formats::ObjectFileDimension(a.files.object) == 3) return RunPose<3>(a, LoadBody3(a.files));
-  return RunPose<2>(a, LoadBody(a.files));
+  if (formats::ObjectFileDimension(a.files.object) == 3) return RunPose<3>(a, LoadBody<3>(a.files));
+  return RunPose<2>(a, LoadBody<2>(a.files));
 }
 
 namespace {
@@ -577,7 +562,7 @@ void ReadStates(const std::string& path, const std::shared_ptr<const BodyModel>&
 }
 void ReadStates(const std::string& path, const std::shared_ptr<const BodyModel3>& body, std::vector<double>* t,
                 std::vector<Eigen::VectorXd>* q) {
-  const record::Trajectory sim = record::ReadTrajectoryCsv(path, {record::DescribeFfd3Body(body)}).trajectory;
+  const record::Trajectory sim = record::ReadTrajectoryCsv(path, {record::DescribeFfdBody(body)}).trajectory;
   for (int k = 0; k < sim.size(); ++k) {
     const Eigen::VectorXd row = sim.q(k, 0);
     const Eigen::Quaterniond orientation(row[3], row[4], row[5], row[6]);
@@ -685,7 +670,7 @@ template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shar
     if (o.fit_times && !(o.switch_width > 0))
       throw UsageError("--fit times needs --switch-width > 0: a hard switch gives the times no gradient");
     if (!a.fit.q0.empty()) start.q0 = po.initial_q;
-    if (!a.qdot0.empty()) start.qd0 = StartVelocity(a.qdot0, "--qdot0", *body);
+    if (!a.qdot0.empty()) start.qd0 = ParseVelocities(a.qdot0, "--qdot0", *body);
     try {
       fit::FrameSteps(frames, o.dt);
     } catch (const std::invalid_argument& e) {
@@ -749,8 +734,8 @@ template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shar
 
 int RunFitTrajectory(const FitTrajectoryArgs& a) {
   CheckOutputs(a.fit);
-  if (formats::ObjectFileDimension(a.files.object) == 3) return RunTrajectory<3>(a, WithActiveModes(LoadBody3(a.files), a.active));
-  return RunTrajectory<2>(a, WithActiveModes(LoadBody(a.files), a.active));
+  if (formats::ObjectFileDimension(a.files.object) == 3) return RunTrajectory<3>(a, WithActiveModes(LoadBody<3>(a.files), a.active));
+  return RunTrajectory<2>(a, WithActiveModes(LoadBody<2>(a.files), a.active));
 }
 
 }  // namespace wobble::app

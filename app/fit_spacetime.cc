@@ -44,7 +44,7 @@ template <class Problem> void SetBounds(const FitSpacetimeArgs& a, int D, Proble
 // centre of mass starts and how --reach reads.
 template <int Dim> struct SpacetimeObject;
 template <> struct SpacetimeObject<2> {
-  static const BodyModel& Body(const StartingWorld& start) { return *start.body; }
+  static const BodyModel& Body(const StartingWorld& start) { return *start.body<2>(); }
   static WorldParamsN<2> World(const StartingWorld& start) { return start.options.params; }
   static Eigen::Vector2d CentreOfMass(const BodyModel& body, const BodyState<2, double>& s) {
     const MassMoments& mm = body.moments();
@@ -55,7 +55,7 @@ template <> struct SpacetimeObject<2> {
   static constexpr const char* kReach = "--reach takes \"X Y T\" for a 2D object";
 };
 template <> struct SpacetimeObject<3> {
-  static const BodyModel3& Body(const StartingWorld& start) { return *start.body3; }
+  static const BodyModel3& Body(const StartingWorld& start) { return *start.body<3>(); }
   static WorldParamsN<3> World(const StartingWorld& start) { return Params3Of(start.options); }
   static Eigen::Vector3d CentreOfMass(const BodyModel3& body, const BodyState<3, double>& s) {
     const MassMoments3& mm = body.moments();
@@ -173,7 +173,7 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
     }
   const StartingWorld start = LoadStartingWorld(a.files, a.q, a.qdot, a.world, Integrator::kThesis, a.dt);
   const int steps = int(std::lround(a.duration / a.dt));
-  const std::vector<std::string> names = start.body3 ? ModeNames(start.body3->modes()) : ModeNames(start.body->modes());
+  const std::vector<std::string> names = start.OnBody([](const auto& body) { return ModeNames(body.modes()); });
   const int D = int(names.size());
   if (D == 0) throw UsageError("the object has no modes to control (--modes)");
   if (a.knots < 2 || a.knots > steps + 1)
@@ -198,10 +198,10 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
     o.on_start = [&bar](int done, int starts, double best) { bar.Update(double(done) / starts, best); };
   }
   nlohmann::json task;
-  const fit::SpacetimeResult r = start.body3 ? FitOf<3>(a, start, first_guess, o, &task) : FitOf<2>(a, start, first_guess, o, &task);
+  const fit::SpacetimeResult r = start.dim() == 3 ? FitOf<3>(a, start, first_guess, o, &task) : FitOf<2>(a, start, first_guess, o, &task);
   if (a.starts == 1) EndIterationLine();
   bar.Finish();
-  const std::string body_name = start.body3 ? start.body3->name() : start.body->name();
+  const std::string body_name = start.OnBody([](const auto& body) { return body.name(); });
 
   if (!a.targets.empty()) formats::WriteTargetSchedule(a.targets, names, a.dt, r.targets);
   nlohmann::json j;

@@ -57,8 +57,8 @@ CLI::App* AddInspectCommand(CLI::App* app, InspectArgs* a) {
 int RunInspect(const InspectArgs& a) {
   if (a.indent < -1 || a.indent > 16) throw UsageError("--indent must be between 0 and 16");
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, Integrator::kThesis, 0.01);
-  if (setup.body3) throw UsageError("inspect takes 2D objects only so far; for a 3D object use condition check or simulate");
-  const std::shared_ptr<const BodyModel>& body = setup.body;
+  if (setup.dim() == 3) throw UsageError("inspect takes 2D objects only so far; for a 3D object use condition check or simulate");
+  const std::shared_ptr<const BodyModel>& body = setup.body<2>();
   const World world = setup.MakeWorld();
   const BodyState<2, double>& s = world.state<2>(0);
   const Lattice& lat = body->lattice();

@@ -118,10 +118,10 @@ int RunSimulate(const SimulateArgs& a) {
   // the summary: one paragraph, a sentence per line
   const Energies e = final_world.ComputeEnergies(0);
   const Ground& g = setup.options.params.ground;
-  const bool three = setup.body3 != nullptr;
-  const std::string name = three ? setup.body3->name() : setup.body->name();
-  const int points = three ? setup.body3->num_points() : setup.body->num_points();
-  const int modes = three ? setup.body3->num_modes() : setup.body->num_modes();
+  const bool three = setup.dim() == 3;
+  const std::string name = setup.OnBody([](const auto& body) { return body.name(); });
+  const int points = setup.OnBody([](const auto& body) { return body.num_points(); });
+  const int modes = setup.OnBody([](const auto& body) { return body.num_modes(); });
   std::ostringstream out;
   out << name << (three ? " (3D)" : "") << ": " << points << " mass points, " << modes << " modes; "
       << IntegratorName(integrator) << " integrator, dt " << Num(a.dt) << "; gravity "

@@ -254,7 +254,7 @@ void BM_ViewerFrame1280x720(benchmark::State& state) {
   scene.options() = WorldOptions();  // the World's defaults, as before the scene runtime
   scene.object().Load(kData + (pot ? "/pot.obj" : "/table.obj"));
   scene.object().LoadModes({kData + (pot ? "/def_pot" : "/table_modes.def")});
-  Eigen::VectorXd q0 = Eigen::VectorXd::Zero(scene.object().Body()->num_q());
+  Eigen::VectorXd q0 = Eigen::VectorXd::Zero(scene.object().Body<2>()->num_q());
   q0[1] = 50;
   scene.object().SetState(q0, Eigen::VectorXd::Zero(q0.size()));
   ViewerOptions o;

@@ -50,7 +50,7 @@ double StepCost(const wobble::script::Interpreter& interp) {
   if (object.loaded()) {
     try {
       dim = object.dim();
-      points = std::max(1, dim == 3 ? object.Body3()->num_points() : object.Body()->num_points());
+      points = std::max(1, dim == 3 ? object.Body<3>()->num_points() : object.Body<2>()->num_points());
     } catch (const std::exception&) {
     }
   }

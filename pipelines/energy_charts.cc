@@ -15,7 +15,7 @@ std::vector<double> Times(const record::Trajectory& run) {
 }
 
 const record::BodyInfo& FfdInfo(const record::Trajectory& run, int body) {
-  if (body < 0 || body >= run.num_bodies() || !(run.bodies()[body].ffd || run.bodies()[body].ffd3))
+  if (body < 0 || body >= run.num_bodies() || !run.bodies()[body].has_ffd())
     throw std::invalid_argument("cond(M): body " + std::to_string(body) + " is not an FFD body of the run");
   return run.bodies()[body];
 }
@@ -53,15 +53,16 @@ std::vector<double> ConditionNumbers(const record::Trajectory& run, int body, in
   std::vector<double> cond;
   for (int k = std::max(0, first); k < run.size(); ++k) {
     const Eigen::VectorXd q = run.q(k, body);
-    if (info.ffd) {
-      cond.push_back(analysis::MassMatrixCondition(*info.ffd, q).cond);  // +∞ when M is singular
+    if (const BodyModel* ffd = info.ffd<2>()) {
+      cond.push_back(analysis::MassMatrixCondition(*ffd, q).cond);  // +∞ when M is singular
     } else {
       // a 3D row: tx ty tz qw qx qy qz γ..
-      BodyState<3, double> s = RestState<3, double>(*info.ffd3);
+      const BodyModel3& model = *info.ffd<3>();
+      BodyState<3, double> s = RestState<3, double>(model);
       s.translation() = q.head<3>();
       Group<3>::SetOrientation(Eigen::Quaterniond(q[3], q[4], q[5], q[6]).normalized(), &s.q);
-      s.gamma() = q.tail(info.ffd3->num_modes());
-      cond.push_back(analysis::MassMatrixCondition(*info.ffd3, s).cond);
+      s.gamma() = q.tail(model.num_modes());
+      cond.push_back(analysis::MassMatrixCondition(model, s).cond);
     }
   }
   return cond;
@@ -99,7 +100,7 @@ ChartSpec EnergyChart(const record::Trajectory& run, int body, const std::string
   add("kinetic", kinetic, true);
   add("gravity", gravity, true);
   for (int d = 0; d < num_modes; ++d) {
-    const std::string& name = info.ffd ? info.ffd->modes()[d].name : info.ffd3->modes()[d].name;
+    const std::string& name = info.mode_name(d);
     add("mode " + (name.empty() ? std::to_string(d + 1) : name), modes[d], false);
   }
   if (info.kind == BodyKind::kLinear) add("deformation", deformation, false);

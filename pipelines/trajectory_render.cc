@@ -294,8 +294,8 @@ RenderOutputs SceneRenderOutputs(const std::string& folder, const std::string& n
 World WorldFor(const record::Trajectory& run, const WorldOptions& options) {
   World world(options);
   for (const record::BodyInfo& b : run.bodies()) {
-    if (b.IsFfd(2)) world.AddBody(b.ffd);
-    else if (b.IsFfd(3)) world.AddBody(b.ffd3);
+    if (b.IsFfd(2)) world.AddBody(b.shared_ffd<2>());
+    else if (b.IsFfd(3)) world.AddBody(b.shared_ffd<3>());
     else world.SetGroundContact(world.AddLinearBody(b.linear), b.ground_contact);
   }
   return world;

@@ -203,7 +203,7 @@ TEST(Keyframes, HeldPointStaysPutWhileTheBodyDeforms) {
     k.interpolation = interp;
     for (double t = 0; t <= 1.2; t += 0.01) {
       k.Evaluate(t, &g, &gd);
-      control::KeyframedState(*body, hold, anchor, Eigen::Vector2d::Zero(), theta, g, gd, &q, &qd);
+      control::KeyframedState(*body, hold, anchor, Eigen::Vector3d(0.0, 0.0, theta), g, gd, &q, &qd);
       EXPECT_NEAR((control::PointAt(*body, hold.lattice_coords, q) - anchor).norm(), 0.0, 1e-10) << t;
       // its velocity J q̇ is zero too
       Eigen::Vector2d b0;
@@ -217,7 +217,7 @@ TEST(Keyframes, HeldPointStaysPutWhileTheBodyDeforms) {
   }
   // the rest of the body did move
   k.Evaluate(0.5, &g, &gd);
-  control::KeyframedState(*body, hold, anchor, Eigen::Vector2d::Zero(), theta, g, gd, &q, &qd);
+  control::KeyframedState(*body, hold, anchor, Eigen::Vector3d(0.0, 0.0, theta), g, gd, &q, &qd);
   EXPECT_GT((control::PointAt(*body, {1.0, 1.0}, q) - control::PointAt(*body, {1.0, 1.0}, Eigen::VectorXd::Zero(7))).norm(), 10.0);
 }
 

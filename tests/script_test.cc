@@ -339,7 +339,7 @@ TEST(CliffJump, LeavesTheCliffLandsUprightOnTheFloorAndSettles) {
   const std::filesystem::path& dir = cliff->dir;
   ASSERT_TRUE(drawn.trajectory);
   const record::Trajectory& states = *drawn.trajectory;
-  const BodyModel& table = *states.bodies()[0].ffd;  // bend, shear, vsquash: every mode of the two runs
+  const BodyModel& table = *states.bodies()[0].ffd<2>();  // bend, shear, vsquash: every mode of the two runs
   ASSERT_EQ(table.num_modes(), 3);
   EXPECT_EQ(drawn.dir, "out/demo");
   ASSERT_TRUE(interp.world_options().params.ground.terrain);  // the scene's terrain reaches the renderer
@@ -411,7 +411,7 @@ TEST(PotFriction, FrictionOffKeepsTheHorizontalSpeedOnSlidesStopsUpright) {
     EXPECT_EQ(script->drawn.dir, expected_dir);
     if (!script->drawn.trajectory) throw std::runtime_error("the pot script rendered nothing");
     const record::Trajectory& run = *script->drawn.trajectory;
-    const BodyModel& pot = *run.bodies()[0].ffd;
+    const BodyModel& pot = *run.bodies()[0].ffd<2>();
     EXPECT_EQ(pot.num_modes(), 0);
     const Eigen::Vector2d c = pot.moments().c0 / pot.moments().m;
     auto com_vx = [&](int k) {  // ṫ + θ̇ R S c̄, its x

@@ -33,14 +33,12 @@ py::object LoadBody(const std::string& object, const std::vector<std::string>& m
   o.Load(object);  // a `mesh` line is refused: this module was built without VTK
 #endif
   o.LoadModes(modes);
-  if (o.dim() == 3) {
-    std::shared_ptr<const BodyModel3> body = o.Body3();
+  const auto checked = [&](auto body) {
     if (check) CheckLoadedModeSet(*body, object);
-    return py::cast(std::const_pointer_cast<BodyModel3>(body));
-  }
-  std::shared_ptr<const BodyModel> body = o.Body();
-  if (check) CheckLoadedModeSet(*body, object);
-  return py::cast(std::const_pointer_cast<BodyModel>(body));
+    using Model = std::remove_const_t<typename decltype(body)::element_type>;
+    return py::cast(std::const_pointer_cast<Model>(body));
+  };
+  return o.dim() == 3 ? checked(o.Body<3>()) : checked(o.Body<2>());
 }
 
 py::array_t<double> Points(const std::vector<Eigen::Vector2d>& points) {

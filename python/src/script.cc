@@ -146,7 +146,7 @@ void BindScript(py::module_& m) {
                              [](PyInterpreter& p) -> py::object {
                                const BodyModel* b = p.interp().body();
                                if (!b) return py::none();
-                               return py::cast(std::const_pointer_cast<BodyModel>(p.interp().scene().object().Body()));
+                               return py::cast(std::const_pointer_cast<BodyModel>(p.interp().scene().object().Body<2>()));
                              },
                              "the FFD object's body (None before load_obj)")
       .def_property_readonly("q", [](PyInterpreter& p) { return Eigen::VectorXd(p.interp().q()); })

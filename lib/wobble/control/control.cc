@@ -139,53 +139,41 @@ void Keyframes::Evaluate(double t, Eigen::VectorXd* gamma, Eigen::VectorXd* gamm
   *gamma_dot = ((6 * u2 - 6 * u) * p0 + (3 * u2 - 4 * u + 1) * m0 + (-6 * u2 + 6 * u) * p1 + (3 * u2 - 2 * u) * m1) / h;
 }
 
-Eigen::Vector2d PointAt(const BodyModel& body, const Eigen::Vector2d& lattice_coords, const Eigen::VectorXd& q) {
-  Eigen::Vector2d b0;
-  Mat2D<double> B;
+template <int Dim>
+Eigen::Matrix<double, Dim, 1> PointAt(const BodyModelN<Dim>& body, const Eigen::Matrix<double, Dim, 1>& lattice_coords,
+                                      const Eigen::VectorXd& q) {
+  Eigen::Matrix<double, Dim, 1> b0;
+  MatND<double, Dim> B;
   body.LocalBasis(lattice_coords, &b0, &B);
   const VecQ<double> qq = q;
-  return WorldFromLocal(Frame<2, double>(qq), LocalPosition<double>(b0, B, qq));
+  return WorldFromLocal(Frame<Dim, double>(qq), LocalPosition<double>(b0, B, qq));
 }
 
-void KeyframedState(const BodyModel& body, const HeldPoint& hold, const Eigen::Vector2d& anchor,
-                    const Eigen::Vector2d& translation, double theta, const Eigen::VectorXd& gamma,
-                    const Eigen::VectorXd& gamma_dot, Eigen::VectorXd* q, Eigen::VectorXd* qd) {
-  const int D = body.num_modes();
-  q->setZero(kRigidDofs + D);
-  qd->setZero(kRigidDofs + D);
+template <int Dim>
+void KeyframedState(const BodyModelN<Dim>& body, const HeldPoint& hold, const Eigen::Matrix<double, Dim, 1>& anchor,
+                    const Eigen::VectorXd& placement, const Eigen::VectorXd& gamma, const Eigen::VectorXd& gamma_dot,
+                    Eigen::VectorXd* q, Eigen::VectorXd* qd) {
+  const int D = body.num_modes(), rigid = Group<Dim>::kRigidParams;
+  q->setZero(rigid + D);
+  qd->setZero(Group<Dim>::kRigidDofs + D);
+  q->head(rigid) = placement.head(rigid);
   q->tail(D) = gamma;
   qd->tail(D) = gamma_dot;
-  (*q)[2] = theta;
-  if (!hold.enabled) {
-    q->head<2>() = translation;
-    return;
-  }
-  // x_p = t + R(θ)(b0 + B γ) = anchor (Eq. 4.2) fixes t; differentiating with θ̇ = 0 gives ṫ
-  Eigen::Vector2d b0;
-  Mat2D<double> B;
-  body.LocalBasis(hold.lattice_coords, &b0, &B);
-  const Eigen::Matrix2d R = Rotation(theta);
-  q->head<2>() = anchor - R * (b0 + B * gamma);
-  qd->head<2>() = -R * (B * gamma_dot);
+  if (!hold.enabled) return;
+  // x_p = t + R (b0 + B γ) = anchor (Eq. 4.2) fixes t; differentiating with R still gives ṫ
+  Eigen::Matrix<double, Dim, 1> b0;
+  MatND<double, Dim> B;
+  body.LocalBasis(hold.coords<Dim>(), &b0, &B);
+  const Eigen::Matrix<double, Dim, Dim> R = Group<Dim>::RotationOf(VecQ<double>(*q));
+  q->template head<Dim>() = anchor - R * (b0 + B * gamma);
+  qd->template head<Dim>() = -R * (B * gamma_dot);
 }
 
-void KeyframedState3(const BodyModel3& body, const HeldPoint& hold, const Eigen::Vector3d& anchor,
-                     const Eigen::Vector3d& translation, const Eigen::Quaterniond& orientation,
-                     const Eigen::VectorXd& gamma, const Eigen::VectorXd& gamma_dot, Eigen::Vector3d* t,
-                     Eigen::VectorXd* v) {
-  const int D = body.num_modes();
-  v->setZero(Group<3>::kRigidDofs + D);
-  v->tail(D) = gamma_dot;
-  if (!hold.enabled) {
-    *t = translation;
-    return;
-  }
-  // x_p = t + R (b0 + B γ) = anchor fixes t; with ω = 0, ṫ = −R B γ̇
-  Eigen::Vector3d b0;
-  Mat3D<double> B;
-  body.LocalBasis(hold.lattice_coords3, &b0, &B);
-  *t = anchor - orientation * (b0 + B * gamma);
-  v->head<3>() = -(orientation * (B * gamma_dot));
-}
+template Eigen::Vector2d PointAt(const BodyModel&, const Eigen::Vector2d&, const Eigen::VectorXd&);
+template Eigen::Vector3d PointAt(const BodyModel3&, const Eigen::Vector3d&, const Eigen::VectorXd&);
+template void KeyframedState(const BodyModel&, const HeldPoint&, const Eigen::Vector2d&, const Eigen::VectorXd&,
+                             const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd*, Eigen::VectorXd*);
+template void KeyframedState(const BodyModel3&, const HeldPoint&, const Eigen::Vector3d&, const Eigen::VectorXd&,
+                             const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd*, Eigen::VectorXd*);
 
 }  // namespace wobble::control

@@ -147,23 +147,26 @@ struct HeldPoint {
   bool enabled = false;
   Eigen::Vector2d lattice_coords = Eigen::Vector2d(0.0, 0.0);    // (s, t) of a 2D body
   Eigen::Vector3d lattice_coords3 = Eigen::Vector3d(0.0, 0.0, 0.0);  // (s, t, u) of a 3D body
+  // The coordinates for a body of dimension Dim.
+  template <int Dim> const Eigen::Matrix<double, Dim, 1>& coords() const {
+    if constexpr (Dim == 3) return lattice_coords3;
+    else return lattice_coords;
+  }
 };
 
-// The full state of a keyframed body at amplitudes γ, γ̇ with θ kept at `theta`: when a point is
-// held, t is solved so that the point stays at `anchor`: t = anchor − R(θ)(b0 + B γ) and
-// ṫ = −R(θ) B γ̇ (θ̇ = 0); otherwise t is `translation` and ṫ = 0.
-void KeyframedState(const BodyModel& body, const HeldPoint& hold, const Eigen::Vector2d& anchor,
-                    const Eigen::Vector2d& translation, double theta, const Eigen::VectorXd& gamma,
-                    const Eigen::VectorXd& gamma_dot, Eigen::VectorXd* q, Eigen::VectorXd* qd);
+// The full state (q, q̇ in body/group.h's layout) of a keyframed body at amplitudes γ, γ̇,
+// placed by `placement` (positions whose first Group<Dim>::kRigidParams entries, the
+// translation and the rotation, are kept; the rest is ignored): when a point is held, t is
+// solved so that the point stays at `anchor`: t = anchor − R (b0 + B γ) and ṫ = −R B γ̇
+// (the rotation does not turn: θ̇ = 0, ω = 0); otherwise t is the placement's and ṫ = 0.
+template <int Dim>
+void KeyframedState(const BodyModelN<Dim>& body, const HeldPoint& hold, const Eigen::Matrix<double, Dim, 1>& anchor,
+                    const Eigen::VectorXd& placement, const Eigen::VectorXd& gamma, const Eigen::VectorXd& gamma_dot,
+                    Eigen::VectorXd* q, Eigen::VectorXd* qd);
 
-// The same for a 3D body, its orientation R kept: t = anchor − R (b0 + B γ), ṫ = −R B γ̇, ω = 0;
-// v = [ṫ, ω, γ̇].
-void KeyframedState3(const BodyModel3& body, const HeldPoint& hold, const Eigen::Vector3d& anchor,
-                     const Eigen::Vector3d& translation, const Eigen::Quaterniond& orientation,
-                     const Eigen::VectorXd& gamma, const Eigen::VectorXd& gamma_dot, Eigen::Vector3d* t,
-                     Eigen::VectorXd* v);
-
-// World position of a point given by lattice coordinates at state q.
-Eigen::Vector2d PointAt(const BodyModel& body, const Eigen::Vector2d& lattice_coords, const Eigen::VectorXd& q);
+// World position of a point given by lattice coordinates at positions q.
+template <int Dim>
+Eigen::Matrix<double, Dim, 1> PointAt(const BodyModelN<Dim>& body, const Eigen::Matrix<double, Dim, 1>& lattice_coords,
+                                      const Eigen::VectorXd& q);
 
 }  // namespace wobble::control

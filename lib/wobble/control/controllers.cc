@@ -56,54 +56,36 @@ void TargetScheduleController::BeforeStep(World& world) {
 
 KeyframeController::KeyframeController(World& world, int body, Keyframes keys, HeldPoint hold)
     : body_(body), keys_(std::move(keys)), hold_(hold), dt_(world.options().dt) {
-  if (world.IsFfd(body, 3)) {  // the same on a 3D body: its orientation is kept
-    const BodyModel3& model = world.body<3>(body);
-    const std::string invalid = keys_.Validate(model.num_modes());
-    if (!invalid.empty()) throw std::invalid_argument("keyframe: " + invalid);
-    const BodyState<3, double>& s = world.state<3>(body);
-    translation3_ = s.translation();
-    orientation_ = s.orientation();
-    if (hold_.enabled) {
-      Eigen::Vector3d b0;
-      Mat3D<double> B;
-      model.LocalBasis(hold_.lattice_coords3, &b0, &B);
-      anchor3_ = s.translation() + s.orientation() * (b0 + B * s.gamma());
-    }
-    world.SetKinematic(body, true);
-    Place(world, 0.0);
-    return;
-  }
-  const BodyModel& model = world.body<2>(body);
+  if (world.IsFfd(body, 3)) Start<3>(world);  // the same on a 3D body: its orientation is kept
+  else Start<2>(world);
+}
+
+template <int Dim> void KeyframeController::Start(World& world) {
+  const BodyModelN<Dim>& model = world.body<Dim>(body_);
   const std::string invalid = keys_.Validate(model.num_modes());
   if (!invalid.empty()) throw std::invalid_argument("keyframe: " + invalid);
-  const Eigen::VectorXd q = world.q(body);
-  // the held point stays where it is at the start; θ and, without a hold, t stay as they are
-  anchor_ = hold_.enabled ? PointAt(model, hold_.lattice_coords, q) : Eigen::Vector2d::Zero();
-  translation_ = q.head<2>();
-  theta_ = q[2];
-  world.SetKinematic(body, true);
-  Place(world, 0.0);
+  const Eigen::VectorXd q = world.q(body_);
+  // the held point stays where it is at the start; the rotation and, without a hold, t stay as they are
+  if (hold_.enabled) anchor_.head<Dim>() = PointAt(model, hold_.coords<Dim>(), q);
+  placement_ = q.head(Group<Dim>::kRigidParams);
+  world.SetKinematic(body_, true);
+  Place<Dim>(world, 0.0);
 }
 
 void KeyframeController::AfterStep(World& world) {
   ++steps_;
   try {
-    Place(world, std::min(double(steps_) * dt_, keys_.Duration()));
+    if (world.IsFfd(body_, 3)) Place<3>(world, std::min(double(steps_) * dt_, keys_.Duration()));
+    else Place<2>(world, std::min(double(steps_) * dt_, keys_.Duration()));
   } catch (const InputError& e) {  // keys that lead to an infinite energy (a key of 1e300): a numerical stop
     world.Stop(StatusCode::kNonFiniteEnergy, body_, std::string("the keyframed state: ") + e.what());
   }
 }
 
-void KeyframeController::Place(World& world, double t) const {
+template <int Dim> void KeyframeController::Place(World& world, double t) const {
   Eigen::VectorXd gamma, gamma_dot, q, qd;
   keys_.Evaluate(t, &gamma, &gamma_dot);
-  if (world.IsFfd(body_, 3)) {
-    Eigen::Vector3d translation;
-    KeyframedState3(world.body<3>(body_), hold_, anchor3_, translation3_, orientation_, gamma, gamma_dot, &translation, &qd);
-    world.SetState(body_, PositionsOf(translation, orientation_, gamma), qd);
-    return;
-  }
-  KeyframedState(world.body<2>(body_), hold_, anchor_, translation_, theta_, gamma, gamma_dot, &q, &qd);
+  KeyframedState<Dim>(world.body<Dim>(body_), hold_, anchor_.head<Dim>(), placement_, gamma, gamma_dot, &q, &qd);
   world.SetState(body_, q, qd);
 }
 

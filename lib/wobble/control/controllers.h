@@ -71,16 +71,14 @@ class KeyframeController : public Controller {
   void Release(World& world) const { world.SetKinematic(body_, false); }
 
  private:
-  void Place(World& world, double t) const;
+  template <int Dim> void Start(World& world);
+  template <int Dim> void Place(World& world, double t) const;
   int body_;
   Keyframes keys_;
   HeldPoint hold_;
   double dt_;
-  Eigen::Vector2d anchor_, translation_;
-  double theta_;
-  // a 3D body's: the held point's place, the translation and the orientation kept
-  Eigen::Vector3d anchor3_ = Eigen::Vector3d::Zero(), translation3_ = Eigen::Vector3d::Zero();
-  Eigen::Quaterniond orientation_ = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d anchor_ = Eigen::Vector3d::Zero();  // the held point's place (2D: x, y)
+  Eigen::VectorXd placement_;                         // the start's translation and rotation, kept
   long steps_ = 0;
 };
 

@@ -22,14 +22,14 @@ BodyInfo DescribeBody(const World& world, int body) {
   info.dim = world.dim(body);
   if (world.IsFfd(body, 2)) {
     const BodyModel& m = world.body<2>(body);
-    info.ffd = world.shared_body<2>(body);  // drawing after the world is gone
+    info.set_ffd(world.shared_body<2>(body));  // drawing after the world is gone
     info.coordinate_names = {"tx", "ty", "theta"};
     for (const DeformationMode& mode : m.modes()) info.coordinate_names.push_back(mode.name);
   } else if (world.IsFfd(body, 3)) {
-    info.ffd3 = world.shared_body<3>(body);
+    info.set_ffd(world.shared_body<3>(body));
     info.coordinate_names = {"tx", "ty", "tz", "qw", "qx", "qy", "qz"};
     info.velocity_names = {"dtx", "dty", "dtz", "wx", "wy", "wz"};
-    for (const DeformationMode3& mode : info.ffd3->modes()) {
+    for (const DeformationMode3& mode : world.body<3>(body).modes()) {
       info.coordinate_names.push_back(mode.name);
       info.velocity_names.push_back("d" + mode.name);
     }
@@ -171,12 +171,12 @@ Energies Trajectory::energies(int k, int body) const {
   out.ground = e[3];
   out.springs = e[4];
   const BodyInfo& b = bodies_[body];
-  if ((b.ffd || b.ffd3) && layout_[body].num_targets == b.num_modes()) {  // K (γ − γ0)² per mode
+  if (b.has_ffd() && layout_[body].num_targets == b.num_modes()) {  // K (γ − γ0)² per mode
     const Eigen::Map<const Eigen::VectorXd> qk = q(k, body), tk = targets(k, body);
     const int first = b.num_q - b.num_modes();
     for (int d = 0; d < b.num_modes(); ++d) {
       const double offset = qk[first + d] - tk[d];
-      out.per_mode.push_back((b.ffd ? b.ffd->modes()[d].stiffness : b.ffd3->modes()[d].stiffness) * offset * offset);
+      out.per_mode.push_back(b.mode_stiffness(d) * offset * offset);
     }
   }
   return out;

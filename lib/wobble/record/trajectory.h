@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "wobble/control/control.h"
@@ -35,14 +36,40 @@ struct BodyInfo {
   int dim = 2;
   int num_q = 0;
   int num_v = 0;                                  // velocities: num_q, but 6 + D for a 3D FFD body
-  std::shared_ptr<const BodyModel> ffd;           // FFD bodies: the model (modes included)
-  std::shared_ptr<const BodyModel3> ffd3;         // 3D FFD bodies
   std::shared_ptr<const LinearBodyModel> linear;  // linear bodies
   bool ground_contact = false;                    // a linear body that touches the ground (FFD: always)
   std::vector<std::string> coordinate_names;      // one per q entry
   std::vector<std::string> velocity_names;        // one per q̇ (v) entry
-  int num_modes() const { return ffd ? ffd->num_modes() : ffd3 ? ffd3->num_modes() : 0; }
+
+  // An FFD body's model (modes included), of either dimension; setting it sets `dim` and
+  // `kind` too, so the two cannot disagree. ffd<Dim>() is null for a body of the other
+  // dimension, a linear body, or one read from a file without its model.
+  template <int Dim> void set_ffd(std::shared_ptr<const BodyModelN<Dim>> model) {
+    kind = BodyKind::kFfd;
+    dim = Dim;
+    ffd_ = std::move(model);
+  }
+  template <int Dim> const BodyModelN<Dim>* ffd() const { return shared_ffd<Dim>().get(); }
+  template <int Dim> std::shared_ptr<const BodyModelN<Dim>> shared_ffd() const {
+    const auto* p = std::get_if<std::shared_ptr<const BodyModelN<Dim>>>(&ffd_);
+    return p ? *p : nullptr;
+  }
+  bool has_ffd() const { return ffd<2>() || ffd<3>(); }
+  int num_modes() const {
+    return std::visit([](const auto& m) { return m ? m->num_modes() : 0; }, ffd_);
+  }
+  // Mode d of the model's (has_ffd()).
+  const std::string& mode_name(int d) const {
+    return std::visit([d](const auto& m) -> const std::string& { return m->modes().at(size_t(d)).name; }, ffd_);
+  }
+  double mode_stiffness(int d) const {
+    return std::visit([d](const auto& m) { return m->modes().at(size_t(d)).stiffness; }, ffd_);
+  }
   bool IsFfd(int d) const { return kind == BodyKind::kFfd && dim == d; }
+
+ private:
+  // One model: a 2D and a 3D pointer side by side could both be set.
+  std::variant<std::shared_ptr<const BodyModel>, std::shared_ptr<const BodyModel3>> ffd_;
 };
 
 class Trajectory {

@@ -47,11 +47,11 @@ BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel> body) {
   info.coordinate_names = {"tx", "ty", "theta"};
   for (const DeformationMode& mode : body->modes()) info.coordinate_names.push_back(mode.name);
   info.num_q = int(info.coordinate_names.size());
-  info.ffd = std::move(body);
+  info.set_ffd(std::move(body));
   return info;
 }
 
-BodyInfo DescribeFfd3Body(std::shared_ptr<const BodyModel3> body) {
+BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel3> body) {  // as a world describes it
   World w;
   w.AddBody(body);
   return DescribeBody(w, 0);

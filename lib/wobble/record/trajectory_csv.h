@@ -26,8 +26,9 @@ struct ReadTrajectory {
 ReadTrajectory ReadTrajectoryCsv(const std::string& path, std::vector<BodyInfo> bodies);
 ReadTrajectory ParseTrajectoryCsv(std::istream& in, const std::string& name_for_errors, std::vector<BodyInfo> bodies);
 
-// The bodies of a file for one FFD body (names of its coordinates from the model).
+// The bodies of a file for one FFD body of either dimension (names of its coordinates from
+// the model).
 BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel> body);
-BodyInfo DescribeFfd3Body(std::shared_ptr<const BodyModel3> body);  // a 3D FFD body's
+BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel3> body);
 
 }  // namespace wobble::record

@@ -36,25 +36,38 @@ void Place(int dim, const Eigen::Vector3d& placement, Eigen::VectorXd* q, Eigen:
 }  // namespace
 
 void FfdObject::Load(const std::string& path, const formats::MeshReader& read_mesh) {
-  def_.reset();
-  def3_.reset();
-  if (formats::ObjectFileDimension(path) == 3) def3_ = formats::ReadObjectFile3(path, read_mesh);
-  else def_ = formats::ReadObjectFile(path);
+  part<2>().def.reset();
+  part<3>().def.reset();
+  if (formats::ObjectFileDimension(path) == 3) part<3>().def = formats::ReadObjectFile3(path, read_mesh);
+  else part<2>().def = formats::ReadObjectFile(path);
   path_ = std::filesystem::absolute(path).string();
-  modes_.clear();
-  modes3_.clear();
+  part<2>().modes.clear();
+  part<3>().modes.clear();
   mode_paths_.clear();
-  const int rigid = def3_ ? Group<3>::kRigidDofs : kRigidDofs;
+  const int rigid = dim() == 3 ? Group<3>::kRigidDofs : Group<2>::kRigidDofs;
   q_.setZero(rigid);
   qd_.setZero(rigid);
   Place(dim(), placement_, &q_, &qd_);  // at rest where `trans` put it
-  body_.reset();
-  body3_.reset();
+  ResetBodies();
+}
+
+void FfdObject::ResetBodies() {
+  part<2>().body.reset();
+  part<3>().body.reset();
 }
 
 // A new mode set (§4.10): amplitudes of modes with the same name carry over, others start at 0.
-template <class Modes> void FfdObject::Remember(Modes modes, std::vector<std::string> paths) {
-  const int rigid = def3_ ? Group<3>::kRigidDofs : kRigidDofs, n = rigid + int(modes.size());
+template <int Dim> void FfdObject::LoadModesOf(const std::vector<std::string>& paths, std::vector<std::string> absolute) {
+  const BodyDefN<Dim>& def = *part<Dim>().def;
+  std::vector<DeformationModeN<Dim>> modes;
+  for (const std::string& path : paths) {
+    std::vector<DeformationModeN<Dim>> more;
+    if constexpr (Dim == 3) more = formats::ReadDeformationFile3(path, def.lattice);
+    else more = formats::ReadDeformationFile(path, def.lattice);  // generators need it
+    modes.insert(modes.end(), more.begin(), more.end());
+  }
+  BodyModelN<Dim> check(def, modes);  // throws when the modes do not fit the object
+  const int rigid = Group<Dim>::kRigidDofs, n = rigid + int(modes.size());
   Eigen::VectorXd q = Eigen::VectorXd::Zero(n), qd = Eigen::VectorXd::Zero(n);
   q.head(rigid) = q_.head(rigid);
   qd.head(rigid) = qd_.head(rigid);
@@ -64,35 +77,18 @@ template <class Modes> void FfdObject::Remember(Modes modes, std::vector<std::st
         q[rigid + int(d)] = q_[rigid + old];
         qd[rigid + int(d)] = qd_[rigid + old];
       }
-  if constexpr (std::is_same_v<Modes, std::vector<DeformationMode3>>) modes3_ = std::move(modes);
-  else modes_ = std::move(modes);
-  mode_paths_ = std::move(paths);
+  part<Dim>().modes = std::move(modes);
+  mode_paths_ = std::move(absolute);
   q_ = q;
   qd_ = qd;
-  body_.reset();
-  body3_.reset();
+  ResetBodies();
 }
 
 void FfdObject::LoadModes(const std::vector<std::string>& paths) {
   std::vector<std::string> absolute;
   for (const std::string& path : paths) absolute.push_back(std::filesystem::absolute(path).string());
-  if (def3_) {
-    std::vector<DeformationMode3> modes;
-    for (const std::string& path : paths) {
-      std::vector<DeformationMode3> more = formats::ReadDeformationFile3(path, def3_->lattice);
-      modes.insert(modes.end(), more.begin(), more.end());
-    }
-    BodyModel3 check(*def3_, modes);  // throws when the modes do not fit the object
-    Remember(std::move(modes), std::move(absolute));
-    return;
-  }
-  std::vector<DeformationMode> modes;
-  for (const std::string& path : paths) {
-    std::vector<DeformationMode> more = formats::ReadDeformationFile(path, def_->lattice);  // generators need it
-    modes.insert(modes.end(), more.begin(), more.end());
-  }
-  BodyModel check(*def_, modes);  // throws when the modes do not fit the object
-  Remember(std::move(modes), std::move(absolute));
+  if (dim() == 3) LoadModesOf<3>(paths, std::move(absolute));
+  else LoadModesOf<2>(paths, std::move(absolute));
 }
 
 std::vector<std::string> FfdObject::mode_names() const {
@@ -108,10 +104,9 @@ int FfdObject::ModeIndex(const std::string& name) const {
 }
 
 template <class F> void FfdObject::ForEachMode(F&& f) {
-  for (DeformationMode& m : modes_) f(m);
-  for (DeformationMode3& m : modes3_) f(m);
-  body_.reset();
-  body3_.reset();
+  for (DeformationMode& m : part<2>().modes) f(m);
+  for (DeformationMode3& m : part<3>().modes) f(m);
+  ResetBodies();
 }
 
 void FfdObject::Assign(int mode, double stiffness, double damping) {
@@ -130,8 +125,7 @@ void FfdObject::SetActive(int mode, bool active) {
 
 void FfdObject::SetCodamActive(double damping) {
   codam_active_ = damping;
-  body_.reset();
-  body3_.reset();
+  ResetBodies();
 }
 
 void FfdObject::SetPlacement(const Eigen::Vector3d& placement) {
@@ -168,22 +162,17 @@ void FfdObject::SetState(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
   qd_ = qd;
 }
 
-std::shared_ptr<const BodyModel> FfdObject::Body() const {
-  if (body_ || !def_) return body_;
-  std::vector<DeformationMode> modes = modes_;
-  for (DeformationMode& m : modes)
+template <int Dim> std::shared_ptr<const BodyModelN<Dim>> FfdObject::Body() const {
+  const Part<Dim>& p = part<Dim>();
+  if (p.body || !p.def) return p.body;
+  std::vector<DeformationModeN<Dim>> modes = p.modes;
+  for (DeformationModeN<Dim>& m : modes)
     if (m.active) m.damping += codam_active_;
-  body_ = std::make_shared<const BodyModel>(*def_, std::move(modes));
-  return body_;
+  p.body = std::make_shared<const BodyModelN<Dim>>(*p.def, std::move(modes));
+  return p.body;
 }
 
-std::shared_ptr<const BodyModel3> FfdObject::Body3() const {
-  if (body3_ || !def3_) return body3_;
-  std::vector<DeformationMode3> modes = modes3_;
-  for (DeformationMode3& m : modes)
-    if (m.active) m.damping += codam_active_;
-  body3_ = std::make_shared<const BodyModel3>(*def3_, std::move(modes));
-  return body3_;
-}
+template std::shared_ptr<const BodyModel> FfdObject::Body<2>() const;
+template std::shared_ptr<const BodyModel3> FfdObject::Body<3>() const;
 
 }  // namespace wobble::scene

@@ -64,14 +64,13 @@ std::vector<double> MappedState(const record::Trajectory& run, int k, const std:
 
 // The body of the whole motion: the object with every mode any run had, in column order.
 template <int Dim>
-std::shared_ptr<const BodyModelN<Dim>> MergedModel(const ObjectRuns& runs, const ModeColumns& columns,
-                                                   std::shared_ptr<const BodyModelN<Dim>> (*model)(const record::BodyInfo&)) {
+std::shared_ptr<const BodyModelN<Dim>> MergedModel(const ObjectRuns& runs, const ModeColumns& columns) {
   std::vector<DeformationModeN<Dim>> modes(columns.names.size());
   for (size_t r = 0; r < runs.size(); ++r) {
-    const BodyModelN<Dim>& body = *model(runs[r]->bodies().at(0));
+    const BodyModelN<Dim>& body = *runs[r]->bodies().at(0).ffd<Dim>();
     for (int d = 0; d < body.num_modes(); ++d) modes[size_t(columns.of_run[r][size_t(d)])] = body.modes()[size_t(d)];
   }
-  return std::make_shared<const BodyModelN<Dim>>(model(runs[0]->bodies()[0])->def(), std::move(modes));
+  return std::make_shared<const BodyModelN<Dim>>(runs[0]->bodies()[0].ffd<Dim>()->def(), std::move(modes));
 }
 
 }  // namespace
@@ -82,8 +81,8 @@ record::Trajectory MergeRuns(const ObjectRuns& runs) {
   const int N = int(columns.names.size());
   record::BodyInfo info = runs[0]->bodies()[0];
   const int rq = RigidQ(info), rv = RigidV(info);
-  if (info.ffd3) info.ffd3 = MergedModel<3>(runs, columns, [](const record::BodyInfo& b) { return b.ffd3; });
-  else info.ffd = MergedModel<2>(runs, columns, [](const record::BodyInfo& b) { return b.ffd; });
+  if (info.ffd<3>()) info.set_ffd(MergedModel<3>(runs, columns));
+  else info.set_ffd(MergedModel<2>(runs, columns));
   info.coordinate_names.resize(size_t(rq));
   info.coordinate_names.insert(info.coordinate_names.end(), columns.names.begin(), columns.names.end());
   info.velocity_names.resize(size_t(rv));

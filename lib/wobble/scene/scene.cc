@@ -65,14 +65,14 @@ WorldOptions Scene::ObjectWorldOptions3() const {
   o.springs_3d.clear();
   if (springs_.enabled && object_.dim() == 3)
     for (const LatticeSpring3& sp : springs_.list3)
-      o.springs_3d.push_back(MakeSpring(*object_.Body3(), sp.lattice_coords, sp.anchor, sp.stiffness, sp.damping,
+      o.springs_3d.push_back(MakeSpring(*object_.Body<3>(), sp.lattice_coords, sp.anchor, sp.stiffness, sp.damping,
                                          sp.rest_length));
   return o;
 }
 
 SimulationSetup Scene::CurrentSetup() const {
   SimulationSetup setup;
-  setup.body = object_.Body();
+  setup.body = object_.Body<2>();
   if (!setup.body) return setup;
   setup.world = ObjectWorldOptions(*setup.body);
   setup.q = object_.q();
@@ -111,18 +111,21 @@ int Scene::AddLinearBody(const std::string& name, std::shared_ptr<const LinearBo
   return b;
 }
 
+namespace {
+// The object as a body of `w` at the object's state: its q holds a 3D orientation as the
+// rotation vector, which SetCoordinates reads (in 2D it is the state itself).
+int AddObjectTo(const FfdObject& object, World& w) {
+  const int b = object.dim() == 3 ? w.AddBody(object.Body<3>()) : w.AddBody(object.Body<2>());
+  w.SetCoordinates(b, object.q(), object.qd());
+  return b;
+}
+}  // namespace
+
 int Scene::AddObjectBody(const std::string& name) {
   if (bodies_.count(name)) throw std::invalid_argument("a body named '" + name + "' exists already");
   if (!object_.loaded()) throw std::logic_error("AddObjectBody: no FFD object is loaded");
   World& w = world();
-  int b = 0;
-  if (object_.dim() == 3) {
-    b = w.AddBody(object_.Body3());
-    w.SetCoordinates(b, object_.q(), object_.qd());
-  } else {
-    b = w.AddBody(object_.Body());
-    w.SetState(b, object_.q(), object_.qd());
-  }
+  const int b = AddObjectTo(object_, w);
   bodies_[name] = b;
   drawings_.resize(w.num_bodies());
   return b;
@@ -200,17 +203,9 @@ void Scene::BeginRun(RunKind kind, bool keep_steps) {
 void Scene::BeginObjectRun(RunKind kind, bool keep_steps) {
   if (!object_.loaded()) throw std::logic_error("BeginRun: no FFD object is loaded");
   std::unique_ptr<World> w;
-  if (object_.dim() == 3) {
-    // the 3D object stands on the plane of the ground line (GroundPlaneOf), under the same gravity
-    w = std::make_unique<World>(ObjectWorldOptions3());
-    w->AddBody(object_.Body3());
-    w->SetCoordinates(0, object_.q(), object_.qd());
-  } else {
-    const std::shared_ptr<const BodyModel> body = object_.Body();
-    w = std::make_unique<World>(ObjectWorldOptions(*body));
-    w->AddBody(body);
-    w->SetState(0, object_.q(), object_.qd());
-  }
+  // the 3D object stands on the plane of the ground line (GroundPlaneOf), under the same gravity
+  w = std::make_unique<World>(object_.dim() == 3 ? ObjectWorldOptions3() : ObjectWorldOptions(*object_.Body<2>()));
+  AddObjectTo(object_, *w);
   w->SetTime(time_);
   auto run = std::make_unique<Run>();
   run->kind = kind;
@@ -312,7 +307,7 @@ long Scene::CheckedRun(double duration, bool object_run) const {
   if (object_run && object_.loaded()) {
     rows = double(steps) + 1.0;
     const record::BodyInfo info =
-        object_.dim() == 3 ? record::DescribeFfd3Body(object_.Body3()) : record::DescribeFfdBody(object_.Body());
+        object_.dim() == 3 ? record::DescribeFfdBody(object_.Body<3>()) : record::DescribeFfdBody(object_.Body<2>());
     width = double(record::Trajectory({info}).Columns().size());
   } else if (recorded_ && record_fps_ > 0) {
     rows = std::min(double(steps), duration * record_fps_) + 1.0;

@@ -144,7 +144,7 @@ void Interpreter::SetMeshReader(formats::MeshReader reader) { state_->mesh_reade
 
 scene::Scene& Interpreter::scene() { return state_->scene; }
 const scene::Scene& Interpreter::scene() const { return state_->scene; }
-const BodyModel* Interpreter::body() const { return state_->scene.object().Body().get(); }
+const BodyModel* Interpreter::body() const { return state_->scene.object().Body<2>().get(); }
 const Eigen::VectorXd& Interpreter::q() const { return state_->scene.object().q(); }
 const Eigen::VectorXd& Interpreter::qd() const { return state_->scene.object().qd(); }
 double Interpreter::time() const { return state_->scene.time(); }

@@ -351,7 +351,7 @@ void Render(State& s, const Words& w, const Context& ctx) {
   if (s.track.empty()) ctx.Fail("render: nothing to draw yet (run 'simul' or 'keyframe' first)");
   if (!s.render_hook) ctx.Fail("render: this program has no renderer ('wobble run' and Python's Interpreter have one, built with VTK)");
   const auto merged = std::make_shared<const record::Trajectory>(scene::MergeRuns(s.track));
-  request.world = merged->bodies()[0].ffd ? s.scene.ObjectWorldOptions(*merged->bodies()[0].ffd)
+  request.world = merged->bodies()[0].ffd<2>() ? s.scene.ObjectWorldOptions(*merged->bodies()[0].ffd<2>())
                                           : s.scene.ObjectWorldOptions3();
   request.trajectory = merged;
   try {

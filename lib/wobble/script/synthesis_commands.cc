@@ -97,10 +97,10 @@ synth::Problem StartOptimising(State& s) {
 synth::Problem MakeProblem(const State& s, long steps) {
   synth::Problem p;
   if (s.scene.object().dim() == 3) {
-    p.body3 = s.scene.object().Body3();
+    p.body3 = s.scene.object().Body<3>();
     p.world = s.scene.ObjectWorldOptions3();
   } else {
-    p.body = s.scene.object().Body();
+    p.body = s.scene.object().Body<2>();
     p.world = s.scene.ObjectWorldOptions(*p.body);
   }
   p.q0 = s.scene.object().q();
@@ -197,7 +197,7 @@ std::string ReplayScript(const State& s, const std::string& schedule_path, const
   scene::ScriptSetup setup;
   setup.object_path = object.path();
   setup.mode_paths = object.mode_paths();
-  setup.modes = object.dim() == 3 ? scene::ModeSettings(object.modes3()) : scene::ModeSettings(object.modes());
+  setup.modes = object.dim() == 3 ? scene::ModeSettings(object.modes<3>()) : scene::ModeSettings(object.modes<2>());
   setup.codam_active = object.codam_active();
   setup.world = sc.options();
   setup.springs_on = sc.springs().enabled;
