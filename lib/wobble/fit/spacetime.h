@@ -64,7 +64,7 @@ Eigen::MatrixXd KnotTargets(const Eigen::MatrixXd& knots, int steps);
 // Ready-made task terms (each a stage cost with its exact gradient in the state's tangent
 // coordinates, adjoint.h), and their sum; one name for both bodies (the 2D and 3D formulas):
 //   CentreOfMassAt: w/2 |x_c − goal|² on the axes asked for, x_c = t + R c/m the centre of mass
-//                   (c = c0 + C γ, the mass moments of Eq. 4.9; 3D kinematics3.h): "be there then".
+//                   (c = c0 + C γ, the mass moments of Eq. 4.9; 3D spatial_inertia.h): "be there then".
 //   CentreOfMassVelocityAt: w/2 |v_c − goal|² on the axes asked for, v_c the velocity of the
 //                   centre of mass (2D ṫ + θ̇ S R c/m + R C γ̇/m; 3D ṫ + R (ω × c + C γ̇)/m, ω in
 //                   the body frame): with goal 0 on y, "at the top of a hop".

@@ -181,7 +181,7 @@ Matrix3d SecondMomentRate(const MassMoments3& mm, const ShapeMoments<double>& sm
   return dK;
 }
 
-// z += ∂ψ/∂z of the mass-moment terms of ψ = λ_rᵀ (Q_gravity − w − M a) at `e` (kinematics3.h's
+// z += ∂ψ/∂z of the mass-moment terms of ψ = λ_rᵀ (Q_gravity − w − M a) at `e` (spatial_inertia.h's
 // formulas; ∂I/∂γ_j = tr(K_j) 1 − K_j with K_j = ∂K/∂γ_j, ∂N_d/∂γ_g = X_gd, ∂L_d/∂γ_g = F_dg,
 // ∂e/∂γ = G, ∂c/∂γ = C; a rotated vector Rᵀy moves by (Rᵀy) × ε).
 void PullMomentTerms(const MassMoments3& mm, const WorldParamsN<3>& world, const BodyState<3, double>& e,

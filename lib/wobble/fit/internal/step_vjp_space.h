@@ -7,7 +7,7 @@
 // for about the price of two plain steps, whatever the number of contacts:
 //  - the mass solve a = M⁻¹ (Q − w) is pulled back through one solve λ_r = M⁻¹ λ_a and the
 //    scalar ψ = λ_rᵀ (Q − w − M a) at fixed a and λ_r, whose gradient is that of λ_aᵀ a;
-//  - ψ's mass-moment terms (M, w, gravity: kinematics3.h) are differentiated by hand, in O(D²)
+//  - ψ's mass-moment terms (M, w, gravity: spatial_inertia.h) are differentiated by hand, in O(D²)
 //    whatever the number of mass points;
 //  - a contact's force (Eq. 4.24/4.25: its one-sided normal force and capped friction) and its
 //    anchor's update (SlipAnchor) by their partials in the point's x, ẋ and anchor, from the
