@@ -109,18 +109,27 @@ double Cond1Estimate(const Eigen::MatrixXd& A) {
   return norm_a * estimate;
 }
 
-DeformationMode SquashMode(const Lattice& lattice, double phi, const Squash& squash, const std::string& name) {
-  const Eigen::Rotation2Dd rot(phi);
-  const Eigen::Matrix2d R = rot.toRotationMatrix();
-  const Eigen::Matrix2d A = R * Eigen::Vector2d(-squash.compress, squash.expand).asDiagonal() * R.transpose();
-  const Eigen::Vector2d anchor =
-      lattice.origin() + squash.anchor_st.x() * lattice.axis_s() + squash.anchor_st.y() * lattice.axis_t();
-  DeformationMode mode;
+template <int Dim>
+DeformationModeN<Dim> SquashMode(const LatticeN<Dim>& lattice, double phi, const Squash& squash,
+                                 const std::string& name) {
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  using Matrix = Eigen::Matrix<double, Dim, Dim>;
+  Matrix R;  // the squash axis turned by φ in the x–y plane (about z in 3D)
+  if constexpr (Dim == 2) R = Eigen::Rotation2Dd(phi).toRotationMatrix();
+  else R = Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  Point scale = Point::Constant(squash.expand);  // bulging across the axis in every other direction
+  scale[0] = -squash.compress;
+  const Matrix A = R * scale.asDiagonal() * R.transpose();
+  Point anchor = lattice.origin() + squash.anchor_st.x() * lattice.axis(0) + squash.anchor_st.y() * lattice.axis(1);
+  if constexpr (Dim == 3) anchor += 0.5 * lattice.axis(2);
+  DeformationModeN<Dim> mode;
   mode.name = name;
   mode.lattice_size = lattice.sizes();
-  for (const Eigen::Vector2d& p : lattice.RestPoints()) mode.displacement.push_back(A * (p - anchor));
+  for (const Point& p : lattice.RestPoints()) mode.displacement.push_back(A * (p - anchor));
   return mode;
 }
+template DeformationModeN<2> SquashMode(const LatticeN<2>&, double, const Squash&, const std::string&);
+template DeformationModeN<3> SquashMode(const LatticeN<3>&, double, const Squash&, const std::string&);
 
 std::vector<SweepSample> AngleSweep(const BodyDef& def, const std::vector<double>& phis, const Squash& squash,
                                     const Eigen::VectorXd& q) {
@@ -133,25 +142,11 @@ std::vector<SweepSample> AngleSweep(const BodyDef& def, const std::vector<double
   return out;
 }
 
-DeformationMode3 SquashMode3(const Lattice3& lattice, double phi, const Squash& squash, const std::string& name) {
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Matrix3d A =
-      R * Eigen::Vector3d(-squash.compress, squash.expand, squash.expand).asDiagonal() * R.transpose();
-  // the anchor at the middle of the bottom face: (s, t, u) = (anchor s, anchor t, ½)
-  const Eigen::Vector3d anchor = lattice.origin() + squash.anchor_st.x() * lattice.axis(0) +
-                                 squash.anchor_st.y() * lattice.axis(1) + 0.5 * lattice.axis(2);
-  DeformationMode3 mode;
-  mode.name = name;
-  mode.lattice_size = lattice.sizes();
-  for (const Eigen::Vector3d& p : lattice.RestPoints()) mode.displacement.push_back(A * (p - anchor));
-  return mode;
-}
-
 std::vector<SweepSample> AngleSweep(const BodyDef3& def, const std::vector<double>& phis, const Squash& squash) {
-  const DeformationMode3 vertical = SquashMode3(def.lattice, kPi / 2, squash, "vsquash");
+  const DeformationMode3 vertical = SquashMode(def.lattice, kPi / 2, squash, "vsquash");
   std::vector<SweepSample> out;
   for (double phi : phis) {
-    const BodyModel3 body(def, {vertical, SquashMode3(def.lattice, phi, squash, "squash(phi)")});
+    const BodyModel3 body(def, {vertical, SquashMode(def.lattice, phi, squash, "squash(phi)")});
     out.push_back({phi, MassMatrixCondition(body, RestState<3, double>(body))});
   }
   return out;

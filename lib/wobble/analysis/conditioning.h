@@ -49,8 +49,13 @@ struct Squash {
   Eigen::Vector2d anchor_st = Eigen::Vector2d(0.5, 0.0);
 };
 // The squash as a deformation mode on `lattice`: the linear field sampled at the control points
-// (the lattice reproduces a linear field exactly). Stiffness and damping are left at zero.
-DeformationMode SquashMode(const Lattice& lattice, double phi, const Squash& squash, const std::string& name);
+// (the lattice reproduces a linear field exactly). Stiffness and damping are left at zero. In 3D
+// the squash's axis turns about z from x (φ = 0) to y and it bulges in both other directions,
+// A(φ) = R_z(φ) diag(−compress, expand, expand) R_z(φ)ᵀ, anchored at (anchor_st, ½): the middle of
+// the bottom face.
+template <int Dim>
+DeformationModeN<Dim> SquashMode(const LatticeN<Dim>& lattice, double phi, const Squash& squash,
+                                 const std::string& name);
 
 struct SweepSample {
   double phi = 0.0;
@@ -61,10 +66,7 @@ struct SweepSample {
 std::vector<SweepSample> AngleSweep(const BodyDef& def, const std::vector<double>& phis, const Squash& squash,
                                     const Eigen::VectorXd& q);
 
-// The sweep for a 3D body at rest: the squash at angle φ turns about z from x (φ = 0) to y,
-// squeezing along its axis and bulging across it in both other directions,
-// A(φ) = R_z(φ) diag(−compress, expand, expand) R_z(φ)ᵀ about the middle of the bottom face.
-DeformationMode3 SquashMode3(const Lattice3& lattice, double phi, const Squash& squash, const std::string& name);
+// The sweep for a 3D body at rest (SquashMode's 3D squash).
 std::vector<SweepSample> AngleSweep(const BodyDef3& def, const std::vector<double>& phis, const Squash& squash);
 
 // ---- how close the modes of a set are -----------------------------------------------------------
