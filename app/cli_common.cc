@@ -242,7 +242,7 @@ StartingWorld LoadStartingWorld(const BodyFiles& files, const std::string& q, co
   s.options.dt = dt;
   if (formats::ObjectFileDimension(files.object) == 3) {
     // the 3D ground: the plane through y = height, tilted by the slope about z as the 2D line
-    s.options.ground_3d = GroundPlaneOf(s.options.params.ground);
+    s.options.params.ground_plane = GroundPlaneOf(s.options.params.ground);
     LoadStartingBody<3>(files, q, qdot, &s);
   } else {
     LoadStartingBody<2>(files, q, qdot, &s);

@@ -591,15 +591,11 @@ std::vector<fit::ReferenceFrameN<Dim>> LoadFrames(const FitTrajectoryArgs& a,
   formats::CheckMassPointIndices(file, body->num_points());
   return ReferenceFrames(file.frames);
 }
-// The world of the flags for a body of each dimension (3D: as simulate's, cli_common.h:
-// StartingWorld).
-void SetWorld(const WorldFlags& flags, fit::DynamicFitOptionsN<2>* o) { o->world = MakeWorldParams(flags); }
-void SetWorld(const WorldFlags& flags, fit::DynamicFitOptionsN<3>* o) {
-  const WorldParams w = MakeWorldParams(flags);
-  o->world.gravity_on = w.gravity_on;
-  o->world.gravity = Eigen::Vector3d(w.gravity.x(), w.gravity.y(), 0.0);
-  o->world.ground = GroundPlaneOf(w.ground);
-  o->world.max_condition = w.max_condition;
+// The world of the flags; a 3D body stands on the plane of the ground line, as in simulate
+// (cli_common.h: StartingWorld).
+template <int Dim> void SetWorld(const WorldFlags& flags, fit::DynamicFitOptionsN<Dim>* o) {
+  o->world = MakeWorldParams(flags);
+  if constexpr (Dim == 3) o->world.ground_plane = GroundPlaneOf(o->world.ground);
 }
 
 template <int Dim> int RunTrajectory(const FitTrajectoryArgs& a, const std::shared_ptr<const BodyModelN<Dim>>& body) {

@@ -40,12 +40,11 @@ template <class Problem> void SetBounds(const FitSpacetimeArgs& a, int D, Proble
   p->control_weight = a.effort;
 }
 
-// What the command's problem takes of each dimension's object: its body, its world, where its
-// centre of mass starts and how --reach reads.
+// What the command's problem takes of each dimension's object: its body, where its centre of
+// mass starts and how --reach reads.
 template <int Dim> struct SpacetimeObject;
 template <> struct SpacetimeObject<2> {
   static const BodyModel& Body(const StartingWorld& start) { return *start.body<2>(); }
-  static WorldParamsN<2> World(const StartingWorld& start) { return start.options.params; }
   static Eigen::Vector2d CentreOfMass(const BodyModel& body, const BodyState<2, double>& s) {
     const MassMoments& mm = body.moments();
     const Eigen::VectorXd q0 = s.q;
@@ -56,7 +55,6 @@ template <> struct SpacetimeObject<2> {
 };
 template <> struct SpacetimeObject<3> {
   static const BodyModel3& Body(const StartingWorld& start) { return *start.body<3>(); }
-  static WorldParamsN<3> World(const StartingWorld& start) { return Params3Of(start.options); }
   static Eigen::Vector3d CentreOfMass(const BodyModel3& body, const BodyState<3, double>& s) {
     const MassMoments3& mm = body.moments();
     return s.translation() + s.orientation() * ((mm.c0 + mm.C * s.gamma()) / mm.m);
@@ -74,7 +72,7 @@ fit::SpacetimeResult FitOf(const FitSpacetimeArgs& a, const StartingWorld& start
   const BodyModelN<Dim>& body = Object::Body(start);
   const int steps = int(first_guess.cols()), D = body.num_modes();
   fit::SpacetimeProblemN<Dim> p;
-  p.rollout.world = Object::World(start);
+  p.rollout.world = start.options.params;
   p.rollout.integrator = Integrator::kThesis;
   p.rollout.dt = a.dt;
   p.rollout.start = StateFromCoordinates<Dim>(start.q0, start.qd0);

@@ -270,7 +270,7 @@ std::shared_ptr<const BodyModel3> Table3(int points = 0, int mesh_vertices = 0) 
   return std::make_shared<const BodyModel3>(def, modes);
 }
 
-void TimeSteps3(benchmark::State& state, const BodyModel3& body, const WorldParamsN<3>& w, double dt,
+void TimeSteps3(benchmark::State& state, const BodyModel3& body, const WorldParams& w, double dt,
                 BodyState<3, double>* s, Integrator integrator = Integrator::kThesis) {
   for (auto _ : state) {
     const StepStatus st = StepBody(body, w, 0, integrator, dt, s);
@@ -286,8 +286,8 @@ void TimeSteps3(benchmark::State& state, const BodyModel3& body, const WorldPara
 // Resting on its four feet after a drop, as BM_TableRestingOnGround does for the 2D table.
 void BM_Table3RestingOnGround(benchmark::State& state) {
   const std::shared_ptr<const BodyModel3> body = Table3();
-  WorldParamsN<3> w;
-  w.ground.enabled = true;
+  WorldParams w;
+  w.ground_plane.enabled = true;
   BodyState<3, double> s = RestState<3, double>(*body);
   s.translation().y() = 10.0;
   for (int i = 0; i < 3000; ++i)
@@ -304,9 +304,9 @@ BENCHMARK(BM_Table3RestingOnGround);
 void BM_Table3OutOfContact(benchmark::State& state) {
   const std::shared_ptr<const BodyModel3> body = Table3(int(state.range(0)), int(state.range(2)));
   state.counters["mesh_vertices"] = double(body->def().mesh.points.size());
-  WorldParamsN<3> w;
-  w.ground.enabled = state.range(1) != 0;
-  w.ground.point = Eigen::Vector3d(0.0, -1e12, 0.0);
+  WorldParams w;
+  w.ground_plane.enabled = state.range(1) != 0;
+  w.ground_plane.point = Eigen::Vector3d(0.0, -1e12, 0.0);
   BodyState<3, double> s = RestState<3, double>(*body);
   TimeSteps3(state, *body, w, 0.01, &s);
 }
@@ -318,8 +318,8 @@ BENCHMARK(BM_Table3OutOfContact)
 // Resting with 1,000 points: the point groups keep the scan near the feet.
 void BM_Table3kRestingOnGround(benchmark::State& state) {
   const std::shared_ptr<const BodyModel3> body = Table3(1000);
-  WorldParamsN<3> w;
-  w.ground.enabled = true;
+  WorldParams w;
+  w.ground_plane.enabled = true;
   BodyState<3, double> s = RestState<3, double>(*body);
   s.translation().y() = 10.0;
   for (int i = 0; i < 3000; ++i)
@@ -335,10 +335,10 @@ BENCHMARK(BM_Table3kRestingOnGround);
 // ground (ground 0), and resting on its feet after a drop (ground 1).
 void BM_Table3Variational(benchmark::State& state) {
   const std::shared_ptr<const BodyModel3> body = Table3();
-  WorldParamsN<3> w;
+  WorldParams w;
   BodyState<3, double> s = RestState<3, double>(*body);
   if (state.range(0) != 0) {
-    w.ground.enabled = true;
+    w.ground_plane.enabled = true;
     s.translation().y() = 10.0;
     for (int i = 0; i < 3000; ++i)
       if (!StepBody(*body, w, 0, Integrator::kVariational, 0.01, &s).ok()) {
@@ -361,7 +361,7 @@ BENCHMARK(BM_Table3Variational)->ArgName("ground")->Arg(0)->Arg(1);
 void BM_WorldTableResting(benchmark::State& state) {
   const int dim = int(state.range(0));
   WorldOptions options;
-  options.ground_3d.enabled = true;
+  options.params.ground_plane.enabled = true;
   World world(options);
   if (dim == 2) {
     world.AddBody(Table11());

@@ -77,7 +77,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   o.integrator = Integrator(in.Int(0, 4));
   o.dt = in.Value(1e-4, 0.05);
   o.params.gravity_on = in.Byte() & 1;
-  o.params.gravity = {in.Value(-20, 20), in.Value(-20, 20)};
+  o.params.gravity = {in.Value(-20, 20), in.Value(-20, 20), 0.0};  // braces: read in order
   Ground& g = o.params.ground;
   g.enabled = in.Byte() & 1;
   g.point = {in.Value(-100, 100), in.Value(-100, 100)};

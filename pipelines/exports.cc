@@ -241,7 +241,7 @@ VtpSeriesWriter::VtpSeriesWriter(const World* world, std::string folder, std::st
     terrain_->SetCenter(0.5 * (x0 + x1), lo);
     terrain_->SetLength(3.0 * span);
     terrain_->SetDepth(0.5 * span);
-  } else if (world_->options().ground_3d.enabled && world_->options().ground_3d.heightfield) {
+  } else if (world_->options().params.ground_plane.enabled && world_->options().params.ground_plane.heightfield) {
     terrain_ = vtkSmartPointer<GroundSource>::New();  // the grid's triangles (GroundSource::DrawHeightfield)
     terrain_->SetWorld(world_);
   }

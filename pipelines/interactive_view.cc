@@ -421,7 +421,7 @@ void InteractiveView::EndDrag() {
 
 std::optional<MaterialPoint> InteractiveView::dragged_point() const {
   const Impl& m = *impl_;
-  if (m.spring_pull) return At(0, Eigen::VectorXd(m.spring_pull->lattice_coords()));
+  if (m.spring_pull) return At(0, Eigen::VectorXd(m.spring_pull->lattice_coords().head<2>()));  // a 2D character
   if (m.constraint_pull) return m.constraint_pull->point();
   return std::nullopt;
 }
@@ -430,7 +430,7 @@ int InteractiveView::drag_constraint() const {
 }
 Eigen::VectorXd InteractiveView::drag_target() const {
   const Impl& m = *impl_;
-  if (m.spring_pull) return m.spring_pull->anchor();
+  if (m.spring_pull) return m.spring_pull->anchor().head<2>();
   if (m.constraint_pull) return m.constraint_pull->aim();
   return Eigen::VectorXd();
 }

@@ -321,8 +321,8 @@ bool InteractiveView::Impl::BeginSpringPull(int x, int y) {
   const double c = options.drag_damping > 0 ? options.drag_damping : std::sqrt(k * mass);
   Spring sp;
   sp.body = 0;
-  sp.lattice_coords = pickable[size_t(pick)];
-  sp.anchor = self->DisplayToWorld(x, y);
+  sp.lattice_coords << pickable[size_t(pick)], 0.0;  // the view's character is 2D
+  sp.anchor << self->DisplayToWorld(x, y), 0.0;
   sp.stiffness = k;
   sp.damping = c;
   spring_pull = std::make_shared<control::SpringPull>(*world, sp);

@@ -210,7 +210,7 @@ std::vector<Eigen::AlignedBox3d> FollowBoxesOf(const World& world, const std::ve
     FollowMomentN<Dim> m;
     m.t = t;
     m.body = Eigen::AlignedBox<double, Dim>(bodies.min().template head<Dim>(), bodies.max().template head<Dim>());
-    m.ground_height = GroundHeightUnder(FfdGround<Dim>(world), m.body.center());
+    m.ground_height = GroundHeightUnder(GroundFor<Dim>(world.options().params), m.body.center());
     moments.push_back(m);
   }
   std::vector<Eigen::AlignedBox3d> boxes;

@@ -269,7 +269,7 @@ template <int Dim> bool MassPointSource::DrawFfdOf(vtkPolyData* out) {
   const BodyState<Dim, double>& s = world_->state<Dim>(Body);
   const Frame<Dim, double> frame(s.q);
   const int n = body.num_points();
-  const Point gravity = world_->options().params.gravity_on ? FfdGravity<Dim>(*world_) : Point::Zero();
+  const Point gravity = world_->options().params.gravity_on ? GravityFor<Dim>(world_->options().params) : Point::Zero();
 
   auto points = DoublePoints();
   points->SetNumberOfPoints(n);
@@ -290,7 +290,7 @@ template <int Dim> bool MassPointSource::DrawFfdOf(vtkPolyData* out) {
   }
   // the ground's penalty and capped friction on every point tied to it (Eq. 4.24, 4.25), as
   // the step's forces see them (ContactSet::kFrozen: the state's contacts)
-  ForEachPointInContact(body, FfdGround<Dim>(*world_), s, frame,
+  ForEachPointInContact(body, GroundFor<Dim>(world_->options().params), s, frame,
                         [&](int k, const Point&, const Point& xk, const Point& vk, const Point& anchor, const auto& face, int) {
                           bool slipping;
                           f[size_t(k)] += GroundForce(face, xk, vk, anchor, &slipping);
@@ -563,7 +563,7 @@ int GroundSource::RequestData(vtkInformation*, vtkInformationVector**, vtkInform
     on_plane.extend(world_->kind(b) == BodyKind::kFfd ? FfdBodyBounds(*world_, b) : LinearBodyBounds(*world_, b));
   }
   if (!on_plane.isEmpty()) {
-    const GroundPlane& plane = world_->options().ground_3d;
+    const GroundPlane& plane = world_->options().params.ground_plane;
     out->SetPoints(points);
     if (!plane.enabled) return 1;
     if (plane.heightfield) return DrawHeightfield(*plane.heightfield, points, out);
@@ -614,12 +614,12 @@ namespace {
 // The springs of the FFD bodies of Dim as lines anchor → held point, with their stretch
 // (length minus rest length).
 template <int Dim> void AddSprings(const World& world, vtkPoints* points, vtkCellArray* lines, vtkDoubleArray* stretch) {
-  for (const SpringN<Dim>& sp : FfdSprings<Dim>(world)) {
+  for (const Spring& sp : world.options().params.springs) {
     if (sp.body < 0 || sp.body >= world.num_bodies() || !world.IsFfd(sp.body, Dim)) continue;
-    const Eigen::Matrix<double, Dim, 1> x = WorldPosition(world, sp.body, sp.rest_local, sp.mode_matrix);
-    const vtkIdType ids[2] = {points->InsertNextPoint(To3(sp.anchor).data()), points->InsertNextPoint(To3(x).data())};
+    const Eigen::Matrix<double, Dim, 1> x = WorldPosition(world, sp.body, sp.RestLocal<Dim>(), sp.ModeMatrix<Dim>());
+    const vtkIdType ids[2] = {points->InsertNextPoint(sp.anchor.data()), points->InsertNextPoint(To3(x).data())};
     lines->InsertNextCell(2, ids);
-    stretch->InsertNextValue((x - sp.anchor).norm() - sp.rest_length);
+    stretch->InsertNextValue((x - sp.Anchor<Dim>()).norm() - sp.rest_length);
   }
 }
 

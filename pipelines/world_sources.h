@@ -281,21 +281,6 @@ template <int Dim> Eigen::AlignedBox<double, Dim> BodyBounds(const World& world,
 // The same for an FFD body of either dimension, in 3 coordinates (z = 0 in 2D).
 Eigen::AlignedBox3d FfdBodyBounds(const World& world, int body);
 
-// The ground, gravity and springs of this world's FFD bodies of Dim (2D: options().params;
-// 3D: ground_3d, gravity_3d, springs_3d).
-template <int Dim> const GroundOf<Dim>& FfdGround(const World& world) {
-  if constexpr (Dim == 2) return world.options().params.ground;
-  else return world.options().ground_3d;
-}
-template <int Dim> Eigen::Matrix<double, Dim, 1> FfdGravity(const World& world) {
-  if constexpr (Dim == 2) return world.options().params.gravity;
-  else return world.options().gravity_3d;
-}
-template <int Dim> const std::vector<SpringN<Dim>>& FfdSprings(const World& world) {
-  if constexpr (Dim == 2) return world.options().params.springs;
-  else return world.options().springs_3d;
-}
-
 // The ground a body stands on, as drawn: 2 for the 2D ground (line or terrain), 3 for the 3D
 // plane, 0 for none. FFD bodies always stand on theirs; a linear body only when it touches it
 // (World::ground_contact), else the ground is not drawn for it (Witkin & Welch's scenes).

@@ -123,7 +123,7 @@ T ReferenceCost(const BodyModel3& passive, const fit::ControlledRolloutN<3>& r, 
     K[d] = param(kNz + d);
     c[d] = param(kNz + kModes + d);
   }
-  UpdateContacts(passive, r.world.ground, &s);
+  UpdateContacts(passive, r.world.ground_plane, &s);
   T total = Stage(passive, 0, s);
   for (int n = 0; n < r.steps(); ++n) {
     for (int d = 0; d < kModes; ++d) target[d] = param(kNz + 2 * kModes + kModes * n + d);
@@ -149,12 +149,12 @@ Case MakeCase(Integrator integrator, bool grounded, int steps, unsigned seed) {
   r.integrator = integrator;
   r.dt = 2e-3;
   if (grounded) {
-    r.world.ground.enabled = true;
-    r.world.ground.normal = Eigen::Vector3d(-0.1, 1.0, 0.05).normalized();
-    r.world.ground.stiffness = 2e4;  // per point of 1/3 kg
-    r.world.ground.normal_damping = 100;
-    r.world.ground.friction_damping = 100;
-    r.world.ground.friction_cap = 0.3;
+    r.world.ground_plane.enabled = true;
+    r.world.ground_plane.normal = Eigen::Vector3d(-0.1, 1.0, 0.05).normalized();
+    r.world.ground_plane.stiffness = 2e4;  // per point of 1/3 kg
+    r.world.ground_plane.normal_damping = 100;
+    r.world.ground_plane.friction_damping = 100;
+    r.world.ground_plane.friction_cap = 0.3;
   }
   BodyState<3, double>& s = r.start;
   s = RestState<3, double>(k.passive);
@@ -178,7 +178,7 @@ Case MakeCase(Integrator integrator, bool grounded, int steps, unsigned seed) {
 // the branches it is meant to test), and the faces touched.
 void ContactEvents(const Case& k, int* onsets, int* ends, int* slips, std::set<int>* faces) {
   BodyState<3, double> s = k.rollout.start;
-  UpdateContacts(k.passive, k.rollout.world.ground, &s);
+  UpdateContacts(k.passive, k.rollout.world.ground_plane, &s);
   *onsets = *ends = *slips = 0;
   std::vector<double> K(k.rollout.stiffness.data(), k.rollout.stiffness.data() + kModes);
   std::vector<double> c(k.rollout.damping.data(), k.rollout.damping.data() + kModes);
@@ -261,7 +261,7 @@ TEST(AdjointSpace, MatchesJetsInAHeightfieldValleyWithASpring) {
     std::vector<double> heights;
     for (int j = 0; j < nz; ++j)
       for (int i = 0; i < nx; ++i) heights.push_back(0.25 * std::abs(-200.0 + 20.0 * i - 50.0));
-    k.rollout.world.ground.heightfield = Heightfield::Make({-200, -200}, {20, 20}, nx, nz, heights);
+    k.rollout.world.ground_plane.heightfield = Heightfield::Make({-200, -200}, {20, 20}, nx, nz, heights);
     k.rollout.world.springs.push_back(MakeSpring(k.passive, Eigen::Vector3d(0.1, 0.9, 0.5), Eigen::Vector3d(0, 150, 0), 50.0, 5.0, 80.0));
     int onsets = 0, ends = 0, slips = 0;
     std::set<int> faces;

@@ -262,14 +262,8 @@ TEST(Adjoint, MatchesJetsOnATerrainAndWithASpring) {
     ExpectJetDirectionalDerivatives(k, 43);
   }
   Case k = MakeCase(Integrator::kThesis, true, 150, 47);
-  Spring spring;
-  spring.lattice_coords = Eigen::Vector2d(1.0, 1.0);
-  spring.anchor = Eigen::Vector2d(350.0, 180.0);
-  spring.stiffness = 2e3;
-  spring.damping = 50.0;
-  spring.rest_length = 40.0;
-  k.passive.LocalBasis(spring.lattice_coords, &spring.rest_local, &spring.mode_matrix);
-  k.rollout.world.springs.push_back(spring);
+  k.rollout.world.springs.push_back(
+      MakeSpring(k.passive, Eigen::Vector2d(1.0, 1.0), Eigen::Vector2d(350.0, 180.0), 2e3, 50.0, 40.0));
   ExpectJetDirectionalDerivatives(k, 53);
 }
 

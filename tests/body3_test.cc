@@ -317,9 +317,9 @@ TEST(Body3, PlanarMotionReproducesThe2DBody) {
       WorldParams w2;
       w2.ground.enabled = ground;
       w2.ground.point = Eigen::Vector2d(0, -10);
-      WorldParamsN<3> w3;
-      w3.ground.enabled = ground;
-      w3.ground.point = Vector3d(0, -10, 0);
+      WorldParams w3;
+      w3.ground_plane.enabled = ground;
+      w3.ground_plane.point = Vector3d(0, -10, 0);
       BodyState<2, double> s2;
       s2.q.setZero(flat.num_q());
       s2.qd.setZero(flat.num_q());
@@ -412,7 +412,7 @@ Vector3d AngularMomentum(const BodyModel3& body, const BodyState<3, double>& s, 
 
 TEST(Body3, TorqueFreeTumblingKeepsEnergyAndMomentumOver1e5Steps) {
   const BodyModel3 body = Box(1.0, 2.0, 3.0);
-  WorldParamsN<3> w;
+  WorldParams w;
   w.gravity_on = false;
   BodyState<3, double> s = Spinning(body, Vector3d(0.8, 1.5, -0.6));
   const double E0 = TotalEnergy(body, s);
@@ -453,7 +453,7 @@ TEST(Body3, IntermediateAxisFlipPeriodMatchesTheEllipticIntegral) {
   // principal moments about the centre, from the eight corners (±a/2, ±b/2, ±c/2)
   const double I1 = 8 * m * (b * b + c * c) / 4, I2 = 8 * m * (a * a + c * c) / 4, I3 = 8 * m * (a * a + b * b) / 4;
   ASSERT_TRUE(I3 < I2 && I2 < I1);  // the box's axes in increasing inertia: z, y, x
-  WorldParamsN<3> w;
+  WorldParams w;
   w.gravity_on = false;
   for (Integrator integrator : {Integrator::kRK4, Integrator::kVariational}) {
     // spin about y (intermediate) with a small push about x and z
@@ -496,7 +496,7 @@ TEST(Body3, SpringAtTheCentreOscillatesWithTheClosedFormPeriod) {
   const BodyModel3 box = Box(1.0, 2.0, 3.0, 0.5);
   const double m = box.moments().m, k = 40.0, A = 0.1;
   const Vector3d centre(0.5, 1.0, 1.5);
-  WorldParamsN<3> w;
+  WorldParams w;
   w.gravity_on = false;
   w.springs.push_back(MakeSpring(box, Vector3d::Constant(0.5), centre + Vector3d(A, 0, 0), k));
   BodyState<3, double> s = RestState<3, double>(box);  // the centre starts A from the anchor, at rest
@@ -516,7 +516,7 @@ TEST(Body3, SpringAtTheCentreOscillatesWithTheClosedFormPeriod) {
 TEST(Body3, OffCentreSpringKeepsMomentumAboutTheAnchor) {
   std::mt19937 rng(29);
   const BodyModel3 body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20, 3000.0);
-  WorldParamsN<3> w;
+  WorldParams w;
   w.gravity_on = false;
   const Vector3d anchor(40, -30, 20);
   w.springs.push_back(MakeSpring(body, Vector3d(0.2, 0.9, 0.4), anchor, 50.0, 0.0, 10.0));
@@ -528,7 +528,7 @@ TEST(Body3, OffCentreSpringKeepsMomentumAboutTheAnchor) {
   };
   auto energy = [&](const BodyState<3, double>& st) {
     const Frame<3, double> f(st.q);
-    const SpringN<3>& sp = w.springs[0];
+    const Spring& sp = w.springs[0];
     const Vector3d x = f.t + f.R * LocalPosition<double>(sp.rest_local, sp.mode_matrix, st.q);
     const double stretch = (x - anchor).norm() - sp.rest_length;
     return TotalEnergy(body, st) + 0.5 * sp.stiffness * stretch * stretch;
@@ -548,7 +548,7 @@ TEST(Body3, OffCentreSpringKeepsMomentumAboutTheAnchor) {
 TEST(Body3, VibratingBodyTumblingKeepsItsMomenta) {
   std::mt19937 rng(17);
   const BodyModel3 body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 4, 30, 2000.0);
-  WorldParamsN<3> w;
+  WorldParams w;
   w.gravity_on = false;
   BodyState<3, double> s = RandomState3(rng, body, 0.5);
   Vector3d P0;
@@ -579,18 +579,18 @@ TEST(Body3, BlockOnAnInclineHoldsBelowTheCapAndSlidesAbove) {
   const double mu = 0.4, g = 9.81;
   for (double alpha_deg : {15.0, 35.0}) {
     const double alpha = alpha_deg * M_PI / 180.0;
-    WorldParamsN<3> w;
-    w.ground.enabled = true;
-    w.ground.friction_cap = mu;
-    w.ground.stiffness = 2e4;
-    w.ground.normal_damping = 100.0;
-    w.ground.friction_damping = 100.0;
+    WorldParams w;
+    w.ground_plane.enabled = true;
+    w.ground_plane.friction_cap = mu;
+    w.ground_plane.stiffness = 2e4;
+    w.ground_plane.normal_damping = 100.0;
+    w.ground_plane.friction_damping = 100.0;
     // the plane through 0 tilted about z: downhill is −x' = (−cos α, −sin α, 0)... normal n
-    w.ground.normal = Vector3d(-std::sin(alpha), std::cos(alpha), 0.0);
+    w.ground_plane.normal = Vector3d(-std::sin(alpha), std::cos(alpha), 0.0);
     const Vector3d downhill(-std::cos(alpha), -std::sin(alpha), 0.0);
     BodyState<3, double> s = RestState<3, double>(block);
     s.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(alpha, Vector3d::UnitZ())));
-    s.translation() = w.ground.normal * 1e-4;  // resting on the plane
+    s.translation() = w.ground_plane.normal * 1e-4;  // resting on the plane
     const double dt = 2e-4;
     auto com_velocity = [&] {
       Vector3d P;
@@ -632,12 +632,12 @@ TEST(Body3, TableDroppedFlatLandsOnItsFourLegsAndSettles) {
       }
   def.masses.assign(def.mass_positions.size(), 2.0);
   const BodyModel3 table(def, {});
-  WorldParamsN<3> w;
-  w.ground.enabled = true;
-  w.ground.stiffness = 2e4;
-  w.ground.normal_damping = 300.0;
-  w.ground.friction_damping = 300.0;
-  w.ground.friction_cap = 0.5;
+  WorldParams w;
+  w.ground_plane.enabled = true;
+  w.ground_plane.stiffness = 2e4;
+  w.ground_plane.normal_damping = 300.0;
+  w.ground_plane.friction_damping = 300.0;
+  w.ground_plane.friction_cap = 0.5;
   BodyState<3, double> s = RestState<3, double>(table);
   s.translation() = Vector3d(0, 0.5, 0);
   for (int step = 0; step < int(3.0 / 5e-4); ++step) ASSERT_TRUE(StepBody(table, w, 0, Integrator::kSymplecticEuler, 5e-4, &s).ok());
@@ -648,7 +648,7 @@ TEST(Body3, TableDroppedFlatLandsOnItsFourLegsAndSettles) {
   // level: the top's normal still points up
   EXPECT_GT((s.orientation() * Vector3d::UnitY()).y(), 1.0 - 1e-9);
   // each foot carries a quarter of the weight: sinks mg/(4K)
-  const double sink = table.moments().m * 9.81 / (4 * w.ground.stiffness);
+  const double sink = table.moments().m * 9.81 / (4 * w.ground_plane.stiffness);
   EXPECT_NEAR(s.translation().y(), -sink, 0.02 * sink);
 }
 
@@ -661,7 +661,7 @@ TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
   auto table3 = std::make_shared<const BodyModel3>(
       def, formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
   WorldOptions o;
-  o.ground_3d.enabled = true;
+  o.params.ground_plane.enabled = true;
   o.integrator = Integrator::kSymplecticEuler;
   o.dt = 0.005;
   World world(o);
@@ -675,8 +675,8 @@ TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
   v << 10, -20, 5, 0.1, 0.3, -0.2, 0, 0, 0, 0;
   world.SetState(b3, PositionsOf(Vector3d(0, 30, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Vector3d::UnitX())), gamma), v);
   // the same body alone, by StepBody3
-  WorldParamsN<3> p;
-  p.ground = o.ground_3d;
+  WorldParams p;
+  p.ground_plane = o.params.ground_plane;
   BodyState<3, double> alone = world.state<3>(b3);
   for (int step = 0; step < 2000; ++step) {
     ASSERT_TRUE(world.Step()) << world.status().message;

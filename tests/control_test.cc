@@ -340,14 +340,14 @@ TEST(Controllers, SpringPullMovesItsAnchorAndReleaseRemovesTheSpring) {
   World world(FreeSpace(Integrator::kRK4, 1e-3));
   world.AddBody(body);
   Spring s;
-  s.lattice_coords = Eigen::Vector2d(0.2, 1.0);
-  s.anchor = Eigen::Vector2d(1, 2);
+  s.lattice_coords = Eigen::Vector3d(0.2, 1.0, 0.0);  // a 2D body: z is 0
+  s.anchor = Eigen::Vector3d(1, 2, 0);
   s.stiffness = 10;
   auto pull = std::make_shared<control::SpringPull>(world, s);
   world.AddController(pull);
   ASSERT_EQ(world.options().params.springs.size(), 1u);
   pull->Aim(world, Eigen::Vector2d(3, 4));
-  EXPECT_EQ(world.options().params.springs[0].anchor, Eigen::Vector2d(3, 4));
+  EXPECT_EQ(world.options().params.springs[0].anchor, Eigen::Vector3d(3, 4, 0));
   EXPECT_EQ(world.options().params.springs[0].lattice_coords, s.lattice_coords);
   ASSERT_TRUE(world.Step());
   pull->Release(world);

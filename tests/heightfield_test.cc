@@ -77,15 +77,15 @@ TEST(Heightfield, APlaneGivenAsAGridIsThatPlane) {
 TEST(Heightfield, ABodyOnAGridOfAPlaneMovesAsOnThePlane) {
   const BodyModel3 chair = testing::Chair3();
   const double a = 0.1, b = -0.05;  // y = a x + b z
-  WorldParamsN<3> on_plane;
-  on_plane.ground.enabled = true;
-  on_plane.ground.normal = Vector3d(-a, 1.0, -b).normalized();
-  on_plane.ground.stiffness = 2e4;  // per point of 1/3 kg
-  on_plane.ground.normal_damping = 100;
-  on_plane.ground.friction_damping = 100;
-  on_plane.ground.friction_cap = 0.3;
-  WorldParamsN<3> on_grid = on_plane;
-  on_grid.ground.heightfield = Sampled([&](double x, double z) { return a * x + b * z; }, {-300, -300}, {15, 15}, 41, 41);
+  WorldParams on_plane;
+  on_plane.ground_plane.enabled = true;
+  on_plane.ground_plane.normal = Vector3d(-a, 1.0, -b).normalized();
+  on_plane.ground_plane.stiffness = 2e4;  // per point of 1/3 kg
+  on_plane.ground_plane.normal_damping = 100;
+  on_plane.ground_plane.friction_damping = 100;
+  on_plane.ground_plane.friction_cap = 0.3;
+  WorldParams on_grid = on_plane;
+  on_grid.ground_plane.heightfield = Sampled([&](double x, double z) { return a * x + b * z; }, {-300, -300}, {15, 15}, 41, 41);
   BodyState<3, double> s1 = RestState<3, double>(chair), s2;
   s1.translation() = Vector3d(-40, 2, 10);
   s1.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Vector3d(1, 0, 1).normalized())));
@@ -93,7 +93,7 @@ TEST(Heightfield, ABodyOnAGridOfAPlaneMovesAsOnThePlane) {
   s1.qd.segment<3>(3) = Vector3d(0.2, 0.5, -0.3);
   s2 = s1;
   int contacts_seen = 0, faces_seen = 0;
-  std::vector<char> face_used(size_t(on_grid.ground.heightfield->num_faces()), 0);
+  std::vector<char> face_used(size_t(on_grid.ground_plane.heightfield->num_faces()), 0);
   for (int step = 0; step < 3000; ++step) {
     ASSERT_TRUE(StepBody(chair, on_plane, 0, Integrator::kSymplecticEuler, 5e-4, &s1).ok());
     ASSERT_TRUE(StepBody(chair, on_grid, 0, Integrator::kSymplecticEuler, 5e-4, &s2).ok());
@@ -138,20 +138,20 @@ TEST(Heightfield, APointInACreaseFeelsBothFaces) {
 TEST(Heightfield, ABoxInAFrictionlessValleyIsHeldByBothWalls) {
   const double alpha = 0.4, width = 1.0, mass = 1.0, g = 9.81;
   const BodyModel3 box = Box(width, 0.4, 0.6, mass);
-  WorldParamsN<3> w;
-  w.ground.enabled = true;
-  w.ground.stiffness = 2e4;
-  w.ground.normal_damping = 200.0;
-  w.ground.friction_damping = 0.0;
-  w.ground.friction_cap = 0.0;
-  w.ground.heightfield = Sampled([&](double x, double) { return std::abs(x) * std::tan(alpha); }, {-3, -2}, {0.5, 0.5}, 13, 9);
+  WorldParams w;
+  w.ground_plane.enabled = true;
+  w.ground_plane.stiffness = 2e4;
+  w.ground_plane.normal_damping = 200.0;
+  w.ground_plane.friction_damping = 0.0;
+  w.ground_plane.friction_cap = 0.0;
+  w.ground_plane.heightfield = Sampled([&](double x, double) { return std::abs(x) * std::tan(alpha); }, {-3, -2}, {0.5, 0.5}, 13, 9);
   BodyState<3, double> s = RestState<3, double>(box);
   s.translation() = Vector3d(-width / 2, width / 2 * std::tan(alpha) + 0.01, -0.3);
   for (int step = 0; step < 8000; ++step) ASSERT_TRUE(StepBody(box, w, 0, Integrator::kSymplecticEuler, 5e-4, &s).ok());
   EXPECT_LT(s.qd.norm(), 1e-6);
   Vector3d on_face[2] = {Vector3d::Zero(), Vector3d::Zero()};
   const Frame<3, double> frame(s.q);
-  ForEachPointInContact(box, w.ground, s, frame, [&](int, const Vector3d&, const Vector3d& x, const Vector3d& v, const Vector3d& anchor, const GroundPlane& plane, int) {
+  ForEachPointInContact(box, w.ground_plane, s, frame, [&](int, const Vector3d&, const Vector3d& x, const Vector3d& v, const Vector3d& anchor, const GroundPlane& plane, int) {
     bool slipping;
     on_face[plane.normal.x() > 0 ? 0 : 1] += GroundForce(plane, x, v, anchor, &slipping);
   }, ContactSet::kFrozen);
@@ -167,13 +167,13 @@ struct Slide {
   size_t contacts;
 };
 Slide SlideDownTheSlope(const BodyModel3& block, double alpha, double mu, std::shared_ptr<const Heightfield> field) {
-  WorldParamsN<3> w;
-  w.ground.enabled = true;
-  w.ground.friction_cap = mu;
-  w.ground.stiffness = 2e4;
-  w.ground.normal_damping = 100.0;
-  w.ground.friction_damping = 100.0;
-  w.ground.heightfield = std::move(field);
+  WorldParams w;
+  w.ground_plane.enabled = true;
+  w.ground_plane.friction_cap = mu;
+  w.ground_plane.stiffness = 2e4;
+  w.ground_plane.normal_damping = 100.0;
+  w.ground_plane.friction_damping = 100.0;
+  w.ground_plane.heightfield = std::move(field);
   const Vector3d downhill(-std::cos(alpha), -std::sin(alpha), 0.0);
   BodyState<3, double> s = RestState<3, double>(block);
   s.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(alpha, Vector3d::UnitZ())));
@@ -272,26 +272,26 @@ TEST(Heightfield, RefusesBadRegions) {
 // had sunk into the top (m g / 4K): it feels that face only that shallowly, never deeper.
 TEST(Heightfield, SlidesOffTheEdgeOfADropIntoFreeFall) {
   const BodyModel3 box = Box(0.5, 0.3, 0.4, 1.0);
-  WorldParamsN<3> w;
-  w.ground.enabled = true;
-  w.ground.stiffness = 2e4;
-  w.ground.normal_damping = 0.0;
-  w.ground.friction_damping = 0.0;
-  w.ground.friction_cap = 0.0;
-  w.ground.heightfield = Sampled([](double x, double) { return x < 0.5 ? 3.0 : 0.0; }, {-3, -2}, {1, 1}, 7, 5);
-  const double sink = box.moments().m * 9.81 / (4 * w.ground.stiffness);
+  WorldParams w;
+  w.ground_plane.enabled = true;
+  w.ground_plane.stiffness = 2e4;
+  w.ground_plane.normal_damping = 0.0;
+  w.ground_plane.friction_damping = 0.0;
+  w.ground_plane.friction_cap = 0.0;
+  w.ground_plane.heightfield = Sampled([](double x, double) { return x < 0.5 ? 3.0 : 0.0; }, {-3, -2}, {1, 1}, 7, 5);
+  const double sink = box.moments().m * 9.81 / (4 * w.ground_plane.stiffness);
   BodyState<3, double> s = RestState<3, double>(box);
   s.translation() = Vector3d(-1.0, 3.0 - sink, -0.2);
   s.qd.head<3>() = Vector3d(2.0, 0, 0);
   const double dt = 1e-4;
   bool airborne = false, landed = false;
-  WorldParamsN<3> no_ground = w;
-  no_ground.ground.enabled = false;
+  WorldParams no_ground = w;
+  no_ground.ground_plane.enabled = false;
   BodyState<3, double> free;
   int checked = 0, drop_contacts = 0;
   for (int step = 0; step < int(1.2 / dt); ++step) {
     ASSERT_TRUE(StepBody(box, w, 0, Integrator::kSymplecticEuler, dt, &s).ok());
-    ForEachPointInContact(box, w.ground, s, Frame<3, double>(s.q),
+    ForEachPointInContact(box, w.ground_plane, s, Frame<3, double>(s.q),
                            [&](int, const Vector3d&, const Vector3d& x, const Vector3d&, const Vector3d&, const GroundPlane& plane, int) {
                              if (plane.normal.y() < 0.99) {
                                ++drop_contacts;

@@ -89,14 +89,14 @@ TEST(Jet, StepDerivativesMatchFiniteDifferences) {
 using Jet3 = ceres::Jet<double, 10>;  // the 3D table: 6 + 4 velocities
 
 template <class T>
-Eigen::Matrix<T, Eigen::Dynamic, 1> Simulate3(const BodyModel3& body, const WorldParamsN<3>& w, Integrator integrator,
+Eigen::Matrix<T, Eigen::Dynamic, 1> Simulate3(const BodyModel3& body, const WorldParams& w, Integrator integrator,
                                               const VecQ<T>& v0, int steps) {
   BodyState<3, T> s = RestState<3, T>(body);
   s.translation() = Vec3<T>(T(0.0), T(-0.5), T(0.0));
   s.set_orientation(Eigen::Quaternion<T>(T(0.999), T(0.02), T(0.01), T(-0.03)).normalized());
   for (int d = 0; d < body.num_modes(); ++d) s.gamma()[d] = T(0.01 * (d + 1));
   s.qd = v0;
-  UpdateContacts(body, w.ground, &s);
+  UpdateContacts(body, w.ground_plane, &s);
   for (int i = 0; i < steps; ++i) EXPECT_TRUE(StepBody(body, w, 0, integrator, 0.005, &s).ok());
   Eigen::Matrix<T, Eigen::Dynamic, 1> out(7 + 2 * body.num_modes() + 6);
   out << s.translation(), s.orientation().coeffs(), s.gamma(), s.qd;
@@ -109,9 +109,9 @@ TEST(Jet, Step3DerivativesMatchFiniteDifferences) {
       formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice);
   for (DeformationMode3& m : modes) m.stiffness = 4e5, m.damping = 1e4;
   const BodyModel3 body(def, modes);
-  WorldParamsN<3> w;
-  w.ground.enabled = true;
-  w.ground.normal = Eigen::Vector3d(0.1, 1.0, 0.05).normalized();
+  WorldParams w;
+  w.ground_plane.enabled = true;
+  w.ground_plane.normal = Eigen::Vector3d(0.1, 1.0, 0.05).normalized();
   VecQ<double> v0(10);
   v0 << 0.3, -2, 0.2, 0.05, 0.1, -0.08, 0.05, 0.02, -0.04, 0.03;
   for (Integrator integrator : {Integrator::kThesis, Integrator::kRK4}) {

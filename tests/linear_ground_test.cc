@@ -188,23 +188,23 @@ TEST(LinearGround, SlidesDownATiltedPlaneIn3D) {
   for (bool heightfield : {false, true}) {
     WorldOptions o;
     o.dt = 0.0005;
-    o.ground_3d.enabled = true;
-    o.ground_3d.normal = Eigen::Vector3d(std::sin(alpha), std::cos(alpha), 0);
-    o.ground_3d.friction_cap = mu;
-    o.ground_3d.normal_damping = 100;
-    o.ground_3d.friction_damping = 500;
+    o.params.ground_plane.enabled = true;
+    o.params.ground_plane.normal = Eigen::Vector3d(std::sin(alpha), std::cos(alpha), 0);
+    o.params.ground_plane.friction_cap = mu;
+    o.params.ground_plane.normal_damping = 100;
+    o.params.ground_plane.friction_damping = 500;
     if (heightfield) {
       const int nx = 161, nz = 25;
       std::vector<double> h;
       for (int j = 0; j < nz; ++j)
         for (int i = 0; i < nx; ++i) h.push_back(-std::tan(alpha) * (-10.0 + 0.25 * i));
-      o.ground_3d.heightfield = Heightfield::Make({-10.0, -3.0}, {0.25, 0.25}, nx, nz, h);
+      o.params.ground_plane.heightfield = Heightfield::Make({-10.0, -3.0}, {0.25, 0.25}, nx, nz, h);
     }
     World w(o);
     const int b = w.AddLinearBody(Block(1, 0.5, 3), Stiff());
     w.SetGroundContact(b, true);
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(-alpha, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    w.SetLinearState(b, w.linear_model(b).PlacedState(turn, 0.5 * o.ground_3d.normal), Eigen::MatrixXd::Zero(3, 4));
+    w.SetLinearState(b, w.linear_model(b).PlacedState(turn, 0.5 * o.params.ground_plane.normal), Eigen::MatrixXd::Zero(3, 4));
     const Eigen::Vector3d down_slope(std::cos(alpha), -std::sin(alpha), 0);
     ASSERT_TRUE(w.RunUntil(2.0)) << w.status().message;
     const double v1 = down_slope.dot(CentreOfMassVelocity(w, b));
@@ -225,15 +225,15 @@ TEST(LinearGround, SlidesDownATiltedPlaneIn3D) {
 TEST(LinearGround, RestsOnThePlaneIn3DWithTheWeightOnItsBottomFace) {
   WorldOptions o;
   o.dt = 0.001;
-  o.ground_3d.enabled = true;
-  o.ground_3d.normal_damping = 100;
+  o.params.ground_plane.enabled = true;
+  o.params.ground_plane.normal_damping = 100;
   World w(o);
   const int b = w.AddLinearBody(Block(1, 0.5, 3), Stiff());
   w.SetGroundContact(b, true);
   w.SetLinearState(b, w.linear_model(b).PlacedState(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0.6, 0)),
                    Eigen::MatrixXd::Zero(3, 4));
   ASSERT_TRUE(w.RunUntil(6.0)) << w.status().message;
-  const double weight = 6.0 * kG, K = o.ground_3d.stiffness;
+  const double weight = 6.0 * kG, K = o.params.ground_plane.stiffness;
   ASSERT_EQ(w.linear_contacts(b).list3.size(), 9u);
   for (const Contact<3, double>& c : w.linear_contacts(b).list3)
     EXPECT_NEAR(Point(w, b, c.point).y(), -weight / (9 * K), 1e-6 * weight / K);

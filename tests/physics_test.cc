@@ -312,20 +312,14 @@ TEST(Spring, HoldsTheTableAtTheStaticStretch) {
   World w(NoGround(Integrator::kRK4, 0.005));
   auto body = std::make_shared<BodyModel>(TableDef(), std::vector<DeformationMode>{});
   w.AddBody(body);
-  Spring sp;
-  sp.body = 0;
   const Eigen::Vector2d com = body->moments().c0 / body->moments().m;
-  sp.lattice_coords = body->lattice().LocalCoords(com);
-  sp.anchor = Eigen::Vector2d(0, 500);
-  sp.stiffness = 2000;
-  sp.damping = 1500;
-  sp.rest_length = 100;
-  w.AddSpring(sp);
+  const Eigen::Vector2d anchor(0, 500);
+  w.AddSpring(MakeSpring(*body, body->lattice().LocalCoords(com), anchor, 2000, 1500, 100));
   w.SetState(0, State({-com.x(), 300 - com.y(), 0}), State({0, 0, 0}));
   ASSERT_TRUE(w.RunUntil(60.0, [](const World&) {})) << w.status().message;
   const double m = body->moments().m;
   const Eigen::Vector2d held(w.q(0)[0] + com.x(), w.q(0)[1] + com.y());
-  EXPECT_NEAR((sp.anchor - held).norm(), 100 + m * kG / 2000, 1e-6);
+  EXPECT_NEAR((anchor - held).norm(), 100 + m * kG / 2000, 1e-6);
   EXPECT_NEAR(held.x(), 0.0, 1e-9);
   EXPECT_NEAR(w.q(0)[2], 0.0, 1e-9);
   EXPECT_NEAR(w.ComputeEnergies(0).springs, 0.5 * 2000 * std::pow(m * kG / 2000, 2), 1e-3);
@@ -382,7 +376,7 @@ TEST(Status, StatesWithoutAFiniteEnergyAreRefused) {
 // state before it. Without the check the trajectory's energy columns read inf with status ok.
 TEST(Status, AStepToAnInfiniteEnergyIsRefusedWithThatCause) {
   WorldOptions o = NoGround(Integrator::kThesis, 0.01);
-  o.params.gravity = Eigen::Vector2d(0.0, -1e300);
+  o.params.gravity = Eigen::Vector3d(0.0, -1e300, 0.0);
   World w(o);
   w.AddBody(std::make_shared<BodyModel>(TableDef(), std::vector<DeformationMode>{}));
   EXPECT_FALSE(w.Step());

@@ -463,8 +463,8 @@ TEST(RenderedExr, A3dHeightfieldIsTheTerrainLayer) {
   for (int j = 0; j < nz; ++j)
     for (int i = 0; i < nx; ++i) heights.push_back(60.0 + 0.15 * (origin.x() + spacing.x() * i));  // a slope in x
   WorldOptions o;
-  o.ground_3d.enabled = true;
-  o.ground_3d.heightfield = Heightfield::Make(origin, spacing, nx, nz, heights);
+  o.params.ground_plane.enabled = true;
+  o.params.ground_plane.heightfield = Heightfield::Make(origin, spacing, nx, nz, heights);
   World world(o);
   world.AddBody(std::make_shared<const BodyModel3>(testing::Chair3()));
   world.SetState(0, PositionsOf(Eigen::Vector3d(-50, 200, -30), Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())), Eigen::VectorXd::Zero(3)), Eigen::VectorXd::Zero(9));

@@ -125,7 +125,7 @@ World MovingPot() {
   BodyDef3 def = ReadObject3(kData + "/pot3.obj");
   std::vector<DeformationMode3> modes = formats::ReadDeformationFile3(kData + "/pot3_modes.def3", def.lattice);
   WorldOptions options;
-  options.ground_3d.enabled = false;
+  options.params.ground_plane.enabled = false;
   World w(options);
   w.AddBody(std::make_shared<const BodyModel3>(std::move(def), std::move(modes)));
   Eigen::VectorXd v(9);
@@ -151,7 +151,7 @@ TEST(Mesh3Sources, SpringsOfA3dBodyRunFromTheAnchorToTheHeldPoint) {
   auto body = std::make_shared<const BodyModel3>(std::move(def), std::move(modes));
   WorldOptions options;
   const Vec3 coords(0.5, 1.0, 0.25), anchor(0, 300, 20);
-  options.springs_3d.push_back(MakeSpring(*body, coords, anchor, 100.0, 1.0, 20.0));
+  options.params.springs.push_back(MakeSpring(*body, coords, anchor, 100.0, 1.0, 20.0));
   World w(options);
   w.AddBody(body);
   w.SetState(0, PositionsOf(Vec3(10, 40, -5), Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Vec3(1, 2, -1).normalized())), Eigen::Vector3d(0.3, -0.2, 0.15)), Eigen::VectorXd::Zero(9));
@@ -256,7 +256,7 @@ TEST(Mesh3Sources, AppliedForcesSumToTheGeneralizedForcesTranslationRows) {
   // J_t = 1 for every point (EvaluateForces3, the step's own forces, frozen at the contacts)
   BodyDef3 def = ReadObject3(kData + "/pot3.obj");
   WorldOptions options;
-  options.ground_3d.enabled = true;
+  options.params.ground_plane.enabled = true;
   World w(options);
   w.AddBody(std::make_shared<const BodyModel3>(std::move(def), std::vector<DeformationMode3>()));
   w.SetState(0, PositionsOf(Vec3(0, -2, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Vec3::UnitX())), Eigen::VectorXd()), (Eigen::VectorXd(6) << 30, -5, 10, 0, 0.4, 0).finished());
@@ -271,9 +271,7 @@ TEST(Mesh3Sources, AppliedForcesSumToTheGeneralizedForcesTranslationRows) {
     sum += f;
   }
   const BodyState<3, double>& s = w.state<3>(0);
-  WorldParamsN<3> params;
-  params.gravity = options.gravity_3d;
-  params.ground = options.ground_3d;
+  const WorldParams& params = options.params;
   ForceBreakdown<3, double> Q;
   EvaluateForces(w.body<3>(0), params, 0, s, Frame<3, double>(s.q), &Q, ContactSet::kFrozen);
   const Vec3 expected = (Q.gravity + Q.ground).head<3>();

@@ -182,18 +182,18 @@ TEST(GroundSource, SurfaceLiesOnTheSlopedGround) {
 TEST(SpringSource, LinesRunFromAnchorToTheHeldPoint) {
   auto world = AirborneWorld();
   Spring sp;
-  sp.lattice_coords = {0.25, 0.75};
-  sp.anchor = {40, 400};
+  sp.lattice_coords = {0.25, 0.75, 0.0};  // a 2D spring: z is 0
+  sp.anchor = {40, 400, 0.0};
   sp.stiffness = 100;
   sp.rest_length = 10;
   world->AddSpring(sp);
   auto src = Source<SpringSource>(*world);
   vtkPolyData* out = src->GetOutput();
   ASSERT_EQ(out->GetNumberOfLines(), 1);
-  const Eigen::Vector2d held = IndependentWorldPoint(world->body<2>(0), world->q(0), sp.lattice_coords);
-  EXPECT_NEAR((Point(out, 0) - sp.anchor).norm(), 0.0, 1e-12);
+  const Eigen::Vector2d held = IndependentWorldPoint(world->body<2>(0), world->q(0), sp.LatticeCoords<2>());
+  EXPECT_NEAR((Point(out, 0) - sp.Anchor<2>()).norm(), 0.0, 1e-12);
   EXPECT_NEAR((Point(out, 1) - held).norm(), 0.0, 1e-9);
-  EXPECT_NEAR(out->GetCellData()->GetArray("stretch")->GetTuple1(0), (held - sp.anchor).norm() - 10, 1e-9);
+  EXPECT_NEAR(out->GetCellData()->GetArray("stretch")->GetTuple1(0), (held - sp.Anchor<2>()).norm() - 10, 1e-9);
 }
 
 TEST(TrailSource, RecordsTheTrackedPointsEachFrame) {

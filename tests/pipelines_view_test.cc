@@ -169,8 +169,8 @@ TEST(InteractiveView, DragInTheAirMatchesAWorldWithASpring) {
   ref.AddBody(start.body);
   ref.SetState(0, start.q, start.qd);
   Spring sp = view.world().options().params.springs.at(0);
-  EXPECT_EQ(sp.lattice_coords, st);
-  EXPECT_NEAR((sp.anchor - cursor).norm(), 0.0, 1e-9);
+  EXPECT_EQ(sp.LatticeCoords<2>(), st);
+  EXPECT_NEAR((sp.Anchor<2>() - cursor).norm(), 0.0, 1e-9);
   ref.AddSpring(sp);
   const double before = (WorldPositionOf(view.world(), 0, st) - cursor).norm();
   std::string frames;

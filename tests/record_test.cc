@@ -131,7 +131,7 @@ TEST(Trajectory, RestoreAtInterpolatesBetweenSamples) {
 
   // a 3D body turning: the orientation between two samples is the normalised blend
   World w3(WorldOptions{});
-  w3.mutable_options().ground_3d.enabled = false;
+  w3.mutable_options().params.ground_plane.enabled = false;
   const int b = w3.AddBody(std::make_shared<const BodyModel3>(testing::Chair3()));
   const Eigen::VectorXd g0 = Eigen::VectorXd::Zero(w3.body<3>(b).num_modes());
   w3.SetState(b, PositionsOf(Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), g0), (Eigen::VectorXd(6 + g0.size()) << Eigen::VectorXd::Zero(3), 0.5, 2.0, -1.0, g0).finished());
@@ -141,7 +141,7 @@ TEST(Trajectory, RestoreAtInterpolatesBetweenSamples) {
   w3.SetRecorder(rec3);
   for (int n = 0; n < 40; ++n) ASSERT_TRUE(w3.Step()) << w3.status().message;
   World at3(WorldOptions{});
-  at3.mutable_options().ground_3d.enabled = false;
+  at3.mutable_options().params.ground_plane.enabled = false;
   at3.AddBody(w3.shared_body<3>(b));
   const double t3 = 0.5 * (run3->time(2) + run3->time(3));
   run3->RestoreAt(t3, at3);

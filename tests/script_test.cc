@@ -267,7 +267,7 @@ TEST(Interpreter, SavedScriptReplaysTheSameMotion) {
   b.RunFile(saved);
   ASSERT_TRUE(b.world_options().params.ground.terrain);  // the terrain and its faces' own parameters
   EXPECT_TRUE(a.world_options().params.ground == b.world_options().params.ground);
-  EXPECT_EQ(b.world_options().params.gravity, Eigen::Vector2d(0, -12));
+  EXPECT_EQ(b.world_options().params.gravity, Eigen::Vector3d(0, -12, 0));
   EXPECT_EQ(a.q(), b.q());
   EXPECT_EQ(a.qd(), b.qd());
   EXPECT_EQ(a.control_energy(), b.control_energy());

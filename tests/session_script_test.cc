@@ -84,8 +84,8 @@ TEST(SessionScript, ChangesOnEveryStepAndSpringsAndAnotherIntegrator) {
   o.integrator = Integrator::kImplicitEuler;
   o.dt = 0.005;
   Spring sp;
-  sp.lattice_coords = {0.5, 1.0};
-  sp.anchor = {150, 160};
+  sp.lattice_coords = {0.5, 1.0, 0.0};  // a 2D spring: z is 0
+  sp.anchor = {150, 160, 0};
   sp.stiffness = 300;
   sp.damping = 5;
   std::map<long, Eigen::VectorXd> every;

@@ -142,7 +142,7 @@ fit::SpacetimeProblemN<3> SquashAtTheEnd(double goal, double bound, int steps, i
   fit::SpacetimeProblemN<3> p;
   fit::ControlledRolloutN<3>& r = p.rollout;
   r.world.gravity_on = false;
-  r.world.ground.enabled = false;
+  r.world.ground_plane.enabled = false;
   r.integrator = Integrator::kSymplecticEuler;
   r.dt = 0.01;
   r.start = RestState<3, double>(Chair());

@@ -149,7 +149,7 @@ TEST(Variational3, CayleyMapOnSE3MatchesTheMatrixFormulas) {
 // so after 100 steps the translation must match the closed form to rounding.
 TEST(Variational3, RigidFreeFallFromRestIsExact) {
   const BodyModel3 box = Box(1.0, 2.0, 3.0, 0.5);  // the centre of mass away from the body origin
-  WorldParamsN<3> w;
+  WorldParams w;
   for (const Eigen::Quaterniond& start :
        {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(0.3, -0.5, 0.7, 0.2).normalized()}) {
     BodyState<3, double> s = RestState<3, double>(box);
@@ -173,7 +173,7 @@ double StateDistance(const BodyState<3, double>& a, const BodyState<3, double>& 
          (a.gamma() - b.gamma()).norm() + (a.qd - b.qd).norm();
 }
 
-BodyState<3, double> Simulate(const BodyModel3& body, const WorldParamsN<3>& w, BodyState<3, double> s, Integrator integrator,
+BodyState<3, double> Simulate(const BodyModel3& body, const WorldParams& w, BodyState<3, double> s, Integrator integrator,
                          double dt, double duration) {
   const int steps = int(std::lround(duration / dt));
   for (int step = 0; step < steps; ++step) {
@@ -199,7 +199,7 @@ TEST(Variational3, ErrorQuartersWhenTheStepHalves) {
   cases.push_back({"tumbling box", Box(1.0, 2.0, 3.0, 0.5), false, 1.0});
   cases.push_back({"vibrating lopsided body", LopsidedBody(50.0), true, 1.0});
   for (const Case& c : cases) {
-    WorldParamsN<3> w;
+    WorldParams w;
     w.gravity_on = c.gravity;
     BodyState<3, double> s0 = Spinning(c.body, Vector3d(0.8, 1.5, -0.6) * c.speed);
     if (c.body.num_modes() > 0) {
@@ -233,7 +233,7 @@ TEST(Variational3, MirrorSymmetricStartStaysInItsPlane) {
   cases.push_back({"corner box", Box(1.0, 2.0, 3.0, 0.5), 1.5});
   cases.push_back({"mirror body with modes", MirrorBody(200.0, 0.75), 0.75});
   for (const Case& c : cases) {
-    WorldParamsN<3> w;  // gravity −y: in the plane
+    WorldParams w;  // gravity −y: in the plane
     BodyState<3, double> s = RestState<3, double>(c.body);
     s.translation() = Vector3d(0.2, 0.1, -c.a);
     s.set_orientation(Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Vector3d::UnitZ())));
@@ -261,7 +261,7 @@ TEST(Variational3, MirrorSymmetricStartStaysInItsPlane) {
 // steps (the second half no worse than the first: no drift) and is O(Δt²) (a quarter at Δt/2).
 TEST(Variational3, FreeSpinningEnergyStaysBoundedOver1e4Steps) {
   const BodyModel3 body = LopsidedBody(50.0);
-  WorldParamsN<3> w;
+  WorldParams w;
   w.gravity_on = false;
   auto run = [&](double dt, int steps, double* first_half) {
     BodyState<3, double> s = Spinning(body, Vector3d(0.8, 1.5, -0.6));

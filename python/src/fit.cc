@@ -152,9 +152,6 @@ template <int Dim> void BindTrajectoryFit(py::module_& m) {
                : "A 3D body: points (F, K, 3); q rows [t, r, γ], the orientation's smoothness on SO(3).");
 }
 
-// The world of a body of each dimension, as World steps it.
-WorldParams FitWorld(const WorldOptions& w, std::integral_constant<int, 2>) { return w.params; }
-WorldParamsN<3> FitWorld(const WorldOptions& w, std::integral_constant<int, 3>) { return Params3Of(w); }
 
 template <int Dim> void BindDynamicFit(py::module_& m) {
   m.def(
@@ -174,7 +171,7 @@ template <int Dim> void BindDynamicFit(py::module_& m) {
         if (world.integrator != Integrator::kThesis)
           throw InputError("fit_dynamic simulates with the thesis integrator (options.integrator = 'thesis')");
         fit::DynamicFitOptionsN<Dim> o;
-        o.world = FitWorld(world, std::integral_constant<int, Dim>{});
+        o.world = world.params;  // as World steps it
         o.dt = world.dt;
         o.fit_q0 = fit_q0;
         o.fit_qd0 = fit_qd0;
@@ -200,7 +197,7 @@ template <int Dim> void BindDynamicFit(py::module_& m) {
                  "and damping None: the body's. Like `wobble fit trajectory --dynamic`; differentiates with Ceres Jets\n"
                  "(Levenberg-Marquardt), or with gradient='adjoint' by one adjoint sweep per gradient (BFGS)."
                : "A 3D body: points (F, K, 3), q0 = [t, r, γ], qd0 = [ṫ, body ω, γ̇]; the world's 3D gravity,\n"
-                 "ground plane and springs (options.gravity_3d, ground_3d, springs_3d).");
+                 "ground plane and springs (options.gravity, ground_plane, springs).");
 }
 
 }  // namespace

@@ -244,10 +244,6 @@ void BindStageCosts(py::module_& m) {
 }
 
 
-// The world of a body's dimension from the options: 2D the options' own, 3D ground_3d,
-// gravity_3d and springs_3d.
-WorldParamsN<2> WorldOf(const BodyModel&, const WorldOptions& options) { return options.params; }
-WorldParamsN<3> WorldOf(const BodyModel3&, const WorldOptions& options) { return Params3Of(options); }
 
 // A rollout from the keyword arguments: the options' world, integrator and dt; the start q0, qd0
 // in World coordinates (at rest at the lattice's pose by default); the gains (the body's own by
@@ -258,7 +254,7 @@ fit::ControlledRolloutN<Dim> RolloutOf(const BodyModelN<Dim>& body, const WorldO
                                        const py::object& stiffness, const py::object& damping) {
   const int nq = body.num_q();
   fit::ControlledRolloutN<Dim> r;
-  r.world = WorldOf(body, options);
+  r.world = options.params;
   r.integrator = options.integrator;
   CheckGradientIntegrator(r.integrator);
   r.dt = options.dt;
@@ -317,8 +313,8 @@ template <int Dim> void BindRollouts(py::module_& m) {
       py::arg("q0") = py::none(), py::arg("qd0") = py::none(), py::arg("stiffness") = py::none(),
       py::arg("damping") = py::none(), py::arg("checkpoint_interval") = 0,
       "The cost sum_n l_n(q_n, qd_n) of a rollout of the body, 2D or 3D (PD targets (modes, steps), one\n"
-      "per step; gains K, c per mode; the options' world of the body's dimension (3D: ground_3d,\n"
-      "gravity_3d, springs_3d), dt and integrator: thesis or symplectic) and its gradient with respect to\n"
+      "per step; gains K, c per mode; the options' world (gravity, the ground of the body's\n"
+      "dimension: 3D ground_plane; springs), dt and integrator: thesis or symplectic) and its gradient with respect to\n"
       "q0, qd0 (World coordinates; 3D q0 = [t, rotation vector, gamma]), K, c and every target, by one\n"
       "adjoint sweep: its cost does not grow with the number of parameters (README: Gradients).\n"
       "checkpoint_interval: 0 keeps the whole run when it fits in 64 MiB, else checkpoints every\n"

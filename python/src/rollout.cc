@@ -169,7 +169,7 @@ void BindRollout(py::module_& m) {
         py::arg("max_record_mb") = Limits().max_record_mb,
         "The same for a 3D FFD body (BodyModel3): q = [t, rotation vector, γ] (|r| <= π as read\n"
         "back), q̇ = [ṫ, body ω, γ̇], as World.q3/qd3/set_state3; the world's 3D ground and gravity\n"
-        "(options.ground_3d, gravity_3d).");
+        "(options.ground_plane, gravity).");
 }
 
 }  // namespace wobble::python

@@ -54,6 +54,17 @@ class PyController : public Controller {
   }
 };
 
+// WorldOptions.gravity from 2 (z = 0) or 3 components.
+void SetGravity(WorldOptions& o, const Eigen::VectorXd& g) {
+  if (g.size() != 2 && g.size() != 3) throw InputError("gravity takes 2 or 3 components, got " + std::to_string(g.size()));
+  o.params.gravity.setZero();
+  o.params.gravity.head(g.size()) = g;
+}
+
+void WarnDeprecated(const char* message) {
+  if (PyErr_WarnEx(PyExc_DeprecationWarning, message, 1) < 0) throw py::error_already_set();
+}
+
 }  // namespace
 
 void BindWorld(py::module_& m) {
@@ -75,7 +86,7 @@ void BindWorld(py::module_& m) {
   py::class_<Heightfield, std::shared_ptr<Heightfield>>(
       m, "Heightfield",
       "The 3D ground y = h(x, z) on a regular grid, two flat triangles per cell, level beyond it\n"
-      "(README: Heightfield terrain). Set it as options.ground_3d.heightfield.")
+      "(README: Heightfield terrain). Set it as options.ground_plane.heightfield.")
       .def(py::init([](const Eigen::Vector2d& origin, const Eigen::Vector2d& spacing, const Eigen::MatrixXd& heights) {
              std::vector<double> h;  // heights[j, i] is node (i, j): a row per z
              for (Eigen::Index j = 0; j < heights.rows(); ++j)
@@ -109,7 +120,7 @@ void BindWorld(py::module_& m) {
       .def_property(
           "normal", [](const GroundPlane& g) { return g.normal; },
           [](GroundPlane& g, const Eigen::Vector3d& n) {
-            if (!(n.norm() > 0) || !n.allFinite()) throw InputError("ground_3d.normal must be a finite, non-zero vector");
+            if (!(n.norm() > 0) || !n.allFinite()) throw InputError("ground_plane.normal must be a finite, non-zero vector");
             g.normal = n.normalized();
           },
           "unit normal out of the ground (normalized when set)")
@@ -133,8 +144,9 @@ void BindWorld(py::module_& m) {
           },
           "the FFD bodies' integrator: thesis (Eq. 4.22/4.23), symplectic, rk4, implicit, variational")
       .def_property(
-          "gravity", [](const WorldOptions& o) { return Eigen::Vector2d(o.params.gravity); },
-          [](WorldOptions& o, const Eigen::Vector2d& g) { o.params.gravity = g; }, "2D gravity (m/s²)")
+          "gravity", [](const WorldOptions& o) { return o.params.gravity; }, SetGravity,
+          "gravity (m/s², x y z), one for bodies of both dimensions: a 2D body feels x and y; set\n"
+          "with 3 components, or 2 (z = 0)")
       .def_property(
           "gravity_on", [](const WorldOptions& o) { return o.params.gravity_on; },
           [](WorldOptions& o, bool on) { o.params.gravity_on = on; })
@@ -148,10 +160,33 @@ void BindWorld(py::module_& m) {
           "runs stop when the estimated condition number of M exceeds this")
       .def_readwrite("feedback_rate", &WorldOptions::feedback_rate, "constraint drift feedback (Witkin & Welch Eq. 10)")
       .def_property(
-          "ground_3d", [](WorldOptions& o) -> GroundPlane& { return o.ground_3d; },
-          [](WorldOptions& o, const GroundPlane& g) { o.ground_3d = g; }, py::return_value_policy::reference_internal,
-          "the 3D FFD bodies' ground plane (changed in place: options.ground_3d.enabled = True)")
-      .def_readwrite("gravity_3d", &WorldOptions::gravity_3d, "the 3D bodies' gravity (m/s²), on with gravity_on");
+          "ground_plane", [](WorldOptions& o) -> GroundPlane& { return o.params.ground_plane; },
+          [](WorldOptions& o, const GroundPlane& g) { o.params.ground_plane = g; },
+          py::return_value_policy::reference_internal,
+          "the ground the 3D bodies stand on (changed in place: options.ground_plane.enabled = True)")
+      // one release: the 3D twins of ground_plane and gravity warn
+      .def_property(
+          "ground_3d",
+          [](WorldOptions& o) -> GroundPlane& {
+            WarnDeprecated("WorldOptions.ground_3d is deprecated: use WorldOptions.ground_plane");
+            return o.params.ground_plane;
+          },
+          [](WorldOptions& o, const GroundPlane& g) {
+            WarnDeprecated("WorldOptions.ground_3d is deprecated: use WorldOptions.ground_plane");
+            o.params.ground_plane = g;
+          },
+          py::return_value_policy::reference_internal, "Deprecated (one release): WorldOptions.ground_plane.")
+      .def_property(
+          "gravity_3d",
+          [](const WorldOptions& o) {
+            WarnDeprecated("WorldOptions.gravity_3d is deprecated: use WorldOptions.gravity (one for both dimensions)");
+            return o.params.gravity;
+          },
+          [](WorldOptions& o, const Eigen::VectorXd& g) {
+            WarnDeprecated("WorldOptions.gravity_3d is deprecated: use WorldOptions.gravity (one for both dimensions)");
+            SetGravity(o, g);
+          },
+          "Deprecated (one release): WorldOptions.gravity.");
 
   py::class_<Energies>(m, "Energies", "Every energy term of one body (J); total() is their sum.")
       .def_readonly("kinetic", &Energies::kinetic, "½ q̇ᵀ M q̇ (Eq. 4.9)")

@@ -121,11 +121,12 @@ class GroundPlane:
 class WorldOptions:
     dt: float
     integrator: str
-    gravity: NDArray
+    gravity: NDArray  # x y z, for both dimensions (a 2D body feels x, y); set with 2 or 3 components
     gravity_on: bool
-    ground: Ground
-    ground_3d: GroundPlane
-    gravity_3d: NDArray
+    ground: Ground  # what 2D bodies stand on
+    ground_plane: GroundPlane  # what 3D bodies stand on
+    ground_3d: GroundPlane  # deprecated (one release, warns): ground_plane
+    gravity_3d: NDArray  # deprecated (one release, warns): gravity
     max_condition: float
     feedback_rate: float
     def __init__(self, **fields: Any) -> None: ...

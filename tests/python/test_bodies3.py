@@ -150,8 +150,8 @@ def test_contacts_and_penetration_of_a_3d_body_on_the_ground(pot3):
     # the pot dropped onto the ground plane: its contacts are mass points below the plane, each
     # with a 3D anchor on the plane's side it entered from
     options = wobble.WorldOptions(dt=0.0005)
-    options.ground_3d.enabled = True
-    options.ground_3d.stiffness = 20000
+    options.ground_plane.enabled = True
+    options.ground_plane.stiffness = 20000
     world = wobble.World(options)
     world.add_body(pot3)
     world.set_state(0, [0, 0.5, 0, 0.1, 0, 0.05, 0, 0, 0])  # its foot 0.5 above the plane, tilted

@@ -99,9 +99,9 @@ def test_a_3d_block_rests_on_a_heightfield_as_on_the_plane_only_higher():
     # a level heightfield 2 high in place of the plane: the same rest, 2 higher, on its faces
     def rest(field, height):
         options = wobble.WorldOptions(dt=0.001)
-        options.ground_3d.enabled = True
-        options.ground_3d.normal_damping = 100
-        options.ground_3d.heightfield = field
+        options.ground_plane.enabled = True
+        options.ground_plane.normal_damping = 100
+        options.ground_plane.heightfield = field
         world = wobble.World(options)
         b = world.add_linear_body(wobble.linear_box(3, [1.0, 0.5, 0.5], per_side=3, mass=6.0),
                                   rigidity=2e4, volume=2e4, damping=0.02, ground=True)

@@ -23,13 +23,14 @@ PathSample ApproachPath::Evaluate(double t) const {
 
 SpringPull::SpringPull(World& world, const Spring& spring)
     : lattice_coords_(spring.lattice_coords), anchor_(spring.anchor) {
-  world.AddSpring(spring);
-  index_ = world.options().params.springs.size() - 1;
+  index_ = size_t(world.AddSpring(spring));
 }
 
-void SpringPull::Aim(World& world, const Eigen::Vector2d& anchor) {
-  world.mutable_options().params.springs.at(index_).anchor = anchor;
-  anchor_ = anchor;
+void SpringPull::Aim(World& world, const Eigen::VectorXd& anchor) {
+  if (anchor.size() < 2 || anchor.size() > 3) throw std::invalid_argument("SpringPull::Aim: an anchor has 2 or 3 coordinates");
+  anchor_.setZero();
+  anchor_.head(anchor.size()) = anchor;
+  world.mutable_options().params.springs.at(index_).anchor = anchor_;
 }
 
 void SpringPull::Release(World& world) {

@@ -40,15 +40,17 @@ class SpringPull : public Controller {
  public:
   // Adds `spring` (body, lattice point, anchor, stiffness, damping) to the world's springs.
   SpringPull(World& world, const Spring& spring);
-  void Aim(World& world, const Eigen::Vector2d& anchor);
+  // The new anchor, in the body's dimension.
+  void Aim(World& world, const Eigen::VectorXd& anchor);
   // Removes the spring (call once, before removing the controller).
   void Release(World& world);
-  const Eigen::Vector2d& lattice_coords() const { return lattice_coords_; }
-  const Eigen::Vector2d& anchor() const { return anchor_; }
+  // In three coordinates (Spring's layout: a 2D body's z is 0).
+  const Eigen::Vector3d& lattice_coords() const { return lattice_coords_; }
+  const Eigen::Vector3d& anchor() const { return anchor_; }
 
  private:
   size_t index_;  // in the world's springs
-  Eigen::Vector2d lattice_coords_, anchor_;
+  Eigen::Vector3d lattice_coords_, anchor_;
 };
 
 class ConstraintPull : public Controller {

@@ -17,42 +17,74 @@
 namespace wobble {
 
 // A damped spring from a world anchor to a point of a body given by lattice coordinates
-// (Fig. 4.4). MakeSpring (or World::AddSpring) fills in the point's b0 and B.
-template <int Dim> struct SpringN {
-  using Point = Eigen::Matrix<double, Dim, 1>;
-  int body = 0;  // the body it holds, among the world's bodies of its dimension
-  Point lattice_coords = Point::Constant(0.5);
-  Point anchor = Point::Zero();
+// (Fig. 4.4). MakeSpring (or World::AddSpring) fills in the point's b0 and B. One type for both
+// dimensions, stored in three: a 2D spring reads its first two rows (the z row stays zero), as
+// the world's constraint ends do, so that one list holds the springs of every body.
+struct Spring {
+  int body = 0;  // the body it holds: the world's body index (0 in a one-body rollout)
+  Eigen::Vector3d lattice_coords = Eigen::Vector3d::Constant(0.5);
+  Eigen::Vector3d anchor = Eigen::Vector3d::Zero();
   double stiffness = 0.0, damping = 0.0, rest_length = 0.0;
-  Point rest_local = Point::Zero();
-  MatND<double, Dim> mode_matrix;
+  Eigen::Vector3d rest_local = Eigen::Vector3d::Zero();
+  Mat3D<double> mode_matrix;
+  template <int Dim> Eigen::Matrix<double, Dim, 1> Anchor() const { return anchor.head<Dim>(); }
+  template <int Dim> Eigen::Matrix<double, Dim, 1> RestLocal() const { return rest_local.head<Dim>(); }
+  template <int Dim> MatND<double, Dim> ModeMatrix() const { return mode_matrix.topRows<Dim>(); }
+  template <int Dim> Eigen::Matrix<double, Dim, 1> LatticeCoords() const { return lattice_coords.head<Dim>(); }
 };
-using Spring = SpringN<2>;
 
+// Fills in b0 and B of the spring's point on `body` (its lattice coordinates of the body's
+// dimension; 2D: the z entries are ignored and stay zero).
+template <int Dim> void AttachSpring(const BodyModelN<Dim>& body, Spring* s) {
+  Eigen::Matrix<double, Dim, 1> b0;
+  MatND<double, Dim> B;
+  body.LocalBasis(Eigen::Matrix<double, Dim, 1>(s->lattice_coords.head<Dim>()), &b0, &B);
+  if constexpr (Dim == 2) s->lattice_coords.z() = 0.0;
+  s->rest_local.setZero();
+  s->rest_local.head<Dim>() = b0;
+  s->mode_matrix.setZero(3, B.cols());
+  s->mode_matrix.topRows<Dim>() = B;
+}
+
+// (Dim is the body's: the points are taken as BodyModelN<Dim>::Point, not deduced from them.)
 template <int Dim>
-SpringN<Dim> MakeSpring(const BodyModelN<Dim>& body, const typename SpringN<Dim>::Point& lattice_coords,
-                        const typename SpringN<Dim>::Point& anchor, double stiffness, double damping = 0.0,
-                        double rest_length = 0.0) {
-  SpringN<Dim> s;
-  s.lattice_coords = lattice_coords;
-  s.anchor = anchor;
+Spring MakeSpring(const BodyModelN<Dim>& body, const typename BodyModelN<Dim>::Point& lattice_coords,
+                  const typename BodyModelN<Dim>::Point& anchor, double stiffness, double damping = 0.0,
+                  double rest_length = 0.0) {
+  Spring s;
+  s.lattice_coords.setZero();
+  s.lattice_coords.head<Dim>() = lattice_coords;
+  s.anchor.setZero();
+  s.anchor.head<Dim>() = anchor;
   s.stiffness = stiffness;
   s.damping = damping;
   s.rest_length = rest_length;
-  body.LocalBasis(lattice_coords, &s.rest_local, &s.mode_matrix);
+  AttachSpring(body, &s);
   return s;
 }
 
-// The world constants a body's step reads: gravity (y up), ground, springs, and the condition
-// number of M past which a run stops.
-template <int Dim> struct WorldParamsN {
+// The world constants a body's step reads, one set for both dimensions: gravity (y up; a 2D
+// body, in the x-y plane, feels its x and y), the ground each dimension stands on, the springs
+// of every body, and the condition number of M past which a run stops.
+struct WorldParams {
   bool gravity_on = true;
-  Eigen::Matrix<double, Dim, 1> gravity = -9.81 * Eigen::Matrix<double, Dim, 1>::Unit(1);
-  GroundOf<Dim> ground;
-  std::vector<SpringN<Dim>> springs;
+  Eigen::Vector3d gravity = Eigen::Vector3d(0.0, -9.81, 0.0);
+  Ground ground;              // 2D bodies: the line or terrain (on by default)
+  GroundPlane ground_plane;   // 3D bodies: the plane or heightfield (off by default; GroundPlaneOf)
+  std::vector<Spring> springs;
   double max_condition = 1e12;
 };
-using WorldParams = WorldParamsN<2>;
+
+// The ground and gravity a body of dimension Dim feels.
+template <int Dim> const GroundOf<Dim>& GroundFor(const WorldParams& w) {
+  if constexpr (Dim == 2) return w.ground;
+  else return w.ground_plane;
+}
+template <int Dim> GroundOf<Dim>& GroundFor(WorldParams& w) {
+  if constexpr (Dim == 2) return w.ground;
+  else return w.ground_plane;
+}
+template <int Dim> Eigen::Matrix<double, Dim, 1> GravityFor(const WorldParams& w) { return w.gravity.head<Dim>(); }
 
 // A point below the ground is tied to its entry point `anchor` on face `face` (0 for the
 // ground line or plane; terrain.h and heightfield.h say which faces a point feels) by the

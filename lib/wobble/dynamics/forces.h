@@ -20,10 +20,10 @@ namespace wobble {
 // A damped spring's pull on its point at x moving at v: f = −(K (|Δ| − L) + C v·Δ̂) Δ̂ along
 // Δ = x − anchor.
 template <int Dim, class T>
-Eigen::Matrix<T, Dim, 1> SpringForce(const SpringN<Dim>& sp, const Eigen::Matrix<T, Dim, 1>& x,
+Eigen::Matrix<T, Dim, 1> SpringForce(const Spring& sp, const Eigen::Matrix<T, Dim, 1>& x,
                                      const Eigen::Matrix<T, Dim, 1>& v) {
   using std::sqrt;
-  const Eigen::Matrix<T, Dim, 1> delta = x - sp.anchor.template cast<T>();
+  const Eigen::Matrix<T, Dim, 1> delta = x - sp.Anchor<Dim>().template cast<T>();
   const T len = sqrt(delta.squaredNorm() + T(1e-300));
   const Eigen::Matrix<T, Dim, 1> dir = delta / len;
   return -(T(sp.stiffness) * (len - T(sp.rest_length)) + T(sp.damping) * dir.dot(v)) * dir;
@@ -31,14 +31,14 @@ Eigen::Matrix<T, Dim, 1> SpringForce(const SpringN<Dim>& sp, const Eigen::Matrix
 
 // All generalized forces on a body, by source. `frame` is Frame(s.q), made once by the caller.
 template <int Dim, class T>
-void EvaluateForces(const BodyModelN<Dim>& body, const WorldParamsN<Dim>& w, int body_index, const BodyState<Dim, T>& s,
+void EvaluateForces(const BodyModelN<Dim>& body, const WorldParams& w, int body_index, const BodyState<Dim, T>& s,
                     const Frame<Dim, T>& frame, ForceBreakdown<Dim, T>* out, ContactSet contact_set = ContactSet::kDetect) {
   using Vector = Eigen::Matrix<T, Dim, 1>;
   constexpr int kRigidParams = Group<Dim>::kRigidParams, kRigid = Group<Dim>::kRigidDofs;
   const int nv = body.num_q(), D = body.num_modes();
   // gravity, exactly from the moments
   if (w.gravity_on) {
-    GravityForce(body.moments(), s.q, frame.R, w.gravity, &out->gravity);
+    GravityForce(body.moments(), s.q, frame.R, GravityFor<Dim>(w), &out->gravity);
   } else {
     out->gravity.setZero(nv);
   }
@@ -52,12 +52,12 @@ void EvaluateForces(const BodyModelN<Dim>& body, const WorldParamsN<Dim>& w, int
     out->modes[kRigid + d] = -T(2.0 * m.stiffness) * offset - T(m.damping) * s.qd[kRigid + d];
   }
   // penalty ground, only over points below it
-  const VecQ<T>* cached = contact_set == ContactSet::kDetect ? CachedGroundForce(s, w.ground) : nullptr;
+  const VecQ<T>* cached = contact_set == ContactSet::kDetect ? CachedGroundForce(s, GroundFor<Dim>(w)) : nullptr;
   if (cached) {
     out->ground = *cached;
   } else {
     out->ground.setZero(nv);
-    ForEachPointInContact(body, w.ground, s, frame, [&](int k, const Vector& l, const Vector& x, const Vector& v,
+    ForEachPointInContact(body, GroundFor<Dim>(w), s, frame, [&](int k, const Vector& l, const Vector& x, const Vector& v,
                                                         const Vector& anchor, const auto& face, int) {
       bool slipping;
       AddGeneralizedForce(frame, l, body.mode_matrix(k), GroundForce(face, x, v, anchor, &slipping), &out->ground);
@@ -65,17 +65,18 @@ void EvaluateForces(const BodyModelN<Dim>& body, const WorldParamsN<Dim>& w, int
   }
   // springs holding a point
   out->springs.setZero(nv);
-  for (const SpringN<Dim>& sp : w.springs) {
+  for (const Spring& sp : w.springs) {
     if (sp.body != body_index) continue;
-    const Vector l = LocalPosition<T>(sp.rest_local, sp.mode_matrix, s.q);
+    const MatND<double, Dim> B = sp.ModeMatrix<Dim>();
+    const Vector l = LocalPosition<T>(sp.RestLocal<Dim>(), B, s.q);
     const Vector x = WorldFromLocal(frame, l);
-    const Vector v = PointVelocity(frame, s.qd, l, sp.mode_matrix);
-    AddGeneralizedForce(frame, l, sp.mode_matrix, SpringForce(sp, x, v), &out->springs);
+    const Vector v = PointVelocity(frame, s.qd, l, B);
+    AddGeneralizedForce(frame, l, B, SpringForce<Dim>(sp, x, v), &out->springs);
   }
   out->total = out->gravity + out->modes + out->ground + out->springs;
 }
 template <int Dim, class T>
-void EvaluateForces(const BodyModelN<Dim>& body, const WorldParamsN<Dim>& w, int body_index, const BodyState<Dim, T>& s,
+void EvaluateForces(const BodyModelN<Dim>& body, const WorldParams& w, int body_index, const BodyState<Dim, T>& s,
                     ForceBreakdown<Dim, T>* out, ContactSet contact_set = ContactSet::kDetect) {
   EvaluateForces(body, w, body_index, s, Frame<Dim, T>(s.q), out, contact_set);
 }

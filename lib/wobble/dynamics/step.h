@@ -21,7 +21,7 @@ namespace wobble {
 // kIllConditioned when the solve's pivot ratio, a lower bound of cond₂(M), exceeds
 // w.max_condition. `extra` is added to Q (and to forces->total).
 template <int Dim, class T, class Extra = NoExtraForce>
-StepStatus Accelerations(const BodyModelN<Dim>& body, const WorldParamsN<Dim>& w, int body_index,
+StepStatus Accelerations(const BodyModelN<Dim>& body, const WorldParams& w, int body_index,
                          const BodyState<Dim, T>& s, VecQ<T>* qdd, ForceBreakdown<Dim, T>* forces = nullptr,
                          ContactSet contact_set = ContactSet::kDetect, const Extra& extra = Extra()) {
   ForceBreakdown<Dim, T> local;
@@ -51,7 +51,7 @@ StepStatus Accelerations(const BodyModelN<Dim>& body, const WorldParamsN<Dim>& w
 //   variational   the dimension's own discrete Lagrangian (variational.h)
 // `extra`: an extra generalized force (see NoExtraForce).
 template <int Dim, class T, class Extra = NoExtraForce>
-StepStatus StepBody(const BodyModelN<Dim>& body, const WorldParamsN<Dim>& w, int body_index, Integrator integrator,
+StepStatus StepBody(const BodyModelN<Dim>& body, const WorldParams& w, int body_index, Integrator integrator,
                     double dt, BodyState<Dim, T>* s, const Extra& extra = Extra()) {
   using G = Group<Dim>;
   const T h(dt);
@@ -117,7 +117,7 @@ StepStatus StepBody(const BodyModelN<Dim>& body, const WorldParamsN<Dim>& w, int
         s->q = q0;
         G::Advance(v, h, &s->q);
         s->qd = v;
-        if (AddMissingContacts(body, w.ground, s) == 0) break;
+        if (AddMissingContacts(body, GroundFor<Dim>(w), s) == 0) break;
       }
       break;
     }
@@ -130,7 +130,7 @@ StepStatus StepBody(const BodyModelN<Dim>& body, const WorldParamsN<Dim>& w, int
     if (!std::isfinite(double(ScalarValue(s->q[i])))) return {StatusCode::kNonFinite, 0.0};
   for (int i = 0; i < s->qd.size(); ++i)
     if (!std::isfinite(double(ScalarValue(s->qd[i])))) return {StatusCode::kNonFinite, 0.0};
-  UpdateContacts(body, w.ground, s);
+  UpdateContacts(body, GroundFor<Dim>(w), s);
   return {};
 }
 
@@ -138,9 +138,9 @@ StepStatus StepBody(const BodyModelN<Dim>& body, const WorldParamsN<Dim>& w, int
 // a body (each copy cost several seconds of compile time); Jet steps are instantiated where used.
 #define WOBBLE_DOUBLE_STEP(prefix, Dim)                                                                     \
   prefix template StepStatus Accelerations<Dim, double, NoExtraForce>(                                              \
-      const BodyModelN<Dim>&, const WorldParamsN<Dim>&, int, const BodyState<Dim, double>&, VecQ<double>*,          \
+      const BodyModelN<Dim>&, const WorldParams&, int, const BodyState<Dim, double>&, VecQ<double>*,          \
       ForceBreakdown<Dim, double>*, ContactSet, const NoExtraForce&);                                               \
-  prefix template StepStatus StepBody<Dim, double, NoExtraForce>(const BodyModelN<Dim>&, const WorldParamsN<Dim>&,  \
+  prefix template StepStatus StepBody<Dim, double, NoExtraForce>(const BodyModelN<Dim>&, const WorldParams&,  \
                                                                  int, Integrator, double, BodyState<Dim, double>*,  \
                                                                  const NoExtraForce&);                              \
   prefix template void UpdateContacts<Dim, double>(const BodyModelN<Dim>&, const GroundOf<Dim>&,                    \

@@ -113,7 +113,7 @@ template <class T> void CayleyMomentumMapSE3(const Vec3<T>& x_v, const Vec3<T>& 
 // mirror-symmetric motion in its plane. Only the force at g_k depends on ξ in the solve: the
 // one at g_{k+1} is evaluated once, with the contacts found there (ContactSet::kDetect).
 template <class T, class Extra>
-StepStatus VariationalStep(const BodyModelN<3>& body, const WorldParamsN<3>& w, int body_index, const T& h,
+StepStatus VariationalStep(const BodyModelN<3>& body, const WorldParams& w, int body_index, const T& h,
                            BodyState<3, T>* s, const Extra& extra) {
   using G = Group<3>;
   constexpr int kRigid = G::kRigidDofs;

@@ -58,7 +58,7 @@
 namespace wobble::fit {
 
 template <int Dim> struct ControlledRolloutN {
-  WorldParamsN<Dim> world;  // gravity, ground (2D: line or terrain; 3D: plane or heightfield), springs
+  WorldParams world;  // gravity, ground (2D: line or terrain; 3D: ground_plane, a plane or heightfield), springs
   Integrator integrator = Integrator::kThesis;  // kThesis or kSymplecticEuler
   double dt = 0.01;
   // The start: 2D q, q̇ (num_q each); 3D t, orientation (normalized here), γ, v. Its contacts

@@ -256,7 +256,7 @@ template <> class AdjointStep<2> {
     // gravity: r_θ = (R S c)·g, r_γ = Cᵀ Rᵀ g, c = c0 + C γ
     const Eigen::Vector2d c = mm.c0 + mm.C * Q.tail(D);
     if (r_.world.gravity_on) {
-      const Eigen::Vector2d& gv = r_.world.gravity;
+      const Eigen::Vector2d gv = GravityFor<2>(r_.world);
       gq[2] += -y_theta * gv.dot(R * c);
       if (D > 0) {
         gq[2] += gv.dot(R * S * (mm.C * y.tail(D)));

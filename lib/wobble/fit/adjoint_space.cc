@@ -50,7 +50,7 @@ template <> class AdjointStep<3> {
     s.q = r_.start.q;
     Group<3>::Normalize(&s.q);
     s.qd = r_.start.qd;
-    UpdateContacts(passive_, r_.world.ground, &s);
+    UpdateContacts(passive_, r_.world.ground_plane, &s);
     return s;
   }
 
@@ -91,7 +91,7 @@ template <> class AdjointStep<3> {
   // The first state's anchors come from its contact update (a point below the ground at the
   // start is anchored at its foot): their adjoint passes on to the start state.
   void StartVjp(const StateAdjoint<3>& start, Eigen::VectorXd* dz0) const {
-    if (!start.anchor.empty()) StartContactsVjp(passive_, r_.world.ground, Start(), start.anchor, dz0);
+    if (!start.anchor.empty()) StartContactsVjp(passive_, r_.world.ground_plane, Start(), start.anchor, dz0);
   }
 
  private:

@@ -53,7 +53,7 @@ struct DynamicParameters {
 enum class FitGradient { kJets, kAdjoint };
 
 template <int Dim> struct DynamicFitOptionsN {
-  WorldParamsN<Dim> world;  // gravity, ground, springs (of the body's dimension)
+  WorldParams world;  // gravity, the ground of the body's dimension, springs
   double dt = 0.01;   // thesis integrator (Eq. 4.22/4.23), as `wobble simulate --integrator thesis`
   bool fit_q0 = true, fit_qd0 = true, fit_stiffness = true, fit_damping = true;
   bool fit_poses = false, fit_times = false;  // the controller's (needs a non-empty graph)

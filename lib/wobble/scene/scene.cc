@@ -47,28 +47,20 @@ Scene::Scene() {
 
 Scene::~Scene() = default;
 
-WorldOptions Scene::ObjectWorldOptions(const BodyModel& body) const {
+template <int Dim> WorldOptions Scene::ObjectWorldOptions(const BodyModelN<Dim>& body) const {
   WorldOptions o = options_;
+  if constexpr (Dim == 3) o.params.ground_plane = GroundPlaneOf(options_.params.ground);
   o.params.springs.clear();
   if (springs_.enabled)
     for (Spring sp : springs_.list) {
-      body.LocalBasis(sp.lattice_coords, &sp.rest_local, &sp.mode_matrix);
+      sp.body = 0;
+      AttachSpring(body, &sp);
       o.params.springs.push_back(sp);
     }
   return o;
 }
-
-WorldOptions Scene::ObjectWorldOptions3() const {
-  WorldOptions o = options_;
-  o.ground_3d = GroundPlaneOf(options_.params.ground);
-  o.gravity_3d = Eigen::Vector3d(options_.params.gravity.x(), options_.params.gravity.y(), 0.0);
-  o.springs_3d.clear();
-  if (springs_.enabled && object_.dim() == 3)
-    for (const LatticeSpring3& sp : springs_.list3)
-      o.springs_3d.push_back(MakeSpring(*object_.Body<3>(), sp.lattice_coords, sp.anchor, sp.stiffness, sp.damping,
-                                         sp.rest_length));
-  return o;
-}
+template WorldOptions Scene::ObjectWorldOptions(const BodyModelN<2>&) const;
+template WorldOptions Scene::ObjectWorldOptions(const BodyModelN<3>&) const;
 
 SimulationSetup Scene::CurrentSetup() const {
   SimulationSetup setup;
@@ -191,8 +183,8 @@ void Scene::BeginRun(RunKind kind, bool keep_steps) {
   bool on_plane = false;
   for (int b = 0; b < w.num_bodies(); ++b)
     on_plane = on_plane || (w.dim(b) == 3 && w.ground_contact(b));
-  if (on_plane || !options_.params.ground.terrain) o.ground_3d = GroundPlaneOf(options_.params.ground);
-  o.gravity_3d = Eigen::Vector3d(options_.params.gravity.x(), options_.params.gravity.y(), 0.0);
+  if (on_plane || !options_.params.ground.terrain) o.params.ground_plane = GroundPlaneOf(options_.params.ground);
+  o.params.gravity = options_.params.gravity;
   if (record_fps_ > 0 && recorded_->num_bodies() != w.num_bodies()) Record(record_fps_);
   if (recorder_) recorder_->Start(w);
   run_ = std::make_unique<Run>();
@@ -204,7 +196,8 @@ void Scene::BeginObjectRun(RunKind kind, bool keep_steps) {
   if (!object_.loaded()) throw std::logic_error("BeginRun: no FFD object is loaded");
   std::unique_ptr<World> w;
   // the 3D object stands on the plane of the ground line (GroundPlaneOf), under the same gravity
-  w = std::make_unique<World>(object_.dim() == 3 ? ObjectWorldOptions3() : ObjectWorldOptions(*object_.Body<2>()));
+  w = std::make_unique<World>(object_.dim() == 3 ? ObjectWorldOptions(*object_.Body<3>())
+                                                 : ObjectWorldOptions(*object_.Body<2>()));
   AddObjectTo(object_, *w);
   w->SetTime(time_);
   auto run = std::make_unique<Run>();

@@ -59,17 +59,11 @@ struct ObjectControl {
   control::HeldPoint hold;     // held in place while keyframing
 };
 
-// A 3D object's spring as a script gives it: the body's b0 and B are filled in for each run.
-struct LatticeSpring3 {
-  Eigen::Vector3d lattice_coords = Eigen::Vector3d::Constant(0.5), anchor = Eigen::Vector3d::Zero();
-  double stiffness = 0.0, damping = 0.0, rest_length = 0.0;
-};
-
-// The FFD object's springs (Fig. 4.4): each from a lattice point to a world point; `list` for a
-// 2D object, `list3` for a 3D one.
+// The FFD object's springs (Fig. 4.4): each from a lattice point to a world point, in the
+// object's dimension (a 2D spring's z entries are 0), as a script gives them; the body's b0
+// and B are filled in for each run (ObjectWorldOptions).
 struct ObjectSprings {
   std::vector<Spring> list;
-  std::vector<LatticeSpring3> list3;
   bool enabled = true;
 };
 
@@ -143,11 +137,9 @@ class Scene {
   // The control energy of the object's runs (control/control.h), summed until reset.
   control::ControlEnergy& control_energy() { return energy_; }
   const control::ControlEnergy& control_energy() const { return energy_; }
-  // options() with the springs (when enabled) on `body`: the world of the object's runs.
-  WorldOptions ObjectWorldOptions(const BodyModel& body) const;
-  // The world of a 3D object's runs: options() with the ground line's plane (GroundPlaneOf),
-  // gravity in the x-y plane and the object's 3D springs (when enabled).
-  WorldOptions ObjectWorldOptions3() const;
+  // The world of the object's runs: options() with the springs (when enabled) on `body`, body
+  // 0 of that world; a 3D body stands on the ground line's plane (GroundPlaneOf).
+  template <int Dim> WorldOptions ObjectWorldOptions(const BodyModelN<Dim>& body) const;
   SimulationSetup CurrentSetup() const;
 
   // ---- the Witkin & Welch scene ----

@@ -81,13 +81,10 @@ void WriteSetup(std::ostream& s, const ScriptSetup& r) {
   else if (r.world.params.ground.heightfield) s << "# the heightfield is kept by `save FILE` only (beside FILE)\n";
   s << "set integrator " << IntegratorName(r.world.integrator) << "\nset dt " << Num(r.world.dt) << "\n";
   s << "set spring " << (r.springs_on ? "T" : "F") << "\nclear springs\n";
-  for (const Spring& sp : r.springs)
-    s << "spring " << Num(sp.lattice_coords.x()) << " " << Num(sp.lattice_coords.y()) << " " << Num(sp.anchor.x()) << " "
-      << Num(sp.anchor.y()) << " " << Num(sp.stiffness) << " " << Num(sp.damping) << " " << Num(sp.rest_length) << "\n";
-  for (const LatticeSpring3& sp : r.springs3) {
+  for (const Spring& sp : r.springs) {
     s << "spring";
-    for (int a = 0; a < 3; ++a) s << " " << Num(sp.lattice_coords[a]);
-    for (int a = 0; a < 3; ++a) s << " " << Num(sp.anchor[a]);
+    for (int a = 0; a < r.dim; ++a) s << " " << Num(sp.lattice_coords[a]);
+    for (int a = 0; a < r.dim; ++a) s << " " << Num(sp.anchor[a]);
     s << " " << Num(sp.stiffness) << " " << Num(sp.damping) << " " << Num(sp.rest_length) << "\n";
   }
   s << "trans 0 0 0\n";

@@ -43,8 +43,8 @@ struct ScriptSetup {
   double codam_active = 0.0;
   WorldOptions world;                   // ground, gravity, integrator, dt
   bool springs_on = true;
-  std::vector<Spring> springs;
-  std::vector<LatticeSpring3> springs3;  // a 3D object's
+  int dim = 2;                          // the object's: how many coordinates a spring has
+  std::vector<Spring> springs;          // lattice coordinates and anchors in the object's dimension
   Eigen::VectorXd q, qd;                // world coordinates (3D: t, rotation vector, γ | ṫ, ω, γ̇)
   std::string heightfield_path;         // where world's heightfield was written (empty: none)
 };

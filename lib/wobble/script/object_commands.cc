@@ -241,7 +241,7 @@ void Keyframe(State& s, const Words& w, const Context& ctx) {
 // `spring S T U X Y Z [K C REST]` for a 3D object: the same spring with a third coordinate.
 void Spring3Command(State& s, const Words& w, const Context& ctx) {
   if (w.size() < 7 || w.size() > 10) ctx.Fail("expected 'spring S T U X Y Z [K [C [REST]]]' for a 3D object");
-  scene::LatticeSpring3 sp;
+  Spring sp;
   sp.lattice_coords = {Number(w[1], "S", ctx), Number(w[2], "T", ctx), Number(w[3], "U", ctx)};
   if (sp.lattice_coords.minCoeff() < 0 || sp.lattice_coords.maxCoeff() > 1)
     ctx.Fail("expected lattice coordinates S, T and U in [0, 1]");
@@ -250,7 +250,7 @@ void Spring3Command(State& s, const Words& w, const Context& ctx) {
   sp.damping = w.size() > 8 ? Number(w[8], "C", ctx) : s.spring_damping;
   sp.rest_length = w.size() > 9 ? Number(w[9], "REST", ctx) : 0.0;
   if (sp.stiffness < 0 || sp.damping < 0 || sp.rest_length < 0) ctx.Fail("expected non-negative K, C and REST");
-  s.scene.springs().list3.push_back(sp);
+  s.scene.springs().list.push_back(sp);
 }
 
 void SpringCommand(State& s, const Words& w, const Context& ctx) {
@@ -258,10 +258,10 @@ void SpringCommand(State& s, const Words& w, const Context& ctx) {
   if (s.scene.object().dim() == 3) return Spring3Command(s, w, ctx);
   ctx.ExpectWords(w, 5, 8);
   Spring sp;
-  sp.lattice_coords = {Number(w[1], "S", ctx), Number(w[2], "T", ctx)};
+  sp.lattice_coords = {Number(w[1], "S", ctx), Number(w[2], "T", ctx), 0.0};
   if (sp.lattice_coords.minCoeff() < 0 || sp.lattice_coords.maxCoeff() > 1)
     ctx.Fail("expected lattice coordinates S and T in [0, 1]");
-  sp.anchor = {Number(w[3], "X", ctx), Number(w[4], "Y", ctx)};
+  sp.anchor = {Number(w[3], "X", ctx), Number(w[4], "Y", ctx), 0.0};
   sp.stiffness = w.size() > 5 ? Number(w[5], "K", ctx) : s.spring_stiffness;
   sp.damping = w.size() > 6 ? Number(w[6], "C", ctx) : s.spring_damping;
   sp.rest_length = w.size() > 7 ? Number(w[7], "REST", ctx) : 0.0;
@@ -351,8 +351,8 @@ void Render(State& s, const Words& w, const Context& ctx) {
   if (s.track.empty()) ctx.Fail("render: nothing to draw yet (run 'simul' or 'keyframe' first)");
   if (!s.render_hook) ctx.Fail("render: this program has no renderer ('wobble run' and Python's Interpreter have one, built with VTK)");
   const auto merged = std::make_shared<const record::Trajectory>(scene::MergeRuns(s.track));
-  request.world = merged->bodies()[0].ffd<2>() ? s.scene.ObjectWorldOptions(*merged->bodies()[0].ffd<2>())
-                                          : s.scene.ObjectWorldOptions3();
+  const record::BodyInfo& body = merged->bodies()[0];
+  request.world = body.ffd<2>() ? s.scene.ObjectWorldOptions(*body.ffd<2>()) : s.scene.ObjectWorldOptions(*body.ffd<3>());
   request.trajectory = merged;
   try {
     s.render_hook(request);

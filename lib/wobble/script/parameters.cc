@@ -81,20 +81,18 @@ const std::vector<Parameter>& ParameterTable() {
        [](State& s, const Value& v) {  // also the springs made already
          s.spring_stiffness = v.NonNegative();
          for (Spring& sp : s.scene.springs().list) sp.stiffness = s.spring_stiffness;
-         for (scene::LatticeSpring3& sp : s.scene.springs().list3) sp.stiffness = s.spring_stiffness;
        }},
       {"spdam",
        [](State& s, const Value& v) {
          s.spring_damping = v.NonNegative();
          for (Spring& sp : s.scene.springs().list) sp.damping = s.spring_damping;
-         for (scene::LatticeSpring3& sp : s.scene.springs().list3) sp.damping = s.spring_damping;
        }},
       {"time", [](State& s, const Value& v) { s.scene.set_time(v.Number()); }},
       {"end", [](State& s, const Value& v) { s.scene.set_end(v.Number()); }},
       {"dt", [](State& s, const Value& v) { s.scene.options().dt = v.Positive(); }},
       // gravity's magnitude along −y (9.81: the thesis' pixels as metres); a scene drawn in
       // centimetres takes 981 (table_cliff.wob)
-      {"g", [](State& s, const Value& v) { s.scene.options().params.gravity = Eigen::Vector2d(0.0, -v.NonNegative()); }},
+      {"g", [](State& s, const Value& v) { s.scene.options().params.gravity = Eigen::Vector3d(0.0, -v.NonNegative(), 0.0); }},
       // work and memory limits (core/limits.h)
       {"max_steps",
        [](State& s, const Value& v) {

@@ -98,7 +98,7 @@ synth::Problem MakeProblem(const State& s, long steps) {
   synth::Problem p;
   if (s.scene.object().dim() == 3) {
     p.body3 = s.scene.object().Body<3>();
-    p.world = s.scene.ObjectWorldOptions3();
+    p.world = s.scene.ObjectWorldOptions(*p.body3);
   } else {
     p.body = s.scene.object().Body<2>();
     p.world = s.scene.ObjectWorldOptions(*p.body);
@@ -201,8 +201,8 @@ std::string ReplayScript(const State& s, const std::string& schedule_path, const
   setup.codam_active = object.codam_active();
   setup.world = sc.options();
   setup.springs_on = sc.springs().enabled;
+  setup.dim = object.dim();
   setup.springs = sc.springs().list;
-  setup.springs3 = sc.springs().list3;
   setup.heightfield_path = heightfield_path;
   // after an anneal: from the state its trials started from, for one trial's length (the
   // motion the cost judged); otherwise from the current state over the current span

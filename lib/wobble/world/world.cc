@@ -116,14 +116,11 @@ void World::RefreshLinearContacts(LinearEntry& e) const {
   if (e.ground_contact) UpdateLinearContacts(*e.model, linear_ground(), e.R, e.R_dot, &e.contacts);
 }
 
-void World::AddSpring(SpringN<2> spring) {
-  body<2>(spring.body).LocalBasis(spring.lattice_coords, &spring.rest_local, &spring.mode_matrix);
+int World::AddSpring(Spring spring) {
+  if (dim(spring.body) == 3) AttachSpring(body<3>(spring.body), &spring);
+  else AttachSpring(body<2>(spring.body), &spring);
   options_.params.springs.push_back(std::move(spring));
-}
-
-void World::AddSpring(SpringN<3> spring) {
-  body<3>(spring.body).LocalBasis(spring.lattice_coords, &spring.rest_local, &spring.mode_matrix);
-  options_.springs_3d.push_back(std::move(spring));
+  return int(options_.params.springs.size()) - 1;
 }
 
 // ---------------------------------------------------------------- stepping
@@ -268,7 +265,7 @@ void World::LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const {
   Q = e.applied;
   AddAffineForce(e.material, e.R, e.R_dot, &Q);
   if (params.gravity_on) {  // Σ m_k g p_kᵀ
-    const double* g = d == 2 ? params.gravity.data() : options_.gravity_3d.data();
+    const double* g = params.gravity.data();  // a 2D body reads x and y
     const Eigen::VectorXd& mu = m.first_moment();
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < d; ++i) Q(i, j) += g[i] * mu[j];
@@ -316,7 +313,7 @@ Energies World::ComputeEnergies(int i) const {
     e.modes = AffineEnergy(l.material, l.R);
     e.ground = LinearGroundEnergy(*l.model, linear_ground(), l.R, l.contacts);
     if (p.gravity_on) {
-      const Eigen::VectorXd g = l.model->dim() == 2 ? Eigen::VectorXd(p.gravity) : Eigen::VectorXd(options_.gravity_3d);
+      const Eigen::VectorXd g = p.gravity.head(l.model->dim());
       e.gravity = -g.dot(l.R * l.model->first_moment());
     }
     return e;
@@ -331,8 +328,7 @@ bool World::AcceptLinearStep(int body, bool screened) {
   LinearEntry& e = linear_[slots_[body].index];
   // the screen of EnergySurelyFinite, for ½ tr(Ṙ M Ṙᵀ), −g·R m̄ and the affine energies (at
   // most seven factors deep: k_c (det A − 1)² with a 3×3 A)
-  const double g = e.model->dim() == 2 ? options_.params.gravity.cwiseAbs().maxCoeff()
-                                       : options_.gravity_3d.cwiseAbs().maxCoeff();
+  const double g = options_.params.gravity.head(e.model->dim()).cwiseAbs().maxCoeff();
   if (screened && e.scale <= kLinearScreen && g <= kLinearScreen) return true;
   const bool finite = e.R.allFinite() && e.R_dot.allFinite();
   if (finite && EnergyFinite(body)) return true;

@@ -78,14 +78,10 @@ double LinearScale(const LinearBodyModel& m, const AffineMaterial& material);  /
 std::string EnergyTerms(const Energies& e);
 
 struct WorldOptions {
-  // 2D gravity (params.gravity; gravity_3d for 3D bodies; both off with params.gravity_on),
-  // the ground, springs and max_condition of the FFD bodies.
+  // Gravity (one vector; 2D bodies feel its x and y), the ground of each dimension (2D: the
+  // line or terrain `ground`; 3D: `ground_plane`), the springs of every FFD body and
+  // max_condition: one set for bodies of both dimensions, which their steps read as it is.
   WorldParams params;
-  Eigen::Vector3d gravity_3d = Eigen::Vector3d(0.0, -9.81, 0.0);
-  // The ground plane of the 3D FFD bodies (off by default) and their springs to world
-  // anchors (each made for its body by MakeSpring; SpringN::body is the world's body index).
-  GroundPlane ground_3d;
-  std::vector<SpringN<3>> springs_3d;
   // The FFD bodies' integrator while no constraint is enabled.
   Integrator integrator = Integrator::kThesis;
   double dt = 0.01;
@@ -97,11 +93,6 @@ struct WorldOptions {
   MultiplierMethod method = MultiplierMethod::kAuto;
   int dense_max_rows = 24;
 };
-
-// The 3D FFD bodies' world from the options: gravity_3d (off with params.gravity_on),
-// ground_3d, springs_3d and params.max_condition. What World steps them in, and the world of
-// a 3D rollout (fit/adjoint.h) built from the same options.
-WorldParamsN<3> Params3Of(const WorldOptions& options);
 
 // A material point of a body. Linear bodies: u in undeformed coordinates (any point, inside
 // or outside the mass points). FFD bodies: u = lattice coordinates (s, t) in [0, 1]². Or
@@ -137,8 +128,7 @@ class World {
 
   // ---- bodies (one numbering for both kinds) ----
   // An FFD body of either dimension starts in its lattice's pose (t = 0, no turn, γ = 0), at
-  // rest. 2D bodies step on options().params, 3D bodies on gravity_3d, ground_3d and
-  // springs_3d (Params3Of), both with options().integrator.
+  // rest. Both step on options().params with options().integrator.
   int AddBody(std::shared_ptr<const BodyModelN<2>> model) { return AddFfdBody<2>(std::move(model)); }
   int AddBody(std::shared_ptr<const BodyModelN<3>> model) { return AddFfdBody<3>(std::move(model)); }
   // A linear body starts at its rest state R = [I | 0 | 0], at rest.
@@ -190,19 +180,19 @@ class World {
   void SetMaterial(int body, const AffineMaterial& material);
   const AffineMaterial& material(int body) const;
   // Whether a linear body feels the ground: a 2D one the 2D ground (line or terrain), a 3D one
-  // ground_3d (linear_ground.h). Off by default, as in Witkin & Welch's scenes, which have no
+  // params.ground_plane (linear_ground.h). Off by default, as in Witkin & Welch's scenes, which have no
   // ground; FFD bodies always feel it. Turning it on or off starts with no contacts.
   void SetGroundContact(int body, bool on);
   bool ground_contact(int body) const;
   // The linear body's contacts with their anchors (empty while ground_contact is off).
   const LinearContacts& linear_contacts(int body) const;
   // The ground of a linear body, for the linear_ground.h functions.
-  LinearGround linear_ground() const { return {options_.params.ground, options_.ground_3d}; }
+  LinearGround linear_ground() const { return {options_.params.ground, options_.params.ground_plane}; }
 
   // Springs hold a point of an FFD body (spring.body) given by lattice coordinates (Fig. 4.4);
-  // into options().params.springs or springs_3d.
-  void AddSpring(SpringN<2> spring);
-  void AddSpring(SpringN<3> spring);
+  // into options().params.springs, with b0 and B of the body's point filled in. Returns its
+  // index there.
+  int AddSpring(Spring spring);
 
   // ---- material points ----
   // Throws std::invalid_argument: unknown body, wrong size, lattice coordinates outside
@@ -369,15 +359,7 @@ class World {
     return const_cast<FfdEntry<Dim>&>(static_cast<const World*>(this)->Ffd<Dim>(body));
   }
   template <int Dim> int AddFfdBody(std::shared_ptr<const BodyModelN<Dim>> model);
-  // The world of a Dim-dimensional FFD body: options_.params, or Params3Of(options_).
-  template <int Dim> decltype(auto) ParamsOf() const {
-    if constexpr (Dim == 2) return (options_.params);
-    else return Params3Of(options_);
-  }
-  template <int Dim> const GroundOf<Dim>& GroundFor() const {
-    if constexpr (Dim == 2) return options_.params.ground;
-    else return options_.ground_3d;
-  }
+  template <int Dim> const GroundOf<Dim>& GroundFor() const { return wobble::GroundFor<Dim>(options_.params); }
   [[noreturn]] void ThrowBadBody(int body, BodyKind wanted, int wanted_dim = 0) const;
   const LinearEntry& Linear(int body) const;
   bool StepEachBody();

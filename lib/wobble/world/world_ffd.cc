@@ -96,16 +96,6 @@ template <int Dim> double ModelScale(const BodyModelN<Dim>& b) {
 template double ModelScale(const BodyModelN<2>&);
 template double ModelScale(const BodyModelN<3>&);
 
-WorldParamsN<3> Params3Of(const WorldOptions& options) {
-  WorldParamsN<3> p;
-  p.gravity_on = options.params.gravity_on;
-  p.gravity = options.gravity_3d;
-  p.ground = options.ground_3d;
-  p.springs = options.springs_3d;
-  p.max_condition = options.params.max_condition;
-  return p;
-}
-
 GroundPlane GroundPlaneOf(const Ground& g) {
   if (g.terrain)
     throw InputError("a 3D body stands on a ground plane; a terrain profile is 2D only (turn it off with 'terrain off')");
@@ -206,7 +196,7 @@ void World::SetModeTargets(int i, const Eigen::VectorXd& targets) {
 
 template <int Dim> ForceBreakdown<Dim, double> World::Forces(int i) const {
   ForceBreakdown<Dim, double> f;
-  EvaluateForces(body<Dim>(i), ParamsOf<Dim>(), i, state<Dim>(i), &f);
+  EvaluateForces(body<Dim>(i), options_.params, i, state<Dim>(i), &f);
   return f;
 }
 template ForceBreakdown<2, double> World::Forces<2>(int) const;
@@ -238,7 +228,7 @@ template <int Dim> bool World::StepFfdBody(int body) {
   FfdEntry<Dim>& e = FfdEntries<Dim>()[size_t(slots_[size_t(body)].index)];
   const VecQ<double> q_before = e.state.q, qd_before = e.state.qd;  // contacts are found again on refusal
   const bool pushed = !e.applied.isZero(0.0);
-  const StepStatus st = StepBody(*e.model, ParamsOf<Dim>(), body, options_.integrator, options_.dt, &e.state,
+  const StepStatus st = StepBody(*e.model, options_.params, body, options_.integrator, options_.dt, &e.state,
                                  AppliedForce<Dim>{pushed ? &e.applied : nullptr});
   if (pushed) e.applied.setZero();
   if (st.ok() && AcceptFfdState<Dim>(body)) return true;
@@ -284,7 +274,7 @@ bool World::RefuseFfdStep(int body, const VecQ<double>& q_before, const VecQ<dou
 template <int Dim> bool World::ForcesFinite(int body) const {
   const FfdEntry<Dim>& e = Ffd<Dim>(body);
   ForceBreakdown<Dim, double> f;
-  EvaluateForces(*e.model, ParamsOf<Dim>(), body, e.state, Frame<Dim, double>(e.state.q), &f, ContactSet::kDetect);
+  EvaluateForces(*e.model, options_.params, body, e.state, Frame<Dim, double>(e.state.q), &f, ContactSet::kDetect);
   return f.total.allFinite();
 }
 
@@ -312,12 +302,12 @@ template <int Dim> double World::PenetrationLimit(const BodyModelN<Dim>& model) 
 template <int Dim> Energies World::FfdEnergies(int i, ContactSet contacts, bool per_mode) const {
   using Vector = Eigen::Matrix<double, Dim, 1>;
   Energies e;
-  const auto& p = ParamsOf<Dim>();
+  const auto& p = options_.params;
   const BodyModelN<Dim>& b = body<Dim>(i);
   const BodyState<Dim, double>& s = state<Dim>(i);
   const Frame<Dim, double> frame(s.q);
   e.kinetic = KineticEnergyOf(b, s, frame);
-  if (p.gravity_on) e.gravity = GravityEnergyOf(b, s, frame, p.gravity);
+  if (p.gravity_on) e.gravity = GravityEnergyOf(b, s, frame, GravityFor<Dim>(p));
   // K (γ − γ0)²: the potential whose gradient is the mode force, PD target γ0 included
   const bool targeted = s.mode_target.size() == b.num_modes();
   for (int d = 0; d < b.num_modes(); ++d) {
@@ -326,14 +316,14 @@ template <int Dim> Energies World::FfdEnergies(int i, ContactSet contacts, bool 
     if (per_mode) e.per_mode.push_back(term);
     e.modes += term;
   }
-  ForEachPointInContact(b, p.ground, s, frame,
+  ForEachPointInContact(b, GroundFor<Dim>(), s, frame,
                         [&](int, const Vector&, const Vector& x, const Vector&, const Vector& anchor, const auto& face,
                             int) { e.ground += 0.5 * face.stiffness * (x - anchor).squaredNorm(); },
                         contacts);
-  for (const SpringN<Dim>& sp : p.springs) {
+  for (const Spring& sp : p.springs) {
     if (sp.body != i) continue;
-    const Vector x = WorldFromLocal(frame, LocalPosition<double>(sp.rest_local, sp.mode_matrix, s.q));
-    const double stretch = (x - sp.anchor).norm() - sp.rest_length;
+    const Vector x = WorldFromLocal(frame, LocalPosition<double>(sp.RestLocal<Dim>(), sp.ModeMatrix<Dim>(), s.q));
+    const double stretch = (x - sp.Anchor<Dim>()).norm() - sp.rest_length;
     e.springs += 0.5 * sp.stiffness * stretch * stretch;
   }
   return e;
@@ -350,18 +340,19 @@ template Energies World::FfdEnergies<3>(int, ContactSet, bool) const;
 template <int Dim> bool World::EnergySurelyFinite(const FfdEntry<Dim>& e) const {
   constexpr double kScreen = 1e30;
   const BodyState<Dim, double>& s = e.state;
-  const auto& p = ParamsOf<Dim>();
+  const auto& p = options_.params;
   if (!(e.scale <= kScreen && s.q.cwiseAbs().maxCoeff() <= kScreen && s.qd.cwiseAbs().maxCoeff() <= kScreen))
     return false;
   if (s.mode_target.size() > 0 && !(s.mode_target.cwiseAbs().maxCoeff() <= kScreen)) return false;
   // a terrain's or a heightfield region's own stiffnesses are at most 1e30 (their makers)
-  if (!(p.gravity.cwiseAbs().maxCoeff() <= kScreen && std::abs(p.ground.stiffness) <= kScreen)) return false;
+  const GroundOf<Dim>& ground = GroundFor<Dim>();
+  if (!(GravityFor<Dim>(p).cwiseAbs().maxCoeff() <= kScreen && std::abs(ground.stiffness) <= kScreen)) return false;
   if constexpr (Dim == 3) {
-    if (!(p.ground.point.cwiseAbs().maxCoeff() <= kScreen)) return false;
+    if (!(ground.point.cwiseAbs().maxCoeff() <= kScreen)) return false;
   }
   for (const Contact<Dim, double>& c : s.contacts)
     if (!(c.anchor.cwiseAbs().maxCoeff() <= kScreen)) return false;
-  for (const SpringN<Dim>& sp : p.springs)
+  for (const Spring& sp : p.springs)
     if (!(std::abs(sp.stiffness) <= kScreen && std::abs(sp.rest_length) <= kScreen &&
           sp.anchor.cwiseAbs().maxCoeff() <= kScreen && sp.rest_local.cwiseAbs().maxCoeff() <= kScreen &&
           (sp.mode_matrix.size() == 0 || sp.mode_matrix.cwiseAbs().maxCoeff() <= kScreen)))
@@ -471,7 +462,7 @@ template <int Dim> void World::FfdApplyGeneralized(int body, const Eigen::Vector
 template <int Dim> bool World::FfdFreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st) const {
   const FfdEntry<Dim>& e = Ffd<Dim>(body);
   VecQ<double> a;
-  *st = wobble::Accelerations(*e.model, ParamsOf<Dim>(), body, e.state, &a);
+  *st = wobble::Accelerations(*e.model, options_.params, body, e.state, &a);
   if (!st->ok()) return false;
   *acc = a;
   if (!e.applied.isZero(0.0)) FfdApplyGeneralized<Dim>(body, e.applied, acc);

@@ -57,7 +57,7 @@ template <> struct Dimension<2> {
 template <> struct Dimension<3> {
   using Body = BodyModel3;
   template <class T> using State = BodyState<3, T>;
-  template <class T> static State<T> Start(const Body& body, const WorldParamsN<3>& w, const T* q0, const T* qd0,
+  template <class T> static State<T> Start(const Body& body, const WorldParams& w, const T* q0, const T* qd0,
                                            const Eigen::Quaterniond& chart) {
     const int D = body.num_modes();
     State<T> s = RestState<3, T>(body);
@@ -66,10 +66,10 @@ template <> struct Dimension<3> {
         Eigen::Quaternion<T>(chart.cast<T>() * ExpRotation<T>(Vec3<T>(q0[3], q0[4], q0[5]))).normalized(), &s.q);
     for (int d = 0; d < D; ++d) s.gamma()[d] = q0[Group<3>::kRigidDofs + d];
     s.qd = Eigen::Map<const VecQ<T>>(qd0, body.num_q());
-    UpdateContacts(body, w.ground, &s);
+    UpdateContacts(body, w.ground_plane, &s);
     return s;
   }
-  template <class T, class Extra> static bool Step(const Body& body, const WorldParamsN<3>& w, double dt, State<T>* s,
+  template <class T, class Extra> static bool Step(const Body& body, const WorldParams& w, double dt, State<T>* s,
                                                    const Extra& extra) {
     return StepBody(body, w, 0, Integrator::kThesis, dt, s, extra).ok();  // non-finite states fail inside
   }

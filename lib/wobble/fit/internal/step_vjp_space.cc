@@ -92,7 +92,7 @@ PointPullback PullAnchorUpdate(const GroundPlane& g, const GroundForceParts<doub
 
 // y = SpringForce's f = −s d with s = K (|Δ| − L) + C d·ẋ, d = Δ/|Δ|, Δ = x − anchor
 // (∂d/∂x = (1 − d dᵀ)/|Δ|); the anchor is fixed.
-PointPullback PullSpringForce(const SpringN<3>& sp, const Vector3d& x, const Vector3d& v, const Vector3d& w) {
+PointPullback PullSpringForce(const Spring& sp, const Vector3d& x, const Vector3d& v, const Vector3d& w) {
   const Vector3d delta = x - sp.anchor;
   const double len = std::sqrt(delta.squaredNorm() + 1e-300);
   const Vector3d d = delta / len;
@@ -184,7 +184,7 @@ Matrix3d SecondMomentRate(const MassMoments3& mm, const ShapeMoments<double>& sm
 // z += ∂ψ/∂z of the mass-moment terms of ψ = λ_rᵀ (Q_gravity − w − M a) at `e` (spatial_inertia.h's
 // formulas; ∂I/∂γ_j = tr(K_j) 1 − K_j with K_j = ∂K/∂γ_j, ∂N_d/∂γ_g = X_gd, ∂L_d/∂γ_g = F_dg,
 // ∂e/∂γ = G, ∂c/∂γ = C; a rotated vector Rᵀy moves by (Rᵀy) × ε).
-void PullMomentTerms(const MassMoments3& mm, const WorldParamsN<3>& world, const BodyState<3, double>& e,
+void PullMomentTerms(const MassMoments3& mm, const WorldParams& world, const BodyState<3, double>& e,
                      const Matrix3d& R, const ShapeMoments<double>& sm, const VecQ<double>& a,
                      const VecQ<double>& lr, const Tangent& ix, Eigen::VectorXd* z) {
   const int D = ix.D;
@@ -268,7 +268,7 @@ void PullAccelerations(const StepModel& m, const VecD<double>& target, const Bod
   }
   // ground and springs, point by point
   ForEachPointInContact(
-      body, m.world.ground, e, frame,
+      body, m.world.ground_plane, e, frame,
       [&](int k, const Vector3d& l, const Vector3d& x, const Vector3d& v, const Vector3d& anchor,
           const GroundPlane& plane, int face) {
         const auto B = body.mode_matrix(k);
@@ -280,7 +280,7 @@ void PullAccelerations(const StepModel& m, const VecD<double>& target, const Bod
         PullVelocity(frame.R, e.qd, l, B, r.dv, ix, &z);
       },
       ContactSet::kDetect);
-  for (const SpringN<3>& sp : m.world.springs) {
+  for (const Spring& sp : m.world.springs) {
     const Vector3d l = LocalPosition<double>(sp.rest_local, sp.mode_matrix, e.q);
     const Vector3d x = frame.t + frame.R * l, v = PointVelocity(frame, e.qd, l, sp.mode_matrix);
     const Vector3d u = PullGeneralizedForce(frame.R, l, sp.mode_matrix, lr, SpringForce(sp, x, v), ix, &z);
@@ -326,7 +326,7 @@ StepStatus RecordStep(const StepModel& m, const VecD<double>& target, const Body
       !after.orientation().coeffs().allFinite())
     return {StatusCode::kNonFinite, 0.0};
   *next = after;
-  UpdateContacts(body, m.world.ground, next);
+  UpdateContacts(body, m.world.ground_plane, next);
   return {};
 }
 
@@ -340,7 +340,7 @@ void StepVjp(const StepModel& m, const VecD<double>& target, const BodyState<3, 
   // v' = v + h a(eval), then the symplectic integrator's advance by v
   in->anchor.clear();
   in->z = out.z;
-  PullContactUpdate(m.passive, m.world.ground, tape.after, out.anchor, ix, &in->z, &in->anchor);
+  PullContactUpdate(m.passive, m.world.ground_plane, tape.after, out.anchor, ix, &in->z, &in->anchor);
   VecQ<double> lambda_v = in->z.tail(nv);
   if (thesis) PullAdvance(tape.after.qd, h, ix, &in->z, &lambda_v);
   VecQ<double> lr;  // M⁻¹ h λ_v (M symmetric: the solve the step made, again)

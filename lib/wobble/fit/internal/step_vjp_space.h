@@ -34,7 +34,7 @@ namespace wobble::fit::internal {
 // the mode forces' gains.
 struct StepModel {
   const BodyModel3& passive;
-  const WorldParamsN<3>& world;
+  const WorldParams& world;
   Integrator integrator;  // kThesis or kSymplecticEuler
   double dt;
   const ModeParams<double>& gains;
