@@ -72,7 +72,7 @@ template <int Dim> std::shared_ptr<const BodyModelN<Dim>> LoadBody(const BodyFil
   return body;
 }
 template std::shared_ptr<const BodyModel> LoadBody<2>(const BodyFiles&, bool);
-template std::shared_ptr<const BodyModel3> LoadBody<3>(const BodyFiles&, bool);
+template std::shared_ptr<const BodyModelN<3>> LoadBody<3>(const BodyFiles&, bool);
 
 void CheckOutputFolder(const std::string& folder) {
   try {
@@ -283,13 +283,13 @@ Eigen::VectorXd ParseVelocities(const std::string& text, const std::string& what
 }
 
 template std::string CoordinateNames(const BodyModel&);
-template std::string CoordinateNames(const BodyModel3&);
+template std::string CoordinateNames(const BodyModelN<3>&);
 template std::string VelocityNames(const BodyModel&);
-template std::string VelocityNames(const BodyModel3&);
+template std::string VelocityNames(const BodyModelN<3>&);
 template Eigen::VectorXd ParseCoordinates(const std::string&, const std::string&, const BodyModel&);
-template Eigen::VectorXd ParseCoordinates(const std::string&, const std::string&, const BodyModel3&);
+template Eigen::VectorXd ParseCoordinates(const std::string&, const std::string&, const BodyModelN<3>&);
 template Eigen::VectorXd ParseVelocities(const std::string&, const std::string&, const BodyModel&);
-template Eigen::VectorXd ParseVelocities(const std::string&, const std::string&, const BodyModel3&);
+template Eigen::VectorXd ParseVelocities(const std::string&, const std::string&, const BodyModelN<3>&);
 
 Eigen::VectorXd ParseNumbers(const std::string& text, const std::string& what, int expected_size,
                              const std::string& names, const std::string& body_name) {

@@ -180,7 +180,7 @@ void WriteSurfaceMesh(const std::string& path, const SurfaceMesh& mesh) {
   });
 }
 
-BodyDef3 ReadObject3(const std::string& path) { return formats::ReadObjectFile3(path, ReadSurfaceMesh); }
+BodyDefN<3> ReadObject3(const std::string& path) { return formats::ReadObjectFile3(path, ReadSurfaceMesh); }
 
 SurfaceMesh MakeTableMesh() {
   auto parts = Ptr<vtkAppendPolyData>::New();

@@ -59,8 +59,8 @@ template <int Dim> std::string Describe(const std::vector<DeformationModeN<Dim>>
 
 // A lattice that is neither axis-aligned nor cubic, so that the 3D generators' use of the
 // axes, their lengths and the sizes all show in the reference.
-const Lattice3& SkewLattice3() {
-  static const Lattice3 lattice(Eigen::Vector3d(-10, 5, 2),
+const LatticeN<3>& SkewLattice3() {
+  static const LatticeN<3> lattice(Eigen::Vector3d(-10, 5, 2),
                                 {Eigen::Vector3d(200, 30, 0), Eigen::Vector3d(-20, 150, 10), Eigen::Vector3d(5, 0, 90)},
                                 {5, 4, 3}, BasisKind::kBernstein);
   return lattice;
@@ -116,7 +116,7 @@ Names InCheckout() {
 
 std::string Current(const Names& names) {
   std::ostringstream out;
-  const Lattice3& table3 = ReadObjectFile3(kSource + "/data/table3.obj").lattice;
+  const LatticeN<3>& table3 = ReadObjectFile3(kSource + "/data/table3.obj").lattice;
   // shipped 2D files: data/*.def, data/def_* and the command-line tests' files, in full
   for (const std::string& file : names.files2)
     out << "file2 " << file << "\n" << Describe(ReadDeformationFile(kSource + "/" + file));

@@ -29,13 +29,13 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 
 struct Character {
-  BodyDef3 def;
-  std::vector<DeformationMode3> modes;
-  BodyModel3 body;
+  BodyDefN<3> def;
+  std::vector<DeformationModeN<3>> modes;
+  BodyModelN<3> body;
 };
 
 Character MakeChair() {
-  BodyModel3 body = testing::Chair3();
+  BodyModelN<3> body = testing::Chair3();
   return {body.def(), body.modes(), body};
 }
 
@@ -262,15 +262,15 @@ std::string TargetError(const std::string& text) {
   return "no error";
 }
 
-TEST(TargetFile3, ParsesEveryStatement) {
+TEST(TargetFileN<3>, ParsesEveryStatement) {
   std::istringstream in("dimension 3\npoint 3 10 20 30\nsample 0.5 1 0.25 1.5 -2 7 weight 4\n");
-  const formats::TargetFile3 f = formats::ParseTargets3(in, "t.tgt");
+  const formats::TargetFileN<3> f = formats::ParseTargets3(in, "t.tgt");
   ASSERT_EQ(f.points.size(), 2u);
   EXPECT_EQ(f.points[0].position, Vec3(10, 20, 30));
   EXPECT_EQ(f.points[1].lattice_coords, Vec3(0.5, 1, 0.25));
   EXPECT_EQ(f.points[1].weight, 4.0);
   std::istringstream surface("dimension 3\nmesh scan.ply   # beside the target file\ncloud 1 2 3\n");
-  const formats::TargetFile3 s = formats::ParseTargets3(surface, "dir/t.tgt", [](const std::string&) { return testing::ChairMesh(); });
+  const formats::TargetFileN<3> s = formats::ParseTargets3(surface, "dir/t.tgt", [](const std::string&) { return testing::ChairMesh(); });
   EXPECT_EQ(s.mesh.triangles.size(), 36u);
   EXPECT_EQ(s.cloud.size(), 1u);
   EXPECT_TRUE(s.has_curve());
@@ -278,7 +278,7 @@ TEST(TargetFile3, ParsesEveryStatement) {
   EXPECT_EQ(formats::ParseTargets3(traj, "k.tgt").frames.size(), 2u);
 }
 
-TEST(TargetFile3, RejectsMalformedInputWithFileAndLine) {
+TEST(TargetFileN<3>, RejectsMalformedInputWithFileAndLine) {
   EXPECT_EQ(TargetError(""), "dir/t.tgt:0: file is empty: expected 'dimension 3' and point, sample, cloud, mesh or frame lines");
   EXPECT_EQ(TargetError("point 0 1 2 3\n"),
             "dir/t.tgt:1: the object is 3D: its target file starts with 'dimension 3' (got 'point')");
@@ -305,11 +305,11 @@ TEST(TargetFile3, RejectsMalformedInputWithFileAndLine) {
 // in the air. K_d from a mode frequency f_d (γ̈ G_dd = −2K γ: ω² = 2K/G_dd), c_d = 2ζ sqrt(2K G_dd).
 struct Vibrating {
   Character chair = MakeChair();
-  std::shared_ptr<const BodyModel3> body;
+  std::shared_ptr<const BodyModelN<3>> body;
   Eigen::VectorXd K, c;
   Vibrating() {
     const double f[] = {2.0, 3.0, 2.5}, zeta[] = {0.05, 0.1, 0.02};
-    std::vector<DeformationMode3> modes = chair.modes;
+    std::vector<DeformationModeN<3>> modes = chair.modes;
     K.resize(3);
     c.resize(3);
     for (int d = 0; d < 3; ++d) {
@@ -319,12 +319,12 @@ struct Vibrating {
       modes[size_t(d)].stiffness = K[d];
       modes[size_t(d)].damping = c[d];
     }
-    body = std::make_shared<const BodyModel3>(chair.def, modes);
+    body = std::make_shared<const BodyModelN<3>>(chair.def, modes);
   }
 };
 
 // Frames of a World run (the world's own mode forces, not the fit's), every `every` steps.
-std::vector<fit::ReferenceFrameN<3>> WorldFrames(const std::shared_ptr<const BodyModel3>& body, const Eigen::VectorXd& q0,
+std::vector<fit::ReferenceFrameN<3>> WorldFrames(const std::shared_ptr<const BodyModelN<3>>& body, const Eigen::VectorXd& q0,
                                               const Eigen::VectorXd& v0, double dt, int steps, int every) {
   WorldOptions o;
   o.dt = dt;

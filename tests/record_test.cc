@@ -132,7 +132,7 @@ TEST(Trajectory, RestoreAtInterpolatesBetweenSamples) {
   // a 3D body turning: the orientation between two samples is the normalised blend
   World w3(WorldOptions{});
   w3.mutable_options().ground_3d.enabled = false;
-  const int b = w3.AddBody(std::make_shared<const BodyModel3>(testing::Chair3()));
+  const int b = w3.AddBody(std::make_shared<const BodyModelN<3>>(testing::Chair3()));
   const Eigen::VectorXd g0 = Eigen::VectorXd::Zero(w3.body<3>(b).num_modes());
   w3.SetState(b, PositionsOf(Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), g0), (Eigen::VectorXd(6 + g0.size()) << Eigen::VectorXd::Zero(3), 0.5, 2.0, -1.0, g0).finished());
   auto run3 = std::make_shared<record::Trajectory>(w3);

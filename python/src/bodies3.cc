@@ -24,32 +24,32 @@ py::array_t<double> Rows3(const std::vector<Eigen::Vector3d>& points) {
 }  // namespace
 
 void BindBodies3(py::module_& m) {
-  py::class_<BodyModel3, std::shared_ptr<BodyModel3>>(
+  py::class_<BodyModelN<3>, std::shared_ptr<BodyModelN<3>>>(
       m, "BodyModel3",
       "A 3D FFD character (issue 15): a trivariate lattice, mass points, modes made by generators,\n"
       "and optionally a user's mesh. Immutable. In a World its q is [tx, ty, tz, rx, ry, rz,\n"
       "γ1..γD] (r the rotation vector) and q̇ [vx, vy, vz, ωx, ωy, ωz (body frame), γ̇1..γ̇D].\n"
       "Make one with wobble.load_body (a 'dimension 3' object file).")
-      .def_property_readonly("name", &BodyModel3::name)
-      .def_property_readonly("num_modes", &BodyModel3::num_modes)
-      .def_property_readonly("num_q", [](const BodyModel3& b) { return Group<3>::kRigidDofs + b.num_modes(); },
+      .def_property_readonly("name", &BodyModelN<3>::name)
+      .def_property_readonly("num_modes", &BodyModelN<3>::num_modes)
+      .def_property_readonly("num_q", [](const BodyModelN<3>& b) { return Group<3>::kRigidDofs + b.num_modes(); },
                              "6 rigid coordinates + one per mode")
-      .def_property_readonly("num_points", &BodyModel3::num_points, "mass points")
+      .def_property_readonly("num_points", &BodyModelN<3>::num_points, "mass points")
       .def_property_readonly("mode_names",
-                             [](const BodyModel3& b) {
+                             [](const BodyModelN<3>& b) {
                                std::vector<std::string> names;
-                               for (const DeformationMode3& d : b.modes()) names.push_back(d.name);
+                               for (const DeformationModeN<3>& d : b.modes()) names.push_back(d.name);
                                return names;
                              })
-      .def_property_readonly("total_mass", [](const BodyModel3& b) { return b.moments().m; })
-      .def_property_readonly("masses", [](const BodyModel3& b) { return b.def().masses; }, "mass of each mass point")
-      .def_property_readonly("mass_positions", [](const BodyModel3& b) { return Rows3(b.def().mass_positions); },
+      .def_property_readonly("total_mass", [](const BodyModelN<3>& b) { return b.moments().m; })
+      .def_property_readonly("masses", [](const BodyModelN<3>& b) { return b.def().masses; }, "mass of each mass point")
+      .def_property_readonly("mass_positions", [](const BodyModelN<3>& b) { return Rows3(b.def().mass_positions); },
                              "(num_points, 3) mass points in the body frame")
-      .def_property_readonly("mesh_points", [](const BodyModel3& b) { return Rows3(b.def().mesh.points); },
+      .def_property_readonly("mesh_points", [](const BodyModelN<3>& b) { return Rows3(b.def().mesh.points); },
                              "(V, 3) the mesh's vertices in the body frame (V = 0 without a mesh)")
       .def_property_readonly(
           "mesh_triangles",
-          [](const BodyModel3& b) {
+          [](const BodyModelN<3>& b) {
             const auto& t = b.def().mesh.triangles;
             py::array_t<int> out({py::ssize_t(t.size()), py::ssize_t(3)});
             auto a = out.mutable_unchecked<2>();
@@ -60,7 +60,7 @@ void BindBodies3(py::module_& m) {
           "(T, 3) vertex indices of each triangle")
       .def(
           "mesh_vertices",
-          [](const BodyModel3& b, const py::object& q_in) {
+          [](const BodyModelN<3>& b, const py::object& q_in) {
             const int n = Group<3>::kRigidDofs + b.num_modes();
             const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
             const Eigen::Quaterniond R = ExpRotation<double>(Eigen::Vector3d(q.segment<3>(3)));
@@ -75,7 +75,7 @@ void BindBodies3(py::module_& m) {
           "moved by the FFD of its lattice")
       .def(
           "mass_points_at",
-          [](const BodyModel3& b, const py::object& q_in) {
+          [](const BodyModelN<3>& b, const py::object& q_in) {
             const int n = Group<3>::kRigidDofs + b.num_modes();
             const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
             std::vector<Eigen::Vector3d> x;
@@ -85,7 +85,7 @@ void BindBodies3(py::module_& m) {
           py::arg("q") = py::none(),
           "(N, 3) world positions of the mass points at q = [t, r, γ] (r a rotation vector), as the\n"
           "fits place them (the correspondences of wobble.fit_pose with mass_points)")
-      .def("__repr__", [](const BodyModel3& b) {
+      .def("__repr__", [](const BodyModelN<3>& b) {
         return "<BodyModel3 '" + b.name() + "': " + std::to_string(b.num_points()) + " points, " +
                std::to_string(b.num_modes()) + " modes, " + std::to_string(b.def().mesh.points.size()) + " mesh vertices>";
       });

@@ -247,7 +247,7 @@ void BindStageCosts(py::module_& m) {
 // The world of a body's dimension from the options: 2D the options' own, 3D ground_3d,
 // gravity_3d and springs_3d.
 WorldParamsN<2> WorldOf(const BodyModel&, const WorldOptions& options) { return options.params; }
-WorldParamsN<3> WorldOf(const BodyModel3&, const WorldOptions& options) { return Params3Of(options); }
+WorldParamsN<3> WorldOf(const BodyModelN<3>&, const WorldOptions& options) { return Params3Of(options); }
 
 // A rollout from the keyword arguments: the options' world, integrator and dt; the start q0, qd0
 // in World coordinates (at rest at the lattice's pose by default); the gains (the body's own by

@@ -140,7 +140,7 @@ void BindSynth(py::module_& m) {
                       "Get the one a script set up with Interpreter.synthesis_problem().")
       .def_property_readonly("body", [](const Problem& p) { return std::const_pointer_cast<BodyModel>(p.body); },
                              "the 2D body (None for a 3D problem)")
-      .def_property_readonly("body3", [](const Problem& p) { return std::const_pointer_cast<BodyModel3>(p.body3); },
+      .def_property_readonly("body3", [](const Problem& p) { return std::const_pointer_cast<BodyModelN<3>>(p.body3); },
                              "the 3D body (None for a 2D problem); q0, qd0 then [t, rotation vector, γ], [ṫ, ω, γ̇]")
       .def_readwrite("options", &Problem::world)
       .def_readwrite("q0", &Problem::q0)

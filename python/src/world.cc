@@ -230,7 +230,7 @@ void BindWorld(py::module_& m) {
       .def(py::init<WorldOptions>(), py::arg("options") = WorldOptions())
       .def("add_body", [](World& w, std::shared_ptr<BodyModel> body) { return w.AddBody(body); }, py::arg("body"),
            "Adds an FFD body (2D or 3D) at q = 0 (its lattice's pose), at rest; returns its index.")
-      .def("add_body", [](World& w, std::shared_ptr<BodyModel3> body) { return w.AddBody(body); }, py::arg("body"))
+      .def("add_body", [](World& w, std::shared_ptr<BodyModelN<3>> body) { return w.AddBody(body); }, py::arg("body"))
       .def_property_readonly("num_bodies", &World::num_bodies)
       .def_property_readonly("time", &World::time)
       .def_property_readonly("steps", &World::steps)
@@ -243,7 +243,7 @@ void BindWorld(py::module_& m) {
           "body",
           [](const World& w, int body) -> py::object {
             CheckBody(w, body);
-            if (w.dim(body) == 3) return py::cast(std::const_pointer_cast<BodyModel3>(w.shared_body<3>(body)));
+            if (w.dim(body) == 3) return py::cast(std::const_pointer_cast<BodyModelN<3>>(w.shared_body<3>(body)));
             return py::cast(std::const_pointer_cast<BodyModel>(w.shared_body<2>(body)));
           },
           py::arg("body"), "the FFD body's model (BodyModel or BodyModel3)")

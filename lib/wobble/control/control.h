@@ -48,14 +48,14 @@ template <int Dim> Eigen::VectorXd TargetsFromPose(const BodyModelN<Dim>& body, 
 // Q_r,d = −(2K_d (γ_d − γ0_d) + c_d γ̇_d) of every mode (the modes' block of the generalized
 // forces). `targets` empty means all zero.
 Eigen::VectorXd ModeControlForces(const BodyModel& body, const BodyState<2, double>& s);
-Eigen::VectorXd ModeControlForces(const BodyModel3& body, const BodyState<3, double>& s);  // 3D: γ, γ̇ of s.gamma, s.v
+Eigen::VectorXd ModeControlForces(const BodyModelN<3>& body, const BodyState<3, double>& s);  // 3D: γ, γ̇ of s.gamma, s.v
 
 struct ControlEnergy {
   double consumed = 0.0;  // Σ_d ∫ |Q_r,d γ̇_d| dt
   double work = 0.0;      // Σ_d ∫ Q_r,d γ̇_d dt (signed)
   // Adds one step of length dt at the state after the step.
   void Accumulate(const BodyModel& body, const BodyState<2, double>& s, double dt);
-  void Accumulate(const BodyModel3& body, const BodyState<3, double>& s, double dt);
+  void Accumulate(const BodyModelN<3>& body, const BodyState<3, double>& s, double dt);
 };
 
 // A pose graph (chapter 5): poses (targets for the active modes) each held for its transition

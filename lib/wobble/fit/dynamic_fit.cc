@@ -193,7 +193,7 @@ AnnealingResult AnnealPoseGraph(const BodyModelN<Dim>& body, const std::vector<R
   if constexpr (Dim == 2) {
     problem.body = std::make_shared<BodyModel>(body);
   } else {
-    problem.body3 = std::make_shared<BodyModel3>(body);
+    problem.body3 = std::make_shared<BodyModelN<3>>(body);
   }
   problem.custom_cost = [&](const control::PoseGraph& g) {
     DynamicParameters p = start;

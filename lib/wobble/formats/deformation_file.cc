@@ -506,12 +506,12 @@ std::vector<DeformationMode> ReadDeformationFile(const std::string& path, const 
   return detail::WithFile(path, [&](std::istream& in) { return ParseDeformations(in, path, lattice); });
 }
 
-std::vector<DeformationMode3> ParseDeformations3(std::istream& in, const std::string& name_for_errors,
-                                                 const Lattice3& lattice) {
+std::vector<DeformationModeN<3>> ParseDeformations3(std::istream& in, const std::string& name_for_errors,
+                                                 const LatticeN<3>& lattice) {
   return ModeFileParser<3>(name_for_errors, &lattice).Parse(in);
 }
 
-std::vector<DeformationMode3> ReadDeformationFile3(const std::string& path, const Lattice3& lattice) {
+std::vector<DeformationModeN<3>> ReadDeformationFile3(const std::string& path, const LatticeN<3>& lattice) {
   return detail::WithFile(path, [&](std::istream& in) { return ParseDeformations3(in, path, lattice); });
 }
 

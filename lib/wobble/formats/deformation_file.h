@@ -100,8 +100,8 @@ std::vector<DeformationMode> ParseDeformations(std::istream& in, const std::stri
 
 // 3D deformation files (first line 'dimension 3'; generator modes only), over the body's lattice
 // (data/table3_modes.def3 is an example).
-std::vector<DeformationMode3> ReadDeformationFile3(const std::string& path, const Lattice3& lattice);
-std::vector<DeformationMode3> ParseDeformations3(std::istream& in, const std::string& name_for_errors,
-                                                 const Lattice3& lattice);
+std::vector<DeformationModeN<3>> ReadDeformationFile3(const std::string& path, const LatticeN<3>& lattice);
+std::vector<DeformationModeN<3>> ParseDeformations3(std::istream& in, const std::string& name_for_errors,
+                                                 const LatticeN<3>& lattice);
 
 }  // namespace wobble::formats

@@ -351,11 +351,11 @@ BodyDef ReadObjectFile(const std::string& path) {
   return detail::WithFile(path, [&](std::istream& in) { return ParseObject(in, path); });
 }
 
-BodyDef3 ParseObject3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh) {
+BodyDefN<3> ParseObject3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh) {
   return ObjectParser<3>(name_for_errors, read_mesh).Parse(in);
 }
 
-BodyDef3 ReadObjectFile3(const std::string& path, const MeshReader& read_mesh) {
+BodyDefN<3> ReadObjectFile3(const std::string& path, const MeshReader& read_mesh) {
   return detail::WithFile(path, [&](std::istream& in) { return ParseObject3(in, path, read_mesh); });
 }
 

@@ -87,8 +87,8 @@ BodyDef ParseObject(std::istream& in, const std::string& name_for_errors);
 // Mesh files are read through `read_mesh` (the app passes VTK's readers,
 // pipelines/mesh_io.h); without one, a 'mesh' line is a ParseError saying so.
 using MeshReader = std::function<SurfaceMesh(const std::string& path)>;
-BodyDef3 ReadObjectFile3(const std::string& path, const MeshReader& read_mesh = nullptr);
-BodyDef3 ParseObject3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh = nullptr);
+BodyDefN<3> ReadObjectFile3(const std::string& path, const MeshReader& read_mesh = nullptr);
+BodyDefN<3> ParseObject3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh = nullptr);
 // 3 for a file whose first statement is 'dimension 3', else 2 (the readers report the rest).
 int ObjectFileDimension(const std::string& path);
 

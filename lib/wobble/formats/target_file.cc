@@ -218,11 +218,11 @@ TargetFile ReadTargetFile(const std::string& path) {
   return detail::WithFile(path, [&](std::istream& in) { return ParseTargets(in, path); });
 }
 
-TargetFile3 ParseTargets3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh) {
+TargetFileN<3> ParseTargets3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh) {
   return TargetParser<3>(name_for_errors, read_mesh).Parse(in);
 }
 
-TargetFile3 ReadTargetFile3(const std::string& path, const MeshReader& read_mesh) {
+TargetFileN<3> ReadTargetFile3(const std::string& path, const MeshReader& read_mesh) {
   return detail::WithFile(path, [&](std::istream& in) { return ParseTargets3(in, path, read_mesh); });
 }
 

@@ -29,7 +29,7 @@ BodyInfo DescribeBody(const World& world, int body) {
     info.set_ffd(world.shared_body<3>(body));
     info.coordinate_names = {"tx", "ty", "tz", "qw", "qx", "qy", "qz"};
     info.velocity_names = {"dtx", "dty", "dtz", "wx", "wy", "wz"};
-    for (const DeformationMode3& mode : world.body<3>(body).modes()) {
+    for (const DeformationModeN<3>& mode : world.body<3>(body).modes()) {
       info.coordinate_names.push_back(mode.name);
       info.velocity_names.push_back("d" + mode.name);
     }

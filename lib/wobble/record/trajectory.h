@@ -69,7 +69,7 @@ struct BodyInfo {
 
  private:
   // One model: a 2D and a 3D pointer side by side could both be set.
-  std::variant<std::shared_ptr<const BodyModel>, std::shared_ptr<const BodyModel3>> ffd_;
+  std::variant<std::shared_ptr<const BodyModel>, std::shared_ptr<const BodyModelN<3>>> ffd_;
 };
 
 class Trajectory {

@@ -51,7 +51,7 @@ BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel> body) {
   return info;
 }
 
-BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel3> body) {  // as a world describes it
+BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModelN<3>> body) {  // as a world describes it
   World w;
   w.AddBody(body);
   return DescribeBody(w, 0);

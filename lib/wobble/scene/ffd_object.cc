@@ -105,7 +105,7 @@ int FfdObject::ModeIndex(const std::string& name) const {
 
 template <class F> void FfdObject::ForEachMode(F&& f) {
   for (DeformationMode& m : part<2>().modes) f(m);
-  for (DeformationMode3& m : part<3>().modes) f(m);
+  for (DeformationModeN<3>& m : part<3>().modes) f(m);
   ResetBodies();
 }
 
@@ -173,6 +173,6 @@ template <int Dim> std::shared_ptr<const BodyModelN<Dim>> FfdObject::Body() cons
 }
 
 template std::shared_ptr<const BodyModel> FfdObject::Body<2>() const;
-template std::shared_ptr<const BodyModel3> FfdObject::Body<3>() const;
+template std::shared_ptr<const BodyModelN<3>> FfdObject::Body<3>() const;
 
 }  // namespace wobble::scene

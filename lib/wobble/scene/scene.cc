@@ -64,7 +64,7 @@ WorldOptions Scene::ObjectWorldOptions3() const {
   o.gravity_3d = Eigen::Vector3d(options_.params.gravity.x(), options_.params.gravity.y(), 0.0);
   o.springs_3d.clear();
   if (springs_.enabled && object_.dim() == 3)
-    for (const LatticeSpring3& sp : springs_.list3)
+    for (const SpringN<3>& sp : springs_.list3)
       o.springs_3d.push_back(MakeSpring(*object_.Body<3>(), sp.lattice_coords, sp.anchor, sp.stiffness, sp.damping,
                                          sp.rest_length));
   return o;

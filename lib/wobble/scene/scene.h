@@ -59,17 +59,12 @@ struct ObjectControl {
   control::HeldPoint hold;     // held in place while keyframing
 };
 
-// A 3D object's spring as a script gives it: the body's b0 and B are filled in for each run.
-struct LatticeSpring3 {
-  Eigen::Vector3d lattice_coords = Eigen::Vector3d::Constant(0.5), anchor = Eigen::Vector3d::Zero();
-  double stiffness = 0.0, damping = 0.0, rest_length = 0.0;
-};
-
 // The FFD object's springs (Fig. 4.4): each from a lattice point to a world point; `list` for a
-// 2D object, `list3` for a 3D one.
+// 2D object, `list3` for a 3D one. As a script gives them: the body's b0 and B are filled in
+// for each run.
 struct ObjectSprings {
   std::vector<Spring> list;
-  std::vector<LatticeSpring3> list3;
+  std::vector<SpringN<3>> list3;
   bool enabled = true;
 };
 

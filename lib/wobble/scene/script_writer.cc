@@ -84,7 +84,7 @@ void WriteSetup(std::ostream& s, const ScriptSetup& r) {
   for (const Spring& sp : r.springs)
     s << "spring " << Num(sp.lattice_coords.x()) << " " << Num(sp.lattice_coords.y()) << " " << Num(sp.anchor.x()) << " "
       << Num(sp.anchor.y()) << " " << Num(sp.stiffness) << " " << Num(sp.damping) << " " << Num(sp.rest_length) << "\n";
-  for (const LatticeSpring3& sp : r.springs3) {
+  for (const SpringN<3>& sp : r.springs3) {
     s << "spring";
     for (int a = 0; a < 3; ++a) s << " " << Num(sp.lattice_coords[a]);
     for (int a = 0; a < 3; ++a) s << " " << Num(sp.anchor[a]);

@@ -44,7 +44,7 @@ struct ScriptSetup {
   WorldOptions world;                   // ground, gravity, integrator, dt
   bool springs_on = true;
   std::vector<Spring> springs;
-  std::vector<LatticeSpring3> springs3;  // a 3D object's
+  std::vector<SpringN<3>> springs3;  // a 3D object's
   Eigen::VectorXd q, qd;                // world coordinates (3D: t, rotation vector, γ | ṫ, ω, γ̇)
   std::string heightfield_path;         // where world's heightfield was written (empty: none)
 };

@@ -241,7 +241,7 @@ void Keyframe(State& s, const Words& w, const Context& ctx) {
 // `spring S T U X Y Z [K C REST]` for a 3D object: the same spring with a third coordinate.
 void Spring3Command(State& s, const Words& w, const Context& ctx) {
   if (w.size() < 7 || w.size() > 10) ctx.Fail("expected 'spring S T U X Y Z [K [C [REST]]]' for a 3D object");
-  scene::LatticeSpring3 sp;
+  SpringN<3> sp;
   sp.lattice_coords = {Number(w[1], "S", ctx), Number(w[2], "T", ctx), Number(w[3], "U", ctx)};
   if (sp.lattice_coords.minCoeff() < 0 || sp.lattice_coords.maxCoeff() > 1)
     ctx.Fail("expected lattice coordinates S, T and U in [0, 1]");

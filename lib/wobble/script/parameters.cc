@@ -81,13 +81,13 @@ const std::vector<Parameter>& ParameterTable() {
        [](State& s, const Value& v) {  // also the springs made already
          s.spring_stiffness = v.NonNegative();
          for (Spring& sp : s.scene.springs().list) sp.stiffness = s.spring_stiffness;
-         for (scene::LatticeSpring3& sp : s.scene.springs().list3) sp.stiffness = s.spring_stiffness;
+         for (SpringN<3>& sp : s.scene.springs().list3) sp.stiffness = s.spring_stiffness;
        }},
       {"spdam",
        [](State& s, const Value& v) {
          s.spring_damping = v.NonNegative();
          for (Spring& sp : s.scene.springs().list) sp.damping = s.spring_damping;
-         for (scene::LatticeSpring3& sp : s.scene.springs().list3) sp.damping = s.spring_damping;
+         for (SpringN<3>& sp : s.scene.springs().list3) sp.damping = s.spring_damping;
        }},
       {"time", [](State& s, const Value& v) { s.scene.set_time(v.Number()); }},
       {"end", [](State& s, const Value& v) { s.scene.set_end(v.Number()); }},

@@ -79,7 +79,7 @@ void CenterOfMassX(const BodyModel& body, const Eigen::VectorXd& q, const Eigen:
 
 void CenterOfMassX(const World& world, double* x, double* v) {
   if (world.IsFfd(0, 2)) return CenterOfMassX(world.body<2>(0), world.q(0), world.qd(0), x, v);
-  const MassMoments3& mm = world.body<3>(0).moments();
+  const MassMomentsN<3>& mm = world.body<3>(0).moments();
   const BodyState<3, double>& s = world.state<3>(0);
   const int D = int(s.gamma().size());
   const Eigen::Vector3d l = (mm.c0 + mm.C * s.gamma()) / mm.m;

@@ -55,7 +55,7 @@ struct Problem {
   std::shared_ptr<const BodyModel> body;
   // A 3D body instead (issue 15): q0 and qd0 then follow the scripts' convention, q = (t,
   // rotation vector, γ) and q̇ = (ṫ, body ω, γ̇); the travel is measured along world x all the same.
-  std::shared_ptr<const BodyModel3> body3;
+  std::shared_ptr<const BodyModelN<3>> body3;
   WorldOptions world;
   Eigen::VectorXd q0, qd0;
   long steps = 1200;  // forward simulation per trial (thesis: 1200 steps of 0.01)
