@@ -164,7 +164,7 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
   Eigen::VectorXd q;
   std::vector<analysis::SweepSample> samples;
   if (three_d) {
-    samples = analysis::AngleSweep(formats::ReadObjectFile3(a.object), phis, squash);
+    samples = analysis::AngleSweep(formats::ReadObjectFile<3>(a.object), phis, squash);
   } else {
     def = formats::ReadObjectFile(a.object);
     // a two-mode body only to parse --q against

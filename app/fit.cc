@@ -374,9 +374,8 @@ void SetShapeOptions(const FitPoseArgs& a, const BodyModelN<3>&, fit::PoseFitOpt
   o->max_mesh_samples = a.mesh_samples;
 }
 
-formats::TargetFile ReadTargets(const std::string& path, const BodyModel&) { return formats::ReadTargetFile(path); }
-formats::TargetFileN<3> ReadTargets(const std::string& path, const BodyModelN<3>&) {
-  return formats::ReadTargetFile3(path, AppMeshReader());
+template <int Dim> formats::TargetFileN<Dim> ReadTargets(const std::string& path, const BodyModelN<Dim>&) {
+  return formats::ReadTargetFile<Dim>(path, AppMeshReader());
 }
 
 // The fitted body's drawing (2D: segments between its curve samples); a 3D body has none here.

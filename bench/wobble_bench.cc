@@ -248,7 +248,7 @@ SurfaceMesh EllipsoidInTable(int vertices) {
 }
 
 std::shared_ptr<const BodyModelN<3>> Table3(int points = 0, int mesh_vertices = 0) {
-  BodyDefN<3> def = formats::ReadObjectFile3(kDataDir + "/table3.obj");
+  BodyDefN<3> def = formats::ReadObjectFile<3>(kDataDir + "/table3.obj");
   if (mesh_vertices > 0) def.mesh = EllipsoidInTable(mesh_vertices);
   if (points > 0) {
     const double total = std::accumulate(def.masses.begin(), def.masses.end(), 0.0);
@@ -266,7 +266,7 @@ std::shared_ptr<const BodyModelN<3>> Table3(int points = 0, int mesh_vertices = 
     }
     def.masses.assign(def.mass_positions.size(), total / double(def.mass_positions.size()));
   }
-  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile3(kDataDir + "/table3_modes.def3", def.lattice);
+  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile(kDataDir + "/table3_modes.def3", def.lattice);
   return std::make_shared<const BodyModelN<3>>(def, modes);
 }
 

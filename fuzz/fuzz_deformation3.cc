@@ -1,4 +1,4 @@
-// formats::ParseDeformations3 on arbitrary bytes over the 3D table's 4 x 4 x 4 lattice: modes or
+// formats::ParseDeformations on arbitrary bytes over the 3D table's 4 x 4 x 4 lattice: modes or
 // a ParseError; the modes are then given to BodyModelN<3> and checked as `wobble condition check`
 // does.
 #include <sstream>
@@ -8,10 +8,10 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace wobble;
-  static const BodyDefN<3> table = formats::ReadObjectFile3(fuzz::kDataDir + "/table3.obj");
+  static const BodyDefN<3> table = formats::ReadObjectFile<3>(fuzz::kDataDir + "/table3.obj");
   fuzz::IgnoringExpectedErrors([&] {
     std::istringstream in(fuzz::AsText(data, size));
-    std::vector<DeformationModeN<3>> modes = formats::ParseDeformations3(in, "fuzz.def3", table.lattice);
+    std::vector<DeformationModeN<3>> modes = formats::ParseDeformations(in, "fuzz.def3", table.lattice);
     if (modes.empty()) std::abort();  // the reader promises at least one mode
     for (const DeformationModeN<3>& m : modes) {
       if (m.lattice_size != table.lattice.sizes() || int(m.displacement.size()) != table.lattice.size()) std::abort();

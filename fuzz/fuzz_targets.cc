@@ -1,4 +1,4 @@
-// formats::ParseTargets and ParseTargets3 on arbitrary bytes (each input is read as both: one
+// formats::ParseTargets<2> and <3> on arbitrary bytes (each input is read as both: one
 // of them refuses it at its first line unless it is a 'dimension' line), then what `wobble
 // fit` does with a file before fitting (app/fit.cc): CheckMassPointIndices against the 2D or
 // 3D table's mass points, the curve or surface target, and the basis of every body point
@@ -34,7 +34,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   });
   fuzz::IgnoringExpectedErrors([&] {
     std::istringstream in(fuzz::AsText(data, size));
-    const formats::TargetFileN<3> targets = formats::ParseTargets3(in, "fuzz.tgt", fuzz::StandInMesh);
+    const formats::TargetFileN<3> targets = formats::ParseTargets<3>(in, "fuzz.tgt", fuzz::StandInMesh);
     if (targets.has_correspondences() && targets.has_curve()) std::abort();
     if (targets.is_trajectory() && targets.has_curve()) std::abort();
     if (!targets.polylines.empty()) std::abort();  // no polylines in 3D

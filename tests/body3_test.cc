@@ -657,9 +657,9 @@ TEST(Body3, TableDroppedFlatLandsOnItsFourLegsAndSettles) {
 
 // One world with a 2D table, a 3D table and a Witkin & Welch box: each steps as it would alone.
 TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
-  const BodyDefN<3> def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(wobble::test_env::DataDir() + "/table3.obj");
   auto table3 = std::make_shared<const BodyModelN<3>>(
-      def, formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
+      def, formats::ReadDeformationFile(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
   WorldOptions o;
   o.ground_3d.enabled = true;
   o.integrator = Integrator::kSymplecticEuler;
@@ -689,7 +689,7 @@ TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
 }
 
 TEST(Body3InWorld, RefusesBadStatesAndPoints) {
-  const BodyDefN<3> def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(wobble::test_env::DataDir() + "/table3.obj");
   World world;
   const int b = world.AddBody(std::make_shared<const BodyModelN<3>>(def, std::vector<DeformationModeN<3>>{}));
   EXPECT_THROW(world.body<2>(b), std::invalid_argument);  // not a 2D FFD body
@@ -713,9 +713,9 @@ TEST(Body3InWorld, RefusesBadStatesAndPoints) {
 // points at the step's start configuration. On the free path and on the constrained one (a
 // nail on another body makes every body step together).
 TEST(Body3InWorld, APointForceGivesTheBodyItsImpulse) {
-  const BodyDefN<3> def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(wobble::test_env::DataDir() + "/table3.obj");
   auto table3 = std::make_shared<const BodyModelN<3>>(
-      def, formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
+      def, formats::ReadDeformationFile(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
   for (const bool constrained : {false, true}) {
     const char* path = constrained ? "constrained" : "free";
     WorldOptions o;

@@ -252,7 +252,7 @@ TEST(TrajectoryFit3, SmoothnessOnTheGroupFiltersNoise) {
 std::string TargetError(const std::string& text) {
   std::istringstream in(text);
   try {
-    formats::ParseTargets3(in, "dir/t.tgt", [](const std::string& path) {
+    formats::ParseTargets<3>(in, "dir/t.tgt", [](const std::string& path) {
       if (path != "dir/scan.ply") throw std::runtime_error("cannot read " + path);
       return testing::ChairMesh();
     });
@@ -262,23 +262,23 @@ std::string TargetError(const std::string& text) {
   return "no error";
 }
 
-TEST(TargetFileN<3>, ParsesEveryStatement) {
+TEST(TargetFile3, ParsesEveryStatement) {
   std::istringstream in("dimension 3\npoint 3 10 20 30\nsample 0.5 1 0.25 1.5 -2 7 weight 4\n");
-  const formats::TargetFileN<3> f = formats::ParseTargets3(in, "t.tgt");
+  const formats::TargetFileN<3> f = formats::ParseTargets<3>(in, "t.tgt");
   ASSERT_EQ(f.points.size(), 2u);
   EXPECT_EQ(f.points[0].position, Vec3(10, 20, 30));
   EXPECT_EQ(f.points[1].lattice_coords, Vec3(0.5, 1, 0.25));
   EXPECT_EQ(f.points[1].weight, 4.0);
   std::istringstream surface("dimension 3\nmesh scan.ply   # beside the target file\ncloud 1 2 3\n");
-  const formats::TargetFileN<3> s = formats::ParseTargets3(surface, "dir/t.tgt", [](const std::string&) { return testing::ChairMesh(); });
+  const formats::TargetFileN<3> s = formats::ParseTargets<3>(surface, "dir/t.tgt", [](const std::string&) { return testing::ChairMesh(); });
   EXPECT_EQ(s.mesh.triangles.size(), 36u);
   EXPECT_EQ(s.cloud.size(), 1u);
   EXPECT_TRUE(s.has_curve());
   std::istringstream traj("dimension 3\nframe 0\npoint 0 1 2 3\nframe 0.5\npoint 0 1 3 4\n");
-  EXPECT_EQ(formats::ParseTargets3(traj, "k.tgt").frames.size(), 2u);
+  EXPECT_EQ(formats::ParseTargets<3>(traj, "k.tgt").frames.size(), 2u);
 }
 
-TEST(TargetFileN<3>, RejectsMalformedInputWithFileAndLine) {
+TEST(TargetFile3, RejectsMalformedInputWithFileAndLine) {
   EXPECT_EQ(TargetError(""), "dir/t.tgt:0: file is empty: expected 'dimension 3' and point, sample, cloud, mesh or frame lines");
   EXPECT_EQ(TargetError("point 0 1 2 3\n"),
             "dir/t.tgt:1: the object is 3D: its target file starts with 'dimension 3' (got 'point')");
@@ -296,7 +296,7 @@ TEST(TargetFileN<3>, RejectsMalformedInputWithFileAndLine) {
             "dir/t.tgt:2: 'polyline' is for 2D target files (expected point, sample, cloud, mesh or frame)");
   EXPECT_EQ(TargetError("dimension 3\npoint 0 1 2 3\ndimension 3\n"), "dir/t.tgt:3: 'dimension' must be the first statement of the file");
   std::istringstream no_reader("dimension 3\nmesh scan.ply\n");
-  EXPECT_THROW(formats::ParseTargets3(no_reader, "t.tgt"), formats::ParseError);
+  EXPECT_THROW(formats::ParseTargets<3>(no_reader, "t.tgt"), formats::ParseError);
 }
 
 // ---- dynamic fits: through the simulation (StepBody3 with Jets) ----

@@ -496,7 +496,7 @@ TEST(ioObjectFileErrors, MissingFile) {
 
 BodyDefN<3> Object3(const std::string& text) {
   std::istringstream in(text);
-  return ParseObject3(in, "test.obj");
+  return ParseObject<3>(in, "test.obj");
 }
 void ExpectObject3Error(const std::string& text, int line, const std::string& message_part) {
   ExpectParseError([&] { Object3(text); }, "test.obj", line, message_part);
@@ -509,14 +509,14 @@ const LatticeN<3>& UnitLattice3() {
 }
 std::vector<DeformationModeN<3>> Modes3(const std::string& text) {
   std::istringstream in(text);
-  return ParseDeformations3(in, "test.def3", UnitLattice3());
+  return ParseDeformations(in, "test.def3", UnitLattice3());
 }
 void ExpectModes3Error(const std::string& text, int line, const std::string& message_part) {
   ExpectParseError([&] { Modes3(text); }, "test.def3", line, message_part);
 }
 
 TEST(io3DFiles, TheTableAndItsModes) {
-  const BodyDefN<3> def = ReadObjectFile3(kData + "/table3.obj");
+  const BodyDefN<3> def = ReadObjectFile<3>(kData + "/table3.obj");
   EXPECT_EQ(def.name, "table3");
   EXPECT_EQ(def.masses.size(), 27u);
   EXPECT_EQ(def.shapes.size(), 5u);
@@ -525,7 +525,7 @@ TEST(io3DFiles, TheTableAndItsModes) {
   EXPECT_EQ(def.lattice.axis(2), Eigen::Vector3d(0, 0, 200));
   EXPECT_EQ(ObjectFileDimension(kData + "/table3.obj"), 3);
   EXPECT_EQ(ObjectFileDimension(kData + "/table.obj"), 2);
-  const std::vector<DeformationModeN<3>> modes = ReadDeformationFile3(kData + "/table3_modes.def3", def.lattice);
+  const std::vector<DeformationModeN<3>> modes = ReadDeformationFile(kData + "/table3_modes.def3", def.lattice);
   ASSERT_EQ(modes.size(), 4u);
   EXPECT_EQ(modes[0].name, "bend");
   EXPECT_TRUE(modes[0].active);

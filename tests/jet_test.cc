@@ -104,9 +104,9 @@ Eigen::Matrix<T, Eigen::Dynamic, 1> Simulate3(const BodyModelN<3>& body, const W
 }
 
 TEST(Jet, Step3DerivativesMatchFiniteDifferences) {
-  const BodyDefN<3> def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(wobble::test_env::DataDir() + "/table3.obj");
   std::vector<DeformationModeN<3>> modes =
-      formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice);
+      formats::ReadDeformationFile(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice);
   for (DeformationModeN<3>& m : modes) m.stiffness = 4e5, m.damping = 1e4;
   const BodyModelN<3> body(def, modes);
   WorldParamsN<3> w;

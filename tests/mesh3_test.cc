@@ -160,13 +160,13 @@ SurfaceMesh BoxReader(const std::string& path) {
 
 BodyDefN<3> Parse(const std::string& text) {
   std::istringstream in(text);
-  return formats::ParseObject3(in, "dir/m.obj", BoxReader);
+  return formats::ParseObject<3>(in, "dir/m.obj", BoxReader);
 }
 
 void ExpectParseError(const std::string& text, int line, const std::string& needle, const formats::MeshReader& reader = BoxReader) {
   std::istringstream in(text);
   try {
-    formats::ParseObject3(in, "m.obj", reader);
+    formats::ParseObject<3>(in, "m.obj", reader);
     FAIL() << "no error for:\n" << text;
   } catch (const formats::ParseError& e) {
     EXPECT_EQ(e.line(), line) << e.what();
@@ -211,7 +211,7 @@ TEST(Mesh3, EveryVertexFollowsTheFfdOfItsLattice) {
   BodyDefN<3> def = Parse("dimension 3\nmesh box\nlattice fit 4 5 6 bspline margin 0.1\nsample surface 30 10\n");
   def.mesh = Join(def.mesh, Box(Vec3(10, 10, 10), Vec3(20, 45, 30)));  // more vertices, inside
   std::istringstream modes_text("dimension 3\nmode bend\n  bend x y 20\nmode twist\n  twist y 25\nmode squash\n  squash y 0.3\n");
-  const std::vector<DeformationModeN<3>> modes = formats::ParseDeformations3(modes_text, "m.def3", def.lattice);
+  const std::vector<DeformationModeN<3>> modes = formats::ParseDeformations(modes_text, "m.def3", def.lattice);
   const BodyModelN<3> body(def, modes);
   const Eigen::Vector3d gamma(0.7, -0.4, 1.3);
   std::vector<Vec3> control = def.lattice.RestPoints();

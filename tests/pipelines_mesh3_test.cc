@@ -102,7 +102,7 @@ TEST(Mesh3Io, BadMeshFilesAreNamed) {
 }
 
 TEST(Mesh3Io, ShippedObjectsLoadWithTheirMass) {
-  const BodyDefN<3> pot = ReadObject3(kData + "/pot3.obj");
+  const BodyDefN<3> pot = ReadObject<3>(kData + "/pot3.obj");
   double total = 0;
   for (double m : pot.masses) total += m;
   EXPECT_NEAR(total, 750, 1e-9);
@@ -112,7 +112,7 @@ TEST(Mesh3Io, ShippedObjectsLoadWithTheirMass) {
   const std::string obj = TempDir() + "/bad_mesh.obj";
   std::ofstream(obj) << "dimension 3\n# a missing mesh\nmesh nowhere.stl\nsample volume 10 1\n";
   try {
-    ReadObject3(obj);
+    ReadObject<3>(obj);
     FAIL();
   } catch (const formats::ParseError& e) {
     EXPECT_EQ(e.line(), 3);
@@ -122,8 +122,8 @@ TEST(Mesh3Io, ShippedObjectsLoadWithTheirMass) {
 
 // A 3D body made of the shipped pot and its modes, turned, moving and deformed.
 World MovingPot() {
-  BodyDefN<3> def = ReadObject3(kData + "/pot3.obj");
-  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile3(kData + "/pot3_modes.def3", def.lattice);
+  BodyDefN<3> def = ReadObject<3>(kData + "/pot3.obj");
+  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile(kData + "/pot3_modes.def3", def.lattice);
   WorldOptions options;
   options.ground_3d.enabled = false;
   World w(options);
@@ -146,8 +146,8 @@ Vec3 DirectWorldPoint(const World& w, const Vec3& body_point) {
 }
 
 TEST(Mesh3Sources, SpringsOfA3dBodyRunFromTheAnchorToTheHeldPoint) {
-  BodyDefN<3> def = ReadObject3(kData + "/pot3.obj");
-  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile3(kData + "/pot3_modes.def3", def.lattice);
+  BodyDefN<3> def = ReadObject<3>(kData + "/pot3.obj");
+  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile(kData + "/pot3_modes.def3", def.lattice);
   auto body = std::make_shared<const BodyModelN<3>>(std::move(def), std::move(modes));
   WorldOptions options;
   const Vec3 coords(0.5, 1.0, 0.25), anchor(0, 300, 20);
@@ -254,7 +254,7 @@ TEST(Mesh3Sources, AppliedForcesSumToTheGeneralizedForcesTranslationRows) {
   // the pot pressed into the ground plane and sliding: Σ_k f_k over the mass points (gravity
   // plus each contact's penalty and capped friction) is the translation rows of Q, since
   // J_t = 1 for every point (EvaluateForces3, the step's own forces, frozen at the contacts)
-  BodyDefN<3> def = ReadObject3(kData + "/pot3.obj");
+  BodyDefN<3> def = ReadObject<3>(kData + "/pot3.obj");
   WorldOptions options;
   options.ground_3d.enabled = true;
   World w(options);

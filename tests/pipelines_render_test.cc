@@ -259,8 +259,8 @@ TEST(RenderOverlay, EnergyIsTheSumOfTheTermsListedAndTheColourBarClearsTheText) 
 // turned above the ground plane, with its lattice and mass points, in perspective.
 TEST(RenderRegression, MeshCharacter3d) {
   REQUIRE_DISPLAY();
-  BodyDefN<3> def = ReadObject3(wobble::test_env::DataDir() + "/pot3.obj");
-  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/pot3_modes.def3", def.lattice);
+  BodyDefN<3> def = ReadObject<3>(wobble::test_env::DataDir() + "/pot3.obj");
+  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile(wobble::test_env::DataDir() + "/pot3_modes.def3", def.lattice);
   WorldOptions options;
   options.ground_3d.enabled = true;
   World world(options);

@@ -256,9 +256,9 @@ namespace {
 // axis away from the centre and with its modes free to ring.
 TEST(Synthesis3d, ATrialMeasuresTheUniformTravelOfAFreeBodysCentre) {
   const std::string data = wobble::test_env::DataDir();
-  const BodyDefN<3> def = formats::ReadObjectFile3(data + "/table3.obj");
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(data + "/table3.obj");
   synth::Problem p;
-  p.body3 = std::make_shared<const BodyModelN<3>>(def, formats::ReadDeformationFile3(data + "/table3_modes.def3", def.lattice));
+  p.body3 = std::make_shared<const BodyModelN<3>>(def, formats::ReadDeformationFile(data + "/table3_modes.def3", def.lattice));
   p.world.params.gravity_on = false;
   p.world.integrator = Integrator::kRK4;
   p.world.dt = 1e-3;

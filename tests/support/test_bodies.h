@@ -136,9 +136,9 @@ inline SurfaceMesh ChairMesh() {
 // of about 300 points, and three modes from generators (bend x by y, twist about y, squash y).
 inline BodyModelN<3> Chair3() {
   std::istringstream object("dimension 3\nmesh chair\nlattice fit 4 4 3 margin 0.05\nsample volume 300 100\n");
-  BodyDefN<3> def = formats::ParseObject3(object, "chair.obj", [](const std::string&) { return ChairMesh(); });
+  BodyDefN<3> def = formats::ParseObject<3>(object, "chair.obj", [](const std::string&) { return ChairMesh(); });
   std::istringstream text("dimension 3\nmode bend\n  bend x y 20\nmode twist\n  twist y 25\nmode squash\n  squash y 0.3\n");
-  std::vector<DeformationModeN<3>> modes = formats::ParseDeformations3(text, "chair.def3", def.lattice);
+  std::vector<DeformationModeN<3>> modes = formats::ParseDeformations(text, "chair.def3", def.lattice);
   return BodyModelN<3>(def, modes);
 }
 
