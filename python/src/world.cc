@@ -210,7 +210,7 @@ void BindWorld(py::module_& m) {
              control::HeldPoint held;
              if (!hold.is_none()) {
                held.enabled = true;
-               held.lattice_coords = AsVector(hold, 2, "hold");
+               held.lattice_coords.head<2>() = AsVector(hold, 2, "hold");
              }
              return std::make_shared<control::KeyframeController>(w, body, keys, held);
            }),

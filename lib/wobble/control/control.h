@@ -145,13 +145,10 @@ struct Keyframes {
 // the object deforms this point remains in place", e.g. a foot on the ground).
 struct HeldPoint {
   bool enabled = false;
-  Eigen::Vector2d lattice_coords = Eigen::Vector2d(0.0, 0.0);    // (s, t) of a 2D body
-  Eigen::Vector3d lattice_coords3 = Eigen::Vector3d(0.0, 0.0, 0.0);  // (s, t, u) of a 3D body
+  // (s, t, u); a 2D body reads (s, t), as constraint ends keep three rows for either dimension
+  Eigen::Vector3d lattice_coords = Eigen::Vector3d::Zero();
   // The coordinates for a body of dimension Dim.
-  template <int Dim> const Eigen::Matrix<double, Dim, 1>& coords() const {
-    if constexpr (Dim == 3) return lattice_coords3;
-    else return lattice_coords;
-  }
+  template <int Dim> Eigen::Matrix<double, Dim, 1> coords() const { return lattice_coords.head<Dim>(); }
 };
 
 // The full state (q, q̇ in body/group.h's layout) of a keyframed body at amplitudes γ, γ̇,
