@@ -427,6 +427,12 @@ void BindWorld(py::module_& m) {
       .def("set_enabled", &World::SetEnabled, py::arg("id"), py::arg("enabled"))
       .def("max_violation", &World::MaxViolation, "the largest |c| of the enabled constraints")
       .def("constraint_error", &World::ConstraintError, py::arg("id"));
+
+  // release 0.1's 3D names: the methods take either body now
+  const py::object world = m.attr("World");
+  for (const auto& [old_name, name] : {std::pair{"add_body3", "add_body"}, {"body3", "body"}, {"q3", "q"},
+                                       {"qd3", "qd"}, {"set_state3", "set_state"}})
+    BindDeprecated(world, old_name, name);
 }
 
 }  // namespace wobble::python
