@@ -227,5 +227,51 @@ TEST(TrajectoryCsv, RefusesAPoseThatIsNoIndex) {
   EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1,pose\n0,1,2,3,4,-1\n1,1,2,3,4,3\n"), "no error");
 }
 
+// A body read from a file without its model takes its mode count from its coordinates: 0 there
+// dropped the target columns from the schema and a 3D body's γ from Restore.
+TEST(BodyInfo, CountsTheModesOfABodyReadWithoutItsModel) {
+  World w;
+  w.AddBody(Table());
+  w.AddBody(std::make_shared<const BodyModelN<3>>(testing::Chair3()));
+  Eigen::VectorXd q3(9), qd3 = Eigen::VectorXd::Zero(9);
+  q3 << 1, 2, 3, 0.1, -0.2, 0.3, 0.05, -0.04, 0.03;
+  w.SetCoordinates(1, q3, qd3);
+  record::Trajectory recorded(w);
+  ASSERT_EQ(recorded.Append(w), -1);
+  std::vector<record::BodyInfo> read;  // what a caller knows of a file: names and dimension
+  for (const record::BodyInfo& b : recorded.bodies()) {
+    record::BodyInfo r;
+    r.name = b.name;
+    r.dim = b.dim;
+    r.num_q = b.num_q;
+    r.coordinate_names = b.coordinate_names;
+    r.velocity_names = b.velocity_names;
+    read.push_back(r);
+  }
+  EXPECT_EQ(read[0].num_modes(), 4);
+  EXPECT_EQ(read[1].num_modes(), 3);
+  record::Trajectory file(read);
+  EXPECT_EQ(file.Columns(), recorded.Columns());
+  file.AppendRow(std::vector<double>(recorded.Row(0), recorded.Row(0) + recorded.num_columns()));
+  World back;
+  back.AddBody(w.shared_body<2>(0));
+  back.AddBody(w.shared_body<3>(1));
+  file.Restore(0, back);
+  EXPECT_NEAR((back.coordinates(1) - q3).norm(), 0.0, 1e-12);
+
+  // an FFD body with neither model nor coordinates says so instead of "no modes"
+  record::BodyInfo unknown;
+  unknown.name = "ghost";
+  try {
+    (void)unknown.num_modes();
+    ADD_FAILURE() << "no error";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("'ghost' has neither a model nor its coordinates"), std::string::npos) << e.what();
+  }
+  record::BodyInfo linear;
+  linear.kind = BodyKind::kLinear;
+  EXPECT_EQ(linear.num_modes(), 0);
+}
+
 }  // namespace
 }  // namespace wobble
