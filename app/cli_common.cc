@@ -48,11 +48,10 @@ template <class Body> void CheckLoadedModes(const Body& body, const std::string&
 
 // The object file: a 3D one's `mesh` line is read by VTK when the CLI has the pipelines.
 template <int Dim> BodyDefN<Dim> ReadObject(const std::string& path) {
-  if constexpr (Dim == 2) return formats::ReadObjectFile(path);
 #ifdef WOBBLE_HAVE_PIPELINES
-  else return pipelines::ReadObject3(path);
+  return pipelines::ReadObject<Dim>(path);
 #else
-  else return formats::ReadObjectFile3(path);
+  return formats::ReadObjectFile<Dim>(path);
 #endif
 }
 }  // namespace
@@ -62,9 +61,7 @@ template <int Dim> std::shared_ptr<const BodyModelN<Dim>> LoadBody(const BodyFil
   std::vector<DeformationModeN<Dim>> modes;
   for (const std::string& path : files.modes) {
     if (path.empty()) throw UsageError("--modes: empty file name in the list");
-    std::vector<DeformationModeN<Dim>> more;
-    if constexpr (Dim == 2) more = formats::ReadDeformationFile(path, def.lattice);  // generators need it
-    else more = formats::ReadDeformationFile3(path, def.lattice);
+    const std::vector<DeformationModeN<Dim>> more = formats::ReadDeformationFile(path, def.lattice);
     modes.insert(modes.end(), more.begin(), more.end());
   }
   auto body = std::make_shared<const BodyModelN<Dim>>(std::move(def), std::move(modes));
@@ -72,7 +69,7 @@ template <int Dim> std::shared_ptr<const BodyModelN<Dim>> LoadBody(const BodyFil
   return body;
 }
 template std::shared_ptr<const BodyModel> LoadBody<2>(const BodyFiles&, bool);
-template std::shared_ptr<const BodyModel3> LoadBody<3>(const BodyFiles&, bool);
+template std::shared_ptr<const BodyModelN<3>> LoadBody<3>(const BodyFiles&, bool);
 
 void CheckOutputFolder(const std::string& folder) {
   try {
@@ -283,13 +280,13 @@ Eigen::VectorXd ParseVelocities(const std::string& text, const std::string& what
 }
 
 template std::string CoordinateNames(const BodyModel&);
-template std::string CoordinateNames(const BodyModel3&);
+template std::string CoordinateNames(const BodyModelN<3>&);
 template std::string VelocityNames(const BodyModel&);
-template std::string VelocityNames(const BodyModel3&);
+template std::string VelocityNames(const BodyModelN<3>&);
 template Eigen::VectorXd ParseCoordinates(const std::string&, const std::string&, const BodyModel&);
-template Eigen::VectorXd ParseCoordinates(const std::string&, const std::string&, const BodyModel3&);
+template Eigen::VectorXd ParseCoordinates(const std::string&, const std::string&, const BodyModelN<3>&);
 template Eigen::VectorXd ParseVelocities(const std::string&, const std::string&, const BodyModel&);
-template Eigen::VectorXd ParseVelocities(const std::string&, const std::string&, const BodyModel3&);
+template Eigen::VectorXd ParseVelocities(const std::string&, const std::string&, const BodyModelN<3>&);
 
 Eigen::VectorXd ParseNumbers(const std::string& text, const std::string& what, int expected_size,
                              const std::string& names, const std::string& body_name) {

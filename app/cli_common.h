@@ -102,7 +102,7 @@ struct StartingWorld {
   int dim() const { return body<3>() ? 3 : 2; }
   // f(body) on the body of either dimension.
   template <class F> decltype(auto) OnBody(F&& f) const { return dim() == 3 ? f(*body<3>()) : f(*body<2>()); }
-  std::tuple<std::shared_ptr<const BodyModel>, std::shared_ptr<const BodyModel3>> bodies;  // one is set
+  std::tuple<std::shared_ptr<const BodyModel>, std::shared_ptr<const BodyModelN<3>>> bodies;  // one is set
   Eigen::VectorXd q0, qd0;
   WorldOptions options;
   World MakeWorld() const;  // the body alone in a world, at (q0, q̇0)

@@ -164,7 +164,7 @@ int RunConditionSweep(const ConditionSweepArgs& a) {
   Eigen::VectorXd q;
   std::vector<analysis::SweepSample> samples;
   if (three_d) {
-    samples = analysis::AngleSweep(formats::ReadObjectFile3(a.object), phis, squash);
+    samples = analysis::AngleSweep(formats::ReadObjectFile<3>(a.object), phis, squash);
   } else {
     def = formats::ReadObjectFile(a.object);
     // a two-mode body only to parse --q against
@@ -307,7 +307,7 @@ int RunConditionCheck(const ConditionCheckArgs& a) {
   options.warn_visibility = a.warn_visibility;
   if (formats::ObjectFileDimension(a.files.object) == 3) {
     if (!a.q.empty()) throw UsageError("--q: a 3D body is checked at rest (its orientation is no coordinate)");
-    const std::shared_ptr<const BodyModel3> body = LoadBody<3>(a.files, /*check_modes=*/false);
+    const std::shared_ptr<const BodyModelN<3>> body = LoadBody<3>(a.files, /*check_modes=*/false);
     return PrintModeSetReport(analysis::CheckModeSet(*body, options), body->name(), a);
   }
   const std::shared_ptr<const BodyModel> body = LoadBody<2>(a.files, /*check_modes=*/false);

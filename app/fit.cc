@@ -368,15 +368,14 @@ void SetShapeOptions(const FitPoseArgs& a, const BodyModel&, fit::PoseFitOptions
   o->max_rounds = a.max_rounds;
   o->joint_closest_points = !a.alternate;
 }
-void SetShapeOptions(const FitPoseArgs& a, const BodyModel3&, fit::PoseFitOptions* o) {
+void SetShapeOptions(const FitPoseArgs& a, const BodyModelN<3>&, fit::PoseFitOptions* o) {
   if (a.alternate) throw UsageError("--alternate: 3D surface fits find the nearest points jointly (2D curves only)");
   if (a.mesh_samples < 0) throw UsageError("--mesh-samples must be >= 0");
   o->max_mesh_samples = a.mesh_samples;
 }
 
-formats::TargetFile ReadTargets(const std::string& path, const BodyModel&) { return formats::ReadTargetFile(path); }
-formats::TargetFile3 ReadTargets(const std::string& path, const BodyModel3&) {
-  return formats::ReadTargetFile3(path, AppMeshReader());
+template <int Dim> formats::TargetFileN<Dim> ReadTargets(const std::string& path, const BodyModelN<Dim>&) {
+  return formats::ReadTargetFile<Dim>(path, AppMeshReader());
 }
 
 // The fitted body's drawing (2D: segments between its curve samples); a 3D body has none here.
@@ -387,7 +386,7 @@ void AddBodyDrawing(const BodyModel& body, const fit::PoseFitOptions& o, const E
   for (const fit::PointBasis& p : drawing.points) drawn.push_back(fit::PointPosition(p, q));
   for (const auto& [a, b] : drawing.segments) (*overlay)["body"].push_back({Point(drawn[size_t(a)]), Point(drawn[size_t(b)])});
 }
-void AddBodyDrawing(const BodyModel3&, const fit::PoseFitOptions&, const Eigen::VectorXd&, json*) {}
+void AddBodyDrawing(const BodyModelN<3>&, const fit::PoseFitOptions&, const Eigen::VectorXd&, json*) {}
 
 // 2D: the body's outline fitted to the file's polylines and cloud; the overlay joins every
 // drawn sample to the nearest target point.
@@ -425,7 +424,7 @@ ShapeFit FitShape(const FitPoseArgs& a, const BodyModel& body, const formats::Ta
 }
 
 // 3D: the body's samples fitted to the file's mesh and cloud (the overlay's targets: the cloud).
-ShapeFit FitShape(const FitPoseArgs&, const BodyModel3& body, const formats::TargetFile3& targets,
+ShapeFit FitShape(const FitPoseArgs&, const BodyModelN<3>& body, const formats::TargetFileN<3>& targets,
                   const fit::PoseFitOptions& o, json* overlay) {
   ShapeFit s;
   s.kind = "surface";
@@ -560,7 +559,7 @@ void ReadStates(const std::string& path, const std::shared_ptr<const BodyModel>&
   const record::Trajectory sim = record::ReadTrajectoryCsv(path, {record::DescribeFfdBody(body)}).trajectory;
   for (int k = 0; k < sim.size(); ++k) t->push_back(sim.time(k)), q->push_back(sim.q(k, 0));
 }
-void ReadStates(const std::string& path, const std::shared_ptr<const BodyModel3>& body, std::vector<double>* t,
+void ReadStates(const std::string& path, const std::shared_ptr<const BodyModelN<3>>& body, std::vector<double>* t,
                 std::vector<Eigen::VectorXd>* q) {
   const record::Trajectory sim = record::ReadTrajectoryCsv(path, {record::DescribeFfdBody(body)}).trajectory;
   for (int k = 0; k < sim.size(); ++k) {

@@ -54,9 +54,9 @@ template <> struct SpacetimeObject<2> {
   static constexpr const char* kReach = "--reach takes \"X Y T\" for a 2D object";
 };
 template <> struct SpacetimeObject<3> {
-  static const BodyModel3& Body(const StartingWorld& start) { return *start.body<3>(); }
-  static Eigen::Vector3d CentreOfMass(const BodyModel3& body, const BodyState<3, double>& s) {
-    const MassMoments3& mm = body.moments();
+  static const BodyModelN<3>& Body(const StartingWorld& start) { return *start.body<3>(); }
+  static Eigen::Vector3d CentreOfMass(const BodyModelN<3>& body, const BodyState<3, double>& s) {
+    const MassMomentsN<3>& mm = body.moments();
     return s.translation() + s.orientation() * ((mm.c0 + mm.C * s.gamma()) / mm.m);
   }
   static constexpr const char* kReach = "--reach takes \"X Y Z T\" for a 3D object";

@@ -76,8 +76,8 @@ void BM_Gradient(benchmark::State& state) {
   state.counters["states_held"] = held;
 }
 
-const BodyModel3& Chair() {
-  static const BodyModel3 body = testing::Chair3();
+const BodyModelN<3>& Chair() {
+  static const BodyModelN<3> body = testing::Chair3();
   return body;
 }
 

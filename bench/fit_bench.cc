@@ -264,7 +264,7 @@ Eigen::VectorXd KnownQChair() {
 
 // Pose with correspondences: every 10th mass point (~30). Baseline: the 2D table's 11-point fit.
 void BM_PoseFit3_Chair(benchmark::State& state) {
-  const BodyModel3 body = testing::Chair3();
+  const BodyModelN<3> body = testing::Chair3();
   std::vector<fit::CorrespondenceN<3>> targets;
   for (int k = 0; k < body.num_points(); k += 10) {
     fit::CorrespondenceN<3> t;
@@ -282,7 +282,7 @@ BENCHMARK(BM_PoseFit3_Chair)->Unit(benchmark::kMicrosecond);
 // Surface without correspondences: the chair's mesh deformed and placed at KnownQChair (36
 // triangles); samples: the body mesh's 24 vertices; 24 axis matchings ranked, 4 solved.
 void BM_SurfaceFit3_Chair(benchmark::State& state) {
-  const BodyModel3 body = testing::Chair3();
+  const BodyModelN<3> body = testing::Chair3();
   SurfaceMesh target_mesh = body.def().mesh;
   const Eigen::VectorXd q = KnownQChair();
   for (size_t v = 0; v < target_mesh.points.size(); ++v)
@@ -298,10 +298,10 @@ BENCHMARK(BM_SurfaceFit3_Chair)->Unit(benchmark::kMillisecond);
 // Dynamic fit of q0, q̇0, K, c: 100 steps of the chair tumbling in the air (51 frames of ~30
 // points), from K×1.4 and c×0.6. Baseline: BM_DynamicFit_100Steps (the 2D table).
 void BM_DynamicFit3_100Steps(benchmark::State& state) {
-  BodyModel3 passive = testing::Chair3();
-  std::vector<DeformationMode3> modes = passive.modes();
-  for (DeformationMode3& m : modes) m.stiffness = 3e5, m.damping = 2e3;
-  const BodyModel3 body(passive.def(), modes);
+  BodyModelN<3> passive = testing::Chair3();
+  std::vector<DeformationModeN<3>> modes = passive.modes();
+  for (DeformationModeN<3>& m : modes) m.stiffness = 3e5, m.damping = 2e3;
+  const BodyModelN<3> body(passive.def(), modes);
   fit::DynamicFitOptionsN<3> o;
   o.dt = 0.005;
   fit::DynamicParameters truth;

@@ -247,8 +247,8 @@ SurfaceMesh EllipsoidInTable(int vertices) {
   return m;
 }
 
-std::shared_ptr<const BodyModel3> Table3(int points = 0, int mesh_vertices = 0) {
-  BodyDef3 def = formats::ReadObjectFile3(kDataDir + "/table3.obj");
+std::shared_ptr<const BodyModelN<3>> Table3(int points = 0, int mesh_vertices = 0) {
+  BodyDefN<3> def = formats::ReadObjectFile<3>(kDataDir + "/table3.obj");
   if (mesh_vertices > 0) def.mesh = EllipsoidInTable(mesh_vertices);
   if (points > 0) {
     const double total = std::accumulate(def.masses.begin(), def.masses.end(), 0.0);
@@ -266,11 +266,11 @@ std::shared_ptr<const BodyModel3> Table3(int points = 0, int mesh_vertices = 0) 
     }
     def.masses.assign(def.mass_positions.size(), total / double(def.mass_positions.size()));
   }
-  std::vector<DeformationMode3> modes = formats::ReadDeformationFile3(kDataDir + "/table3_modes.def3", def.lattice);
-  return std::make_shared<const BodyModel3>(def, modes);
+  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile(kDataDir + "/table3_modes.def3", def.lattice);
+  return std::make_shared<const BodyModelN<3>>(def, modes);
 }
 
-void TimeSteps3(benchmark::State& state, const BodyModel3& body, const WorldParams& w, double dt,
+void TimeSteps3(benchmark::State& state, const BodyModelN<3>& body, const WorldParams& w, double dt,
                 BodyState<3, double>* s, Integrator integrator = Integrator::kThesis) {
   for (auto _ : state) {
     const StepStatus st = StepBody(body, w, 0, integrator, dt, s);
@@ -285,7 +285,7 @@ void TimeSteps3(benchmark::State& state, const BodyModel3& body, const WorldPara
 
 // Resting on its four feet after a drop, as BM_TableRestingOnGround does for the 2D table.
 void BM_Table3RestingOnGround(benchmark::State& state) {
-  const std::shared_ptr<const BodyModel3> body = Table3();
+  const std::shared_ptr<const BodyModelN<3>> body = Table3();
   WorldParams w;
   w.ground_plane.enabled = true;
   BodyState<3, double> s = RestState<3, double>(*body);
@@ -302,7 +302,7 @@ BENCHMARK(BM_Table3RestingOnGround);
 // Falling freely, far above a ground (the convex-hull test only) or with none: 27 points (the
 // file) against 20 and 1,000 redistributed points, and 1,000 with a 10,000-vertex mesh.
 void BM_Table3OutOfContact(benchmark::State& state) {
-  const std::shared_ptr<const BodyModel3> body = Table3(int(state.range(0)), int(state.range(2)));
+  const std::shared_ptr<const BodyModelN<3>> body = Table3(int(state.range(0)), int(state.range(2)));
   state.counters["mesh_vertices"] = double(body->def().mesh.points.size());
   WorldParams w;
   w.ground_plane.enabled = state.range(1) != 0;
@@ -317,7 +317,7 @@ BENCHMARK(BM_Table3OutOfContact)
 
 // Resting with 1,000 points: the point groups keep the scan near the feet.
 void BM_Table3kRestingOnGround(benchmark::State& state) {
-  const std::shared_ptr<const BodyModel3> body = Table3(1000);
+  const std::shared_ptr<const BodyModelN<3>> body = Table3(1000);
   WorldParams w;
   w.ground_plane.enabled = true;
   BodyState<3, double> s = RestState<3, double>(*body);
@@ -334,7 +334,7 @@ BENCHMARK(BM_Table3kRestingOnGround);
 // The variational integrator (variational.h) on the 3D table: tumbling and vibrating with no
 // ground (ground 0), and resting on its feet after a drop (ground 1).
 void BM_Table3Variational(benchmark::State& state) {
-  const std::shared_ptr<const BodyModel3> body = Table3();
+  const std::shared_ptr<const BodyModelN<3>> body = Table3();
   WorldParams w;
   BodyState<3, double> s = RestState<3, double>(*body);
   if (state.range(0) != 0) {
@@ -367,7 +367,7 @@ void BM_WorldTableResting(benchmark::State& state) {
     world.AddBody(Table11());
     world.SetState(0, TableQ(*Table11(), 10.0), Eigen::VectorXd::Zero(Table11()->num_q()));
   } else {
-    const std::shared_ptr<const BodyModel3> body = Table3();
+    const std::shared_ptr<const BodyModelN<3>> body = Table3();
     world.AddBody(body);
     Eigen::VectorXd coordinates = Eigen::VectorXd::Zero(body->num_q());  // t, rotation vector, γ
     coordinates[1] = 10.0;

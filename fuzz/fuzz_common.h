@@ -42,11 +42,11 @@ inline std::shared_ptr<const BodyModel> TableBody() {
 }
 
 // The 3D table (data/table3.obj, mass points only) with its four modes, read once per process.
-inline std::shared_ptr<const BodyModel3> Table3Body() {
-  static const std::shared_ptr<const BodyModel3> body = [] {
-    BodyDef3 def = formats::ReadObjectFile3(kDataDir + "/table3.obj");
-    auto modes = formats::ReadDeformationFile3(kDataDir + "/table3_modes.def3", def.lattice);
-    return std::make_shared<const BodyModel3>(std::move(def), std::move(modes));
+inline std::shared_ptr<const BodyModelN<3>> Table3Body() {
+  static const std::shared_ptr<const BodyModelN<3>> body = [] {
+    BodyDefN<3> def = formats::ReadObjectFile<3>(kDataDir + "/table3.obj");
+    auto modes = formats::ReadDeformationFile(kDataDir + "/table3_modes.def3", def.lattice);
+    return std::make_shared<const BodyModelN<3>>(std::move(def), std::move(modes));
   }();
   return body;
 }

@@ -1,4 +1,4 @@
-// formats::ParseTargets and ParseTargets3 on arbitrary bytes (each input is read as both: one
+// formats::ParseTargets<2> and <3> on arbitrary bytes (each input is read as both: one
 // of them refuses it at its first line unless it is a 'dimension' line), then what `wobble
 // fit` does with a file before fitting (app/fit.cc): CheckMassPointIndices against the 2D or
 // 3D table's mass points, the curve or surface target, and the basis of every body point
@@ -34,13 +34,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   });
   fuzz::IgnoringExpectedErrors([&] {
     std::istringstream in(fuzz::AsText(data, size));
-    const formats::TargetFile3 targets = formats::ParseTargets3(in, "fuzz.tgt", fuzz::StandInMesh);
+    const formats::TargetFileN<3> targets = formats::ParseTargets<3>(in, "fuzz.tgt", fuzz::StandInMesh);
     if (targets.has_correspondences() && targets.has_curve()) std::abort();
     if (targets.is_trajectory() && targets.has_curve()) std::abort();
     if (!targets.polylines.empty()) std::abort();  // no polylines in 3D
     for (size_t f = 1; f < targets.frames.size(); ++f)
       if (!(targets.frames[f].time > targets.frames[f - 1].time)) std::abort();
-    const BodyModel3& table = *fuzz::Table3Body();
+    const BodyModelN<3>& table = *fuzz::Table3Body();
     formats::CheckMassPointIndices(targets, table.num_points());
     fit::SurfaceTarget surface;
     if (!targets.mesh.empty()) surface.AddMesh(targets.mesh);
@@ -49,13 +49,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       for (int i : t)
         if (i < 0 || i >= int(surface.points.size())) std::abort();
     const Eigen::VectorXd q = Eigen::VectorXd::Zero(table.num_q());
-    auto basis = [&](const formats::PointTarget3& t) {
+    auto basis = [&](const formats::PointTargetN<3>& t) {
       const fit::PointBasisN<3> b = fit::BasisOf(table, t.mass_point, t.lattice_coords);
       if (!b.b0.allFinite() || !b.B.allFinite() || !fit::PointPosition(b, q).allFinite()) std::abort();
     };
-    for (const formats::PointTarget3& t : targets.points) basis(t);
-    for (const formats::TargetFrame3& f : targets.frames)
-      for (const formats::PointTarget3& t : f.points) basis(t);
+    for (const formats::PointTargetN<3>& t : targets.points) basis(t);
+    for (const formats::TargetFrameN<3>& f : targets.frames)
+      for (const formats::PointTargetN<3>& t : f.points) basis(t);
   });
   return 0;
 }

@@ -57,7 +57,7 @@ std::vector<double> ConditionNumbers(const record::Trajectory& run, int body, in
       cond.push_back(analysis::MassMatrixCondition(*ffd, q).cond);  // +∞ when M is singular
     } else {
       // a 3D row: tx ty tz qw qx qy qz γ..
-      const BodyModel3& model = *info.ffd<3>();
+      const BodyModelN<3>& model = *info.ffd<3>();
       BodyState<3, double> s = RestState<3, double>(model);
       s.translation() = q.head<3>();
       Group<3>::SetOrientation(Eigen::Quaterniond(q[3], q[4], q[5], q[6]).normalized(), &s.q);

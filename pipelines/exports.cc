@@ -157,8 +157,8 @@ std::vector<ExrChannel> DisplacementImage(const World& world, int body_index, in
 
 vtkSmartPointer<vtkImageData> DisplacementVolume(const World& world, int body_index, int nx, int ny, int nz) {
   if (nx <= 0 || ny <= 0 || nz <= 0) throw std::invalid_argument("displacement volume size must be positive");
-  const BodyModel3& body = world.body<3>(body_index);
-  const Lattice3& lat = body.lattice();
+  const BodyModelN<3>& body = world.body<3>(body_index);
+  const LatticeN<3>& lat = body.lattice();
   const BodyState<3, double>& s = world.state<3>(body_index);
   // deformed control points in the world, W_c = t + R (L_c + Σ γ_d d^d_c): the weights are a
   // partition of unity, so x(s, t, u) = Σ_c W_c B_c(s, t, u) is Eq. 4.2 with the rigid motion

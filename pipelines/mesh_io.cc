@@ -180,7 +180,11 @@ void WriteSurfaceMesh(const std::string& path, const SurfaceMesh& mesh) {
   });
 }
 
-BodyDef3 ReadObject3(const std::string& path) { return formats::ReadObjectFile3(path, ReadSurfaceMesh); }
+template <int Dim> BodyDefN<Dim> ReadObject(const std::string& path) {
+  return formats::ReadObjectFile<Dim>(path, ReadSurfaceMesh);
+}
+template BodyDefN<2> ReadObject<2>(const std::string&);
+template BodyDefN<3> ReadObject<3>(const std::string&);
 
 SurfaceMesh MakeTableMesh() {
   auto parts = Ptr<vtkAppendPolyData>::New();

@@ -21,8 +21,8 @@ SurfaceMesh ReadSurfaceMesh(const std::string& path);
 // then rename); std::runtime_error with the reason on failure.
 void WriteSurfaceMesh(const std::string& path, const SurfaceMesh& mesh);
 
-// A 3D object file with its mesh: formats::ReadObjectFile3 with the reader above.
-BodyDef3 ReadObject3(const std::string& path);
+// An object file with its mesh: formats::ReadObjectFile<Dim> with the reader above.
+template <int Dim> BodyDefN<Dim> ReadObject(const std::string& path);
 
 // The meshes wobble makes itself (`wobble mesh`), in the body frame of their object files:
 // - the table of data/table3.obj built from five boxes (vtkCubeSource): a 300 x 200 top,

@@ -148,7 +148,7 @@ std::vector<DispTarget> DispTargets(const World& world, const RenderOutputs& out
   for (int b : ffd) {
     const std::string stem = ffd.size() == 1 ? "disp" : "disp_" + world.body_name(b);
     if (world.dim(b) == 3) {  // disp_volume voxels along the longest axis
-      const Lattice3& lat = world.body<3>(b).lattice();
+      const LatticeN<3>& lat = world.body<3>(b).lattice();
       double longest = 0;
       for (const auto& axis : lat.axes()) longest = std::max(longest, axis.norm());
       int n[3];

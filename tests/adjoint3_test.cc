@@ -27,16 +27,16 @@ constexpr int kModes = 3;                  // the chair's bend, twist and squash
 constexpr int kNz = 12 + 2 * kModes;       // tangent coordinates of a state
 constexpr int kPoint = 7;                  // the cost follows this mass point
 
-BodyModel3 PassiveChair() {
-  const BodyModel3 chair = testing::Chair3();
-  std::vector<DeformationMode3> modes = chair.modes();
-  for (DeformationMode3& m : modes) m.stiffness = m.damping = 0.0;
-  return BodyModel3(chair.def(), modes);
+BodyModelN<3> PassiveChair() {
+  const BodyModelN<3> chair = testing::Chair3();
+  std::vector<DeformationModeN<3>> modes = chair.modes();
+  for (DeformationModeN<3>& m : modes) m.stiffness = m.damping = 0.0;
+  return BodyModelN<3>(chair.def(), modes);
 }
 
 // ℓ_n = ½ w |x_k − y(n)|² + ½ ρ |v|² + ½ σ |γ|²: a point chasing a moving target, a velocity
 // penalty and a shape penalty. Templated so that the reference can run it on Jets.
-template <class T> T Stage(const BodyModel3& body, int n, const BodyState<3, T>& s) {
+template <class T> T Stage(const BodyModelN<3>& body, int n, const BodyState<3, T>& s) {
   const Vec3<T> l = LocalPosition<T>(body.rest_local(kPoint), body.mode_matrix(kPoint), s.q);
   const Vec3<T> x = s.translation() + s.orientation().toRotationMatrix() * l;
   const Eigen::Vector3d y(20.0 + 2.0 * n, 60.0 - 0.5 * n, 10.0 + 1.0 * n);
@@ -47,7 +47,7 @@ template <class T> T Stage(const BodyModel3& body, int n, const BodyState<3, T>&
 }
 
 // The stage cost's gradient in the tangent coordinates (δt, ε, δγ, δv) of adjoint.h, by Jets.
-fit::StageCostN<3> StageOf(const BodyModel3& body) {
+fit::StageCostN<3> StageOf(const BodyModelN<3>& body) {
   return [&body](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     using J = ceres::Jet<double, kNz>;
     BodyState<3, J> sj;
@@ -98,7 +98,7 @@ Eigen::VectorXd Flatten(const fit::RolloutGradient& g) {
 // The cost with parameters p + ε v (Flatten's order; the start moved along its tangent
 // coordinates), ε a Jet of one dimension (or double, v unused).
 template <class T>
-T ReferenceCost(const BodyModel3& passive, const fit::ControlledRolloutN<3>& r, const Eigen::VectorXd& p,
+T ReferenceCost(const BodyModelN<3>& passive, const fit::ControlledRolloutN<3>& r, const Eigen::VectorXd& p,
                 const Eigen::VectorXd& v) {
   auto param = [&](int i) {
     T x(p[i]);
@@ -134,8 +134,8 @@ T ReferenceCost(const BodyModel3& passive, const fit::ControlledRolloutN<3>& r, 
 }
 
 struct Case {
-  BodyModel3 body;     // the chair with its own mode gains, which the rollout's replace
-  BodyModel3 passive;  // the same with none: the reference's
+  BodyModelN<3> body;     // the chair with its own mode gains, which the rollout's replace
+  BodyModelN<3> passive;  // the same with none: the reference's
   fit::ControlledRolloutN<3> rollout;
 };
 

@@ -37,12 +37,12 @@ std::string Sci(double x) {
 }
 
 // A random 3D body: skew lattice of any size and basis, random points, masses and modes.
-BodyModel3 RandomBody3(std::mt19937& rng, std::array<int, 3> sizes, BasisKind basis, int num_modes, int num_points,
+BodyModelN<3> RandomBody3(std::mt19937& rng, std::array<int, 3> sizes, BasisKind basis, int num_modes, int num_points,
                        double stiffness = 0.0) {
   std::uniform_real_distribution<double> u(0.0, 1.0), disp(-30.0, 30.0), mass(1.0, 80.0);
-  BodyDef3 def;
+  BodyDefN<3> def;
   def.name = "random3";
-  def.lattice = Lattice3(Vector3d(-20, 5, 3), {Vector3d(250, 20, -10), Vector3d(-30, 120, 15), Vector3d(10, -5, 90)},
+  def.lattice = LatticeN<3>(Vector3d(-20, 5, 3), {Vector3d(250, 20, -10), Vector3d(-30, 120, 15), Vector3d(10, -5, 90)},
                          sizes, basis);
   for (int k = 0; k < num_points; ++k) {
     Vector3d p = def.lattice.origin();
@@ -50,17 +50,17 @@ BodyModel3 RandomBody3(std::mt19937& rng, std::array<int, 3> sizes, BasisKind ba
     def.mass_positions.push_back(p);
     def.masses.push_back(mass(rng));
   }
-  std::vector<DeformationMode3> modes(num_modes);
+  std::vector<DeformationModeN<3>> modes(num_modes);
   for (int d = 0; d < num_modes; ++d) {
     modes[d].name = "m" + std::to_string(d);
     modes[d].lattice_size = sizes;
     modes[d].stiffness = stiffness;
     for (int c = 0; c < def.lattice.size(); ++c) modes[d].displacement.push_back({disp(rng), disp(rng), disp(rng)});
   }
-  return BodyModel3(def, modes);
+  return BodyModelN<3>(def, modes);
 }
 
-BodyState<3, double> RandomState3(std::mt19937& rng, const BodyModel3& body, double speed = 1.0) {
+BodyState<3, double> RandomState3(std::mt19937& rng, const BodyModelN<3>& body, double speed = 1.0) {
   std::normal_distribution<double> n(0.0, 1.0);
   BodyState<3, double> s = RestState<3, double>(body);
   s.translation() = Vector3d(n(rng), n(rng), n(rng)) * 50.0;
@@ -71,13 +71,13 @@ BodyState<3, double> RandomState3(std::mt19937& rng, const BodyModel3& body, dou
 }
 
 // Per-point quantities computed from the lattice weights and the mode displacements directly
-// (not from BodyModel3's precomputed b0_k, B_k or its moments).
+// (not from BodyModelN<3>'s precomputed b0_k, B_k or its moments).
 struct PointKinematics {
   Vector3d l;
   Eigen::Matrix<double, 3, Eigen::Dynamic> B;
 };
-PointKinematics DirectPoint(const BodyModel3& body, int k, const VecD<double>& gamma) {
-  const Lattice3& lat = body.lattice();
+PointKinematics DirectPoint(const BodyModelN<3>& body, int k, const VecD<double>& gamma) {
+  const LatticeN<3>& lat = body.lattice();
   const std::vector<double> w = lat.Weights(lat.LocalCoords(body.def().mass_positions[k]));
   PointKinematics p{Vector3d::Zero(), Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, body.num_modes())};
   const std::vector<Vector3d> rest = lat.RestPoints();
@@ -91,7 +91,7 @@ PointKinematics DirectPoint(const BodyModel3& body, int k, const VecD<double>& g
   return p;
 }
 
-// J_k = [1 | −R[l]× | R B] of kinematics3.h, from its definition ẋ = ṫ + R(ω × l + B γ̇).
+// J_k = [1 | −R[l]× | R B] of spatial_inertia.h, from its definition ẋ = ṫ + R(ω × l + B γ̇).
 Eigen::MatrixXd Jacobian(const Matrix3d& R, const PointKinematics& p) {
   Eigen::MatrixXd J(3, Group<3>::kRigidDofs + p.B.cols());
   J.block<3, 3>(0, 0).setIdentity();
@@ -109,7 +109,7 @@ TEST(Body3, FastPathMatchesSumsOverThePoints) {
   };
   for (const Case& c : {Case{{2, 2, 2}, BasisKind::kBernstein, 0}, Case{{4, 4, 4}, BasisKind::kBernstein, 3},
                         Case{{3, 5, 2}, BasisKind::kBernstein, 5}, Case{{5, 4, 6}, BasisKind::kCubicBSpline, 4}}) {
-    const BodyModel3 body = RandomBody3(rng, c.sizes, c.basis, c.modes, 25);
+    const BodyModelN<3> body = RandomBody3(rng, c.sizes, c.basis, c.modes, 25);
     for (int trial = 0; trial < 5; ++trial) {
       const BodyState<3, double> s = RandomState3(rng, body);
       const Matrix3d R = s.orientation().toRotationMatrix();
@@ -170,7 +170,7 @@ TEST(Body3, MassSolveAboutTheCentreMatchesTheDirectSolve) {
   for (const Case& c : {Case{{2, 2, 2}, BasisKind::kBernstein, 0}, Case{{4, 4, 4}, BasisKind::kBernstein, 3},
                         Case{{3, 5, 2}, BasisKind::kBernstein, 5}, Case{{5, 4, 6}, BasisKind::kCubicBSpline, 4},
                         Case{{4, 4, 4}, BasisKind::kBernstein, 8}}) {
-    const BodyModel3 body = RandomBody3(rng, c.sizes, c.basis, c.modes, 30);
+    const BodyModelN<3> body = RandomBody3(rng, c.sizes, c.basis, c.modes, 30);
     for (int trial = 0; trial < 5; ++trial) {
       const BodyState<3, double> s = RandomState3(rng, body);
       const Matrix3d R = s.orientation().toRotationMatrix();
@@ -212,10 +212,10 @@ TEST(Body3, MassSolveAboutTheCentreMatchesTheDirectSolve) {
 // no mass relative to the centre: M is singular and the solve says so (kSingularMass).
 TEST(Body3, MassSolveRefusesAModeThatIsARigidTranslation) {
   std::mt19937 rng(43);
-  BodyModel3 random = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20);
-  std::vector<DeformationMode3> modes = random.modes();
+  BodyModelN<3> random = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20);
+  std::vector<DeformationModeN<3>> modes = random.modes();
   for (auto& d : modes[1].displacement) d = {4.0, -2.0, 1.0};
-  const BodyModel3 body(random.def(), modes);
+  const BodyModelN<3> body(random.def(), modes);
   const BodyState<3, double> s = RandomState3(rng, body);
   VecQ<double> qdd, Q = VecQ<double>::Zero(body.num_q());
   double cond_estimate = 0.0;
@@ -227,7 +227,7 @@ TEST(Body3, MassSolveRefusesAModeThatIsARigidTranslation) {
 // (t + εṫ, R exp(εω̂), γ + εγ̇) at fixed v.
 TEST(Body3, PointAccelerationFormulaMatchesFiniteDifference) {
   std::mt19937 rng(11);
-  const BodyModel3 body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 3, 4);
+  const BodyModelN<3> body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 3, 4);
   const BodyState<3, double> s = RandomState3(rng, body);
   auto velocity = [&](double eps, int k) {
     BodyState<3, double> moved = s;
@@ -249,7 +249,7 @@ TEST(Body3, PointAccelerationFormulaMatchesFiniteDifference) {
 // ∂T/∂g of the variational integrator against central differences of T = ½ Σ m |ẋ|².
 TEST(Body3, KineticGradientMatchesFiniteDifference) {
   std::mt19937 rng(5);
-  const BodyModel3 body = RandomBody3(rng, {4, 3, 3}, BasisKind::kBernstein, 4, 20);
+  const BodyModelN<3> body = RandomBody3(rng, {4, 3, 3}, BasisKind::kBernstein, 4, 20);
   const BodyState<3, double> s = RandomState3(rng, body);
   auto energy = [&](const Eigen::Quaterniond& q, const VecD<double>& gamma) {
     const ShapeMoments<double> sm(body.moments(), gamma);
@@ -277,18 +277,18 @@ TEST(Body3, KineticGradientMatchesFiniteDifference) {
 
 // The 2D body embedded in the plane z = 0: a lattice one layer deep (linear in z), modes with
 // no z part, mass points at z = 0.
-BodyModel3 Embed(const BodyModel& flat, double depth = 50.0) {
+BodyModelN<3> Embed(const BodyModel& flat, double depth = 50.0) {
   const Lattice& lat = flat.lattice();
-  BodyDef3 def;
+  BodyDefN<3> def;
   def.name = flat.name() + "_3d";
   auto lift = [](const Eigen::Vector2d& p) { return Vector3d(p.x(), p.y(), 0.0); };
-  def.lattice = Lattice3(lift(lat.origin()), {lift(lat.axis_s()), lift(lat.axis_t()), Vector3d(0, 0, depth)},
+  def.lattice = LatticeN<3>(lift(lat.origin()), {lift(lat.axis_s()), lift(lat.axis_t()), Vector3d(0, 0, depth)},
                          {lat.num_s(), lat.num_t(), 2}, lat.basis());
   for (int k = 0; k < flat.num_points(); ++k) def.mass_positions.push_back(lift(flat.def().mass_positions[k]));
   def.masses = flat.def().masses;
-  std::vector<DeformationMode3> modes;
+  std::vector<DeformationModeN<3>> modes;
   for (const DeformationMode& m2 : flat.modes()) {
-    DeformationMode3 m;
+    DeformationModeN<3> m;
     m.name = m2.name;
     m.stiffness = m2.stiffness;
     m.damping = m2.damping;
@@ -300,7 +300,7 @@ BodyModel3 Embed(const BodyModel& flat, double depth = 50.0) {
     }
     modes.push_back(m);
   }
-  return BodyModel3(def, modes);
+  return BodyModelN<3>(def, modes);
 }
 
 TEST(Body3, PlanarMotionReproducesThe2DBody) {
@@ -309,7 +309,7 @@ TEST(Body3, PlanarMotionReproducesThe2DBody) {
   std::vector<DeformationMode> modes = random.modes();
   for (size_t d = 0; d < modes.size(); ++d) modes[d].stiffness = 200.0 * (d + 1), modes[d].damping = 5.0;
   const BodyModel flat(random.def(), modes);
-  const BodyModel3 body = Embed(flat);
+  const BodyModelN<3> body = Embed(flat);
   for (bool ground : {false, true}) {
     for (Integrator integrator : {Integrator::kThesis, Integrator::kSymplecticEuler, Integrator::kRK4,
                                   Integrator::kImplicitEuler}) {
@@ -361,7 +361,7 @@ TEST(Body3, PlanarMotionReproducesThe2DBody) {
 // exactly the points below the plane that a scan of every point finds.
 TEST(Body3, PointGroupsFindExactlyThePointsBelowTheGround) {
   std::mt19937 rng(23);
-  const BodyModel3 body = RandomBody3(rng, {4, 4, 4}, BasisKind::kBernstein, 3, 3000);
+  const BodyModelN<3> body = RandomBody3(rng, {4, 4, 4}, BasisKind::kBernstein, 3, 3000);
   ASSERT_GT(body.clusters().size(), 8u);
   GroundPlane g;
   g.enabled = true;
@@ -387,7 +387,7 @@ TEST(Body3, PointGroupsFindExactlyThePointsBelowTheGround) {
 }
 
 // Spinning about its centre of mass (ṫ chosen so the centre stays put), no gravity.
-BodyState<3, double> Spinning(const BodyModel3& body, const Vector3d& omega) {
+BodyState<3, double> Spinning(const BodyModelN<3>& body, const Vector3d& omega) {
   BodyState<3, double> s = RestState<3, double>(body);
   s.qd.segment<3>(3) = omega;
   const Vector3d com_local = body.moments().c0 / body.moments().m;
@@ -395,14 +395,14 @@ BodyState<3, double> Spinning(const BodyModel3& body, const Vector3d& omega) {
   return s;
 }
 
-double TotalEnergy(const BodyModel3& body, const BodyState<3, double>& s) {
+double TotalEnergy(const BodyModelN<3>& body, const BodyState<3, double>& s) {
   const ShapeMoments<double> sm(body.moments(), s.gamma());
   double V = 0.0;
   for (int d = 0; d < body.num_modes(); ++d) V += body.modes()[d].stiffness * s.gamma()[d] * s.gamma()[d];
   return KineticEnergy(body.moments(), sm, Matrix3d(s.orientation().toRotationMatrix()), s.qd) + V;
 }
 
-Vector3d AngularMomentum(const BodyModel3& body, const BodyState<3, double>& s, Vector3d* linear = nullptr) {
+Vector3d AngularMomentum(const BodyModelN<3>& body, const BodyState<3, double>& s, Vector3d* linear = nullptr) {
   const ShapeMoments<double> sm(body.moments(), s.gamma());
   Vector3d P, L;
   Momentum(body.moments(), sm, Frame<3, double>(s.q), s.qd, &P, &L);
@@ -411,7 +411,7 @@ Vector3d AngularMomentum(const BodyModel3& body, const BodyState<3, double>& s, 
 }
 
 TEST(Body3, TorqueFreeTumblingKeepsEnergyAndMomentumOver1e5Steps) {
-  const BodyModel3 body = Box(1.0, 2.0, 3.0);
+  const BodyModelN<3> body = Box(1.0, 2.0, 3.0);
   WorldParams w;
   w.gravity_on = false;
   BodyState<3, double> s = Spinning(body, Vector3d(0.8, 1.5, -0.6));
@@ -449,7 +449,7 @@ double CompleteEllipticK(double k) {
 
 TEST(Body3, IntermediateAxisFlipPeriodMatchesTheEllipticIntegral) {
   const double a = 1.0, b = 2.0, c = 3.0, m = 1.0;
-  const BodyModel3 body = Box(a, b, c, m);
+  const BodyModelN<3> body = Box(a, b, c, m);
   // principal moments about the centre, from the eight corners (±a/2, ±b/2, ±c/2)
   const double I1 = 8 * m * (b * b + c * c) / 4, I2 = 8 * m * (a * a + c * c) / 4, I3 = 8 * m * (a * a + b * b) / 4;
   ASSERT_TRUE(I3 < I2 && I2 < I1);  // the box's axes in increasing inertia: z, y, x
@@ -493,7 +493,7 @@ TEST(Body3, IntermediateAxisFlipPeriodMatchesTheEllipticIntegral) {
 // A spring at the centre of mass of a rigid box moves it as a harmonic oscillator,
 // x(t) = A cos(√(k/m) t), without turning it.
 TEST(Body3, SpringAtTheCentreOscillatesWithTheClosedFormPeriod) {
-  const BodyModel3 box = Box(1.0, 2.0, 3.0, 0.5);
+  const BodyModelN<3> box = Box(1.0, 2.0, 3.0, 0.5);
   const double m = box.moments().m, k = 40.0, A = 0.1;
   const Vector3d centre(0.5, 1.0, 1.5);
   WorldParams w;
@@ -515,7 +515,7 @@ TEST(Body3, SpringAtTheCentreOscillatesWithTheClosedFormPeriod) {
 // no damping so is the energy (variational integrator), for a point off the centre.
 TEST(Body3, OffCentreSpringKeepsMomentumAboutTheAnchor) {
   std::mt19937 rng(29);
-  const BodyModel3 body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20, 3000.0);
+  const BodyModelN<3> body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20, 3000.0);
   WorldParams w;
   w.gravity_on = false;
   const Vector3d anchor(40, -30, 20);
@@ -547,7 +547,7 @@ TEST(Body3, OffCentreSpringKeepsMomentumAboutTheAnchor) {
 
 TEST(Body3, VibratingBodyTumblingKeepsItsMomenta) {
   std::mt19937 rng(17);
-  const BodyModel3 body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 4, 30, 2000.0);
+  const BodyModelN<3> body = RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 4, 30, 2000.0);
   WorldParams w;
   w.gravity_on = false;
   BodyState<3, double> s = RandomState3(rng, body, 0.5);
@@ -575,7 +575,7 @@ TEST(Body3, VibratingBodyTumblingKeepsItsMomenta) {
 // A block on an incline of angle α (the plane tilted, gravity −y): below the friction cap
 // (tan α < μ) it stays; above it, it slides with acceleration g (sin α − μ cos α).
 TEST(Body3, BlockOnAnInclineHoldsBelowTheCapAndSlidesAbove) {
-  const BodyModel3 block = Box(0.4, 0.2, 0.3, 0.5);
+  const BodyModelN<3> block = Box(0.4, 0.2, 0.3, 0.5);
   const double mu = 0.4, g = 9.81;
   for (double alpha_deg : {15.0, 35.0}) {
     const double alpha = alpha_deg * M_PI / 180.0;
@@ -617,9 +617,9 @@ TEST(Body3, BlockOnAnInclineHoldsBelowTheCapAndSlidesAbove) {
 // A table (top slab and four legs of mass points) dropped flat lands on its four feet and
 // settles level.
 TEST(Body3, TableDroppedFlatLandsOnItsFourLegsAndSettles) {
-  BodyDef3 def;
+  BodyDefN<3> def;
   def.name = "table3";
-  def.lattice = Lattice3(Vector3d::Zero(), {Vector3d(1.2, 0, 0), Vector3d(0, 0.8, 0), Vector3d(0, 0, 0.6)}, {4, 4, 4},
+  def.lattice = LatticeN<3>(Vector3d::Zero(), {Vector3d(1.2, 0, 0), Vector3d(0, 0.8, 0), Vector3d(0, 0, 0.6)}, {4, 4, 4},
                          BasisKind::kBernstein);
   std::vector<int> feet;
   for (double x : {0.0, 0.4, 0.8, 1.2})
@@ -631,7 +631,7 @@ TEST(Body3, TableDroppedFlatLandsOnItsFourLegsAndSettles) {
         def.mass_positions.push_back(Vector3d(x, y, z));
       }
   def.masses.assign(def.mass_positions.size(), 2.0);
-  const BodyModel3 table(def, {});
+  const BodyModelN<3> table(def, {});
   WorldParams w;
   w.ground_plane.enabled = true;
   w.ground_plane.stiffness = 2e4;
@@ -657,9 +657,9 @@ TEST(Body3, TableDroppedFlatLandsOnItsFourLegsAndSettles) {
 
 // One world with a 2D table, a 3D table and a Witkin & Welch box: each steps as it would alone.
 TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
-  const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
-  auto table3 = std::make_shared<const BodyModel3>(
-      def, formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(wobble::test_env::DataDir() + "/table3.obj");
+  auto table3 = std::make_shared<const BodyModelN<3>>(
+      def, formats::ReadDeformationFile(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
   WorldOptions o;
   o.params.ground_plane.enabled = true;
   o.integrator = Integrator::kSymplecticEuler;
@@ -689,9 +689,9 @@ TEST(Body3InWorld, StepsBesideTheOtherKindsAsItDoesAlone) {
 }
 
 TEST(Body3InWorld, RefusesBadStatesAndPoints) {
-  const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(wobble::test_env::DataDir() + "/table3.obj");
   World world;
-  const int b = world.AddBody(std::make_shared<const BodyModel3>(def, std::vector<DeformationMode3>{}));
+  const int b = world.AddBody(std::make_shared<const BodyModelN<3>>(def, std::vector<DeformationModeN<3>>{}));
   EXPECT_THROW(world.body<2>(b), std::invalid_argument);  // not a 2D FFD body
   EXPECT_THROW(world.AddNail(At(b, Eigen::Vector2d(0.5, 0.5))), std::invalid_argument);  // (s, t, u) needed
   EXPECT_THROW(world.AddNail(At(b, Eigen::Vector3d(0.5, 1.5, 0.5))), std::invalid_argument);
@@ -713,9 +713,9 @@ TEST(Body3InWorld, RefusesBadStatesAndPoints) {
 // points at the step's start configuration. On the free path and on the constrained one (a
 // nail on another body makes every body step together).
 TEST(Body3InWorld, APointForceGivesTheBodyItsImpulse) {
-  const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
-  auto table3 = std::make_shared<const BodyModel3>(
-      def, formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(wobble::test_env::DataDir() + "/table3.obj");
+  auto table3 = std::make_shared<const BodyModelN<3>>(
+      def, formats::ReadDeformationFile(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
   for (const bool constrained : {false, true}) {
     const char* path = constrained ? "constrained" : "free";
     WorldOptions o;
@@ -765,7 +765,7 @@ TEST(Body3InWorld, APointForceGivesTheBodyItsImpulse) {
 // z have the period 2π √(I_pivot / (m g d)), d the distance from the nail to the centre.
 TEST(Body3InWorld, NailedBoxSwingsWithThePhysicalPendulumPeriod) {
   const double a = 1.0, b = 2.0, c = 3.0, m = 0.5, g = 9.81;
-  auto box = std::make_shared<const BodyModel3>(Box(a, b, c, m));
+  auto box = std::make_shared<const BodyModelN<3>>(Box(a, b, c, m));
   WorldOptions o;
   o.dt = 1e-4;
   World world(o);
@@ -803,8 +803,8 @@ struct AttachedRun {
 };
 AttachedRun RunAttached(double dt) {
   std::mt19937 rng(31);
-  auto body_a = std::make_shared<const BodyModel3>(RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20, 3000.0));
-  auto body_b = std::make_shared<const BodyModel3>(RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20, 3000.0));
+  auto body_a = std::make_shared<const BodyModelN<3>>(RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20, 3000.0));
+  auto body_b = std::make_shared<const BodyModelN<3>>(RandomBody3(rng, {3, 3, 3}, BasisKind::kBernstein, 2, 20, 3000.0));
   auto slab = std::make_shared<const LinearBodyModel>(
       MakeBoxBody("slab", 3, LinearOrder::kAffine, Eigen::Vector3d(40, 15, 25), 3, 200.0));
   WorldOptions o;

@@ -197,8 +197,8 @@ TEST(ModeCheck, ZeroAndMasslessModesAreErrors) {
 // ---- 3D bodies ----
 
 TEST(conditioning3D, TheTableModesAreIndependent) {
-  const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
-  const BodyModel3 body(def, formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(wobble::test_env::DataDir() + "/table3.obj");
+  const BodyModelN<3> body(def, formats::ReadDeformationFile(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice));
   const ModeSetReport r = CheckModeSet(body);
   EXPECT_EQ(r.level, ModeSetReport::Level::kOk) << (r.messages.empty() ? "" : r.messages[0]);
   ASSERT_EQ(r.dofs.size(), 10u);
@@ -209,16 +209,16 @@ TEST(conditioning3D, TheTableModesAreIndependent) {
 
 // A "mode" that is a rigid turn about the vertical: dependent on the rotation dof, and named so.
 TEST(conditioning3D, ARigidTurnAsAModeIsFoundWithTheRotation) {
-  const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
-  std::vector<DeformationMode3> modes =
-      formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice);
-  DeformationMode3 turn;
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(wobble::test_env::DataDir() + "/table3.obj");
+  std::vector<DeformationModeN<3>> modes =
+      formats::ReadDeformationFile(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice);
+  DeformationModeN<3> turn;
   turn.name = "turn";
   turn.lattice_size = def.lattice.sizes();
   for (const Eigen::Vector3d& p : def.lattice.RestPoints())
     turn.displacement.push_back(Eigen::Vector3d::UnitY().cross(p - Eigen::Vector3d(150, 50, 100)));
   modes.push_back(turn);
-  const ModeSetReport r = CheckModeSet(BodyModel3(def, modes));
+  const ModeSetReport r = CheckModeSet(BodyModelN<3>(def, modes));
   EXPECT_EQ(r.level, ModeSetReport::Level::kError);
   EXPECT_EQ(r.smallest_angle_deg, 0.0);
   const ModeFinding& f = r.modes.back();
@@ -230,7 +230,7 @@ TEST(conditioning3D, ARigidTurnAsAModeIsFoundWithTheRotation) {
 
 // Fig. 4.7 in 3D: the squash whose axis turns from x to y meets the vertical squash at 90°.
 TEST(conditioning3D, AngleSweepIsSingularOnlyWhereTheSquashesMeet) {
-  const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(wobble::test_env::DataDir() + "/table3.obj");
   std::vector<double> phis;
   for (int deg = 30; deg <= 90; deg += 5) phis.push_back(deg * M_PI / 180.0);
   const std::vector<SweepSample> sweep = AngleSweep(def, phis, Squash());

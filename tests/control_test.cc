@@ -195,7 +195,7 @@ TEST(Keyframes, HeldPointStaysPutWhileTheBodyDeforms) {
   control::Keyframes k;
   k.times = {0.0, 0.5, 1.2};
   k.amplitudes = {Eigen::Vector4d(0, 0, 0, 0), Eigen::Vector4d(0.2, -0.1, 0.05, 0), Eigen::Vector4d(-0.1, 0.3, 0, 0.1)};
-  control::HeldPoint hold{true, {0.0, 0.0}};  // the left foot
+  control::HeldPoint hold{true, {0.0, 0.0, 0.0}};  // the left foot
   const Eigen::Vector2d anchor(12.0, 3.0);
   const double theta = 0.2;
   Eigen::VectorXd g, gd, q, qd;
@@ -204,11 +204,11 @@ TEST(Keyframes, HeldPointStaysPutWhileTheBodyDeforms) {
     for (double t = 0; t <= 1.2; t += 0.01) {
       k.Evaluate(t, &g, &gd);
       control::KeyframedState(*body, hold, anchor, Eigen::Vector3d(0.0, 0.0, theta), g, gd, &q, &qd);
-      EXPECT_NEAR((control::PointAt(*body, hold.lattice_coords, q) - anchor).norm(), 0.0, 1e-10) << t;
+      EXPECT_NEAR((control::PointAt(*body, hold.coords<2>(), q) - anchor).norm(), 0.0, 1e-10) << t;
       // its velocity J q̇ is zero too
       Eigen::Vector2d b0;
       Mat2D<double> B;
-      body->LocalBasis(hold.lattice_coords, &b0, &B);
+      body->LocalBasis(hold.coords<2>(), &b0, &B);
       const VecQ<double> qq = q, qqd = qd;
       const Frame<2, double> frame(qq);
       EXPECT_NEAR(PointVelocity(frame, qqd, LocalPosition<double>(b0, B, qq), B).norm(), 0.0, 1e-10) << t;

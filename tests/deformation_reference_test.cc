@@ -59,8 +59,8 @@ template <int Dim> std::string Describe(const std::vector<DeformationModeN<Dim>>
 
 // A lattice that is neither axis-aligned nor cubic, so that the 3D generators' use of the
 // axes, their lengths and the sizes all show in the reference.
-const Lattice3& SkewLattice3() {
-  static const Lattice3 lattice(Eigen::Vector3d(-10, 5, 2),
+const LatticeN<3>& SkewLattice3() {
+  static const LatticeN<3> lattice(Eigen::Vector3d(-10, 5, 2),
                                 {Eigen::Vector3d(200, 30, 0), Eigen::Vector3d(-20, 150, 10), Eigen::Vector3d(5, 0, 90)},
                                 {5, 4, 3}, BasisKind::kBernstein);
   return lattice;
@@ -116,15 +116,15 @@ Names InCheckout() {
 
 std::string Current(const Names& names) {
   std::ostringstream out;
-  const Lattice3& table3 = ReadObjectFile3(kSource + "/data/table3.obj").lattice;
+  const LatticeN<3>& table3 = ReadObjectFile<3>(kSource + "/data/table3.obj").lattice;
   // shipped 2D files: data/*.def, data/def_* and the command-line tests' files, in full
   for (const std::string& file : names.files2)
     out << "file2 " << file << "\n" << Describe(ReadDeformationFile(kSource + "/" + file));
   // shipped 3D files in full over the 3D table's lattice, and as digests over a skew one
   for (const std::string& file : names.files3) {
     const std::string path = kSource + "/" + file;
-    out << "file3 " << file << " table3\n" << Describe(ReadDeformationFile3(path, table3));
-    out << "file3 " << file << " skew " << Digest(Describe(ReadDeformationFile3(path, SkewLattice3()))) << "\n";
+    out << "file3 " << file << " table3\n" << Describe(ReadDeformationFile(path, table3));
+    out << "file3 " << file << " skew " << Digest(Describe(ReadDeformationFile(path, SkewLattice3()))) << "\n";
   }
   // the fuzz corpora: hostile inputs read the same way (same modes or an error on the same line)
   for (const std::string& name : names.corpus2) {
@@ -135,7 +135,7 @@ std::string Current(const Names& names) {
   for (const std::string& name : names.corpus3) {
     const std::string path = kSource + "/fuzz/corpus/deformation3/" + name;
     out << "corpus3 " << name << " "
-        << Outcome([&] { return Digest(Describe(ReadDeformationFile3(path, table3))); }) << "\n";
+        << Outcome([&] { return Digest(Describe(ReadDeformationFile(path, table3))); }) << "\n";
   }
   return out.str();
 }

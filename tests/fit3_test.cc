@@ -29,13 +29,13 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 
 struct Character {
-  BodyDef3 def;
-  std::vector<DeformationMode3> modes;
-  BodyModel3 body;
+  BodyDefN<3> def;
+  std::vector<DeformationModeN<3>> modes;
+  BodyModelN<3> body;
 };
 
 Character MakeChair() {
-  BodyModel3 body = testing::Chair3();
+  BodyModelN<3> body = testing::Chair3();
   return {body.def(), body.modes(), body};
 }
 
@@ -252,7 +252,7 @@ TEST(TrajectoryFit3, SmoothnessOnTheGroupFiltersNoise) {
 std::string TargetError(const std::string& text) {
   std::istringstream in(text);
   try {
-    formats::ParseTargets3(in, "dir/t.tgt", [](const std::string& path) {
+    formats::ParseTargets<3>(in, "dir/t.tgt", [](const std::string& path) {
       if (path != "dir/scan.ply") throw std::runtime_error("cannot read " + path);
       return testing::ChairMesh();
     });
@@ -264,18 +264,18 @@ std::string TargetError(const std::string& text) {
 
 TEST(TargetFile3, ParsesEveryStatement) {
   std::istringstream in("dimension 3\npoint 3 10 20 30\nsample 0.5 1 0.25 1.5 -2 7 weight 4\n");
-  const formats::TargetFile3 f = formats::ParseTargets3(in, "t.tgt");
+  const formats::TargetFileN<3> f = formats::ParseTargets<3>(in, "t.tgt");
   ASSERT_EQ(f.points.size(), 2u);
   EXPECT_EQ(f.points[0].position, Vec3(10, 20, 30));
   EXPECT_EQ(f.points[1].lattice_coords, Vec3(0.5, 1, 0.25));
   EXPECT_EQ(f.points[1].weight, 4.0);
   std::istringstream surface("dimension 3\nmesh scan.ply   # beside the target file\ncloud 1 2 3\n");
-  const formats::TargetFile3 s = formats::ParseTargets3(surface, "dir/t.tgt", [](const std::string&) { return testing::ChairMesh(); });
+  const formats::TargetFileN<3> s = formats::ParseTargets<3>(surface, "dir/t.tgt", [](const std::string&) { return testing::ChairMesh(); });
   EXPECT_EQ(s.mesh.triangles.size(), 36u);
   EXPECT_EQ(s.cloud.size(), 1u);
   EXPECT_TRUE(s.has_curve());
   std::istringstream traj("dimension 3\nframe 0\npoint 0 1 2 3\nframe 0.5\npoint 0 1 3 4\n");
-  EXPECT_EQ(formats::ParseTargets3(traj, "k.tgt").frames.size(), 2u);
+  EXPECT_EQ(formats::ParseTargets<3>(traj, "k.tgt").frames.size(), 2u);
 }
 
 TEST(TargetFile3, RejectsMalformedInputWithFileAndLine) {
@@ -296,7 +296,7 @@ TEST(TargetFile3, RejectsMalformedInputWithFileAndLine) {
             "dir/t.tgt:2: 'polyline' is for 2D target files (expected point, sample, cloud, mesh or frame)");
   EXPECT_EQ(TargetError("dimension 3\npoint 0 1 2 3\ndimension 3\n"), "dir/t.tgt:3: 'dimension' must be the first statement of the file");
   std::istringstream no_reader("dimension 3\nmesh scan.ply\n");
-  EXPECT_THROW(formats::ParseTargets3(no_reader, "t.tgt"), formats::ParseError);
+  EXPECT_THROW(formats::ParseTargets<3>(no_reader, "t.tgt"), formats::ParseError);
 }
 
 // ---- dynamic fits: through the simulation (StepBody3 with Jets) ----
@@ -305,11 +305,11 @@ TEST(TargetFile3, RejectsMalformedInputWithFileAndLine) {
 // in the air. K_d from a mode frequency f_d (γ̈ G_dd = −2K γ: ω² = 2K/G_dd), c_d = 2ζ sqrt(2K G_dd).
 struct Vibrating {
   Character chair = MakeChair();
-  std::shared_ptr<const BodyModel3> body;
+  std::shared_ptr<const BodyModelN<3>> body;
   Eigen::VectorXd K, c;
   Vibrating() {
     const double f[] = {2.0, 3.0, 2.5}, zeta[] = {0.05, 0.1, 0.02};
-    std::vector<DeformationMode3> modes = chair.modes;
+    std::vector<DeformationModeN<3>> modes = chair.modes;
     K.resize(3);
     c.resize(3);
     for (int d = 0; d < 3; ++d) {
@@ -319,12 +319,12 @@ struct Vibrating {
       modes[size_t(d)].stiffness = K[d];
       modes[size_t(d)].damping = c[d];
     }
-    body = std::make_shared<const BodyModel3>(chair.def, modes);
+    body = std::make_shared<const BodyModelN<3>>(chair.def, modes);
   }
 };
 
 // Frames of a World run (the world's own mode forces, not the fit's), every `every` steps.
-std::vector<fit::ReferenceFrameN<3>> WorldFrames(const std::shared_ptr<const BodyModel3>& body, const Eigen::VectorXd& q0,
+std::vector<fit::ReferenceFrameN<3>> WorldFrames(const std::shared_ptr<const BodyModelN<3>>& body, const Eigen::VectorXd& q0,
                                               const Eigen::VectorXd& v0, double dt, int steps, int every) {
   WorldOptions o;
   o.dt = dt;

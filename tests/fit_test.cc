@@ -359,11 +359,11 @@ TEST(TargetFile, RejectsMalformedInputWithFileAndLine) {
 // ---- both dimensions: one fit, one set of checks (the 2D table, fit3_test's 3D chair) ----
 
 template <class Body> class FitOverDimension : public ::testing::Test {};
-using Bodies = ::testing::Types<BodyModel, BodyModel3>;
+using Bodies = ::testing::Types<BodyModel, BodyModelN<3>>;
 TYPED_TEST_SUITE(FitOverDimension, Bodies);
 
 BodyModel MakeBody(BodyModel*) { return Table(); }
-BodyModel3 MakeBody(BodyModel3*) { return testing::Chair3(); }
+BodyModelN<3> MakeBody(BodyModelN<3>*) { return testing::Chair3(); }
 
 // Every third mass point where the rest pose (q = 0) has it.
 template <int Dim> std::vector<fit::CorrespondenceN<Dim>> RestTargets(const BodyModelN<Dim>& body) {

@@ -37,7 +37,7 @@ std::shared_ptr<const Heightfield> Sampled(F&& f, Vector2d origin, Vector2d spac
   return Heightfield::Make(origin, spacing, nx, nz, std::move(h));
 }
 
-Vector3d LinearMomentum(const BodyModel3& body, const BodyState<3, double>& s) {
+Vector3d LinearMomentum(const BodyModelN<3>& body, const BodyState<3, double>& s) {
   const ShapeMoments<double> sm(body.moments(), s.gamma());
   Vector3d P, L;
   Momentum(body.moments(), sm, Frame<3, double>(s.q), s.qd, &P, &L);
@@ -75,7 +75,7 @@ TEST(Heightfield, APlaneGivenAsAGridIsThatPlane) {
 // A body dropped onto a tilted plane and onto the same plane as a heightfield of many
 // triangles moves the same: contacts carried across the triangles' edges keep their anchors.
 TEST(Heightfield, ABodyOnAGridOfAPlaneMovesAsOnThePlane) {
-  const BodyModel3 chair = testing::Chair3();
+  const BodyModelN<3> chair = testing::Chair3();
   const double a = 0.1, b = -0.05;  // y = a x + b z
   WorldParams on_plane;
   on_plane.ground_plane.enabled = true;
@@ -137,7 +137,7 @@ TEST(Heightfield, APointInACreaseFeelsBothFaces) {
 // settles there; each wall then holds N = m g / (2 cos α) along its normal.
 TEST(Heightfield, ABoxInAFrictionlessValleyIsHeldByBothWalls) {
   const double alpha = 0.4, width = 1.0, mass = 1.0, g = 9.81;
-  const BodyModel3 box = Box(width, 0.4, 0.6, mass);
+  const BodyModelN<3> box = Box(width, 0.4, 0.6, mass);
   WorldParams w;
   w.ground_plane.enabled = true;
   w.ground_plane.stiffness = 2e4;
@@ -166,7 +166,7 @@ struct Slide {
   double v_at_1, v_at_2, travelled;
   size_t contacts;
 };
-Slide SlideDownTheSlope(const BodyModel3& block, double alpha, double mu, std::shared_ptr<const Heightfield> field) {
+Slide SlideDownTheSlope(const BodyModelN<3>& block, double alpha, double mu, std::shared_ptr<const Heightfield> field) {
   WorldParams w;
   w.ground_plane.enabled = true;
   w.ground_plane.friction_cap = mu;
@@ -197,7 +197,7 @@ std::shared_ptr<const Heightfield> SlopeOfTriangles(double alpha) {
 // Down a 35° slope made of triangles 0.2 wide (the box crosses dozens of them) with friction
 // cap μ = 0.4: the acceleration is g (sin α − μ cos α); at 15° (tan α < μ) it holds.
 TEST(Heightfield, SlidesDownASlopeOfTrianglesAtTheClosedForm) {
-  const BodyModel3 block = Box(0.4, 0.2, 0.3, 0.5);
+  const BodyModelN<3> block = Box(0.4, 0.2, 0.3, 0.5);
   const double mu = 0.4, g = 9.81;
   for (double alpha_deg : {15.0, 35.0}) {
     const double alpha = alpha_deg * M_PI / 180.0;
@@ -217,7 +217,7 @@ TEST(Heightfield, SlidesDownASlopeOfTrianglesAtTheClosedForm) {
 // box holds, but where a region of the cells under its path sets frsin 0.4 it slides at
 // g (sin α − 0.4 cos α); and the other way round. Cells outside the region keep the ground's.
 TEST(Heightfield, ARegionsOwnFrictionCapDecidesWhetherItSlides) {
-  const BodyModel3 block = Box(0.4, 0.2, 0.3, 0.5);
+  const BodyModelN<3> block = Box(0.4, 0.2, 0.3, 0.5);
   const double alpha = 35.0 * M_PI / 180.0, g = 9.81;
   const Vector2d lo(-30, -2), hi(2, 1);  // the box's path, z from −0.3 to 0.15; not the cells beyond z = 1
   for (const auto& [ground_cap, region_cap] : {std::pair{0.8, 0.4}, std::pair{0.4, 0.8}}) {
@@ -271,7 +271,7 @@ TEST(Heightfield, RefusesBadRegions) {
 // just past the edge is still inside the solid under the drop's face, by at most how far it
 // had sunk into the top (m g / 4K): it feels that face only that shallowly, never deeper.
 TEST(Heightfield, SlidesOffTheEdgeOfADropIntoFreeFall) {
-  const BodyModel3 box = Box(0.5, 0.3, 0.4, 1.0);
+  const BodyModelN<3> box = Box(0.5, 0.3, 0.4, 1.0);
   WorldParams w;
   w.ground_plane.enabled = true;
   w.ground_plane.stiffness = 2e4;

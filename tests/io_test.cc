@@ -494,29 +494,29 @@ TEST(ioObjectFileErrors, MissingFile) {
 
 // ---------------------------------------------------------------- 3D files
 
-BodyDef3 Object3(const std::string& text) {
+BodyDefN<3> Object3(const std::string& text) {
   std::istringstream in(text);
-  return ParseObject3(in, "test.obj");
+  return ParseObject<3>(in, "test.obj");
 }
 void ExpectObject3Error(const std::string& text, int line, const std::string& message_part) {
   ExpectParseError([&] { Object3(text); }, "test.obj", line, message_part);
 }
-const Lattice3& UnitLattice3() {
-  static const Lattice3 lattice(Eigen::Vector3d(0, 0, 0),
+const LatticeN<3>& UnitLattice3() {
+  static const LatticeN<3> lattice(Eigen::Vector3d(0, 0, 0),
                                 {Eigen::Vector3d(300, 0, 0), Eigen::Vector3d(0, 100, 0), Eigen::Vector3d(0, 0, 200)},
                                 {4, 4, 4}, BasisKind::kBernstein);
   return lattice;
 }
-std::vector<DeformationMode3> Modes3(const std::string& text) {
+std::vector<DeformationModeN<3>> Modes3(const std::string& text) {
   std::istringstream in(text);
-  return ParseDeformations3(in, "test.def3", UnitLattice3());
+  return ParseDeformations(in, "test.def3", UnitLattice3());
 }
 void ExpectModes3Error(const std::string& text, int line, const std::string& message_part) {
   ExpectParseError([&] { Modes3(text); }, "test.def3", line, message_part);
 }
 
 TEST(io3DFiles, TheTableAndItsModes) {
-  const BodyDef3 def = ReadObjectFile3(kData + "/table3.obj");
+  const BodyDefN<3> def = ReadObjectFile<3>(kData + "/table3.obj");
   EXPECT_EQ(def.name, "table3");
   EXPECT_EQ(def.masses.size(), 27u);
   EXPECT_EQ(def.shapes.size(), 5u);
@@ -525,23 +525,23 @@ TEST(io3DFiles, TheTableAndItsModes) {
   EXPECT_EQ(def.lattice.axis(2), Eigen::Vector3d(0, 0, 200));
   EXPECT_EQ(ObjectFileDimension(kData + "/table3.obj"), 3);
   EXPECT_EQ(ObjectFileDimension(kData + "/table.obj"), 2);
-  const std::vector<DeformationMode3> modes = ReadDeformationFile3(kData + "/table3_modes.def3", def.lattice);
+  const std::vector<DeformationModeN<3>> modes = ReadDeformationFile(kData + "/table3_modes.def3", def.lattice);
   ASSERT_EQ(modes.size(), 4u);
   EXPECT_EQ(modes[0].name, "bend");
   EXPECT_TRUE(modes[0].active);
   EXPECT_EQ(modes[3].stiffness, 4000000.0);
   EXPECT_EQ(modes[2].source, kData + "/table3_modes.def3:8");
-  EXPECT_NO_THROW(BodyModel3 body(def, modes));
+  EXPECT_NO_THROW(BodyModelN<3> body(def, modes));
 }
 
 // Each generator against what it promises, at the control points of a 300 x 100 x 200 lattice
 // (abscissas 0, 1/3, 2/3, 1 per axis).
 TEST(io3DFiles, GeneratorsMakeTheFieldsTheyDescribe) {
-  const Lattice3& lat = UnitLattice3();
+  const LatticeN<3>& lat = UnitLattice3();
   const std::vector<Eigen::Vector3d> rest = lat.RestPoints();
   const Eigen::Vector3d centre(150, 50, 100);
   auto mode = [&](const std::string& line) { return Modes3("dimension 3\nmode m\n" + line + "\n").front(); };
-  const DeformationMode3 bend = mode("bend x y 90"), twist = mode("twist y 40"), squash = mode("squash y 0.5"),
+  const DeformationModeN<3> bend = mode("bend x y 90"), twist = mode("twist y 40"), squash = mode("squash y 0.5"),
                          shear = mode("shear y x 100"), taper = mode("taper z 0.4");
   for (int c = 0; c < lat.size(); ++c) {
     const auto cell = lat.CellOf(c);
@@ -565,7 +565,7 @@ TEST(io3DFiles, GeneratorsMakeTheFieldsTheyDescribe) {
     EXPECT_NEAR((taper.displacement[c] - 0.4 * (u.z() - 0.5) * Eigen::Vector3d(r.x(), r.y(), 0)).norm(), 0, 1e-9);
   }
   // generators add, and 'point' moves one control point
-  const DeformationMode3 sum = Modes3("dimension 3\nmode m\nshear y x 100\npoint 1 2 3 1 2 3\n").front();
+  const DeformationModeN<3> sum = Modes3("dimension 3\nmode m\nshear y x 100\npoint 1 2 3 1 2 3\n").front();
   const int c = lat.FlatIndex({1, 2, 3});
   EXPECT_NEAR((sum.displacement[c] - shear.displacement[c] - Eigen::Vector3d(1, 2, 3)).norm(), 0, 1e-12);
 }
@@ -573,8 +573,8 @@ TEST(io3DFiles, GeneratorsMakeTheFieldsTheyDescribe) {
 // The squash keeps the volume to first order: the deformed lattice's Jacobian determinant at
 // amplitude γ is 1 + O(γ²) (the field is linear, which the Bernstein lattice reproduces).
 TEST(io3DFiles, SquashKeepsVolumeToFirstOrder) {
-  const Lattice3& lat = UnitLattice3();
-  const DeformationMode3 squash = Modes3("dimension 3\nmode m\nsquash x 0.3\n").front();
+  const LatticeN<3>& lat = UnitLattice3();
+  const DeformationModeN<3> squash = Modes3("dimension 3\nmode m\nsquash x 0.3\n").front();
   const double gamma = 1e-3;
   std::vector<Eigen::Vector3d> control = lat.RestPoints();
   for (int c = 0; c < lat.size(); ++c) control[c] += gamma * squash.displacement[c];
@@ -593,13 +593,13 @@ TEST(io3DFiles, SquashKeepsVolumeToFirstOrder) {
 // point at its file coordinates, and q places the origin: at t = (1, 2, 3) turned 90 degrees
 // about z (R (x, y, z) = (-y, x, z)) a point p goes to t + R p, worked out by hand below.
 TEST(io3DFiles, BodyOriginIsTheFileOriginNotTheLatticeCorner) {
-  const BodyDef3 def = Object3(
+  const BodyDefN<3> def = Object3(
       "dimension 3\nlattice 10 20 30 40 50 60\n"
       "mass 10 20 30 1\n"   // the lattice corner
       "mass 50 70 90 2\n"   // the opposite corner
       "mass 20 45 60 3\n");
   EXPECT_EQ(def.lattice.origin(), Eigen::Vector3d(10, 20, 30));
-  auto body = std::make_shared<const BodyModel3>(def, std::vector<DeformationMode3>{});
+  auto body = std::make_shared<const BodyModelN<3>>(def, std::vector<DeformationModeN<3>>{});
   const Eigen::Vector3d file[3] = {{10, 20, 30}, {50, 70, 90}, {20, 45, 60}};
   for (int k = 0; k < 3; ++k) EXPECT_LT((body->rest_local(k) - file[k]).norm(), 1e-12) << "mass point " << k;
   // Σ m p = (10 + 100 + 60, 20 + 140 + 135, 30 + 180 + 180)

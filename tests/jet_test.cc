@@ -89,7 +89,7 @@ TEST(Jet, StepDerivativesMatchFiniteDifferences) {
 using Jet3 = ceres::Jet<double, 10>;  // the 3D table: 6 + 4 velocities
 
 template <class T>
-Eigen::Matrix<T, Eigen::Dynamic, 1> Simulate3(const BodyModel3& body, const WorldParams& w, Integrator integrator,
+Eigen::Matrix<T, Eigen::Dynamic, 1> Simulate3(const BodyModelN<3>& body, const WorldParams& w, Integrator integrator,
                                               const VecQ<T>& v0, int steps) {
   BodyState<3, T> s = RestState<3, T>(body);
   s.translation() = Vec3<T>(T(0.0), T(-0.5), T(0.0));
@@ -104,11 +104,11 @@ Eigen::Matrix<T, Eigen::Dynamic, 1> Simulate3(const BodyModel3& body, const Worl
 }
 
 TEST(Jet, Step3DerivativesMatchFiniteDifferences) {
-  const BodyDef3 def = formats::ReadObjectFile3(wobble::test_env::DataDir() + "/table3.obj");
-  std::vector<DeformationMode3> modes =
-      formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice);
-  for (DeformationMode3& m : modes) m.stiffness = 4e5, m.damping = 1e4;
-  const BodyModel3 body(def, modes);
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(wobble::test_env::DataDir() + "/table3.obj");
+  std::vector<DeformationModeN<3>> modes =
+      formats::ReadDeformationFile(wobble::test_env::DataDir() + "/table3_modes.def3", def.lattice);
+  for (DeformationModeN<3>& m : modes) m.stiffness = 4e5, m.damping = 1e4;
+  const BodyModelN<3> body(def, modes);
   WorldParams w;
   w.ground_plane.enabled = true;
   w.ground_plane.normal = Eigen::Vector3d(0.1, 1.0, 0.05).normalized();

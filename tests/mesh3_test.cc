@@ -79,8 +79,8 @@ TEST(Mesh3, BadMeshesAreRefusedByName) {
 
 TEST(Mesh3, FittedLatticeHoldsTheMeshWithTheMargin) {
   const SurfaceMesh m = Box(Vec3(-10, 0, 5), Vec3(30, 20, 15));  // largest side 40
-  const Lattice3 lat = FitLattice(m, {4, 5, 6}, BasisKind::kCubicBSpline, 0.05);
-  EXPECT_EQ(lat.sizes(), (Lattice3::Sizes{4, 5, 6}));
+  const LatticeN<3> lat = FitLattice(m, {4, 5, 6}, BasisKind::kCubicBSpline, 0.05);
+  EXPECT_EQ(lat.sizes(), (LatticeN<3>::Sizes{4, 5, 6}));
   EXPECT_EQ(lat.basis(), BasisKind::kCubicBSpline);
   EXPECT_TRUE(lat.origin().isApprox(Vec3(-12, -2, 3), 1e-12));
   EXPECT_NEAR(lat.axis(0).x(), 44, 1e-12);
@@ -158,15 +158,15 @@ SurfaceMesh BoxReader(const std::string& path) {
   throw std::runtime_error("cannot read " + path);
 }
 
-BodyDef3 Parse(const std::string& text) {
+BodyDefN<3> Parse(const std::string& text) {
   std::istringstream in(text);
-  return formats::ParseObject3(in, "dir/m.obj", BoxReader);
+  return formats::ParseObject<3>(in, "dir/m.obj", BoxReader);
 }
 
 void ExpectParseError(const std::string& text, int line, const std::string& needle, const formats::MeshReader& reader = BoxReader) {
   std::istringstream in(text);
   try {
-    formats::ParseObject3(in, "m.obj", reader);
+    formats::ParseObject<3>(in, "m.obj", reader);
     FAIL() << "no error for:\n" << text;
   } catch (const formats::ParseError& e) {
     EXPECT_EQ(e.line(), line) << e.what();
@@ -175,17 +175,17 @@ void ExpectParseError(const std::string& text, int line, const std::string& need
 }
 
 TEST(Mesh3, ObjectFileFitsTheLatticeAndSamplesTheMass) {
-  const BodyDef3 def = Parse("dimension 3\nmesh box\nsample volume 400 1000\nsample surface 50 20\n");
+  const BodyDefN<3> def = Parse("dimension 3\nmesh box\nsample volume 400 1000\nsample surface 50 20\n");
   EXPECT_EQ(def.mesh.triangles.size(), 12u);
-  EXPECT_EQ(def.lattice.sizes(), (Lattice3::Sizes{4, 4, 4}));  // the default fit
+  EXPECT_EQ(def.lattice.sizes(), (LatticeN<3>::Sizes{4, 4, 4}));  // the default fit
   EXPECT_TRUE(def.lattice.origin().isApprox(Vec3(-5, -5, -5)));  // 5% of the largest side, 100
   double total = 0;
   for (double mass : def.masses) total += mass;
   EXPECT_NEAR(total, 1020, 1e-9);
   EXPECT_EQ(def.masses.back(), 20.0 / 50);
-  EXPECT_NEAR(BodyModel3(def, {}).moments().m, 1020, 1e-9);
+  EXPECT_NEAR(BodyModelN<3>(def, {}).moments().m, 1020, 1e-9);
   // the volume grid is symmetric in the box: its centre of mass is the box's
-  const BodyModel3 solid(Parse("dimension 3\nmesh box\nsample volume 400 1000\n"), {});
+  const BodyModelN<3> solid(Parse("dimension 3\nmesh box\nsample volume 400 1000\n"), {});
   EXPECT_TRUE((solid.moments().c0 / solid.moments().m).isApprox(Vec3(50, 25, 40), 1e-12));
 }
 
@@ -206,13 +206,13 @@ TEST(Mesh3, ObjectFileMeshErrorsNameTheLine) {
 }
 
 TEST(Mesh3, EveryVertexFollowsTheFfdOfItsLattice) {
-  // the vertex bases of BodyModel3 against Eq. 4.1/4.2 evaluated directly: the deformed control
+  // the vertex bases of BodyModelN<3> against Eq. 4.1/4.2 evaluated directly: the deformed control
   // points L + Σ γ_d d^d, weighted at the vertex's lattice coordinates
-  BodyDef3 def = Parse("dimension 3\nmesh box\nlattice fit 4 5 6 bspline margin 0.1\nsample surface 30 10\n");
+  BodyDefN<3> def = Parse("dimension 3\nmesh box\nlattice fit 4 5 6 bspline margin 0.1\nsample surface 30 10\n");
   def.mesh = Join(def.mesh, Box(Vec3(10, 10, 10), Vec3(20, 45, 30)));  // more vertices, inside
   std::istringstream modes_text("dimension 3\nmode bend\n  bend x y 20\nmode twist\n  twist y 25\nmode squash\n  squash y 0.3\n");
-  const std::vector<DeformationMode3> modes = formats::ParseDeformations3(modes_text, "m.def3", def.lattice);
-  const BodyModel3 body(def, modes);
+  const std::vector<DeformationModeN<3>> modes = formats::ParseDeformations(modes_text, "m.def3", def.lattice);
+  const BodyModelN<3> body(def, modes);
   const Eigen::Vector3d gamma(0.7, -0.4, 1.3);
   std::vector<Vec3> control = def.lattice.RestPoints();
   for (size_t c = 0; c < control.size(); ++c)

@@ -466,7 +466,7 @@ TEST(RenderedExr, A3dHeightfieldIsTheTerrainLayer) {
   o.params.ground_plane.enabled = true;
   o.params.ground_plane.heightfield = Heightfield::Make(origin, spacing, nx, nz, heights);
   World world(o);
-  world.AddBody(std::make_shared<const BodyModel3>(testing::Chair3()));
+  world.AddBody(std::make_shared<const BodyModelN<3>>(testing::Chair3()));
   world.SetState(0, PositionsOf(Eigen::Vector3d(-50, 200, -30), Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())), Eigen::VectorXd::Zero(3)), Eigen::VectorXd::Zero(9));
   SceneOptions opt;
   opt.width = 320;

@@ -102,7 +102,7 @@ TEST(Mesh3Io, BadMeshFilesAreNamed) {
 }
 
 TEST(Mesh3Io, ShippedObjectsLoadWithTheirMass) {
-  const BodyDef3 pot = ReadObject3(kData + "/pot3.obj");
+  const BodyDefN<3> pot = ReadObject<3>(kData + "/pot3.obj");
   double total = 0;
   for (double m : pot.masses) total += m;
   EXPECT_NEAR(total, 750, 1e-9);
@@ -112,7 +112,7 @@ TEST(Mesh3Io, ShippedObjectsLoadWithTheirMass) {
   const std::string obj = TempDir() + "/bad_mesh.obj";
   std::ofstream(obj) << "dimension 3\n# a missing mesh\nmesh nowhere.stl\nsample volume 10 1\n";
   try {
-    ReadObject3(obj);
+    ReadObject<3>(obj);
     FAIL();
   } catch (const formats::ParseError& e) {
     EXPECT_EQ(e.line(), 3);
@@ -122,12 +122,12 @@ TEST(Mesh3Io, ShippedObjectsLoadWithTheirMass) {
 
 // A 3D body made of the shipped pot and its modes, turned, moving and deformed.
 World MovingPot() {
-  BodyDef3 def = ReadObject3(kData + "/pot3.obj");
-  std::vector<DeformationMode3> modes = formats::ReadDeformationFile3(kData + "/pot3_modes.def3", def.lattice);
+  BodyDefN<3> def = ReadObject<3>(kData + "/pot3.obj");
+  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile(kData + "/pot3_modes.def3", def.lattice);
   WorldOptions options;
   options.params.ground_plane.enabled = false;
   World w(options);
-  w.AddBody(std::make_shared<const BodyModel3>(std::move(def), std::move(modes)));
+  w.AddBody(std::make_shared<const BodyModelN<3>>(std::move(def), std::move(modes)));
   Eigen::VectorXd v(9);
   v << 3, -2, 1, 0.4, -0.7, 0.25, 0.5, -0.3, 0.8;
   w.SetState(0, PositionsOf(Vec3(10, 40, -5), Eigen::Quaterniond(Eigen::AngleAxisd(0.6, Vec3(1, 2, -1).normalized())), Eigen::Vector3d(0.3, -0.2, 0.15)), v);
@@ -137,7 +137,7 @@ World MovingPot() {
 // Eq. 4.1/4.2 at a body-frame point: the deformed control points L + Σ γ_d d^d weighted at
 // the point's lattice coordinates, then into the world.
 Vec3 DirectWorldPoint(const World& w, const Vec3& body_point) {
-  const BodyModel3& m = w.body<3>(0);
+  const BodyModelN<3>& m = w.body<3>(0);
   const BodyState<3, double>& s = w.state<3>(0);
   std::vector<Vec3> control = m.lattice().RestPoints();
   for (size_t c = 0; c < control.size(); ++c)
@@ -146,9 +146,9 @@ Vec3 DirectWorldPoint(const World& w, const Vec3& body_point) {
 }
 
 TEST(Mesh3Sources, SpringsOfA3dBodyRunFromTheAnchorToTheHeldPoint) {
-  BodyDef3 def = ReadObject3(kData + "/pot3.obj");
-  std::vector<DeformationMode3> modes = formats::ReadDeformationFile3(kData + "/pot3_modes.def3", def.lattice);
-  auto body = std::make_shared<const BodyModel3>(std::move(def), std::move(modes));
+  BodyDefN<3> def = ReadObject<3>(kData + "/pot3.obj");
+  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile(kData + "/pot3_modes.def3", def.lattice);
+  auto body = std::make_shared<const BodyModelN<3>>(std::move(def), std::move(modes));
   WorldOptions options;
   const Vec3 coords(0.5, 1.0, 0.25), anchor(0, 300, 20);
   options.params.springs.push_back(MakeSpring(*body, coords, anchor, 100.0, 1.0, 20.0));
@@ -172,7 +172,7 @@ TEST(Mesh3Sources, SpringsOfA3dBodyRunFromTheAnchorToTheHeldPoint) {
 // the voxel's place from the image's origin, spacing and direction is that rest point.
 TEST(Mesh3Sources, DisplacementVolumeHoldsEachVoxelsMotion) {
   const World w = MovingPot();
-  const BodyModel3& body = w.body<3>(0);
+  const BodyModelN<3>& body = w.body<3>(0);
   const BodyState<3, double>& s = w.state<3>(0);
   const int nx = 8, ny = 6, nz = 5;
   const vtkSmartPointer<vtkImageData> image = pipelines::DisplacementVolume(w, 0, nx, ny, nz);
@@ -186,7 +186,7 @@ TEST(Mesh3Sources, DisplacementVolumeHoldsEachVoxelsMotion) {
       for (int k : {0, 2, 4}) {
         const Vec3 u((i + 0.5) / nx, (j + 0.5) / ny, (k + 0.5) / nz);
         Vec3 b0;
-        BodyModel3::ModeMatrix B;
+        BodyModelN<3>::ModeMatrix B;
         body.LocalBasis(u, &b0, &B);
         const Vec3 rest = body.lattice().Evaluate(body.lattice().RestPoints(), u);
         const Vec3 moved = s.translation() + s.orientation() * (b0 + B * s.gamma());
@@ -223,7 +223,7 @@ TEST(Mesh3Sources, LatticeAndMassPointsOfA3dBody) {
   EXPECT_EQ(lattice->GetOutput()->GetNumberOfLines(), 3 * 16);  // 4 x 4 rows along each axis
   const auto points = Source<MassPointSource>(w);
   vtkPolyData* pd = points->GetOutput();
-  const BodyModel3& m = w.body<3>(0);
+  const BodyModelN<3>& m = w.body<3>(0);
   ASSERT_EQ(pd->GetNumberOfPoints(), m.num_points());
   // velocities against a central difference of the positions: t + h ṫ, R exp(h ω̂) (ω in the
   // body frame), γ + h γ̇
@@ -254,11 +254,11 @@ TEST(Mesh3Sources, AppliedForcesSumToTheGeneralizedForcesTranslationRows) {
   // the pot pressed into the ground plane and sliding: Σ_k f_k over the mass points (gravity
   // plus each contact's penalty and capped friction) is the translation rows of Q, since
   // J_t = 1 for every point (EvaluateForces3, the step's own forces, frozen at the contacts)
-  BodyDef3 def = ReadObject3(kData + "/pot3.obj");
+  BodyDefN<3> def = ReadObject<3>(kData + "/pot3.obj");
   WorldOptions options;
   options.params.ground_plane.enabled = true;
   World w(options);
-  w.AddBody(std::make_shared<const BodyModel3>(std::move(def), std::vector<DeformationMode3>()));
+  w.AddBody(std::make_shared<const BodyModelN<3>>(std::move(def), std::vector<DeformationModeN<3>>()));
   w.SetState(0, PositionsOf(Vec3(0, -2, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Vec3::UnitX())), Eigen::VectorXd()), (Eigen::VectorXd(6) << 30, -5, 10, 0, 0.4, 0).finished());
   ASSERT_TRUE(w.Step());
   ASSERT_GT(w.state<3>(0).contacts.size(), 10u);
@@ -289,7 +289,7 @@ TEST(Mesh3Record, ConditionNumberOverA3dRunIsThePerPointMassMatrixs) {
   }
   const std::vector<double> cond = pipelines::ConditionNumbers(run, 0);
   ASSERT_EQ(int(cond.size()), run.size());
-  const BodyModel3& body = w.body<3>(0);
+  const BodyModelN<3>& body = w.body<3>(0);
   const int n = body.num_q();
   double lo = HUGE_VAL, hi = 0;
   for (int k = 0; k < run.size(); k += 13) {

@@ -259,12 +259,12 @@ TEST(RenderOverlay, EnergyIsTheSumOfTheTermsListedAndTheColourBarClearsTheText) 
 // turned above the ground plane, with its lattice and mass points, in perspective.
 TEST(RenderRegression, MeshCharacter3d) {
   REQUIRE_DISPLAY();
-  BodyDef3 def = ReadObject3(wobble::test_env::DataDir() + "/pot3.obj");
-  std::vector<DeformationMode3> modes = formats::ReadDeformationFile3(wobble::test_env::DataDir() + "/pot3_modes.def3", def.lattice);
+  BodyDefN<3> def = ReadObject<3>(wobble::test_env::DataDir() + "/pot3.obj");
+  std::vector<DeformationModeN<3>> modes = formats::ReadDeformationFile(wobble::test_env::DataDir() + "/pot3_modes.def3", def.lattice);
   WorldOptions options;
   options.params.ground_plane.enabled = true;
   World world(options);
-  world.AddBody(std::make_shared<const BodyModel3>(std::move(def), std::move(modes)));
+  world.AddBody(std::make_shared<const BodyModelN<3>>(std::move(def), std::move(modes)));
   world.SetState(0, PositionsOf(Eigen::Vector3d(0, 40, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 0, 0.5).normalized())), Eigen::Vector3d(-0.3, 0.4, 0.5)), Eigen::VectorXd::Zero(9));
   SceneOptions o;
   o.width = 240;

@@ -132,7 +132,7 @@ TEST(Trajectory, RestoreAtInterpolatesBetweenSamples) {
   // a 3D body turning: the orientation between two samples is the normalised blend
   World w3(WorldOptions{});
   w3.mutable_options().params.ground_plane.enabled = false;
-  const int b = w3.AddBody(std::make_shared<const BodyModel3>(testing::Chair3()));
+  const int b = w3.AddBody(std::make_shared<const BodyModelN<3>>(testing::Chair3()));
   const Eigen::VectorXd g0 = Eigen::VectorXd::Zero(w3.body<3>(b).num_modes());
   w3.SetState(b, PositionsOf(Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), g0), (Eigen::VectorXd(6 + g0.size()) << Eigen::VectorXd::Zero(3), 0.5, 2.0, -1.0, g0).finished());
   auto run3 = std::make_shared<record::Trajectory>(w3);
@@ -225,6 +225,52 @@ TEST(TrajectoryCsv, RefusesAPoseThatIsNoIndex) {
   EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1,pose\n0,1,2,3,4,-2\n"),
             "ref.csv:2: expected a whole number >= -1 in column 6 (pose), got '-2'");
   EXPECT_EQ(CsvMessage("t,tx,ty,theta,g1,pose\n0,1,2,3,4,-1\n1,1,2,3,4,3\n"), "no error");
+}
+
+// A body read from a file without its model takes its mode count from its coordinates: 0 there
+// dropped the target columns from the schema and a 3D body's γ from Restore.
+TEST(BodyInfo, CountsTheModesOfABodyReadWithoutItsModel) {
+  World w;
+  w.AddBody(Table());
+  w.AddBody(std::make_shared<const BodyModelN<3>>(testing::Chair3()));
+  Eigen::VectorXd q3(9), qd3 = Eigen::VectorXd::Zero(9);
+  q3 << 1, 2, 3, 0.1, -0.2, 0.3, 0.05, -0.04, 0.03;
+  w.SetCoordinates(1, q3, qd3);
+  record::Trajectory recorded(w);
+  ASSERT_EQ(recorded.Append(w), -1);
+  std::vector<record::BodyInfo> read;  // what a caller knows of a file: names and dimension
+  for (const record::BodyInfo& b : recorded.bodies()) {
+    record::BodyInfo r;
+    r.name = b.name;
+    r.dim = b.dim;
+    r.num_q = b.num_q;
+    r.coordinate_names = b.coordinate_names;
+    r.velocity_names = b.velocity_names;
+    read.push_back(r);
+  }
+  EXPECT_EQ(read[0].num_modes(), 4);
+  EXPECT_EQ(read[1].num_modes(), 3);
+  record::Trajectory file(read);
+  EXPECT_EQ(file.Columns(), recorded.Columns());
+  file.AppendRow(std::vector<double>(recorded.Row(0), recorded.Row(0) + recorded.num_columns()));
+  World back;
+  back.AddBody(w.shared_body<2>(0));
+  back.AddBody(w.shared_body<3>(1));
+  file.Restore(0, back);
+  EXPECT_NEAR((back.coordinates(1) - q3).norm(), 0.0, 1e-12);
+
+  // an FFD body with neither model nor coordinates says so instead of "no modes"
+  record::BodyInfo unknown;
+  unknown.name = "ghost";
+  try {
+    (void)unknown.num_modes();
+    ADD_FAILURE() << "no error";
+  } catch (const std::logic_error& e) {
+    EXPECT_NE(std::string(e.what()).find("'ghost' has neither a model nor its coordinates"), std::string::npos) << e.what();
+  }
+  record::BodyInfo linear;
+  linear.kind = BodyKind::kLinear;
+  EXPECT_EQ(linear.num_modes(), 0);
 }
 
 }  // namespace

@@ -488,7 +488,7 @@ TEST(Script3d, FreeFallAndSpinFollowTheClosedForms) {
   script::Interpreter interp(out);
   const double g = 9.81, t = 0.8, w = 0.5;
   Run3d(interp, "set ground F\nset integrator rk4\nset dt 1e-3\n", false);  // rigid: no modes to excite
-  const BodyModel3 body(formats::ReadObjectFile3(kData + "/table3.obj"), {});
+  const BodyModelN<3> body(formats::ReadObjectFile<3>(kData + "/table3.obj"), {});
   const Eigen::Vector3d c = body.moments().c0 / body.moments().m;
   const Eigen::Vector3d v = -Eigen::Vector3d(0, w, 0).cross(c);  // ṫ = −ω × c: the centre at rest
   std::ostringstream lines;
@@ -516,12 +516,12 @@ TEST(Script3d, PlacementTurnsAboutZAndPoseGraphsKeepTheMomentum) {
   EXPECT_LT((q.head<3>() - Eigen::Vector3d(10 + std::cos(0.3), 20 + std::sin(0.3), 0)).norm(), 1e-14);
   EXPECT_LT((q.segment<3>(3) - Eigen::Vector3d(0, 0, 0.3)).norm(), 1e-14);
   // a pose graph on the bend: internal forces only, so the centre of mass stays where it was
-  const BodyDef3 def = formats::ReadObjectFile3(kData + "/table3.obj");
-  const BodyModel3 body(def, formats::ReadDeformationFile3(kData + "/table3_modes.def3", def.lattice));
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(kData + "/table3.obj");
+  const BodyModelN<3> body(def, formats::ReadDeformationFile(kData + "/table3_modes.def3", def.lattice));
   auto centre = [&](const Eigen::VectorXd& x) {
     const Eigen::Vector3d r = x.segment<3>(3);
     const Eigen::Quaterniond R(Eigen::AngleAxisd(r.norm(), r.normalized()));
-    const MassMoments3& mm = body.moments();
+    const MassMomentsN<3>& mm = body.moments();
     return Eigen::Vector3d(x.head<3>() + R * ((mm.c0 + mm.C * x.tail(4)) / mm.m));
   };
   const Eigen::Vector3d c0 = centre(q);
@@ -549,7 +549,7 @@ TEST(Script3d, A3dObjectJoinsAWitkinWelchSceneNailedAndAttached) {
 TEST(Script3d, ASpringAtTheCentreOfMassOscillatesWithItsPeriod) {
   // no gravity, no ground, no modes: a spring from the centre of mass to the world point where
   // the centre rests pulls it back as x(t) = A cos(√(k/m) t), and never turns the body
-  const BodyModel3 body(formats::ReadObjectFile3(kData + "/table3.obj"), {});
+  const BodyModelN<3> body(formats::ReadObjectFile<3>(kData + "/table3.obj"), {});
   const double m = body.moments().m, k = 5e4, A = 12.0;
   const Eigen::Vector3d c = body.moments().c0 / m, u = body.lattice().LocalCoords(c);
   const double omega = std::sqrt(k / m), period = 2 * M_PI / omega, t = 0.75 * period;
@@ -576,8 +576,8 @@ TEST(Script3d, KeyframesHoldAPointAndHandOverContinuously) {
   script::Interpreter interp(out);
   Run3d(interp, "set gravity F\nset ground F\nset dt 1e-3\nset_vec q 10 20 30 0.1 0.4 -0.2 0 0 0 0\nhold 0 0 0\n"
                 "key 0\nkey 0.3 bend=0.2 twist=-0.1\nkey 0.5 bend=0.3 twist=0.1\n");
-  const BodyDef3 def = formats::ReadObjectFile3(kData + "/table3.obj");
-  const BodyModel3 body(def, formats::ReadDeformationFile3(kData + "/table3_modes.def3", def.lattice));
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(kData + "/table3.obj");
+  const BodyModelN<3> body(def, formats::ReadDeformationFile(kData + "/table3_modes.def3", def.lattice));
   auto foot = [&](const Eigen::VectorXd& q) {
     const Eigen::Vector3d r = q.segment<3>(3);
     const Eigen::Quaterniond R(Eigen::AngleAxisd(r.norm(), r.normalized()));

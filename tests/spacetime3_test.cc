@@ -17,8 +17,8 @@ namespace {
 constexpr int kModes = 3;             // the chair's bend, twist and squash
 constexpr int kNz = 12 + 2 * kModes;  // tangent coordinates of a state
 
-const BodyModel3& Chair() {
-  static const BodyModel3 chair = testing::Chair3();
+const BodyModelN<3>& Chair() {
+  static const BodyModelN<3> chair = testing::Chair3();
   return chair;
 }
 
@@ -53,7 +53,7 @@ BodyState<3, double> Moved(const BodyState<3, double>& s, int i, double h) {
 
 // Centre of mass and its velocity by the direct per-point formulas: x_k = t + R l_k,
 // ẋ_k = ṫ + R (ω × l_k + B_k γ̇), l_k = b0_k + B_k γ, summed with the point masses.
-void PerPointCentre(const BodyModel3& body, const BodyState<3, double>& s, Eigen::Vector3d* x, Eigen::Vector3d* v) {
+void PerPointCentre(const BodyModelN<3>& body, const BodyState<3, double>& s, Eigen::Vector3d* x, Eigen::Vector3d* v) {
   const Eigen::Matrix3d R = s.orientation().toRotationMatrix();
   const Eigen::Vector3d omega = s.qd.segment<3>(3);
   double m = 0.0;

@@ -256,9 +256,9 @@ namespace {
 // axis away from the centre and with its modes free to ring.
 TEST(Synthesis3d, ATrialMeasuresTheUniformTravelOfAFreeBodysCentre) {
   const std::string data = wobble::test_env::DataDir();
-  const BodyDef3 def = formats::ReadObjectFile3(data + "/table3.obj");
+  const BodyDefN<3> def = formats::ReadObjectFile<3>(data + "/table3.obj");
   synth::Problem p;
-  p.body3 = std::make_shared<const BodyModel3>(def, formats::ReadDeformationFile3(data + "/table3_modes.def3", def.lattice));
+  p.set_body(std::make_shared<const BodyModelN<3>>(def, formats::ReadDeformationFile(data + "/table3_modes.def3", def.lattice)));
   p.world.params.gravity_on = false;
   p.world.integrator = Integrator::kRK4;
   p.world.dt = 1e-3;
@@ -269,7 +269,7 @@ TEST(Synthesis3d, ATrialMeasuresTheUniformTravelOfAFreeBodysCentre) {
   p.qd0 << 3, 1, 0, 0, 0.8, 0.2, 0, 0, 0, 0;
   // the centre's x velocity at the start, from the same state in a world
   World w(p.world);
-  w.AddBody(p.body3);
+  w.AddBody(p.body<3>());
   w.SetCoordinates(0, p.q0, p.qd0);
   double x0, v0;
   synth::CenterOfMassX(w, &x0, &v0);

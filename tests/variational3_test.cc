@@ -26,7 +26,7 @@ std::string Sci(double x) {
   return text;
 }
 
-double TotalEnergy(const BodyModel3& body, const BodyState<3, double>& s) {
+double TotalEnergy(const BodyModelN<3>& body, const BodyState<3, double>& s) {
   const ShapeMoments<double> sm(body.moments(), s.gamma());
   double V = 0.0;
   for (int d = 0; d < body.num_modes(); ++d) V += body.modes()[d].stiffness * s.gamma()[d] * s.gamma()[d];
@@ -35,7 +35,7 @@ double TotalEnergy(const BodyModel3& body, const BodyState<3, double>& s) {
 
 // Velocities of a rigid spin at ω (body frame) about the centre of mass, which stays still:
 // ẋ_com = ṫ + R(ω × c/m) = 0.
-BodyState<3, double> Spinning(const BodyModel3& body, const Vector3d& omega) {
+BodyState<3, double> Spinning(const BodyModelN<3>& body, const Vector3d& omega) {
   BodyState<3, double> s = RestState<3, double>(body);
   s.qd.segment<3>(3) = omega;
   s.qd.head<3>() = -(s.orientation().toRotationMatrix() * omega.cross(body.moments().c0 / body.moments().m));
@@ -45,11 +45,11 @@ BodyState<3, double> Spinning(const BodyModel3& body, const Vector3d& omega) {
 // A body mirror-symmetric about its plane l_z = a for every γ: a 3x3x3 lattice spanning
 // z ∈ [0, 2a], masses in mirrored pairs, and modes whose x, y displacements are even in l_z − a
 // and whose z displacement is odd in it. The body origin (the lattice corner) is off that plane.
-BodyModel3 MirrorBody(double stiffness, double a = 0.75) {
-  BodyDef3 def;
+BodyModelN<3> MirrorBody(double stiffness, double a = 0.75) {
+  BodyDefN<3> def;
   def.name = "mirror";
   const Vector3d size(1.0, 2.0, 2 * a);
-  def.lattice = Lattice3(Vector3d(-0.5, -1.0, 0.0), {Vector3d(size.x(), 0, 0), Vector3d(0, size.y(), 0),
+  def.lattice = LatticeN<3>(Vector3d(-0.5, -1.0, 0.0), {Vector3d(size.x(), 0, 0), Vector3d(0, size.y(), 0),
                                                      Vector3d(0, 0, size.z())},
                          {3, 3, 3}, BasisKind::kBernstein);
   std::mt19937 rng(5);
@@ -62,7 +62,7 @@ BodyModel3 MirrorBody(double stiffness, double a = 0.75) {
     def.masses.push_back(m);
     def.masses.push_back(m);
   }
-  std::vector<DeformationMode3> modes(2);
+  std::vector<DeformationModeN<3>> modes(2);
   const std::vector<Vector3d> rest = def.lattice.RestPoints();
   for (int d = 0; d < 2; ++d) {
     modes[d].name = "m" + std::to_string(d);
@@ -74,16 +74,16 @@ BodyModel3 MirrorBody(double stiffness, double a = 0.75) {
       else modes[d].displacement.push_back({0.1 * p.x() * p.y(), -0.25 * p.y(), -0.3 * z * p.x()});
     }
   }
-  return BodyModel3(def, modes);
+  return BodyModelN<3>(def, modes);
 }
 
 // A body with no symmetry: skew lattice, random masses and modes (as body3_test's RandomBody3).
-BodyModel3 LopsidedBody(double stiffness) {
+BodyModelN<3> LopsidedBody(double stiffness) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0), disp(-0.3, 0.3), mass(1.0, 5.0);
-  BodyDef3 def;
+  BodyDefN<3> def;
   def.name = "lopsided";
-  def.lattice = Lattice3(Vector3d(-0.2, 0.05, 0.03),
+  def.lattice = LatticeN<3>(Vector3d(-0.2, 0.05, 0.03),
                          {Vector3d(2.5, 0.2, -0.1), Vector3d(-0.3, 1.2, 0.15), Vector3d(0.1, -0.05, 0.9)}, {3, 3, 3},
                          BasisKind::kBernstein);
   for (int k = 0; k < 15; ++k) {
@@ -92,14 +92,14 @@ BodyModel3 LopsidedBody(double stiffness) {
     def.mass_positions.push_back(p);
     def.masses.push_back(mass(rng));
   }
-  std::vector<DeformationMode3> modes(3);
+  std::vector<DeformationModeN<3>> modes(3);
   for (int d = 0; d < 3; ++d) {
     modes[d].name = "m" + std::to_string(d);
     modes[d].lattice_size = {3, 3, 3};
     modes[d].stiffness = stiffness;
     for (int c = 0; c < def.lattice.size(); ++c) modes[d].displacement.push_back({disp(rng), disp(rng), disp(rng)});
   }
-  return BodyModel3(def, modes);
+  return BodyModelN<3>(def, modes);
 }
 
 // The Cayley map on SE(3) and its momentum map (variational.h) against the 4x4 matrices:
@@ -148,7 +148,7 @@ TEST(Variational3, CayleyMapOnSE3MatchesTheMatrixFormulas) {
 // A symmetric discrete Lagrangian (midpoint or trapezoid) integrates a constant force exactly,
 // so after 100 steps the translation must match the closed form to rounding.
 TEST(Variational3, RigidFreeFallFromRestIsExact) {
-  const BodyModel3 box = Box(1.0, 2.0, 3.0, 0.5);  // the centre of mass away from the body origin
+  const BodyModelN<3> box = Box(1.0, 2.0, 3.0, 0.5);  // the centre of mass away from the body origin
   WorldParams w;
   for (const Eigen::Quaterniond& start :
        {Eigen::Quaterniond::Identity(), Eigen::Quaterniond(0.3, -0.5, 0.7, 0.2).normalized()}) {
@@ -173,7 +173,7 @@ double StateDistance(const BodyState<3, double>& a, const BodyState<3, double>& 
          (a.gamma() - b.gamma()).norm() + (a.qd - b.qd).norm();
 }
 
-BodyState<3, double> Simulate(const BodyModel3& body, const WorldParams& w, BodyState<3, double> s, Integrator integrator,
+BodyState<3, double> Simulate(const BodyModelN<3>& body, const WorldParams& w, BodyState<3, double> s, Integrator integrator,
                          double dt, double duration) {
   const int steps = int(std::lround(duration / dt));
   for (int step = 0; step < steps; ++step) {
@@ -191,7 +191,7 @@ BodyState<3, double> Simulate(const BodyModel3& body, const WorldParams& w, Body
 TEST(Variational3, ErrorQuartersWhenTheStepHalves) {
   struct Case {
     const char* name;
-    BodyModel3 body;
+    BodyModelN<3> body;
     bool gravity;
     double speed;
   };
@@ -226,7 +226,7 @@ TEST(Variational3, ErrorQuartersWhenTheStepHalves) {
 TEST(Variational3, MirrorSymmetricStartStaysInItsPlane) {
   struct Case {
     const char* name;
-    BodyModel3 body;
+    BodyModelN<3> body;
     double a;  // the symmetry plane is l_z = a
   };
   std::vector<Case> cases;
@@ -260,7 +260,7 @@ TEST(Variational3, MirrorSymmetricStartStaysInItsPlane) {
 // (d) Symplectic: the energy error of a free spinning, vibrating body stays bounded over 10⁴
 // steps (the second half no worse than the first: no drift) and is O(Δt²) (a quarter at Δt/2).
 TEST(Variational3, FreeSpinningEnergyStaysBoundedOver1e4Steps) {
-  const BodyModel3 body = LopsidedBody(50.0);
+  const BodyModelN<3> body = LopsidedBody(50.0);
   WorldParams w;
   w.gravity_on = false;
   auto run = [&](double dt, int steps, double* first_half) {

@@ -19,8 +19,7 @@ namespace wobble::python {
 namespace py = pybind11;
 
 void BindErrors(py::module_& m);   // exceptions (errors.cc)
-void BindBodies(py::module_& m);   // BodyModel, modes, loading (bodies.cc)
-void BindBodies3(py::module_& m);  // BodyModel3, the deprecated 3D names of the bodies and the World (bodies3.cc)
+void BindBodies(py::module_& m);   // BodyModel, BodyModel3 (3D), modes, loading (bodies.cc)
 void BindWorld(py::module_& m);    // WorldOptions, Ground, World, Energies (world.cc)
 void BindBehaviours(py::module_& m);  // anchors and goal behaviours as a controller (behaviours.cc)
 void BindRecord(py::module_& m);   // Trajectory, simulate (record.cc)

@@ -291,7 +291,7 @@ void BindFit(py::module_& m) {
 
   m.def(
       "fit_pose_to_surface",
-      [](std::shared_ptr<BodyModel3> body, const py::object& vertices, const py::object& triangles,
+      [](std::shared_ptr<BodyModelN<3>> body, const py::object& vertices, const py::object& triangles,
          const py::object& cloud, const py::object& initial_q, const std::string& loss, double loss_scale,
          double prior_weight, std::pair<double, double> bounds, int max_iterations, int mesh_samples, bool two_sided) {
         fit::SurfaceTarget target;

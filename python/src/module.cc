@@ -9,7 +9,6 @@ PYBIND11_MODULE(_wobble, m) {
   BindErrors(m);
   BindBodies(m);
   BindWorld(m);
-  BindBodies3(m);  // after World: it adds the World's 3D methods
   BindBehaviours(m);  // after World: a Controller
   BindRecord(m);
   BindRollout(m);

@@ -36,7 +36,7 @@ py::array_t<double, py::array::c_style> Rows(const py::handle& h, long n, const 
 // A 2D body's state is (q, q̇); a 3D body's q = [t, rotation vector, γ] and q̇ = [ṫ, body ω, γ̇]
 // (World.q3 / set_state3).
 void SetStart(World* w, const BodyModel&, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) { w->SetState(0, q, qd); }
-void SetStart(World* w, const BodyModel3&, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+void SetStart(World* w, const BodyModelN<3>&, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
   w->SetCoordinates(0, q, qd);
 }
 void ReadState(const World& w, const BodyModel&, double* q, double* qd) {
@@ -44,7 +44,7 @@ void ReadState(const World& w, const BodyModel&, double* q, double* qd) {
   std::copy(s.q.data(), s.q.data() + s.q.size(), q);
   std::copy(s.qd.data(), s.qd.data() + s.qd.size(), qd);
 }
-void ReadState(const World& w, const BodyModel3&, double* q, double* qd) {
+void ReadState(const World& w, const BodyModelN<3>&, double* q, double* qd) {
   const Eigen::VectorXd q3 = w.coordinates(0), qd3 = w.qd(0);
   std::copy(q3.data(), q3.data() + q3.size(), q);
   std::copy(qd3.data(), qd3.data() + qd3.size(), qd);

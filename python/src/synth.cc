@@ -35,7 +35,7 @@ Eigen::MatrixXd PosesOf(const PoseGraph& g) {
 }
 
 int NumActive(const Problem& p) {
-  return int(p.body3 ? control::ActiveModes(*p.body3).size() : control::ActiveModes(*p.body).size());
+  return int(p.dim() == 3 ? control::ActiveModes(*p.body<3>()).size() : control::ActiveModes(*p.body<2>()).size());
 }
 
 struct TrialResults {
@@ -138,9 +138,9 @@ void BindSynth(py::module_& m) {
   py::class_<Problem>(m, "SynthesisProblem",
                       "A body, its world and start state, the trial length and the cost: what `anneal` solves.\n"
                       "Get the one a script set up with Interpreter.synthesis_problem().")
-      .def_property_readonly("body", [](const Problem& p) { return std::const_pointer_cast<BodyModel>(p.body); },
+      .def_property_readonly("body", [](const Problem& p) { return std::const_pointer_cast<BodyModel>(p.body<2>()); },
                              "the 2D body (None for a 3D problem)")
-      .def_property_readonly("body3", [](const Problem& p) { return std::const_pointer_cast<BodyModel3>(p.body3); },
+      .def_property_readonly("body3", [](const Problem& p) { return std::const_pointer_cast<BodyModelN<3>>(p.body<3>()); },
                              "the 3D body (None for a 2D problem); q0, qd0 then [t, rotation vector, γ], [ṫ, ω, γ̇]")
       .def_readwrite("options", &Problem::world)
       .def_readwrite("q0", &Problem::q0)

@@ -245,7 +245,7 @@ void BindWorld(py::module_& m) {
              control::HeldPoint held;
              if (!hold.is_none()) {
                held.enabled = true;
-               held.lattice_coords = AsVector(hold, 2, "hold");
+               held.lattice_coords.head<2>() = AsVector(hold, 2, "hold");
              }
              return std::make_shared<control::KeyframeController>(w, body, keys, held);
            }),
@@ -265,7 +265,7 @@ void BindWorld(py::module_& m) {
       .def(py::init<WorldOptions>(), py::arg("options") = WorldOptions())
       .def("add_body", [](World& w, std::shared_ptr<BodyModel> body) { return w.AddBody(body); }, py::arg("body"),
            "Adds an FFD body (2D or 3D) at q = 0 (its lattice's pose), at rest; returns its index.")
-      .def("add_body", [](World& w, std::shared_ptr<BodyModel3> body) { return w.AddBody(body); }, py::arg("body"))
+      .def("add_body", [](World& w, std::shared_ptr<BodyModelN<3>> body) { return w.AddBody(body); }, py::arg("body"))
       .def_property_readonly("num_bodies", &World::num_bodies)
       .def_property_readonly("time", &World::time)
       .def_property_readonly("steps", &World::steps)
@@ -278,7 +278,7 @@ void BindWorld(py::module_& m) {
           "body",
           [](const World& w, int body) -> py::object {
             CheckBody(w, body);
-            if (w.dim(body) == 3) return py::cast(std::const_pointer_cast<BodyModel3>(w.shared_body<3>(body)));
+            if (w.dim(body) == 3) return py::cast(std::const_pointer_cast<BodyModelN<3>>(w.shared_body<3>(body)));
             return py::cast(std::const_pointer_cast<BodyModel>(w.shared_body<2>(body)));
           },
           py::arg("body"), "the FFD body's model (BodyModel or BodyModel3)")
@@ -462,6 +462,12 @@ void BindWorld(py::module_& m) {
       .def("set_enabled", &World::SetEnabled, py::arg("id"), py::arg("enabled"))
       .def("max_violation", &World::MaxViolation, "the largest |c| of the enabled constraints")
       .def("constraint_error", &World::ConstraintError, py::arg("id"));
+
+  // release 0.1's 3D names: the methods take either body now
+  const py::object world = m.attr("World");
+  for (const auto& [old_name, name] : {std::pair{"add_body3", "add_body"}, {"body3", "body"}, {"q3", "q"},
+                                       {"qd3", "qd"}, {"set_state3", "set_state"}})
+    BindDeprecated(world, old_name, name);
 }
 
 }  // namespace wobble::python

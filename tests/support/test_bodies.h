@@ -134,24 +134,24 @@ inline SurfaceMesh ChairMesh() {
 
 // The chair as a 3D FFD character: its lattice fitted with a 5% margin, 100 kg on a volume grid
 // of about 300 points, and three modes from generators (bend x by y, twist about y, squash y).
-inline BodyModel3 Chair3() {
+inline BodyModelN<3> Chair3() {
   std::istringstream object("dimension 3\nmesh chair\nlattice fit 4 4 3 margin 0.05\nsample volume 300 100\n");
-  BodyDef3 def = formats::ParseObject3(object, "chair.obj", [](const std::string&) { return ChairMesh(); });
+  BodyDefN<3> def = formats::ParseObject<3>(object, "chair.obj", [](const std::string&) { return ChairMesh(); });
   std::istringstream text("dimension 3\nmode bend\n  bend x y 20\nmode twist\n  twist y 25\nmode squash\n  squash y 0.3\n");
-  std::vector<DeformationMode3> modes = formats::ParseDeformations3(text, "chair.def3", def.lattice);
-  return BodyModel3(def, modes);
+  std::vector<DeformationModeN<3>> modes = formats::ParseDeformations(text, "chair.def3", def.lattice);
+  return BodyModelN<3>(def, modes);
 }
 
 // A 3D box of eight corner masses with unequal sides: principal axes along the lattice axes,
 // centre of mass away from the body origin (the lattice corner).
-inline BodyModel3 Box(double a, double b, double c, double mass = 1.0) {
-  BodyDef3 def;
+inline BodyModelN<3> Box(double a, double b, double c, double mass = 1.0) {
+  BodyDefN<3> def;
   def.name = "box";
-  def.lattice = Lattice3(Eigen::Vector3d::Zero(), {Eigen::Vector3d(a, 0, 0), Eigen::Vector3d(0, b, 0), Eigen::Vector3d(0, 0, c)},
+  def.lattice = LatticeN<3>(Eigen::Vector3d::Zero(), {Eigen::Vector3d(a, 0, 0), Eigen::Vector3d(0, b, 0), Eigen::Vector3d(0, 0, c)},
                          {2, 2, 2}, BasisKind::kBernstein);
   for (int i = 0; i < 8; ++i) def.mass_positions.push_back(Eigen::Vector3d(a * (i & 1), b * ((i >> 1) & 1), c * ((i >> 2) & 1)));
   def.masses.assign(8, mass);
-  return BodyModel3(def, {});
+  return BodyModelN<3>(def, {});
 }
 
 }  // namespace wobble::testing

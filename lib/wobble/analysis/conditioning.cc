@@ -142,11 +142,11 @@ std::vector<SweepSample> AngleSweep(const BodyDef& def, const std::vector<double
   return out;
 }
 
-std::vector<SweepSample> AngleSweep(const BodyDef3& def, const std::vector<double>& phis, const Squash& squash) {
-  const DeformationMode3 vertical = SquashMode(def.lattice, kPi / 2, squash, "vsquash");
+std::vector<SweepSample> AngleSweep(const BodyDefN<3>& def, const std::vector<double>& phis, const Squash& squash) {
+  const DeformationModeN<3> vertical = SquashMode(def.lattice, kPi / 2, squash, "vsquash");
   std::vector<SweepSample> out;
   for (double phi : phis) {
-    const BodyModel3 body(def, {vertical, SquashMode(def.lattice, phi, squash, "squash(phi)")});
+    const BodyModelN<3> body(def, {vertical, SquashMode(def.lattice, phi, squash, "squash(phi)")});
     out.push_back({phi, MassMatrixCondition(body, RestState<3, double>(body))});
   }
   return out;
@@ -300,7 +300,7 @@ ModeSetReport CheckModeSet(const BodyModel& body, const Eigen::VectorXd& q_in, c
   return CheckModes(body, Eigen::MatrixXd(M), options);
 }
 
-ModeSetReport CheckModeSet(const BodyModel3& body, const ModeCheckOptions& options) {
+ModeSetReport CheckModeSet(const BodyModelN<3>& body, const ModeCheckOptions& options) {
   const BodyState<3, double> rest = RestState<3, double>(body);
   const ShapeMoments<double> sm(body.moments(), rest.gamma());
   MatQ<double> M;
@@ -308,7 +308,7 @@ ModeSetReport CheckModeSet(const BodyModel3& body, const ModeCheckOptions& optio
   return CheckModes(body, Eigen::MatrixXd(M), options);
 }
 
-ConditionNumber MassMatrixCondition(const BodyModel3& body, const BodyState<3, double>& s) {
+ConditionNumber MassMatrixCondition(const BodyModelN<3>& body, const BodyState<3, double>& s) {
   const ShapeMoments<double> sm(body.moments(), s.gamma());
   MatQ<double> M;
   MassMatrix(body.moments(), sm, Mat3<double>(s.orientation().toRotationMatrix()), &M);

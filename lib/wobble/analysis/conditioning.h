@@ -28,7 +28,7 @@ ConditionNumber Condition(const Eigen::MatrixXd& M);
 // M(q) of a body (from its mass moments).
 ConditionNumber MassMatrixCondition(const BodyModel& body, const Eigen::VectorXd& q);
 // M of a 3D body at state s.
-ConditionNumber MassMatrixCondition(const BodyModel3& body, const BodyState<3, double>& s);
+ConditionNumber MassMatrixCondition(const BodyModelN<3>& body, const BodyState<3, double>& s);
 
 // Estimate of cond₁(A) = ‖A‖₁ ‖A⁻¹‖₁ by Hager's method (Higham's refinement of the iteration):
 // a few solves with an LU factorization, never A⁻¹ itself. A lower bound of cond₁, usually
@@ -67,7 +67,7 @@ std::vector<SweepSample> AngleSweep(const BodyDef& def, const std::vector<double
                                     const Eigen::VectorXd& q);
 
 // The sweep for a 3D body at rest (SquashMode's 3D squash).
-std::vector<SweepSample> AngleSweep(const BodyDef3& def, const std::vector<double>& phis, const Squash& squash);
+std::vector<SweepSample> AngleSweep(const BodyDefN<3>& def, const std::vector<double>& phis, const Squash& squash);
 
 // ---- how close the modes of a set are -----------------------------------------------------------
 
@@ -113,7 +113,7 @@ struct ModeSetReport {
 ModeSetReport CheckModeSet(const BodyModel& body, const Eigen::VectorXd& q = Eigen::VectorXd(),
                            const ModeCheckOptions& options = {});
 // The same check for a 3D body at rest (dofs: translations x, y, z, rotations x, y, z, modes).
-ModeSetReport CheckModeSet(const BodyModel3& body, const ModeCheckOptions& options = {});
+ModeSetReport CheckModeSet(const BodyModelN<3>& body, const ModeCheckOptions& options = {});
 std::string LevelName(ModeSetReport::Level level);
 
 }  // namespace wobble::analysis

@@ -35,7 +35,6 @@ template <int Dim> struct BodyDefN {
   TriangleMeshN<Dim> mesh;  // a surface to draw (3D: a user's mesh), moved by the FFD; never simulated
 };
 using BodyDef = BodyDefN<2>;
-using BodyDef3 = BodyDefN<3>;
 
 // Mass moments: with l_k(γ) = b0_k + B_k γ the local position of point k, sums over the mass
 // points that make every term of the dynamics a polynomial in γ of degree ≤ 2 (derivation in
@@ -64,7 +63,7 @@ using MassMoments = MassMomentsN<2>;
 //   S0 = Σ m_k b0_k b0_kᵀ, E_d = Σ m_k b0_k B^dᵀ, F_de = Σ m_k B^d B^eᵀ (3 x 3 each),
 //   H0 = [Σ m_k b0_k × B^d]_d (3 x D), X_de = Σ m_k B^d × B^e (= −X_ed).
 // The second moment K(γ) = Σ m_k l_k l_kᵀ = S0 + Σ_d γ_d (E_d + E_dᵀ) + Σ_de γ_d γ_e F_de gives
-// the inertia tensor about the body origin, I(γ) = tr(K) 1 − K; kinematics3.h has the rest.
+// the inertia tensor about the body origin, I(γ) = tr(K) 1 − K; dynamics/spatial_inertia.h has the rest.
 template <> struct MassMomentsN<3> {
   double m = 0;
   Eigen::Vector3d c0 = Eigen::Vector3d::Zero();
@@ -78,7 +77,6 @@ template <> struct MassMomentsN<3> {
   MatD<double> G_com_factor;       // CholeskyInPlace(G − CᵀC/m), as in 2D
   bool G_com_positive = false;
 };
-using MassMoments3 = MassMomentsN<3>;
 
 // Mass points grouped by where they sit in the lattice, with interval bounds of their local
 // positions: every l_k = b0_k + B_k γ of the group lies in the box centre(γ) ± half(γ) with
@@ -175,7 +173,6 @@ template <int Dim> class BodyModelN {
 };
 
 using BodyModel = BodyModelN<2>;
-using BodyModel3 = BodyModelN<3>;
 
 extern template class BodyModelN<2>;
 extern template class BodyModelN<3>;

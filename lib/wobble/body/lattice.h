@@ -84,7 +84,6 @@ template <int Dim> class LatticeN {
 };
 
 using Lattice = LatticeN<2>;
-using Lattice3 = LatticeN<3>;
 
 extern template class LatticeN<2>;
 extern template class LatticeN<3>;

@@ -29,6 +29,5 @@ template <int Dim> struct DeformationModeN {
 };
 
 using DeformationMode = DeformationModeN<2>;
-using DeformationMode3 = DeformationModeN<3>;
 
 }  // namespace wobble

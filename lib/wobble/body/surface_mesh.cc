@@ -80,7 +80,7 @@ double WindingNumber(const SurfaceMesh& mesh, const Vec3& p) {
   return total / (4.0 * M_PI);
 }
 
-Lattice3 FitLattice(const SurfaceMesh& mesh, const Lattice3::Sizes& sizes, BasisKind basis, double margin) {
+LatticeN<3> FitLattice(const SurfaceMesh& mesh, const LatticeN<3>::Sizes& sizes, BasisKind basis, double margin) {
   CheckSurfaceMesh(mesh);
   if (!(margin >= 0.0 && margin <= 10.0)) throw InputError("lattice margin must be in [0, 10], got " + std::to_string(margin));
   const Eigen::AlignedBox3d box = Bounds(mesh);
@@ -88,7 +88,7 @@ Lattice3 FitLattice(const SurfaceMesh& mesh, const Lattice3::Sizes& sizes, Basis
   const double pad = margin * size.maxCoeff();
   if (!(size.maxCoeff() > 0.0)) throw InputError("the mesh is a single point: no lattice fits around it");
   // a flat mesh (a sheet) still gets a lattice of some thickness: pad its thin axes to the margin
-  Lattice3::Axes axes;
+  LatticeN<3>::Axes axes;
   Vec3 origin;
   for (int a = 0; a < 3; ++a) {
     double side = size[a] + 2.0 * pad;
@@ -96,7 +96,7 @@ Lattice3 FitLattice(const SurfaceMesh& mesh, const Lattice3::Sizes& sizes, Basis
     origin[a] = box.center()[a] - 0.5 * side;
     axes[size_t(a)] = Vec3::Unit(a) * side;
   }
-  return Lattice3(origin, axes, sizes, basis);
+  return LatticeN<3>(origin, axes, sizes, basis);
 }
 
 std::vector<Vec3> SampleSurface(const SurfaceMesh& mesh, int n) {

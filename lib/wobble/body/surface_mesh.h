@@ -48,7 +48,7 @@ double WindingNumber(const SurfaceMesh& mesh, const Eigen::Vector3d& p);
 // The lattice around the mesh: its bounding box, grown by `margin` times the box's largest
 // side on every side (so no vertex sits on the lattice's boundary, where a B-spline lattice
 // has fewer control points' influence), axis-aligned, with `sizes` control points per axis.
-Lattice3 FitLattice(const SurfaceMesh& mesh, const Lattice3::Sizes& sizes, BasisKind basis, double margin);
+LatticeN<3> FitLattice(const SurfaceMesh& mesh, const LatticeN<3>::Sizes& sizes, BasisKind basis, double margin);
 
 // n points on the surface, spread by area: point i takes the triangle where the cumulative
 // area passes (i + ½)/n of the total, and a place in it from the R2 low-discrepancy sequence

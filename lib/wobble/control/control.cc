@@ -27,7 +27,7 @@ Eigen::VectorXd ModeControlForces(const BodyModel& body, const BodyState<2, doub
   return PdForces(body.modes(), s.q.tail(D), s.qd.tail(D), s.mode_target);
 }
 
-Eigen::VectorXd ModeControlForces(const BodyModel3& body, const BodyState<3, double>& s) {
+Eigen::VectorXd ModeControlForces(const BodyModelN<3>& body, const BodyState<3, double>& s) {
   const int D = body.num_modes();
   return PdForces(body.modes(), s.gamma(), s.qd.tail(D), s.mode_target);
 }
@@ -41,7 +41,7 @@ void ControlEnergy::Accumulate(const BodyModel& body, const BodyState<2, double>
   }
 }
 
-void ControlEnergy::Accumulate(const BodyModel3& body, const BodyState<3, double>& s, double dt) {
+void ControlEnergy::Accumulate(const BodyModelN<3>& body, const BodyState<3, double>& s, double dt) {
   const Eigen::VectorXd f = ModeControlForces(body, s);
   const int first = Group<3>::kRigidDofs;
   for (int d = 0; d < f.size(); ++d) {
@@ -170,10 +170,10 @@ void KeyframedState(const BodyModelN<Dim>& body, const HeldPoint& hold, const Ei
 }
 
 template Eigen::Vector2d PointAt(const BodyModel&, const Eigen::Vector2d&, const Eigen::VectorXd&);
-template Eigen::Vector3d PointAt(const BodyModel3&, const Eigen::Vector3d&, const Eigen::VectorXd&);
+template Eigen::Vector3d PointAt(const BodyModelN<3>&, const Eigen::Vector3d&, const Eigen::VectorXd&);
 template void KeyframedState(const BodyModel&, const HeldPoint&, const Eigen::Vector2d&, const Eigen::VectorXd&,
                              const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd*, Eigen::VectorXd*);
-template void KeyframedState(const BodyModel3&, const HeldPoint&, const Eigen::Vector3d&, const Eigen::VectorXd&,
+template void KeyframedState(const BodyModelN<3>&, const HeldPoint&, const Eigen::Vector3d&, const Eigen::VectorXd&,
                              const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd*, Eigen::VectorXd*);
 
 }  // namespace wobble::control

@@ -48,14 +48,14 @@ template <int Dim> Eigen::VectorXd TargetsFromPose(const BodyModelN<Dim>& body, 
 // Q_r,d = −(2K_d (γ_d − γ0_d) + c_d γ̇_d) of every mode (the modes' block of the generalized
 // forces). `targets` empty means all zero.
 Eigen::VectorXd ModeControlForces(const BodyModel& body, const BodyState<2, double>& s);
-Eigen::VectorXd ModeControlForces(const BodyModel3& body, const BodyState<3, double>& s);  // 3D: γ, γ̇ of s.gamma, s.v
+Eigen::VectorXd ModeControlForces(const BodyModelN<3>& body, const BodyState<3, double>& s);  // 3D: γ, γ̇ of s.gamma, s.v
 
 struct ControlEnergy {
   double consumed = 0.0;  // Σ_d ∫ |Q_r,d γ̇_d| dt
   double work = 0.0;      // Σ_d ∫ Q_r,d γ̇_d dt (signed)
   // Adds one step of length dt at the state after the step.
   void Accumulate(const BodyModel& body, const BodyState<2, double>& s, double dt);
-  void Accumulate(const BodyModel3& body, const BodyState<3, double>& s, double dt);
+  void Accumulate(const BodyModelN<3>& body, const BodyState<3, double>& s, double dt);
 };
 
 // A pose graph (chapter 5): poses (targets for the active modes) each held for its transition
@@ -145,13 +145,10 @@ struct Keyframes {
 // the object deforms this point remains in place", e.g. a foot on the ground).
 struct HeldPoint {
   bool enabled = false;
-  Eigen::Vector2d lattice_coords = Eigen::Vector2d(0.0, 0.0);    // (s, t) of a 2D body
-  Eigen::Vector3d lattice_coords3 = Eigen::Vector3d(0.0, 0.0, 0.0);  // (s, t, u) of a 3D body
+  // (s, t, u); a 2D body reads (s, t), as constraint ends keep three rows for either dimension
+  Eigen::Vector3d lattice_coords = Eigen::Vector3d::Zero();
   // The coordinates for a body of dimension Dim.
-  template <int Dim> const Eigen::Matrix<double, Dim, 1>& coords() const {
-    if constexpr (Dim == 3) return lattice_coords3;
-    else return lattice_coords;
-  }
+  template <int Dim> Eigen::Matrix<double, Dim, 1> coords() const { return lattice_coords.head<Dim>(); }
 };
 
 // The full state (q, q̇ in body/group.h's layout) of a keyframed body at amplitudes γ, γ̇,

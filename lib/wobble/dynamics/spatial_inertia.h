@@ -9,7 +9,7 @@
 // quasi-velocity ω), Σ_k m_k J_kᵀ (ẍ_k − f_k/m_k) = 0 gives
 //   M v̇ = Q − w,   M = Σ m_k J_kᵀ J_k,   w = Σ m_k J_kᵀ J̇_k v,   Q = Σ J_kᵀ f_k,
 // the 3D Eq. 4.21, with J̇_k v = R a_k, a_k = ω × (ω × l_k) + 2 ω × B_k γ̇ (centripetal and
-// Coriolis). Summed with the moments of MassMoments3 (body_model.h), with c = c0 + Cγ,
+// Coriolis). Summed with the moments of MassMomentsN<3> (body_model.h), with c = c0 + Cγ,
 // K = Σ m l lᵀ, I = tr(K) 1 − K, N_d = Σ m l × B^d, L_d = Σ m B^d lᵀ, e_d = tr L_d:
 //   M = [ m 1     −R[c]×   R C ]
 //       [ ·       I        N   ]
@@ -35,7 +35,7 @@ namespace wobble {
 
 // The γ-dependent moments at one shape γ, computed once per evaluation.
 template <class T> struct ShapeMoments {
-  ShapeMoments(const MassMoments3& mm, const VecD<T>& gamma) {
+  ShapeMoments(const MassMomentsN<3>& mm, const VecD<T>& gamma) {
     const int D = int(gamma.size());
     c = mm.c0.cast<T>() + mm.C.cast<T>() * gamma;
     e = mm.e0.cast<T>() + mm.G.cast<T>() * gamma;
@@ -62,7 +62,7 @@ template <class T> struct ShapeMoments {
 };
 
 // M of the header comment.
-template <class T> void MassMatrix(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, MatQ<T>* M) {
+template <class T> void MassMatrix(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, MatQ<T>* M) {
   const int D = int(sm.e.size());
   M->setZero(Group<3>::kRigidDofs + D, Group<3>::kRigidDofs + D);
   M->template block<3, 3>(0, 0) = Mat3<T>::Identity() * T(mm.m);
@@ -81,7 +81,7 @@ template <class T> void MassMatrix(const MassMoments3& mm, const ShapeMoments<T>
 
 // ½ vᵀ M v.
 template <class T>
-T KineticEnergy(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& v) {
+T KineticEnergy(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& v) {
   MatQ<T> M;
   MassMatrix(mm, sm, R, &M);
   return T(0.5) * v.dot(M * v);
@@ -89,7 +89,7 @@ T KineticEnergy(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>
 
 // w of the header comment.
 template <class T>
-void VelocityTerms(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& v,
+void VelocityTerms(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& v,
                     VecQ<T>* w) {
   const int D = int(sm.e.size());
   const Vec3<T> omega = v.template segment<3>(3);
@@ -110,7 +110,7 @@ void VelocityTerms(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3
 
 // Generalized gravity Σ m_k J_kᵀ g = [m g ; c × Rᵀg ; Cᵀ Rᵀ g].
 template <class T>
-void GravityForce(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const Eigen::Vector3d& g,
+void GravityForce(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const Eigen::Vector3d& g,
                    VecQ<T>* Q) {
   const int D = int(sm.e.size());
   const Vec3<T> g_local = R.transpose() * g.cast<T>();
@@ -122,7 +122,7 @@ void GravityForce(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<
 
 // Potential energy of gravity, −Σ m_k g·x_k = −g·(m t + R c).
 template <class T>
-T GravityEnergy(const MassMoments3& mm, const ShapeMoments<T>& sm, const Frame<3, T>& frame, const Eigen::Vector3d& g) {
+T GravityEnergy(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, const Frame<3, T>& frame, const Eigen::Vector3d& g) {
   return -(T(mm.m) * frame.t + frame.R * sm.c).dot(g.cast<T>());
 }
 
@@ -131,7 +131,7 @@ T GravityEnergy(const MassMoments3& mm, const ShapeMoments<T>& sm, const Frame<3
 //   L = Σ m x × ẋ = t × P + R (Σ m l × ẋ_local) with Σ m l × (ω × l + B γ̇) = I ω + N γ̇
 //   (plus the cross term R c × ṫ from l × Rᵀṫ).
 template <class T>
-void Momentum(const MassMoments3& mm, const ShapeMoments<T>& sm, const Frame<3, T>& frame, const VecQ<T>& v,
+void Momentum(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, const Frame<3, T>& frame, const VecQ<T>& v,
                Vec3<T>* linear, Vec3<T>* angular) {
   const int D = int(sm.e.size());
   const Vec3<T> t_dot = v.template head<3>(), omega = v.template segment<3>(3);
@@ -147,7 +147,7 @@ void Momentum(const MassMoments3& mm, const ShapeMoments<T>& sm, const Frame<3, 
 //   ∂T/∂γ_d = ṫ·R(ω × C_d) + e_d|ω|² − ωᵀ L_d ω + ω·Σ_e γ̇_e X_de
 // (∂K/∂γ_d = L_d + L_dᵀ, ∂I/∂γ_d = 2 e_d 1 − L_d − L_dᵀ, ∂N_e/∂γ_d = X_de).
 template <class T>
-void KineticGradient(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& xi,
+void KineticGradient(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& xi,
                       VecQ<T>* out) {
   const int D = int(sm.e.size());
   const Vec3<T> t_dot = xi.template head<3>(), omega = xi.template segment<3>(3);
@@ -167,7 +167,7 @@ void KineticGradient(const MassMoments3& mm, const ShapeMoments<T>& sm, const Ma
 
 // Gravity's generalized force at positions q (group.h's layout), without the other moments.
 template <class T>
-void GravityForce(const MassMoments3& mm, const VecQ<T>& q, const Mat3<T>& R, const Eigen::Vector3d& g, VecQ<T>* Q) {
+void GravityForce(const MassMomentsN<3>& mm, const VecQ<T>& q, const Mat3<T>& R, const Eigen::Vector3d& g, VecQ<T>* Q) {
   const int D = int(mm.e0.size());
   const Vec3<T> g_local = R.transpose() * g.cast<T>();
   const Vec3<T> c = mm.c0.cast<T>() + mm.C.cast<T>() * q.tail(D);
@@ -184,7 +184,7 @@ void GravityForce(const MassMoments3& mm, const VecQ<T>& q, const Mat3<T>& R, co
 // and eliminating them leaves
 //   [ I_com   U     ] [a_ω]   [ r_ω − c × r̂/m ]      I_com = I − (|c|² 1 − c cᵀ)/m
 //   [ Uᵀ      G_com ] [a_γ] = [ r_γ − Cᵀ r̂/m  ],     U = N − [c]× C/m,
-// whose mode block G_com = G − CᵀC/m is constant and factored once (MassMoments3, as in 2D).
+// whose mode block G_com = G − CᵀC/m is constant and factored once (MassMomentsN<3>, as in 2D).
 // Then G_com y = ρ_γ, G_com Z = Uᵀ (three solves), the 3x3 Schur complement
 // S = I_com − U Z (factored by Cholesky), S a_ω = ρ_ω − U y, a_γ = y − Z a_ω and
 // a_t = (r_t − R(C a_γ − c × a_ω))/m. Returns false when M is singular. *cond_estimate receives
@@ -193,7 +193,7 @@ void GravityForce(const MassMoments3& mm, const VecQ<T>& q, const Mat3<T>& R, co
 // [λ_min(P), λ_max(P)] ⊂ [λ_min(M), λ_max(M)] (Cauchy interlacing), and the ratio is a lower
 // bound of cond₂(M).
 template <class T>
-bool SolveMassSystem(const MassMoments3& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& r,
+bool SolveMassSystem(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& r,
                      VecQ<T>* a, double* cond_estimate) {
   constexpr int kRigid = Group<3>::kRigidDofs;
   const int D = int(sm.e.size());
@@ -245,7 +245,7 @@ bool SolveMassSystem(const MassMoments3& mm, const ShapeMoments<T>& sm, const Ma
 // q̈ of M q̈ = Q − w at positions q and velocities q̇ (the 3D Eq. 4.21 of the header), by
 // SolveMassSystem above (about the centre of mass, M never formed).
 template <class T>
-bool SolveAccelerations(const MassMoments3& mm, const VecQ<T>& q, const VecQ<T>& qd, const Mat3<T>& R,
+bool SolveAccelerations(const MassMomentsN<3>& mm, const VecQ<T>& q, const VecQ<T>& qd, const Mat3<T>& R,
                         const VecQ<T>& Q, VecQ<T>* qdd, double* cond_estimate) {
   const int D = int(mm.e0.size());
   const ShapeMoments<T> sm(mm, VecD<T>(q.tail(D)));

@@ -117,7 +117,7 @@ StepStatus VariationalStep(const BodyModelN<3>& body, const WorldParams& w, int 
                            BodyState<3, T>* s, const Extra& extra) {
   using G = Group<3>;
   constexpr int kRigid = G::kRigidDofs;
-  const MassMoments3& mm = body.moments();
+  const MassMomentsN<3>& mm = body.moments();
   const int D = body.num_modes();
   const Mat3<T> identity = Mat3<T>::Identity();
   const VecQ<T> q0 = s->q;

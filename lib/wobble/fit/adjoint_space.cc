@@ -21,7 +21,7 @@ template <> class AdjointStep<3> {
   static constexpr bool kTaped = true;
   using Tape = StepTape;
 
-  template <class Fail> static void CheckStartSizes(const BodyModel3& body, const BodyState<3, double>& s, Fail fail) {
+  template <class Fail> static void CheckStartSizes(const BodyModelN<3>& body, const BodyState<3, double>& s, Fail fail) {
     const int D = body.num_modes();
     if (s.gamma().size() != D || s.qd.size() != body.num_q())
       fail("the start needs " + std::to_string(D) + " mode amplitudes and " + std::to_string(body.num_q()) +
@@ -40,7 +40,7 @@ template <> class AdjointStep<3> {
     return sizeof(StepTape) + sizeof(start) + 3 * start.contacts.size() * sizeof(Contact<3, double>);
   }
 
-  AdjointStep(const BodyModel3& body, const ControlledRolloutN<3>& r) : passive_(body.WithoutModeGains()), r_(r) {
+  AdjointStep(const BodyModelN<3>& body, const ControlledRolloutN<3>& r) : passive_(body.WithoutModeGains()), r_(r) {
     params_.K = r.stiffness;
     params_.c = r.damping;
   }
@@ -97,7 +97,7 @@ template <> class AdjointStep<3> {
  private:
   StepModel Model() const { return {passive_, r_.world, r_.integrator, r_.dt, params_}; }
 
-  const BodyModel3 passive_;
+  const BodyModelN<3> passive_;
   const ControlledRolloutN<3>& r_;
   ModeParams<double> params_;
 };

@@ -190,11 +190,7 @@ AnnealingResult AnnealPoseGraph(const BodyModelN<Dim>& body, const std::vector<R
   if (start.graph.empty()) throw std::invalid_argument("anneal: needs a pose graph to start from");
   // the synthesis problem of lib/wobble/synth with this fit's cost in place of Table 5.1's
   synth::Problem problem;
-  if constexpr (Dim == 2) {
-    problem.body = std::make_shared<BodyModel>(body);
-  } else {
-    problem.body3 = std::make_shared<BodyModel3>(body);
-  }
+  problem.set_body(std::make_shared<const BodyModelN<Dim>>(body));
   problem.custom_cost = [&](const control::PoseGraph& g) {
     DynamicParameters p = start;
     p.graph = g;

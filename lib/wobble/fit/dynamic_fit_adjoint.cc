@@ -104,7 +104,7 @@ void TakeStartGradient(const BodyModel&, const Blocks<2>&, const Eigen::VectorXd
 }
 
 // 3D: the start as Dimension<3>::Start makes it: t, chart · exp(δ̂), γ, v.
-void SetStart(const BodyModel3& body, const Blocks<3>& b, const DynamicParameters& p, BodyState<3, double>* start) {
+void SetStart(const BodyModelN<3>& body, const Blocks<3>& b, const DynamicParameters& p, BodyState<3, double>* start) {
   const int D = body.num_modes();
   const Eigen::Vector3d delta(b.q0[3], b.q0[4], b.q0[5]);
   *start = RestState<3, double>(body);
@@ -114,7 +114,7 @@ void SetStart(const BodyModel3& body, const Blocks<3>& b, const DynamicParameter
   start->qd = p.qd0;
 }
 // z = (δt, ε, δγ, δv); the block's δ moves R = chart exp(δ̂) by ε = J_r(δ) δδ
-void TakeStartGradient(const BodyModel3& body, const Blocks<3>& b, const Eigen::VectorXd& dz, BlockGradient* g) {
+void TakeStartGradient(const BodyModelN<3>& body, const Blocks<3>& b, const Eigen::VectorXd& dz, BlockGradient* g) {
   const int D = body.num_modes();
   const Eigen::Vector3d delta(b.q0[3], b.q0[4], b.q0[5]);
   g->q0.resize(Group<3>::kRigidDofs + D);

@@ -164,7 +164,7 @@ PoseFitResult FitPoseToCurve(const BodyModel& body, const CurveTarget& target, c
 // evenly spread over its vertex list; the mass points when there are none (no mesh, or
 // max_mesh_samples = 0). Not both: mass points sampled in the volume lie inside the skin,
 // and pulling them onto the target's surface would squeeze the body.
-std::vector<PointBasisN<3>> SurfaceSamples(const BodyModel3& body, const PoseFitOptions& options);
+std::vector<PointBasisN<3>> SurfaceSamples(const BodyModelN<3>& body, const PoseFitOptions& options);
 
 // Fits a 3D body to a surface target without correspondences: the residual of every body
 // sample is its distance to the nearest target triangle or cloud point, chosen anew at every
@@ -177,6 +177,6 @@ std::vector<PointBasisN<3>> SurfaceSamples(const BodyModel3& body, const PoseFit
 // order and with any signs (24 rotations); the four that fit best before solving are solved,
 // best first, until one meets the target exactly (cost down by 1e12); the lowest cost wins.
 // point_residuals are those of the body samples.
-PoseFitResult FitPoseToSurface(const BodyModel3& body, const SurfaceTarget& target, const PoseFitOptions& options);
+PoseFitResult FitPoseToSurface(const BodyModelN<3>& body, const SurfaceTarget& target, const PoseFitOptions& options);
 
 }  // namespace wobble::fit

@@ -109,7 +109,7 @@ StageCostN<3> CentreOfMassAt(const BodyModelN<3>& body, int step, const Eigen::V
                              Axes axes) {
   CheckTerm(step, weight, "CentreOfMassAt");
   if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassAt: the goal must be finite");
-  const MassMoments3 mm = body.moments();
+  const MassMomentsN<3> mm = body.moments();
   return [mm, step, goal, weight, axes](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
     const SpaceTangent z{int(s.gamma().size())};
@@ -128,7 +128,7 @@ StageCostN<3> CentreOfMassVelocityAt(const BodyModelN<3>& body, int step, const 
                                    Axes axes) {
   CheckTerm(step, weight, "CentreOfMassVelocityAt");
   if (!goal.allFinite()) throw std::invalid_argument("CentreOfMassVelocityAt: the goal must be finite");
-  const MassMoments3 mm = body.moments();
+  const MassMomentsN<3> mm = body.moments();
   return [mm, step, goal, weight, axes](int n, const BodyState<3, double>& s, Eigen::VectorXd* dz) {
     if (n != step) return 0.0;
     const SpaceTangent z{int(s.gamma().size())};

@@ -175,7 +175,7 @@ struct NearestSampleResidual {
 
 }  // namespace
 
-std::vector<PointBasisN<3>> SurfaceSamples(const BodyModel3& body, const PoseFitOptions& o) {
+std::vector<PointBasisN<3>> SurfaceSamples(const BodyModelN<3>& body, const PoseFitOptions& o) {
   std::vector<PointBasisN<3>> samples;
   const size_t nv = body.def().mesh.points.size(), keep = std::min(nv, size_t(o.max_mesh_samples));
   if (keep == 0)  // no mesh to sample: the mass points (a volume grid's lie inside the skin)
@@ -249,7 +249,7 @@ PoseFitResult DecodeSolve(const Bytes& bytes) {
 
 }  // namespace
 
-PoseFitResult FitPoseToSurface(const BodyModel3& body, const SurfaceTarget& target, const PoseFitOptions& o) {
+PoseFitResult FitPoseToSurface(const BodyModelN<3>& body, const SurfaceTarget& target, const PoseFitOptions& o) {
   CheckOptions(body, o, "surface fit");
   if (target.empty()) throw std::invalid_argument("surface fit: the target has no triangles or points");
   const std::vector<PointBasisN<3>> samples = SurfaceSamples(body, o);

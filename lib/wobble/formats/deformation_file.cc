@@ -493,26 +493,24 @@ std::vector<DeformationMode> ParseDeformations(std::istream& in, const std::stri
   return ModeFileParser<2>(name_for_errors, nullptr).Parse(in);
 }
 
-std::vector<DeformationMode> ParseDeformations(std::istream& in, const std::string& name_for_errors,
-                                               const Lattice& lattice) {
-  return ModeFileParser<2>(name_for_errors, &lattice).Parse(in);
+template <int Dim>
+std::vector<DeformationModeN<Dim>> ParseDeformations(std::istream& in, const std::string& name_for_errors,
+                                                     const LatticeN<Dim>& lattice) {
+  return ModeFileParser<Dim>(name_for_errors, &lattice).Parse(in);
 }
 
 std::vector<DeformationMode> ReadDeformationFile(const std::string& path) {
   return detail::WithFile(path, [&](std::istream& in) { return ParseDeformations(in, path); });
 }
 
-std::vector<DeformationMode> ReadDeformationFile(const std::string& path, const Lattice& lattice) {
+template <int Dim>
+std::vector<DeformationModeN<Dim>> ReadDeformationFile(const std::string& path, const LatticeN<Dim>& lattice) {
   return detail::WithFile(path, [&](std::istream& in) { return ParseDeformations(in, path, lattice); });
 }
 
-std::vector<DeformationMode3> ParseDeformations3(std::istream& in, const std::string& name_for_errors,
-                                                 const Lattice3& lattice) {
-  return ModeFileParser<3>(name_for_errors, &lattice).Parse(in);
-}
-
-std::vector<DeformationMode3> ReadDeformationFile3(const std::string& path, const Lattice3& lattice) {
-  return detail::WithFile(path, [&](std::istream& in) { return ParseDeformations3(in, path, lattice); });
-}
+template std::vector<DeformationModeN<2>> ParseDeformations(std::istream&, const std::string&, const LatticeN<2>&);
+template std::vector<DeformationModeN<3>> ParseDeformations(std::istream&, const std::string&, const LatticeN<3>&);
+template std::vector<DeformationModeN<2>> ReadDeformationFile(const std::string&, const LatticeN<2>&);
+template std::vector<DeformationModeN<3>> ReadDeformationFile(const std::string&, const LatticeN<3>&);
 
 }  // namespace wobble::formats

@@ -86,22 +86,19 @@
 
 namespace wobble::formats {
 
-// Reads every mode of a 2D deformation file; ParseError (line 0) if it cannot be opened.
-// Without the body's lattice, generator lines are a ParseError (they are computed over it):
-// pass the lattice of the body the modes are for whenever it is known.
+// Reads every mode of a deformation file over the lattice of the body the modes are for (its
+// dimension is the file's); ParseError (line 0) if it cannot be opened. Generator lines are
+// computed over the lattice: pass it whenever it is known.
+template <int Dim>
+std::vector<DeformationModeN<Dim>> ReadDeformationFile(const std::string& path, const LatticeN<Dim>& lattice);
+// A 2D file without the body's lattice: its generator lines are a ParseError.
 std::vector<DeformationMode> ReadDeformationFile(const std::string& path);
-std::vector<DeformationMode> ReadDeformationFile(const std::string& path, const Lattice& lattice);
 
 // Parses deformation modes from `in`; `name_for_errors` is the file name used in errors and,
 // through its stem, the default mode names.
+template <int Dim>
+std::vector<DeformationModeN<Dim>> ParseDeformations(std::istream& in, const std::string& name_for_errors,
+                                                     const LatticeN<Dim>& lattice);
 std::vector<DeformationMode> ParseDeformations(std::istream& in, const std::string& name_for_errors);
-std::vector<DeformationMode> ParseDeformations(std::istream& in, const std::string& name_for_errors,
-                                               const Lattice& lattice);
-
-// 3D deformation files (first line 'dimension 3'; generator modes only), over the body's lattice
-// (data/table3_modes.def3 is an example).
-std::vector<DeformationMode3> ReadDeformationFile3(const std::string& path, const Lattice3& lattice);
-std::vector<DeformationMode3> ParseDeformations3(std::istream& in, const std::string& name_for_errors,
-                                                 const Lattice3& lattice);
 
 }  // namespace wobble::formats

@@ -125,7 +125,7 @@ template <int Dim> class ObjectParser {
     if (line.words.size() != 2) Fail(line.number, std::string("expected one file name after 'mesh' (") + kMeshUsage + ")");
     if (!read_mesh_)
       Fail(line.number, "mesh: this reader cannot read mesh files (VTK reads them: load the object with the wobble "
-                        "command or pipelines::ReadObject3)");
+                        "command or pipelines::ReadObject<3>)");
     // relative to the object file's folder, as a user expects of a file beside it
     std::filesystem::path mesh_path(line.words[1]);
     if (mesh_path.is_relative()) mesh_path = std::filesystem::path(file_).parent_path() / mesh_path;
@@ -343,21 +343,19 @@ template <int Dim> class ObjectParser {
 
 }  // namespace
 
-BodyDef ParseObject(std::istream& in, const std::string& name_for_errors) {
-  return ObjectParser<2>(name_for_errors, MeshReader()).Parse(in);
+template <int Dim>
+BodyDefN<Dim> ParseObject(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh) {
+  return ObjectParser<Dim>(name_for_errors, read_mesh).Parse(in);
 }
 
-BodyDef ReadObjectFile(const std::string& path) {
-  return detail::WithFile(path, [&](std::istream& in) { return ParseObject(in, path); });
+template <int Dim> BodyDefN<Dim> ReadObjectFile(const std::string& path, const MeshReader& read_mesh) {
+  return detail::WithFile(path, [&](std::istream& in) { return ParseObject<Dim>(in, path, read_mesh); });
 }
 
-BodyDef3 ParseObject3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh) {
-  return ObjectParser<3>(name_for_errors, read_mesh).Parse(in);
-}
-
-BodyDef3 ReadObjectFile3(const std::string& path, const MeshReader& read_mesh) {
-  return detail::WithFile(path, [&](std::istream& in) { return ParseObject3(in, path, read_mesh); });
-}
+template BodyDefN<2> ParseObject<2>(std::istream&, const std::string&, const MeshReader&);
+template BodyDefN<3> ParseObject<3>(std::istream&, const std::string&, const MeshReader&);
+template BodyDefN<2> ReadObjectFile<2>(const std::string&, const MeshReader&);
+template BodyDefN<3> ReadObjectFile<3>(const std::string&, const MeshReader&);
 
 int ObjectFileDimension(const std::string& path) {
   return detail::WithFile(path, [&](std::istream& in) {

@@ -35,13 +35,6 @@
 
 namespace wobble::formats {
 
-// Reads an object file; ParseError (line 0) if it cannot be opened.
-BodyDef ReadObjectFile(const std::string& path);
-
-// Parses an object description from `in`; `name_for_errors` is the file name used in errors
-// and, through its stem, the default body name.
-BodyDef ParseObject(std::istream& in, const std::string& name_for_errors);
-
 // 3D object files: the same statements with a third coordinate, after a first line
 // 'dimension 3' (a 2D file may start with 'dimension 2'):
 //
@@ -87,8 +80,17 @@ BodyDef ParseObject(std::istream& in, const std::string& name_for_errors);
 // Mesh files are read through `read_mesh` (the app passes VTK's readers,
 // pipelines/mesh_io.h); without one, a 'mesh' line is a ParseError saying so.
 using MeshReader = std::function<SurfaceMesh(const std::string& path)>;
-BodyDef3 ReadObjectFile3(const std::string& path, const MeshReader& read_mesh = nullptr);
-BodyDef3 ParseObject3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh = nullptr);
+
+// Reads an object file of dimension Dim (2, as BodyDef, unless told); ParseError (line 0) if it
+// cannot be opened, at its first statement if the file is of the other dimension.
+template <int Dim = 2>
+BodyDefN<Dim> ReadObjectFile(const std::string& path, const MeshReader& read_mesh = nullptr);
+
+// Parses an object description from `in`; `name_for_errors` is the file name used in errors
+// and, through its stem, the default body name.
+template <int Dim = 2>
+BodyDefN<Dim> ParseObject(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh = nullptr);
+
 // 3 for a file whose first statement is 'dimension 3', else 2 (the readers report the rest).
 int ObjectFileDimension(const std::string& path);
 

@@ -210,21 +210,19 @@ template <int Dim> class TargetParser {
 
 }  // namespace
 
-TargetFile ParseTargets(std::istream& in, const std::string& name_for_errors) {
-  return TargetParser<2>(name_for_errors, nullptr).Parse(in);
+template <int Dim>
+TargetFileN<Dim> ParseTargets(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh) {
+  return TargetParser<Dim>(name_for_errors, read_mesh).Parse(in);
 }
 
-TargetFile ReadTargetFile(const std::string& path) {
-  return detail::WithFile(path, [&](std::istream& in) { return ParseTargets(in, path); });
+template <int Dim> TargetFileN<Dim> ReadTargetFile(const std::string& path, const MeshReader& read_mesh) {
+  return detail::WithFile(path, [&](std::istream& in) { return ParseTargets<Dim>(in, path, read_mesh); });
 }
 
-TargetFile3 ParseTargets3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh) {
-  return TargetParser<3>(name_for_errors, read_mesh).Parse(in);
-}
-
-TargetFile3 ReadTargetFile3(const std::string& path, const MeshReader& read_mesh) {
-  return detail::WithFile(path, [&](std::istream& in) { return ParseTargets3(in, path, read_mesh); });
-}
+template TargetFileN<2> ParseTargets<2>(std::istream&, const std::string&, const MeshReader&);
+template TargetFileN<3> ParseTargets<3>(std::istream&, const std::string&, const MeshReader&);
+template TargetFileN<2> ReadTargetFile<2>(const std::string&, const MeshReader&);
+template TargetFileN<3> ReadTargetFile<3>(const std::string&, const MeshReader&);
 
 template <int Dim> void CheckMassPointIndices(const TargetFileN<Dim>& targets, int num_points) {
   auto check = [&](const PointTargetN<Dim>& p) {

@@ -81,16 +81,14 @@ template <int Dim> struct TargetFileN {
 using PointTarget = PointTargetN<2>;
 using TargetFrame = TargetFrameN<2>;
 using TargetFile = TargetFileN<2>;
-using PointTarget3 = PointTargetN<3>;
-using TargetFrame3 = TargetFrameN<3>;
-using TargetFile3 = TargetFileN<3>;
 
-// Reads a target file; ParseError (line 0) if it cannot be opened or holds nothing.
-TargetFile ReadTargetFile(const std::string& path);
-TargetFile ParseTargets(std::istream& in, const std::string& name_for_errors);
-// The same for a 3D file; `read_mesh` reads its 'mesh' statements (none: they are refused).
-TargetFile3 ReadTargetFile3(const std::string& path, const MeshReader& read_mesh = nullptr);
-TargetFile3 ParseTargets3(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh = nullptr);
+// Reads a target file of dimension Dim (2, as TargetFile, unless told); ParseError (line 0) if
+// it cannot be opened or holds nothing. `read_mesh` reads a 3D file's 'mesh' statements (none:
+// they are refused).
+template <int Dim = 2>
+TargetFileN<Dim> ReadTargetFile(const std::string& path, const MeshReader& read_mesh = nullptr);
+template <int Dim = 2>
+TargetFileN<Dim> ParseTargets(std::istream& in, const std::string& name_for_errors, const MeshReader& read_mesh = nullptr);
 
 // Checks that every mass point index exists in a body with `num_points` points: ParseError at
 // the line of the first one that does not.

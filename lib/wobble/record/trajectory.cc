@@ -1,5 +1,6 @@
 #include "wobble/record/trajectory.h"
 
+#include "wobble/body/group.h"
 #include "wobble/core/errors.h"
 
 #include <algorithm>
@@ -29,7 +30,7 @@ BodyInfo DescribeBody(const World& world, int body) {
     info.set_ffd(world.shared_body<3>(body));
     info.coordinate_names = {"tx", "ty", "tz", "qw", "qx", "qy", "qz"};
     info.velocity_names = {"dtx", "dty", "dtz", "wx", "wy", "wz"};
-    for (const DeformationMode3& mode : world.body<3>(body).modes()) {
+    for (const DeformationModeN<3>& mode : world.body<3>(body).modes()) {
       info.coordinate_names.push_back(mode.name);
       info.velocity_names.push_back("d" + mode.name);
     }
@@ -45,6 +46,17 @@ BodyInfo DescribeBody(const World& world, int body) {
   info.num_q = int(info.coordinate_names.size());
   info.num_v = int(info.velocity_names.size());
   return info;
+}
+
+int BodyInfo::num_modes() const {
+  if (kind == BodyKind::kLinear) return 0;
+  const int of_model = std::visit([](const auto& m) { return m ? m->num_modes() : -1; }, ffd_);
+  if (of_model >= 0) return of_model;
+  const int rigid = dim == 3 ? Group<3>::kRigidParams : Group<2>::kRigidParams;
+  if (num_q < rigid)
+    throw std::logic_error("BodyInfo::num_modes: the FFD body '" + name + "' has neither a model nor its coordinates (num_q " +
+                           std::to_string(num_q) + " < " + std::to_string(rigid) + " rigid ones)");
+  return num_q - rigid;
 }
 
 Trajectory::Trajectory(const World& world) {

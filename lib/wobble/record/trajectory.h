@@ -55,9 +55,10 @@ struct BodyInfo {
     return p ? *p : nullptr;
   }
   bool has_ffd() const { return ffd<2>() || ffd<3>(); }
-  int num_modes() const {
-    return std::visit([](const auto& m) { return m ? m->num_modes() : 0; }, ffd_);
-  }
+  // An FFD body's modes: its model's, or, for a body read without its model, the coordinates
+  // after the rigid ones (num_q); 0 for a linear body. std::logic_error for an FFD body with
+  // neither: "no modes" would be a guess, and a wrong one shifts every column after q.
+  int num_modes() const;
   // Mode d of the model's (has_ffd()).
   const std::string& mode_name(int d) const {
     return std::visit([d](const auto& m) -> const std::string& { return m->modes().at(size_t(d)).name; }, ffd_);
@@ -69,7 +70,7 @@ struct BodyInfo {
 
  private:
   // One model: a 2D and a 3D pointer side by side could both be set.
-  std::variant<std::shared_ptr<const BodyModel>, std::shared_ptr<const BodyModel3>> ffd_;
+  std::variant<std::shared_ptr<const BodyModel>, std::shared_ptr<const BodyModelN<3>>> ffd_;
 };
 
 class Trajectory {

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <sstream>
 
-#include "wobble/body/group.h"
 #include "wobble/formats/csv.h"
 #include "wobble/formats/line_reader.h"
 #include "wobble/formats/parse_error.h"
@@ -27,12 +26,8 @@ std::vector<std::string> SplitCommas(const std::string& text) {
 
 // " (a body with D modes)" for one FFD body, the bodies' names otherwise.
 std::string BodiesText(const Trajectory& t) {
-  if (t.num_bodies() == 1 && t.bodies()[0].kind == BodyKind::kFfd)
-  {  // from the header's layout: the caller's BodyInfo need not carry the model
-    const BodyInfo& b = t.bodies()[0];
-    const int rigid = b.dim == 3 ? Group<3>::kRigidParams : Group<2>::kRigidParams;
-    return " (a body with " + std::to_string(b.num_q - rigid) + " modes)";
-  }
+  if (t.num_bodies() == 1 && t.bodies()[0].kind == BodyKind::kFfd)  // the caller's BodyInfo need not carry the model
+    return " (a body with " + std::to_string(t.bodies()[0].num_modes()) + " modes)";
   std::string names;
   for (const BodyInfo& b : t.bodies()) names += (names.empty() ? "" : ", ") + b.name;
   return " (bodies " + names + ")";
@@ -51,7 +46,7 @@ BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel> body) {
   return info;
 }
 
-BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel3> body) {  // as a world describes it
+BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModelN<3>> body) {  // as a world describes it
   World w;
   w.AddBody(body);
   return DescribeBody(w, 0);

@@ -29,6 +29,6 @@ ReadTrajectory ParseTrajectoryCsv(std::istream& in, const std::string& name_for_
 // The bodies of a file for one FFD body of either dimension (names of its coordinates from
 // the model).
 BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel> body);
-BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModel3> body);
+BodyInfo DescribeFfdBody(std::shared_ptr<const BodyModelN<3>> body);
 
 }  // namespace wobble::record

@@ -38,7 +38,7 @@ void Place(int dim, const Eigen::Vector3d& placement, Eigen::VectorXd* q, Eigen:
 void FfdObject::Load(const std::string& path, const formats::MeshReader& read_mesh) {
   part<2>().def.reset();
   part<3>().def.reset();
-  if (formats::ObjectFileDimension(path) == 3) part<3>().def = formats::ReadObjectFile3(path, read_mesh);
+  if (formats::ObjectFileDimension(path) == 3) part<3>().def = formats::ReadObjectFile<3>(path, read_mesh);
   else part<2>().def = formats::ReadObjectFile(path);
   path_ = std::filesystem::absolute(path).string();
   part<2>().modes.clear();
@@ -61,9 +61,7 @@ template <int Dim> void FfdObject::LoadModesOf(const std::vector<std::string>& p
   const BodyDefN<Dim>& def = *part<Dim>().def;
   std::vector<DeformationModeN<Dim>> modes;
   for (const std::string& path : paths) {
-    std::vector<DeformationModeN<Dim>> more;
-    if constexpr (Dim == 3) more = formats::ReadDeformationFile3(path, def.lattice);
-    else more = formats::ReadDeformationFile(path, def.lattice);  // generators need it
+    const std::vector<DeformationModeN<Dim>> more = formats::ReadDeformationFile(path, def.lattice);
     modes.insert(modes.end(), more.begin(), more.end());
   }
   BodyModelN<Dim> check(def, modes);  // throws when the modes do not fit the object
@@ -105,7 +103,7 @@ int FfdObject::ModeIndex(const std::string& name) const {
 
 template <class F> void FfdObject::ForEachMode(F&& f) {
   for (DeformationMode& m : part<2>().modes) f(m);
-  for (DeformationMode3& m : part<3>().modes) f(m);
+  for (DeformationModeN<3>& m : part<3>().modes) f(m);
   ResetBodies();
 }
 
@@ -173,6 +171,6 @@ template <int Dim> std::shared_ptr<const BodyModelN<Dim>> FfdObject::Body() cons
 }
 
 template std::shared_ptr<const BodyModel> FfdObject::Body<2>() const;
-template std::shared_ptr<const BodyModel3> FfdObject::Body<3>() const;
+template std::shared_ptr<const BodyModelN<3>> FfdObject::Body<3>() const;
 
 }  // namespace wobble::scene

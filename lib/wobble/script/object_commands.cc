@@ -208,14 +208,14 @@ void Hold(State& s, const Words& w, const Context& ctx) {
     const Eigen::Vector3d st(Number(w[1], "S", ctx), Number(w[2], "T", ctx), Number(w[3], "U", ctx));
     if (st.minCoeff() < 0 || st.maxCoeff() > 1) ctx.Fail("expected lattice coordinates S, T and U in [0, 1]");
     hold.enabled = true;
-    hold.lattice_coords3 = st;
+    hold.lattice_coords = st;
     return;
   }
   ctx.ExpectWords(w, 3, 3);
   const double u = Number(w[1], "S", ctx), v = Number(w[2], "T", ctx);
   if (u < 0 || u > 1 || v < 0 || v > 1) ctx.Fail("expected lattice coordinates S and T in [0, 1]");
   hold.enabled = true;
-  hold.lattice_coords = {u, v};
+  hold.lattice_coords = Eigen::Vector3d(u, v, 0.0);
 }
 
 void Keyframe(State& s, const Words& w, const Context& ctx) {

@@ -97,11 +97,11 @@ synth::Problem StartOptimising(State& s) {
 synth::Problem MakeProblem(const State& s, long steps) {
   synth::Problem p;
   if (s.scene.object().dim() == 3) {
-    p.body3 = s.scene.object().Body<3>();
-    p.world = s.scene.ObjectWorldOptions(*p.body3);
+    p.set_body(s.scene.object().Body<3>());
+    p.world = s.scene.ObjectWorldOptions(*p.body<3>());
   } else {
-    p.body = s.scene.object().Body<2>();
-    p.world = s.scene.ObjectWorldOptions(*p.body);
+    p.set_body(s.scene.object().Body<2>());
+    p.world = s.scene.ObjectWorldOptions(*p.body<2>());
   }
   p.q0 = s.scene.object().q();
   p.qd0 = s.scene.object().qd();

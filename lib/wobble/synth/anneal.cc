@@ -79,7 +79,7 @@ void CenterOfMassX(const BodyModel& body, const Eigen::VectorXd& q, const Eigen:
 
 void CenterOfMassX(const World& world, double* x, double* v) {
   if (world.IsFfd(0, 2)) return CenterOfMassX(world.body<2>(0), world.q(0), world.qd(0), x, v);
-  const MassMoments3& mm = world.body<3>(0).moments();
+  const MassMomentsN<3>& mm = world.body<3>(0).moments();
   const BodyState<3, double>& s = world.state<3>(0);
   const int D = int(s.gamma().size());
   const Eigen::Vector3d l = (mm.c0 + mm.C * s.gamma()) / mm.m;
@@ -98,11 +98,11 @@ TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
     return out;
   }
   World world(p.world);
-  if (p.body3) {
-    world.AddBody(p.body3);
+  if (p.dim() == 3) {
+    world.AddBody(p.body<3>());
     world.SetCoordinates(0, p.q0, p.qd0);
   } else {
-    world.AddBody(p.body);
+    world.AddBody(p.body<2>());
     world.SetState(0, p.q0, p.qd0);
   }
   double x0, v0;
@@ -124,8 +124,8 @@ TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
       out.cost = p.cost.high;
       return out;
     }
-    if (p.body3) energy.Accumulate(*p.body3, world.state<3>(0), dt);
-    else energy.Accumulate(*p.body, world.state<2>(0), dt);
+    if (p.dim() == 3) energy.Accumulate(*p.body<3>(), world.state<3>(0), dt);
+    else energy.Accumulate(*p.body<2>(), world.state<2>(0), dt);
     if (on_step) on_step(world);
   }
   out.ok = true;

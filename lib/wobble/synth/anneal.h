@@ -13,6 +13,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "wobble/control/control.h"
@@ -52,10 +53,15 @@ double EvaluateCost(const CostFunction& cost, const TrialOutcome& outcome);
 // One synthesis problem: a body with its active modes, the world, the start state, the trial
 // length and the cost.
 struct Problem {
-  std::shared_ptr<const BodyModel> body;
-  // A 3D body instead (issue 15): q0 and qd0 then follow the scripts' convention, q = (t,
-  // rotation vector, γ) and q̇ = (ṫ, body ω, γ̇); the travel is measured along world x all the same.
-  std::shared_ptr<const BodyModel3> body3;
+  // The body, 2D or 3D (issue 15): body<Dim>() is null for the other dimension. A 3D body's q0
+  // and qd0 follow the scripts' convention, q = (t, rotation vector, γ) and q̇ = (ṫ, body ω, γ̇);
+  // the travel is measured along world x all the same.
+  template <int Dim> const std::shared_ptr<const BodyModelN<Dim>>& body() const { return std::get<Dim - 2>(bodies_); }
+  template <int Dim> void set_body(std::shared_ptr<const BodyModelN<Dim>> body) {
+    bodies_ = {};  // one body: setting one clears the other
+    std::get<Dim - 2>(bodies_) = std::move(body);
+  }
+  int dim() const { return body<3>() ? 3 : 2; }
   WorldOptions world;
   Eigen::VectorXd q0, qd0;
   long steps = 1200;  // forward simulation per trial (thesis: 1200 steps of 0.01)
@@ -64,6 +70,9 @@ struct Problem {
   // `cost` (e.g. the dynamic fit's distance to a reference trajectory, lib/wobble/fit), so the
   // same annealer can be compared with other optimisers on their problem. Must be thread-safe.
   std::function<double(const control::PoseGraph&)> custom_cost;
+
+ private:
+  std::tuple<std::shared_ptr<const BodyModel>, std::shared_ptr<const BodyModelN<3>>> bodies_;
 };
 
 // x position and velocity of the body's centre of mass: m x_c = m t + R (c0 + C γ), from the

@@ -55,7 +55,7 @@ template <> struct Dimension<2> {
 };
 
 template <> struct Dimension<3> {
-  using Body = BodyModel3;
+  using Body = BodyModelN<3>;
   template <class T> using State = BodyState<3, T>;
   template <class T> static State<T> Start(const Body& body, const WorldParams& w, const T* q0, const T* qd0,
                                            const Eigen::Quaterniond& chart) {

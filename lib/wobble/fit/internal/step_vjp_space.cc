@@ -140,7 +140,7 @@ void PullAdvance(const VecQ<double>& u, double h, const Tangent& ix, Eigen::Vect
 // The part of λ_A' (the anchors after a step) that goes back through UpdateContacts at `after`
 // (the state after the step, still with the contacts before it): into z (λ at `after`) and into
 // the adjoint of the anchors before.
-void PullContactUpdate(const BodyModel3& body, const GroundPlane& ground, const BodyState<3, double>& after,
+void PullContactUpdate(const BodyModelN<3>& body, const GroundPlane& ground, const BodyState<3, double>& after,
                        const AnchorAdjoints& lambda_new, const Tangent& ix, Eigen::VectorXd* z,
                        AnchorAdjoints* lambda_old) {
   if (lambda_new.empty()) return;
@@ -174,7 +174,7 @@ Vector3d PullGeneralizedForce(const Matrix3d& R, const Vector3d& l, const ModeMa
 }
 
 // ∂K/∂γ_j of K(γ) = S0 + Σ_d γ_d (E_d + E_dᵀ) + Σ_de γ_d γ_e F_de: E_j + L_j + Σ_d γ_d F_dj.
-Matrix3d SecondMomentRate(const MassMoments3& mm, const ShapeMoments<double>& sm, const VecD<double>& gamma, int j) {
+Matrix3d SecondMomentRate(const MassMomentsN<3>& mm, const ShapeMoments<double>& sm, const VecD<double>& gamma, int j) {
   const int D = int(gamma.size());
   Matrix3d dK = mm.E[size_t(j)] + sm.L[size_t(j)];
   for (int d = 0; d < D; ++d) dK += gamma[d] * mm.F[size_t(d) * D + j];
@@ -184,7 +184,7 @@ Matrix3d SecondMomentRate(const MassMoments3& mm, const ShapeMoments<double>& sm
 // z += ∂ψ/∂z of the mass-moment terms of ψ = λ_rᵀ (Q_gravity − w − M a) at `e` (spatial_inertia.h's
 // formulas; ∂I/∂γ_j = tr(K_j) 1 − K_j with K_j = ∂K/∂γ_j, ∂N_d/∂γ_g = X_gd, ∂L_d/∂γ_g = F_dg,
 // ∂e/∂γ = G, ∂c/∂γ = C; a rotated vector Rᵀy moves by (Rᵀy) × ε).
-void PullMomentTerms(const MassMoments3& mm, const WorldParams& world, const BodyState<3, double>& e,
+void PullMomentTerms(const MassMomentsN<3>& mm, const WorldParams& world, const BodyState<3, double>& e,
                      const Matrix3d& R, const ShapeMoments<double>& sm, const VecQ<double>& a,
                      const VecQ<double>& lr, const Tangent& ix, Eigen::VectorXd* z) {
   const int D = ix.D;
@@ -251,14 +251,14 @@ void PullMomentTerms(const MassMoments3& mm, const WorldParams& world, const Bod
 void PullAccelerations(const StepModel& m, const VecD<double>& target, const BodyState<3, double>& e,
                        const Frame<3, double>& frame, const ShapeMoments<double>& sm, const VecQ<double>& a,
                        const VecQ<double>& lr, const Tangent& ix, StateAdjoint<3>* in, ControlAdjoint* controls) {
-  const BodyModel3& body = m.passive;
+  const BodyModelN<3>& body = m.passive;
   const int D = ix.D;
   Eigen::VectorXd& z = in->z;
   PullMomentTerms(body.moments(), m.world, e, frame.R, sm, a, lr, ix, &z);
   // the body's own mode potentials (off in a rollout) and the PD mode forces of ModeForce
   const VecD<double> s = lr.tail(D);
   for (int d = 0; d < D; ++d) {
-    const DeformationMode3& mode = body.modes()[size_t(d)];
+    const DeformationModeN<3>& mode = body.modes()[size_t(d)];
     const double offset = e.gamma()[d] - target[d];
     z[Tangent::kGamma + d] -= 2.0 * (mode.stiffness + m.gains.K[d]) * s[d];
     z[ix.gamma_dot() + d] -= (mode.damping + m.gains.c[d]) * s[d];
@@ -294,8 +294,8 @@ void PullAccelerations(const StepModel& m, const VecD<double>& target, const Bod
 
 StepStatus RecordStep(const StepModel& m, const VecD<double>& target, const BodyState<3, double>& s,
                        StepTape* tape, BodyState<3, double>* next) {
-  const BodyModel3& body = m.passive;
-  const MassMoments3& mm = body.moments();
+  const BodyModelN<3>& body = m.passive;
+  const MassMomentsN<3>& mm = body.moments();
   const double h = m.dt;
   const bool thesis = m.integrator == Integrator::kThesis;
   // accelerations at `eval`: the start for the thesis integrator, the advanced configuration
@@ -356,7 +356,7 @@ void StepVjp(const StepModel& m, const VecD<double>& target, const BodyState<3, 
   }
 }
 
-void StartContactsVjp(const BodyModel3& passive, const GroundPlane& ground, BodyState<3, double> s,
+void StartContactsVjp(const BodyModelN<3>& passive, const GroundPlane& ground, BodyState<3, double> s,
                        const AnchorAdjoints& anchor, Eigen::VectorXd* dz) {
   s.contacts.clear();
   AnchorAdjoints none;  // without contacts before, every anchor comes from its point's foot

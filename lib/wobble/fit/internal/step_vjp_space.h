@@ -33,7 +33,7 @@ namespace wobble::fit::internal {
 // What a step is: the body (its own mode gains off), the world, the integrator, the step and
 // the mode forces' gains.
 struct StepModel {
-  const BodyModel3& passive;
+  const BodyModelN<3>& passive;
   const WorldParams& world;
   Integrator integrator;  // kThesis or kSymplecticEuler
   double dt;
@@ -71,7 +71,7 @@ void StepVjp(const StepModel& m, const VecD<double>& target, const BodyState<3, 
 
 // The start's contact update (UpdateContacts on `s`, whose contacts are ignored): adds the
 // part of ∂cost/∂z that reaches s through the anchors it gives.
-void StartContactsVjp(const BodyModel3& passive, const GroundPlane& ground, BodyState<3, double> s,
+void StartContactsVjp(const BodyModelN<3>& passive, const GroundPlane& ground, BodyState<3, double> s,
                        const std::map<ContactKey, Eigen::Vector3d>& anchor, Eigen::VectorXd* dz);
 
 }  // namespace wobble::fit::internal
