@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <tuple>
 #include <stdexcept>
 
@@ -128,7 +129,23 @@ BodyModelN<Dim>::BodyModelN(BodyDefN<Dim> def, std::vector<DeformationModeN<Dim>
                                 "that the mass moments overflow");
   mm.G_com_factor = mm.G - mm.C.transpose() * mm.C / mm.m;
   mm.G_com_positive = CholeskyInPlace(&mm.G_com_factor);
+  if constexpr (Dim == 3) {
+    if (mm.G_com_positive) {
+      // column j of G_com⁻¹ solves G_com x = e_j; symmetrized, as the exact inverse is
+      mm.G_com_inverse.setIdentity(D, D);
+      for (int j = 0; j < D; ++j) {
+        VecD<double> x = mm.G_com_inverse.col(j);
+        CholeskySolveInPlace(mm.G_com_factor, &x);
+        mm.G_com_inverse.col(j) = x;
+      }
+      mm.G_com_inverse = (0.5 * (mm.G_com_inverse + mm.G_com_inverse.transpose())).eval();
+      mm.G_com_pivot_lo = std::numeric_limits<double>::infinity();
+      mm.G_com_pivot_hi = 0.0;
+      CholeskyPivotRange(mm.G_com_factor, &mm.G_com_pivot_lo, &mm.G_com_pivot_hi);
+    }
+  }
   BuildClusters();
+  BuildTree();
 
   const int V = int(def_.mesh.points.size());
   mesh_rest_local_.resize(V);
@@ -174,6 +191,69 @@ template <int Dim> void BodyModelN<Dim>::BuildClusters() {
     }
     clusters_.push_back(std::move(c));
   }
+}
+
+template <int Dim> void BodyModelN<Dim>::BuildTree() {
+  const int N = num_points(), D = num_modes();
+  tree_ = PointTreeN<Dim>();
+  if (clusters_.size() <= 1) return;  // small bodies: the scan tests every point
+  tree_.width = Dim * (D + 1);
+  tree_.stride = 2 * tree_.width + Dim;
+  std::vector<int> rank(static_cast<size_t>(N), 0);
+  for (const PointClusterN<Dim>& c : clusters_)
+    for (int k : c.points) {
+      rank[size_t(k)] = int(tree_.by_rank.size());
+      tree_.by_rank.push_back(k);
+    }
+  std::vector<int> points(static_cast<size_t>(N));
+  for (int k = 0; k < N; ++k) points[size_t(k)] = k;
+  BuildNode(points.begin(), points.end(), rank);
+}
+
+// Node of the points [begin, end): its bounds (as the clusters'), then its children, split at
+// the median of b0 along the axis where b0 spreads most. Returns the node's index.
+template <int Dim>
+int BodyModelN<Dim>::BuildNode(std::vector<int>::iterator begin, std::vector<int>::iterator end,
+                               const std::vector<int>& rank) {
+  const int D = num_modes(), L = Dim * (D + 1);
+  const int node = int(tree_.skip.size());
+  tree_.skip.push_back(0);
+  tree_.first.push_back(0);
+  tree_.last.push_back(0);
+  tree_.bounds.resize(tree_.bounds.size() + size_t(tree_.stride), 0.0);
+  double* centre = tree_.bounds.data() + size_t(node) * size_t(tree_.stride);
+  double* half = centre + L;
+  for (int block = 0; block <= D; ++block) {
+    auto value = [&](int k) { return block == 0 ? rest_local_[size_t(k)] : Point(mode_matrix(k).col(block - 1)); };
+    Point lo = value(*begin), hi = lo;
+    for (auto it = begin; it != end; ++it) lo = lo.cwiseMin(value(*it)), hi = hi.cwiseMax(value(*it));
+    for (int a = 0; a < Dim; ++a) {
+      centre[Dim * block + a] = 0.5 * (lo[a] + hi[a]);
+      half[Dim * block + a] = 0.5 * (hi[a] - lo[a]);
+      if (block > 0)
+        half[L + a] = std::max(half[L + a], std::abs(centre[Dim * block + a]) + half[Dim * block + a]);
+    }
+  }
+  const auto count = end - begin;
+  if (count <= PointTreeN<Dim>::kLeafPoints) {
+    tree_.first[size_t(node)] = int(tree_.leaf_ranks.size());
+    for (auto it = begin; it != end; ++it) tree_.leaf_ranks.push_back(rank[size_t(*it)]);
+    std::sort(tree_.leaf_ranks.begin() + tree_.first[size_t(node)], tree_.leaf_ranks.end());
+    tree_.last[size_t(node)] = int(tree_.leaf_ranks.size());
+  } else {
+    int axis = 0;
+    for (int a = 1; a < Dim; ++a)
+      if (half[a] > half[axis]) axis = a;
+    const auto middle = begin + count / 2;
+    std::nth_element(begin, middle, end, [&](int i, int j) {
+      const double xi = rest_local_[size_t(i)][axis], xj = rest_local_[size_t(j)][axis];
+      return xi < xj || (xi == xj && i < j);
+    });
+    BuildNode(begin, middle, rank);
+    BuildNode(middle, end, rank);
+  }
+  tree_.skip[size_t(node)] = int(tree_.skip.size());
+  return node;
 }
 
 template <int Dim> void BodyModelN<Dim>::LocalBasis(const Point& st, Point* b0, ModeMatrix* B) const {
