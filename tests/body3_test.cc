@@ -435,6 +435,52 @@ TEST(Body3, PointGroupsFindExactlyThePointsBelowTheGround) {
   EXPECT_GT(found, 1000);  // the states do reach into the ground
 }
 
+// Over a long run of a 3,000-point body thrown tumbling onto a tilted plane (bouncing, rolling,
+// deforming), every step's scan visits exactly the points a test of every point finds below
+// the plane, in the full scan's order (the clusters'): the contacts and the ground force are
+// the full scan's, bit for bit. The contacts the step leaves are those points.
+TEST(Body3, TreeScanMatchesTheFullScanOverALongTumblingRun) {
+  std::mt19937 rng(29);
+  const BodyModel3 body = RandomBody3(rng, {4, 4, 4}, BasisKind::kBernstein, 3, 3000, 1e9);
+  ASSERT_GT(body.clusters().size(), 8u);
+  WorldParamsN<3> w;
+  w.ground.enabled = true;
+  w.ground.normal = Vector3d(0.2, 1.0, -0.1).normalized();
+  BodyState<3, double> s = RestState<3, double>(body);
+  s.translation() = Vector3d(0.0, 40.0, 0.0);
+  s.set_orientation(Eigen::AngleAxisd(0.3, Vector3d(0.3, 0.2, 1.0).normalized()));
+  // turning about its centre of mass c, which moves at (60, 0, −30): ṫ = v − R(ω × c)
+  const Matrix3d R = s.orientation().toRotationMatrix();
+  const Vector3d c = body.moments().c0 / body.moments().m, omega(0.2, 0.1, -0.3);
+  s.qd.head<3>() = Vector3d(60.0, 0.0, -30.0) - R * omega.cross(c);
+  s.qd.segment<3>(3) = omega;
+  int touching = 0, partial = 0;
+  for (int step = 0; step < 4000; ++step) {
+    ASSERT_TRUE(StepBody(body, w, 0, Integrator::kThesis, 0.002, &s).ok()) << "step " << step;
+    const Frame<3, double> frame(s.q);
+    std::vector<int> visited, expected;
+    ForEachPointInContact(body, w.ground, s, frame,
+                          [&](int k, const Vector3d&, const Vector3d&, const Vector3d&, const Vector3d&,
+                              const GroundPlane&, int) { visited.push_back(k); });
+    for (const PointClusterN<3>& c : body.clusters())
+      for (int k : c.points) {
+        const Vector3d x = frame.t + frame.R * LocalPosition<double>(body.rest_local(k), body.mode_matrix(k), s.q);
+        if (w.ground.Height(x) < 0.0) expected.push_back(k);
+      }
+    ASSERT_EQ(visited, expected) << "step " << step;
+    std::vector<int> contacts;
+    for (const Contact<3, double>& c : s.contacts) contacts.push_back(c.point);
+    std::sort(expected.begin(), expected.end());
+    ASSERT_EQ(contacts, expected) << "step " << step;
+    touching += !expected.empty();
+    partial += !expected.empty() && int(expected.size()) < body.num_points() / 20;
+  }
+  EXPECT_GT(touching, 1000);  // of 4,000 steps
+  EXPECT_GT(partial, 100);
+  RecordProperty("steps_touching", touching);
+  RecordProperty("steps_with_few_points_below", partial);
+}
+
 // Spinning about its centre of mass (ṫ chosen so the centre stays put), no gravity.
 BodyState<3, double> Spinning(const BodyModel3& body, const Vector3d& omega) {
   BodyState<3, double> s = RestState<3, double>(body);
