@@ -193,67 +193,68 @@ template <int Dim> void BodyModelN<Dim>::BuildClusters() {
   }
 }
 
-template <int Dim> void BodyModelN<Dim>::BuildTree() {
-  const int N = num_points(), D = num_modes();
-  tree_ = PointTreeN<Dim>();
-  if (clusters_.size() <= 1) return;  // small bodies: the scan tests every point
-  tree_.width = Dim * (D + 1);
-  tree_.stride = 2 * tree_.width + Dim;
-  std::vector<int> rank(static_cast<size_t>(N), 0);
-  for (const PointClusterN<Dim>& c : clusters_)
-    for (int k : c.points) {
-      rank[size_t(k)] = int(tree_.by_rank.size());
-      tree_.by_rank.push_back(k);
-    }
-  std::vector<int> points(static_cast<size_t>(N));
-  for (int k = 0; k < N; ++k) points[size_t(k)] = k;
-  BuildNode(points.begin(), points.end(), rank);
-}
+namespace {
 
-// Node of the points [begin, end): its bounds (as the clusters'), then its children, split at
-// the median of b0 along the axis where b0 spreads most. Returns the node's index.
+// Node of the points of ranks [lo, hi) of tree->by_rank (the scan order): its bounds (as the
+// clusters'), then its children, split at the group boundary nearest the middle, or at the
+// middle inside one group. Splitting the scan order, not space, keeps the leaves in scan
+// order, so the scan never sorts what it visits; the groups are cells of the lattice, and
+// inside a group, points given in order along the body (a drawing resampled, a grid) make
+// tight boxes.
 template <int Dim>
-int BodyModelN<Dim>::BuildNode(std::vector<int>::iterator begin, std::vector<int>::iterator end,
-                               const std::vector<int>& rank) {
-  const int D = num_modes(), L = Dim * (D + 1);
-  const int node = int(tree_.skip.size());
-  tree_.skip.push_back(0);
-  tree_.first.push_back(0);
-  tree_.last.push_back(0);
-  tree_.bounds.resize(tree_.bounds.size() + size_t(tree_.stride), 0.0);
-  double* centre = tree_.bounds.data() + size_t(node) * size_t(tree_.stride);
+void BuildTreeNode(const BodyModelN<Dim>& body, int lo, int hi, const std::vector<int>& group_starts,
+                   PointTreeN<Dim>* tree) {
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  const int D = body.num_modes(), L = tree->width;
+  const int node = int(tree->skip.size());
+  tree->skip.push_back(0);
+  tree->first.push_back(0);
+  tree->last.push_back(0);
+  tree->bounds.resize(tree->bounds.size() + size_t(tree->stride), 0.0);
+  double* centre = tree->bounds.data() + size_t(node) * size_t(tree->stride);
   double* half = centre + L;
   for (int block = 0; block <= D; ++block) {
-    auto value = [&](int k) { return block == 0 ? rest_local_[size_t(k)] : Point(mode_matrix(k).col(block - 1)); };
-    Point lo = value(*begin), hi = lo;
-    for (auto it = begin; it != end; ++it) lo = lo.cwiseMin(value(*it)), hi = hi.cwiseMax(value(*it));
+    auto value = [&](int r) {
+      const int k = tree->by_rank[size_t(r)];
+      return block == 0 ? body.rest_local(k) : Point(body.mode_matrix(k).col(block - 1));
+    };
+    Point low = value(lo), high = low;
+    for (int r = lo; r < hi; ++r) low = low.cwiseMin(value(r)), high = high.cwiseMax(value(r));
     for (int a = 0; a < Dim; ++a) {
-      centre[Dim * block + a] = 0.5 * (lo[a] + hi[a]);
-      half[Dim * block + a] = 0.5 * (hi[a] - lo[a]);
-      if (block > 0)
-        half[L + a] = std::max(half[L + a], std::abs(centre[Dim * block + a]) + half[Dim * block + a]);
+      centre[Dim * block + a] = 0.5 * (low[a] + high[a]);
+      half[Dim * block + a] = 0.5 * (high[a] - low[a]);
+      if (block > 0) half[L + a] = std::max(half[L + a], std::abs(centre[Dim * block + a]) + half[Dim * block + a]);
     }
   }
-  const auto count = end - begin;
-  if (count <= PointTreeN<Dim>::kLeafPoints) {
-    tree_.first[size_t(node)] = int(tree_.leaf_ranks.size());
-    for (auto it = begin; it != end; ++it) tree_.leaf_ranks.push_back(rank[size_t(*it)]);
-    std::sort(tree_.leaf_ranks.begin() + tree_.first[size_t(node)], tree_.leaf_ranks.end());
-    tree_.last[size_t(node)] = int(tree_.leaf_ranks.size());
+  if (hi - lo <= PointTreeN<Dim>::kLeafPoints) {
+    tree->first[size_t(node)] = int(tree->leaf_ranks.size());
+    for (int r = lo; r < hi; ++r) tree->leaf_ranks.push_back(r);
+    tree->last[size_t(node)] = int(tree->leaf_ranks.size());
   } else {
-    int axis = 0;
-    for (int a = 1; a < Dim; ++a)
-      if (half[a] > half[axis]) axis = a;
-    const auto middle = begin + count / 2;
-    std::nth_element(begin, middle, end, [&](int i, int j) {
-      const double xi = rest_local_[size_t(i)][axis], xj = rest_local_[size_t(j)][axis];
-      return xi < xj || (xi == xj && i < j);
-    });
-    BuildNode(begin, middle, rank);
-    BuildNode(middle, end, rank);
+    const int middle = lo + (hi - lo) / 2;
+    int split = -1;
+    for (int start : group_starts)
+      if (start > lo && start < hi && (split < 0 || std::abs(start - middle) < std::abs(split - middle))) split = start;
+    if (split < 0) split = middle;
+    BuildTreeNode(body, lo, split, group_starts, tree);
+    BuildTreeNode(body, split, hi, group_starts, tree);
   }
-  tree_.skip[size_t(node)] = int(tree_.skip.size());
-  return node;
+  tree->skip[size_t(node)] = int(tree->skip.size());
+}
+
+}  // namespace
+
+template <int Dim> void BodyModelN<Dim>::BuildTree() {
+  tree_ = PointTreeN<Dim>();
+  if (clusters_.size() <= 1) return;  // small bodies: the scan tests every point
+  tree_.width = Dim * (num_modes() + 1);
+  tree_.stride = 2 * tree_.width + Dim;
+  std::vector<int> group_starts;
+  for (const PointClusterN<Dim>& c : clusters_) {
+    group_starts.push_back(int(tree_.by_rank.size()));
+    tree_.by_rank.insert(tree_.by_rank.end(), c.points.begin(), c.points.end());
+  }
+  BuildTreeNode(*this, 0, int(tree_.by_rank.size()), group_starts, &tree_);
 }
 
 template <int Dim> void BodyModelN<Dim>::LocalBasis(const Point& st, Point* b0, ModeMatrix* B) const {

@@ -89,9 +89,9 @@ using MassMoments3 = MassMomentsN<3>;
 
 // Mass points grouped by where they sit in the lattice, with interval bounds of their local
 // positions: every l_k = b0_k + B_k γ of the group lies in the box centre(γ) ± half(γ) with
-// centre = centre0 + centre_modes γ and half = half0 + half_modes |γ|. The ground scan skips a
-// group whose box is above the ground, so a large body resting on its feet visits only the
-// points near them (any basis: the bound needs no convex-hull property).
+// centre = centre0 + centre_modes γ and half = half0 + half_modes |γ| (any basis: the bound
+// needs no convex-hull property). The groups fix the ground scan's order; the scan skips by
+// the same bounds over the finer nodes of PointTreeN (below).
 template <int Dim> struct PointClusterN {
   using Point = Eigen::Matrix<double, Dim, 1>;
   std::vector<int> points;  // ascending
@@ -101,8 +101,8 @@ template <int Dim> struct PointClusterN {
 using PointCluster = PointClusterN<2>;
 
 // A tree of such interval bounds over the mass points of a large body (more than one point
-// group), for the ground scan: each node bounds the points of its subtree, children split the
-// parent's points at the median of b0 along its widest axis, leaves hold at most kLeafPoints.
+// group), for the ground scan: each node bounds a range of the scan order, its children split
+// it at the group boundary nearest its middle (else the middle), leaves hold ≤ kLeafPoints.
 // Nodes are stored in preorder with `skip` (the node after the subtree), so a scan that rejects
 // a node jumps past everything below it. A node's numbers sit at bounds[i * stride]: the
 // centres of b0 and of each mode column (width = Dim (D + 1) numbers: [centre0, centre_modes
