@@ -226,16 +226,29 @@ void BuildTreeNode(const BodyModelN<Dim>& body, int lo, int hi, const std::vecto
       if (block > 0) half[L + a] = std::max(half[L + a], std::abs(centre[Dim * block + a]) + half[Dim * block + a]);
     }
   }
-  if (hi - lo <= PointTreeN<Dim>::kLeafPoints) {
+  int split = -1;
+  if (hi - lo > PointTreeN<Dim>::kLeafPoints) {
+    const int middle = lo + (hi - lo) / 2;
+    for (int start : group_starts)
+      if (start > lo && start < hi && (split < 0 || std::abs(start - middle) < std::abs(split - middle))) split = start;
+    const bool inside_group = split < 0;
+    if (inside_group) split = middle;
+    // Inside a group whose points come in no order along the body, halves of the range are
+    // as wide as the whole and every node below would pass where the whole passes: such a
+    // node stays a leaf (the group's own test, as before the tree). Across groups, always split.
+    auto size = [&](int from, int to) {
+      Point low = body.rest_local(tree->by_rank[size_t(from)]), high = low;
+      for (int r = from; r < to; ++r)
+        low = low.cwiseMin(body.rest_local(tree->by_rank[size_t(r)])), high = high.cwiseMax(body.rest_local(tree->by_rank[size_t(r)]));
+      return (high - low).sum();
+    };
+    if (inside_group && std::max(size(lo, split), size(split, hi)) > 0.75 * size(lo, hi)) split = -1;
+  }
+  if (split < 0) {
     tree->first[size_t(node)] = int(tree->leaf_ranks.size());
     for (int r = lo; r < hi; ++r) tree->leaf_ranks.push_back(r);
     tree->last[size_t(node)] = int(tree->leaf_ranks.size());
   } else {
-    const int middle = lo + (hi - lo) / 2;
-    int split = -1;
-    for (int start : group_starts)
-      if (start > lo && start < hi && (split < 0 || std::abs(start - middle) < std::abs(split - middle))) split = start;
-    if (split < 0) split = middle;
     BuildTreeNode(body, lo, split, group_starts, tree);
     BuildTreeNode(body, split, hi, group_starts, tree);
   }

@@ -101,8 +101,8 @@ template <int Dim> struct PointClusterN {
 using PointCluster = PointClusterN<2>;
 
 // A tree of such interval bounds over the mass points of a large body (more than one point
-// group), for the ground scan: each node bounds a range of the scan order, its children split
-// it at the group boundary nearest its middle (else the middle), leaves hold ≤ kLeafPoints.
+// group), for the ground scan: each node bounds a range of the scan order, split at the group
+// boundary nearest its middle, else the middle while halves shrink, down to kLeafPoints.
 // Nodes are stored in preorder with `skip` (the node after the subtree), so a scan that rejects
 // a node jumps past everything below it. A node's numbers sit at bounds[i * stride]: the
 // centres of b0 and of each mode column (width = Dim (D + 1) numbers: [centre0, centre_modes
