@@ -273,7 +273,6 @@ template <int Dim> class BodyModelN {
 
   void BuildClusters();
   void BuildTree();
-  int BuildNode(std::vector<int>::iterator begin, std::vector<int>::iterator end, const std::vector<int>& rank);
 };
 
 using BodyModel = BodyModelN<2>;
