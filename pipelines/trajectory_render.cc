@@ -304,9 +304,23 @@ World WorldFor(const record::Trajectory& run, const WorldOptions& options) {
 RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, const SceneSpec& spec, const RenderOutputs& out) {
   if (run.empty()) throw std::invalid_argument("nothing was recorded: no frames to render");
   if (caller.num_bodies() != run.num_bodies()) throw std::invalid_argument("RenderTrajectory: the world's bodies are not the run's");
-  // each pass replays the run in a copy of the caller's world as it is now (which is left
-  // untouched but for the state of the last sample drawn, put back at the end)
-  World world = caller;
+  // each pass replays the run in the caller's world, whose data (states, contacts, clock:
+  // WorldData, not the models) is kept first and put back between the passes and at the end,
+  // where the world is left in the state of the last sample drawn (and as it was on a throw)
+  World& world = caller;
+  const WorldData start = caller.data();
+  struct PutBack {
+    World& world;
+    const WorldData& data;
+    bool done = false;
+    ~PutBack() {
+      if (done) return;
+      try {
+        world.SetData(data);
+      } catch (...) {  // its own data always fits; a destructor must not throw
+      }
+    }
+  } put_back{caller, start};
   const double dt = world.options().dt;
   long num_frames = 0;
   const std::vector<Visit> visits = PlanVisits(run, out, dt, &num_frames);
@@ -373,7 +387,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     }
     const FollowOptions follow_options{double(out.view.width) / out.view.height};
     if (follow) follow_boxes = flat ? FollowBoxesOf<2>(world, seen, follow_options) : FollowBoxesOf<3>(world, seen, follow_options);
-    world = caller;  // the writing pass replays the run from the start again
+    world.SetData(start);  // the writing pass replays the run from the start again
   }
   for (SceneView* v : {view.get(), strip_view.get()})
     if (v && !out.trail.empty() && v->trails()) v->trails()->SetTrackedPoints(out.trail);
@@ -464,6 +478,8 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     if (vtp) where += ", and " + vtp->WriteCollection() + " for them";
     throw Interrupted("rendering stopped by Ctrl-C: " + where + " written in " + out.folder);
   }
+  world.SetData(start);
+  put_back.done = true;
   if (!visits.empty()) run.Restore(visits.back().sample, caller);
 
   if (out.frames) report.files.push_back({out.folder + "/frames/frame_NNNN.png", ""});

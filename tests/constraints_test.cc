@@ -725,5 +725,54 @@ TEST(World, QuadraticBodyHeldAndPulledBends3D) {
   EXPECT_LT(world.PointPosition(At(b, Eigen::Vector3d(-1.0, 0.3, 0.0)))[0], -1.0);
 }
 
+// ---------------------------------------------------------------- model and data
+
+// Every body kind, a nail and a pending point force: going back to a saved WorldData and
+// stepping again repeats the run to the last bit (the data is all a run changes), and data
+// that does not fit the world is refused by name.
+TEST(WorldData, PuttingBackTheDataRepeatsTheRunExactly) {
+  WorldOptions opt = testing::WitkinWelchOptions();
+  opt.dt = 1e-3;
+  opt.params.ground_plane.enabled = true;
+  World world(opt);
+  const int table = world.AddBody(std::make_shared<const BodyModel>(testing::TableDef(), testing::TableModes(4e6, 1e6)));
+  const int box = world.AddBody(std::make_shared<const BodyModelN<3>>(testing::Box(1.0, 0.5, 0.8, 3.0)));
+  world.SetCoordinates(box, (Eigen::VectorXd(6) << 0, 0.05, 0, 0.1, 0, 0).finished(), Eigen::VectorXd::Zero(6));
+  const int bar = world.AddLinearBody(Bar2D(), AffineMaterial{200.0, 200.0, 0.0, 0.0});
+  const int nail = world.AddNail(At(bar, Eigen::Vector2d(-0.5, 0.0)));
+  world.ApplyPointForce(At(bar, Eigen::Vector2d(0.5, 0.0)), Eigen::Vector2d(0.0, 30.0));
+  const WorldData start = world.data();
+  ASSERT_TRUE(world.RunUntil(0.3)) << world.status().message;
+  const WorldData end = world.data();
+  EXPECT_FALSE(world.state<3>(box).contacts.empty());  // the box landed: contacts are data too
+  world.SetData(start);
+  EXPECT_EQ(world.time(), 0.0);
+  EXPECT_EQ(world.steps(), 0);
+  EXPECT_EQ(world.q(table), start.ffd_of<2>()[0].state.q);
+  ASSERT_TRUE(world.RunUntil(0.3)) << world.status().message;
+  EXPECT_EQ(world.steps(), end.steps);
+  EXPECT_EQ(world.time(), end.time);
+  EXPECT_EQ(world.q(table), end.ffd_of<2>()[0].state.q);
+  EXPECT_EQ(world.qd(table), end.ffd_of<2>()[0].state.qd);
+  EXPECT_EQ(world.q(box), end.ffd_of<3>()[0].state.q);
+  EXPECT_EQ(world.qd(box), end.ffd_of<3>()[0].state.qd);
+  EXPECT_EQ(world.state<3>(box).contacts.size(), end.ffd_of<3>()[0].state.contacts.size());
+  EXPECT_EQ(world.linear_R(bar), end.linear[0].R);
+  EXPECT_EQ(world.linear_R_dot(bar), end.linear[0].R_dot);
+  EXPECT_EQ(world.Multiplier(nail), end.multipliers[size_t(nail)]);
+  EXPECT_NE(end.multipliers[size_t(nail)], Eigen::VectorXd::Zero(2));
+
+  World other(opt);
+  other.AddLinearBody(Bar2D());
+  EXPECT_THROW(world.SetData(other.data()), std::invalid_argument);  // other bodies
+  WorldData bad = end;
+  bad.ffd_of<3>()[0].state.qd.resize(3);
+  EXPECT_THROW(world.SetData(bad), std::invalid_argument);  // a state that does not fit its model
+  bad = end;
+  bad.multipliers.pop_back();
+  EXPECT_THROW(world.SetData(bad), std::invalid_argument);  // other constraints
+  EXPECT_EQ(world.q(box), end.ffd_of<3>()[0].state.q);  // a refused SetData changes nothing
+}
+
 }  // namespace
 }  // namespace wobble

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <tuple>
 #include <stdexcept>
 
@@ -128,7 +129,23 @@ BodyModelN<Dim>::BodyModelN(BodyDefN<Dim> def, std::vector<DeformationModeN<Dim>
                                 "that the mass moments overflow");
   mm.G_com_factor = mm.G - mm.C.transpose() * mm.C / mm.m;
   mm.G_com_positive = CholeskyInPlace(&mm.G_com_factor);
+  if constexpr (Dim == 3) {
+    if (mm.G_com_positive) {
+      // column j of G_com⁻¹ solves G_com x = e_j; symmetrized, as the exact inverse is
+      mm.G_com_inverse.setIdentity(D, D);
+      for (int j = 0; j < D; ++j) {
+        VecD<double> x = mm.G_com_inverse.col(j);
+        CholeskySolveInPlace(mm.G_com_factor, &x);
+        mm.G_com_inverse.col(j) = x;
+      }
+      mm.G_com_inverse = (0.5 * (mm.G_com_inverse + mm.G_com_inverse.transpose())).eval();
+      mm.G_com_pivot_lo = std::numeric_limits<double>::infinity();
+      mm.G_com_pivot_hi = 0.0;
+      CholeskyPivotRange(mm.G_com_factor, &mm.G_com_pivot_lo, &mm.G_com_pivot_hi);
+    }
+  }
   BuildClusters();
+  BuildTree();
 
   const int V = int(def_.mesh.points.size());
   mesh_rest_local_.resize(V);
@@ -174,6 +191,83 @@ template <int Dim> void BodyModelN<Dim>::BuildClusters() {
     }
     clusters_.push_back(std::move(c));
   }
+}
+
+namespace {
+
+// Node of the points of ranks [lo, hi) of tree->by_rank (the scan order): its bounds (as the
+// clusters'), then its children, split at the group boundary nearest the middle, or at the
+// middle inside one group. Splitting the scan order, not space, keeps the leaves in scan
+// order, so the scan never sorts what it visits; the groups are cells of the lattice, and
+// inside a group, points given in order along the body (a drawing resampled, a grid) make
+// tight boxes.
+template <int Dim>
+void BuildTreeNode(const BodyModelN<Dim>& body, int lo, int hi, const std::vector<int>& group_starts,
+                   PointTreeN<Dim>* tree) {
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  const int D = body.num_modes(), L = tree->width;
+  const int node = int(tree->skip.size());
+  tree->skip.push_back(0);
+  tree->first.push_back(0);
+  tree->last.push_back(0);
+  tree->bounds.resize(tree->bounds.size() + size_t(tree->stride), 0.0);
+  double* centre = tree->bounds.data() + size_t(node) * size_t(tree->stride);
+  double* half = centre + L;
+  for (int block = 0; block <= D; ++block) {
+    auto value = [&](int r) {
+      const int k = tree->by_rank[size_t(r)];
+      return block == 0 ? body.rest_local(k) : Point(body.mode_matrix(k).col(block - 1));
+    };
+    Point low = value(lo), high = low;
+    for (int r = lo; r < hi; ++r) low = low.cwiseMin(value(r)), high = high.cwiseMax(value(r));
+    for (int a = 0; a < Dim; ++a) {
+      centre[Dim * block + a] = 0.5 * (low[a] + high[a]);
+      half[Dim * block + a] = 0.5 * (high[a] - low[a]);
+      if (block > 0) half[L + a] = std::max(half[L + a], std::abs(centre[Dim * block + a]) + half[Dim * block + a]);
+    }
+  }
+  int split = -1;
+  if (hi - lo > PointTreeN<Dim>::kLeafPoints) {
+    const int middle = lo + (hi - lo) / 2;
+    for (int start : group_starts)
+      if (start > lo && start < hi && (split < 0 || std::abs(start - middle) < std::abs(split - middle))) split = start;
+    const bool inside_group = split < 0;
+    if (inside_group) split = middle;
+    // Inside a group whose points come in no order along the body, halves of the range are
+    // as wide as the whole and every node below would pass where the whole passes: such a
+    // node stays a leaf (the group's own test, as before the tree). Across groups, always split.
+    auto size = [&](int from, int to) {
+      Point low = body.rest_local(tree->by_rank[size_t(from)]), high = low;
+      for (int r = from; r < to; ++r)
+        low = low.cwiseMin(body.rest_local(tree->by_rank[size_t(r)])), high = high.cwiseMax(body.rest_local(tree->by_rank[size_t(r)]));
+      return (high - low).sum();
+    };
+    if (inside_group && std::max(size(lo, split), size(split, hi)) > 0.75 * size(lo, hi)) split = -1;
+  }
+  if (split < 0) {
+    tree->first[size_t(node)] = int(tree->leaf_ranks.size());
+    for (int r = lo; r < hi; ++r) tree->leaf_ranks.push_back(r);
+    tree->last[size_t(node)] = int(tree->leaf_ranks.size());
+  } else {
+    BuildTreeNode(body, lo, split, group_starts, tree);
+    BuildTreeNode(body, split, hi, group_starts, tree);
+  }
+  tree->skip[size_t(node)] = int(tree->skip.size());
+}
+
+}  // namespace
+
+template <int Dim> void BodyModelN<Dim>::BuildTree() {
+  tree_ = PointTreeN<Dim>();
+  if (clusters_.size() <= 1) return;  // small bodies: the scan tests every point
+  tree_.width = Dim * (num_modes() + 1);
+  tree_.stride = 2 * tree_.width + Dim;
+  std::vector<int> group_starts;
+  for (const PointClusterN<Dim>& c : clusters_) {
+    group_starts.push_back(int(tree_.by_rank.size()));
+    tree_.by_rank.insert(tree_.by_rank.end(), c.points.begin(), c.points.end());
+  }
+  BuildTreeNode(*this, 0, int(tree_.by_rank.size()), group_starts, &tree_);
 }
 
 template <int Dim> void BodyModelN<Dim>::LocalBasis(const Point& st, Point* b0, ModeMatrix* B) const {

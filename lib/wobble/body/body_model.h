@@ -6,6 +6,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -76,13 +78,18 @@ template <> struct MassMomentsN<3> {
   std::vector<Eigen::Vector3d> X;  // D x D, at d*D + e
   MatD<double> G_com_factor;       // CholeskyInPlace(G − CᵀC/m), as in 2D
   bool G_com_positive = false;
+  // G_com⁻¹, made once from the factor: G_com is constant, so the step's solves with it are
+  // products, as Witkin & Welch 1990 precompute the inverse W of their constant mass matrix
+  // (Eq. 4–5: R̈ = Q W); and the range of the factor's pivots, for the condition estimate.
+  MatD<double> G_com_inverse;
+  double G_com_pivot_lo = 0.0, G_com_pivot_hi = 0.0;
 };
 
 // Mass points grouped by where they sit in the lattice, with interval bounds of their local
 // positions: every l_k = b0_k + B_k γ of the group lies in the box centre(γ) ± half(γ) with
-// centre = centre0 + centre_modes γ and half = half0 + half_modes |γ|. The ground scan skips a
-// group whose box is above the ground, so a large body resting on its feet visits only the
-// points near them (any basis: the bound needs no convex-hull property).
+// centre = centre0 + centre_modes γ and half = half0 + half_modes |γ| (any basis: the bound
+// needs no convex-hull property). The groups fix the ground scan's order; the scan skips by
+// the same bounds over the finer nodes of PointTreeN (below).
 template <int Dim> struct PointClusterN {
   using Point = Eigen::Matrix<double, Dim, 1>;
   std::vector<int> points;  // ascending
@@ -90,6 +97,72 @@ template <int Dim> struct PointClusterN {
   MatND<double, Dim> centre_modes, half_modes;  // Dim x D
 };
 using PointCluster = PointClusterN<2>;
+
+// A tree of such interval bounds over the mass points of a large body (more than one point
+// group), for the ground scan: each node bounds a range of the scan order, split at the group
+// boundary nearest its middle, else the middle while halves shrink, down to kLeafPoints.
+// Nodes are stored in preorder with `skip` (the node after the subtree), so a scan that rejects
+// a node jumps past everything below it. A node's numbers sit at bounds[i * stride]: the
+// centres of b0 and of each mode column (width = Dim (D + 1) numbers: [centre0, centre_modes
+// column 0, ...]), the half widths in the same layout, then per axis the largest
+// |centre| + half over the mode columns (for a coarse first test, PlaneReach).
+template <int Dim> struct PointTreeN {
+  static constexpr int kLeafPoints = 4;
+  int width = 0, stride = 0;
+  std::vector<double> bounds;
+  std::vector<int> skip;
+  std::vector<int> first, last;  // a leaf's points: leaf_ranks[first, last); empty for inner nodes
+  std::vector<int> leaf_ranks;   // ascending within a leaf
+  std::vector<int> by_rank;      // the scan order (the clusters', each ascending): rank -> point
+};
+
+// Whether a node of the tree may reach below a plane of body-frame normal n at offset
+// n·(t − p) (a point's height is offset + n·l): l lies in centre(γ) ± half(γ), so its height is
+// at least offset + w·centre − |w|·half with w = [n, γ_0 n, …], two dot products over the node's
+// numbers. A coarse test first, offset + n·centre0 − |n|·half0 − ‖γ‖₁ |n|·ρ with ρ the node's
+// largest |centre| + half over the mode columns (Dim numbers), rejects most nodes of a body at
+// rest. Decisions on plain values: a node counts as reaching when its bound is below a margin,
+// 1e-10 of the scale of t, p and the body (≥ the rounding of the bound and of the points' own
+// height test by far), so the scan visits every point that the test of every point finds.
+template <int Dim> class PlaneReach {
+ public:
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  // gamma_of(d): the amplitude γ_d; scale: |t|₁ + |p|₁
+  template <class GammaOf>
+  PlaneReach(const PointTreeN<Dim>& tree, int D, const Point& n, double offset, double scale, GammaOf&& gamma_of)
+      : width_(tree.width), offset_(offset) {
+    const Point n_abs = n.cwiseAbs();
+    double gamma_norm = 0.0, extent = 0.0;
+    const double* root = tree.bounds.data();
+    for (int block = 0; block <= D; ++block) {
+      const double gamma = block == 0 ? 1.0 : double(gamma_of(block - 1));
+      for (int a = 0; a < Dim; ++a) {
+        w_[Dim * block + a] = gamma * n[a];
+        w_abs_[Dim * block + a] = std::abs(gamma) * n_abs[a];
+        extent += std::abs(gamma) * (std::abs(root[Dim * block + a]) + root[tree.width + Dim * block + a]);
+      }
+      if (block > 0) gamma_norm += std::abs(gamma);
+    }
+    for (int a = 0; a < Dim; ++a) coarse_[a] = gamma_norm * n_abs[a];
+    margin_ = 1e-10 * (scale + std::abs(offset) + extent);
+  }
+  bool operator()(const double* box) const {
+    const double* half = box + width_;
+    const double* rho = half + width_;
+    double lower = offset_;
+    for (int a = 0; a < Dim; ++a) lower += w_[a] * box[a] - w_abs_[a] * half[a] - coarse_[a] * rho[a];
+    if (lower >= margin_) return false;
+    lower = offset_;
+    for (int j = 0; j < width_; ++j) lower += w_[j] * box[j] - w_abs_[j] * half[j];
+    return lower < margin_;
+  }
+  double margin() const { return margin_; }
+
+ private:
+  int width_;
+  double offset_, margin_ = 0.0;
+  double w_[Dim * (kMaxModes + 1)], w_abs_[Dim * (kMaxModes + 1)], coarse_[Dim];
+};
 
 // An FFD body as loaded: lattice, modes, mass points, drawing geometry, and the mass moments
 // that make its dynamics cost O(D²) per step instead of O(N). One template serves the 2D body
@@ -158,6 +231,32 @@ template <int Dim> class BodyModelN {
   // The points in groups of about kPointsPerCluster; a single group for small bodies.
   static constexpr int kPointsPerCluster = 64;
   const std::vector<PointClusterN<Dim>>& clusters() const { return clusters_; }
+  const PointTreeN<Dim>& point_tree() const { return tree_; }
+
+  // Calls visit(k) for every point of the tree's leaves whose node (and every ancestor)
+  // reaches(bounds) accepts, in the scan order of the clusters (the order of a scan of every
+  // point group), so sums over the visited points add in the same order whatever is skipped.
+  // `reaches` must be conservative; visit must not start another scan on this thread.
+  template <class Reaches, class Visit> void ForEachPointInReach(Reaches&& reaches, Visit&& visit) const {
+    thread_local std::vector<int> ranks;
+    ranks.clear();
+    bool sorted = true;
+    const int n = int(tree_.skip.size());
+    for (int i = 0; i < n;) {
+      if (!reaches(tree_.bounds.data() + size_t(i) * size_t(tree_.stride))) {
+        i = tree_.skip[size_t(i)];
+        continue;
+      }
+      const int first = tree_.first[size_t(i)], last = tree_.last[size_t(i)];
+      if (first < last) {
+        if (!ranks.empty() && tree_.leaf_ranks[size_t(first)] < ranks.back()) sorted = false;
+        ranks.insert(ranks.end(), tree_.leaf_ranks.begin() + first, tree_.leaf_ranks.begin() + last);
+      }
+      ++i;
+    }
+    if (!sorted) std::sort(ranks.begin(), ranks.end());
+    for (int r : ranks) visit(tree_.by_rank[size_t(r)]);
+  }
 
  private:
   BodyDefN<Dim> def_;
@@ -168,8 +267,10 @@ template <int Dim> class BodyModelN {
   std::vector<double> mesh_mode_rows_;  // per mesh vertex, as mode_rows_
   MassMomentsN<Dim> moments_;
   std::vector<PointClusterN<Dim>> clusters_;
+  PointTreeN<Dim> tree_;
 
   void BuildClusters();
+  void BuildTree();
 };
 
 using BodyModel = BodyModelN<2>;

@@ -125,36 +125,38 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
         });
   };
   if (ClearOfGround(body, g, s.q, frame)) return;
-  const std::vector<PointCluster>& clusters = body.clusters();
-  if (clusters.size() <= 1) {
+  if (body.clusters().size() <= 1) {
     for (int k = 0; k < body.num_points(); ++k) visit(k);
     return;
   }
-  // Large bodies: only groups whose bounding box reaches below the ground. The box test is a
-  // decision, so it runs on plain values: on the line, height = n·(t − p) + (Rᵀn)·l; on a
-  // terrain, the box's world bounds against the highest surface point under them.
-  const int D = body.num_modes();
+  // Large bodies: only the points of the point tree's nodes (body_model.h) whose box reaches
+  // below the ground. The box test is a decision, so it runs on plain values: on the line,
+  // height = n·(t − p) + (Rᵀn)·l (PlaneReach); on a terrain, the box's world bounds against the
+  // highest surface point under them, widened by PlaneReach's margin.
+  const int D = body.num_modes(), L = body.point_tree().width;
   const Eigen::Matrix2d R = frame.R.unaryExpr([](const T& v) { return double(ScalarValue(v)); });
-  const Eigen::Vector2d n_local = R.transpose() * line.n;
   const Eigen::Vector2d t(ScalarValue(s.q[0]), ScalarValue(s.q[1]));
-  const double offset = line.n.dot(t - line.point);
-  for (const PointCluster& c : clusters) {
-    Eigen::Vector2d centre = c.centre0, half = c.half0;
-    for (int d = 0; d < D; ++d) {
-      const double gamma = ScalarValue(s.q[kRigidDofs + d]);
-      centre += gamma * c.centre_modes.col(d);
-      half += std::abs(gamma) * c.half_modes.col(d);
-    }
-    if (!g.terrain) {
-      if (offset + n_local.dot(centre) - n_local.cwiseAbs().dot(half) >= 0.0) continue;
-    } else {
-      const Eigen::Vector2d world_centre = t + R * centre, world_half = R.cwiseAbs() * half;
-      if (world_centre.y() - world_half.y() >
-          g.terrain->MaxHeight(world_centre.x() - world_half.x(), world_centre.x() + world_half.x()))
-        continue;
-    }
-    for (int k : c.points) visit(k);
+  const PlaneReach<2> below_line(body.point_tree(), D, R.transpose() * line.n, line.n.dot(t - line.point),
+                                 t.cwiseAbs().sum() + line.point.cwiseAbs().sum(),
+                                 [&](int d) { return ScalarValue(s.q[kRigidDofs + d]); });
+  if (!g.terrain) {
+    body.ForEachPointInReach(below_line, visit);
+    return;
   }
+  body.ForEachPointInReach(
+      [&](const double* box) {
+        Eigen::Vector2d centre(box[0], box[1]), half(box[L], box[L + 1]);
+        for (int d = 0; d < D; ++d) {
+          const double gamma = ScalarValue(s.q[kRigidDofs + d]);
+          centre += gamma * Eigen::Vector2d(box[2 * (d + 1)], box[2 * (d + 1) + 1]);
+          half += std::abs(gamma) * Eigen::Vector2d(box[L + 2 * (d + 1)], box[L + 2 * (d + 1) + 1]);
+        }
+        const Eigen::Vector2d world_centre = t + R * centre,
+                              world_half = R.cwiseAbs() * half + Eigen::Vector2d::Constant(below_line.margin());
+        return world_centre.y() - world_half.y() <=
+               g.terrain->MaxHeight(world_centre.x() - world_half.x(), world_centre.x() + world_half.x());
+      },
+      visit);
 }
 
 // The anchor of a point whose friction hit the cap, moved so that −K Δt − FR v_t equals the

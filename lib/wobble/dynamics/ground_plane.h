@@ -98,22 +98,16 @@ void ForEachPointInContact(const BodyModelN<3>& body, const GroundPlane& g, cons
                        f(k, l, x, PointVelocity(frame, s.qd, l, B), anchor, plane, face);
                      });
   };
-  const std::vector<PointClusterN<3>>& clusters = body.clusters();
-  if (clusters.size() <= 1) {
+  if (body.clusters().size() <= 1) {
     for (int k = 0; k < body.num_points(); ++k) visit(k);
     return;
   }
-  // large bodies: only point groups whose bounding box reaches below the plane (as in 2D)
-  for (const PointClusterN<3>& c : clusters) {
-    Eigen::Vector3d centre = c.centre0, half = c.half0;
-    for (int d = 0; d < D; ++d) {
-      const double gamma = ScalarValue(s.q[Group<3>::kRigidParams + d]);
-      centre += gamma * c.centre_modes.col(d);
-      half += std::abs(gamma) * c.half_modes.col(d);
-    }
-    if (offset + n_local.dot(centre) - n_local.cwiseAbs().dot(half) >= 0.0) continue;
-    for (int k : c.points) visit(k);
-  }
+  // large bodies: only the points of the point tree's nodes whose box reaches below the plane
+  // (as in 2D, ground_line.h)
+  body.ForEachPointInReach(PlaneReach<3>(body.point_tree(), D, n_local, offset,
+                                         t.cwiseAbs().sum() + through.cwiseAbs().sum(),
+                                         [&](int d) { return ScalarValue(s.q[Group<3>::kRigidParams + d]); }),
+                           visit);
 }
 
 // Eq. 4.24/4.25 in the plane's frame: f_n = −K Δn − C_dam v_n (never pulling),

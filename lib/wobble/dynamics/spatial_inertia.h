@@ -22,6 +22,7 @@
 // over the points.
 #pragma once
 
+#include <algorithm>
 #include <array>
 
 #include "wobble/body/body_model.h"
@@ -184,61 +185,93 @@ void GravityForce(const MassMomentsN<3>& mm, const VecQ<T>& q, const Mat3<T>& R,
 // and eliminating them leaves
 //   [ I_com   U     ] [a_ω]   [ r_ω − c × r̂/m ]      I_com = I − (|c|² 1 − c cᵀ)/m
 //   [ Uᵀ      G_com ] [a_γ] = [ r_γ − Cᵀ r̂/m  ],     U = N − [c]× C/m,
-// whose mode block G_com = G − CᵀC/m is constant and factored once (MassMomentsN<3>, as in 2D).
-// Then G_com y = ρ_γ, G_com Z = Uᵀ (three solves), the 3x3 Schur complement
+// whose mode block G_com = G − CᵀC/m is constant, so MassMomentsN<3> keeps its inverse W (as
+// Witkin & Welch 1990, Eq. 5, precompute the inverse of their constant mass matrix): y = W ρ_γ
+// and Z = W Uᵀ are products, not solves. Then the 3x3 Schur complement
 // S = I_com − U Z (factored by Cholesky), S a_ω = ρ_ω − U y, a_γ = y − Z a_ω and
 // a_t = (r_t − R(C a_γ − c × a_ω))/m. Returns false when M is singular. *cond_estimate receives
 // the ratio of the largest to the smallest elimination pivot (m, G_com's pivots, S's pivots):
 // each pivot is a 1x1 Schur complement of a principal submatrix P of M, so lies in
 // [λ_min(P), λ_max(P)] ⊂ [λ_min(M), λ_max(M)] (Cauchy interlacing), and the ratio is a lower
 // bound of cond₂(M).
-template <class T>
-bool SolveMassSystem(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& r,
-                     VecQ<T>* a, double* cond_estimate) {
-  constexpr int kRigid = Group<3>::kRigidDofs;
+//
+// Everything but the right-hand side depends on the shape alone (U, Z, S, the pivots), so it is
+// one SpatialMassFactor, made by FactorMassSystem; SolveFactored applies it to any r. A step factors
+// once; the 3D adjoint keeps the factor of each recorded step and solves with M again
+// (M⁻¹ λ, M symmetric) without redoing the elimination.
+template <class T> struct SpatialMassFactor {
+  MatND<T, 3> U;                                     // N − [c]× C/m
+  Eigen::Matrix<T, Eigen::Dynamic, 3, 0, kMaxModes, 3> Z;  // G_com⁻¹ Uᵀ
+  Mat3<T> S;                                         // CholeskyInPlace(I_com − U Z)
+  double cond_estimate = 0.0;
+};
+template <class T> bool FactorMassSystem(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, SpatialMassFactor<T>* f) {
   const int D = int(sm.e.size());
   if (D > 0 && !mm.G_com_positive) return false;
   const T inv_m = T(1.0 / mm.m);
   const Vec3<T>& c = sm.c;
+  f->S = sm.I - (Mat3<T>::Identity() * c.squaredNorm() - c * c.transpose()) * inv_m;
+  if (D > 0) {
+    // by hand: D is dynamic (at most kMaxModes), and Eigen's products of such sizes call its
+    // general kernels, slower here than the solves they replace
+    const MatD<double>& W = mm.G_com_inverse;
+    f->U.resize(3, D);
+    for (int d = 0; d < D; ++d) f->U.col(d) = sm.N.col(d) - c.cross(Vec3<T>(mm.C.col(d).template cast<T>())) * inv_m;
+    f->Z.resize(D, 3);
+    for (int d = 0; d < D; ++d) {
+      Vec3<T> z = Vec3<T>::Zero();
+      for (int e = 0; e < D; ++e) z += T(W(d, e)) * Vec3<T>(f->U.col(e));
+      f->Z.row(d) = z.transpose();
+    }
+    for (int d = 0; d < D; ++d) f->S -= Vec3<T>(f->U.col(d)) * f->Z.row(d);
+  } else {
+    f->U.resize(3, 0);
+    f->Z.resize(0, 3);
+  }
+  if (!CholeskyInPlace(&f->S)) return false;
+  double lo = mm.m, hi = mm.m;
+  CholeskyPivotRange(f->S, &lo, &hi);
+  if (D > 0) lo = std::min(lo, mm.G_com_pivot_lo), hi = std::max(hi, mm.G_com_pivot_hi);
+  f->cond_estimate = hi / lo;
+  return true;
+}
+template <class T>
+void SolveFactored(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, const SpatialMassFactor<T>& f, const Mat3<T>& R,
+                   const VecQ<T>& r, VecQ<T>* a) {
+  constexpr int kRigid = Group<3>::kRigidDofs;
+  const int D = int(sm.e.size());
+  const T inv_m = T(1.0 / mm.m);
+  const Vec3<T>& c = sm.c;
   const Vec3<T> r_hat = R.transpose() * r.template head<3>();
-  Mat3<T> S = sm.I - (Mat3<T>::Identity() * c.squaredNorm() - c * c.transpose()) * inv_m;
   Vec3<T> rho = r.template segment<3>(3) - c.cross(r_hat) * inv_m;
   a->resize(kRigid + D);
-  MatND<T, 3> U;
-  Eigen::Matrix<T, Eigen::Dynamic, 3, 0, kMaxModes, 3> Z;
-  VecD<T> y;
-  if (D > 0) {
-    U.resize(3, D);
-    Z.resize(D, 3);
-    y = r.tail(D);
-    for (int d = 0; d < D; ++d) {
-      const Vec3<T> C_d = mm.C.col(d).cast<T>();
-      U.col(d) = sm.N.col(d) - c.cross(C_d) * inv_m;
-      y[d] -= C_d.dot(r_hat) * inv_m;
-    }
-    CholeskySolveInPlace(mm.G_com_factor, &y);
-    for (int i = 0; i < 3; ++i) {
-      VecD<T> z = U.row(i).transpose();
-      CholeskySolveInPlace(mm.G_com_factor, &z);
-      Z.col(i) = z;
-    }
-    S -= U * Z;
-    rho -= U * y;
+  VecD<T> y(D), rho_gamma(D);
+  const Vec3<T> r_hat_m = r_hat * inv_m;
+  for (int d = 0; d < D; ++d) rho_gamma[d] = r[kRigid + d] - Vec3<T>(mm.C.col(d).template cast<T>()).dot(r_hat_m);
+  for (int d = 0; d < D; ++d) {  // y = G_com⁻¹ ρ_γ
+    T yd = T(0.0);
+    for (int e = 0; e < D; ++e) yd += T(mm.G_com_inverse(d, e)) * rho_gamma[e];
+    y[d] = yd;
+    rho -= Vec3<T>(f.U.col(d)) * yd;
   }
-  if (!CholeskyInPlace(&S)) return false;
   Vec3<T> a_omega = rho;
-  CholeskySolveInPlace(S, &a_omega);
+  CholeskySolveInPlace(f.S, &a_omega);
   Vec3<T> local = -c.cross(a_omega);
-  if (D > 0) {
-    a->tail(D) = y - Z * a_omega;
-    local += mm.C.cast<T>() * a->tail(D);
+  for (int d = 0; d < D; ++d) {
+    (*a)[kRigid + d] = y[d] - f.Z.row(d).dot(a_omega.transpose());
+    local += Vec3<T>(mm.C.col(d).template cast<T>()) * (*a)[kRigid + d];
   }
   a->template segment<3>(3) = a_omega;
   a->template head<3>() = (r.template head<3>() - R * local) * inv_m;
-  double lo = mm.m, hi = mm.m;
-  CholeskyPivotRange(S, &lo, &hi);
-  if (D > 0) CholeskyPivotRange(mm.G_com_factor, &lo, &hi);
-  *cond_estimate = hi / lo;
+}
+template <class T>
+bool SolveMassSystem(const MassMomentsN<3>& mm, const ShapeMoments<T>& sm, const Mat3<T>& R, const VecQ<T>& r,
+                     VecQ<T>* a, double* cond_estimate, SpatialMassFactor<T>* factor = nullptr) {
+  SpatialMassFactor<T> local;
+  SpatialMassFactor<T>& f = factor ? *factor : local;
+  if (!FactorMassSystem(mm, sm, &f)) return false;
+  SolveFactored(mm, sm, f, R, r, a);
+  *cond_estimate = f.cond_estimate;
   return true;
 }
 

@@ -23,13 +23,15 @@ int World::AddLinearBody(std::shared_ptr<const LinearBodyModel> model, AffineMat
   if (!model) throw std::invalid_argument("AddLinearBody: no model");
   LinearEntry e;
   const int model_dim = model->dim();
-  e.R = model->RestState();
-  e.R_dot = Eigen::MatrixXd::Zero(e.R.rows(), e.R.cols());
-  e.applied = e.R_dot;
+  WorldData::Linear x;
+  x.R = model->RestState();
+  x.R_dot = Eigen::MatrixXd::Zero(x.R.rows(), x.R.cols());
+  x.applied = x.R_dot;
   e.model = std::move(model);
   e.material = material;
   e.scale = LinearScale(*e.model, material);
   linear_.push_back(std::move(e));
+  data_.linear.push_back(std::move(x));
   slots_.push_back({BodyKind::kLinear, model_dim, int(linear_.size()) - 1});
   return num_bodies() - 1;
 }
@@ -64,6 +66,11 @@ const World::LinearEntry& World::Linear(int body) const {
   return linear_[slots_[body].index];
 }
 
+const WorldData::Linear& World::LinearData(int body) const {
+  Linear(body);
+  return data_.linear[size_t(slots_[body].index)];
+}
+
 const LinearBodyModel& World::linear_model(int body) const { return *Linear(body).model; }
 const std::shared_ptr<const LinearBodyModel>& World::shared_linear_model(int body) const { return Linear(body).model; }
 
@@ -74,21 +81,22 @@ void World::SetLinearState(int body, const Eigen::MatrixXd& R, const Eigen::Matr
                                 std::to_string(m.basis_size()));
   if (!R.allFinite() || !R_dot.allFinite()) throw std::invalid_argument("linear body '" + m.name() + "': non-finite state");
   LinearEntry& e = linear_[slots_[body].index];
-  e.R_before = e.R;
-  e.R_dot_before = e.R_dot;
-  e.R = R;
-  e.R_dot = R_dot;
-  RefreshLinearContacts(e);
+  WorldData::Linear& x = data_.linear[size_t(slots_[body].index)];
+  e.R_before = x.R;
+  e.R_dot_before = x.R_dot;
+  x.R = R;
+  x.R_dot = R_dot;
+  RefreshLinearContacts(body);
   if (EnergyFinite(body)) return;
   const std::string terms = EnergyTerms(ComputeEnergies(body));
-  e.R = e.R_before;
-  e.R_dot = e.R_dot_before;
-  RefreshLinearContacts(e);
+  x.R = e.R_before;
+  x.R_dot = e.R_dot_before;
+  RefreshLinearContacts(body);
   throw InputError("linear body '" + m.name() + "': a state whose energy is not finite (" + terms + ")");
 }
 
-const Eigen::MatrixXd& World::linear_R(int body) const { return Linear(body).R; }
-const Eigen::MatrixXd& World::linear_R_dot(int body) const { return Linear(body).R_dot; }
+const Eigen::MatrixXd& World::linear_R(int body) const { return LinearData(body).R; }
+const Eigen::MatrixXd& World::linear_R_dot(int body) const { return LinearData(body).R_dot; }
 
 void World::SetMaterial(int body, const AffineMaterial& material) {
   linear_model(body);
@@ -101,19 +109,21 @@ const AffineMaterial& World::material(int body) const { return Linear(body).mate
 
 void World::SetGroundContact(int body, bool on) {
   linear_model(body);
-  LinearEntry& e = linear_[slots_[body].index];
-  e.ground_contact = on;
-  e.contacts.clear();  // found at the next SetLinearState or step, not at a state about to be replaced
+  linear_[slots_[body].index].ground_contact = on;
+  // found at the next SetLinearState or step, not at a state about to be replaced
+  data_.linear[size_t(slots_[body].index)].contacts.clear();
 }
 
 bool World::ground_contact(int body) const {
   return kind(body) != BodyKind::kLinear || Linear(body).ground_contact;
 }
 
-const LinearContacts& World::linear_contacts(int body) const { return Linear(body).contacts; }
+const LinearContacts& World::linear_contacts(int body) const { return LinearData(body).contacts; }
 
-void World::RefreshLinearContacts(LinearEntry& e) const {
-  if (e.ground_contact) UpdateLinearContacts(*e.model, linear_ground(), e.R, e.R_dot, &e.contacts);
+void World::RefreshLinearContacts(int body) {
+  const LinearEntry& e = linear_[slots_[body].index];
+  WorldData::Linear& x = data_.linear[size_t(slots_[body].index)];
+  if (e.ground_contact) UpdateLinearContacts(*e.model, linear_ground(), x.R, x.R_dot, &x.contacts);
 }
 
 int World::AddSpring(Spring spring) {
@@ -123,10 +133,48 @@ int World::AddSpring(Spring spring) {
   return int(options_.params.springs.size()) - 1;
 }
 
+// ---------------------------------------------------------------- model and data
+
+namespace {
+template <int Dim, class Entries>
+void CheckFfdData(const Entries& models, const std::vector<WorldData::Ffd<Dim>>& data) {
+  if (data.size() != models.size())
+    throw std::invalid_argument("World::SetData: the data has " + std::to_string(data.size()) + " " +
+                                std::to_string(Dim) + "D FFD bodies, the world " + std::to_string(models.size()));
+  for (size_t i = 0; i < data.size(); ++i) {
+    const auto& m = *models[i].model;
+    const BodyState<Dim, double>& s = data[i].state;
+    bool ok = s.q.size() == m.num_positions() && s.qd.size() == m.num_q() && data[i].applied.size() == m.num_q() &&
+              (s.mode_target.size() == 0 || s.mode_target.size() == m.num_modes());
+    for (const Contact<Dim, double>& c : s.contacts) ok = ok && c.point >= 0 && c.point < m.num_points();
+    if (!ok) throw std::invalid_argument("World::SetData: the state of body '" + m.name() + "' does not fit its model");
+  }
+}
+}  // namespace
+
+void World::SetData(WorldData data) {
+  CheckFfdData<2>(FfdEntries<2>(), data.ffd_of<2>());
+  CheckFfdData<3>(FfdEntries<3>(), data.ffd_of<3>());
+  if (data.linear.size() != linear_.size())
+    throw std::invalid_argument("World::SetData: the data has " + std::to_string(data.linear.size()) +
+                                " linear bodies, the world " + std::to_string(linear_.size()));
+  for (size_t i = 0; i < linear_.size(); ++i) {
+    const LinearBodyModel& m = *linear_[i].model;
+    const WorldData::Linear& x = data.linear[i];
+    for (const Eigen::MatrixXd* R : {&x.R, &x.R_dot, &x.applied})
+      if (R->rows() != m.dim() || R->cols() != m.basis_size())
+        throw std::invalid_argument("World::SetData: the state of linear body '" + m.name() + "' does not fit its model");
+  }
+  if (data.multipliers.size() != constraints_.size())
+    throw std::invalid_argument("World::SetData: the data has " + std::to_string(data.multipliers.size()) +
+                                " constraints, the world " + std::to_string(constraints_.size()));
+  data_ = std::move(data);
+}
+
 // ---------------------------------------------------------------- stepping
 
 bool World::Step() {
-  if (!status_.ok()) return false;
+  if (!data_.status.ok()) return false;
   if (controllers_.empty()) {  // the fast path of a world nobody drives
     if (!(enabled_count_ == 0 ? StepEachBody() : StepConstrained())) return false;
     FinishStep();
@@ -183,16 +231,17 @@ bool World::kinematic(int body) const {
 }
 
 void World::FinishStep() {
-  if (options_.dt != origin_dt_) {  // dt changed: count from here
-    time_origin_ = time_;
-    origin_dt_ = options_.dt;
-    origin_steps_ = 0;
+  WorldData& d = data_;
+  if (options_.dt != d.origin_dt) {  // dt changed: count from here
+    d.time_origin = d.time;
+    d.origin_dt = options_.dt;
+    d.origin_steps = 0;
   }
-  ++steps_;
-  ++origin_steps_;
-  time_ = time_origin_ + origin_steps_ * options_.dt;
-  status_.step = steps_;
-  status_.time = time_;
+  ++d.steps;
+  ++d.origin_steps;
+  d.time = d.time_origin + d.origin_steps * options_.dt;
+  d.status.step = d.steps;
+  d.status.time = d.time;
 }
 
 // No constraint: each body on its own. FFD bodies on the templated StepBody (the fast path).
@@ -203,9 +252,8 @@ bool World::StepEachBody() {
       if (!(slots_[body].dim == 3 ? StepFfdBody<3>(body) : StepFfdBody<2>(body))) return false;
       continue;
     }
-    LinearEntry& e = linear_[slots_[body].index];
     Eigen::VectorXd& acc = acc_.empty() ? acc_.emplace_back() : acc_[0];
-    LinearFreeAcceleration(e, &acc);
+    LinearFreeAcceleration(body, &acc);
     if (!acc.allFinite()) return Fail(StatusCode::kNonFinite, body, "non-finite acceleration");
     if (!StepLinearBody(body, acc)) return false;
   }
@@ -221,6 +269,7 @@ constexpr double kLinearScreen = 1e30;  // AcceptLinearStep's bound on every fac
 // Plain loops (d ≤ 3, n ≤ 10), which also apply AcceptLinearStep's screen to R and Ṙ on the way.
 bool World::StepLinearBody(int body, const Eigen::VectorXd& acc) {
   LinearEntry& e = linear_[slots_[body].index];
+  WorldData::Linear& x = data_.linear[size_t(slots_[body].index)];
   const double h = options_.dt;
   const int d = e.model->dim(), n = e.model->basis_size();
   e.R_before.resize(d, n);
@@ -228,49 +277,51 @@ bool World::StepLinearBody(int body, const Eigen::VectorXd& acc) {
   bool screened = true;  // every |R|, |Ṙ| ≤ kLinearScreen (false for NaN and inf too)
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < d; ++i) {
-      const double rd = e.R_dot(i, j) + h * acc[i * n + j];
-      const double r = e.R(i, j) + h * rd;
+      const double rd = x.R_dot(i, j) + h * acc[i * n + j];
+      const double r = x.R(i, j) + h * rd;
       e.R_dot_before(i, j) = rd;
       e.R_before(i, j) = r;
       screened &= std::abs(rd) <= kLinearScreen && std::abs(r) <= kLinearScreen;
     }
-  e.R.swap(e.R_before);
-  e.R_dot.swap(e.R_dot_before);
-  e.applied.setZero();
+  x.R.swap(e.R_before);
+  x.R_dot.swap(e.R_dot_before);
+  x.applied.setZero();
   if (!AcceptLinearStep(body, screened)) return false;
   if (!e.ground_contact) return true;
   // the contacts of the accepted state; a point deeper than half the body's thickness went
   // through the ground (a step too long for its stiffness): refused, as for FFD bodies
-  e.contacts_before = e.contacts;  // copy-assigned: reuses its storage from step to step
-  RefreshLinearContacts(e);
+  e.contacts_before = x.contacts;  // copy-assigned: reuses its storage from step to step
+  RefreshLinearContacts(body);
   const double limit = options_.params.ground.max_penetration > 0 ? options_.params.ground.max_penetration
                                                                   : e.model->half_thickness();
-  if (!(e.contacts.penetration > limit)) return true;
+  if (!(x.contacts.penetration > limit)) return true;
   std::ostringstream detail;
-  detail << "a point is " << e.contacts.penetration << " below the ground (limit " << limit
+  detail << "a point is " << x.contacts.penetration << " below the ground (limit " << limit
          << "); reduce dt, or the ground's stiffness or damping";
-  e.R.swap(e.R_before);
-  e.R_dot.swap(e.R_dot_before);
-  e.contacts.list2.swap(e.contacts_before.list2);
-  e.contacts.list3.swap(e.contacts_before.list3);
-  e.contacts.penetration = e.contacts_before.penetration;
+  x.R.swap(e.R_before);
+  x.R_dot.swap(e.R_dot_before);
+  x.contacts.list2.swap(e.contacts_before.list2);
+  x.contacts.list3.swap(e.contacts_before.list3);
+  x.contacts.penetration = e.contacts_before.penetration;
   return Fail(StatusCode::kPenetration, body, detail.str());
 }
 
-void World::LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const {
+void World::LinearFreeAcceleration(int body, Eigen::VectorXd* acc) {
+  LinearEntry& e = linear_[slots_[body].index];
+  const WorldData::Linear& x = data_.linear[size_t(slots_[body].index)];
   const WorldParams& params = options_.params;
   const LinearBodyModel& m = *e.model;
   const int d = m.dim(), n = m.basis_size();
   Eigen::MatrixXd& Q = e.Q;
-  Q = e.applied;
-  AddAffineForce(e.material, e.R, e.R_dot, &Q);
+  Q = x.applied;
+  AddAffineForce(e.material, x.R, x.R_dot, &Q);
   if (params.gravity_on) {  // Σ m_k g p_kᵀ
     const double* g = params.gravity.data();  // a 2D body reads x and y
     const Eigen::VectorXd& mu = m.first_moment();
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < d; ++i) Q(i, j) += g[i] * mu[j];
   }
-  if (e.ground_contact) AddLinearGroundForce(m, linear_ground(), e.R, e.R_dot, e.contacts, &Q);
+  if (e.ground_contact) AddLinearGroundForce(m, linear_ground(), x.R, x.R_dot, x.contacts, &Q);
   // R̈ = Q W (Eq. 5), flattened row by row; plain loops, as TimesBasis in world_constraints.cc
   acc->resize(m.num_q());
   const Eigen::MatrixXd& W = m.inverse_mass_matrix();
@@ -284,21 +335,22 @@ void World::LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const {
 
 void World::ThrowInterrupted() const {
   std::ostringstream msg;
-  msg << "stopped by Ctrl-C at t = " << time_ << " (after step " << steps_ << ")";
+  msg << "stopped by Ctrl-C at t = " << data_.time << " (after step " << data_.steps << ")";
   throw Interrupted(msg.str());
 }
 
 bool World::Fail(StatusCode code, int body, const std::string& detail, double value) {
-  status_.code = code;
-  status_.step = steps_ + 1;
-  status_.time = time_;
-  status_.body = body;
+  WorldStatus& status = data_.status;
+  status.code = code;
+  status.step = data_.steps + 1;
+  status.time = data_.time;
+  status.body = body;
   std::ostringstream msg;
-  msg << StatusCodeName(code) << " at step " << status_.step << " (t = " << time_ << ")";
+  msg << StatusCodeName(code) << " at step " << status.step << " (t = " << data_.time << ")";
   if (body >= 0) msg << " in body '" << body_name(body) << "'";
   if (code == StatusCode::kIllConditioned) msg << ": condition estimate " << value;
   if (!detail.empty()) msg << ": " << detail;
-  status_.message = msg.str();
+  status.message = msg.str();
   return false;
 }
 
@@ -309,12 +361,13 @@ Energies World::ComputeEnergies(int i) const {
   const WorldParams& p = options_.params;
   if (kind(i) == BodyKind::kLinear) {
     const LinearEntry& l = Linear(i);
-    e.kinetic = 0.5 * (l.R_dot * l.model->mass_matrix() * l.R_dot.transpose()).trace();  // ½ Ṙ_ij Ṙ_ik M_jk
-    e.modes = AffineEnergy(l.material, l.R);
-    e.ground = LinearGroundEnergy(*l.model, linear_ground(), l.R, l.contacts);
+    const WorldData::Linear& x = LinearData(i);
+    e.kinetic = 0.5 * (x.R_dot * l.model->mass_matrix() * x.R_dot.transpose()).trace();  // ½ Ṙ_ij Ṙ_ik M_jk
+    e.modes = AffineEnergy(l.material, x.R);
+    e.ground = LinearGroundEnergy(*l.model, linear_ground(), x.R, x.contacts);
     if (p.gravity_on) {
       const Eigen::VectorXd g = p.gravity.head(l.model->dim());
-      e.gravity = -g.dot(l.R * l.model->first_moment());
+      e.gravity = -g.dot(x.R * l.model->first_moment());
     }
     return e;
   }
@@ -326,25 +379,26 @@ Energies World::ComputeEnergies(int i) const {
 // `screened`: every entry of R and Ṙ is at most kLinearScreen in size.
 bool World::AcceptLinearStep(int body, bool screened) {
   LinearEntry& e = linear_[slots_[body].index];
+  WorldData::Linear& x = data_.linear[size_t(slots_[body].index)];
   // the screen of EnergySurelyFinite, for ½ tr(Ṙ M Ṙᵀ), −g·R m̄ and the affine energies (at
   // most seven factors deep: k_c (det A − 1)² with a 3×3 A)
   const double g = options_.params.gravity.head(e.model->dim()).cwiseAbs().maxCoeff();
   if (screened && e.scale <= kLinearScreen && g <= kLinearScreen) return true;
-  const bool finite = e.R.allFinite() && e.R_dot.allFinite();
+  const bool finite = x.R.allFinite() && x.R_dot.allFinite();
   if (finite && EnergyFinite(body)) return true;
   const Energies energies = finite ? ComputeEnergies(body) : Energies();
-  e.R.swap(e.R_before);
-  e.R_dot.swap(e.R_dot_before);
+  x.R.swap(e.R_before);
+  x.R_dot.swap(e.R_dot_before);
   return finite ? Fail(StatusCode::kNonFiniteEnergy, body, EnergyTerms(energies)) : Fail(StatusCode::kNonFinite, body);
 }
 
 bool World::EnergyFinite(int body) const {
   if (kind(body) == BodyKind::kFfd) {
     if (dim(body) == 3) {
-      if (EnergySurelyFinite(Ffd<3>(body))) return true;
+      if (EnergySurelyFinite<3>(body)) return true;
       return std::isfinite(FfdEnergies<3>(body, ContactSet::kFrozen, false).total());
     }
-    if (EnergySurelyFinite(Ffd<2>(body))) return true;
+    if (EnergySurelyFinite<2>(body)) return true;
     return std::isfinite(FfdEnergies<2>(body, ContactSet::kFrozen, false).total());
   }
   return std::isfinite(ComputeEnergies(body).total());

@@ -35,6 +35,7 @@
 
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "wobble/body/affine_energy.h"
@@ -122,6 +123,37 @@ struct VelocityGoal {
 // friction.
 GroundPlane GroundPlaneOf(const Ground& ground);
 
+// What a run changes (MuJoCo's mjData): each body's state with its ground contacts and the
+// point forces waiting for the next step, the constraints' multipliers, the clock and the
+// status. Everything else a World holds is its model (MuJoCo's mjModel), which steps do not
+// change: the body models and materials, the options (gravity, ground, springs, integrator),
+// the constraint topology, the kinematic flags and the controllers. A replay, trials from one
+// start or an undo copies this and puts it back (World::data, World::SetData), not the world.
+struct WorldData {
+  template <int Dim> struct Ffd {
+    BodyState<Dim, double> state;
+    Eigen::VectorXd applied;  // Σ Jᵀ f of ApplyPointForce for the next step
+  };
+  struct Linear {
+    Eigen::MatrixXd R, R_dot;
+    Eigen::MatrixXd applied;  // Σ f pᵀ of ApplyPointForce for the next step
+    LinearContacts contacts;
+  };
+  // the FFD bodies by dimension and the linear bodies, each in the order added
+  std::tuple<std::vector<Ffd<2>>, std::vector<Ffd<3>>> ffd;
+  std::vector<Linear> linear;
+  std::vector<Eigen::VectorXd> multipliers;  // λ of each constraint id at the last step
+  // the clock: time = time_origin + origin_steps dt (no drift from summing dt) since the clock
+  // was set or dt changed
+  double time = 0.0, time_origin = 0.0, origin_dt = 0.0;
+  long origin_steps = 0;
+  long steps = 0;
+  WorldStatus status;
+
+  template <int Dim> std::vector<Ffd<Dim>>& ffd_of() { return std::get<Dim - 2>(ffd); }
+  template <int Dim> const std::vector<Ffd<Dim>>& ffd_of() const { return std::get<Dim - 2>(ffd); }
+};
+
 class World {
  public:
   explicit World(WorldOptions options = {});
@@ -145,7 +177,7 @@ class World {
   template <int Dim> const BodyModelN<Dim>& body(int i) const { return *Ffd<Dim>(i).model; }
   // for whoever outlives the world
   template <int Dim> const std::shared_ptr<const BodyModelN<Dim>>& shared_body(int i) const { return Ffd<Dim>(i).model; }
-  template <int Dim> const BodyState<Dim, double>& state(int i) const { return Ffd<Dim>(i).state; }
+  template <int Dim> const BodyState<Dim, double>& state(int i) const { return FfdData<Dim>(i).state; }
   // Either dimension: positions q (2D [t, θ, γ]; 3D [t, unit quaternion x y z w, γ]) and
   // velocities q̇ (2D dq/dt; 3D [ṫ, body ω, γ̇]), as body_state.h lays them out.
   const VecQ<double>& q(int i) const;
@@ -260,7 +292,7 @@ class World {
   // Steps until time >= t_end or trouble; calls on_step(world) after every accepted step.
   // Ctrl-C (core/interrupt.h) between two steps throws Interrupted saying where.
   template <class F> bool RunUntil(double t_end, F&& on_step) {
-    while (time_ + 0.5 * options_.dt < t_end) {
+    while (data_.time + 0.5 * options_.dt < t_end) {
       if (InterruptRequested()) ThrowInterrupted();
       if (!Step()) return false;
       on_step(*this);
@@ -271,22 +303,29 @@ class World {
     return RunUntil(t_end, [](World&) {});
   }
   [[noreturn]] void ThrowInterrupted() const;  // "stopped by Ctrl-C at t = T (step N)"
-  const WorldStatus& status() const { return status_; }
+  const WorldStatus& status() const { return data_.status; }
   // Stops the world after the step now (a controller's or the recorder's call: a record row
   // that overflowed); the state stays. body -1: not one body's trouble.
   void Stop(StatusCode code, int body, const std::string& detail) { Fail(code, body, detail); }
-  void ClearStatus() { status_ = WorldStatus(); }
+  void ClearStatus() { data_.status = WorldStatus(); }
   // Sets the clock (replays of recorded states, scenes that start later); steps continue from t.
   void SetTime(double t) {
-    time_ = time_origin_ = t;
-    origin_steps_ = 0;
+    data_.time = data_.time_origin = t;
+    data_.origin_steps = 0;
   }
-  double time() const { return time_; }
-  long steps() const { return steps_; }
+  double time() const { return data_.time; }
+  long steps() const { return data_.steps; }
   const WorldOptions& options() const { return options_; }
   // Changing dt, gravity, the ground, springs or the integrator between steps is allowed
   // (scripts and the viewer do).
   WorldOptions& mutable_options() { return options_; }
+
+  // ---- model and data (WorldData) ----
+  // Everything a step changes. SetData puts back a copy taken of this world (or of a world
+  // with the same bodies and constraints): std::invalid_argument when its bodies, sizes or
+  // constraints do not match. Controllers and the recorder are not called.
+  const WorldData& data() const { return data_; }
+  void SetData(WorldData data);
 
   // ---- energies ----
   // Every term of one body (Energies); kinetic ½ q̇ᵀ M q̇ (FFD, Eq. 4.9) or ½ tr(Ṙ M Ṙᵀ) (linear).
@@ -308,27 +347,25 @@ class World {
   struct Slot {
     BodyKind kind;
     int dim;    // 2 or 3
-    int index;  // into ffd2_, ffd3_ (by dim) or linear_
+    int index;  // into ffd_ (by dim) or linear_, and the same in data_
     bool kinematic = false;
   };
   // A point or constraint value (d ≤ 3) on the stack: the per-step loops allocate nothing.
   using PointVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
-  // An FFD body of dimension Dim: its model and what a run changes.
+  // The model of an FFD body of dimension Dim (its state: data_.ffd_of<Dim>(), same index).
   template <int Dim> struct FfdEntry {
     std::shared_ptr<const BodyModelN<Dim>> model;
-    BodyState<Dim, double> state;
-    Eigen::VectorXd applied;  // Σ Jᵀ f of ApplyPointForce for the next step
-    double scale = 0.0;       // the largest |number| of the model (ModelScale), for EnergySurelyFinite
+    double scale = 0.0;  // the largest |number| of the model (ModelScale), for EnergySurelyFinite
   };
+  // The model of a linear body (its state: data_.linear, same index) and its per-step work.
   struct LinearEntry {
     std::shared_ptr<const LinearBodyModel> model;
     AffineMaterial material;
-    Eigen::MatrixXd R, R_dot, applied;  // applied: Σ f pᵀ of ApplyPointForce for the next step
-    Eigen::MatrixXd Q;                  // per-step work: the body's generalized force
-    Eigen::MatrixXd R_before, R_dot_before;  // per-step work: the state a refused step restores
     double scale = 0.0;  // the largest |number| of the mass matrix, first moment and material
     bool ground_contact = false;
-    LinearContacts contacts, contacts_before;  // contacts_before: per-step work, as R_before
+    // per-step work, not state: the generalized force, and what a refused step restores
+    Eigen::MatrixXd Q, R_before, R_dot_before;
+    LinearContacts contacts_before;
   };
   // A resolved material point: linear bodies keep p(u) and W p; FFD bodies b0 and B (their
   // first dim(body) rows: one layout for both dimensions).
@@ -345,7 +382,6 @@ class World {
     std::shared_ptr<const PointPath> path;
     Feedback fb;
     bool enabled = true, removed = false;
-    Eigen::VectorXd lambda;
     int row = -1;  // first row in A while enabled
   };
 
@@ -354,14 +390,17 @@ class World {
   void CheckBody(int body) const;
   template <int Dim> std::vector<FfdEntry<Dim>>& FfdEntries();
   template <int Dim> const std::vector<FfdEntry<Dim>>& FfdEntries() const;
-  template <int Dim> const FfdEntry<Dim>& Ffd(int body) const;
-  template <int Dim> FfdEntry<Dim>& Ffd(int body) {
-    return const_cast<FfdEntry<Dim>&>(static_cast<const World*>(this)->Ffd<Dim>(body));
+  template <int Dim> int FfdIndex(int body) const;  // into FfdEntries<Dim> and data_.ffd_of<Dim>
+  template <int Dim> const FfdEntry<Dim>& Ffd(int body) const { return FfdEntries<Dim>()[size_t(FfdIndex<Dim>(body))]; }
+  template <int Dim> const WorldData::Ffd<Dim>& FfdData(int body) const {
+    return data_.ffd_of<Dim>()[size_t(FfdIndex<Dim>(body))];
   }
+  template <int Dim> WorldData::Ffd<Dim>& FfdData(int body) { return data_.ffd_of<Dim>()[size_t(FfdIndex<Dim>(body))]; }
   template <int Dim> int AddFfdBody(std::shared_ptr<const BodyModelN<Dim>> model);
   template <int Dim> const GroundOf<Dim>& GroundFor() const { return wobble::GroundFor<Dim>(options_.params); }
   [[noreturn]] void ThrowBadBody(int body, BodyKind wanted, int wanted_dim = 0) const;
   const LinearEntry& Linear(int body) const;
+  const WorldData::Linear& LinearData(int body) const;
   bool StepEachBody();
   template <int Dim> void SetFfdState(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
   template <int Dim> bool StepFfdBody(int body);
@@ -376,7 +415,7 @@ class World {
   // Every energy term of the body is finite: a finite state can hold an infinite energy (a
   // q̇ of 1e160 squares past the largest double), and no accepted step leaves one.
   bool EnergyFinite(int body) const;
-  template <int Dim> bool EnergySurelyFinite(const FfdEntry<Dim>& e) const;
+  template <int Dim> bool EnergySurelyFinite(int body) const;
   template <int Dim> void ResolveFfd(const MaterialPoint& point, End* e) const;
   template <int Dim> PointVec FfdEndPosition(const End& e) const;
   template <int Dim> PointVec FfdEndVelocity(const End& e) const;
@@ -387,8 +426,8 @@ class World {
   template <int Dim> bool FfdFreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st) const;
   template <int Dim> bool FfdAcceptConstrainedStep(int body, const Eigen::VectorXd& acc);
   template <int Dim> void FfdAddVelocity(int body, const Eigen::VectorXd& dv);
-  void LinearFreeAcceleration(LinearEntry& e, Eigen::VectorXd* acc) const;
-  void RefreshLinearContacts(LinearEntry& e) const;  // the contacts of its state now
+  void LinearFreeAcceleration(int body, Eigen::VectorXd* acc);
+  void RefreshLinearContacts(int body);  // the contacts of its state now
   bool Fail(StatusCode code, int body, const std::string& detail = "", double value = 0.0);
   bool StepLinearBody(int body, const Eigen::VectorXd& acc);
   bool AcceptLinearStep(int body, bool screened);
@@ -429,8 +468,7 @@ class World {
   std::shared_ptr<Controller> recorder_;
   bool stepping_ = false;
   bool removed_while_stepping_ = false;  // controllers_ has null entries to erase
-  std::vector<FfdEntry<2>> ffd2_;
-  std::vector<FfdEntry<3>> ffd3_;
+  std::tuple<std::vector<FfdEntry<2>>, std::vector<FfdEntry<3>>> ffd_;  // the FFD bodies' models, by dimension
   std::vector<LinearEntry> linear_;
   std::vector<Constraint> constraints_;
   int enabled_count_ = 0;
@@ -439,12 +477,7 @@ class World {
   MultiplierSolver constant_solver_, dynamic_solver_;
   bool structure_dirty_ = true;
   MultiplierMethod last_method_ = MultiplierMethod::kAuto;
-  double time_ = 0.0;
-  // time = origin + n dt (no drift from summing dt) since the clock was set or dt changed
-  double time_origin_ = 0.0, origin_dt_ = 0.0;
-  long origin_steps_ = 0;
-  long steps_ = 0;
-  WorldStatus status_;
+  WorldData data_;
 };
 
 inline void World::CheckBody(int body) const {
@@ -454,15 +487,13 @@ inline BodyKind World::kind(int body) const {
   CheckBody(body);
   return slots_[size_t(body)].kind;
 }
-template <> inline std::vector<World::FfdEntry<2>>& World::FfdEntries<2>() { return ffd2_; }
-template <> inline std::vector<World::FfdEntry<3>>& World::FfdEntries<3>() { return ffd3_; }
-template <> inline const std::vector<World::FfdEntry<2>>& World::FfdEntries<2>() const { return ffd2_; }
-template <> inline const std::vector<World::FfdEntry<3>>& World::FfdEntries<3>() const { return ffd3_; }
+template <int Dim> std::vector<World::FfdEntry<Dim>>& World::FfdEntries() { return std::get<Dim - 2>(ffd_); }
+template <int Dim> const std::vector<World::FfdEntry<Dim>>& World::FfdEntries() const { return std::get<Dim - 2>(ffd_); }
 // inline: the per-step loops of controllers call body() and state()
-template <int Dim> const World::FfdEntry<Dim>& World::Ffd(int body) const {
+template <int Dim> int World::FfdIndex(int body) const {
   if (unsigned(body) >= slots_.size() || slots_[size_t(body)].kind != BodyKind::kFfd || slots_[size_t(body)].dim != Dim)
     ThrowBadBody(body, BodyKind::kFfd, Dim);
-  return FfdEntries<Dim>()[size_t(slots_[size_t(body)].index)];
+  return slots_[size_t(body)].index;
 }
 
 }  // namespace wobble

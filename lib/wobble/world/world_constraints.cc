@@ -74,13 +74,13 @@ World::End World::Resolve(const MaterialPoint& point) const {
 
 World::PointVec World::EndPosition(const End& e) const {
   const Slot& b = slots_[e.body];
-  if (b.kind == BodyKind::kLinear) return TimesBasis(linear_[b.index].R, e.p);
+  if (b.kind == BodyKind::kLinear) return TimesBasis(data_.linear[size_t(b.index)].R, e.p);
   return b.dim == 3 ? FfdEndPosition<3>(e) : FfdEndPosition<2>(e);
 }
 
 World::PointVec World::EndVelocity(const End& e) const {
   const Slot& b = slots_[e.body];
-  if (b.kind == BodyKind::kLinear) return TimesBasis(linear_[b.index].R_dot, e.p);
+  if (b.kind == BodyKind::kLinear) return TimesBasis(data_.linear[size_t(b.index)].R_dot, e.p);
   return b.dim == 3 ? FfdEndVelocity<3>(e) : FfdEndVelocity<2>(e);
 }
 
@@ -107,11 +107,12 @@ void World::ApplyPointForce(const MaterialPoint& point, const Eigen::VectorXd& f
                                 std::to_string(dim(point.body)) + " finite components");
   const Slot& b = slots_[e.body];
   if (b.kind == BodyKind::kLinear) {
-    linear_[b.index].applied += f * e.p.transpose();
+    data_.linear[size_t(b.index)].applied += f * e.p.transpose();
     return;
   }
   // FFD bodies of either dimension: Jᵀ f (Eq. 4.20), as a constraint's force enters
-  Eigen::VectorXd& applied = b.dim == 3 ? ffd3_[size_t(b.index)].applied : ffd2_[size_t(b.index)].applied;
+  Eigen::VectorXd& applied =
+      b.dim == 3 ? data_.ffd_of<3>()[size_t(b.index)].applied : data_.ffd_of<2>()[size_t(b.index)].applied;
   std::vector<Eigen::VectorXd> Q(num_bodies());
   Q[e.body] = Eigen::VectorXd::Zero(applied.size());
   AddEndForce(e, f, &Q);
@@ -167,7 +168,7 @@ void World::ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd
 // ---------------------------------------------------------------- constraints
 
 int World::AddConstraint(Constraint c) {
-  c.lambda = Eigen::VectorXd::Zero(dim(c.a.body));
+  data_.multipliers.push_back(Eigen::VectorXd::Zero(dim(c.a.body)));
   constraints_.push_back(std::move(c));
   structure_dirty_ = true;
   ++enabled_count_;
@@ -260,10 +261,13 @@ void World::Remove(int id) {
 bool World::enabled(int id) const { return Get(id).enabled; }
 bool World::exists(int id) const { return id >= 0 && id < num_constraints() && !constraints_[id].removed; }
 ConstraintKind World::constraint_kind(int id) const { return Get(id).kind; }
-Eigen::VectorXd World::Multiplier(int id) const { return Get(id).lambda; }
+Eigen::VectorXd World::Multiplier(int id) const {
+  Get(id);
+  return data_.multipliers[size_t(id)];
+}
 
 void World::Targets(const Constraint& c, double t, PointVec* n, PointVec* n_dot, PointVec* n_ddot) const {
-  const int d = int(c.lambda.size());
+  const int d = dim(c.a.body);
   if (c.kind == ConstraintKind::kTrajectory) {
     const PathSample s = c.path->Evaluate(t);
     if (s.n.size() != d || s.n_dot.size() != d || s.n_ddot.size() != d)
@@ -288,7 +292,7 @@ void World::Targets(const Constraint& c, double t, PointVec* n, PointVec* n_dot,
 Eigen::VectorXd World::ConstraintError(int id) const {
   const Constraint& c = Get(id);
   PointVec n, nd, ndd;
-  Targets(c, time_, &n, &nd, &ndd);
+  Targets(c, data_.time, &n, &nd, &ndd);
   PointVec e = EndPosition(c.a) - n;
   if (c.b.body >= 0) e -= EndPosition(c.b);
   return e;
@@ -297,7 +301,7 @@ Eigen::VectorXd World::ConstraintError(int id) const {
 Eigen::VectorXd World::ConstraintVelocityError(int id) const {
   const Constraint& c = Get(id);
   PointVec n, nd, ndd;
-  Targets(c, time_, &n, &nd, &ndd);
+  Targets(c, data_.time, &n, &nd, &ndd);
   PointVec e = EndVelocity(c.a) - nd;
   if (c.b.body >= 0) e -= EndVelocity(c.b);
   return e;
@@ -423,7 +427,7 @@ bool World::FreeAccelerations(std::vector<Eigen::VectorXd>* acc, int* failed_bod
     const Slot& b = slots_[body];
     Eigen::VectorXd& a = (*acc)[body];
     if (b.kind == BodyKind::kLinear) {
-      LinearFreeAcceleration(linear_[b.index], &a);
+      LinearFreeAcceleration(body, &a);
     } else if (!(b.dim == 3 ? FfdFreeAcceleration<3>(body, &a, st) : FfdFreeAcceleration<2>(body, &a, st))) {
       *failed_body = body;
       return false;
@@ -452,7 +456,7 @@ bool World::StepConstrained() {
       PointVec n, nd, ndd;
       for (const Constraint& c : constraints_) {
         if (!c.enabled) continue;
-        Targets(c, time_, &n, &nd, &ndd);
+        Targets(c, data_.time, &n, &nd, &ndd);
         const int d = int(n.size());
         // Velocity-first symplectic Euler staggers velocities: q̇ₙ = (qₙ − qₙ₋₁)/Δt is the velocity
         // of t − Δt/2, so ċ compares it with ṅ(t − Δt/2) ≈ ṅ − ½Δt n̈. Against ṅ(t) the β term
@@ -468,7 +472,7 @@ bool World::StepConstrained() {
         auto add_end = [&](const End& e, double sign) {
           const Slot& b = slots_[e.body];
           if (b.kind == BodyKind::kLinear) {  // x = R p, ẋ = Ṙ p, J a = R̈ p (J̇ = 0)
-            const LinearEntry& l = linear_[b.index];
+            const WorldData::Linear& l = data_.linear[size_t(b.index)];
             const int n_basis = int(e.p.size());
             const double* a = acc[e.body].data();  // R̈ row by row
             for (int i = 0; i < d; ++i) {
@@ -503,10 +507,12 @@ bool World::StepConstrained() {
       std::vector<Eigen::VectorXd>& force = force_;
       force.resize(num_bodies());
       for (Eigen::VectorXd& f : force) f.resize(0);
-      for (const Constraint& c : constraints_) {
+      for (size_t id = 0; id < constraints_.size(); ++id) {
+        const Constraint& c = constraints_[id];
         if (!c.enabled) continue;
         const int d = dim(c.a.body);
-        const_cast<Constraint&>(c).lambda = lambda.segment(c.row, d);
+        Eigen::VectorXd& c_lambda = data_.multipliers[id];
+        c_lambda = lambda.segment(c.row, d);
         for (int end = 0; end < (c.b.body >= 0 ? 2 : 1); ++end) {
           const End& e = end == 0 ? c.a : c.b;
           const double sign = end == 0 ? 1.0 : -1.0;
@@ -516,10 +522,10 @@ bool World::StepConstrained() {
             // (λ pᵀ) W, by plain loops as TimesBasis
             double* a = acc[e.body].data();
             for (int i = 0; i < d; ++i)
-              for (int j = 0; j < n_basis; ++j) a[i * n_basis + j] += sign * c.lambda[i] * e.Wp[j];
+              for (int j = 0; j < n_basis; ++j) a[i * n_basis + j] += sign * c_lambda[i] * e.Wp[j];
           } else {
             if (force[e.body].size() == 0) force[e.body] = Eigen::VectorXd::Zero(acc[e.body].size());
-            AddEndForce(e, sign * c.lambda, &force);
+            AddEndForce(e, sign * c_lambda, &force);
           }
         }
       }
@@ -573,7 +579,7 @@ bool World::ApplyImpulse(const std::vector<VelocityGoal>& goals, std::string* er
     for (const Constraint& c : constraints_) {
       if (!c.enabled) continue;
       rows.push_back(&c);
-      Targets(c, time_, &n, &nd, &ndd);
+      Targets(c, data_.time, &n, &nd, &ndd);
       Eigen::VectorXd v = EndVelocity(c.a) - nd;
       if (c.b.body >= 0) v -= EndVelocity(c.b);
       jump.push_back(-v);
@@ -630,8 +636,8 @@ bool World::ApplyImpulse(const std::vector<VelocityGoal>& goals, std::string* er
       if (dv[body].size() == 0) continue;
       const Slot& b = slots_[body];
       if (b.kind == BodyKind::kLinear) {
-        LinearEntry& e = linear_[b.index];
-        e.R_dot += AsMatrix(dv[body], e.model->dim(), e.model->basis_size());
+        const LinearBodyModel& m = *linear_[b.index].model;
+        data_.linear[size_t(b.index)].R_dot += AsMatrix(dv[body], m.dim(), m.basis_size());
       } else if (b.dim == 3) {
         FfdAddVelocity<3>(body, dv[body]);
       } else {

@@ -116,14 +116,16 @@ GroundPlane GroundPlaneOf(const Ground& g) {
 template <int Dim> int World::AddFfdBody(std::shared_ptr<const BodyModelN<Dim>> model) {
   if (!model) throw std::invalid_argument("AddBody: no model");
   FfdEntry<Dim> e;
-  e.state = RestState<Dim, double>(*model);
-  e.applied = Eigen::VectorXd::Zero(model->num_q());
+  WorldData::Ffd<Dim> x;
+  x.state = RestState<Dim, double>(*model);
+  x.applied = Eigen::VectorXd::Zero(model->num_q());
+  UpdateContacts(*model, GroundFor<Dim>(), &x.state);
   e.scale = ModelScale(*model);
   e.model = std::move(model);
   std::vector<FfdEntry<Dim>>& entries = FfdEntries<Dim>();
   entries.push_back(std::move(e));
+  data_.ffd_of<Dim>().push_back(std::move(x));
   slots_.push_back({BodyKind::kFfd, Dim, int(entries.size()) - 1});
-  UpdateContacts(*entries.back().model, GroundFor<Dim>(), &entries.back().state);
   return num_bodies() - 1;
 }
 template int World::AddFfdBody(std::shared_ptr<const BodyModelN<2>>);
@@ -135,8 +137,8 @@ void World::SetState(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& 
 }
 
 template <int Dim> void World::SetFfdState(int body, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  FfdEntry<Dim>& e = Ffd<Dim>(body);
-  const BodyModelN<Dim>& m = *e.model;
+  const BodyModelN<Dim>& m = *Ffd<Dim>(body).model;
+  WorldData::Ffd<Dim>& e = FfdData<Dim>(body);
   if (q.size() != m.num_positions() || qd.size() != m.num_q())
     throw InputError("body '" + m.name() + "' has " + std::to_string(m.num_positions()) + " positions (" +
                      (Dim == 2 ? "tx ty theta" : "tx ty tz, quaternion x y z w") + " and one per mode) and " +
@@ -181,7 +183,7 @@ const VecD<double>& World::mode_targets(int i) const {
 }
 
 double World::Penetration(int body) const {
-  if (kind(body) == BodyKind::kLinear) return Linear(body).contacts.penetration;
+  if (kind(body) == BodyKind::kLinear) return LinearData(body).contacts.penetration;
   return dim(body) == 3 ? state<3>(body).penetration : state<2>(body).penetration;
 }
 
@@ -190,8 +192,8 @@ void World::SetModeTargets(int i, const Eigen::VectorXd& targets) {
   if (targets.size() != 0 && targets.size() != D)
     throw std::invalid_argument("body '" + body_name(i) + "' has " + std::to_string(D) + " modes, got " +
                                 std::to_string(targets.size()) + " targets");
-  if (dim(i) == 3) Ffd<3>(i).state.mode_target = targets;
-  else Ffd<2>(i).state.mode_target = targets;
+  if (dim(i) == 3) FfdData<3>(i).state.mode_target = targets;
+  else FfdData<2>(i).state.mode_target = targets;
 }
 
 template <int Dim> ForceBreakdown<Dim, double> World::Forces(int i) const {
@@ -225,10 +227,12 @@ template std::vector<Eigen::Vector3d> World::PointPositions<3>(int) const;
 // ---------------------------------------------------------------- stepping
 
 template <int Dim> bool World::StepFfdBody(int body) {
-  FfdEntry<Dim>& e = FfdEntries<Dim>()[size_t(slots_[size_t(body)].index)];
+  const size_t index = size_t(slots_[size_t(body)].index);
+  const BodyModelN<Dim>& model = *FfdEntries<Dim>()[index].model;
+  WorldData::Ffd<Dim>& e = data_.ffd_of<Dim>()[index];
   const VecQ<double> q_before = e.state.q, qd_before = e.state.qd;  // contacts are found again on refusal
   const bool pushed = !e.applied.isZero(0.0);
-  const StepStatus st = StepBody(*e.model, options_.params, body, options_.integrator, options_.dt, &e.state,
+  const StepStatus st = StepBody(model, options_.params, body, options_.integrator, options_.dt, &e.state,
                                  AppliedForce<Dim>{pushed ? &e.applied : nullptr});
   if (pushed) e.applied.setZero();
   if (st.ok() && AcceptFfdState<Dim>(body)) return true;
@@ -239,16 +243,17 @@ template bool World::StepFfdBody<3>(int);
 
 // The screen implies a finite state; past it, the state and the energies are checked in full.
 template <int Dim> bool World::AcceptFfdState(int body) {
-  const FfdEntry<Dim>& e = FfdEntries<Dim>()[size_t(slots_[size_t(body)].index)];
-  const BodyState<Dim, double>& s = e.state;
-  return s.penetration <= PenetrationLimit(*e.model) &&
-         (EnergySurelyFinite(e) || (s.q.allFinite() && s.qd.allFinite() && EnergyFinite(body)));
+  const size_t index = size_t(slots_[size_t(body)].index);
+  const BodyState<Dim, double>& s = data_.ffd_of<Dim>()[index].state;
+  return s.penetration <= PenetrationLimit(*FfdEntries<Dim>()[index].model) &&
+         (EnergySurelyFinite<Dim>(body) || (s.q.allFinite() && s.qd.allFinite() && EnergyFinite(body)));
 }
 
 template <int Dim>
 bool World::RefuseFfdStep(int body, const VecQ<double>& q_before, const VecQ<double>& qd_before, StepStatus st) {
-  FfdEntry<Dim>& e = FfdEntries<Dim>()[size_t(slots_[size_t(body)].index)];
-  BodyState<Dim, double>& s = e.state;
+  const size_t index = size_t(slots_[size_t(body)].index);
+  const FfdEntry<Dim>& e = FfdEntries<Dim>()[index];
+  BodyState<Dim, double>& s = data_.ffd_of<Dim>()[index].state;
   const bool finite = s.q.allFinite() && s.qd.allFinite();
   const double limit = PenetrationLimit(*e.model);
   const double depth = s.penetration;
@@ -272,9 +277,9 @@ bool World::RefuseFfdStep(int body, const VecQ<double>& q_before, const VecQ<dou
 }
 
 template <int Dim> bool World::ForcesFinite(int body) const {
-  const FfdEntry<Dim>& e = Ffd<Dim>(body);
+  const BodyState<Dim, double>& s = state<Dim>(body);
   ForceBreakdown<Dim, double> f;
-  EvaluateForces(*e.model, options_.params, body, e.state, Frame<Dim, double>(e.state.q), &f, ContactSet::kDetect);
+  EvaluateForces(*Ffd<Dim>(body).model, options_.params, body, s, Frame<Dim, double>(s.q), &f, ContactSet::kDetect);
   return f.total.allFinite();
 }
 
@@ -337,9 +342,10 @@ template Energies World::FfdEnergies<3>(int, ContactSet, bool) const;
 // energy term is a sum of at most ~10^6 products of at most five factors (γᵀGγ θ̇², k |x − a|²
 // with x = t + R(b0 + Bγ)), so below 10^6 · 15^4 · kScreen^5, far from the largest double. A
 // normal step passes; one that does not has its energies computed (EnergyFinite).
-template <int Dim> bool World::EnergySurelyFinite(const FfdEntry<Dim>& e) const {
+template <int Dim> bool World::EnergySurelyFinite(int body) const {
+  const FfdEntry<Dim>& e = Ffd<Dim>(body);
   constexpr double kScreen = 1e30;
-  const BodyState<Dim, double>& s = e.state;
+  const BodyState<Dim, double>& s = state<Dim>(body);
   const auto& p = options_.params;
   if (!(e.scale <= kScreen && s.q.cwiseAbs().maxCoeff() <= kScreen && s.qd.cwiseAbs().maxCoeff() <= kScreen))
     return false;
@@ -450,9 +456,8 @@ template <int Dim> void World::FfdAddEndForce(const End& e, const Eigen::VectorX
 }
 
 template <int Dim> void World::FfdApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const {
-  const FfdEntry<Dim>& e = Ffd<Dim>(body);
   VecQ<double> x;
-  if (!SolveMass(*e.model, e.state, VecQ<double>(Q), &x)) {
+  if (!SolveMass(*Ffd<Dim>(body).model, state<Dim>(body), VecQ<double>(Q), &x)) {
     *acc = Eigen::VectorXd::Constant(acc->size(), std::nan(""));  // caught by the finite checks
     return;
   }
@@ -460,9 +465,9 @@ template <int Dim> void World::FfdApplyGeneralized(int body, const Eigen::Vector
 }
 
 template <int Dim> bool World::FfdFreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st) const {
-  const FfdEntry<Dim>& e = Ffd<Dim>(body);
+  const WorldData::Ffd<Dim>& e = FfdData<Dim>(body);
   VecQ<double> a;
-  *st = wobble::Accelerations(*e.model, options_.params, body, e.state, &a);
+  *st = wobble::Accelerations(*Ffd<Dim>(body).model, options_.params, body, e.state, &a);
   if (!st->ok()) return false;
   *acc = a;
   if (!e.applied.isZero(0.0)) FfdApplyGeneralized<Dim>(body, e.applied, acc);
@@ -471,22 +476,23 @@ template <int Dim> bool World::FfdFreeAcceleration(int body, Eigen::VectorXd* ac
 
 // Semi-implicit Euler, velocity first, on the group (the Störmer form of Eq. 4.22/4.23).
 template <int Dim> bool World::FfdAcceptConstrainedStep(int body, const Eigen::VectorXd& acc) {
-  FfdEntry<Dim>& e = Ffd<Dim>(body);
+  const BodyModelN<Dim>& model = *Ffd<Dim>(body).model;
+  WorldData::Ffd<Dim>& e = FfdData<Dim>(body);
   const VecQ<double> q_before = e.state.q, qd_before = e.state.qd;
   e.state.qd += options_.dt * acc;
   Group<Dim>::Advance(e.state.qd, options_.dt, &e.state.q);
-  UpdateContacts(*e.model, GroundFor<Dim>(), &e.state);
+  UpdateContacts(model, GroundFor<Dim>(), &e.state);
   e.applied.setZero();  // acc holds it
-  if (e.state.q.allFinite() && e.state.qd.allFinite() && e.state.penetration <= PenetrationLimit(*e.model) &&
+  if (e.state.q.allFinite() && e.state.qd.allFinite() && e.state.penetration <= PenetrationLimit(model) &&
       EnergyFinite(body))
     return true;
   return RefuseFfdStep<Dim>(body, q_before, qd_before, StepStatus{});
 }
 
 template <int Dim> void World::FfdAddVelocity(int body, const Eigen::VectorXd& dv) {
-  FfdEntry<Dim>& e = Ffd<Dim>(body);
+  WorldData::Ffd<Dim>& e = FfdData<Dim>(body);
   e.state.qd += dv;
-  UpdateContacts(*e.model, GroundFor<Dim>(), &e.state);
+  UpdateContacts(*Ffd<Dim>(body).model, GroundFor<Dim>(), &e.state);
 }
 
 #define WOBBLE_WORLD_FFD(Dim)                                                                             \
@@ -500,7 +506,7 @@ template <int Dim> void World::FfdAddVelocity(int body, const Eigen::VectorXd& d
   template bool World::FfdFreeAcceleration<Dim>(int, Eigen::VectorXd*, StepStatus*) const;              \
   template bool World::FfdAcceptConstrainedStep<Dim>(int, const Eigen::VectorXd&);                      \
   template void World::FfdAddVelocity<Dim>(int, const Eigen::VectorXd&);                                \
-  template bool World::EnergySurelyFinite<Dim>(const FfdEntry<Dim>&) const;
+  template bool World::EnergySurelyFinite<Dim>(int) const;
 WOBBLE_WORLD_FFD(2)
 WOBBLE_WORLD_FFD(3)
 #undef WOBBLE_WORLD_FFD

@@ -313,7 +313,7 @@ StepStatus RecordStep(const StepModel& m, const VecD<double>& target, const Body
   // SolveAccelerations' solve, so the recorded step is StepBody's to the last bit (the
   // checkpointed sweep mixes recorded and plain steps)
   double cond_estimate = 0.0;
-  if (!SolveMassSystem(mm, sm, frame.R, VecQ<double>(forces.total - w), &tape->a, &cond_estimate)) {
+  if (!SolveMassSystem(mm, sm, frame.R, VecQ<double>(forces.total - w), &tape->a, &cond_estimate, &tape->factor)) {
     if (!forces.total.allFinite()) return {StatusCode::kOverflowingForce, 0.0};
     return {StatusCode::kSingularMass, 0.0};
   }
@@ -343,9 +343,8 @@ void StepVjp(const StepModel& m, const VecD<double>& target, const BodyState<3, 
   PullContactUpdate(m.passive, m.world.ground_plane, tape.after, out.anchor, ix, &in->z, &in->anchor);
   VecQ<double> lambda_v = in->z.tail(nv);
   if (thesis) PullAdvance(tape.after.qd, h, ix, &in->z, &lambda_v);
-  VecQ<double> lr;  // M⁻¹ h λ_v (M symmetric: the solve the step made, again)
-  double cond_estimate = 0.0;
-  SolveMassSystem(m.passive.moments(), *tape.moments, tape.frame->R, VecQ<double>(h * lambda_v), &lr, &cond_estimate);
+  VecQ<double> lr;  // M⁻¹ h λ_v (M symmetric: the step's own factor, applied again)
+  SolveFactored(m.passive.moments(), *tape.moments, tape.factor, tape.frame->R, VecQ<double>(h * lambda_v), &lr);
   in->z.tail(nv) = lambda_v;
   controls->target = VecD<double>::Zero(D);
   PullAccelerations(m, target, tape.eval, *tape.frame, *tape.moments, tape.a, lr, ix, in, controls);

@@ -55,6 +55,7 @@ struct StepTape {
   BodyState<3, double> eval, after;
   std::optional<Frame<3, double>> frame;
   std::optional<ShapeMoments<double>> moments;
+  SpatialMassFactor<double> factor;  // the step's elimination about the centre of mass (spatial_inertia.h)
   VecQ<double> a;
 };
 
