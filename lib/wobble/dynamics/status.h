@@ -30,6 +30,7 @@ enum class StatusCode {
   kBadPath,              // a trajectory's path returned a non-finite or wrongly sized sample
   kOverflowingForce,     // a generalized force past the largest double (huge stiffness, speed, ...)
   kNonFiniteEnergy,      // a finite state whose energy is not (q̇ = 1e160 squares to inf)
+  kUnsupported,          // the integrator cannot step what the world holds (variational with constraints)
 };
 std::string StatusCodeName(StatusCode code);
 

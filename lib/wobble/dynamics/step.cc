@@ -47,6 +47,7 @@ std::string StatusCodeName(StatusCode code) {
     case StatusCode::kBadPath: return "bad trajectory path";
     case StatusCode::kOverflowingForce: return "overflowing force";
     case StatusCode::kNonFiniteEnergy: return "non-finite energy";
+    case StatusCode::kUnsupported: return "unsupported";
   }
   return "?";
 }

@@ -176,6 +176,7 @@ void Scene::BeginRun(RunKind kind, bool keep_steps) {
   // the scene's parameters as they are now apply to its world
   WorldOptions& o = w.mutable_options();
   o.dt = options_.dt;
+  o.integrator = integrator_chosen_ ? options_.integrator : Integrator::kThesis;
   o.params.gravity_on = options_.params.gravity_on;
   o.params.ground = options_.params.ground;
   // 3D bodies stand on the plane of the same ground, set now; a terrain is 2D only, so it is

@@ -111,10 +111,16 @@ class Scene {
 
   // ---- parameters ----
   // dt, integrator, gravity and the ground of every run (the object's springs are below).
-  // The scene's world takes dt, gravity and the ground at every BeginRun; its FFD bodies keep
-  // the thesis integrator.
+  // The scene's world takes dt, gravity and the ground at every BeginRun, and the integrator
+  // once a script chose one (ChooseIntegrator): until then it steps with thesis, the
+  // velocity-first Euler Witkin & Welch's scenes were made with, while the object's runs
+  // default to implicit Euler (Scene()).
   WorldOptions& options() { return options_; }
   const WorldOptions& options() const { return options_; }
+  void ChooseIntegrator(Integrator integrator) {
+    options_.integrator = integrator;
+    integrator_chosen_ = true;
+  }
   // What one run may take (core/limits.h): Simulate and Keyframe refuse a run of more steps
   // than limits().max_steps, or one whose record would take the records kept (every object
   // run someone still holds, and the scene's `record`) past limits().max_record_mb.
@@ -217,6 +223,7 @@ class Scene {
   double KeptRecordValues() const;
 
   WorldOptions options_;
+  bool integrator_chosen_ = false;  // the scene's world takes options_.integrator
   Limits limits_;
   double time_ = 0.0, end_ = 10.0;
   FfdObject object_;

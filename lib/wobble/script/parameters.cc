@@ -115,8 +115,10 @@ const std::vector<Parameter>& ParameterTable() {
       // words
       {"integrator",
        [](State& s, const Value& v) {
-         if (!ParseIntegrator(v.text, &s.scene.options().integrator))
-           v.ctx.Fail("expected an integrator (thesis, symplectic, rk4, implicit, variational), got '" + v.text + "'");
+         Integrator integrator;
+         if (!ParseIntegrator(v.text, &integrator))
+           v.ctx.Fail("expected an integrator (" + IntegratorNames() + "), got '" + v.text + "'");
+         s.scene.ChooseIntegrator(integrator);
        }},
       {"interp",
        [](State& s, const Value& v) {

@@ -246,12 +246,17 @@ void World::FinishStep() {
 
 // No constraint: each body on its own. FFD bodies on the templated StepBody (the fast path).
 bool World::StepEachBody() {
+  // linear bodies by the world's integrator: the Euler forms here, the others in stages
+  const bool staged_linear = !linear_.empty() && options_.integrator != Integrator::kThesis &&
+                             options_.integrator != Integrator::kVariational;
+  if (staged_linear && !StepConstrainedStaged(/*linear_only=*/true)) return false;
   for (int body = 0; body < num_bodies(); ++body) {
     if (slots_[body].kinematic) continue;
     if (slots_[body].kind == BodyKind::kFfd) {
       if (!(slots_[body].dim == 3 ? StepFfdBody<3>(body) : StepFfdBody<2>(body))) return false;
       continue;
     }
+    if (staged_linear) continue;
     Eigen::VectorXd& acc = acc_.empty() ? acc_.emplace_back() : acc_[0];
     LinearFreeAcceleration(body, &acc);
     if (!acc.allFinite()) return Fail(StatusCode::kNonFinite, body, "non-finite acceleration");
@@ -285,6 +290,22 @@ bool World::StepLinearBody(int body, const Eigen::VectorXd& acc) {
     }
   x.R.swap(e.R_before);
   x.R_dot.swap(e.R_dot_before);
+  return FinishLinearStep(body, screened);
+}
+
+bool World::AcceptLinearState(int body, const Eigen::MatrixXd& R_before, const Eigen::MatrixXd& R_dot_before) {
+  LinearEntry& e = linear_[slots_[body].index];
+  const WorldData::Linear& x = data_.linear[size_t(slots_[body].index)];
+  e.R_before = R_before;
+  e.R_dot_before = R_dot_before;
+  // NaN fails both comparisons, so a non-finite state is not screened
+  const bool screened = (x.R.array().abs() <= kLinearScreen).all() && (x.R_dot.array().abs() <= kLinearScreen).all();
+  return FinishLinearStep(body, screened);
+}
+
+bool World::FinishLinearStep(int body, bool screened) {
+  LinearEntry& e = linear_[slots_[body].index];
+  WorldData::Linear& x = data_.linear[size_t(slots_[body].index)];
   x.applied.setZero();
   if (!AcceptLinearStep(body, screened)) return false;
   if (!e.ground_contact) return true;

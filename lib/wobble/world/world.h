@@ -17,12 +17,16 @@
 // Stepping. While no constraint is enabled, every FFD body is advanced on its own by the
 // templated StepBody (wobble/dynamics/step.h) with the world's integrator: the per-body fast
 // path of the thesis, which the fits differentiate with Ceres Jets, and whose cost is O(D²)
-// from the mass moments (ARCHITECTURE.md). Linear bodies take semi-implicit Euler on their
-// constant, pre-inverted mass matrix. While a constraint is enabled, every body is advanced
-// together through the multipliers (world_constraints.cc):
+// from the mass moments (ARCHITECTURE.md). Linear bodies take the same integrator on their
+// constant, pre-inverted mass matrix (thesis and variational: velocity-first Euler, which is
+// the variational integrator of a constant M). While a constraint is enabled, every body is
+// advanced together through the multipliers (world_constraints.cc), with the same integrator:
+// the constrained accelerations
 //   J W Jᵀ λ = −(J W Q + J̇ q̇ − n̈ + α c + β ċ),   q̈ = W (Q + Jᵀ λ)   (Witkin & Welch Eq. 6–10)
-// and semi-implicit Euler, velocity first: q̇ₙ₊₁ = q̇ₙ + Δt q̈, qₙ₊₁ = qₙ + Δt q̇ₙ₊₁, which is the
-// Störmer form of the thesis integrator (Eq. 4.22/4.23) for FFD bodies. c̈ = −α c − β ċ makes a
+// are a stage, evaluated wherever the integrator evaluates q̈: thesis (velocity-first Euler
+// q̇ₙ₊₁ = q̇ₙ + Δt q̈, qₙ₊₁ = qₙ·exp(Δt q̇ₙ₊₁), Eq. 4.22/4.23's Störmer form), symplectic, rk4 and
+// implicit. The variational integrator's discrete Lagrangian has no constraint forces: a
+// constrained variational step is refused (StatusCode::kUnsupported). c̈ = −α c − β ċ makes a
 // violation decay like a critically damped spring instead of drifting.
 //
 // Linear bodies: ∂x/∂R = δ_ir p_s (§3.3) is constant, so J is constant and J̇ = 0, and A = J W Jᵀ
@@ -423,13 +427,22 @@ class World {
   template <int Dim> Eigen::MatrixXd FfdEndJacobian(const End& e) const;
   template <int Dim> void FfdAddEndForce(const End& e, const Eigen::VectorXd& f, Eigen::VectorXd* Q) const;
   template <int Dim> void FfdApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const;
-  template <int Dim> bool FfdFreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st) const;
+  template <int Dim>
+  bool FfdFreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st, ContactSet contacts = ContactSet::kDetect) const;
   template <int Dim> bool FfdAcceptConstrainedStep(int body, const Eigen::VectorXd& acc);
+  // The new state is in data_: contacts found, the checks of a step, or back to the state given.
+  template <int Dim> bool FfdAcceptState(int body, const VecQ<double>& q_before, const VecQ<double>& qd_before);
+  template <int Dim> void FfdMoveToStage(int body, const Eigen::VectorXd& q0, const Eigen::VectorXd& v0,
+                                         const Eigen::VectorXd& dy, const Eigen::VectorXd& dv);
   template <int Dim> void FfdAddVelocity(int body, const Eigen::VectorXd& dv);
   void LinearFreeAcceleration(int body, Eigen::VectorXd* acc);
   void RefreshLinearContacts(int body);  // the contacts of its state now
   bool Fail(StatusCode code, int body, const std::string& detail = "", double value = 0.0);
   bool StepLinearBody(int body, const Eigen::VectorXd& acc);
+  // The linear body's new state is in data_, the one before it in R_before and R_dot_before:
+  // the checks and contacts of a step, or the state before it back.
+  bool FinishLinearStep(int body, bool screened);
+  bool AcceptLinearState(int body, const Eigen::MatrixXd& R_before, const Eigen::MatrixXd& R_dot_before);
   bool AcceptLinearStep(int body, bool screened);
   void FinishStep();
 
@@ -457,9 +470,30 @@ class World {
   // *factored (if given) is the solver that holds it.
   bool EnsureFactored(std::string* why, const MultiplierSolver** factored = nullptr);
   // Free accelerations of every body (flattened), or false with the failing body and status.
-  bool FreeAccelerations(std::vector<Eigen::VectorXd>* a, int* failed_body, StepStatus* st);
+  bool FreeAccelerations(std::vector<Eigen::VectorXd>* a, int* failed_body, StepStatus* st,
+                         ContactSet contacts = ContactSet::kDetect);
   void ApplyGeneralized(int body, const Eigen::VectorXd& Q, Eigen::VectorXd* acc) const;  // += W Q
-  bool StepConstrained();
+  // The constrained q̈ = W (Q + Jᵀ λ) of every body at the state in data_ and time t (Eq. 6–10
+  // with feedback), λ recorded in data_.multipliers. `lag`: how far the velocities lag the
+  // positions (½Δt in the Euler forms, 0 at a Runge–Kutta stage). false: the status says why.
+  bool ConstrainedAccelerations(double t, double lag, ContactSet contacts, std::vector<Eigen::VectorXd>* acc);
+  bool StepConstrained();        // the world's integrator over every body through the multipliers
+  bool StepConstrainedThesis();  // velocity-first Euler (Eq. 4.22/4.23's Störmer form)
+  // symplectic, rk4, implicit: their stages at constrained q̈ (linear_only: the linear bodies of
+  // a world without constraints, at their free q̈)
+  bool StepConstrainedStaged(bool linear_only = false);
+  // The start of a constrained step, every body flattened (FFD q and q̇; linear R and Ṙ row by
+  // row), and the moves of its stages about it: q0·exp(dy), v0 + dv on the body's group.
+  struct StepStart {
+    std::vector<Eigen::VectorXd> q, v;
+  };
+  void SaveStart(StepStart* start) const;
+  void RestoreStart(const StepStart& start);
+  void MoveToStage(int body, const StepStart& start, const Eigen::VectorXd& dy, const Eigen::VectorXd& dv);
+  // the rate of the stage's tangent coordinates dy at velocity v (dexp⁻¹; v itself but in 3D)
+  Eigen::VectorXd StageRate(int body, const Eigen::VectorXd& dy, const Eigen::VectorXd& v) const;
+  // Checks the new state in data_ as every step does; a refused body gets its start back.
+  bool AcceptStagedState(int body, const StepStart& start);
   int num_q(int body) const;
 
   WorldOptions options_;

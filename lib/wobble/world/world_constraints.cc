@@ -421,14 +421,15 @@ bool World::EnsureFactored(std::string* why, const MultiplierSolver** factored) 
 
 // ---------------------------------------------------------------- stepping
 
-bool World::FreeAccelerations(std::vector<Eigen::VectorXd>* acc, int* failed_body, StepStatus* st) {
+bool World::FreeAccelerations(std::vector<Eigen::VectorXd>* acc, int* failed_body, StepStatus* st, ContactSet contacts) {
   acc->resize(num_bodies());
   for (int body = 0; body < num_bodies(); ++body) {
     const Slot& b = slots_[body];
     Eigen::VectorXd& a = (*acc)[body];
     if (b.kind == BodyKind::kLinear) {
       LinearFreeAcceleration(body, &a);
-    } else if (!(b.dim == 3 ? FfdFreeAcceleration<3>(body, &a, st) : FfdFreeAcceleration<2>(body, &a, st))) {
+    } else if (!(b.dim == 3 ? FfdFreeAcceleration<3>(body, &a, st, contacts)
+                            : FfdFreeAcceleration<2>(body, &a, st, contacts))) {
       *failed_body = body;
       return false;
     }
@@ -436,14 +437,13 @@ bool World::FreeAccelerations(std::vector<Eigen::VectorXd>* acc, int* failed_bod
   return true;
 }
 
-// Every body together through the multipliers, then semi-implicit Euler (world.h).
-bool World::StepConstrained() {
-  const double h = options_.dt;
+// The constrained accelerations of every body (world.h), at whatever stage an integrator asks.
+bool World::ConstrainedAccelerations(double t, double lag, ContactSet contacts, std::vector<Eigen::VectorXd>* acc_out) {
   // unconstrained accelerations W Q of every body
-  std::vector<Eigen::VectorXd>& acc = acc_;
+  std::vector<Eigen::VectorXd>& acc = *acc_out;
   int failed = -1;
   StepStatus st;
-  if (!FreeAccelerations(&acc, &failed, &st)) return Fail(st.code, failed, "", st.value);
+  if (!FreeAccelerations(&acc, &failed, &st, contacts)) return Fail(st.code, failed, "", st.value);
   // the multipliers: J W Jᵀ λ = −(J W Q + J̇ q̇ − n̈ + α c + β ċ)  (Eq. 8/10 with feedback)
   std::string why;
   try {
@@ -456,17 +456,17 @@ bool World::StepConstrained() {
       PointVec n, nd, ndd;
       for (const Constraint& c : constraints_) {
         if (!c.enabled) continue;
-        Targets(c, data_.time, &n, &nd, &ndd);
+        Targets(c, t, &n, &nd, &ndd);
         const int d = int(n.size());
-        // Velocity-first symplectic Euler staggers velocities: q̇ₙ = (qₙ − qₙ₋₁)/Δt is the velocity
-        // of t − Δt/2, so ċ compares it with ṅ(t − Δt/2) ≈ ṅ − ½Δt n̈. Against ṅ(t) the β term
-        // would see a false ċ = −½Δt n̈ and hold the point β Δt n̈ / (2α) behind its path.
+        // The Euler forms stagger velocities: in velocity-first Euler q̇ₙ = (qₙ − qₙ₋₁)/Δt is the
+        // velocity of t − Δt/2, so ċ compares it with ṅ(t − lag) ≈ ṅ − lag n̈. Against ṅ(t) the β
+        // term would see a false ċ = −½Δt n̈ and hold the point β Δt n̈ / (2α) behind its path.
         // c, ċ and c̈ summed end by end in plain arrays: scalar stores read back by vector loads
         // (Eigen on d ≤ 3 temporaries) stall store forwarding, a tenth of Fig. 2's step
         double pos_c[3], vel_c[3], accel_c[3];
         for (int i = 0; i < d; ++i) {
           pos_c[i] = -n[i];
-          vel_c[i] = -nd[i] + 0.5 * h * ndd[i];
+          vel_c[i] = -nd[i] + lag * ndd[i];
           accel_c[i] = -ndd[i];
         }
         auto add_end = [&](const End& e, double sign) {
@@ -535,19 +535,8 @@ bool World::StepConstrained() {
   } catch (const std::invalid_argument& e) {  // only paths throw here
     return Fail(StatusCode::kBadPath, -1, e.what());
   }
-  // semi-implicit Euler, velocity first; the whole step is refused when anything is non-finite
   for (int body = 0; body < num_bodies(); ++body)
-    if (!acc[body].allFinite()) return Fail(StatusCode::kNonFinite, body, "non-finite acceleration");
-  for (int body = 0; body < num_bodies(); ++body) {
-    const Slot& b = slots_[body];
-    if (b.kinematic) continue;
-    if (b.kind == BodyKind::kLinear) {
-      if (!StepLinearBody(body, acc[body])) return false;
-    } else if (!(b.dim == 3 ? FfdAcceptConstrainedStep<3>(body, acc[body])
-                            : FfdAcceptConstrainedStep<2>(body, acc[body]))) {
-      return false;
-    }
-  }
+    if (!(*acc_out)[body].allFinite()) return Fail(StatusCode::kNonFinite, body, "non-finite acceleration");
   return true;
 }
 

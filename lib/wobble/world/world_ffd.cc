@@ -464,10 +464,12 @@ template <int Dim> void World::FfdApplyGeneralized(int body, const Eigen::Vector
   *acc += x;
 }
 
-template <int Dim> bool World::FfdFreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st) const {
+template <int Dim>
+bool World::FfdFreeAcceleration(int body, Eigen::VectorXd* acc, StepStatus* st, ContactSet contacts) const {
   const WorldData::Ffd<Dim>& e = FfdData<Dim>(body);
   VecQ<double> a;
-  *st = wobble::Accelerations(*Ffd<Dim>(body).model, options_.params, body, e.state, &a);
+  *st = wobble::Accelerations(*Ffd<Dim>(body).model, options_.params, body, e.state, &a,
+                              static_cast<ForceBreakdown<Dim, double>*>(nullptr), contacts);
   if (!st->ok()) return false;
   *acc = a;
   if (!e.applied.isZero(0.0)) FfdApplyGeneralized<Dim>(body, e.applied, acc);
@@ -476,17 +478,32 @@ template <int Dim> bool World::FfdFreeAcceleration(int body, Eigen::VectorXd* ac
 
 // Semi-implicit Euler, velocity first, on the group (the Störmer form of Eq. 4.22/4.23).
 template <int Dim> bool World::FfdAcceptConstrainedStep(int body, const Eigen::VectorXd& acc) {
-  const BodyModelN<Dim>& model = *Ffd<Dim>(body).model;
   WorldData::Ffd<Dim>& e = FfdData<Dim>(body);
   const VecQ<double> q_before = e.state.q, qd_before = e.state.qd;
   e.state.qd += options_.dt * acc;
   Group<Dim>::Advance(e.state.qd, options_.dt, &e.state.q);
+  return FfdAcceptState<Dim>(body, q_before, qd_before);
+}
+
+template <int Dim>
+bool World::FfdAcceptState(int body, const VecQ<double>& q_before, const VecQ<double>& qd_before) {
+  const BodyModelN<Dim>& model = *Ffd<Dim>(body).model;
+  WorldData::Ffd<Dim>& e = FfdData<Dim>(body);
   UpdateContacts(model, GroundFor<Dim>(), &e.state);
-  e.applied.setZero();  // acc holds it
+  e.applied.setZero();  // the step's accelerations held it
   if (e.state.q.allFinite() && e.state.qd.allFinite() && e.state.penetration <= PenetrationLimit(model) &&
       EnergyFinite(body))
     return true;
   return RefuseFfdStep<Dim>(body, q_before, qd_before, StepStatus{});
+}
+
+// A Runge–Kutta–Munthe-Kaas stage on the group (step.h): q0·exp(dy), v0 + dv; contacts kept.
+template <int Dim>
+void World::FfdMoveToStage(int body, const Eigen::VectorXd& q0, const Eigen::VectorXd& v0, const Eigen::VectorXd& dy,
+                           const Eigen::VectorXd& dv) {
+  BodyState<Dim, double>& s = FfdData<Dim>(body).state;
+  Group<Dim>::Retract(VecQ<double>(q0), VecQ<double>(dy), &s.q);
+  s.qd = v0 + dv;
 }
 
 template <int Dim> void World::FfdAddVelocity(int body, const Eigen::VectorXd& dv) {
@@ -503,8 +520,11 @@ template <int Dim> void World::FfdAddVelocity(int body, const Eigen::VectorXd& d
   template Eigen::MatrixXd World::FfdEndJacobian<Dim>(const End&) const;                               \
   template void World::FfdAddEndForce<Dim>(const End&, const Eigen::VectorXd&, Eigen::VectorXd*) const; \
   template void World::FfdApplyGeneralized<Dim>(int, const Eigen::VectorXd&, Eigen::VectorXd*) const;   \
-  template bool World::FfdFreeAcceleration<Dim>(int, Eigen::VectorXd*, StepStatus*) const;              \
+  template bool World::FfdFreeAcceleration<Dim>(int, Eigen::VectorXd*, StepStatus*, ContactSet) const;  \
   template bool World::FfdAcceptConstrainedStep<Dim>(int, const Eigen::VectorXd&);                      \
+  template bool World::FfdAcceptState<Dim>(int, const VecQ<double>&, const VecQ<double>&);              \
+  template void World::FfdMoveToStage<Dim>(int, const Eigen::VectorXd&, const Eigen::VectorXd&,         \
+                                           const Eigen::VectorXd&, const Eigen::VectorXd&);             \
   template void World::FfdAddVelocity<Dim>(int, const Eigen::VectorXd&);                                \
   template bool World::EnergySurelyFinite<Dim>(int) const;
 WOBBLE_WORLD_FFD(2)
