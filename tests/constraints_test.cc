@@ -123,6 +123,34 @@ TEST(LinearBody, FreeFallIsUniform3D) {
   }
 }
 
+// Linear bodies step with the world's integrator: a free fall from rest under each, against
+// its closed form after n steps (constant force): velocity-first and implicit Euler
+// y_n = −g h² n(n+1)/2, position-first −g h² n(n−1)/2, RK4 and the variational (velocity-
+// first for a constant M) step, exact −g (nh)²/2 and −g h² n(n+1)/2.
+TEST(LinearBody, FreeFallUnderEachIntegratorMatchesItsClosedForm) {
+  const double n = 1000, h = 1e-3, g = 9.81;
+  struct Expect {
+    Integrator integrator;
+    double y;
+  };
+  for (const Expect& e : {Expect{Integrator::kThesis, -g * h * h * n * (n + 1) / 2},
+                          Expect{Integrator::kSymplecticEuler, -g * h * h * n * (n - 1) / 2},
+                          Expect{Integrator::kRK4, -g * (n * h) * (n * h) / 2},
+                          Expect{Integrator::kImplicitEuler, -g * h * h * n * (n + 1) / 2},
+                          Expect{Integrator::kVariational, -g * h * h * n * (n + 1) / 2}}) {
+    WorldOptions opt = testing::WitkinWelchOptions();
+    opt.dt = h;
+    opt.integrator = e.integrator;
+    World world(opt);
+    const int b = world.AddLinearBody(std::make_shared<LinearBodyModel>(
+        MakeBoxBody("cube", 3, LinearOrder::kQuadratic, Eigen::Vector3d(1, 1, 1), 3, 5.0)));
+    ASSERT_TRUE(world.RunUntil(1.0)) << world.status().message;
+    const Eigen::VectorXd x = world.PointPosition(At(b, Eigen::Vector3d(-1, 0.3, 0.2)));
+    EXPECT_NEAR(x[1] - 0.3, e.y, 1e-9) << IntegratorName(e.integrator);
+    EXPECT_NEAR(x[0], -1.0, 1e-12) << IntegratorName(e.integrator);
+  }
+}
+
 // ---------------------------------------------------------------- affine energies (§2.4)
 
 Eigen::MatrixXd RandomR(std::mt19937& rng, int d, int n) {
