@@ -72,6 +72,37 @@ TEST(Annealing, SameSeedSameResultWhateverTheThreadCount) {
   EXPECT_EQ(results[0].trials, 1 + 6 * 4);
 }
 
+// A batch worker keeps one world and puts its start data back for every trial (TrialWorld):
+// each trial of a sequence, whatever ran before it in that world (a graph the controller
+// refuses, a graph that shakes the table apart, another gait), is the trial a fresh world gives,
+// bit for bit.
+TEST(Annealing, AWorkersWorldRepeatsAFreshWorldsTrials) {
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  std::istringstream in(kBoundingSetup);
+  interp.RunStream(in, "setup.wob", kData);
+  synth::Problem problem = interp.SynthesisProblem();
+  problem.steps = 300;  // 3 s: a cycle and a half of the gait
+  control::PoseGraph gait = interp.pose_graph();
+  control::PoseGraph faster = gait, wrong = gait, violent = gait;
+  for (double& d : faster.durations) d *= 0.7;
+  wrong.poses[0].resize(wrong.poses[0].size() + 1);  // one target too many: refused
+  for (Eigen::VectorXd& pose : violent.poses) pose *= 40.0;
+  synth::TrialWorld worker(problem);
+  int failed = 0;
+  for (const control::PoseGraph* g : {&gait, &wrong, &violent, &faster, &gait, &violent, &faster}) {
+    const synth::TrialOutcome reused = worker.Run(*g), fresh = synth::RunTrial(problem, *g);
+    EXPECT_EQ(reused.ok, fresh.ok);
+    EXPECT_EQ(reused.cost, fresh.cost);
+    EXPECT_EQ(reused.distance, fresh.distance);
+    EXPECT_EQ(reused.speed, fresh.speed);
+    EXPECT_EQ(reused.energy, fresh.energy);
+    EXPECT_EQ(reused.failure, fresh.failure);
+    failed += !fresh.ok;
+  }
+  EXPECT_GE(failed, 1);  // the refused graph at least: a failed trial is among those repeated
+}
+
 TEST(Annealing, RestartsKeepTheBestOfIndependentSeeds) {
   // `set restarts 3` is the best of three anneals from seeds 11, 12, 13 run one by one
   const std::string setup = kBoundingSetup + "set trial_steps 400\nset batch 4\n";

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <random>
 #include <sstream>
 
@@ -90,21 +91,35 @@ void CenterOfMassX(const World& world, double* x, double* v) {
 
 TrialOutcome RunTrial(const Problem& p, const control::PoseGraph& graph,
                       const std::function<void(const World&)>& on_step) {
-  TrialOutcome out;
   if (p.custom_cost) {
+    TrialOutcome out;
     out.cost = p.custom_cost(graph);
     out.ok = std::isfinite(out.cost);
     if (!out.ok) out.cost = p.cost.high;
     return out;
   }
-  World world(p.world);
+  return TrialWorld(p).Run(graph, on_step);
+}
+
+TrialWorld::TrialWorld(const Problem& p) : problem_(p), world_(p.world) {
+  if (p.custom_cost) return;  // Run asks the cost
   if (p.dim() == 3) {
-    world.AddBody(p.body<3>());
-    world.SetCoordinates(0, p.q0, p.qd0);
+    world_.AddBody(p.body<3>());
+    world_.SetCoordinates(0, p.q0, p.qd0);
   } else {
-    world.AddBody(p.body<2>());
-    world.SetState(0, p.q0, p.qd0);
+    world_.AddBody(p.body<2>());
+    world_.SetState(0, p.q0, p.qd0);
   }
+  start_ = world_.data();
+}
+
+TrialOutcome TrialWorld::Run(const control::PoseGraph& graph, const std::function<void(const World&)>& on_step) {
+  const Problem& p = problem_;
+  if (p.custom_cost) return RunTrial(p, graph, on_step);
+  TrialOutcome out;
+  World& world = world_;
+  world.SetData(start_);  // the start state, clock and status: nothing of the last trial stays
+  world.ClearControllers();
   double x0, v0;
   CenterOfMassX(world, &x0, &v0);
   if (!graph.empty()) {  // the pose graph picks the targets of every step (chapter 5)
@@ -164,14 +179,29 @@ TrialOutcome DecodeTrialOutcome(const Bytes& bytes) {
 std::vector<TrialOutcome> RunTrials(const Problem& p, const std::vector<control::PoseGraph>& graphs, int threads) {
   MapOptions options;
   options.threads = threads;
+  // the worlds of the workers: one per trial running at a time, made at first need and handed
+  // back after each trial (TrialWorld resets its data, so which one runs a trial does not matter)
+  std::mutex mutex;
+  std::vector<std::unique_ptr<TrialWorld>> idle;
   const std::vector<Bytes> results = DistributedMap(graphs.size(), options, [&](size_t i) {
     TrialOutcome out;
     if (InterruptRequested()) {  // Ctrl-C: the trials not yet started are not run
       out.failure = kInterruptedTrial;
       out.cost = p.cost.high;
-    } else {
-      out = RunTrial(p, graphs[i]);
+      return EncodeTrialOutcome(out);
     }
+    std::unique_ptr<TrialWorld> world;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!idle.empty()) {
+        world = std::move(idle.back());
+        idle.pop_back();
+      }
+    }
+    if (!world) world = std::make_unique<TrialWorld>(p);
+    out = world->Run(graphs[i]);
+    std::lock_guard<std::mutex> lock(mutex);
+    idle.push_back(std::move(world));
     return EncodeTrialOutcome(out);
   });
   std::vector<TrialOutcome> out;

@@ -87,6 +87,20 @@ void CenterOfMassX(const World& world, double* x, double* v);
 TrialOutcome RunTrial(const Problem& problem, const control::PoseGraph& graph,
                       const std::function<void(const World&)>& on_step = nullptr);
 
+// The world of a batch worker: the problem's body added once, its start kept as WorldData;
+// every trial puts that data back (World::SetData) and swaps the controller, so a trial copies
+// only the data, never the model. Run gives what RunTrial gives, bit for bit.
+class TrialWorld {
+ public:
+  explicit TrialWorld(const Problem& problem);  // the problem must outlive it
+  TrialOutcome Run(const control::PoseGraph& graph, const std::function<void(const World&)>& on_step = nullptr);
+
+ private:
+  const Problem& problem_;
+  World world_;
+  WorldData start_;
+};
+
 // A trial's outcome as bytes and back, exactly: how trials cross threads and MPI ranks
 // (core/distribute.h).
 std::string EncodeTrialOutcome(const TrialOutcome& outcome);
