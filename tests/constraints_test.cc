@@ -319,58 +319,66 @@ TEST(World, SmallAnglePendulumPeriodMatchesPhysicalPendulum) {
   EXPECT_LT(world.MaxViolation(), 1e-9);
 }
 
-// The constraint force does no work: a frictionless, undamped nailed pendulum (swinging 60°,
-// deforming) keeps its total energy; the bound is the O(Δt) oscillation of symplectic Euler.
-TEST(World, NailedPendulumConservesEnergy) {
+// A nailed pendulum of either dimension, frictionless and undamped: 2D, an affine bar turned
+// 30° from the horizontal and nailed at its left end (it swings 60°, deforming); 3D, an affine
+// slab tilted about an oblique axis and nailed at a corner (a spherical pendulum that also turns
+// about its own axis). `scale`: m g × the pivot-to-centre distance, the swing's energy scale.
+struct NailedSlab {
+  World world;
+  double scale = 0;
+  int body = -1;
+};
+
+NailedSlab MakeNailedSlab(int dim, WorldOptions opt) {
+  NailedSlab n{World(opt)};
+  const AffineMaterial mat{500.0, 500.0, 0.0, 0.0};
+  if (dim == 2) {
+    const auto model = Bar2D(0.5, 0.1, 2.0);
+    n.body = n.world.AddLinearBody(model, mat);
+    n.world.SetLinearState(n.body, model->PlacedState(Rot2(-kPi / 6), Eigen::Vector2d::Zero()), Eigen::MatrixXd::Zero(2, 3));
+    n.world.AddNail(At(n.body, Eigen::Vector2d(-0.5, 0.0)));
+    n.scale = model->total_mass() * 9.81 * 0.5;
+  } else {
+    const auto model = std::make_shared<LinearBodyModel>(
+        MakeBoxBody("slab", 3, LinearOrder::kAffine, Eigen::Vector3d(0.5, 0.15, 0.25), 3, 2.0));
+    EXPECT_LE(opt.dt, StableTimeStep(*model, mat));
+    n.body = n.world.AddLinearBody(model, mat);
+    const Eigen::Matrix3d tilt = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, 0.2, 1.0).normalized()).toRotationMatrix();
+    n.world.SetLinearState(n.body, model->PlacedState(tilt, Eigen::Vector3d::Zero()), Eigen::MatrixXd::Zero(3, 4));
+    n.world.AddNail(At(n.body, Eigen::Vector3d(-0.5, 0.15, 0.25)));
+    n.scale = model->total_mass() * 9.81 * 0.6;
+  }
+  return n;
+}
+
+// The dimension as a type, for the tests written once over it.
+template <class T> class OverTheDimension : public ::testing::Test {
+ public:
+  static constexpr int kDim = T::value;
+};
+using Dimensions = ::testing::Types<std::integral_constant<int, 2>, std::integral_constant<int, 3>>;
+TYPED_TEST_SUITE(OverTheDimension, Dimensions);
+
+// The constraint force does no work: the nailed pendulum keeps its total energy over 20 s with
+// either multiplier solve; the bound is the O(Δt) oscillation of velocity-first Euler.
+TYPED_TEST(OverTheDimension, NailedPendulumConservesEnergy) {
   for (MultiplierMethod method : {MultiplierMethod::kDense, MultiplierMethod::kSparse}) {
     WorldOptions opt = testing::WitkinWelchOptions();
     opt.dt = 5e-4;
     opt.method = method;
-    World world(opt);
-    const auto model = Bar2D(0.5, 0.1, 2.0);
-    const int bar = world.AddLinearBody(model, AffineMaterial{500.0, 500.0, 0.0, 0.0});
-    world.AddNail(At(bar, Eigen::Vector2d(-0.5, 0.0)));
-    world.SetLinearState(bar, model->PlacedState(Rot2(-kPi / 6), Eigen::Vector2d::Zero()), Eigen::MatrixXd::Zero(2, 3));
-    world.SetNailPosition(0, world.PointPosition(At(bar, Eigen::Vector2d(-0.5, 0.0))));
-    const double E0 = world.TotalEnergy();
-    const double scale = model->total_mass() * 9.81 * 0.5;  // m g L: the swing's energy scale
+    NailedSlab n = MakeNailedSlab(TestFixture::kDim, opt);
+    const double E0 = n.world.TotalEnergy();
     double worst = 0, worst_c = 0;
-    ASSERT_TRUE(world.RunUntil(20.0, [&](World& w) {
+    ASSERT_TRUE(n.world.RunUntil(20.0, [&](World& w) {
       worst = std::max(worst, std::abs(w.TotalEnergy() - E0));
       worst_c = std::max(worst_c, w.MaxViolation());
-    })) << world.status().message;
-    EXPECT_LT(worst, 2e-3 * scale) << MultiplierMethodName(method);
+    })) << n.world.status().message;
+    EXPECT_LT(worst, 2e-3 * n.scale) << MultiplierMethodName(method);
     EXPECT_LT(worst_c, 1e-9) << MultiplierMethodName(method);
-    EXPECT_EQ(world.last_method(), method);
-    std::printf("%s: max |E - E0| = %.3g (m g L = %.3g), max |c| = %.3g over 40000 steps\n",
-                MultiplierMethodName(method), worst, scale, worst_c);
+    EXPECT_EQ(n.world.last_method(), method);
+    std::printf("%dD, %s: max |E - E0| = %.3g (m g L = %.3g), max |c| = %.3g over 40000 steps\n", TestFixture::kDim,
+                MultiplierMethodName(method), worst, n.scale, worst_c);
   }
-}
-
-// The same in 3D: an affine slab nailed at a corner swings in space (a spherical pendulum that
-// also turns about its own axis), frictionless; the energy stays within the same kind of bound.
-TEST(World, NailedPendulumConservesEnergy3D) {
-  WorldOptions opt = testing::WitkinWelchOptions();
-  opt.dt = 5e-4;
-  World world(opt);
-  const auto model = std::make_shared<LinearBodyModel>(
-      MakeBoxBody("slab", 3, LinearOrder::kAffine, Eigen::Vector3d(0.5, 0.15, 0.25), 3, 2.0));
-  const AffineMaterial mat{500.0, 500.0, 0.0, 0.0};
-  ASSERT_LE(opt.dt, StableTimeStep(*model, mat));
-  const int slab = world.AddLinearBody(model, mat);
-  const Eigen::Matrix3d tilt = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, 0.2, 1.0).normalized()).toRotationMatrix();
-  world.SetLinearState(slab, model->PlacedState(tilt, Eigen::Vector3d::Zero()), Eigen::MatrixXd::Zero(3, 4));
-  world.AddNail(At(slab, Eigen::Vector3d(-0.5, 0.15, 0.25)));
-  const double E0 = world.TotalEnergy();
-  const double scale = model->total_mass() * 9.81 * 0.6;  // m g × pivot-to-centre distance
-  double worst = 0, worst_c = 0;
-  ASSERT_TRUE(world.RunUntil(20.0, [&](World& w) {
-    worst = std::max(worst, std::abs(w.TotalEnergy() - E0));
-    worst_c = std::max(worst_c, w.MaxViolation());
-  })) << world.status().message;
-  std::printf("3D slab: max |E - E0| = %.3g (m g L = %.3g), max |c| = %.3g\n", worst, scale, worst_c);
-  EXPECT_LT(worst, 2e-3 * scale);
-  EXPECT_LT(worst_c, 1e-9);
 }
 
 // Fig. 2: a triple pendulum of affine parts attached end to end, nailed at the top; long run.
@@ -475,27 +483,15 @@ double NailedSlabEnergyError(int dim, Integrator integrator, double dt) {
   WorldOptions opt = testing::WitkinWelchOptions();
   opt.dt = dt;
   opt.integrator = integrator;
-  World world(opt);
-  const auto model = dim == 2 ? Bar2D(0.5, 0.1, 2.0)
-                              : std::make_shared<LinearBodyModel>(MakeBoxBody("slab", 3, LinearOrder::kAffine,
-                                                                              Eigen::Vector3d(0.5, 0.15, 0.25), 3, 2.0));
-  const int slab = world.AddLinearBody(model, AffineMaterial{500.0, 500.0, 0.0, 0.0});
-  if (dim == 2) {
-    world.SetLinearState(slab, model->PlacedState(Rot2(-kPi / 6), Eigen::Vector2d::Zero()), Eigen::MatrixXd::Zero(2, 3));
-    world.AddNail(At(slab, Eigen::Vector2d(-0.5, 0.0)));
-  } else {
-    const Eigen::Matrix3d tilt = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, 0.2, 1.0).normalized()).toRotationMatrix();
-    world.SetLinearState(slab, model->PlacedState(tilt, Eigen::Vector3d::Zero()), Eigen::MatrixXd::Zero(3, 4));
-    world.AddNail(At(slab, Eigen::Vector3d(-0.5, 0.15, 0.25)));
-  }
-  const double E0 = world.TotalEnergy();
+  NailedSlab n = MakeNailedSlab(dim, opt);
+  const double E0 = n.world.TotalEnergy();
   double worst = 0, worst_c = 0;
-  EXPECT_TRUE(world.RunUntil(5.0, [&](World& w) {
+  EXPECT_TRUE(n.world.RunUntil(5.0, [&](World& w) {
     worst = std::max(worst, std::abs(w.TotalEnergy() - E0));
     worst_c = std::max(worst_c, w.MaxViolation());
-  })) << world.status().message;
+  })) << n.world.status().message;
   EXPECT_LT(worst_c, 1e-9);
-  return worst / (model->total_mass() * 9.81 * 0.5);
+  return worst / n.scale;
 }
 
 TEST(ConstraintStage, Rk4HoldsANailedSlabsEnergy) {
