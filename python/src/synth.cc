@@ -113,6 +113,13 @@ TrialResults RunTrials(const Problem& problem, const py::object& graphs_or_poses
   return r;
 }
 
+// The problem's body, of whichever dimension it has (None before one is set).
+py::object ProblemBody(const synth::Problem& p) {
+  if (p.body<3>()) return py::cast(std::const_pointer_cast<BodyModelN<3>>(p.body<3>()));
+  if (p.body<2>()) return py::cast(std::const_pointer_cast<BodyModel>(p.body<2>()));
+  return py::none();
+}
+
 }  // namespace
 
 void BindSynth(py::module_& m) {
@@ -138,10 +145,18 @@ void BindSynth(py::module_& m) {
   py::class_<Problem>(m, "SynthesisProblem",
                       "A body, its world and start state, the trial length and the cost: what `anneal` solves.\n"
                       "Get the one a script set up with Interpreter.synthesis_problem().")
-      .def_property_readonly("body", [](const Problem& p) { return std::const_pointer_cast<BodyModel>(p.body<2>()); },
-                             "the 2D body (None for a 3D problem)")
-      .def_property_readonly("body3", [](const Problem& p) { return std::const_pointer_cast<BodyModelN<3>>(p.body<3>()); },
-                             "the 3D body (None for a 2D problem); q0, qd0 then [t, rotation vector, γ], [ṫ, ω, γ̇]")
+      .def_property_readonly("body", &ProblemBody,
+                             "the body, 2D (BodyModel) or 3D (BodyModel3); a 3D problem's q0, qd0 are [t, rotation "
+                             "vector, γ], [ṫ, ω, γ̇]")
+      .def_property_readonly(
+          "body3",
+          [](const Problem& p) {
+            if (PyErr_WarnEx(PyExc_DeprecationWarning, "SynthesisProblem.body3 is deprecated: use SynthesisProblem.body",
+                             1) < 0)
+              throw py::error_already_set();
+            return ProblemBody(p);
+          },
+          "deprecated: body")
       .def_readwrite("options", &Problem::world)
       .def_readwrite("q0", &Problem::q0)
       .def_readwrite("qd0", &Problem::qd0)

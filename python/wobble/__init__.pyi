@@ -292,8 +292,8 @@ class TrialOutcome:
     failure: str
 
 class SynthesisProblem:
-    body: Optional[BodyModel]
-    body3: Optional[BodyModel3]
+    body: Optional[BodyModel | BodyModel3]  # the body of either dimension
+    body3: Optional[BodyModel | BodyModel3]  # deprecated (DeprecationWarning): body
     options: WorldOptions
     q0: NDArray
     qd0: NDArray

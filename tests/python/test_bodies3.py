@@ -128,7 +128,9 @@ def test_synthesis_of_the_3d_bounding_table_from_python():
     # threads equal to one at a time, and annealing that lowers the cost
     from conftest import bounding_table
     problem = bounding_table(DATA, "bounding_table3.wob").synthesis_problem()
-    assert problem.body is None and problem.body3.num_q == 6 + 4 and problem.num_active == 2
+    assert isinstance(problem.body, wobble.BodyModel3) and problem.body.num_q == 6 + 4 and problem.num_active == 2
+    with pytest.warns(DeprecationWarning, match="SynthesisProblem.body3 is deprecated: use SynthesisProblem.body"):
+        assert problem.body3.num_q == 6 + 4
     problem.steps = 300
     poses = np.array([[[0.1, 0], [0, -0.1], [-0.1, 0], [0, 0.1]],
                       [[0.2, 0], [0, -0.2], [-0.2, 0], [0, 0.2]],
