@@ -300,6 +300,20 @@ TEST(SceneScript, AnFfdTableJoinsTheSceneNailedAtACornerAndAttachedToALinearBloc
             std::string::npos);
 }
 
+// Synthesis trials simulate the FFD object alone: while a constraint holds it in the scene,
+// annealing is refused by name, not run without the constraint; released, it runs.
+TEST(SceneScript, SynthesisRefusesAnObjectTheSceneHolds) {
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  const std::string setup = "load_obj " + kData + "/table.obj\nload_def " + kData + "/table_modes.def\n" +
+                            "set integrator thesis\nset ground F\nset trial_steps 20\n" +
+                            "pose 0.1 0 0.4\npose 0 -0.1 0.4\n" + "ffd table\npoint corner table 0 1\nnail hold corner\n";
+  const std::string message = RunScript(interp, setup + "anneal 1\n");
+  EXPECT_NE(message.find("s.wob:11: "), std::string::npos) << message;
+  EXPECT_NE(message.find("'hold' holds it in the scene: release it first (release hold)"), std::string::npos) << message;
+  EXPECT_EQ(RunScript(interp, "release hold\nsimul 0.01\nanneal 1\n"), "");
+}
+
 TEST(SceneScript, GravitySetAfterTheBodiesAppliesToTheNextSimul) {
   std::ostringstream out;
   script::Interpreter interp(out);

@@ -151,6 +151,7 @@ class Scene {
   // ---- the Witkin & Welch scene ----
   // Its world, made at first use from options() (dt, gravity, ground, feedback_rate).
   World& world();
+  const World* world_if_made() const { return world_.get(); }  // null until first use
   bool has_bodies() const { return world_ && world_->num_bodies() > 0; }
   // Bodies by name; std::invalid_argument when the name is taken. A linear body starts at
   // rest at `at`; the FFD object joins with its state now (`ffd NAME`).
@@ -166,6 +167,7 @@ class Scene {
   // Named constraints, made at once (`nail`, `attach`) or by behaviours. Constraint(): the id
   // of a name, or -1 (unknown or removed).
   control::ConstraintNames& constraints() { return constraints_; }
+  const control::ConstraintNames& constraints() const { return constraints_; }
   int Constraint(const std::string& name) const;
   // The names queued behaviours will give the constraints they make (a name is promised
   // until the behaviour makes it).

@@ -95,6 +95,16 @@ synth::Problem StartOptimising(State& s) {
 }  // namespace
 
 synth::Problem MakeProblem(const State& s, long steps) {
+  // trials simulate the object alone: a constraint holding it in the Witkin & Welch scene
+  // (`ffd NAME` then `nail`, `attach`, a behaviour's) would be silently left out, so refuse
+  if (const World* w = s.scene.world_if_made())
+    for (const auto& [name, id] : s.scene.constraints()) {
+      if (!w->exists(id) || !w->enabled(id)) continue;
+      const auto [a, b] = w->constraint_bodies(id);
+      if (w->kind(a) == BodyKind::kFfd || (b >= 0 && w->kind(b) == BodyKind::kFfd))
+        throw std::invalid_argument("the synthesis trials simulate the FFD object alone, without the scene's constraints, "
+                                    "but '" + name + "' holds it in the scene: release it first (release " + name + ")");
+    }
   synth::Problem p;
   if (s.scene.object().dim() == 3) {
     p.set_body(s.scene.object().Body<3>());

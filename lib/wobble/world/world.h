@@ -40,6 +40,7 @@
 #include <memory>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "wobble/body/affine_energy.h"
@@ -253,6 +254,8 @@ class World {
   bool enabled(int id) const;
   bool exists(int id) const;
   ConstraintKind constraint_kind(int id) const;
+  // The bodies of its ends: {a, b}, b = −1 for a nail or a trajectory.
+  std::pair<int, int> constraint_bodies(int id) const { return {Get(id).a.body, Get(id).b.body}; }
   int num_constraints() const { return int(constraints_.size()); }  // ids are 0..n−1
   int num_enabled_constraints() const { return enabled_count_; }
   // c = x_a − x_b (or x_a − n(t)) now, and its largest norm over the enabled constraints.
