@@ -35,8 +35,11 @@ template <> struct Group<2> {
   template <class T> static void AddTorque(const Vec2<T>& l, const Vec2<T>& f_local, VecQ<T>* Q) {
     (*Q)[2] += Perp(l).dot(f_local);
   }
-  // q ← q·exp(h v): an abelian group, so plain addition on every coordinate.
-  template <class T> static void Advance(const VecQ<T>& v, const T& h, VecQ<T>* q) { *q += h * v; }
+  // q ← q·exp(h v): an abelian group, so plain addition on every coordinate. A plain loop: at
+  // this size Eigen's run-time sized expression is an out-of-line call per step (callgrind).
+  template <class T> static void Advance(const VecQ<T>& v, const T& h, VecQ<T>* q) {
+    for (int i = 0; i < int(v.size()); ++i) (*q)[i] += h * v[i];
+  }
   // q0·exp(Θ) for a tangent increment dy = [δt, Θ, δγ] (a Runge–Kutta–Munthe-Kaas stage).
   template <class T> static void Retract(const VecQ<T>& q0, const VecQ<T>& dy, VecQ<T>* q) { *q = q0 + dy; }
   // Θ̇ of the stage coordinates for the velocity v at the stage offset dy: dexp⁻¹ is 1 on SO(2).

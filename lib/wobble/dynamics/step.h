@@ -64,7 +64,7 @@ StepStatus StepBody(const BodyModelN<Dim>& body, const WorldParams& w, int body_
   switch (integrator) {
     case Integrator::kThesis: {
       if (!(st = accel(&a)).ok()) return st;
-      s->qd += h * a;
+      for (int i = 0; i < int(a.size()); ++i) s->qd[i] += h * a[i];  // a loop: see Group<2>::Advance
       G::Advance(s->qd, h, &s->q);
       break;
     }

@@ -342,26 +342,34 @@ template Energies World::FfdEnergies<3>(int, ContactSet, bool) const;
 // energy term is a sum of at most ~10^6 products of at most five factors (γᵀGγ θ̇², k |x − a|²
 // with x = t + R(b0 + Bγ)), so below 10^6 · 15^4 · kScreen^5, far from the largest double. A
 // normal step passes; one that does not has its energies computed (EnergyFinite).
+namespace {
+constexpr double kScreen = 1e30;
+// Every |x| ≤ kScreen: a plain loop (maxCoeff is an out-of-line reduction per call here, and
+// its result for a NaN is unspecified; !(|x| ≤ bound) is true for a NaN).
+template <class V> bool Screened(const V& v) {
+  for (int i = 0; i < int(v.size()); ++i)
+    if (!(std::abs(v.data()[i]) <= kScreen)) return false;
+  return true;
+}
+}  // namespace
+
 template <int Dim> bool World::EnergySurelyFinite(int body) const {
   const FfdEntry<Dim>& e = Ffd<Dim>(body);
-  constexpr double kScreen = 1e30;
   const BodyState<Dim, double>& s = state<Dim>(body);
   const auto& p = options_.params;
-  if (!(e.scale <= kScreen && s.q.cwiseAbs().maxCoeff() <= kScreen && s.qd.cwiseAbs().maxCoeff() <= kScreen))
-    return false;
-  if (s.mode_target.size() > 0 && !(s.mode_target.cwiseAbs().maxCoeff() <= kScreen)) return false;
+  if (!(e.scale <= kScreen && Screened(s.q) && Screened(s.qd))) return false;
+  if (!Screened(s.mode_target)) return false;
   // a terrain's or a heightfield region's own stiffnesses are at most 1e30 (their makers)
   const GroundOf<Dim>& ground = GroundFor<Dim>();
-  if (!(GravityFor<Dim>(p).cwiseAbs().maxCoeff() <= kScreen && std::abs(ground.stiffness) <= kScreen)) return false;
+  if (!(Screened(GravityFor<Dim>(p)) && std::abs(ground.stiffness) <= kScreen)) return false;
   if constexpr (Dim == 3) {
-    if (!(ground.point.cwiseAbs().maxCoeff() <= kScreen)) return false;
+    if (!Screened(ground.point)) return false;
   }
   for (const Contact<Dim, double>& c : s.contacts)
-    if (!(c.anchor.cwiseAbs().maxCoeff() <= kScreen)) return false;
+    if (!Screened(c.anchor)) return false;
   for (const Spring& sp : p.springs)
-    if (!(std::abs(sp.stiffness) <= kScreen && std::abs(sp.rest_length) <= kScreen &&
-          sp.anchor.cwiseAbs().maxCoeff() <= kScreen && sp.rest_local.cwiseAbs().maxCoeff() <= kScreen &&
-          (sp.mode_matrix.size() == 0 || sp.mode_matrix.cwiseAbs().maxCoeff() <= kScreen)))
+    if (!(std::abs(sp.stiffness) <= kScreen && std::abs(sp.rest_length) <= kScreen && Screened(sp.anchor) &&
+          Screened(sp.rest_local) && Screened(sp.mode_matrix)))
       return false;
   return true;
 }
