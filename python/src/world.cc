@@ -428,8 +428,8 @@ void BindWorld(py::module_& m) {
             CheckLinear(w, body);
             const LinearContacts& c = w.linear_contacts(body);
             py::list out;
-            for (const Contact<2, double>& k : c.list2) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
-            for (const Contact<3, double>& k : c.list3) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
+            for (const Contact<2, double>& k : c.list<2>()) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
+            for (const Contact<3, double>& k : c.list<3>()) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
             return out;
           },
           py::arg("body"), "A linear body's ground contacts: (mass point, face, anchor) each")
