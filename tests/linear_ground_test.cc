@@ -50,7 +50,7 @@ std::vector<Eigen::Vector2d> ForcePerFace(const World& w, int b) {
   const LinearContacts& c = w.linear_contacts(b);
   const std::vector<Eigen::VectorXd> f =
       LinearContactForces(w.linear_model(b), w.linear_ground(), w.linear_R(b), w.linear_R_dot(b), c);
-  for (size_t i = 0; i < f.size(); ++i) per_face[c.list2[i].face] += f[i];
+  for (size_t i = 0; i < f.size(); ++i) per_face[c.list<2>()[i].face] += f[i];
   return per_face;
 }
 
@@ -81,8 +81,8 @@ TEST(LinearGround, RestsOnFlatGroundWithTheWeightOnItsBottomRow) {
   ASSERT_TRUE(w.RunUntil(6.0)) << w.status().message;
   const double weight = 6.0 * kG, K = o.params.ground.stiffness;
   const LinearContacts& c = w.linear_contacts(b);
-  ASSERT_EQ(c.list2.size(), 3u);
-  for (const Contact<2, double>& contact : c.list2) {
+  ASSERT_EQ(c.list<2>().size(), 3u);
+  for (const Contact<2, double>& contact : c.list<2>()) {
     EXPECT_NEAR(w.linear_model(b).def().points[contact.point].y(), -0.5, 0.0);  // the bottom row
     EXPECT_NEAR(Point(w, b, contact.point).y(), -weight / (3 * K), 1e-6 * weight / K);
   }
@@ -152,7 +152,7 @@ TEST(LinearGround, BlockCornerDownInAValleyFeelsBothFaces) {
     EXPECT_NEAR(per_face[face].dot(o.params.ground.Face(face).tau), 0.0, 1e-12 * weight);  // no friction
   }
   int corner_contacts = 0;
-  for (const Contact<2, double>& c : w.linear_contacts(b).list2) corner_contacts += c.point == 0;
+  for (const Contact<2, double>& c : w.linear_contacts(b).list<2>()) corner_contacts += c.point == 0;
   EXPECT_EQ(corner_contacts, 2);  // point 0 is u = (−0.5, −0.5)
 }
 
@@ -212,7 +212,7 @@ TEST(LinearGround, SlidesDownATiltedPlaneIn3D) {
     const double v2 = down_slope.dot(CentreOfMassVelocity(w, b));
     const double a = kG * (std::sin(alpha) - mu * std::cos(alpha));
     EXPECT_NEAR((v2 - v1) / 2.0, a, 1e-3 * a) << (heightfield ? "heightfield" : "plane");
-    EXPECT_EQ(w.linear_contacts(b).list3.size(), 9u);  // the bottom face's 3 × 3 points
+    EXPECT_EQ(w.linear_contacts(b).list<3>().size(), 9u);  // the bottom face's 3 × 3 points
     if (heightfield) {
       EXPECT_GT(CentreOfMass(w, b).x(), 8.0) << "slid over dozens of triangles";
     }
@@ -234,8 +234,8 @@ TEST(LinearGround, RestsOnThePlaneIn3DWithTheWeightOnItsBottomFace) {
                    Eigen::MatrixXd::Zero(3, 4));
   ASSERT_TRUE(w.RunUntil(6.0)) << w.status().message;
   const double weight = 6.0 * kG, K = o.params.ground_plane.stiffness;
-  ASSERT_EQ(w.linear_contacts(b).list3.size(), 9u);
-  for (const Contact<3, double>& c : w.linear_contacts(b).list3)
+  ASSERT_EQ(w.linear_contacts(b).list<3>().size(), 9u);
+  for (const Contact<3, double>& c : w.linear_contacts(b).list<3>())
     EXPECT_NEAR(Point(w, b, c.point).y(), -weight / (9 * K), 1e-6 * weight / K);
 }
 
@@ -263,14 +263,14 @@ TEST(LinearGround, BlockSlidingOffACliffEdgeFollowsTheFreeFall) {
     ASSERT_TRUE(w.Step()) << w.status().message;
     const LinearContacts& c = w.linear_contacts(b);
     for (int k = 0; k < w.linear_model(b).num_points(); ++k) {
-      const bool has = std::any_of(c.list2.begin(), c.list2.end(), [k](const Contact<2, double>& x) { return x.point == k; });
+      const bool has = std::any_of(c.list<2>().begin(), c.list<2>().end(), [k](const Contact<2, double>& x) { return x.point == k; });
       ASSERT_EQ(terrain.Inside(Point(w, b, k)), has) << "point " << k << " at t = " << w.time();
     }
-    for (const Contact<2, double>& contact : c.list2) {
+    for (const Contact<2, double>& contact : c.list<2>()) {
       if (contact.face == 1) wall_depth = std::max(wall_depth, 10 - Point(w, b, contact.point).y());
       landed = landed || contact.face == 2;
     }
-    if (!c.list2.empty()) {
+    if (!c.list<2>().empty()) {
       touched = true;
       free_since = -1;  // (a corner may touch again as the block tips over the edge)
       continue;
@@ -375,7 +375,7 @@ TEST(LinearGround, TheBoundNeverSkipsAPointBelowTheGround) {
         const Eigen::Vector2d x = R * model.point_bases().col(k);
         if (terrain ? g.terrain->Inside(x) : g.Face(0).Height(x) < 0) expected.push_back(k);
       }
-      for (const Contact<2, double>& contact : c.list2)
+      for (const Contact<2, double>& contact : c.list<2>())
         if (got.empty() || got.back() != contact.point) got.push_back(contact.point);
       ASSERT_EQ(got, expected) << "trial " << trial;
       touching += !expected.empty() && int(expected.size()) < model.num_points();

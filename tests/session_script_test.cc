@@ -104,6 +104,25 @@ TEST(SessionScript, ChangesOnEveryStepAndSpringsAndAnotherIntegrator) {
   EXPECT_LT((q - s.q).cwiseAbs().maxCoeff(), 1e-12) << q.transpose() << "\n" << s.q.transpose();
 }
 
+// A session that began with keys and a held point: its script holds the same point (every
+// lattice coordinate, to the last bit) when the interpreter reads it back.
+TEST(SessionScript, AKeyedSessionKeepsItsHeldPoint) {
+  Session s = RunByHand(WorldOptions{}, V({0, 40, 0, 0, 0, 0, 0}), 10, {});
+  s.record.keys.times = {0.0, 0.05};
+  s.record.keys.amplitudes = {V({0, 0, 0, 0}), V({0.1, 0, 0, 0})};
+  s.record.key_steps = 5;
+  s.record.hold.enabled = true;
+  s.record.hold.lattice_coords = {1.0 / 3.0, 0.7, 0.0};  // a 2D body's point: u is 0
+  const std::string text = scene::SessionScript(s.record);
+  std::ostringstream out;
+  script::Interpreter interp(out);
+  std::istringstream in(text);
+  interp.RunStream(in, "<session>", "");
+  const control::HeldPoint& hold = interp.scene().control().hold;
+  EXPECT_TRUE(hold.enabled) << text;
+  EXPECT_EQ(hold.lattice_coords, s.record.hold.lattice_coords) << text;
+}
+
 TEST(SessionScript, RefusesBadRecordsAndNotesPulls) {
   Session s = RunByHand(WorldOptions{}, V({0, 0, 0, 0, 0, 0, 0}), 10, {{0, V({0.1, 0, 0, 0})}, {5, V({0, 0, 0, 0})}});
   s.record.drags = 2;

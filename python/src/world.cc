@@ -255,6 +255,17 @@ void BindWorld(py::module_& m) {
       .def("finished", &control::KeyframeController::Finished)
       .def("release", &control::KeyframeController::Release, py::arg("world"));
 
+  py::class_<WorldData>(m, "WorldData",
+                        "Everything a World's steps change (states, contacts, pending forces, multipliers,\n"
+                        "clock, status), apart from its model: World.data() takes a copy, World.set_data(d)\n"
+                        "puts one back into that world or one with the same bodies and constraints.")
+      .def(py::init<const WorldData&>(), py::arg("other"), "a copy")
+      .def("__copy__", [](const WorldData& d) { return WorldData(d); })
+      .def("__deepcopy__", [](const WorldData& d, py::dict) { return WorldData(d); }, py::arg("memo"))
+      .def_property_readonly("time", [](const WorldData& d) { return d.time; })
+      .def_property_readonly("steps", [](const WorldData& d) { return d.steps; })
+      .def("__repr__", [](const WorldData& d) { return py::str("<WorldData t={} steps={}>").format(d.time, d.steps); });
+
   py::class_<World>(m, "World",
                     "THE world: FFD bodies of either dimension (2D q = [tx, ty, θ, γ1..γD], Eq. 4.4; 3D q =\n"
                     "[tx, ty, tz, rx, ry, rz, γ1..γD], r the rotation vector, q̇ = [ṫ, body ω, γ̇]), linear\n"
@@ -321,6 +332,11 @@ void BindWorld(py::module_& m) {
           "energies", [](const World& w, int body) { CheckIndex(w, body); return w.ComputeEnergies(body); },
           py::arg("body") = 0)
       .def("total_energy", &World::TotalEnergy, "every body's every term")
+      .def("data", [](const World& w) { return WorldData(w.data()); },
+           "a copy of everything the steps change (WorldData): set_data puts it back")
+      .def("set_data", [](World& w, const WorldData& d) { w.SetData(d); }, py::arg("data"),
+           "Puts back a copy of data taken from this world or one with the same bodies and constraints;\n"
+           "InputError (a ValueError) when its bodies, sizes or constraints do not fit. Controllers are not called.")
       .def(
           "contacts",
           [](const World& w, int body) {
@@ -428,8 +444,8 @@ void BindWorld(py::module_& m) {
             CheckLinear(w, body);
             const LinearContacts& c = w.linear_contacts(body);
             py::list out;
-            for (const Contact<2, double>& k : c.list2) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
-            for (const Contact<3, double>& k : c.list3) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
+            for (const Contact<2, double>& k : c.list<2>()) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
+            for (const Contact<3, double>& k : c.list<3>()) out.append(py::make_tuple(k.point, k.face, Eigen::VectorXd(k.anchor)));
             return out;
           },
           py::arg("body"), "A linear body's ground contacts: (mass point, face, anchor) each")

@@ -1,6 +1,8 @@
 #include "wobble/dynamics/linear_ground.h"
 
 #include <algorithm>
+#include <type_traits>
+#include <utility>
 
 namespace wobble {
 
@@ -49,45 +51,48 @@ bool ClearOf(const LinearBodyModel& m, const GroundPlane& g, const Eigen::Matrix
   return LowerBound(m, along_n) - g.normal.dot(g.point) >= 0.0;
 }
 
-// Visits every point below the 2D ground as f(k, p, x, v, anchor, face, face_index), once per
-// face it feels (ForEachFaceFelt of ground_line.h, the FFD bodies' rules).
-template <class F>
-void ForEachContact2(const LinearBodyModel& m, const Ground& g, const Eigen::MatrixXd& R, const Eigen::MatrixXd& R_dot,
-                     const std::vector<Contact<2, double>>& contacts, F&& f) {
+// The ground a body of dimension Dim feels and the type of its faces.
+template <int Dim> const auto& GroundOf(const LinearGround& g) {
+  if constexpr (Dim == 2) return g.ground;
+  else return g.plane;
+}
+template <int Dim> using FaceOf = std::conditional_t<Dim == 2, GroundFace, GroundPlane>;
+template <int Dim> using VecD = Eigen::Matrix<double, Dim, 1>;
+
+// Visits every point below the ground of dimension Dim as f(k, p, x, v, anchor, face,
+// face_index), once per face it feels (ForEachFaceFelt of ground_line.h or ground_plane.h, the
+// FFD bodies' rules): in the order of the points, then of the faces felt.
+template <int Dim, class F>
+void ForEachContact(const LinearBodyModel& m, const LinearGround& ground, const Eigen::MatrixXd& R,
+                    const Eigen::MatrixXd& R_dot, const std::vector<Contact<Dim, double>>& contacts, F&& f) {
+  const auto& g = GroundOf<Dim>(ground);
   if (!g.enabled || ClearOf(m, g, R)) return;
-  const GroundFace line = g.Face(0);
+  [[maybe_unused]] const auto line = [&] {  // the 2D line's face, made once
+    if constexpr (Dim == 2) return g.Face(0);
+    else return 0;
+  }();
   const Eigen::MatrixXd& P = m.point_bases();
   auto first = contacts.begin();
   for (int k = 0; k < m.num_points(); ++k) {
     const double* p = P.col(k).data();
-    const Vec2<double> x = Times<2>(R, p);
+    const VecD<Dim> x = Times<Dim>(R, p);
+    auto velocity = [&] { return Times<Dim>(R_dot, p); };
     auto contacts_of_k = [&] {  // points come in order: the cursor only moves forward
       while (first != contacts.end() && first->point < k) ++first;
       auto last = first;
       while (last != contacts.end() && last->point == k) ++last;
       return std::make_pair(first, last);
     };
-    ForEachFaceFelt(g, line, x, [&] { return Times<2>(R_dot, p); }, contacts_of_k,
-                    [&](const GroundFace& face, int face_index, const Vec2<double>& anchor, const Vec2<double>& v) {
-                      f(k, p, x, v, anchor, face, face_index);
-                    });
-  }
-}
-
-// Visits every point below the 3D ground (plane or heightfield) as f(k, p, x, v, anchor, face,
-// face_index), once per face it feels (ForEachFaceFelt of ground_plane.h, the FFD bodies' rules).
-template <class F>
-void ForEachContact3(const LinearBodyModel& m, const GroundPlane& g, const Eigen::MatrixXd& R,
-                     const Eigen::MatrixXd& R_dot, const std::vector<Contact<3, double>>& contacts, F&& f) {
-  if (!g.enabled || ClearOf(m, g, R)) return;
-  const Eigen::MatrixXd& P = m.point_bases();
-  for (int k = 0; k < m.num_points(); ++k) {
-    const double* p = P.col(k).data();
-    const Vec3<double> x = Times<3>(R, p);
-    ForEachFaceFelt(g, x, [&] { return ContactsOfPoint(contacts, k); },
-                     [&](int face_index, const GroundPlane& face, const Vec3<double>& anchor) {
-                       f(k, p, x, Times<3>(R_dot, p), anchor, face, face_index);
-                     });
+    if constexpr (Dim == 2) {
+      ForEachFaceFelt(g, line, x, velocity, contacts_of_k,
+                      [&](const GroundFace& face, int face_index, const Vec2<double>& anchor, const Vec2<double>& v) {
+                        f(k, p, x, v, anchor, face, face_index);
+                      });
+    } else {
+      ForEachFaceFelt(g, x, contacts_of_k, [&](int face_index, const GroundPlane& face, const Vec3<double>& anchor) {
+        f(k, p, x, velocity(), anchor, face, face_index);
+      });
+    }
   }
 }
 
@@ -97,81 +102,97 @@ template <int D> void AddPointForce(const Eigen::Matrix<double, D, 1>& f, const 
     for (int i = 0; i < D; ++i) (*Q)(i, j) += f[i] * p[j];
 }
 
+template <int Dim>
+void AddGroundForce(const LinearBodyModel& model, const LinearGround& g, const Eigen::MatrixXd& R,
+                    const Eigen::MatrixXd& R_dot, const LinearContacts& contacts, Eigen::MatrixXd* Q) {
+  bool slipping;
+  ForEachContact<Dim>(model, g, R, R_dot, contacts.list<Dim>(),
+                      [&](int, const double* p, const VecD<Dim>& x, const VecD<Dim>& v, const VecD<Dim>& anchor,
+                          const FaceOf<Dim>& face, int) {
+                        AddPointForce<Dim>(GroundForce(face, x, v, anchor, &slipping), p, Q);
+                      });
+}
+
+// The contacts of the state (R, Ṙ) in place of *contacts; the deepest point's depth.
+template <int Dim>
+double UpdateContacts(const LinearBodyModel& model, const LinearGround& g, const Eigen::MatrixXd& R,
+                      const Eigen::MatrixXd& R_dot, std::vector<Contact<Dim, double>>* contacts) {
+  thread_local std::vector<Contact<Dim, double>> next;  // no heap traffic while a body rests
+  next.clear();
+  double deepest = 0.0;
+  ForEachContact<Dim>(model, g, R, R_dot, *contacts,
+                      [&](int k, const double*, const VecD<Dim>& x, const VecD<Dim>& v, VecD<Dim> anchor,
+                          const FaceOf<Dim>& face, int face_index) {
+                        bool slipping;
+                        VecD<Dim> f = GroundForce(face, x, v, anchor, &slipping);
+                        if (slipping) SlipAnchor(face, x, v, &anchor, &f);
+                        next.push_back({k, anchor, face_index});
+                        deepest = std::max(deepest, -face.Height(x));
+                      });
+  contacts->swap(next);
+  return deepest;
+}
+
+// Adds ½ K_d |x_k − anchor|² of each contact in list<Dim>() to *energy.
+template <int Dim>
+void AddGroundEnergy(const LinearBodyModel& model, const LinearGround& g, const Eigen::MatrixXd& R,
+                     const LinearContacts& contacts, double* energy) {
+  const Eigen::MatrixXd& P = model.point_bases();
+  for (const Contact<Dim, double>& c : contacts.list<Dim>()) {
+    const double stiffness = [&] {
+      if constexpr (Dim == 2) return g.ground.Face(c.face).stiffness;
+      else return g.plane.stiffness;  // the plane's, even where a heightfield face has its own
+    }();
+    *energy += 0.5 * stiffness * (Times<Dim>(R, P.col(c.point).data()) - c.anchor).squaredNorm();
+  }
+}
+
+// Appends the ground's force on each contact in list<Dim>() to *forces.
+template <int Dim>
+void AppendContactForces(const LinearBodyModel& model, const LinearGround& g, const Eigen::MatrixXd& R,
+                         const Eigen::MatrixXd& R_dot, const LinearContacts& contacts,
+                         std::vector<Eigen::VectorXd>* forces) {
+  const Eigen::MatrixXd& P = model.point_bases();
+  bool slipping;
+  for (const Contact<Dim, double>& c : contacts.list<Dim>()) {
+    const double* p = P.col(c.point).data();
+    const VecD<Dim> x = Times<Dim>(R, p);
+    const FaceOf<Dim> face = [&] {
+      if constexpr (Dim == 2) return g.ground.Face(c.face);
+      else return g.plane.Face(c.face, x);
+    }();
+    forces->push_back(GroundForce(face, x, Times<Dim>(R_dot, p), c.anchor, &slipping));
+  }
+}
+
 }  // namespace
 
 void AddLinearGroundForce(const LinearBodyModel& model, const LinearGround& g, const Eigen::MatrixXd& R,
                           const Eigen::MatrixXd& R_dot, const LinearContacts& contacts, Eigen::MatrixXd* Q) {
-  bool slipping;
-  if (model.dim() == 2) {
-    ForEachContact2(model, g.ground, R, R_dot, contacts.list2,
-                    [&](int, const double* p, const Vec2<double>& x, const Vec2<double>& v, const Vec2<double>& anchor,
-                        const GroundFace& face, int) { AddPointForce<2>(GroundForce(face, x, v, anchor, &slipping), p, Q); });
-    return;
-  }
-  ForEachContact3(model, g.plane, R, R_dot, contacts.list3,
-                  [&](int, const double* p, const Vec3<double>& x, const Vec3<double>& v, const Vec3<double>& anchor,
-                      const GroundPlane& face, int) { AddPointForce<3>(GroundForce(face, x, v, anchor, &slipping), p, Q); });
+  if (model.dim() == 2) AddGroundForce<2>(model, g, R, R_dot, contacts, Q);
+  else AddGroundForce<3>(model, g, R, R_dot, contacts, Q);
 }
 
 void UpdateLinearContacts(const LinearBodyModel& model, const LinearGround& g, const Eigen::MatrixXd& R,
                           const Eigen::MatrixXd& R_dot, LinearContacts* contacts) {
-  double deepest = 0.0;
-  if (model.dim() == 2) {
-    thread_local std::vector<Contact<2, double>> next;  // no heap traffic while a body rests
-    next.clear();
-    ForEachContact2(model, g.ground, R, R_dot, contacts->list2,
-                    [&](int k, const double*, const Vec2<double>& x, const Vec2<double>& v, Vec2<double> anchor,
-                        const GroundFace& face, int face_index) {
-                      bool slipping;
-                      Vec2<double> f = GroundForce(face, x, v, anchor, &slipping);
-                      if (slipping) SlipAnchor(face, x, v, &anchor, &f);
-                      next.push_back({k, anchor, face_index});
-                      deepest = std::max(deepest, -face.Height(x));
-                    });
-    contacts->list2.swap(next);
-  } else {
-    thread_local std::vector<Contact<3, double>> next;
-    next.clear();
-    ForEachContact3(model, g.plane, R, R_dot, contacts->list3,
-                    [&](int k, const double*, const Vec3<double>& x, const Vec3<double>& v, Vec3<double> anchor,
-                        const GroundPlane& face, int face_index) {
-                      bool slipping;
-                      Vec3<double> f = GroundForce(face, x, v, anchor, &slipping);
-                      if (slipping) SlipAnchor(face, x, v, &anchor, &f);
-                      next.push_back({k, anchor, face_index});
-                      deepest = std::max(deepest, -face.Height(x));
-                    });
-    contacts->list3.swap(next);
-  }
-  contacts->penetration = deepest;
+  contacts->penetration = model.dim() == 2 ? UpdateContacts<2>(model, g, R, R_dot, &contacts->list<2>())
+                                           : UpdateContacts<3>(model, g, R, R_dot, &contacts->list<3>());
 }
 
 double LinearGroundEnergy(const LinearBodyModel& model, const LinearGround& g, const Eigen::MatrixXd& R,
                           const LinearContacts& contacts) {
-  const Eigen::MatrixXd& P = model.point_bases();
   double energy = 0.0;
-  for (const Contact<2, double>& c : contacts.list2)
-    energy += 0.5 * g.ground.Face(c.face).stiffness * (Times<2>(R, P.col(c.point).data()) - c.anchor).squaredNorm();
-  for (const Contact<3, double>& c : contacts.list3)
-    energy += 0.5 * g.plane.stiffness * (Times<3>(R, P.col(c.point).data()) - c.anchor).squaredNorm();
+  AddGroundEnergy<2>(model, g, R, contacts, &energy);
+  AddGroundEnergy<3>(model, g, R, contacts, &energy);
   return energy;
 }
 
 std::vector<Eigen::VectorXd> LinearContactForces(const LinearBodyModel& model, const LinearGround& g,
                                                  const Eigen::MatrixXd& R, const Eigen::MatrixXd& R_dot,
                                                  const LinearContacts& contacts) {
-  const Eigen::MatrixXd& P = model.point_bases();
   std::vector<Eigen::VectorXd> forces;
-  bool slipping;
-  for (const Contact<2, double>& c : contacts.list2) {
-    const double* p = P.col(c.point).data();
-    forces.push_back(GroundForce(g.ground.Face(c.face), Times<2>(R, p), Times<2>(R_dot, p), c.anchor, &slipping));
-  }
-  for (const Contact<3, double>& c : contacts.list3) {
-    const double* p = P.col(c.point).data();
-    const Vec3<double> x = Times<3>(R, p);
-    forces.push_back(GroundForce(g.plane.Face(c.face, x), x, Times<3>(R_dot, p), c.anchor, &slipping));
-  }
+  AppendContactForces<2>(model, g, R, R_dot, contacts, &forces);
+  AppendContactForces<3>(model, g, R, R_dot, contacts, &forces);
   return forces;
 }
 

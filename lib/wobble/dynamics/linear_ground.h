@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <tuple>
 #include <vector>
 
 #include "wobble/body/linear_body.h"
@@ -17,16 +18,17 @@
 
 namespace wobble {
 
-// The contacts of one linear body: `list2` on a 2D ground (sorted by point, then face),
-// `list3` on the 3D plane (sorted by point); the deepest point at the last update.
+// The contacts of one linear body, by dimension: list<2>() on a 2D ground (sorted by point,
+// then face), list<3>() on the 3D plane (sorted by point); the deepest point at the last update.
 struct LinearContacts {
-  std::vector<Contact<2, double>> list2;
-  std::vector<Contact<3, double>> list3;
+  std::tuple<std::vector<Contact<2, double>>, std::vector<Contact<3, double>>> lists;
   double penetration = 0.0;
-  int size() const { return int(list2.size() + list3.size()); }
+  template <int Dim> std::vector<Contact<Dim, double>>& list() { return std::get<Dim - 2>(lists); }
+  template <int Dim> const std::vector<Contact<Dim, double>>& list() const { return std::get<Dim - 2>(lists); }
+  int size() const { return int(list<2>().size() + list<3>().size()); }
   void clear() {
-    list2.clear();
-    list3.clear();
+    list<2>().clear();
+    list<3>().clear();
     penetration = 0.0;
   }
 };
@@ -52,7 +54,7 @@ void UpdateLinearContacts(const LinearBodyModel& model, const LinearGround& g, c
 double LinearGroundEnergy(const LinearBodyModel& model, const LinearGround& g, const Eigen::MatrixXd& R,
                           const LinearContacts& contacts);
 
-// The ground's force on each contact (world frame, in the order of list2 or list3): what the
+// The ground's force on each contact (world frame, in the order of list<2>() then list<3>()): what the
 // tests sum to check statics.
 std::vector<Eigen::VectorXd> LinearContactForces(const LinearBodyModel& model, const LinearGround& g,
                                                  const Eigen::MatrixXd& R, const Eigen::MatrixXd& R_dot,

@@ -152,7 +152,11 @@ std::string SessionScript(const SessionRecord& r) {
   long simulated = r.steps;
   if (!r.keys.times.empty()) {
     if (r.keys.amplitudes.size() != r.keys.times.size()) throw std::invalid_argument("SessionScript: one amplitude set per key");
-    if (r.hold.enabled) s << "hold " << Num(r.hold.lattice_coords.x()) << " " << Num(r.hold.lattice_coords.y()) << "\n";
+    if (r.hold.enabled) {  // `hold S T` or `hold S T U`: as many coordinates as the body has dimensions
+      s << "hold";
+      for (int a = 0; a < r.body->dim(); ++a) s << " " << Num(r.hold.lattice_coords[a]);
+      s << "\n";
+    }
     s << "set interp " << (r.keys.interpolation == control::Interpolation::kSmooth ? "smooth" : "linear") << "\n";
     for (size_t k = 0; k < r.keys.times.size(); ++k) {
       if (r.keys.amplitudes[k].size() != D) throw std::invalid_argument("SessionScript: a key has the wrong number of amplitudes");

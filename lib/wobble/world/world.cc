@@ -321,8 +321,7 @@ bool World::FinishLinearStep(int body, bool screened) {
          << "); reduce dt, or the ground's stiffness or damping";
   x.R.swap(e.R_before);
   x.R_dot.swap(e.R_dot_before);
-  x.contacts.list2.swap(e.contacts_before.list2);
-  x.contacts.list3.swap(e.contacts_before.list3);
+  x.contacts.lists.swap(e.contacts_before.lists);
   x.contacts.penetration = e.contacts_before.penetration;
   return Fail(StatusCode::kPenetration, body, detail.str());
 }
