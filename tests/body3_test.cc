@@ -481,6 +481,46 @@ TEST(Body3, TreeScanMatchesTheFullScanOverALongTumblingRun) {
   RecordProperty("steps_with_few_points_below", partial);
 }
 
+// A small body (one point group: every point is tested) thrown tumbling onto a tilted plane:
+// the per-point bound before the exact test (PointClearOfPlane) skips only points the exact
+// test rejects, so every step's scan visits exactly, in point order, the points whose exact
+// position x = t + R (b0 + B γ) is below the plane, and the contacts the step leaves are those
+// points (the resting-table references check the same bit for bit).
+TEST(Body3, PointBoundScanMatchesTheFullScanOfASmallBody) {
+  std::mt19937 rng(31);
+  const BodyModelN<3> body = RandomBody3(rng, {4, 4, 4}, BasisKind::kBernstein, 3, 40, 1e9);
+  ASSERT_EQ(body.clusters().size(), 1u);
+  WorldParams w;
+  w.ground_plane.enabled = true;
+  w.ground_plane.normal = Vector3d(0.2, 1.0, -0.1).normalized();
+  BodyState<3, double> s = RestState<3, double>(body);
+  s.translation() = Vector3d(0.0, 40.0, 0.0);
+  s.set_orientation(Eigen::AngleAxisd(0.3, Vector3d(0.3, 0.2, 1.0).normalized()));
+  s.qd.head<3>() = Vector3d(60.0, 0.0, -30.0);
+  s.qd.segment<3>(3) = Vector3d(0.2, 0.1, -0.3);
+  int touching = 0, partial = 0;
+  for (int step = 0; step < 4000; ++step) {
+    ASSERT_TRUE(StepBody(body, w, 0, Integrator::kThesis, 0.002, &s).ok()) << "step " << step;
+    const Frame<3, double> frame(s.q);
+    std::vector<int> visited, expected;
+    ForEachPointInContact(body, w.ground_plane, s, frame,
+                          [&](int k, const Vector3d&, const Vector3d&, const Vector3d&, const Vector3d&,
+                              const GroundPlane&, int) { visited.push_back(k); });
+    for (int k = 0; k < body.num_points(); ++k) {
+      const Vector3d x = frame.t + frame.R * LocalPosition<double>(body.rest_local(k), body.mode_matrix(k), s.q);
+      if (w.ground_plane.Height(x) < 0.0) expected.push_back(k);
+    }
+    ASSERT_EQ(visited, expected) << "step " << step;
+    std::vector<int> contacts;
+    for (const Contact<3, double>& c : s.contacts) contacts.push_back(c.point);
+    ASSERT_EQ(contacts, expected) << "step " << step;
+    touching += !expected.empty();
+    partial += !expected.empty() && int(expected.size()) < body.num_points() / 2;
+  }
+  EXPECT_GT(touching, 1000);  // of 4,000 steps
+  EXPECT_GT(partial, 100);
+}
+
 // Spinning about its centre of mass (ṫ chosen so the centre stays put), no gravity.
 BodyState<3, double> Spinning(const BodyModelN<3>& body, const Vector3d& omega) {
   BodyState<3, double> s = RestState<3, double>(body);

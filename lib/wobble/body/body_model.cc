@@ -144,6 +144,12 @@ BodyModelN<Dim>::BodyModelN(BodyDefN<Dim> def, std::vector<DeformationModeN<Dim>
       CholeskyPivotRange(mm.G_com_factor, &mm.G_com_pivot_lo, &mm.G_com_pivot_hi);
     }
   }
+  mode_reach_.assign(size_t(N), 0.0);
+  for (int k = 0; k < N; ++k) {
+    for (int d = 0; d < D; ++d) mode_reach_[size_t(k)] = std::max(mode_reach_[size_t(k)], mode_matrix(k).col(d).cwiseAbs().sum());
+    rest_extent_ = std::max(rest_extent_, rest_local_[k].cwiseAbs().sum());
+    max_mode_reach_ = std::max(max_mode_reach_, mode_reach_[size_t(k)]);
+  }
   BuildClusters();
   BuildTree();
 

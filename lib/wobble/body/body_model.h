@@ -164,6 +164,33 @@ template <int Dim> class PlaneReach {
   double w_[Dim * (kMaxModes + 1)], w_abs_[Dim * (kMaxModes + 1)], coarse_[Dim];
 };
 
+// A per-point bound before a scan's exact test of a point against a plane, in the body frame
+// as PlaneReach: the point's height offset + n·l_k, l_k = b0_k + B_k γ, is at least
+// offset + n·b0_k − max_a |n_a| ‖γ‖₁ mode_reach(k) (n = Rᵀ·normal). A point
+// counts as clear only when that bound is above a margin of 1e-10 of the scale of t, p, the
+// body and γ (as PlaneReach's: far above the rounding of the bound and of the point's own height
+// test), so a point the scan skips is one its exact test rejects. Costs Dim + 1 products a
+// point instead of the position's Dim (D + Dim): most points of a resting body are far above.
+template <int Dim> class PointClearOfPlane {
+ public:
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  // gamma_norm: ‖γ‖₁; scale: |t|₁ + |p|₁
+  PointClearOfPlane(double rest_extent, double max_mode_reach, const Point& n, double offset, double scale,
+                    double gamma_norm)
+      : n_(n), offset_(offset) {
+    const double n_max = n.cwiseAbs().maxCoeff();  // 1 for a unit n, up to rounding
+    gamma_norm_ = gamma_norm * n_max;
+    margin_ = 1e-10 * (scale + std::abs(offset) + n_max * (rest_extent + gamma_norm * max_mode_reach));
+  }
+  bool operator()(const Point& b0, double mode_reach) const {
+    return offset_ + n_.dot(b0) - gamma_norm_ * mode_reach > margin_;  // NaN: not clear
+  }
+
+ private:
+  Point n_;
+  double offset_, gamma_norm_, margin_;
+};
+
 // An FFD body as loaded: lattice, modes, mass points, drawing geometry, and the mass moments
 // that make its dynamics cost O(D²) per step instead of O(N). One template serves the 2D body
 // of the thesis and the 3D body of its §6.2 outlook.
@@ -225,6 +252,14 @@ template <int Dim> class BodyModelN {
     return {mesh_mode_rows_.data() + Dim * num_modes() * v, Dim, num_modes()};
   }
 
+  // max_d ‖b^d_k‖₁, the largest mode column of point k: for any n with |n_a| ≤ 1 its height
+  // n·l_k is within ‖γ‖₁ mode_reach(k) of n·b0_k, a bound the ground scan tests before the
+  // exact position (PointClearOfPlane).
+  double mode_reach(int k) const { return mode_reach_[size_t(k)]; }
+  // max_k ‖b0_k‖₁ and max_k mode_reach(k), for the scale of that bound's rounding margin
+  double rest_extent() const { return rest_extent_; }
+  double max_mode_reach() const { return max_mode_reach_; }
+
   // Rest control points (flat index), for the convex-hull ground test and drawing.
   const std::vector<Point>& rest_control() const { return rest_control_; }
 
@@ -263,6 +298,8 @@ template <int Dim> class BodyModelN {
   std::vector<DeformationModeN<Dim>> modes_;
   std::vector<Point> lattice_coords_, rest_local_, rest_control_;
   std::vector<double> mode_rows_;  // per point, column-major Dim x D
+  std::vector<double> mode_reach_;
+  double rest_extent_ = 0.0, max_mode_reach_ = 0.0;
   std::vector<Point> mesh_rest_local_;
   std::vector<double> mesh_mode_rows_;  // per mesh vertex, as mode_rows_
   MassMomentsN<Dim> moments_;

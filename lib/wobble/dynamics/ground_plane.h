@@ -89,7 +89,13 @@ void ForEachPointInContact(const BodyModelN<3>& body, const GroundPlane& g, cons
     clear = h > 0.0;
   }
   if (clear) return;
+  double gamma_norm = 0.0;
+  for (int d = 0; d < D; ++d) gamma_norm += std::abs(ScalarValue(s.q[Group<3>::kRigidParams + d]));
+  const PointClearOfPlane<3> clear_of_plane(body.rest_extent(), body.max_mode_reach(), n_local, offset,
+                                            t.cwiseAbs().sum() + through.cwiseAbs().sum(), gamma_norm);
   auto visit = [&](int k) {
+    // most points of a body at rest are far above: a bound first, then the exact position
+    if (clear_of_plane(body.rest_local(k), body.mode_reach(k))) return;
     const auto B = body.mode_matrix(k);
     const Vec3<T> l = LocalPosition<T>(body.rest_local(k), B, s.q);
     const Vec3<T> x = frame.t + frame.R * l;

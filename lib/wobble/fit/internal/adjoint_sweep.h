@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -79,15 +80,23 @@ double PlainRolloutCost(int steps, State state, const Step& step, const Stage& s
 //   vjp(n, state, next, λ_{n+1}, &λ_n) → bool
 //   stage(n, state, &λ)          adds ℓ_n's value to the cost and its gradient to λ
 // Returns false as soon as step or vjp does (they say why).
+// `checkpoints` and `segment` are the sweep's storage, emptied here (their capacity is kept:
+// SweepBuffers below), and reserved to their final sizes, so no state is copied by a vector
+// growing.
 template <class State, class Adjoint, class Step, class Recompute, class Vjp, class Stage>
 bool CheckpointedAdjointSweep(int steps, int interval, const State& start, Adjoint* lambda, const Step& step,
-                              const Recompute& recompute, const Vjp& vjp, const Stage& stage, int* states_held) {
+                              const Recompute& recompute, const Vjp& vjp, const Stage& stage, int* states_held,
+                              std::vector<State>* checkpoints_storage, std::vector<State>* segment_storage) {
   const bool whole = steps > 0 && interval >= steps;
-  std::vector<State> checkpoints, segment;
+  std::vector<State>& checkpoints = *checkpoints_storage;
+  std::vector<State>& segment = *segment_storage;
+  checkpoints.clear();
+  segment.clear();
+  checkpoints.reserve(whole ? 1 : size_t((steps + interval - 1) / std::max(interval, 1)));
+  segment.reserve(size_t(std::max(std::min(interval, steps), 1)));
   State last = start;
   if (whole) {
     checkpoints.push_back(start);
-    segment.reserve(size_t(std::max(steps, 1)));
     segment.push_back(start);
     for (int n = 0; n < steps; ++n) {
       if (n + 1 < steps) segment.push_back(segment.back());
@@ -126,6 +135,26 @@ bool CheckpointedAdjointSweep(int steps, int interval, const State& start, Adjoi
   }
   return true;  // with no step, the start was the last state and its stage is in
 }
+
+// The storage of a gradient's sweep (checkpointed states, an interval's states and tapes),
+// kept per thread from one gradient to the next: an optimizer asks for thousands, and fresh
+// storage costs a page fault per 4 kB touched (a 3D chair's ⌈√steps⌉ tapes are about 400 kB,
+// 10 % of its gradient, measured on adjoint_bench's GradientChair/10000/1/-1). Storage above
+// kKeptBytes is given back after each gradient (a whole run of 64 MiB is not held on to).
+// A gradient taken inside another on the same thread (from a stage cost) uses storage of its own.
+template <class State, class Tape> struct SweepBuffers {
+  static constexpr size_t kKeptBytes = size_t(4) << 20;
+  std::vector<State> checkpoints, segment;
+  std::vector<Tape> tapes;
+  bool in_use = false;
+  size_t Bytes() const {
+    return (checkpoints.capacity() + segment.capacity()) * sizeof(State) + tapes.capacity() * sizeof(Tape);
+  }
+  void Release() {
+    if (Bytes() > kKeptBytes) *this = SweepBuffers();
+    in_use = false;
+  }
+};
 
 // Each dimension's step piece: AdjointStep<2> (adjoint_plane.cc), AdjointStep<3> (adjoint_space.cc).
 template <int Dim> class AdjointStep;
@@ -194,7 +223,18 @@ RolloutGradient RolloutGradientOf(const BodyModelN<Dim>& body, const ControlledR
   // time: about one simulation less per gradient (the interval's last step has none and is
   // taken again, except when the interval is the whole run, whose forward run keeps every tape).
   using Tape = typename Piece::Tape;
-  std::vector<Tape> tapes(Piece::kTaped ? size_t(std::min(interval, std::max(N, 1))) : 0);
+  using Buffers = SweepBuffers<BodyState<Dim, double>, Tape>;
+  thread_local Buffers kept;
+  Buffers own;
+  Buffers& buffers = kept.in_use ? own : kept;
+  buffers.in_use = true;
+  struct ReleaseAtExit {
+    Buffers* b;
+    ~ReleaseAtExit() { b->Release(); }
+  } release_at_exit{&buffers};
+  std::vector<Tape>& tapes = buffers.tapes;
+  // a slot is read only after Record wrote it in this gradient (`taped`), so old contents are harmless
+  tapes.resize(Piece::kTaped ? size_t(std::min(interval, std::max(N, 1))) : 0);
   std::vector<int> taped(tapes.size(), -1);
   auto recompute = [&](int n, BodyState<Dim, double>* s) {
     if constexpr (Piece::kTaped) {
@@ -215,7 +255,9 @@ RolloutGradient RolloutGradientOf(const BodyModelN<Dim>& body, const ControlledR
     return r.Vjp(n, state, next, tape, out, in, &g, &g.message);
   };
   StateAdjoint<Dim> lambda{Eigen::VectorXd::Zero(nz), {}};
-  if (!CheckpointedAdjointSweep(N, interval, start, &lambda, step, recompute, vjp, stage, &g.states_held)) return g;
+  if (!CheckpointedAdjointSweep(N, interval, start, &lambda, step, recompute, vjp, stage, &g.states_held,
+                                &buffers.checkpoints, &buffers.segment))
+    return g;
   g.start = lambda.z;
   r.StartVjp(lambda, &g.start);
   if (!std::isfinite(g.cost)) {
