@@ -142,7 +142,8 @@ void BindWorld(py::module_& m) {
             if (!ParseIntegrator(name, &o.integrator))
               throw InputError("integrator: '" + name + "' is not one of " + IntegratorNames());
           },
-          "the FFD bodies' integrator: thesis (Eq. 4.22/4.23), symplectic, rk4, implicit, variational")
+          "every body's integrator: thesis (Eq. 4.22/4.23), symplectic, rk4, implicit, variational; constraints are a "
+          "stage of it (variational refuses a constrained step)")
       .def_property(
           "gravity", [](const WorldOptions& o) { return o.params.gravity; }, SetGravity,
           "gravity (m/s², x y z), one for bodies of both dimensions: a 2D body feels x and y; set\n"
