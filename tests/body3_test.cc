@@ -435,90 +435,85 @@ TEST(Body3, PointGroupsFindExactlyThePointsBelowTheGround) {
   EXPECT_GT(found, 1000);  // the states do reach into the ground
 }
 
-// Over a long run of a 3,000-point body thrown tumbling onto a tilted plane (bouncing, rolling,
-// deforming), every step's scan visits exactly the points a test of every point finds below
-// the plane, in the full scan's order (the clusters'): the contacts and the ground force are
-// the full scan's, bit for bit. The contacts the step leaves are those points.
+// A 3D body thrown tumbling onto a tilted plane (bouncing, rolling, deforming) for 4,000 steps
+// from `s`: every step's scan visits exactly the points an exact test of every point, taken in
+// `order` (the order the scan visits them), finds below the plane, x = t + R (b0 + B γ), and
+// the contacts the step leaves are those points. Counts the steps touching the plane and those
+// with fewer than num_points / few_below_divisor points below it.
+struct ScanRun {
+  int touching = 0, partial = 0;
+};
+ScanRun CheckScanAgainstTheExactTest(const BodyModelN<3>& body, BodyState<3, double> s, const std::vector<int>& order,
+                                     int few_below_divisor) {
+  WorldParams w;
+  w.ground_plane.enabled = true;
+  w.ground_plane.normal = Vector3d(0.2, 1.0, -0.1).normalized();
+  ScanRun r;
+  for (int step = 0; step < 4000; ++step) {
+    EXPECT_TRUE(StepBody(body, w, 0, Integrator::kThesis, 0.002, &s).ok()) << "step " << step;
+    const Frame<3, double> frame(s.q);
+    std::vector<int> visited, expected;
+    ForEachPointInContact(body, w.ground_plane, s, frame,
+                          [&](int k, const Vector3d&, const Vector3d&, const Vector3d&, const Vector3d&,
+                              const GroundPlane&, int) { visited.push_back(k); });
+    for (int k : order) {
+      const Vector3d x = frame.t + frame.R * LocalPosition<double>(body.rest_local(k), body.mode_matrix(k), s.q);
+      if (w.ground_plane.Height(x) < 0.0) expected.push_back(k);
+    }
+    EXPECT_EQ(visited, expected) << "step " << step;
+    std::vector<int> contacts;
+    for (const Contact<3, double>& c : s.contacts) contacts.push_back(c.point);
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(contacts, expected) << "step " << step;
+    if (::testing::Test::HasFailure()) return r;  // one step's report is enough
+    r.touching += !expected.empty();
+    r.partial += !expected.empty() && int(expected.size()) < body.num_points() / few_below_divisor;
+  }
+  return r;
+}
+
+BodyState<3, double> ThrownOntoThePlane(const BodyModelN<3>& body, const Vector3d& v, const Vector3d& omega) {
+  BodyState<3, double> s = RestState<3, double>(body);
+  s.translation() = Vector3d(0.0, 40.0, 0.0);
+  s.set_orientation(Eigen::AngleAxisd(0.3, Vector3d(0.3, 0.2, 1.0).normalized()));
+  s.qd.head<3>() = v;
+  s.qd.segment<3>(3) = omega;
+  return s;
+}
+
+// A 3,000-point body in point groups: the tree's scan visits the points in the groups' order,
+// and the contacts and the ground force are the full scan's, bit for bit.
 TEST(Body3, TreeScanMatchesTheFullScanOverALongTumblingRun) {
   std::mt19937 rng(29);
   const BodyModelN<3> body = RandomBody3(rng, {4, 4, 4}, BasisKind::kBernstein, 3, 3000, 1e9);
   ASSERT_GT(body.clusters().size(), 8u);
-  WorldParams w;
-  w.ground_plane.enabled = true;
-  w.ground_plane.normal = Vector3d(0.2, 1.0, -0.1).normalized();
-  BodyState<3, double> s = RestState<3, double>(body);
-  s.translation() = Vector3d(0.0, 40.0, 0.0);
-  s.set_orientation(Eigen::AngleAxisd(0.3, Vector3d(0.3, 0.2, 1.0).normalized()));
   // turning about its centre of mass c, which moves at (60, 0, −30): ṫ = v − R(ω × c)
-  const Matrix3d R = s.orientation().toRotationMatrix();
-  const Vector3d c = body.moments().c0 / body.moments().m, omega(0.2, 0.1, -0.3);
-  s.qd.head<3>() = Vector3d(60.0, 0.0, -30.0) - R * omega.cross(c);
-  s.qd.segment<3>(3) = omega;
-  int touching = 0, partial = 0;
-  for (int step = 0; step < 4000; ++step) {
-    ASSERT_TRUE(StepBody(body, w, 0, Integrator::kThesis, 0.002, &s).ok()) << "step " << step;
-    const Frame<3, double> frame(s.q);
-    std::vector<int> visited, expected;
-    ForEachPointInContact(body, w.ground_plane, s, frame,
-                          [&](int k, const Vector3d&, const Vector3d&, const Vector3d&, const Vector3d&,
-                              const GroundPlane&, int) { visited.push_back(k); });
-    for (const PointClusterN<3>& c : body.clusters())
-      for (int k : c.points) {
-        const Vector3d x = frame.t + frame.R * LocalPosition<double>(body.rest_local(k), body.mode_matrix(k), s.q);
-        if (w.ground_plane.Height(x) < 0.0) expected.push_back(k);
-      }
-    ASSERT_EQ(visited, expected) << "step " << step;
-    std::vector<int> contacts;
-    for (const Contact<3, double>& c : s.contacts) contacts.push_back(c.point);
-    std::sort(expected.begin(), expected.end());
-    ASSERT_EQ(contacts, expected) << "step " << step;
-    touching += !expected.empty();
-    partial += !expected.empty() && int(expected.size()) < body.num_points() / 20;
-  }
-  EXPECT_GT(touching, 1000);  // of 4,000 steps
-  EXPECT_GT(partial, 100);
-  RecordProperty("steps_touching", touching);
-  RecordProperty("steps_with_few_points_below", partial);
+  const Vector3d omega(0.2, 0.1, -0.3), c = body.moments().c0 / body.moments().m;
+  BodyState<3, double> s = ThrownOntoThePlane(body, Vector3d::Zero(), omega);
+  s.qd.head<3>() = Vector3d(60.0, 0.0, -30.0) - s.orientation().toRotationMatrix() * omega.cross(c);
+  std::vector<int> order;
+  for (const PointClusterN<3>& cluster : body.clusters()) order.insert(order.end(), cluster.points.begin(), cluster.points.end());
+  const ScanRun r = CheckScanAgainstTheExactTest(body, s, order, 20);
+  EXPECT_GT(r.touching, 1000);  // of 4,000 steps
+  EXPECT_GT(r.partial, 100);
+  RecordProperty("steps_touching", r.touching);
+  RecordProperty("steps_with_few_points_below", r.partial);
 }
 
-// A small body (one point group: every point is tested) thrown tumbling onto a tilted plane:
-// the per-point bound before the exact test (PointClearOfPlane) skips only points the exact
-// test rejects, so every step's scan visits exactly, in point order, the points whose exact
-// position x = t + R (b0 + B γ) is below the plane, and the contacts the step leaves are those
-// points (the resting-table references check the same bit for bit).
+// A small body (one point group: every point is tested): the per-point bound before the exact
+// test (PointClearOfPlane) skips only points the exact test rejects, so the scan visits, in
+// point order, exactly the points below the plane (the resting-table references check the same
+// bit for bit).
 TEST(Body3, PointBoundScanMatchesTheFullScanOfASmallBody) {
   std::mt19937 rng(31);
   const BodyModelN<3> body = RandomBody3(rng, {4, 4, 4}, BasisKind::kBernstein, 3, 40, 1e9);
   ASSERT_EQ(body.clusters().size(), 1u);
-  WorldParams w;
-  w.ground_plane.enabled = true;
-  w.ground_plane.normal = Vector3d(0.2, 1.0, -0.1).normalized();
-  BodyState<3, double> s = RestState<3, double>(body);
-  s.translation() = Vector3d(0.0, 40.0, 0.0);
-  s.set_orientation(Eigen::AngleAxisd(0.3, Vector3d(0.3, 0.2, 1.0).normalized()));
-  s.qd.head<3>() = Vector3d(60.0, 0.0, -30.0);
-  s.qd.segment<3>(3) = Vector3d(0.2, 0.1, -0.3);
-  int touching = 0, partial = 0;
-  for (int step = 0; step < 4000; ++step) {
-    ASSERT_TRUE(StepBody(body, w, 0, Integrator::kThesis, 0.002, &s).ok()) << "step " << step;
-    const Frame<3, double> frame(s.q);
-    std::vector<int> visited, expected;
-    ForEachPointInContact(body, w.ground_plane, s, frame,
-                          [&](int k, const Vector3d&, const Vector3d&, const Vector3d&, const Vector3d&,
-                              const GroundPlane&, int) { visited.push_back(k); });
-    for (int k = 0; k < body.num_points(); ++k) {
-      const Vector3d x = frame.t + frame.R * LocalPosition<double>(body.rest_local(k), body.mode_matrix(k), s.q);
-      if (w.ground_plane.Height(x) < 0.0) expected.push_back(k);
-    }
-    ASSERT_EQ(visited, expected) << "step " << step;
-    std::vector<int> contacts;
-    for (const Contact<3, double>& c : s.contacts) contacts.push_back(c.point);
-    ASSERT_EQ(contacts, expected) << "step " << step;
-    touching += !expected.empty();
-    partial += !expected.empty() && int(expected.size()) < body.num_points() / 2;
-  }
-  EXPECT_GT(touching, 1000);  // of 4,000 steps
-  EXPECT_GT(partial, 100);
+  std::vector<int> order(size_t(body.num_points()));
+  for (int k = 0; k < body.num_points(); ++k) order[size_t(k)] = k;
+  const ScanRun r = CheckScanAgainstTheExactTest(
+      body, ThrownOntoThePlane(body, Vector3d(60.0, 0.0, -30.0), Vector3d(0.2, 0.1, -0.3)), order, 2);
+  EXPECT_GT(r.touching, 1000);  // of 4,000 steps
+  EXPECT_GT(r.partial, 100);
 }
 
 // Spinning about its centre of mass (ṫ chosen so the centre stays put), no gravity.
