@@ -9,7 +9,8 @@
 // The chair rows (SimulationChair, GradientChair) do the same for the chair of tests/support (about 300
 // mass points, 3 modes; 12 + 2·3 state coordinates), controls/3 steps of 0.002 s, falling onto
 // a plane in the grounded case; GradientChair's third argument is its checkpoint interval (0: the
-// default, the whole run kept within the budget; -1: ⌈√steps⌉ checkpoints), to compare the two.
+// default, the whole run kept within checkpoints.h's budget, else ⌈√steps⌉ checkpoints; -1:
+// ⌈√steps⌉ checkpoints; 2^30: the whole run kept at any size), to compare them.
 // Run: build/bench/adjoint_bench --benchmark_min_time=0.5
 #include <benchmark/benchmark.h>
 
@@ -135,7 +136,7 @@ BENCHMARK(BM_Simulation)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(ben
 BENCHMARK(BM_Gradient)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SimulationChair)->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_GradientChair)
-    ->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}, {fit::kCheckpointAuto, fit::kCheckpointSqrt}})
+    ->ArgsProduct({{16, 64, 1024, 10000}, {0, 1}, {fit::kCheckpointAuto, fit::kCheckpointSqrt, 1 << 30}})
     ->Unit(benchmark::kMicrosecond);
 
 }  // namespace

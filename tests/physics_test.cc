@@ -292,6 +292,45 @@ TEST(Ground, TreeScanMatchesTheFullScanOverALongTumblingRun) {
   RecordProperty("steps_with_few_points_below", partial);
 }
 
+// A small body (one point group: every point is tested) on a sloped line: the per-point bound
+// before the exact test (PointClearOfPlane, as in 3D) skips only points the exact test rejects,
+// so over a long tumbling, deforming run every step's scan visits, in point order, exactly the
+// points below the line, and the contacts the step leaves are those points.
+TEST(Ground, PointBoundScanMatchesTheFullScanOfASmallBody) {
+  const BodyModel body(TableDef(), TableModes(2e5, 2e3));
+  ASSERT_EQ(body.clusters().size(), 1u);
+  WorldParams w;
+  w.ground.slope = 0.2;
+  BodyState<2, double> s = RestState<2, double>(body);
+  s.q[1] = 15.0;
+  s.q[2] = 0.5;   // tilted against the slope: it lands on one foot, rocks onto both, slides
+  s.qd[0] = 5.0;
+  s.qd[2] = 0.3;
+  int touching = 0, partial = 0;
+  for (int step = 0; step < 4000; ++step) {
+    ASSERT_TRUE(StepBody(body, w, 0, Integrator::kThesis, 0.01, &s).ok()) << "step " << step;
+    const Frame<2, double> frame(s.q);
+    std::vector<int> visited, expected;
+    ForEachPointInContact(body, w.ground, s, frame,
+                          [&](int k, const Vec2<double>&, const Vec2<double>&, const Vec2<double>&,
+                              const Vec2<double>&, const GroundFace&, int) { visited.push_back(k); });
+    const GroundFace line = w.ground.Face(0);
+    for (int k = 0; k < body.num_points(); ++k) {
+      const Vec2<double> x = WorldFromLocal(frame, LocalPosition<double>(body.rest_local(k), body.mode_matrix(k), s.q));
+      if (line.Height(x) < 0.0) expected.push_back(k);
+    }
+    ASSERT_EQ(visited, expected) << "step " << step;
+    std::vector<int> contacts;
+    for (const Contact<2, double>& c : s.contacts) contacts.push_back(c.point);
+    ASSERT_EQ(contacts, expected) << "step " << step;
+    touching += !expected.empty();
+    partial += !expected.empty() && int(expected.size()) < body.num_points();
+  }
+  EXPECT_GT(touching, 1000);  // of 4,000 steps
+  EXPECT_GT(partial, 1000);   // some points below, most above: where the bound skips
+  RecordProperty("steps_touching", touching);
+}
+
 TEST(Ground, SticksBelowFrictionCapAndSlidesAbove) {
   const double mu = std::tan(20.0 * kPi / 180);
   for (double alpha_deg : {10.0, 30.0}) {

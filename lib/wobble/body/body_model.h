@@ -121,7 +121,8 @@ template <int Dim> struct PointTreeN {
 // at least offset + w·centre − |w|·half with w = [n, γ_0 n, …], two dot products over the node's
 // numbers. A coarse test first, offset + n·centre0 − |n|·half0 − ‖γ‖₁ |n|·ρ with ρ the node's
 // largest |centre| + half over the mode columns (Dim numbers), rejects most nodes of a body at
-// rest. Decisions on plain values: a node counts as reaching when its bound is below a margin,
+// rest; an inner node is answered by it alone (the full test rarely rejects what it lets
+// through, and the children are tested anyway), a leaf by both. Decisions on plain values: a node counts as reaching when its bound is below a margin,
 // 1e-10 of the scale of t, p and the body (≥ the rounding of the bound and of the points' own
 // height test by far), so the scan visits every point that the test of every point finds.
 template <int Dim> class PlaneReach {
@@ -146,12 +147,13 @@ template <int Dim> class PlaneReach {
     for (int a = 0; a < Dim; ++a) coarse_[a] = gamma_norm * n_abs[a];
     margin_ = 1e-10 * (scale + std::abs(offset) + extent);
   }
-  bool operator()(const double* box) const {
+  bool operator()(const double* box, bool leaf) const {
     const double* half = box + width_;
     const double* rho = half + width_;
     double lower = offset_;
     for (int a = 0; a < Dim; ++a) lower += w_[a] * box[a] - w_abs_[a] * half[a] - coarse_[a] * rho[a];
-    if (lower >= margin_) return false;
+    if (!(lower < margin_)) return false;
+    if (!leaf) return true;
     lower = offset_;
     for (int j = 0; j < width_; ++j) lower += w_[j] * box[j] - w_abs_[j] * half[j];
     return lower < margin_;
@@ -269,20 +271,22 @@ template <int Dim> class BodyModelN {
   const PointTreeN<Dim>& point_tree() const { return tree_; }
 
   // Calls visit(k) for every point of the tree's leaves whose node (and every ancestor)
-  // reaches(bounds) accepts, in the scan order of the clusters (the order of a scan of every
+  // reaches(bounds, leaf) accepts, in the scan order of the clusters (the order of a scan of every
   // point group), so sums over the visited points add in the same order whatever is skipped.
-  // `reaches` must be conservative; visit must not start another scan on this thread.
+  // `reaches` must be conservative; it may answer an inner node (leaf false) with a cheaper,
+  // looser bound, since a wrong "yes" there costs only the children's tests. visit must not
+  // start another scan on this thread.
   template <class Reaches, class Visit> void ForEachPointInReach(Reaches&& reaches, Visit&& visit) const {
     thread_local std::vector<int> ranks;
     ranks.clear();
     bool sorted = true;
     const int n = int(tree_.skip.size());
     for (int i = 0; i < n;) {
-      if (!reaches(tree_.bounds.data() + size_t(i) * size_t(tree_.stride))) {
+      const int first = tree_.first[size_t(i)], last = tree_.last[size_t(i)];
+      if (!reaches(tree_.bounds.data() + size_t(i) * size_t(tree_.stride), first < last)) {
         i = tree_.skip[size_t(i)];
         continue;
       }
-      const int first = tree_.first[size_t(i)], last = tree_.last[size_t(i)];
       if (first < last) {
         if (!ranks.empty() && tree_.leaf_ranks[size_t(first)] < ranks.back()) sorted = false;
         ranks.insert(ranks.end(), tree_.leaf_ranks.begin() + first, tree_.leaf_ranks.begin() + last);

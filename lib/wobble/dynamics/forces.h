@@ -121,7 +121,9 @@ template <int Dim, class T> void UpdateContacts(const BodyModelN<Dim>& body, con
     next.push_back({k, anchor, face_index});
     s->penetration = std::max(s->penetration, -double(ScalarValue(face.Height(x))));
   });
-  if (body.clusters().size() > 1)  // groups are visited in lattice order, not point order
+  // groups are visited in lattice order, not point order; a resting body's few contacts
+  // usually come out sorted already
+  if (body.clusters().size() > 1 && !std::is_sorted(next.begin(), next.end(), ContactBefore<Dim, T>))
     std::sort(next.begin(), next.end(), ContactBefore<Dim, T>);
   s->contacts.swap(next);
   cache.q = s->q;

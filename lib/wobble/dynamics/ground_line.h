@@ -114,8 +114,21 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
     }
     return;
   }
+  if (ClearOfGround(body, g, s.q, frame)) return;
+  const int D = body.num_modes();
+  const Eigen::Matrix2d R = frame.R.unaryExpr([](const T& v) { return double(ScalarValue(v)); });
+  const Eigen::Vector2d t(ScalarValue(s.q[0]), ScalarValue(s.q[1]));
+  const Eigen::Vector2d n_local = R.transpose() * line.n;
+  const double offset = line.n.dot(t - line.point), scale = t.cwiseAbs().sum() + line.point.cwiseAbs().sum();
+  double gamma_norm = 0.0;
+  for (int d = 0; d < D; ++d) gamma_norm += std::abs(ScalarValue(s.q[kRigidDofs + d]));
+  // On the line, most points of a body at rest are far above it: a bound first (as in 3D,
+  // ground_plane.h), then the exact position. A terrain's faces are not one plane: no bound.
+  const PointClearOfPlane<2> clear_of_line(body.rest_extent(), body.max_mode_reach(), n_local, offset, scale,
+                                           gamma_norm);
   // One point: on the line, below it or not; on a terrain, every face it feels.
   auto visit = [&](int k) {
+    if (!g.terrain && clear_of_line(body.rest_local(k), body.mode_reach(k))) return;
     Vec2<T> l, x;
     point_at(k, &l, &x);
     ForEachFaceFelt(
@@ -124,7 +137,6 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
           f(k, l, x, v, anchor, face, face_index);
         });
   };
-  if (ClearOfGround(body, g, s.q, frame)) return;
   if (body.clusters().size() <= 1) {
     for (int k = 0; k < body.num_points(); ++k) visit(k);
     return;
@@ -133,18 +145,15 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
   // below the ground. The box test is a decision, so it runs on plain values: on the line,
   // height = n·(t − p) + (Rᵀn)·l (PlaneReach); on a terrain, the box's world bounds against the
   // highest surface point under them, widened by PlaneReach's margin.
-  const int D = body.num_modes(), L = body.point_tree().width;
-  const Eigen::Matrix2d R = frame.R.unaryExpr([](const T& v) { return double(ScalarValue(v)); });
-  const Eigen::Vector2d t(ScalarValue(s.q[0]), ScalarValue(s.q[1]));
-  const PlaneReach<2> below_line(body.point_tree(), D, R.transpose() * line.n, line.n.dot(t - line.point),
-                                 t.cwiseAbs().sum() + line.point.cwiseAbs().sum(),
+  const int L = body.point_tree().width;
+  const PlaneReach<2> below_line(body.point_tree(), D, n_local, offset, scale,
                                  [&](int d) { return ScalarValue(s.q[kRigidDofs + d]); });
   if (!g.terrain) {
     body.ForEachPointInReach(below_line, visit);
     return;
   }
   body.ForEachPointInReach(
-      [&](const double* box) {
+      [&](const double* box, bool /*leaf: one test serves every node*/) {
         Eigen::Vector2d centre(box[0], box[1]), half(box[L], box[L + 1]);
         for (int d = 0; d < D; ++d) {
           const double gamma = ScalarValue(s.q[kRigidDofs + d]);

@@ -9,9 +9,13 @@
 namespace wobble::fit {
 
 // The memory a gradient may keep for its whole forward run (every state, and in 3D every
-// step's tape) before it checkpoints instead: 64 MiB holds about 70,000 steps of a 2D table
-// (about 0.9 kB a state) and 9,000 of a 3D chair (about 7 kB a state and tape).
-constexpr std::size_t kWholeRunMemoryBudget = std::size_t(64) << 20;
+// step's tape) before it checkpoints instead: 4 MiB holds about 4,500 steps of a 2D table
+// (about 0.9 kB a state) and 600 of a 3D chair (about 7 kB a state and tape). Kept whole,
+// a run saves the checkpoints' extra simulation but is slower once it leaves the caches and
+// the storage a thread keeps between gradients (adjoint_sweep.h): on adjoint_bench the
+// chair's whole run was 27 % faster than ⌈√steps⌉ checkpoints at 342 steps (2.4 MB) and
+// 7–10 % slower at 3,334 steps (23 MB).
+constexpr std::size_t kWholeRunMemoryBudget = std::size_t(4) << 20;
 
 // Values of a gradient's checkpoint_interval besides a positive interval.
 constexpr int kCheckpointAuto = 0;   // the whole run when it fits the budget, else ⌈√steps⌉

@@ -88,7 +88,7 @@ struct WorldOptions {
   // line or terrain `ground`; 3D: `ground_plane`), the springs of every FFD body and
   // max_condition: one set for bodies of both dimensions, which their steps read as it is.
   WorldParams params;
-  // The FFD bodies' integrator while no constraint is enabled.
+  // Every body's integrator, constraints a stage of it (variational: refused with constraints).
   Integrator integrator = Integrator::kThesis;
   double dt = 0.01;
   // Default constraint feedback: α = (rate/Δt)², β = 2 rate/Δt (critically damped).

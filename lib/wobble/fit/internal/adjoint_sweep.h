@@ -140,10 +140,12 @@ bool CheckpointedAdjointSweep(int steps, int interval, const State& start, Adjoi
 // kept per thread from one gradient to the next: an optimizer asks for thousands, and fresh
 // storage costs a page fault per 4 kB touched (a 3D chair's ⌈√steps⌉ tapes are about 400 kB,
 // 10 % of its gradient, measured on adjoint_bench's GradientChair/10000/1/-1). Storage above
-// kKeptBytes is given back after each gradient (a whole run of 64 MiB is not held on to).
+// kKeptBytes (twice the whole-run budget of checkpoints.h, so a default gradient's storage is
+// always kept) is given back after each gradient: a long run with an interval asked for is
+// not held on to.
 // A gradient taken inside another on the same thread (from a stage cost) uses storage of its own.
 template <class State, class Tape> struct SweepBuffers {
-  static constexpr size_t kKeptBytes = size_t(4) << 20;
+  static constexpr size_t kKeptBytes = 2 * kWholeRunMemoryBudget;
   std::vector<State> checkpoints, segment;
   std::vector<Tape> tapes;
   bool in_use = false;
