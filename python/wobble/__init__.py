@@ -15,7 +15,7 @@ records a Trajectory; rollout() runs many trials on every core; Interpreter runs
 import warnings as _warnings
 
 from ._wobble import *  # noqa: F401,F403  (the extension's names are the package's)
-from ._wobble import BodyModel, Ground, WorldOptions, __doc__ as _extension_doc  # noqa: F401
+from ._wobble import BodyModel, Ground, RolloutGradient, StageCost, WorldOptions, __doc__ as _extension_doc  # noqa: F401
 
 __version__ = "0.2"
 
@@ -57,6 +57,8 @@ for _name, _obj in list(globals().items()):
 # DeprecationWarning when read and is the object named (the same class, for isinstance).
 _DEPRECATED = {
     "BodyModel3": ("BodyModel", BodyModel, "which is one class for 2D and 3D bodies (its dim says which)"),
+    "StageCost3": ("StageCost", StageCost, "which takes a body of either dimension"),
+    "RolloutGradient3": ("RolloutGradient", RolloutGradient, "which serves both dimensions"),
 }
 
 

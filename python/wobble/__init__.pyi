@@ -482,7 +482,8 @@ def fit_spacetime(body: BodyModel, task: StageCost, *, targets: ArrayLike, knots
 
 # Deprecated (one release; issue 45): the 3D body's names of before. The functions warn
 # (DeprecationWarning) and call the names above, which take either body; upright_at3 and still_at3
-# give the 3D form only (as their StageCost3 did). The classes are the same class objects.
+# give the 3D form only (as their StageCost3 did). The classes are the same class objects and
+# warn when their old name is read, as BodyModel3 does.
 class StageCost3(StageCost):
     """Deprecated: StageCost itself (it takes either body)."""
 class RolloutGradient3(RolloutGradient):
