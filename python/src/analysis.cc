@@ -80,7 +80,7 @@ void BindAnalysis(py::module_& m) {
       .def_readonly("condition", &analysis::ModeSetReport::condition);
 
   m.def(
-      "check_mode_set", [](std::shared_ptr<BodyModel> body) { return analysis::CheckModeSet(*body); }, py::arg("body"),
+      "check_mode_set", [](const BodyModel& body) { return analysis::CheckModeSet(body); }, py::arg("body"),
       "How close the body's modes are to each other (pair angles, dependencies) and cond(M) at rest.");
 }
 

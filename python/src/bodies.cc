@@ -1,10 +1,12 @@
-// FFD bodies (BodyModel, Faloutsos 1995 ch. 4; BodyModel3, a 3D character of issue 15 with its
-// mesh moved by the FFD): loading an object with its modes, and what a body is made of, as
-// numpy arrays.
+// FFD bodies, one Python class wobble.BodyModel for both dimensions (2D: Faloutsos 1995 ch. 4;
+// 3D: a character of issue 15 with its mesh moved by the FFD): loading an object with its
+// modes, and what a body is made of, as numpy arrays.
 #include "bindings.h"
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <unordered_map>
 
 #include "wobble/analysis/conditioning.h"
 #include "wobble/body/body_model.h"
@@ -25,7 +27,6 @@ namespace {
 
 // The object file and its modes, read as a script's load_obj and load_def would (one loader:
 // scene::FfdObject), then the mode set checked as `wobble simulate` does.
-// (pybind11 holds bodies as shared_ptr<BodyModel>; Python never changes one.)
 // A 2D or 3D body, as the object file's `dimension` says (a 3D file's `mesh` is read by VTK's
 // readers when the module has the pipelines).
 py::object LoadBody(const std::string& object, const std::vector<std::string>& modes, bool check) {
@@ -38,8 +39,7 @@ py::object LoadBody(const std::string& object, const std::vector<std::string>& m
   o.LoadModes(modes);
   const auto checked = [&](auto body) {
     if (check) CheckLoadedModeSet(*body, object);
-    using Model = std::remove_const_t<typename decltype(body)::element_type>;
-    return py::cast(std::const_pointer_cast<Model>(body));
+    return WrapBody(body);
   };
   return o.dim() == 3 ? checked(o.Body<3>()) : checked(o.Body<2>());
 }
@@ -51,6 +51,57 @@ template <int Dim> py::array_t<double> Points(const std::vector<Eigen::Matrix<do
   for (size_t k = 0; k < points.size(); ++k)
     for (int c = 0; c < Dim; ++c) a(k, c) = points[k][c];
   return out;
+}
+
+// f(body) with the body of whichever dimension b holds (f returns the same type for both).
+template <class F> auto Either(const PyBody& b, F&& f) { return b.b3 ? f(*b.b3) : f(*b.b2); }
+
+// The rigid coordinates (3 in 2D, 6 in 3D: t and a rotation vector) and one per mode.
+template <int Dim> int NumQ(const BodyModelN<Dim>& b) { return Group<Dim>::kRigidDofs + b.num_modes(); }
+
+// wobble.DeformationMode: a mode of either dimension, copied (a body's modes are few and small).
+struct PyMode {
+  std::string name, source;
+  double stiffness = 0, damping = 0;
+  bool active = false;
+  Eigen::MatrixXd displacement;  // (control points, Dim)
+};
+template <int Dim> PyMode ModeOf(const DeformationModeN<Dim>& d) {
+  PyMode out{d.name, d.source, d.stiffness, d.damping, d.active, Eigen::MatrixXd(d.displacement.size(), Dim)};
+  for (size_t c = 0; c < d.displacement.size(); ++c) out.displacement.row(Eigen::Index(c)) = d.displacement[c].transpose();
+  return out;
+}
+
+// (N, Dim) world positions of the mass points at q (None: 0), as the fits place them.
+template <int Dim> py::array_t<double> MassPointsAt(const BodyModelN<Dim>& b, const py::object& q_in) {
+  const int n = NumQ(b);
+  const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
+  std::vector<Eigen::Matrix<double, Dim, 1>> x;
+  for (int k = 0; k < b.num_points(); ++k)
+    x.push_back(fit::PointPosition(fit::BasisOf<Dim>(b, k, Eigen::Matrix<double, Dim, 1>::Zero()), q));
+  return Points(x);
+}
+
+// One wobble.BodyModel a body while Python holds one (the object pybind11 finds for a live
+// PyBody): the same object comes back from World.body, SynthesisProblem.body, ... as went in.
+// Keyed by the body; the entries of dead objects are swept as the table grows (with the GIL).
+template <int Dim> py::object Wrap(std::shared_ptr<const BodyModelN<Dim>> body) {
+  if (!body) return py::none();
+  static std::unordered_map<const void*, std::weak_ptr<PyBody>> live;
+  static size_t sweep_at = 64;
+  std::weak_ptr<PyBody>& slot = live[body.get()];
+  std::shared_ptr<PyBody> held = slot.lock();
+  if (!held) {
+    held = std::make_shared<PyBody>();
+    if constexpr (Dim == 2) held->b2 = std::move(body);
+    else held->b3 = std::move(body);
+    slot = held;
+    if (live.size() >= sweep_at) {
+      for (auto it = live.begin(); it != live.end();) it = it->second.expired() ? live.erase(it) : std::next(it);
+      sweep_at = 2 * live.size() + 64;
+    }
+  }
+  return py::cast(held);
 }
 
 // The body's drawing at q: each polyline of the object file sampled `samples` times a segment
@@ -110,6 +161,9 @@ std::shared_ptr<LinearBodyModel> Linear(LinearBodyDef def) { return std::make_sh
 
 }  // namespace
 
+py::object WrapBody(std::shared_ptr<const BodyModelN<2>> body) { return Wrap<2>(std::move(body)); }
+py::object WrapBody(std::shared_ptr<const BodyModelN<3>> body) { return Wrap<3>(std::move(body)); }
+
 Eigen::VectorXd VectorOr(const py::object& v, long n, const Eigen::VectorXd& otherwise, const std::string& what) {
   if (v.is_none()) return otherwise;
   auto a = AsMatrix(v, n, -1, what);
@@ -141,88 +195,97 @@ Eigen::VectorXd AsVector(const py::handle& h, long n, const std::string& what) {
 }
 
 void BindBodies(py::module_& m) {
-  py::class_<DeformationMode>(m, "DeformationMode", "One user-drawn deformation mode (thesis §4.3) and its PD constants.")
-      .def_readonly("name", &DeformationMode::name)
-      .def_readonly("stiffness", &DeformationMode::stiffness, "K of the mode potential V = K γ²")
-      .def_readonly("damping", &DeformationMode::damping, "c of the mode damping Q = −c γ̇")
-      .def_readonly("active", &DeformationMode::active, "driven by a controller (chapter 5)")
-      .def_readonly("source", &DeformationMode::source, "FILE:LINE it was read from")
+  py::class_<PyMode>(m, "DeformationMode",
+                     "One user-drawn deformation mode (thesis §4.3) and its PD constants, of a 2D or a 3D body.")
+      .def_readonly("name", &PyMode::name)
+      .def_readonly("stiffness", &PyMode::stiffness, "K of the mode potential V = K γ²")
+      .def_readonly("damping", &PyMode::damping, "c of the mode damping Q = −c γ̇")
+      .def_readonly("active", &PyMode::active, "driven by a controller (chapter 5)")
+      .def_readonly("source", &PyMode::source, "FILE:LINE it was read from")
       .def_property_readonly(
-          "displacement", [](const DeformationMode& d) { return Points(d.displacement); },
-          "(num_s·num_t, 2) control-point displacements, index i·num_t + j")
-      .def("__repr__", [](const DeformationMode& d) { return "<DeformationMode " + d.name + ">"; });
+          "displacement", [](const PyMode& d) { return Eigen::MatrixXd(d.displacement); },
+          "(num_s·num_t, 2) control-point displacements, index i·num_t + j; of a 3D body\n"
+          "(num_s·num_t·num_u, 3), index (i·num_t + j)·num_u + k")
+      .def("__repr__", [](const PyMode& d) { return "<DeformationMode " + d.name + ">"; });
 
-  py::class_<BodyModel, std::shared_ptr<BodyModel>>(
+  py::class_<PyBody, std::shared_ptr<PyBody>>(
       m, "BodyModel",
-      "An FFD character: a Bernstein (or B-spline) lattice, mass points and deformation modes.\n"
-      "Immutable; q = [tx, ty, θ, γ1..γD] (Eq. 4.4). Make one with wobble.load_body.")
-      .def_property_readonly("name", &BodyModel::name)
-      .def_property_readonly("num_modes", &BodyModel::num_modes)
-      .def_property_readonly("num_q", &BodyModel::num_q, "3 rigid coordinates + one per mode")
-      .def_property_readonly("num_points", &BodyModel::num_points, "mass points")
-      .def_property_readonly("modes", &BodyModel::modes)
-      .def_property_readonly("mode_names",
-                             [](const BodyModel& b) {
-                               std::vector<std::string> names;
-                               for (const DeformationMode& d : b.modes()) names.push_back(d.name);
-                               return names;
+      "An FFD character of either dimension (dim): a Bernstein (or B-spline) lattice, mass points and\n"
+      "deformation modes. Immutable. 2D (Faloutsos 1995 ch. 4): q = [tx, ty, θ, γ1..γD] (Eq. 4.4).\n"
+      "3D (issue 15): a trivariate lattice, modes made by generators and optionally a user's mesh;\n"
+      "in a World its q is [tx, ty, tz, rx, ry, rz, γ1..γD] (r the rotation vector) and q̇\n"
+      "[vx, vy, vz, ωx, ωy, ωz (body frame), γ̇1..γ̇D]. Make one with wobble.load_body (a\n"
+      "'dimension 3' object file gives a 3D one). What needs one dimension (outline: 2D; the mesh: 3D)\n"
+      "raises InputError on the other.")
+      .def_property_readonly("name", &PyBody::name)
+      .def_property_readonly("dim", &PyBody::dim, "2 or 3: the dimension of the lattice, points and q")
+      .def_property_readonly("num_modes", [](const PyBody& b) { return Either(b, [](const auto& x) { return x.num_modes(); }); })
+      .def_property_readonly("num_q", [](const PyBody& b) { return Either(b, [](const auto& x) { return NumQ(x); }); },
+                             "3 rigid coordinates (3D: 6) + one per mode")
+      .def_property_readonly("num_points", [](const PyBody& b) { return Either(b, [](const auto& x) { return x.num_points(); }); },
+                             "mass points")
+      .def_property_readonly("modes",
+                             [](const PyBody& b) {
+                               return Either(b, [](const auto& x) {
+                                 std::vector<PyMode> modes;
+                                 for (const auto& d : x.modes()) modes.push_back(ModeOf(d));
+                                 return modes;
+                               });
                              })
-      .def_property_readonly("total_mass", [](const BodyModel& b) { return b.moments().m; })
+      .def_property_readonly("mode_names",
+                             [](const PyBody& b) {
+                               return Either(b, [](const auto& x) {
+                                 std::vector<std::string> names;
+                                 for (const auto& d : x.modes()) names.push_back(d.name);
+                                 return names;
+                               });
+                             })
+      .def_property_readonly("total_mass", [](const PyBody& b) { return Either(b, [](const auto& x) { return x.moments().m; }); })
       .def_property_readonly(
-          "masses", [](const BodyModel& b) { return py::array_t<double>(b.def().masses.size(), b.def().masses.data()); },
+          "masses",
+          [](const PyBody& b) {
+            return Either(b, [](const auto& x) { return py::array_t<double>(x.def().masses.size(), x.def().masses.data()); });
+          },
           "(num_points,) the mass of each point")
-      .def_property_readonly(
-          "mass_positions", [](const BodyModel& b) { return Points(b.def().mass_positions); },
-          "(num_points, 2) mass points in the body frame")
-      .def_property_readonly("rest_control", [](const BodyModel& b) { return Points(b.rest_control()); },
-                             "(num_s·num_t, 2) control points of the undeformed lattice")
+      .def_property_readonly("mass_positions",
+                             [](const PyBody& b) { return Either(b, [](const auto& x) { return Points(x.def().mass_positions); }); },
+                             "(num_points, dim) mass points in the body frame")
+      .def_property_readonly("rest_control",
+                             [](const PyBody& b) { return Either(b, [](const auto& x) { return Points(x.rest_control()); }); },
+                             "(num_s·num_t, 2) control points of the undeformed lattice (3D: (num_s·num_t·num_u, 3);\n"
+                             "the index as DeformationMode.displacement's)")
       .def_property_readonly("lattice_shape",
-                             [](const BodyModel& b) { return py::make_tuple(b.lattice().num_s(), b.lattice().num_t()); })
-      .def("outline", &Outline, py::arg("q") = py::none(), py::arg("samples_per_segment") = 8,
-           "The drawing at q (None: at rest) as world-space polylines, each (M, 2), bent by the FFD.")
-      .def("__repr__", [](const BodyModel& b) {
-        return "<BodyModel " + b.name() + ": " + std::to_string(b.num_points()) + " mass points, " +
-               std::to_string(b.num_modes()) + " modes>";
-      });
-
-  py::class_<BodyModelN<3>, std::shared_ptr<BodyModelN<3>>>(
-      m, "BodyModel3",
-      "A 3D FFD character (issue 15): a trivariate lattice, mass points, modes made by generators,\n"
-      "and optionally a user's mesh. Immutable. In a World its q is [tx, ty, tz, rx, ry, rz,\n"
-      "γ1..γD] (r the rotation vector) and q̇ [vx, vy, vz, ωx, ωy, ωz (body frame), γ̇1..γ̇D].\n"
-      "Make one with wobble.load_body (a 'dimension 3' object file).")
-      .def_property_readonly("name", &BodyModelN<3>::name)
-      .def_property_readonly("num_modes", &BodyModelN<3>::num_modes)
-      .def_property_readonly("num_q", [](const BodyModelN<3>& b) { return Group<3>::kRigidDofs + b.num_modes(); },
-                             "6 rigid coordinates + one per mode")
-      .def_property_readonly("num_points", &BodyModelN<3>::num_points, "mass points")
-      .def_property_readonly("mode_names",
-                             [](const BodyModelN<3>& b) {
-                               std::vector<std::string> names;
-                               for (const DeformationModeN<3>& d : b.modes()) names.push_back(d.name);
-                               return names;
-                             })
-      .def_property_readonly("total_mass", [](const BodyModelN<3>& b) { return b.moments().m; })
-      .def_property_readonly("masses", [](const BodyModelN<3>& b) { return b.def().masses; }, "mass of each mass point")
-      .def_property_readonly("mass_positions", [](const BodyModelN<3>& b) { return Points(b.def().mass_positions); },
-                             "(num_points, 3) mass points in the body frame")
-      .def_property_readonly("mesh_points", [](const BodyModelN<3>& b) { return Points(b.def().mesh.points); },
-                             "(V, 3) the mesh's vertices in the body frame (V = 0 without a mesh)")
+                             [](const PyBody& b) {
+                               return Either(b, [](const auto& x) {
+                                 py::tuple shape(x.lattice().dim());
+                                 for (int a = 0; a < x.lattice().dim(); ++a) shape[a] = x.lattice().num(a);
+                                 return shape;
+                               });
+                             },
+                             "control points per axis: (num_s, num_t), 3D (num_s, num_t, num_u)")
+      .def(
+          "outline", [](const PyBody& b, const py::object& q, int samples) { return Outline(b.Need<2>("outline"), q, samples); },
+          py::arg("q") = py::none(), py::arg("samples_per_segment") = 8,
+          "The drawing at q (None: at rest) as world-space polylines, each (M, 2), bent by the FFD.\n"
+          "2D bodies only (InputError for a 3D one: its mesh_vertices(q) is its drawing).")
+      .def_property_readonly("mesh_points", [](const PyBody& b) { return Points(b.Need<3>("mesh_points").def().mesh.points); },
+                             "(V, 3) the mesh's vertices in the body frame (V = 0 without a mesh); 3D bodies only")
       .def_property_readonly(
           "mesh_triangles",
-          [](const BodyModelN<3>& b) {
-            const auto& t = b.def().mesh.triangles;
+          [](const PyBody& b) {
+            const auto& t = b.Need<3>("mesh_triangles").def().mesh.triangles;
             py::array_t<int> out({py::ssize_t(t.size()), py::ssize_t(3)});
             auto a = out.mutable_unchecked<2>();
             for (size_t k = 0; k < t.size(); ++k)
               for (int c = 0; c < 3; ++c) a(k, c) = t[k][size_t(c)];
             return out;
           },
-          "(T, 3) vertex indices of each triangle")
+          "(T, 3) vertex indices of each triangle; 3D bodies only")
       .def(
           "mesh_vertices",
-          [](const BodyModelN<3>& b, const py::object& q_in) {
-            const int n = Group<3>::kRigidDofs + b.num_modes();
+          [](const PyBody& body, const py::object& q_in) {
+            const BodyModelN<3>& b = body.Need<3>("mesh_vertices");
+            const int n = NumQ(b);
             const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
             const Eigen::Quaterniond R = ExpRotation<double>(Eigen::Vector3d(q.segment<3>(3)));
             const Eigen::VectorXd gamma = q.tail(b.num_modes());
@@ -233,23 +296,22 @@ void BindBodies(py::module_& m) {
           },
           py::arg("q") = py::none(),
           "(V, 3) world positions of the mesh's vertices at q: x = t + R (b0 + B γ), every vertex\n"
-          "moved by the FFD of its lattice")
+          "moved by the FFD of its lattice; 3D bodies only")
       .def(
           "mass_points_at",
-          [](const BodyModelN<3>& b, const py::object& q_in) {
-            const int n = Group<3>::kRigidDofs + b.num_modes();
-            const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
-            std::vector<Eigen::Vector3d> x;
-            for (int k = 0; k < b.num_points(); ++k) x.push_back(fit::PointPosition(fit::BasisOf(b, k, {}), q));
-            return Points(x);
-          },
+          [](const PyBody& b, const py::object& q) { return Either(b, [&](const auto& x) { return MassPointsAt(x, q); }); },
           py::arg("q") = py::none(),
-          "(N, 3) world positions of the mass points at q = [t, r, γ] (r a rotation vector), as the\n"
-          "fits place them (the correspondences of wobble.fit_pose with mass_points)")
-      .def("__repr__", [](const BodyModelN<3>& b) {
-        return "<BodyModel3 '" + b.name() + "': " + std::to_string(b.num_points()) + " points, " +
-               std::to_string(b.num_modes()) + " modes, " + std::to_string(b.def().mesh.points.size()) + " mesh vertices>";
+          "(N, dim) world positions of the mass points at q (2D: [t, θ, γ]; 3D: [t, r, γ], r a rotation\n"
+          "vector), as the fits place them (the correspondences of wobble.fit_pose with mass_points)")
+      .def("__repr__", [](const PyBody& b) {
+        const std::string head = "<BodyModel '" + b.name() + "' (" + std::to_string(b.dim()) + "D): ";
+        return Either(b, [&](const auto& x) {
+          std::string out = head + std::to_string(x.num_points()) + " mass points, " + std::to_string(x.num_modes()) + " modes";
+          if (b.dim() == 3) out += ", " + std::to_string(x.def().mesh.points.size()) + " mesh vertices";
+          return out + ">";
+        });
       });
+  // the 3D class's old name: wobble.BodyModel3 (python/wobble/__init__.py) warns and gives BodyModel
 
   py::class_<LinearBodyModel, std::shared_ptr<LinearBodyModel>>(
       m, "LinearBodyModel",
@@ -322,7 +384,7 @@ void BindBodies(py::module_& m) {
         py::arg("check") = true,
         "Reads an object file (.obj: lattice, mass points, drawing; 'dimension 3': a 3D lattice or\n"
         "'lattice fit', 'sample', a 'mesh') and its deformation files, the modes of all files in\n"
-        "order; returns a BodyModel or a BodyModel3. check: refuse a mode set that cannot be simulated\n"
+        "order; returns a BodyModel (its dim 2 or 3). check: refuse a mode set that cannot be simulated\n"
         "(InputError, as `wobble simulate`), and warn about a poorly conditioned one.\n"
         "Errors name FILE:LINE (wobble.ParseError).");
   BindDeprecated(m, "load_body3", "load_body");  // release 0.1's name: load_body reads either

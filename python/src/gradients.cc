@@ -435,9 +435,8 @@ void BindGradients(py::module_& m) {
   BindRollouts<2>(m);
   BindRollouts<3>(m);
 
-  // The 3D names of before, one release (python/wobble/__init__.pyi marks them deprecated).
-  m.attr("StageCost3") = m.attr("StageCost");
-  m.attr("RolloutGradient3") = m.attr("RolloutGradient");
+  // The 3D names of before, one release (python/wobble/__init__.pyi marks them deprecated; the
+  // classes' old names, StageCost3 and RolloutGradient3, are wobble/__init__.py's _DEPRECATED).
   BindDeprecated(m, "rollout_gradient3", "rollout_gradient");
   BindDeprecated(m, "rollout_cost3", "rollout_cost");
   BindDeprecated(m, "fit_spacetime3", "fit_spacetime");

@@ -167,8 +167,8 @@ void BindRollout(py::module_& m) {
         py::kw_only(), py::arg("options") = WorldOptions(), py::arg("mode_targets") = py::none(), py::arg("every") = 1,
         py::arg("threads") = 0, py::arg("energies") = false, py::arg("max_steps") = Limits().max_steps,
         py::arg("max_record_mb") = Limits().max_record_mb,
-        "The same for a 3D FFD body (BodyModel3): q = [t, rotation vector, γ] (|r| <= π as read\n"
-        "back), q̇ = [ṫ, body ω, γ̇], as World.q3/qd3/set_state3; the world's 3D ground and gravity\n"
+        "The same for a 3D FFD body (a BodyModel of dim 3): q = [t, rotation vector, γ] (|r| <= π as read\n"
+        "back), q̇ = [ṫ, body ω, γ̇], as World.q/qd/set_state; the world's 3D ground and gravity\n"
         "(options.ground_plane, gravity).");
 }
 

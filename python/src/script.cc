@@ -144,11 +144,10 @@ void BindScript(py::module_& m) {
       .def("take_output", &PyInterpreter::TakeOutput, "What the scripts printed since the last call.")
       .def_property_readonly("body",
                              [](PyInterpreter& p) -> py::object {
-                               const BodyModel* b = p.interp().body();
-                               if (!b) return py::none();
-                               return py::cast(std::const_pointer_cast<BodyModel>(p.interp().scene().object().Body<2>()));
+                               const auto& object = p.interp().scene().object();
+                               return object.dim() == 3 ? WrapBody(object.Body<3>()) : WrapBody(object.Body<2>());
                              },
-                             "the FFD object's body (None before load_obj)")
+                             "the FFD object's body, a BodyModel of dim 2 or 3 (None before load_obj)")
       .def_property_readonly("q", [](PyInterpreter& p) { return Eigen::VectorXd(p.interp().q()); })
       .def_property_readonly("qd", [](PyInterpreter& p) { return Eigen::VectorXd(p.interp().qd()); })
       .def_property_readonly("time", [](PyInterpreter& p) { return p.interp().time(); })

@@ -115,8 +115,8 @@ TrialResults RunTrials(const Problem& problem, const py::object& graphs_or_poses
 
 // The problem's body, of whichever dimension it has (None before one is set).
 py::object ProblemBody(const synth::Problem& p) {
-  if (p.body<3>()) return py::cast(std::const_pointer_cast<BodyModelN<3>>(p.body<3>()));
-  if (p.body<2>()) return py::cast(std::const_pointer_cast<BodyModel>(p.body<2>()));
+  if (p.body<3>()) return WrapBody(p.body<3>());
+  if (p.body<2>()) return WrapBody(p.body<2>());
   return py::none();
 }
 
@@ -146,7 +146,7 @@ void BindSynth(py::module_& m) {
                       "A body, its world and start state, the trial length and the cost: what `anneal` solves.\n"
                       "Get the one a script set up with Interpreter.synthesis_problem().")
       .def_property_readonly("body", &ProblemBody,
-                             "the body, 2D (BodyModel) or 3D (BodyModel3); a 3D problem's q0, qd0 are [t, rotation "
+                             "the body, a BodyModel of dim 2 or 3; a 3D problem's q0, qd0 are [t, rotation "
                              "vector, γ], [ṫ, ω, γ̇]")
       .def_property_readonly(
           "body3",

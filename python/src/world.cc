@@ -290,10 +290,10 @@ void BindWorld(py::module_& m) {
           "body",
           [](const World& w, int body) -> py::object {
             CheckBody(w, body);
-            if (w.dim(body) == 3) return py::cast(std::const_pointer_cast<BodyModelN<3>>(w.shared_body<3>(body)));
-            return py::cast(std::const_pointer_cast<BodyModel>(w.shared_body<2>(body)));
+            if (w.dim(body) == 3) return WrapBody(w.shared_body<3>(body));
+            return WrapBody(w.shared_body<2>(body));
           },
-          py::arg("body"), "the FFD body's model (BodyModel or BodyModel3)")
+          py::arg("body"), "the FFD body's model (a BodyModel, 2D or 3D; the object added, while Python holds it)")
       .def(
           "q", [](const World& w, int body) { CheckBody(w, body); return w.coordinates(body); },
           py::arg("body") = 0, "a copy of the body's q (3D: [t, rotation vector, γ])")

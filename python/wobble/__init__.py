@@ -12,8 +12,10 @@ records a Trajectory; rollout() runs many trials on every core; Interpreter runs
     run = wobble.simulate(world, 10.0)
     print(run.q()[-1], run.column("total")[-1])
 """
+import warnings as _warnings
+
 from ._wobble import *  # noqa: F401,F403  (the extension's names are the package's)
-from ._wobble import Ground, WorldOptions, __doc__ as _extension_doc  # noqa: F401
+from ._wobble import BodyModel, Ground, RolloutGradient, StageCost, WorldOptions, __doc__ as _extension_doc  # noqa: F401
 
 __version__ = "0.2"
 
@@ -50,3 +52,23 @@ _repr_fields(Ground, ["enabled", "slope", "stiffness", "normal_damping", "fricti
 for _name, _obj in list(globals().items()):
     if isinstance(_obj, type) and getattr(_obj, "__module__", "") == "wobble._wobble":
         _obj.__module__ = "wobble"
+
+# Names of before kept one release more (__init__.pyi marks them): each warns
+# DeprecationWarning when read and is the object named (the same class, for isinstance).
+_DEPRECATED = {
+    "BodyModel3": ("BodyModel", BodyModel, "which is one class for 2D and 3D bodies (its dim says which)"),
+    "StageCost3": ("StageCost", StageCost, "which takes a body of either dimension"),
+    "RolloutGradient3": ("RolloutGradient", RolloutGradient, "which serves both dimensions"),
+}
+
+
+def __getattr__(name):
+    if name in _DEPRECATED:
+        new_name, obj, why = _DEPRECATED[name]
+        _warnings.warn(f"wobble.{name} is deprecated: use wobble.{new_name}, {why}", DeprecationWarning, stacklevel=2)
+        return obj
+    raise AttributeError(f"module 'wobble' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_DEPRECATED))

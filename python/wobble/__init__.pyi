@@ -30,7 +30,10 @@ class DeformationMode:
     displacement: NDArray
 
 class BodyModel:
+    """An FFD character of either dimension: 2D q = [tx, ty, θ, γ...]; 3D (in a World) q = [tx, ty, tz,
+    rx, ry, rz, γ...], q̇ = [v, body ω, γ̇...]. outline is 2D only, the mesh 3D only (InputError)."""
     name: str
+    dim: int  # 2 or 3
     num_modes: int
     num_q: int
     num_points: int
@@ -38,10 +41,14 @@ class BodyModel:
     mode_names: list[str]
     total_mass: float
     masses: NDArray
-    mass_positions: NDArray
-    rest_control: NDArray
-    lattice_shape: tuple[int, int]
+    mass_positions: NDArray  # (num_points, dim)
+    rest_control: NDArray  # (control points, dim)
+    lattice_shape: tuple[int, ...]  # (num_s, num_t), 3D (num_s, num_t, num_u)
     def outline(self, q: Optional[ArrayLike] = None, samples_per_segment: int = 8) -> list[NDArray]: ...
+    mesh_points: NDArray
+    mesh_triangles: NDArray
+    def mesh_vertices(self, q: Optional[ArrayLike] = None) -> NDArray: ...
+    def mass_points_at(self, q: Optional[ArrayLike] = None) -> NDArray: ...
 
 class LinearBodyModel:
     name: str
@@ -62,26 +69,14 @@ def linear_pyramid(dim: int, half_width: float, height: float, *, levels: int = 
 def linear_body(points: ArrayLike, masses: Sequence[float], *, order: str = "affine",
                 name: str = "body") -> LinearBodyModel: ...
 
-def load_body(object: str, modes: Sequence[str] = ..., check: bool = True) -> BodyModel | BodyModel3:
-    """A 2D or 3D body, as the object file's `dimension` says."""
+def load_body(object: str, modes: Sequence[str] = ..., check: bool = True) -> BodyModel:
+    """A 2D or 3D body (its dim), as the object file's `dimension` says."""
 
-class BodyModel3:
-    """A 3D FFD character; in a World q = [tx, ty, tz, rx, ry, rz, γ...], q̇ = [v, body ω, γ̇...]."""
-    name: str
-    num_modes: int
-    num_q: int
-    num_points: int
-    mode_names: list[str]
-    total_mass: float
-    masses: list[float]
-    mass_positions: NDArray
-    mesh_points: NDArray
-    mesh_triangles: NDArray
-    def mesh_vertices(self, q: Optional[ArrayLike] = None) -> NDArray: ...
-    def mass_points_at(self, q: Optional[ArrayLike] = None) -> NDArray: ...
-
-def load_body3(object: str, modes: Sequence[str] = ..., check: bool = True) -> BodyModel | BodyModel3:
+def load_body3(object: str, modes: Sequence[str] = ..., check: bool = True) -> BodyModel:
     """Deprecated (warns DeprecationWarning; removed in the next release): load_body."""
+class BodyModel3(BodyModel):
+    """Deprecated (warns DeprecationWarning when read; removed in the next release): BodyModel itself,
+    one class for 2D and 3D bodies (wobble.BodyModel3 is wobble.BodyModel)."""
 
 class Ground:
     enabled: bool
@@ -214,15 +209,15 @@ class World:
     status: WorldStatus
     def __init__(self, options: WorldOptions = ...) -> None: ...
     # Either dimension: a 3D body's q is [t, rotation vector r, γ], its q̇ [ṫ, body ω, γ̇].
-    def add_body(self, body: BodyModel | BodyModel3) -> int: ...
-    def body(self, body: int) -> BodyModel | BodyModel3: ...
+    def add_body(self, body: BodyModel) -> int: ...
+    def body(self, body: int) -> BodyModel: ...
     def q(self, body: int = 0) -> NDArray: ...
     def qd(self, body: int = 0) -> NDArray: ...
     def set_state(self, body: int, q: ArrayLike, qd: Optional[ArrayLike] = None) -> None: ...
     # Deprecated (each warns DeprecationWarning; removed in the next release): add_body, body,
     # q, qd, set_state under their old 3D names.
-    def add_body3(self, body: BodyModel | BodyModel3) -> int: ...
-    def body3(self, body: int) -> BodyModel | BodyModel3: ...
+    def add_body3(self, body: BodyModel) -> int: ...
+    def body3(self, body: int) -> BodyModel: ...
     def q3(self, body: int = 0) -> NDArray: ...
     def qd3(self, body: int = 0) -> NDArray: ...
     def set_state3(self, body: int, q: ArrayLike, qd: Optional[ArrayLike] = None) -> None: ...
@@ -270,7 +265,7 @@ class Trajectory:
 
 def simulate(world: World, duration: float, *, every: int = 1, fps: float = 0.0, max_steps: int = ...,
              max_record_mb: float = ...) -> Trajectory: ...
-def read_trajectory_csv(path: str, body: BodyModel) -> Trajectory: ...
+def read_trajectory_csv(path: str, body: BodyModel) -> Trajectory: ...  # a 2D body
 
 class RolloutResult:
     time: NDArray
@@ -281,7 +276,7 @@ class RolloutResult:
     status: list[str]
     messages: list[str]
 
-def rollout(body: BodyModel | BodyModel3, q0: ArrayLike, qd0: Optional[ArrayLike] = None, steps: int = 1, *,
+def rollout(body: BodyModel, q0: ArrayLike, qd0: Optional[ArrayLike] = None, steps: int = 1, *,
             options: WorldOptions = ..., mode_targets: Optional[ArrayLike] = None, every: int = 1,
             threads: int = 0, energies: bool = False, max_steps: int = ...,
             max_record_mb: float = ...) -> RolloutResult: ...
@@ -303,8 +298,8 @@ class TrialOutcome:
     failure: str
 
 class SynthesisProblem:
-    body: Optional[BodyModel | BodyModel3]  # the body of either dimension
-    body3: Optional[BodyModel | BodyModel3]  # deprecated (DeprecationWarning): body
+    body: Optional[BodyModel]  # the body of either dimension
+    body3: Optional[BodyModel]  # deprecated (DeprecationWarning): body
     options: WorldOptions
     q0: NDArray
     qd0: NDArray
@@ -388,7 +383,7 @@ class PoseFitResult:
     rounds: int
 
 # Every fit takes a 3D body too (points (K, 3) / (F, K, 3), q = [t, rotation vector, γ]).
-def fit_pose(body: BodyModel | BodyModel3, points: ArrayLike, *, mass_points: Optional[Sequence[int]] = None,
+def fit_pose(body: BodyModel, points: ArrayLike, *, mass_points: Optional[Sequence[int]] = None,
              lattice_coords: Optional[ArrayLike] = None, weights: Optional[ArrayLike] = None,
              initial_q: Optional[ArrayLike] = None, loss: str = "squared", loss_scale: float = 1.0,
              prior_weight: float = 0.0, mode_bounds: tuple[float, float] = (-1.0, 1.0),
@@ -401,7 +396,7 @@ class TrajectoryFitResult:
     rms_residual: float
     linear_solver: str
 
-def fit_trajectory(body: BodyModel | BodyModel3, times: ArrayLike, points: ArrayLike, mass_points: Sequence[int], *,
+def fit_trajectory(body: BodyModel, times: ArrayLike, points: ArrayLike, mass_points: Sequence[int], *,
                    smoothness: float = 1.0, loss: str = "squared", loss_scale: float = 1.0, prior_weight: float = 0.0,
                    mode_bounds: tuple[float, float] = (-1.0, 1.0), max_iterations: int = 200) -> TrajectoryFitResult: ...
 
@@ -418,7 +413,7 @@ class DynamicFitResult:
     rms_residual: float
     simulations: int
 
-def fit_dynamic(body: BodyModel | BodyModel3, times: ArrayLike, points: ArrayLike, mass_points: Sequence[int], *,
+def fit_dynamic(body: BodyModel, times: ArrayLike, points: ArrayLike, mass_points: Sequence[int], *,
                 q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None, stiffness: Optional[ArrayLike] = None,
                 damping: Optional[ArrayLike] = None, graph: Optional[PoseGraph] = None, options: WorldOptions = ...,
                 fit_q0: bool = True, fit_qd0: bool = True, fit_stiffness: bool = True, fit_damping: bool = True,
@@ -435,10 +430,10 @@ class StageCost:
         """(value, dq, dqd) at step n; dim 2 or 3 picks the body's form (0: the cost's own, 2D when both)."""
     def __add__(self, other: StageCost) -> StageCost: ...
 
-def centre_of_mass_at(body: BodyModel | BodyModel3, step: int, goal: ArrayLike, *, weight: float = 1.0,
+def centre_of_mass_at(body: BodyModel, step: int, goal: ArrayLike, *, weight: float = 1.0,
                       axes: str = ...) -> StageCost:
     """axes: 2D 'x', 'y', 'xy' (default 'xy'); 3D some of 'x', 'y', 'z' (default 'xyz')."""
-def centre_of_mass_velocity_at(body: BodyModel | BodyModel3, step: int, goal: ArrayLike, *, weight: float = 1.0,
+def centre_of_mass_velocity_at(body: BodyModel, step: int, goal: ArrayLike, *, weight: float = 1.0,
                                axes: str = ...) -> StageCost: ...
 def upright_at(step: int, *, weight: float = 1.0, time_scale: float = 0.0) -> StageCost:
     """2D w/2 (theta^2 + tau^2 thetadot^2); 3D w/2 (|R e_y - e_y|^2 + tau^2 |omega|^2). Serves both bodies."""
@@ -457,11 +452,11 @@ class RolloutGradient:
     targets: NDArray
     states_held: int
 
-def rollout_gradient(body: BodyModel | BodyModel3, cost: StageCost, *, targets: ArrayLike,
+def rollout_gradient(body: BodyModel, cost: StageCost, *, targets: ArrayLike,
                      options: WorldOptions = ..., q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
                      stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None,
                      checkpoint_interval: int = 0) -> RolloutGradient: ...
-def rollout_cost(body: BodyModel | BodyModel3, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
+def rollout_cost(body: BodyModel, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
                  q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
                  stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None) -> float: ...
 
@@ -478,7 +473,7 @@ class SpacetimeResult:
     best_start: int
     start_costs: list[float]
 
-def fit_spacetime(body: BodyModel | BodyModel3, task: StageCost, *, targets: ArrayLike, knots: int = 21,
+def fit_spacetime(body: BodyModel, task: StageCost, *, targets: ArrayLike, knots: int = 21,
                   bound: float = 0.3, control_weight: float = 1.0, options: WorldOptions = ...,
                   q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
                   stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None,
@@ -487,31 +482,32 @@ def fit_spacetime(body: BodyModel | BodyModel3, task: StageCost, *, targets: Arr
 
 # Deprecated (one release; issue 45): the 3D body's names of before. The functions warn
 # (DeprecationWarning) and call the names above, which take either body; upright_at3 and still_at3
-# give the 3D form only (as their StageCost3 did). The classes are the same class objects.
+# give the 3D form only (as their StageCost3 did). The classes are the same class objects and
+# warn when their old name is read, as BodyModel3 does.
 class StageCost3(StageCost):
     """Deprecated: StageCost itself (it takes either body)."""
 class RolloutGradient3(RolloutGradient):
     """Deprecated: RolloutGradient itself."""
-def centre_of_mass_at3(body: BodyModel3, step: int, goal: ArrayLike, *, weight: float = 1.0,
+def centre_of_mass_at3(body: BodyModel, step: int, goal: ArrayLike, *, weight: float = 1.0,
                        axes: str = "xyz") -> StageCost:
     """Deprecated: centre_of_mass_at."""
-def centre_of_mass_velocity_at3(body: BodyModel3, step: int, goal: ArrayLike, *, weight: float = 1.0,
+def centre_of_mass_velocity_at3(body: BodyModel, step: int, goal: ArrayLike, *, weight: float = 1.0,
                                 axes: str = "xyz") -> StageCost:
     """Deprecated: centre_of_mass_velocity_at."""
 def upright_at3(step: int, *, weight: float = 1.0, time_scale: float = 0.0) -> StageCost:
     """Deprecated: upright_at (its 3D form)."""
 def still_at3(step: int, *, weight: float = 1.0) -> StageCost:
     """Deprecated: still_at (its 3D form)."""
-def rollout_gradient3(body: BodyModel3, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
+def rollout_gradient3(body: BodyModel, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
                       q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
                       stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None,
                       checkpoint_interval: int = 0) -> RolloutGradient:
     """Deprecated: rollout_gradient."""
-def rollout_cost3(body: BodyModel3, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
+def rollout_cost3(body: BodyModel, cost: StageCost, *, targets: ArrayLike, options: WorldOptions = ...,
                   q0: Optional[ArrayLike] = None, qd0: Optional[ArrayLike] = None,
                   stiffness: Optional[ArrayLike] = None, damping: Optional[ArrayLike] = None) -> float:
     """Deprecated: rollout_cost."""
-def fit_spacetime3(body: BodyModel3, task: StageCost, *, targets: ArrayLike, knots: int = 21, bound: float = 0.3,
+def fit_spacetime3(body: BodyModel, task: StageCost, *, targets: ArrayLike, knots: int = 21, bound: float = 0.3,
                    control_weight: float = 1.0, options: WorldOptions = ..., q0: Optional[ArrayLike] = None,
                    qd0: Optional[ArrayLike] = None, stiffness: Optional[ArrayLike] = None,
                    damping: Optional[ArrayLike] = None, max_iterations: int = 100, starts: int = 1,
@@ -519,11 +515,12 @@ def fit_spacetime3(body: BodyModel3, task: StageCost, *, targets: ArrayLike, kno
     """Deprecated: fit_spacetime."""
 def write_target_schedule(path: str, modes: Sequence[str], dt: float, targets: ArrayLike) -> None: ...
 def read_target_schedule(path: str, modes: Sequence[str], dt: float) -> NDArray: ...
+# fit_pose_to_curves takes a 2D body, fit_pose_to_surface a 3D one (TypeError for the other dimension)
 def fit_pose_to_curves(body: BodyModel, polylines: Sequence[ArrayLike], *, closed: bool = False,
                        initial_q: Optional[ArrayLike] = None, loss: str = "squared", loss_scale: float = 1.0,
                        prior_weight: float = 0.0, mode_bounds: tuple[float, float] = (-1.0, 1.0),
                        max_iterations: int = 200) -> PoseFitResult: ...
-def fit_pose_to_surface(body: BodyModel3, *, vertices: Optional[ArrayLike] = None, triangles: Optional[ArrayLike] = None,
+def fit_pose_to_surface(body: BodyModel, *, vertices: Optional[ArrayLike] = None, triangles: Optional[ArrayLike] = None,
                         cloud: Optional[ArrayLike] = None, initial_q: Optional[ArrayLike] = None, loss: str = "squared",
                         loss_scale: float = 1.0, prior_weight: float = 0.0,
                         mode_bounds: tuple[float, float] = (-1.0, 1.0), max_iterations: int = 200,
@@ -544,6 +541,7 @@ class ModeSetReport:
     smallest_mode: str
     condition: ConditionNumber
 
+# condition_number, mass_matrix and check_mode_set take a 2D body (TypeError for a 3D one)
 def condition_number(body: BodyModel, q: Optional[ArrayLike] = None) -> ConditionNumber: ...
 def mass_matrix(body: BodyModel, q: Optional[ArrayLike] = None) -> NDArray: ...
 def angle_sweep(object: str, phis: Sequence[float], *, compress: float = 1.0,

@@ -61,11 +61,11 @@ def test_free_fall_follows_the_parabola_and_is_recorded(pot3):
 
 def test_one_loader_and_one_world_api_for_both_dimensions(pot3):
     assert isinstance(wobble.load_body(str(DATA / "table.obj")), wobble.BodyModel)
-    assert isinstance(pot3, wobble.BodyModel3)
+    assert isinstance(pot3, wobble.BodyModel) and pot3.dim == 3
     world = wobble.World(no_ground("rk4", 0.001))
     assert world.add_body(wobble.load_body(str(DATA / "table.obj"))) == 0
     assert world.add_body(pot3) == 1
-    assert isinstance(world.body(0), wobble.BodyModel) and isinstance(world.body(1), wobble.BodyModel3)
+    assert isinstance(world.body(0), wobble.BodyModel) and isinstance(world.body(1), wobble.BodyModel)
     assert world.q(0).shape == (3,) and world.q(1).shape == (9,)
     assert world.point_positions(0).shape[1] == 2 and world.point_positions(1).shape[1] == 3
     assert world.forces(1)["total"].shape == (9,)
@@ -128,7 +128,7 @@ def test_synthesis_of_the_3d_bounding_table_from_python():
     # threads equal to one at a time, and annealing that lowers the cost
     from conftest import bounding_table
     problem = bounding_table(DATA, "bounding_table3.wob").synthesis_problem()
-    assert isinstance(problem.body, wobble.BodyModel3) and problem.body.num_q == 6 + 4 and problem.num_active == 2
+    assert isinstance(problem.body, wobble.BodyModel) and problem.body.dim == 3 and problem.body.num_q == 6 + 4 and problem.num_active == 2
     with pytest.warns(DeprecationWarning, match="SynthesisProblem.body3 is deprecated: use SynthesisProblem.body"):
         assert problem.body3.num_q == 6 + 4
     problem.steps = 300

@@ -1,5 +1,5 @@
 """Gradients through whole 3D rollouts and 3D spacetime fits from Python (issue 18; the same
-functions as the 2D body's, given a BodyModel3): the adjoint
+functions as the 2D body's, given a 3D BodyModel): the adjoint
 gradient against central differences of the plain cost in the numbers Python passes (q0 with
 its rotation vector, qd0, targets, gains), stage costs written in Python, and a fit."""
 import numpy as np

@@ -76,13 +76,17 @@ def test_each_function_alias_warns_and_gives_the_new_result(pot3):
     np.testing.assert_array_equal(a.knots, b.knots)
 
 
-def test_the_class_aliases_are_the_classes(pot3):
-    assert wobble.StageCost3 is wobble.StageCost
-    assert wobble.RolloutGradient3 is wobble.RolloutGradient
+def test_the_class_aliases_are_the_classes_and_warn(pot3):
+    with pytest.warns(DeprecationWarning, match="StageCost3 is deprecated"):
+        stage_cost3 = wobble.StageCost3
+    with pytest.warns(DeprecationWarning, match="RolloutGradient3 is deprecated"):
+        rollout_gradient3 = wobble.RolloutGradient3
+    assert stage_cost3 is wobble.StageCost
+    assert rollout_gradient3 is wobble.RolloutGradient
     kw, steps = problem(pot3)
     g = wobble.rollout_gradient(pot3, wobble.still_at(steps, weight=1.0), **kw)
-    assert isinstance(g, wobble.RolloutGradient3)
-    assert isinstance(wobble.StageCost3(lambda n, q, qd: (0.0, None, None)), wobble.StageCost)
+    assert isinstance(g, rollout_gradient3)
+    assert isinstance(stage_cost3(lambda n, q, qd: (0.0, None, None)), wobble.StageCost)
 
 
 def test_one_function_takes_either_body_and_refuses_the_other_dimension_s_terms(pot3, table):
