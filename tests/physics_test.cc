@@ -247,26 +247,22 @@ TEST(Ground, GroupedScanVisitsExactlyThePointsBelowTheGround) {
   EXPECT_GE(partial, 10);  // partial contacts, where skipping groups matters
 }
 
-// The scan skips the point tree's nodes (body_model.h) whose box stays above the ground. Over
-// a long run of a 3,200-point table thrown spinning onto the ground (it bounces, lands on its
-// legs and top, rolls and slides), every step's scan visits exactly the points that a test of
-// every point finds below the ground, in that full scan's order (the clusters'), so the
-// contacts and the summed ground force are the full scan's, bit for bit; and the contacts the
-// step leaves are those points.
-TEST(Ground, TreeScanMatchesTheFullScanOverALongTumblingRun) {
-  const BodyModel body(TableDef(1100, 1000, 550.0 / 3200), {testing::Bend(4e5, 2.5e4), testing::Shear(4e5, 2.5e4)});
-  ASSERT_GT(body.clusters().size(), 1u);
-  WorldParams w;
-  BodyState<2, double> s = RestState<2, double>(body);
-  s.q[1] = 40.0;
-  s.q[2] = 0.4;  // tilted: it lands on one foot, rocks onto both and slides
-  // turning at 0.5 rad/s about its centre of mass c, which moves at (80, 0): ṫ = v − ω S R c
-  const Eigen::Vector2d c = Rotation(s.q[2]) * body.moments().c0 / body.moments().m;
-  s.qd[2] = 0.5;
-  s.qd.head<2>() = Eigen::Vector2d(80.0, 0.0) - s.qd[2] * Eigen::Vector2d(-c.y(), c.x());
+// Steps `body` from `s` and checks that every step's scan visits exactly the points that a test
+// of every point finds below the ground, in that full scan's order (the clusters'; for a small
+// body, point order), so the contacts and the summed ground force are the full scan's, bit for
+// bit; and that the contacts the step leaves are those points. Counts the steps touching and
+// those with fewer than `few` points below (where skipping matters).
+struct ScanRun {
   int touching = 0, partial = 0;
-  for (int step = 0; step < 6000; ++step) {
-    ASSERT_TRUE(StepBody(body, w, 0, Integrator::kThesis, 0.002, &s).ok()) << "step " << step;
+};
+ScanRun CheckScanAgainstTheExactTest(const BodyModel& body, const WorldParams& w, BodyState<2, double> s, double dt,
+                                     int steps, int few) {
+  ScanRun r;
+  for (int step = 0; step < steps; ++step) {
+    if (!StepBody(body, w, 0, Integrator::kThesis, dt, &s).ok()) {
+      ADD_FAILURE() << "the step failed at step " << step;
+      return r;
+    }
     const Frame<2, double> frame(s.q);
     std::vector<int> visited, expected;
     ForEachPointInContact(body, w.ground, s, frame,
@@ -278,24 +274,47 @@ TEST(Ground, TreeScanMatchesTheFullScanOverALongTumblingRun) {
         const Vec2<double> x = WorldFromLocal(frame, LocalPosition<double>(body.rest_local(k), body.mode_matrix(k), s.q));
         if (line.Height(x) < 0.0) expected.push_back(k);
       }
-    ASSERT_EQ(visited, expected) << "step " << step;
+    if (visited != expected) {
+      ADD_FAILURE() << "the scan's points differ from the exact test's at step " << step;
+      return r;
+    }
     std::vector<int> contacts;
     for (const Contact<2, double>& c : s.contacts) contacts.push_back(c.point);
     std::sort(expected.begin(), expected.end());
-    ASSERT_EQ(contacts, expected) << "step " << step;
-    touching += !expected.empty();
-    partial += !expected.empty() && int(expected.size()) < body.num_points() / 20;
+    if (contacts != expected) {
+      ADD_FAILURE() << "the step's contacts differ from the exact test's points at step " << step;
+      return r;
+    }
+    r.touching += !expected.empty();
+    r.partial += !expected.empty() && int(expected.size()) < few;
   }
-  EXPECT_GT(touching, 1500);  // the run is mostly in contact ...
-  EXPECT_GT(partial, 1500);   // ... through few points, where skipping matters
-  RecordProperty("steps_touching", touching);
-  RecordProperty("steps_with_few_points_below", partial);
+  return r;
+}
+
+// The scan skips the point tree's nodes (body_model.h) whose box stays above the ground, over
+// a long run of a 3,200-point table thrown spinning onto the ground (it bounces, lands on its
+// legs and top, rolls and slides).
+TEST(Ground, TreeScanMatchesTheFullScanOverALongTumblingRun) {
+  const BodyModel body(TableDef(1100, 1000, 550.0 / 3200), {testing::Bend(4e5, 2.5e4), testing::Shear(4e5, 2.5e4)});
+  ASSERT_GT(body.clusters().size(), 1u);
+  WorldParams w;
+  BodyState<2, double> s = RestState<2, double>(body);
+  s.q[1] = 40.0;
+  s.q[2] = 0.4;  // tilted: it lands on one foot, rocks onto both and slides
+  // turning at 0.5 rad/s about its centre of mass c, which moves at (80, 0): ṫ = v − ω S R c
+  const Eigen::Vector2d c = Rotation(s.q[2]) * body.moments().c0 / body.moments().m;
+  s.qd[2] = 0.5;
+  s.qd.head<2>() = Eigen::Vector2d(80.0, 0.0) - s.qd[2] * Eigen::Vector2d(-c.y(), c.x());
+  const ScanRun r = CheckScanAgainstTheExactTest(body, w, s, 0.002, 6000, body.num_points() / 20);
+  EXPECT_GT(r.touching, 1500);  // the run is mostly in contact ...
+  EXPECT_GT(r.partial, 1500);   // ... through few points, where skipping matters
+  RecordProperty("steps_touching", r.touching);
+  RecordProperty("steps_with_few_points_below", r.partial);
 }
 
 // A small body (one point group: every point is tested) on a sloped line: the per-point bound
-// before the exact test (PointClearOfPlane, as in 3D) skips only points the exact test rejects,
-// so over a long tumbling, deforming run every step's scan visits, in point order, exactly the
-// points below the line, and the contacts the step leaves are those points.
+// before the exact test (PointClearOfPlane, as in 3D) skips only points the exact test
+// rejects, over a long tumbling, deforming run.
 TEST(Ground, PointBoundScanMatchesTheFullScanOfASmallBody) {
   const BodyModel body(TableDef(), TableModes(2e5, 2e3));
   ASSERT_EQ(body.clusters().size(), 1u);
@@ -303,32 +322,13 @@ TEST(Ground, PointBoundScanMatchesTheFullScanOfASmallBody) {
   w.ground.slope = 0.2;
   BodyState<2, double> s = RestState<2, double>(body);
   s.q[1] = 15.0;
-  s.q[2] = 0.5;   // tilted against the slope: it lands on one foot, rocks onto both, slides
+  s.q[2] = 0.5;  // tilted against the slope: it lands on one foot, rolls over and slides down
   s.qd[0] = 5.0;
   s.qd[2] = 0.3;
-  int touching = 0, partial = 0;
-  for (int step = 0; step < 4000; ++step) {
-    ASSERT_TRUE(StepBody(body, w, 0, Integrator::kThesis, 0.01, &s).ok()) << "step " << step;
-    const Frame<2, double> frame(s.q);
-    std::vector<int> visited, expected;
-    ForEachPointInContact(body, w.ground, s, frame,
-                          [&](int k, const Vec2<double>&, const Vec2<double>&, const Vec2<double>&,
-                              const Vec2<double>&, const GroundFace&, int) { visited.push_back(k); });
-    const GroundFace line = w.ground.Face(0);
-    for (int k = 0; k < body.num_points(); ++k) {
-      const Vec2<double> x = WorldFromLocal(frame, LocalPosition<double>(body.rest_local(k), body.mode_matrix(k), s.q));
-      if (line.Height(x) < 0.0) expected.push_back(k);
-    }
-    ASSERT_EQ(visited, expected) << "step " << step;
-    std::vector<int> contacts;
-    for (const Contact<2, double>& c : s.contacts) contacts.push_back(c.point);
-    ASSERT_EQ(contacts, expected) << "step " << step;
-    touching += !expected.empty();
-    partial += !expected.empty() && int(expected.size()) < body.num_points();
-  }
-  EXPECT_GT(touching, 1000);  // of 4,000 steps
-  EXPECT_GT(partial, 1000);   // some points below, most above: where the bound skips
-  RecordProperty("steps_touching", touching);
+  const ScanRun r = CheckScanAgainstTheExactTest(body, w, s, 0.01, 4000, body.num_points());
+  EXPECT_GT(r.touching, 1000);  // of 4,000 steps
+  EXPECT_GT(r.partial, 1000);   // some points below, most above: where the bound skips
+  RecordProperty("steps_touching", r.touching);
 }
 
 TEST(Ground, SticksBelowFrictionCapAndSlidesAbove) {

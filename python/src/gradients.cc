@@ -317,7 +317,7 @@ template <int Dim> void BindRollouts(py::module_& m) {
       "dimension: 3D ground_plane; springs), dt and integrator: thesis or symplectic) and its gradient with respect to\n"
       "q0, qd0 (World coordinates; 3D q0 = [t, rotation vector, gamma]), K, c and every target, by one\n"
       "adjoint sweep: its cost does not grow with the number of parameters (README: Gradients).\n"
-      "checkpoint_interval: 0 keeps the whole run when it fits in 64 MiB, else checkpoints every\n"
+      "checkpoint_interval: 0 keeps the whole run when it fits in 4 MiB, else checkpoints every\n"
       "ceil(sqrt(steps)) steps; -1 always does; N > 0 every N steps.");
   m.def(
       "rollout_cost",
