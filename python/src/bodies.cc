@@ -56,9 +56,6 @@ template <int Dim> py::array_t<double> Points(const std::vector<Eigen::Matrix<do
 // f(body) with the body of whichever dimension b holds (f returns the same type for both).
 template <class F> auto Either(const PyBody& b, F&& f) { return b.b3 ? f(*b.b3) : f(*b.b2); }
 
-// The rigid coordinates (3 in 2D, 6 in 3D: t and a rotation vector) and one per mode.
-template <int Dim> int NumQ(const BodyModelN<Dim>& b) { return Group<Dim>::kRigidDofs + b.num_modes(); }
-
 // wobble.DeformationMode: a mode of either dimension, copied (a body's modes are few and small).
 struct PyMode {
   std::string name, source;
@@ -74,7 +71,7 @@ template <int Dim> PyMode ModeOf(const DeformationModeN<Dim>& d) {
 
 // (N, Dim) world positions of the mass points at q (None: 0), as the fits place them.
 template <int Dim> py::array_t<double> MassPointsAt(const BodyModelN<Dim>& b, const py::object& q_in) {
-  const int n = NumQ(b);
+  const int n = b.num_q();
   const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
   std::vector<Eigen::Matrix<double, Dim, 1>> x;
   for (int k = 0; k < b.num_points(); ++k)
@@ -220,7 +217,7 @@ void BindBodies(py::module_& m) {
       .def_property_readonly("name", &PyBody::name)
       .def_property_readonly("dim", &PyBody::dim, "2 or 3: the dimension of the lattice, points and q")
       .def_property_readonly("num_modes", [](const PyBody& b) { return Either(b, [](const auto& x) { return x.num_modes(); }); })
-      .def_property_readonly("num_q", [](const PyBody& b) { return Either(b, [](const auto& x) { return NumQ(x); }); },
+      .def_property_readonly("num_q", [](const PyBody& b) { return Either(b, [](const auto& x) { return x.num_q(); }); },
                              "3 rigid coordinates (3D: 6) + one per mode")
       .def_property_readonly("num_points", [](const PyBody& b) { return Either(b, [](const auto& x) { return x.num_points(); }); },
                              "mass points")
@@ -285,7 +282,7 @@ void BindBodies(py::module_& m) {
           "mesh_vertices",
           [](const PyBody& body, const py::object& q_in) {
             const BodyModelN<3>& b = body.Need<3>("mesh_vertices");
-            const int n = NumQ(b);
+            const int n = b.num_q();
             const Eigen::VectorXd q = q_in.is_none() ? Eigen::VectorXd::Zero(n) : AsVector(q_in, n, "q");
             const Eigen::Quaterniond R = ExpRotation<double>(Eigen::Vector3d(q.segment<3>(3)));
             const Eigen::VectorXd gamma = q.tail(b.num_modes());
