@@ -440,8 +440,10 @@ TEST(Body3, PointGroupsFindExactlyThePointsBelowTheGround) {
 // `order` (the order the scan visits them), finds below the plane, x = t + R (b0 + B γ), and
 // the contacts the step leaves are those points. Counts the steps touching the plane and those
 // with fewer than num_points / few_below_divisor points below it.
+// Each step is also redone from the same state without the memo of earlier walks of the point
+// tree (PlaneScanMemo): the contacts, anchors and ground force must be the same bit for bit.
 struct ScanRun {
-  int touching = 0, partial = 0;
+  int touching = 0, partial = 0, reused = 0;
 };
 ScanRun CheckScanAgainstTheExactTest(const BodyModelN<3>& body, BodyState<3, double> s, const std::vector<int>& order,
                                      int few_below_divisor) {
@@ -450,6 +452,7 @@ ScanRun CheckScanAgainstTheExactTest(const BodyModelN<3>& body, BodyState<3, dou
   w.ground_plane.normal = Vector3d(0.2, 1.0, -0.1).normalized();
   ScanRun r;
   for (int step = 0; step < 4000; ++step) {
+    const BodyState<3, double> before = s;
     EXPECT_TRUE(StepBody(body, w, 0, Integrator::kThesis, 0.002, &s).ok()) << "step " << step;
     const Frame<3, double> frame(s.q);
     std::vector<int> visited, expected;
@@ -465,9 +468,21 @@ ScanRun CheckScanAgainstTheExactTest(const BodyModelN<3>& body, BodyState<3, dou
     for (const Contact<3, double>& c : s.contacts) contacts.push_back(c.point);
     std::sort(expected.begin(), expected.end());
     EXPECT_EQ(contacts, expected) << "step " << step;
+    BodyState<3, double> fresh = s;
+    fresh.contacts = before.contacts;
+    fresh.scan_memo = PlaneScanMemo<3>();
+    UpdateContacts(body, w.ground_plane, &fresh);
+    EXPECT_EQ(fresh.contacts.size(), s.contacts.size()) << "step " << step;
+    for (size_t i = 0; i < std::min(fresh.contacts.size(), s.contacts.size()); ++i)
+      EXPECT_TRUE(fresh.contacts[i].point == s.contacts[i].point && fresh.contacts[i].face == s.contacts[i].face &&
+                  fresh.contacts[i].anchor == s.contacts[i].anchor)
+          << "step " << step << ", contact " << i;
+    EXPECT_TRUE(fresh.ground_cache.force == s.ground_cache.force && fresh.penetration == s.penetration)
+        << "step " << step;
     if (::testing::Test::HasFailure()) return r;  // one step's report is enough
     r.touching += !expected.empty();
     r.partial += !expected.empty() && int(expected.size()) < body.num_points() / few_below_divisor;
+    r.reused += !expected.empty() && before.scan_memo.valid && s.scan_memo.offset == before.scan_memo.offset;
   }
   return r;
 }
@@ -498,6 +513,7 @@ TEST(Body3, TreeScanMatchesTheFullScanOverALongTumblingRun) {
   EXPECT_GT(r.partial, 100);
   RecordProperty("steps_touching", r.touching);
   RecordProperty("steps_with_few_points_below", r.partial);
+  RecordProperty("steps_reusing_the_walk", r.reused);
 }
 
 // A small body (one point group: every point is tested): the per-point bound before the exact

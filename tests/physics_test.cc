@@ -252,13 +252,18 @@ TEST(Ground, GroupedScanVisitsExactlyThePointsBelowTheGround) {
 // body, point order), so the contacts and the summed ground force are the full scan's, bit for
 // bit; and that the contacts the step leaves are those points. Counts the steps touching and
 // those with fewer than `few` points below (where skipping matters).
+// The step's contact update may skip the point tree's walk on the memo of an earlier one
+// (PlaneScanMemo): each step is also redone from the same state with no memo, and the contacts,
+// anchors and ground force must be the same bit for bit. Counts the touching steps that
+// skipped the walk (`reused`).
 struct ScanRun {
-  int touching = 0, partial = 0;
+  int touching = 0, partial = 0, reused = 0;
 };
 ScanRun CheckScanAgainstTheExactTest(const BodyModel& body, const WorldParams& w, BodyState<2, double> s, double dt,
                                      int steps, int few) {
   ScanRun r;
   for (int step = 0; step < steps; ++step) {
+    const BodyState<2, double> before = s;
     if (!StepBody(body, w, 0, Integrator::kThesis, dt, &s).ok()) {
       ADD_FAILURE() << "the step failed at step " << step;
       return r;
@@ -285,8 +290,22 @@ ScanRun CheckScanAgainstTheExactTest(const BodyModel& body, const WorldParams& w
       ADD_FAILURE() << "the step's contacts differ from the exact test's points at step " << step;
       return r;
     }
+    BodyState<2, double> fresh = s;
+    fresh.contacts = before.contacts;
+    fresh.scan_memo = PlaneScanMemo<2>();
+    UpdateContacts(body, w.ground, &fresh);
+    bool same = fresh.contacts.size() == s.contacts.size() && fresh.ground_cache.force == s.ground_cache.force &&
+                fresh.penetration == s.penetration;
+    for (size_t i = 0; same && i < s.contacts.size(); ++i)
+      same = fresh.contacts[i].point == s.contacts[i].point && fresh.contacts[i].face == s.contacts[i].face &&
+             fresh.contacts[i].anchor == s.contacts[i].anchor;
+    if (!same) {
+      ADD_FAILURE() << "the contact update with the memo differs from a fresh walk's at step " << step;
+      return r;
+    }
     r.touching += !expected.empty();
     r.partial += !expected.empty() && int(expected.size()) < few;
+    r.reused += !expected.empty() && before.scan_memo.valid && s.scan_memo.offset == before.scan_memo.offset;
   }
   return r;
 }
@@ -310,6 +329,26 @@ TEST(Ground, TreeScanMatchesTheFullScanOverALongTumblingRun) {
   EXPECT_GT(r.partial, 1500);   // ... through few points, where skipping matters
   RecordProperty("steps_touching", r.touching);
   RecordProperty("steps_with_few_points_below", r.partial);
+  RecordProperty("steps_reusing_the_walk", r.reused);
+}
+
+// A 3,200-point table dropped on its feet comes to rest, and then its contact updates reuse
+// the point tree's walk of an earlier step on most steps (PlaneScanMemo), with the contacts
+// and force of a fresh walk bit for bit (CheckScanAgainstTheExactTest redoes every step).
+TEST(Ground, ARestingBodyReusesItsTreeWalk) {
+  const BodyModel body(TableDef(1100, 1000, 550.0 / 3200), {testing::Bend(4e5, 2.5e4), testing::Shear(4e5, 2.5e4)});
+  ASSERT_GT(body.clusters().size(), 1u);
+  WorldParams w;
+  BodyState<2, double> s = RestState<2, double>(body);
+  s.q[1] = 10.0;
+  const ScanRun landing = CheckScanAgainstTheExactTest(body, w, s, 0.01, 1000, body.num_points() / 20);
+  EXPECT_GT(landing.touching, 500);  // it falls, lands and settles within the first 1,000 steps
+  for (int i = 0; i < 1000; ++i) ASSERT_TRUE(StepBody(body, w, 0, Integrator::kThesis, 0.01, &s).ok());
+  const ScanRun resting = CheckScanAgainstTheExactTest(body, w, s, 0.01, 500, body.num_points() / 20);
+  EXPECT_EQ(resting.touching, 500);
+  EXPECT_GT(resting.reused, 400);  // of 500 steps at rest
+  RecordProperty("landing_steps_reusing_the_walk", landing.reused);
+  RecordProperty("resting_steps_reusing_the_walk", resting.reused);
 }
 
 // A small body (one point group: every point is tested) on a sloped line: the per-point bound

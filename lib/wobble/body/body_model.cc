@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -266,6 +267,8 @@ void BuildTreeNode(const BodyModelN<Dim>& body, int lo, int hi, const std::vecto
 template <int Dim> void BodyModelN<Dim>::BuildTree() {
   tree_ = PointTreeN<Dim>();
   if (clusters_.size() <= 1) return;  // small bodies: the scan tests every point
+  static std::atomic<std::uint64_t> serials{0};
+  tree_.serial = ++serials;
   tree_.width = Dim * (num_modes() + 1);
   tree_.stride = 2 * tree_.width + Dim;
   std::vector<int> group_starts;

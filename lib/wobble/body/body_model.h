@@ -8,6 +8,8 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -108,12 +110,28 @@ using PointCluster = PointClusterN<2>;
 // |centre| + half over the mode columns (for a coarse first test, PlaneReach).
 template <int Dim> struct PointTreeN {
   static constexpr int kLeafPoints = 4;
+  std::uint64_t serial = 0;  // unique per tree built (copies share it): a scan memo's key
   int width = 0, stride = 0;
   std::vector<double> bounds;
   std::vector<int> skip;
   std::vector<int> first, last;  // a leaf's points: leaf_ranks[first, last); empty for inner nodes
   std::vector<int> leaf_ranks;   // ascending within a leaf
   std::vector<int> by_rank;      // the scan order (the clusters', each ascending): rank -> point
+};
+
+// What the last full walk of a point tree against a plane found, kept with the body's state
+// between steps (BodyState::scan_memo): the plane test's numbers (PlaneReach's), the leaves that
+// reached, and the least amount by which a rejected node's bound cleared the margin. A body at
+// rest moves so little from step to step that those leaves still hold every point that can
+// reach (PlaneReach::StillCovers) for many steps: the scan then skips the walk.
+template <int Dim> struct PlaneScanMemo {
+  bool valid = false;
+  std::uint64_t tree = 0;  // the serial of the tree walked
+  int width = 0;           // the tree's: Dim (D + 1)
+  double offset = 0.0, margin = 0.0;
+  double slack = 0.0;  // min over rejected nodes of (bound − margin); +inf when none was
+  double w[Dim * (kMaxModes + 1)] = {}, coarse[Dim] = {};
+  std::vector<int> leaves;  // node indices, in walk order
 };
 
 // Whether a node of the tree may reach below a plane of body-frame normal n at offset
@@ -147,18 +165,47 @@ template <int Dim> class PlaneReach {
     for (int a = 0; a < Dim; ++a) coarse_[a] = gamma_norm * n_abs[a];
     margin_ = 1e-10 * (scale + std::abs(offset) + extent);
   }
-  bool operator()(const double* box, bool leaf) const {
+  bool operator()(const double* box, bool leaf) const { return Lower(box, leaf) < margin_; }
+  // The bound that decides a node: the coarse one, and for a leaf the full one if the coarse
+  // one lets it through.
+  double Lower(const double* box, bool leaf) const {
     const double* half = box + width_;
     const double* rho = half + width_;
     double lower = offset_;
     for (int a = 0; a < Dim; ++a) lower += w_[a] * box[a] - w_abs_[a] * half[a] - coarse_[a] * rho[a];
-    if (!(lower < margin_)) return false;
-    if (!leaf) return true;
+    if (!(lower < margin_) || !leaf) return lower;
     lower = offset_;
     for (int j = 0; j < width_; ++j) lower += w_[j] * box[j] - w_abs_[j] * half[j];
-    return lower < margin_;
+    return lower;
   }
   double margin() const { return margin_; }
+
+  // Saves this test's numbers in *memo (the walk fills in leaves and slack).
+  void Remember(const PointTreeN<Dim>& tree, PlaneScanMemo<Dim>* memo) const {
+    memo->tree = tree.serial;
+    memo->width = width_;
+    memo->offset = offset_;
+    memo->margin = margin_;
+    std::copy(w_, w_ + width_, memo->w);
+    std::copy(coarse_, coarse_ + Dim, memo->coarse);
+  }
+  // Whether every node the memo's walk rejected is still rejected by this test, so that the
+  // memo's leaves hold every point that can reach. Both bounds of a node are affine in
+  // (offset, w, coarse) with coefficients |centre| + half (and ρ) of the node, at most the
+  // root's (each node's boxes lie in its parent's): a node's bound moved by at most
+  //   Δ = |Δoffset| + Σ_j |Δw_j| (|centre_j| + half_j)_root + Σ_a |Δcoarse_a| ρ_root,a.
+  // A rejected node had bound ≥ margin_then + slack; it is still clear of the plane by more
+  // than this test's margin when margin_then + slack − Δ ≥ margin_now (Δ widened by 1e-9 for
+  // its own rounding; NaN or inf anywhere answers no).
+  bool StillCovers(const PlaneScanMemo<Dim>& memo, const PointTreeN<Dim>& tree) const {
+    if (!memo.valid || memo.tree != tree.serial || memo.width != width_) return false;
+    const double* root = tree.bounds.data();
+    const double* rho = root + 2 * width_;
+    double delta = std::abs(offset_ - memo.offset);
+    for (int j = 0; j < width_; ++j) delta += std::abs(w_[j] - memo.w[j]) * (std::abs(root[j]) + root[width_ + j]);
+    for (int a = 0; a < Dim; ++a) delta += std::abs(coarse_[a] - memo.coarse[a]) * rho[a];
+    return memo.margin + memo.slack - delta * (1.0 + 1e-9) >= margin_;
+  }
 
  private:
   int width_;
@@ -277,27 +324,64 @@ template <int Dim> class BodyModelN {
   // looser bound, since a wrong "yes" there costs only the children's tests. visit must not
   // start another scan on this thread.
   template <class Reaches, class Visit> void ForEachPointInReach(Reaches&& reaches, Visit&& visit) const {
-    thread_local std::vector<int> ranks;
-    ranks.clear();
-    bool sorted = true;
+    thread_local std::vector<int> leaves;
+    CollectLeavesInReach(reaches, &leaves);
+    VisitLeaves(leaves, visit);
+  }
+  // The same for a plane, with the memo of the last walk (PlaneScanMemo): when the memo still
+  // covers this test, its leaves are visited without a walk; otherwise the tree is walked and
+  // the memo rewritten. Either way visit(k) sees the same points in the same order as
+  // ForEachPointInReach, except points of leaves that the walk would have rejected, which the
+  // caller's exact test rejects too.
+  template <class Visit>
+  void ForEachPointInPlaneReach(const PlaneReach<Dim>& reach, PlaneScanMemo<Dim>* memo, Visit&& visit) const {
+    if (!reach.StillCovers(*memo, tree_)) {
+      double slack = std::numeric_limits<double>::infinity();
+      CollectLeavesInReach(
+          [&](const double* box, bool leaf) {
+            const double lower = reach.Lower(box, leaf);
+            if (lower < reach.margin()) return true;
+            slack = std::min(slack, lower - reach.margin());
+            return false;
+          },
+          &memo->leaves);
+      reach.Remember(tree_, memo);
+      memo->slack = slack;
+      memo->valid = slack == slack;  // a NaN bound: walk again next time
+    }
+    VisitLeaves(memo->leaves, visit);
+  }
+
+ private:
+  // The leaves (node indices, in walk order) of the nodes that reaches() accepts with every
+  // ancestor; a rejected node's subtree is skipped.
+  template <class Reaches> void CollectLeavesInReach(Reaches&& reaches, std::vector<int>* leaves) const {
+    leaves->clear();
     const int n = int(tree_.skip.size());
     for (int i = 0; i < n;) {
-      const int first = tree_.first[size_t(i)], last = tree_.last[size_t(i)];
-      if (!reaches(tree_.bounds.data() + size_t(i) * size_t(tree_.stride), first < last)) {
+      const bool leaf = tree_.first[size_t(i)] < tree_.last[size_t(i)];
+      if (!reaches(tree_.bounds.data() + size_t(i) * size_t(tree_.stride), leaf)) {
         i = tree_.skip[size_t(i)];
         continue;
       }
-      if (first < last) {
-        if (!ranks.empty() && tree_.leaf_ranks[size_t(first)] < ranks.back()) sorted = false;
-        ranks.insert(ranks.end(), tree_.leaf_ranks.begin() + first, tree_.leaf_ranks.begin() + last);
-      }
+      if (leaf) leaves->push_back(i);
       ++i;
+    }
+  }
+  // visit(k) for the points of those leaves in scan order.
+  template <class Visit> void VisitLeaves(const std::vector<int>& leaves, Visit&& visit) const {
+    thread_local std::vector<int> ranks;
+    ranks.clear();
+    bool sorted = true;
+    for (int i : leaves) {
+      const int first = tree_.first[size_t(i)], last = tree_.last[size_t(i)];
+      if (!ranks.empty() && tree_.leaf_ranks[size_t(first)] < ranks.back()) sorted = false;
+      ranks.insert(ranks.end(), tree_.leaf_ranks.begin() + first, tree_.leaf_ranks.begin() + last);
     }
     if (!sorted) std::sort(ranks.begin(), ranks.end());
     for (int r : ranks) visit(tree_.by_rank[size_t(r)]);
   }
 
- private:
   BodyDefN<Dim> def_;
   std::vector<DeformationModeN<Dim>> modes_;
   std::vector<Point> lattice_coords_, rest_local_, rest_control_;

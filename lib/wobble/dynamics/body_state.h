@@ -124,6 +124,11 @@ template <int Dim, class T> struct BodyState {
     VecQ<T> q, qd, force;
     GroundOf<Dim> ground;
   } ground_cache;
+  // What UpdateContacts' last walk of a large body's point tree found (body_model.h): a body at
+  // rest then scans the same few leaves without walking the tree. Any state is valid with any
+  // memo (it keeps the plane test's numbers and checks how far they moved), so copying or
+  // replacing q never makes it wrong, only slower once.
+  PlaneScanMemo<Dim> scan_memo;
   // PD targets γ0 of the modes (chapter 5: Q_r = −(C(q − q0) + D q̇)); empty means all zero,
   // i.e. every mode is passive and pulled back to its rest shape. Set by wobble/control.
   VecD<T> mode_target;

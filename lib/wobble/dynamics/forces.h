@@ -120,7 +120,7 @@ template <int Dim, class T> void UpdateContacts(const BodyModelN<Dim>& body, con
     AddGeneralizedForce(frame, l, body.mode_matrix(k), f, &cache.force);
     next.push_back({k, anchor, face_index});
     s->penetration = std::max(s->penetration, -double(ScalarValue(face.Height(x))));
-  });
+  }, ContactSet::kDetect, &s->scan_memo);
   // groups are visited in lattice order, not point order; a resting body's few contacts
   // usually come out sorted already
   if (body.clusters().size() > 1 && !std::is_sorted(next.begin(), next.end(), ContactBefore<Dim, T>))

@@ -95,10 +95,11 @@ template <class T, class V, class C, class F>
 // x world, v velocity, anchor its contact's anchor (existing, or the entry point projected on
 // the face for a new contact), face the ground face it feels (a point in a terrain's valley is
 // visited once per face). Bodies clear of the ground by the hull test cost nothing. `frame` is
-// Frame(s.q), made once by the caller.
+// Frame(s.q), made once by the caller. With `memo` (the state's own, by the once-a-step contact
+// update) a large body on the line skips the point tree's walk while the last one still holds.
 template <class T, class F>
 void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodyState<2, T>& s, const Frame<2, T>& frame, F&& f,
-                           ContactSet set = ContactSet::kDetect) {
+                           ContactSet set = ContactSet::kDetect, PlaneScanMemo<2>* memo = nullptr) {
   if (!g.enabled) return;
   const GroundFace line = g.Face(0);
   auto point_at = [&](int k, Vec2<T>* l, Vec2<T>* x) {
@@ -149,7 +150,11 @@ void ForEachPointInContact(const BodyModel& body, const Ground& g, const BodySta
   const PlaneReach<2> below_line(body.point_tree(), D, n_local, offset, scale,
                                  [&](int d) { return ScalarValue(s.q[kRigidDofs + d]); });
   if (!g.terrain) {
-    body.ForEachPointInReach(below_line, visit);
+    if (memo) {
+      body.ForEachPointInPlaneReach(below_line, memo, visit);
+    } else {
+      body.ForEachPointInReach(below_line, visit);
+    }
     return;
   }
   body.ForEachPointInReach(

@@ -52,10 +52,12 @@ void ForEachFaceFelt(const GroundPlane& g, const Vec3<T>& x, ContactsOf&& contac
 }
 
 // The (point, face) pairs the ground acts on during an evaluation (ContactSet of the 2D body):
-// f(k, l, x, v, anchor, plane, face) with the face's plane (the 2D visitor's order).
+// f(k, l, x, v, anchor, plane, face) with the face's plane (the 2D visitor's order). `memo`: as
+// in 2D, the walk of a large body's point tree skipped while the last one still holds.
 template <class T, class F>
 void ForEachPointInContact(const BodyModelN<3>& body, const GroundPlane& g, const BodyState<3, T>& s,
-                            const Frame<3, T>& frame, F&& f, ContactSet set = ContactSet::kDetect) {
+                            const Frame<3, T>& frame, F&& f, ContactSet set = ContactSet::kDetect,
+                            PlaneScanMemo<3>* memo = nullptr) {
   if (!g.enabled) return;
   if (set == ContactSet::kFrozen) {
     for (const Contact<3, T>& c : s.contacts) {
@@ -110,10 +112,13 @@ void ForEachPointInContact(const BodyModelN<3>& body, const GroundPlane& g, cons
   }
   // large bodies: only the points of the point tree's nodes whose box reaches below the plane
   // (as in 2D, ground_line.h)
-  body.ForEachPointInReach(PlaneReach<3>(body.point_tree(), D, n_local, offset,
-                                         t.cwiseAbs().sum() + through.cwiseAbs().sum(),
-                                         [&](int d) { return ScalarValue(s.q[Group<3>::kRigidParams + d]); }),
-                           visit);
+  const PlaneReach<3> below_plane(body.point_tree(), D, n_local, offset, t.cwiseAbs().sum() + through.cwiseAbs().sum(),
+                                  [&](int d) { return ScalarValue(s.q[Group<3>::kRigidParams + d]); });
+  if (memo) {
+    body.ForEachPointInPlaneReach(below_plane, memo, visit);
+  } else {
+    body.ForEachPointInReach(below_plane, visit);
+  }
 }
 
 // Eq. 4.24/4.25 in the plane's frame: f_n = −K Δn − C_dam v_n (never pulling),
