@@ -310,15 +310,26 @@ ScanRun CheckScanAgainstTheExactTest(const BodyModel& body, const WorldParams& w
   return r;
 }
 
+// A table of 3,200 points in point groups (so the scan walks the point tree), at rest at
+// height y.
+const BodyModel& Table3200() {
+  static const BodyModel body(TableDef(1100, 1000, 550.0 / 3200), {testing::Bend(4e5, 2.5e4), testing::Shear(4e5, 2.5e4)});
+  return body;
+}
+BodyState<2, double> Table3200At(double y) {
+  BodyState<2, double> s = RestState<2, double>(Table3200());
+  s.q[1] = y;
+  return s;
+}
+
 // The scan skips the point tree's nodes (body_model.h) whose box stays above the ground, over
 // a long run of a 3,200-point table thrown spinning onto the ground (it bounces, lands on its
 // legs and top, rolls and slides).
 TEST(Ground, TreeScanMatchesTheFullScanOverALongTumblingRun) {
-  const BodyModel body(TableDef(1100, 1000, 550.0 / 3200), {testing::Bend(4e5, 2.5e4), testing::Shear(4e5, 2.5e4)});
+  const BodyModel& body = Table3200();
   ASSERT_GT(body.clusters().size(), 1u);
   WorldParams w;
-  BodyState<2, double> s = RestState<2, double>(body);
-  s.q[1] = 40.0;
+  BodyState<2, double> s = Table3200At(40.0);
   s.q[2] = 0.4;  // tilted: it lands on one foot, rocks onto both and slides
   // turning at 0.5 rad/s about its centre of mass c, which moves at (80, 0): ṫ = v − ω S R c
   const Eigen::Vector2d c = Rotation(s.q[2]) * body.moments().c0 / body.moments().m;
@@ -336,11 +347,9 @@ TEST(Ground, TreeScanMatchesTheFullScanOverALongTumblingRun) {
 // the point tree's walk of an earlier step on most steps (PlaneScanMemo), with the contacts
 // and force of a fresh walk bit for bit (CheckScanAgainstTheExactTest redoes every step).
 TEST(Ground, ARestingBodyReusesItsTreeWalk) {
-  const BodyModel body(TableDef(1100, 1000, 550.0 / 3200), {testing::Bend(4e5, 2.5e4), testing::Shear(4e5, 2.5e4)});
-  ASSERT_GT(body.clusters().size(), 1u);
+  const BodyModel& body = Table3200();
   WorldParams w;
-  BodyState<2, double> s = RestState<2, double>(body);
-  s.q[1] = 10.0;
+  BodyState<2, double> s = Table3200At(10.0);
   const ScanRun landing = CheckScanAgainstTheExactTest(body, w, s, 0.01, 1000, body.num_points() / 20);
   EXPECT_GT(landing.touching, 500);  // it falls, lands and settles within the first 1,000 steps
   for (int i = 0; i < 1000; ++i) ASSERT_TRUE(StepBody(body, w, 0, Integrator::kThesis, 0.01, &s).ok());
