@@ -72,10 +72,15 @@ template std::shared_ptr<const BodyModel> LoadBody<2>(const BodyFiles&, bool);
 template std::shared_ptr<const BodyModelN<3>> LoadBody<3>(const BodyFiles&, bool);
 
 void CheckOutputFolder(const std::string& folder) {
+  CheckOutputFile("--out", (std::filesystem::path(folder) / ".wobble-probe").string());  // leaves nothing behind
+}
+
+void CheckOutputFile(const std::string& flag, const std::string& path) {
+  if (path.empty()) return;
   try {
-    formats::CheckWritable((std::filesystem::path(folder) / ".wobble-probe").string());  // leaves nothing behind
+    formats::CheckWritable(path);
   } catch (const std::runtime_error& e) {
-    throw UsageError(std::string("--out: ") + e.what());
+    throw UsageError(flag + ": " + e.what());
   }
 }
 
@@ -113,10 +118,8 @@ std::vector<std::string> ListWords(const std::string& text) {
 std::vector<double> ParseNumbers(const std::string& text, const std::string& flag) {
   std::vector<double> out;
   for (const std::string& word : ListWords(text)) {
-    char* end = nullptr;
-    const double v = std::strtod(word.c_str(), &end);
-    if (end == word.c_str() || *end != '\0' || !std::isfinite(v))
-      throw UsageError(flag + ": '" + word + "' is not a finite number");
+    double v = 0.0;
+    if (!formats::detail::ParseNumber(word, &v)) throw UsageError(flag + ": '" + word + "' is not a finite number");
     out.push_back(v);
   }
   return out;
@@ -294,14 +297,16 @@ Eigen::VectorXd ParseNumbers(const std::string& text, const std::string& what, i
   std::string token;
   auto flush = [&]() {
     if (token.empty()) return;
-    errno = 0;
-    char* end = nullptr;
-    const double v = std::strtod(token.c_str(), &end);
-    if (end != token.c_str() + token.size())
-      throw UsageError(what + ": '" + token + "' is not a number (expected " + std::to_string(expected_size) +
-                       " numbers: " + names + ")");
-    if (!std::isfinite(v) || errno == ERANGE)
+    // the one number grammar of wobble's files (subnormals are finite numbers: accepted)
+    double v = 0.0;
+    if (!formats::detail::ParseNumber(token, &v)) {
+      char* end = nullptr;
+      std::strtod(token.c_str(), &end);  // only to tell "inf", "nan" and 1e999 from words
+      if (end != token.c_str() + token.size())
+        throw UsageError(what + ": '" + token + "' is not a number (expected " + std::to_string(expected_size) +
+                         " numbers: " + names + ")");
       throw UsageError(what + ": '" + token + "' is not a finite number");
+    }
     values.push_back(v);
     token.clear();
   };

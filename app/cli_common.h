@@ -136,6 +136,9 @@ Eigen::VectorXd ParseNumbers(const std::string& text, const std::string& what, i
 // An output folder that can be written (made if missing): a UsageError (exit 2) before any work
 // otherwise, the same for every subcommand.
 void CheckOutputFolder(const std::string& folder);
+// The same for an output file given by `flag` (nothing to check when `path` is empty): its
+// folder is made, and it and its temporary file must be regular files or absent.
+void CheckOutputFile(const std::string& flag, const std::string& path);
 
 // Requires a finite number, optionally positive or non-negative.
 void RequireFinite(double value, const std::string& what);

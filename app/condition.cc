@@ -302,6 +302,7 @@ int PrintModeSetReport(const analysis::ModeSetReport& r, const std::string& body
 int RunConditionCheck(const ConditionCheckArgs& a) {
   RequirePositive(a.warn_angle_deg, "--warn-angle");
   RequireNonNegative(a.warn_visibility, "--warn-visibility");
+  CheckOutputFile("--json", a.json);
   analysis::ModeCheckOptions options;
   options.warn_angle_deg = a.warn_angle_deg;
   options.warn_visibility = a.warn_visibility;

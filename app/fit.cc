@@ -12,6 +12,7 @@
 
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/csv.h"
+#include "wobble/formats/line_reader.h"
 #include "wobble/fit/dynamic_fit.h"
 #include "wobble/core/rotation3.h"
 #include "wobble/fit/pose_fit.h"
@@ -77,14 +78,8 @@ template <int Dim> fit::PoseFitOptions PoseOptions(const FitFlags& f, const Body
 }
 
 void CheckOutputs(const FitFlags& f) {
-  for (const std::string* path : {&f.out, &f.costs}) {
-    if (path->empty()) continue;
-    try {
-      formats::CheckWritable(*path);
-    } catch (const std::runtime_error& e) {
-      throw UsageError(std::string(path == &f.out ? "--out: " : "--costs: ") + e.what());
-    }
-  }
+  CheckOutputFile("--out", f.out);
+  CheckOutputFile("--costs", f.costs);
 }
 
 json ReportJson(const fit::FitReport& r) {
@@ -534,9 +529,8 @@ control::PoseGraph ParsePoseGraph(const std::string& text, int num_active, bool 
     std::istringstream words(item);
     std::vector<double> v;
     for (std::string w; words >> w;) {
-      char* end = nullptr;
-      const double x = std::strtod(w.c_str(), &end);
-      if (end == w.c_str() || *end != '\0' || !std::isfinite(x)) throw UsageError("--poses: '" + w + "' is not a number");
+      double x = 0.0;
+      if (!formats::detail::ParseNumber(w, &x)) throw UsageError("--poses: '" + w + "' is not a number");
       v.push_back(x);
     }
     if (v.empty()) continue;

@@ -161,14 +161,8 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
   if (a.max_iterations < 1) throw UsageError("--max-iterations must be at least 1");
   if (a.rise.empty() && a.reach.empty() && !a.upright && !a.still)
     throw UsageError("no task: give --rise, --reach, --upright and/or --still");
-  for (const std::string* path : {&a.targets, &a.out})
-    if (!path->empty()) {
-      try {
-        formats::CheckWritable(*path);
-      } catch (const std::runtime_error& e) {
-        throw UsageError((path == &a.targets ? "--targets: " : "--out: ") + std::string(e.what()));
-      }
-    }
+  CheckOutputFile("--targets", a.targets);
+  CheckOutputFile("--out", a.out);
   const StartingWorld start = LoadStartingWorld(a.files, a.q, a.qdot, a.world, Integrator::kThesis, a.dt);
   const int steps = int(std::lround(a.duration / a.dt));
   const std::vector<std::string> names = start.OnBody([](const auto& body) { return ModeNames(body.modes()); });

@@ -39,6 +39,7 @@ int RunMesh(const MeshArgs& a) {
     return kExitOk;
   }
   if (a.out.empty()) throw UsageError("mesh --make: --out FILE is required");
+  CheckOutputFile("--out", a.out);
   SurfaceMesh mesh;
   if (a.make == "table") mesh = pipelines::MakeTableMesh();
   else if (a.make == "pot") mesh = pipelines::MakePotMesh();

@@ -65,13 +65,7 @@ int RunSimulate(const SimulateArgs& a) {
   RequireNonNegative(a.duration, "--duration");
   if (a.every < 1) throw UsageError("--every must be at least 1");
 
-  if (!a.out.empty()) {
-    try {
-      formats::CheckWritable(a.out);
-    } catch (const std::runtime_error& e) {
-      throw UsageError(std::string("--out: ") + e.what());
-    }
-  }
+  CheckOutputFile("--out", a.out);
 
   // the body and its world
   const StartingWorld setup = LoadStartingWorld(a.files, a.q, a.qdot, a.world, integrator, a.dt);

@@ -210,6 +210,9 @@ int RunSweep(const SweepArgs& a) {
   CheckOutputFolder(a.out);
   const std::filesystem::path out(a.out);
   const std::string table_path = (out / "sweep.csv").string();
+  // the files it will write, before any case runs (a FIFO left at one would block the run)
+  for (const std::string& file : {table_path, table_path + ".partial", (out / "sweep.png").string()})
+    CheckOutputFile("--out", file);
 
   const size_t n = o.plan.cases.size();
   const Distributor& where = CurrentDistributor();

@@ -193,6 +193,36 @@ def main():
              [wobble, "run", script("folder_out.wob", f"load_obj {obj}\nload_def {modes}\n{line}\nsimul 1\n")], work, 2,
              "folder_out.wob:3:", "names a folder")
 
+    # ---- one policy for every command (issue 50): an output it cannot write is bad input (exit 2,
+    # naming the flag) before any work; a FIFO at an output or its temporary or partial file is
+    # refused, never opened (opening one for writing blocks until a reader comes)
+    case("condition check: --json under a regular file",
+         [wobble, "condition", "check"] + body + ["--json", os.path.join(a_file, "r.json")], work, 2, "--json:")
+    case("mesh --make: --out under a regular file",
+         [wobble, "mesh", "--make", "table", "--out", os.path.join(a_file, "t.vtp")], work, 2, "--out:")
+    fifos = os.path.join(work, "fifos")
+    os.makedirs(fifos)
+    os.mkfifo(os.path.join(fifos, "x.csv.tmp"))
+    case("simulate: a FIFO at the temporary file", sim + ["--duration", "0.1", "--out", os.path.join(fifos, "x.csv")], work,
+         2, "--out:", "is a FIFO", timeout=30)
+    os.mkfifo(os.path.join(fifos, "sweep.csv.partial"))
+    case("sweep: a FIFO at sweep.csv.partial",
+         [wobble, "sweep", os.path.join(data, "sweep_bounding.wob"), "--param", "seed=1:2:2", "--out", fifos], work, 2,
+         "sweep.csv.partial", "is a FIFO", timeout=30)
+    # a subnormal number is a finite number: accepted like any other (was refused as not finite)
+    case("simulate: a subnormal mode amplitude (1e-310)", sim + ["--q", "0 50 0 1e-310 0 0 0", "--duration", "0.1"], work, 0)
+    case("inspect: the smallest subnormal (4.9e-324) in --q", [wobble, "inspect"] + body + ["--q", "0 50 0 4.9e-324 0 0 0"],
+         work, 0)
+    # standard input that is no script: refused at its first line, not read whole into memory
+    for label, source in (("/dev/zero", "/dev/zero"), ("a 1 MB line", write(os.path.join(work, "long_line.txt"), "x" * 1000000))):
+        with open(source, "rb") as stdin:
+            try:
+                p = subprocess.run([wobble, "run"], cwd=work, stdin=stdin, capture_output=True, text=True, timeout=30)
+                expect(p.returncode == 2 and "<stdin>:1:" in p.stderr,
+                       f"run < {label}: exit {p.returncode} (2 expected) naming <stdin>:1: {p.stderr.strip()[-200:]}")
+            except subprocess.TimeoutExpired:
+                expect(False, f"run < {label}: returned within 30 s")
+
     # ---- a full disk (a 400 kB tmpfs, when this machine lets us mount one): exit 1 with the
     # system's text, and the files of the earlier run unchanged (was: exit 0, empty EXRs). A
     # displacement EXR is 176 kB and two are written at once (one writer thread per core): the

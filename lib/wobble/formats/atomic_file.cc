@@ -37,6 +37,11 @@ void CreateParentFolder(const std::string& path) {
   const std::string kind = NonRegularKind(path);
   if (kind == "a directory") throw std::runtime_error(path + ": is a directory");
   if (!kind.empty()) throw std::runtime_error(path + ": is " + kind + ", not a regular file; wobble writes only regular files");
+  // the temporary file is opened for writing before the rename: a FIFO there would block the
+  // open forever (any other kind fails at the open or the write, with the system's reason)
+  const std::string tmp = TempPathFor(path);
+  if (NonRegularKind(tmp) == "a FIFO")
+    throw std::runtime_error(path + ": its temporary file " + tmp + " is a FIFO, not a regular file; remove it");
   if (!target.has_parent_path()) return;  // the working directory
   fs::create_directories(target.parent_path(), ec);
   if (ec) throw std::runtime_error(path + ": cannot create its folder: " + ec.message());

@@ -23,8 +23,8 @@ std::string TempPathFor(const std::string& path);
 std::string NonRegularKind(const std::string& path);
 
 // Creates the folder of `path` if needed. Throws std::runtime_error naming the path and reason,
-// also when `path` exists and is not a regular file: wobble replaces only regular files (a
-// rename over /dev/null or a FIFO would put a regular file in its place).
+// also when `path` exists and is not a regular file, or its temporary file is a FIFO: wobble
+// replaces only regular files, and opening a FIFO for writing blocks until a reader comes.
 void CreateParentFolder(const std::string& path);
 
 // Opens `temp_path` for writing, lets `fill` write it (false: a write fell short) and closes

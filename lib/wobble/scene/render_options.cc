@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "wobble/formats/line_reader.h"
+
 namespace wobble::scene {
 
 const std::vector<RenderOptionInfo>& RenderOptionTable() {
@@ -69,10 +71,8 @@ std::vector<double> Numbers(const std::string& option, const std::string& text) 
   std::istringstream in(t);
   std::vector<double> out;
   for (std::string word; in >> word;) {
-    char* end = nullptr;
-    const double v = std::strtod(word.c_str(), &end);
-    if (end == word.c_str() || *end != '\0' || !std::isfinite(v))
-      throw RenderOptionError(option, "'" + word + "' is not a finite number");
+    double v = 0.0;
+    if (!formats::detail::ParseNumber(word, &v)) throw RenderOptionError(option, "'" + word + "' is not a finite number");
     out.push_back(v);
   }
   return out;

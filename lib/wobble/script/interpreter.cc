@@ -86,13 +86,33 @@ void Interpreter::RunFile(const std::string& path) {
   });
 }
 
+namespace {
+
+// No script line is this long; a stream with no line ends (a binary file, /dev/zero on
+// standard input) is refused at its first line instead of being read whole into memory.
+constexpr size_t kMaxScriptLine = 65536;
+
+// std::getline with that bound, and refusing a NUL byte (binary input, not a script).
+bool ReadScriptLine(std::istream& in, const std::string& name, int number, std::string* line) {
+  line->clear();
+  std::streambuf* buffer = in.rdbuf();
+  for (bool any = false;; any = true) {
+    const int c = buffer->sbumpc();
+    if (c == std::char_traits<char>::eof()) return any;
+    if (c == '\n') return true;
+    if (c == '\0') throw formats::ParseError(name, number, "holds a NUL byte: a script is text");
+    if (line->size() == kMaxScriptLine)
+      throw formats::ParseError(name, number, "is longer than " + std::to_string(kMaxScriptLine) + " characters: a script line is shorter");
+    line->push_back(char(c));
+  }
+}
+
+}  // namespace
+
 void Interpreter::RunStream(std::istream& in, const std::string& name, const std::string& dir) {
   std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
+  for (int number = 1; ReadScriptLine(in, name, number, &line); ++number)
     if (!RunLine(line, name, number, dir)) return;
-  }
 }
 
 bool Interpreter::RunLine(const std::string& line, const std::string& name, int line_number, const std::string& dir) {
