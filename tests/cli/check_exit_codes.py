@@ -214,7 +214,7 @@ def main():
     case("inspect: the smallest subnormal (4.9e-324) in --q", [wobble, "inspect"] + body + ["--q", "0 50 0 4.9e-324 0 0 0"],
          work, 0)
     # standard input that is no script: refused at its first line, not read whole into memory
-    for label, source in (("/dev/zero", "/dev/zero"), ("a 1 MB line", write(os.path.join(work, "long_line.txt"), "x" * 1000000))):
+    for label, source in (("/dev/zero", "/dev/zero"), ("a 1 MB comment line", write(os.path.join(work, "long_line.txt"), "#" + "x" * 1000000))):
         with open(source, "rb") as stdin:
             try:
                 p = subprocess.run([wobble, "run"], cwd=work, stdin=stdin, capture_output=True, text=True, timeout=30)
