@@ -12,6 +12,7 @@
 #include "wobble/fit/spacetime.h"
 #include "wobble/formats/atomic_file.h"
 #include "wobble/formats/csv.h"
+#include "wobble/formats/line_reader.h"
 #include "wobble/formats/target_schedule.h"
 
 namespace wobble::app {
@@ -165,6 +166,9 @@ int RunFitSpacetime(const FitSpacetimeArgs& a) {
   CheckOutputFile("--out", a.out);
   const StartingWorld start = LoadStartingWorld(a.files, a.q, a.qdot, a.world, Integrator::kThesis, a.dt);
   const int steps = int(std::lround(a.duration / a.dt));
+  if (steps < 1)
+    throw UsageError("--duration " + formats::detail::FormatNumber(a.duration) + " is shorter than half a step (--dt " +
+                     formats::detail::FormatNumber(a.dt) + "): there is no step to fit");
   const std::vector<std::string> names = start.OnBody([](const auto& body) { return ModeNames(body.modes()); });
   const int D = int(names.size());
   if (D == 0) throw UsageError("the object has no modes to control (--modes)");

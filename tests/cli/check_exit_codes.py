@@ -209,6 +209,10 @@ def main():
     case("sweep: a FIFO at sweep.csv.partial",
          [wobble, "sweep", os.path.join(data, "sweep_bounding.wob"), "--param", "seed=1:2:2", "--out", fifos], work, 2,
          "sweep.csv.partial", "is a FIFO", timeout=30)
+    # a true cause: a duration under half a step leaves no step (was "--knots must be from 2 to 1")
+    case("fit spacetime: --duration shorter than half a step",
+         [wobble, "fit", "spacetime"] + body + ["--duration", "0.001", "--dt", "0.01", "--upright"], work, 2,
+         "--duration 0.001 is shorter than half a step")
     # a subnormal number is a finite number: accepted like any other (was refused as not finite)
     case("simulate: a subnormal mode amplitude (1e-310)", sim + ["--q", "0 50 0 1e-310 0 0 0", "--duration", "0.1"], work, 0)
     case("inspect: the smallest subnormal (4.9e-324) in --q", [wobble, "inspect"] + body + ["--q", "0 50 0 4.9e-324 0 0 0"],
