@@ -137,7 +137,7 @@ Eigen::VectorXd ParseNumbers(const std::string& text, const std::string& what, i
 // otherwise, the same for every subcommand.
 void CheckOutputFolder(const std::string& folder);
 // The same for an output file given by `flag` (nothing to check when `path` is empty): its
-// folder is made, and it and its temporary file must be regular files or absent.
+// folder is made, it must be a regular file or absent, and its temporary file no FIFO.
 void CheckOutputFile(const std::string& flag, const std::string& path);
 
 // Requires a finite number, optionally positive or non-negative.
