@@ -53,7 +53,7 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
   cmd->add_option("--out", a->out, "Output folder")->required()->type_name("DIR");
   AddLimitFlags(cmd, &a->limits);
   cmd->add_option("--what", a->what,
-                  "What to write, comma separated: frames, filmstrip, charts, vtp, exr, disp (default: " +
+                  "What to write, comma separated: frames, filmstrip, charts, vtp, exr, disp, mp4 (default: " +
                       default_what + ")")
       ->type_name("LIST");
   for (const scene::RenderOptionInfo& o : scene::RenderOptionTable()) {
@@ -114,7 +114,8 @@ RenderRequest ParseRenderRequest(const RenderArgs& a, const std::string& default
 }
 
 void CheckRenderRequest(const RenderRequest& r, const std::string& out) {
-  const bool draws = r.what.count("frames") || r.what.count("filmstrip") || r.what.count("charts") || r.what.count("exr");
+  const bool draws = r.what.count("frames") || r.what.count("filmstrip") || r.what.count("charts") || r.what.count("exr") ||
+                     r.what.count("mp4");
   if (draws && !pl::HasDisplay())
     throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"
                      "  xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble ...\n"

@@ -18,6 +18,7 @@
 #include "pipelines/energy_charts.h"
 #include "pipelines/exr_frame.h"
 #include "pipelines/exports.h"
+#include "pipelines/video_writer.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -252,7 +253,7 @@ void ApplyRenderSettings(const scene::RenderSettings& s, RenderOutputs* out) {
 }
 
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out) {
-  out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = false;
+  out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = out->mp4 = false;
   for (const std::string& w : what) {
     bool* flag = w == "frames"      ? &out->frames
                  : w == "filmstrip" ? &out->filmstrip
@@ -260,8 +261,9 @@ std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out)
                  : w == "vtp"       ? &out->vtp
                  : w == "exr"       ? &out->exr
                  : w == "disp"      ? &out->disp
+                 : w == "mp4"       ? &out->mp4
                                     : nullptr;
-    if (!flag) return "'" + w + "' is not one of frames, filmstrip, charts, vtp, exr, disp";
+    if (!flag) return "'" + w + "' is not one of frames, filmstrip, charts, vtp, exr, disp, mp4";
     *flag = true;
   }
   if (what.empty()) return "nothing to write";
@@ -271,7 +273,7 @@ std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out)
 std::vector<std::string> KeepWithoutDisplay(RenderOutputs* out) {
   std::vector<std::string> skipped;
   for (auto [flag, name] : {std::pair{&out->frames, "frames"}, std::pair{&out->filmstrip, "filmstrip"},
-                            std::pair{&out->charts, "charts"}, std::pair{&out->exr, "exr"}})
+                            std::pair{&out->charts, "charts"}, std::pair{&out->exr, "exr"}, std::pair{&out->mp4, "mp4"}})
     if (*flag) {
       skipped.push_back(name);
       *flag = false;
@@ -327,7 +329,8 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   RenderReport report;
 
   std::unique_ptr<SceneView> view, strip_view;
-  if (out.frames || out.exr) view = std::make_unique<SceneView>(&world, out.view, spec);
+  if (out.mp4 && !(out.fps > 0.0)) throw std::invalid_argument("a video needs frames at a rate: fps must be above 0");
+  if (out.frames || out.exr || out.mp4) view = std::make_unique<SceneView>(&world, out.view, spec);
   if (out.filmstrip) {
     SceneOptions s = out.view;
     s.width = out.filmstrip_width;
@@ -398,6 +401,12 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   PvdCollection volumes;  // 3D bodies' displacement volumes
   std::vector<vtkSmartPointer<vtkImageData>> panels;
   BackgroundWriter writer;  // files are compressed and written while the next frame renders
+  std::unique_ptr<VideoWriter> video;  // encodes on its own thread, in frame order
+  if (out.mp4) {
+    VideoOptions video_options;
+    video_options.fps = out.fps;
+    video = std::make_unique<VideoWriter>(out.folder + "/" + out.name + ".mp4", out.view.width, out.view.height, video_options);
+  }
   // An EXR frame waits for the next frame's characters: its motion vectors point to them (and,
   // in Blender's Vector pass, to the previous frame's too).
   struct PendingExr {
@@ -450,6 +459,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     if (view) {
       view->Render();
       if (out.frames) view->WritePng(Numbered(out.folder + "/frames", "frame", v.frame, "png"), &writer);
+      if (video) video->AddFrame(PixelsOf(view->Capture()));
       if (out.exr) {
         ExrFrame frame = view->CaptureExrFrame();
         frame.metadata.frames_per_second = out.fps;
@@ -473,9 +483,11 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   }
   submit_exr(nullptr);  // the last frame drawn has no next frame: no motion
   writer.Wait();
+  const long video_frames = video ? video->Finish() : 0;  // an interrupted run's video holds the frames drawn
   if (interrupted) {
     std::string where = std::to_string(report.frames) + " of " + std::to_string(num_frames) + " frames";
     if (vtp) where += ", and " + vtp->WriteCollection() + " for them";
+    if (video) where += ", and " + video->path() + " of them";
     throw Interrupted("rendering stopped by Ctrl-C: " + where + " written in " + out.folder);
   }
   world.SetData(start);
@@ -483,6 +495,12 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   if (!visits.empty()) run.Restore(visits.back().sample, caller);
 
   if (out.frames) report.files.push_back({out.folder + "/frames/frame_NNNN.png", ""});
+  if (video) {
+    char note[96];
+    std::snprintf(note, sizeof(note), "H.264 video, %ld frames at %g fps, %.4g s", video_frames, out.fps,
+                  double(video_frames) / out.fps);
+    report.files.push_back({video->path(), note});
+  }
   if (out.exr)
     report.files.push_back({out.folder + "/exr/frame_NNNN.exr",
                             std::string("characters R, G, B, A; ") + (out.view.exr_terrain_layer ? "terrain.R, G, B, A; " : "") +

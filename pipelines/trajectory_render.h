@@ -20,6 +20,7 @@
 //   vti/disp_NNNN.vti       a 3D FFD body's displacement volume instead (DisplacementVolume),
 //   vti/disp.pvd            with their ParaView time series
 //   energy.png/.csv, condition.png/.csv   charts of body chart_body (condition: FFD bodies)
+//   NAME.mp4                the frames as an H.264 video at fps (video_writer.h)
 #pragma once
 
 #include <Eigen/Core>
@@ -38,7 +39,7 @@ namespace wobble::pipelines {
 struct RenderOutputs {
   std::string folder;         // created if missing
   std::string name = "run";   // stem of the .pvd
-  bool frames = true, filmstrip = true, charts = false, vtp = true, exr = false, disp = false;
+  bool frames = true, filmstrip = true, charts = false, vtp = true, exr = false, disp = false, mp4 = false;
   // Frames at t0 + k/fps (t0 the first sample's time) up to t_end, those the run reached (up
   // to half a step after its last sample), each at its exact time: the state interpolated
   // between the samples around it (record::Trajectory::RestoreAt); fps 0:
@@ -110,11 +111,11 @@ World WorldFor(const record::Trajectory& run, const WorldOptions& options);
 // script's NAME=VALUE) put into `out`: sizes, fps, filmstrip, camera, style, trails, ...
 void ApplyRenderSettings(const scene::RenderSettings& settings, RenderOutputs* out);
 
-// The outputs the words of `what` name (frames, filmstrip, charts, vtp, exr, disp) on, the
+// The outputs the words of `what` name (frames, filmstrip, charts, vtp, exr, disp, mp4) on, the
 // others off: "" when every word is one of them and one at least is given, else what is wrong
 // (`wobble render --what`, a script's `render` and Python's render read it the same way).
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out);
-// Of those, the ones drawn without an X display (vtp, disp): the rest are switched off and
+// Of those, the ones written without an X display (vtp, disp): the rest are switched off and
 // returned, for the message that says they were skipped.
 std::vector<std::string> KeepWithoutDisplay(RenderOutputs* out);
 
