@@ -27,6 +27,8 @@ ASAN_BUILD ?= build-asan
 JOBS       ?= 2
 OUT        ?= out/demo
 
+# ffmpeg's libraries encode the videos; the ffmpeg package (ffprobe) and chromium are the tests'
+# readers of them, programs wobble does not contain
 PACKAGES := libvtk9-dev libeigen3-dev libceres-dev libopenexr-dev libimath-dev \
             libgtest-dev libgmock-dev libbenchmark-dev xvfb xauth libcli11-dev \
             nlohmann-json3-dev cmake g++ make libpagmo-dev libpng-dev zlib1g-dev \
@@ -53,7 +55,7 @@ DEMO_SCRIPT   ?= data/table_cliff.wob  # writes and renders into out/demo (its `
 # from 30 above the ground, tilted 0.34 rad, falling at 60 and spinning at 1.2 rad/s about its axis
 DEMO3D_ARGS   ?= --object data/pot3.obj --modes data/pot3_modes.def3 --q "0 30 0 0.3 0 0.15 0 0 0" \
                  --qdot "0 -60 0 0 1.2 0 0 0 0" --duration 4 --dt 0.001 --orbit 30 --elevation 25 \
-                 --filmstrip "0 0.4 0.8 1.5 2.5 4" --what frames,filmstrip,charts,vtp,exr
+                 --filmstrip "0 0.4 0.8 1.5 2.5 4" --what frames,filmstrip,charts,vtp,exr,mp4
 
 .PHONY: all deps fuzz-deps configure build demo-build demo test test-quick asan bench-build bench bench-mujoco bench-mpi bench-python fuzz clean
 
@@ -120,13 +122,14 @@ demo: demo-build
 	echo "files (the cliff jump, in $(OUT)/):"
 	echo "  trajectory  $(OUT)/table_cliff.csv  (t, q, q-dot, energies, control energy, contacts per step)"
 	echo "  frames      $(OUT)/frames/frame_NNNN.png  (640x480, 30 fps)"
+	echo "  video       $(OUT)/table.mp4  (H.264; plays in a browser: chromium $(OUT)/table.mp4, or ffplay)"
 	echo "  filmstrip   $(OUT)/filmstrip.png"
 	echo "  ParaView    $(OUT)/vtp/table.pvd  (lattice, mass points, shape per frame; the terrain as its last part)"
 	echo "  EXR         $(OUT)/exr/frame_NNNN.exr  (R,G,B,A, depth.Z, forward.u/v motion to the next frame; camera and timeCode in the header), $(OUT)/exr/disp_NNNN.exr  (disp.X, disp.Y)"
 	echo "  plots       $(OUT)/energy.png, $(OUT)/condition.png  (numbers in the .csv beside them)"
 	echo "  table drop  $(OUT)/table_drop.csv  (the sloped-ground drop, simulated only: README, Pictures and exports)"
 	echo "  sky hook    out/fig3/filmstrip.png, out/fig3/frames/, out/fig3/vtp/fig3_sky_hook.pvd  (Witkin & Welch Fig. 3)"
-	echo "  3D pot      $(OUT)/pot3/filmstrip.png, $(OUT)/pot3/frames/, $(OUT)/pot3/vtp/pot3.pvd (deformed mesh, lattice, points), $(OUT)/pot3/exr/"
+	echo "  3D pot      $(OUT)/pot3/filmstrip.png, $(OUT)/pot3/pot3.mp4, $(OUT)/pot3/frames/, $(OUT)/pot3/vtp/pot3.pvd (deformed mesh, lattice, points), $(OUT)/pot3/exr/"
 	echo "  command     $(WOBBLE)  (see $(WOBBLE) --help, and README.md)"
 	exit $$status
 

@@ -22,6 +22,7 @@
 #include "pipelines/exr_io.h"
 #include "pipelines/interactive_view.h"
 #include "pipelines/scene_view.h"
+#include "pipelines/trajectory_render.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
 #include "support/source_paths.h"
@@ -275,6 +276,37 @@ void BM_ViewerFrame1280x720(benchmark::State& state) {
   state.SetLabel(pot ? "pot" : "table");
 }
 BENCHMARK(BM_ViewerFrame1280x720)->Args({0, 1})->Args({1, 1})->Args({0, 0})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The video's cost on the render (issue 48: at most 20% on the critical path): the demo's
+// 10 s table run, recorded once, rendered to 301 frames at 640x480 as `wobble render --what`
+// does. Arguments: 0 frames (PNG) alone, the baseline; 1 frames and mp4; 2 mp4 alone.
+void BM_RenderTable300Frames(benchmark::State& state) {
+  if (!NeedDisplay(state)) return;
+  static const std::shared_ptr<const record::Trajectory> run = [] {
+    auto world = DemoWorld();
+    auto recorded = std::make_shared<record::Trajectory>(*world);
+    auto recorder = std::make_shared<record::Recorder>(recorded);
+    world->SetRecorder(recorder);
+    recorder->Start(*world);
+    world->RunUntil(10.0 + 0.005, [](const World&) {});
+    return recorded;
+  }();
+  RenderOutputs out;
+  out.folder = OutDir() + "/render_video";
+  out.name = "table";
+  out.fps = 30;
+  out.filmstrip = out.vtp = false;
+  out.frames = state.range(0) != 2;
+  out.mp4 = state.range(0) != 0;
+  long frames = 0;
+  for (auto _ : state) {
+    auto world = DemoWorld();
+    frames += RenderTrajectory(*world, *run, SceneSpec{}, out).frames;
+  }
+  state.SetItemsProcessed(frames);
+  state.SetLabel(state.range(0) == 0 ? "frames (baseline)" : state.range(0) == 1 ? "frames + mp4" : "mp4");
+}
+BENCHMARK(BM_RenderTable300Frames)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(2);
 
 }  // namespace
 }  // namespace wobble::pipelines

@@ -169,7 +169,7 @@ void VideoWriter::Encode() {
       // RGB (full range) to BT.709 limited-range 4:2:0, the colours the file is tagged with
       std::unique_ptr<SwsContext, ScalerCloser> scaler(
           sws_getContext(even_width, even_height, AV_PIX_FMT_RGB24, even_width, even_height, AV_PIX_FMT_YUV420P,
-                         SWS_BICUBIC | SWS_ACCURATE_RND | SWS_FULL_CHR_H_INP, nullptr, nullptr, nullptr));
+                         SWS_BILINEAR, nullptr, nullptr, nullptr));
       if (!scaler) throw std::runtime_error("cannot convert RGB to yuv420p");
       sws_setColorspaceDetails(scaler.get(), sws_getCoefficients(SWS_CS_DEFAULT), 1, sws_getCoefficients(SWS_CS_ITU709),
                                0, 0, 1 << 16, 1 << 16);

@@ -35,7 +35,7 @@ struct VideoOptions {
   // flat-shaded pictures and keeps a 10 s 640x480 run well under a megabyte.
   int crf = 18;
   // x264's speed/size trade-off; "fast" keeps encoding off the render's critical path on two cores
-  std::string preset = "fast";
+  std::string preset = "veryfast";
 };
 
 class VideoWriter {

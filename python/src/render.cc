@@ -116,7 +116,8 @@ void BindRender(py::module_& m) {
       py::arg("width") = 640, py::arg("height") = 480, py::arg("filmstrip_times") = std::vector<double>(),
       py::arg("color_by") = "",
       "Renders a recorded run into `folder` as `wobble render` does: what is any of frames,\n"
-      "filmstrip, vtp (the ParaView .pvd series), charts, exr, disp; frames at `fps`. options: the\n"
+      "filmstrip, vtp (the ParaView .pvd series), charts, exr, disp, mp4 (H.264 video NAME.mp4); frames\n"
+      "at `fps`. options: the "
       "world the run had (ground, gravity). Returns the paths written (frame series as patterns).");
 }
 

@@ -1,6 +1,7 @@
 """Pictures into numpy and files (pipelines/, VTK under X), and controllers from Python."""
 import os
 import pathlib
+import subprocess
 
 import numpy as np
 import pytest
@@ -45,6 +46,18 @@ def test_render_writes_frames_filmstrip_and_paraview_series(table, tmp_path):
     assert len(files) >= 3
     with pytest.raises(wobble.InputError, match="what"):
         wobble.render(run, options, str(tmp_path), what=["gif"])
+
+
+@needs_display
+def test_render_writes_a_video_ffprobe_reads(table, tmp_path):
+    _, options, run = dropped(table, 1.0)
+    files = wobble.render(run, options, str(tmp_path), name="drop", what=["mp4"], fps=10, width=320, height=240)
+    video = tmp_path / "drop.mp4"
+    assert any(str(video) in f for f in files)
+    probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                            "stream=codec_name,nb_read_frames,width,height", "-of", "csv=p=0", str(video)],
+                           capture_output=True, text=True, check=True).stdout.strip()
+    assert probe == "h264,320,240,11"  # 0, 0.1, ..., 1.0 s
 
 
 def test_a_pose_graph_controller_drives_the_active_modes(data):
