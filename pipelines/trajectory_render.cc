@@ -4,6 +4,7 @@
 #include "wobble/core/interrupt.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -18,6 +19,7 @@
 #include "pipelines/energy_charts.h"
 #include "pipelines/exr_frame.h"
 #include "pipelines/exports.h"
+#include "pipelines/gltf_export.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -252,7 +254,7 @@ void ApplyRenderSettings(const scene::RenderSettings& s, RenderOutputs* out) {
 }
 
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out) {
-  out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = false;
+  out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = out->gltf = false;
   for (const std::string& w : what) {
     bool* flag = w == "frames"      ? &out->frames
                  : w == "filmstrip" ? &out->filmstrip
@@ -260,8 +262,9 @@ std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out)
                  : w == "vtp"       ? &out->vtp
                  : w == "exr"       ? &out->exr
                  : w == "disp"      ? &out->disp
+                 : w == "gltf"      ? &out->gltf
                                     : nullptr;
-    if (!flag) return "'" + w + "' is not one of frames, filmstrip, charts, vtp, exr, disp";
+    if (!flag) return "'" + w + "' is not one of frames, filmstrip, charts, vtp, exr, disp, gltf";
     *flag = true;
   }
   if (what.empty()) return "nothing to write";
@@ -394,6 +397,9 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
 
   std::unique_ptr<VtpSeriesWriter> vtp;
   if (out.vtp) vtp = std::make_unique<VtpSeriesWriter>(&world, out.folder + "/vtp", out.name, spec.drawings, out.view.shape_samples);
+  std::unique_ptr<GltfRecorder> gltf;
+  if (out.gltf) gltf = std::make_unique<GltfRecorder>(&world);
+  double gltf_seconds = 0;  // the glTF part's own time (its frames' keys and the file), for the report
   const std::vector<DispTarget> disp = out.disp ? DispTargets(world, out) : std::vector<DispTarget>();
   PvdCollection volumes;  // 3D bodies' displacement volumes
   std::vector<vtkSmartPointer<vtkImageData>> panels;
@@ -459,6 +465,11 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       }
     }
     if (vtp) vtp->WriteFrame(int(v.frame), &writer);
+    if (gltf) {
+      const auto start_key = std::chrono::steady_clock::now();
+      gltf->AddFrame();
+      gltf_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_key).count();
+    }
     for (const DispTarget& d : disp) {
       if (d.depth == 0) {
         WriteDisplacementExr(Numbered(out.folder + "/exr", d.stem, v.frame, "exr"), world, d.body, d.width, d.height, &writer);
@@ -506,6 +517,19 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     const std::string path = out.folder + "/filmstrip.png";
     WritePng(path, TileImages(panels, out.filmstrip_columns));
     report.files.push_back({path, ""});
+  }
+  if (gltf && gltf->num_frames() > 0) {
+    const auto start_write = std::chrono::steady_clock::now();
+    const std::string path = out.folder + "/" + out.name + ".glb";
+    gltf->Write(path);
+    gltf_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_write).count();
+    char seconds[32];
+    std::snprintf(seconds, sizeof(seconds), "%.3g", gltf_seconds);
+    std::string note = "glTF 2.0: " + std::to_string(gltf->num_bodies()) + " 3D FFD bod" +
+                       (gltf->num_bodies() == 1 ? "y" : "ies") + ", morph targets per mode, " +
+                       std::to_string(gltf->num_frames()) + " keys; " + seconds + " s";
+    for (const std::string& skipped : gltf->SkippedBodies()) note += "; " + skipped + " not in it (not a 3D FFD body)";
+    report.files.push_back({path, note});
   }
   if (out.charts) WriteCharts(run, out, &report);
   return report;
