@@ -1,6 +1,13 @@
 #include "pipelines/gltf_export.h"
 
 #include <tiny_gltf.h>
+#include <vtkCellArray.h>
+#include <vtkContourTriangulator.h>
+#include <vtkIdList.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkTriangleFilter.h>
 
 #include <algorithm>
 #include <cstring>
@@ -8,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pipelines/world_sources.h"
 #include "wobble/dynamics/kinematics.h"
 #include "wobble/formats/atomic_file.h"
 
@@ -20,8 +28,9 @@ class BufferBuilder {
  public:
   explicit BufferBuilder(tinygltf::Model* model) : model_(model) { model_->buffers.emplace_back(); }
 
-  // `count` elements of `components` floats (type TINYGLTF_TYPE_*); with_bounds: min and max
-  // per component, which glTF requires of POSITION (targets too) and animation inputs.
+  // `values.size() / components` elements of `components` floats (type TINYGLTF_TYPE_*);
+  // with_bounds: min and max per component, which glTF requires of POSITION (targets' too)
+  // and of animation inputs.
   int AddFloats(const std::vector<float>& values, int components, int type, bool with_bounds) {
     const size_t count = values.size() / size_t(components);
     tinygltf::Accessor a;
@@ -71,53 +80,187 @@ void Append3(std::vector<float>* out, const Eigen::Vector3d& v) {
   for (int i = 0; i < 3; ++i) out->push_back(float(v[i]));
 }
 
+// The closed polylines of a 2D drawing filled (the clean style's fill): each polygon of
+// `samples` (rest positions, in order from `first`) triangulated by VTK's contour
+// triangulator, which takes concave outlines.
+void FillClosedOutlines(const std::vector<Eigen::Vector2d>& rest, const std::vector<std::pair<int, bool>>& polylines,
+                        unsigned first, std::vector<unsigned>* triangles) {
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetDataTypeToDouble();
+  for (const Eigen::Vector2d& p : rest) points->InsertNextPoint(p.x(), p.y(), 0.0);
+  int start = 0;
+  for (const auto& [count, closed] : polylines) {
+    if (closed && count >= 3) {
+      auto polygon = vtkSmartPointer<vtkIdList>::New();
+      for (int k = 0; k < count; ++k) polygon->InsertNextId(start + k);
+      auto cells = vtkSmartPointer<vtkCellArray>::New();
+      vtkContourTriangulator::TriangulatePolygon(polygon, points, cells);  // 0: partly filled, still drawn
+      auto cell = vtkSmartPointer<vtkIdList>::New();
+      for (cells->InitTraversal(); cells->GetNextCell(cell);)
+        if (cell->GetNumberOfIds() == 3)
+          for (int i = 0; i < 3; ++i) triangles->push_back(first + unsigned(cell->GetId(i)));
+    }
+    start += count;
+  }
+}
+
+// The segments of polylines of `count` samples each, from vertex `first` on (closed: back to the start).
+void AddPolylines(const std::vector<std::pair<int, bool>>& polylines, unsigned first, std::vector<unsigned>* lines) {
+  for (const auto& [count, closed] : polylines) {
+    for (int k = 0; k + 1 < count; ++k) lines->insert(lines->end(), {first + unsigned(k), first + unsigned(k + 1)});
+    if (closed && count > 2) lines->insert(lines->end(), {first + unsigned(count - 1), first});
+    first += unsigned(count);
+  }
+}
+
 }  // namespace
 
-GltfRecorder::GltfRecorder(const World* world) : world_(world) {
+GltfRecorder::GltfRecorder(const World* world, const std::vector<LinearDrawing>& drawings, int shape_samples)
+    : world_(world), shape_samples_(shape_samples) {
   for (int b = 0; b < world->num_bodies(); ++b) {
-    if (!world->IsFfd(b, 3)) {
-      skipped_.push_back(world->body_name(b));
-      continue;
-    }
-    const BodyModelN<3>& model = world->body<3>(b);
-    const TriangleMeshN<3>& mesh = model.def().mesh;
-    Body body;
-    body.index = b;
-    body.name = world->body_name(b);
-    body.num_modes = model.num_modes();
-    body.targets.resize(size_t(body.num_modes));
-    // the same b0 and B per vertex that ShapeSource draws the mesh with (world_sources.cc)
-    for (int v = 0; v < int(mesh.points.size()); ++v) {
-      Append3(&body.rest, model.mesh_rest_local(v));
-      const auto B = model.mesh_mode_matrix(v);
-      for (int d = 0; d < body.num_modes; ++d) Append3(&body.targets[size_t(d)], B.col(d));
-    }
-    for (const std::array<int, 3>& t : mesh.triangles)
-      for (int i : t) body.triangles.push_back(unsigned(i));
-    for (int d = 0; d < body.num_modes; ++d) {
-      const std::string& name = model.modes()[size_t(d)].name;
-      body.mode_names.push_back(name.empty() ? "mode_" + std::to_string(d + 1) : name);
-    }
-    bodies_.push_back(std::move(body));
+    if (world->IsFfd(b, 3)) parts_.push_back(FfdPart<3>(b));
+    else if (world->IsFfd(b, 2)) parts_.push_back(FfdPart<2>(b));
+    else if (b < int(drawings.size()) && drawings[size_t(b)].dim() != 0) parts_.push_back(LinearPart(b, drawings[size_t(b)]));
+    else skipped_.push_back(world->body_name(b));  // a linear body is seen only through a drawing
   }
+}
+
+int GltfRecorder::num_bodies() const {
+  return int(std::count_if(parts_.begin(), parts_.end(), [](const Part& p) { return p.body >= 0; }));
+}
+
+// An FFD body: its mesh's vertices and then its drawing's samples, each with the b0 and B that
+// ShapeSource moves it with (world_sources.cc): the mesh's from the body (mesh_rest_local),
+// the samples' from BodyModelN::LocalBasis (MakeDrawingSamples).
+template <int Dim> GltfRecorder::Part GltfRecorder::FfdPart(int b) const {
+  const BodyModelN<Dim>& model = world_->body<Dim>(b);
+  Part part;
+  part.motion = Part::Motion::kFfd;
+  part.body = b;
+  part.name = world_->body_name(b);
+  const int modes = model.num_modes();
+  part.targets.resize(size_t(modes));
+  auto add = [&](const Eigen::Matrix<double, Dim, 1>& b0, const auto& B) {
+    Append3(&part.rest, To3(b0));
+    for (int d = 0; d < modes; ++d) Append3(&part.targets[size_t(d)], To3(Eigen::Matrix<double, Dim, 1>(B.col(d))));
+  };
+  const TriangleMeshN<Dim>& mesh = model.def().mesh;
+  for (int v = 0; v < int(mesh.points.size()); ++v) add(model.mesh_rest_local(v), model.mesh_mode_matrix(v));
+  for (const std::array<int, 3>& t : mesh.triangles)
+    for (int i : t) part.triangles.push_back(unsigned(i));
+  const DrawingSamples<Dim> samples = MakeDrawingSamples(model, shape_samples_);
+  const unsigned first = unsigned(mesh.points.size());
+  for (size_t k = 0; k < samples.st.size(); ++k) add(samples.b0[k], samples.B[k]);
+  AddPolylines(samples.polylines, first, &part.lines);
+  if constexpr (Dim == 2) FillClosedOutlines(samples.b0, samples.polylines, first, &part.triangles);
+  for (int d = 0; d < modes; ++d) {
+    const std::string& name = model.modes()[size_t(d)].name;
+    part.target_names.push_back(name.empty() ? "mode_" + std::to_string(d + 1) : name);
+  }
+  return part;
+}
+
+// A linear body: x = R p(u) = Σ_ij R_ij p_j(u) e_i, so the base is 0 and target (i, j) holds
+// p_j(u) e_i at every vertex; the weights are R's entries (row by row).
+GltfRecorder::Part GltfRecorder::LinearPart(int b, const LinearDrawing& drawing) const {
+  const LinearBodyModel& model = world_->linear_model(b);
+  Part part;
+  part.motion = Part::Motion::kLinear;
+  part.body = b;
+  part.name = world_->body_name(b);
+  const int d = model.dim(), n = model.basis_size();
+  part.targets.resize(size_t(d * n));
+  for (int i = 0; i < d; ++i)
+    for (int j = 0; j < n; ++j) part.target_names.push_back("R_" + std::to_string(i) + "_" + std::to_string(j));
+  auto add = [&](const Eigen::VectorXd& u) {
+    const Eigen::VectorXd p = model.Basis(u);
+    for (int k = 0; k < 3; ++k) part.rest.push_back(0.0f);
+    for (int i = 0; i < d; ++i)
+      for (int j = 0; j < n; ++j) {
+        std::vector<float>& target = part.targets[size_t(i * n + j)];
+        for (int k = 0; k < 3; ++k) target.push_back(k == i ? float(p[j]) : 0.0f);
+      }
+  };
+  std::vector<std::pair<int, bool>> polylines;
+  for (const LinearDrawing::Polyline& line : drawing.polylines) {
+    for (const Eigen::VectorXd& u : line.points) add(u);
+    polylines.push_back({int(line.points.size()), line.closed});
+  }
+  AddPolylines(polylines, 0, &part.lines);
+  const unsigned first = unsigned(part.rest.size() / 3);
+  for (const Eigen::VectorXd& u : drawing.vertices) add(u);
+  for (const auto& t : drawing.triangles)
+    for (int i : t) part.triangles.push_back(first + unsigned(i));
+  return part;
+}
+
+// The ground as GroundSource draws it now, under the bodies standing on it, triangulated.
+void GltfRecorder::AddGround() {
+  bool stands = false;
+  Eigen::AlignedBox3d bodies;
+  for (int b = 0; b < world_->num_bodies(); ++b) {
+    if (GroundDimensionOf(*world_, b) == 0) continue;
+    stands = true;
+    bodies.extend(world_->kind(b) == BodyKind::kFfd ? FfdBodyBounds(*world_, b) : LinearBodyBounds(*world_, b));
+  }
+  if (!stands) return;
+  auto ground = vtkSmartPointer<GroundSource>::New();
+  ground->SetWorld(world_);
+  if (const std::shared_ptr<const Terrain>& terrain = world_->options().params.ground.terrain) {
+    FrameWholeTerrain(*terrain, ground);
+  } else {  // a line's band or the plane's square under the bodies, wide enough for their travel
+    ground->SetCenter(bodies.center().x(), bodies.center().y());
+    ground->SetLength(std::max(2000.0, 20.0 * bodies.diagonal().norm()));
+  }
+  auto triangles = vtkSmartPointer<vtkTriangleFilter>::New();
+  triangles->SetInputConnection(ground->GetOutputPort());
+  triangles->PassVertsOff();
+  triangles->PassLinesOff();
+  triangles->Update();
+  vtkPolyData* mesh = triangles->GetOutput();
+  if (mesh->GetNumberOfPolys() == 0) return;  // no ground drawn (none enabled)
+  Part part;
+  part.name = "ground";
+  for (vtkIdType i = 0; i < mesh->GetNumberOfPoints(); ++i) Append3(&part.rest, Eigen::Vector3d(mesh->GetPoint(i)));
+  auto cell = vtkSmartPointer<vtkIdList>::New();
+  vtkCellArray* polys = mesh->GetPolys();
+  for (polys->InitTraversal(); polys->GetNextCell(cell);)
+    for (vtkIdType i = 0; i < cell->GetNumberOfIds(); ++i) part.triangles.push_back(unsigned(cell->GetId(i)));
+  parts_.push_back(std::move(part));
+}
+
+// t and R of the frame (Frame, kinematics.h) and γ; a 2D body's R turns about z.
+template <int Dim> void GltfRecorder::KeyFfd(Part* part) const {
+  const VecQ<double>& q = world_->q(part->body);
+  const Frame<Dim, double> frame(q);
+  Append3(&part->translation, To3(frame.t));
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  R.topLeftCorner<Dim, Dim>() = frame.R;
+  Eigen::Quaterniond r(R);
+  r.normalize();
+  if (part->rotation.size() >= 4) {  // q and -q are one turn: keep the one nearest the last frame's
+    const float* last = &part->rotation[part->rotation.size() - 4];
+    if (r.x() * last[0] + r.y() * last[1] + r.z() * last[2] + r.w() * last[3] < 0) r.coeffs() = -r.coeffs();
+  }
+  for (int i = 0; i < 4; ++i) part->rotation.push_back(float(r.coeffs()[i]));  // x y z w, as glTF
+  const double* gamma = q.data() + Group<Dim>::kRigidParams;
+  for (size_t d = 0; d < part->targets.size(); ++d) part->weights.push_back(float(gamma[d]));
 }
 
 void GltfRecorder::AddFrame() {
   if (!times_.empty() && !(world_->time() > times_.back()))
     throw std::logic_error("GltfRecorder: frame times must increase");
+  if (times_.empty()) AddGround();
   times_.push_back(world_->time());
-  for (Body& body : bodies_) {
-    const VecQ<double>& q = world_->q(body.index);
-    Append3(&body.translation, q.head<3>());
-    // R of the state, as Frame (kinematics.h) makes it: the quaternion of q (Group<3>)
-    Eigen::Quaterniond r = Group<3>::OrientationOf(q).normalized();
-    if (body.rotation.size() >= 4) {  // q and -q are one turn: keep the one nearest the last frame's
-      const float* last = &body.rotation[body.rotation.size() - 4];
-      if (r.x() * last[0] + r.y() * last[1] + r.z() * last[2] + r.w() * last[3] < 0) r.coeffs() = -r.coeffs();
+  for (Part& part : parts_) {
+    if (part.motion == Part::Motion::kFfd) {
+      if (world_->dim(part.body) == 3) KeyFfd<3>(&part);
+      else KeyFfd<2>(&part);
+    } else if (part.motion == Part::Motion::kLinear) {
+      const Eigen::MatrixXd& R = world_->linear_R(part.body);
+      for (int i = 0; i < R.rows(); ++i)
+        for (int j = 0; j < R.cols(); ++j) part.weights.push_back(float(R(i, j)));
     }
-    for (int i = 0; i < 4; ++i) body.rotation.push_back(float(r.coeffs()[i]));  // x y z w, as glTF
-    const double* gamma = q.data() + Group<3>::kRigidParams;
-    for (int d = 0; d < body.num_modes; ++d) body.weights.push_back(float(gamma[d]));
   }
 }
 
@@ -126,28 +269,45 @@ std::string GltfRecorder::Bytes() const {
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "wobble";
+  tinygltf::Material material;  // one light grey, double-sided: outlines and meshes face either way
+  material.name = "wobble";
+  material.doubleSided = true;
+  material.pbrMetallicRoughness.baseColorFactor = {0.8, 0.8, 0.8, 1.0};
+  material.pbrMetallicRoughness.metallicFactor = 0.0;
+  model.materials.push_back(material);
   BufferBuilder buffer(&model);
   tinygltf::Scene scene;
   tinygltf::Animation animation;
   animation.name = "run";
   const std::vector<float> times(times_.begin(), times_.end());
-  const int input = bodies_.empty() ? -1 : buffer.AddFloats(times, 1, TINYGLTF_TYPE_SCALAR, true);
+  const bool moves = std::any_of(parts_.begin(), parts_.end(), [](const Part& p) { return p.motion != Part::Motion::kStatic; });
+  const int input = moves ? buffer.AddFloats(times, 1, TINYGLTF_TYPE_SCALAR, true) : -1;
 
-  for (const Body& body : bodies_) {
-    tinygltf::Primitive primitive;
-    primitive.mode = TINYGLTF_MODE_TRIANGLES;
-    primitive.attributes["POSITION"] = buffer.AddFloats(body.rest, 3, TINYGLTF_TYPE_VEC3, true);
-    primitive.indices = buffer.AddIndices(body.triangles);
+  for (const Part& part : parts_) {
+    if (part.triangles.empty() && part.lines.empty()) continue;  // nothing to draw
+    tinygltf::Primitive triangles;
+    triangles.attributes["POSITION"] = buffer.AddFloats(part.rest, 3, TINYGLTF_TYPE_VEC3, true);
+    triangles.material = 0;
     tinygltf::Value::Array names;
-    for (int d = 0; d < body.num_modes; ++d) {
-      primitive.targets.push_back({{"POSITION", buffer.AddFloats(body.targets[size_t(d)], 3, TINYGLTF_TYPE_VEC3, true)}});
-      names.emplace_back(body.mode_names[size_t(d)]);
+    for (size_t j = 0; j < part.targets.size(); ++j) {
+      triangles.targets.push_back({{"POSITION", buffer.AddFloats(part.targets[j], 3, TINYGLTF_TYPE_VEC3, true)}});
+      names.emplace_back(part.target_names[j]);
     }
+    tinygltf::Primitive lines = triangles;  // the same vertices and targets
     tinygltf::Mesh mesh;
-    mesh.name = body.name;
-    mesh.primitives.push_back(std::move(primitive));
-    mesh.weights.assign(size_t(body.num_modes), 0.0);
-    if (body.num_modes > 0) {  // Blender and three.js name the shape keys from extras.targetNames
+    mesh.name = part.name;
+    if (!part.triangles.empty()) {
+      triangles.mode = TINYGLTF_MODE_TRIANGLES;
+      triangles.indices = buffer.AddIndices(part.triangles);
+      mesh.primitives.push_back(std::move(triangles));
+    }
+    if (!part.lines.empty()) {
+      lines.mode = TINYGLTF_MODE_LINE;
+      lines.indices = buffer.AddIndices(part.lines);
+      mesh.primitives.push_back(std::move(lines));
+    }
+    mesh.weights.assign(part.targets.size(), 0.0);
+    if (!names.empty()) {  // Blender and three.js name the shape keys from extras.targetNames
       tinygltf::Value::Object extras;
       extras["targetNames"] = tinygltf::Value(names);
       mesh.extras = tinygltf::Value(extras);
@@ -156,11 +316,13 @@ std::string GltfRecorder::Bytes() const {
     model.meshes.push_back(std::move(mesh));
 
     tinygltf::Node node;
-    node.name = body.name;
+    node.name = part.name;
     node.mesh = mesh_index;
-    node.translation.assign(body.translation.begin(), body.translation.begin() + 3);
-    node.rotation.assign(body.rotation.begin(), body.rotation.begin() + 4);
-    node.weights.assign(body.weights.begin(), body.weights.begin() + body.num_modes);
+    if (part.motion == Part::Motion::kFfd) {
+      node.translation.assign(part.translation.begin(), part.translation.begin() + 3);
+      node.rotation.assign(part.rotation.begin(), part.rotation.begin() + 4);
+    }
+    node.weights.assign(part.weights.begin(), part.weights.begin() + std::ptrdiff_t(part.targets.size()));
     const int node_index = int(model.nodes.size());
     model.nodes.push_back(std::move(node));
     scene.nodes.push_back(node_index);
@@ -177,10 +339,13 @@ std::string GltfRecorder::Bytes() const {
       animation.samplers.push_back(std::move(sampler));
       animation.channels.push_back(std::move(channel));
     };
-    animate(body.translation, 3, TINYGLTF_TYPE_VEC3, "translation");
-    animate(body.rotation, 4, TINYGLTF_TYPE_VEC4, "rotation");
-    // weights: frames × modes scalars (glTF's layout for morph weights); a body without modes has none
-    if (body.num_modes > 0) animate(body.weights, 1, TINYGLTF_TYPE_SCALAR, "weights");
+    if (part.motion == Part::Motion::kFfd) {
+      animate(part.translation, 3, TINYGLTF_TYPE_VEC3, "translation");
+      animate(part.rotation, 4, TINYGLTF_TYPE_VEC4, "rotation");
+    }
+    // weights: frames × targets scalars (glTF's layout for morph weights); none without targets
+    if (part.motion != Part::Motion::kStatic && !part.targets.empty())
+      animate(part.weights, 1, TINYGLTF_TYPE_SCALAR, "weights");
   }
   model.buffers[0].data.resize((model.buffers[0].data.size() + 3) / 4 * 4);  // the BIN chunk's padding
   if (!animation.channels.empty()) model.animations.push_back(std::move(animation));

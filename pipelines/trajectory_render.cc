@@ -398,7 +398,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   std::unique_ptr<VtpSeriesWriter> vtp;
   if (out.vtp) vtp = std::make_unique<VtpSeriesWriter>(&world, out.folder + "/vtp", out.name, spec.drawings, out.view.shape_samples);
   std::unique_ptr<GltfRecorder> gltf;
-  if (out.gltf) gltf = std::make_unique<GltfRecorder>(&world);
+  if (out.gltf) gltf = std::make_unique<GltfRecorder>(&world, spec.drawings, out.view.shape_samples);
   double gltf_seconds = 0;  // the glTF part's own time (its frames' keys and the file), for the report
   const std::vector<DispTarget> disp = out.disp ? DispTargets(world, out) : std::vector<DispTarget>();
   PvdCollection volumes;  // 3D bodies' displacement volumes
@@ -525,10 +525,10 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     gltf_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_write).count();
     char seconds[32];
     std::snprintf(seconds, sizeof(seconds), "%.3g", gltf_seconds);
-    std::string note = "glTF 2.0: " + std::to_string(gltf->num_bodies()) + " 3D FFD bod" +
-                       (gltf->num_bodies() == 1 ? "y" : "ies") + ", morph targets per mode, " +
-                       std::to_string(gltf->num_frames()) + " keys; " + seconds + " s";
-    for (const std::string& skipped : gltf->SkippedBodies()) note += "; " + skipped + " not in it (not a 3D FFD body)";
+    std::string note = "glTF 2.0: " + std::to_string(gltf->num_bodies()) + " bod" + (gltf->num_bodies() == 1 ? "y" : "ies") +
+                       " with morph targets (FFD: one per mode), " + std::to_string(gltf->num_frames()) + " keys; " +
+                       seconds + " s";
+    for (const std::string& skipped : gltf->SkippedBodies()) note += "; " + skipped + " not in it (a linear body without a drawing)";
     report.files.push_back({path, note});
   }
   if (out.charts) WriteCharts(run, out, &report);

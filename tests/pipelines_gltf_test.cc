@@ -20,6 +20,8 @@
 #include "pipelines/world_sources.h"
 #include "support/pipelines_test_util.h"
 #include "support/source_paths.h"
+#include "support/test_bodies.h"
+#include "wobble/body/linear_shapes.h"
 #include "wobble/dynamics/body_state.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/record/trajectory.h"
@@ -67,9 +69,9 @@ fs::path TestDir(const std::string& name) {
   return dir;
 }
 
-// A pot falling and spinning for 0.5 s beside a 2D table (a body the .glb does not hold),
-// rendered with gltf only at 30 fps: one node and mesh (the pot), a target per mode, three
-// LINEAR samplers sharing the 16 frame times t0 + k/30.
+// A pot falling and spinning for 0.5 s beside a 2D table, rendered with gltf only at 30 fps:
+// nodes pot3, table and ground (static), a target per mode, three LINEAR samplers per body
+// sharing the 16 frame times t0 + k/30.
 TEST(GltfExport, StructureThroughTinygltfsLoader) {
   World world(WithGroundPlane());
   world.AddBody(Pot());
@@ -97,22 +99,42 @@ TEST(GltfExport, StructureThroughTinygltfsLoader) {
   ASSERT_EQ(report.frames, 16);
   ASSERT_EQ(report.files.size(), 1u);
   EXPECT_EQ(report.files[0].path, (dir / "pot3.glb").string());
-  EXPECT_NE(report.files[0].note.find("morph targets per mode, 16 keys"), std::string::npos) << report.files[0].note;
-  EXPECT_NE(report.files[0].note.find("table not in it"), std::string::npos) << report.files[0].note;
+  EXPECT_NE(report.files[0].note.find("2 bodies with morph targets (FFD: one per mode), 16 keys"), std::string::npos)
+      << report.files[0].note;
   EXPECT_FALSE(fs::exists(dir / "pot3.glb.tmp"));
 
   const tinygltf::Model m = Load((dir / "pot3.glb").string());
   EXPECT_EQ(m.asset.version, "2.0");
   ASSERT_EQ(m.scenes.size(), 1u);
-  EXPECT_EQ(m.scenes[0].nodes, std::vector<int>{0});
-  ASSERT_EQ(m.nodes.size(), 1u);
-  ASSERT_EQ(m.meshes.size(), 1u);
+  EXPECT_EQ(m.scenes[0].nodes, (std::vector<int>{0, 1, 2}));
+  ASSERT_EQ(m.nodes.size(), 3u);
+  ASSERT_EQ(m.meshes.size(), 3u);
+  EXPECT_EQ(m.nodes[1].name, "table");
+  EXPECT_EQ(m.nodes[2].name, "ground");
+  ASSERT_EQ(m.materials.size(), 1u);
+  EXPECT_TRUE(m.materials[0].doubleSided);
+  {  // the table: its three open polylines as LINES (nothing to fill), a target per mode
+    const tinygltf::Mesh& table = m.meshes.at(size_t(m.nodes[1].mesh));
+    ASSERT_EQ(table.primitives.size(), 1u);
+    EXPECT_EQ(table.primitives[0].mode, TINYGLTF_MODE_LINE);
+    EXPECT_EQ(int(table.primitives[0].targets.size()), world.body<2>(1).num_modes());
+    const size_t samples = 3 * (16 + 1);  // 3 segments at shape_samples 16, and their ends
+    EXPECT_EQ(m.accessors.at(size_t(table.primitives[0].attributes.at("POSITION"))).count, samples);
+    EXPECT_EQ(m.accessors.at(size_t(table.primitives[0].indices)).count, 2 * 3 * 16);
+  }
+  {  // the ground: the 3D plane under the pot (GroundSource), two triangles, no targets
+    const tinygltf::Mesh& ground = m.meshes.at(size_t(m.nodes[2].mesh));
+    ASSERT_EQ(ground.primitives.size(), 1u);
+    EXPECT_EQ(ground.primitives[0].mode, TINYGLTF_MODE_TRIANGLES);
+    EXPECT_EQ(m.accessors.at(size_t(ground.primitives[0].indices)).count, 6u);
+    EXPECT_TRUE(ground.primitives[0].targets.empty());
+  }
   const tinygltf::Node& node = m.nodes[0];
   EXPECT_EQ(node.name, "pot3");
   EXPECT_EQ(node.mesh, 0);
   const tinygltf::Mesh& mesh = m.meshes[0];
   ASSERT_EQ(mesh.primitives.size(), 1u);
-  const tinygltf::Primitive& p = mesh.primitives[0];
+  const tinygltf::Primitive& p = mesh.primitives[0];  // the pot has no polylines: its mesh only
   EXPECT_EQ(p.mode, TINYGLTF_MODE_TRIANGLES);
   const TriangleMeshN<3>& pot_mesh = world.body<3>(0).def().mesh;
   EXPECT_EQ(m.accessors.at(size_t(p.attributes.at("POSITION"))).count, pot_mesh.points.size());
@@ -132,15 +154,15 @@ TEST(GltfExport, StructureThroughTinygltfsLoader) {
 
   ASSERT_EQ(m.animations.size(), 1u);
   const tinygltf::Animation& anim = m.animations[0];
-  ASSERT_EQ(anim.samplers.size(), 3u);
-  ASSERT_EQ(anim.channels.size(), 3u);
+  ASSERT_EQ(anim.samplers.size(), 6u);  // the pot's and the table's; the ground stands still
+  ASSERT_EQ(anim.channels.size(), 6u);
   std::vector<std::string> paths;
   for (const tinygltf::AnimationChannel& c : anim.channels) {
-    EXPECT_EQ(c.target_node, 0);
+    EXPECT_EQ(c.target_node, int(&c - anim.channels.data()) / 3);
     paths.push_back(c.target_path);
     const tinygltf::AnimationSampler& s = anim.samplers.at(size_t(c.sampler));
     EXPECT_EQ(s.interpolation, "LINEAR");
-    const size_t per_key = c.target_path == "weights" ? 3 : 1;  // morph weights: modes per key
+    const size_t per_key = c.target_path != "weights" ? 1 : c.target_node == 0 ? 3 : size_t(world.body<2>(1).num_modes());
     EXPECT_EQ(m.accessors.at(size_t(s.output)).count, 16 * per_key) << c.target_path;
     const tinygltf::Accessor& input = m.accessors.at(size_t(s.input));
     ASSERT_EQ(input.count, 16u);
@@ -149,7 +171,7 @@ TEST(GltfExport, StructureThroughTinygltfsLoader) {
     EXPECT_EQ(input.minValues, std::vector<double>{double(times[0])});
     EXPECT_EQ(input.maxValues, std::vector<double>{double(times[15])});
   }
-  EXPECT_EQ(paths, (std::vector<std::string>{"translation", "rotation", "weights"}));
+  EXPECT_EQ(paths, (std::vector<std::string>{"translation", "rotation", "weights", "translation", "rotation", "weights"}));
   // the node's own TRS is the first frame's, for a viewer that does not play the animation
   ASSERT_EQ(node.translation.size(), 3u);
   EXPECT_NEAR(node.translation[1], 30.0, 1e-5);
@@ -173,7 +195,7 @@ TEST(GltfExport, VerticesAtAStateAreTheWorldPositions) {
   const fs::path dir = TestDir("state");
   gltf.Write((dir / "pot.glb").string());
   const tinygltf::Model m = Load((dir / "pot.glb").string());
-  ASSERT_EQ(m.meshes.size(), 1u);
+  ASSERT_EQ(m.meshes.size(), 2u);  // the pot and the ground
   EXPECT_EQ(m.meshes[0].extras.Get("targetNames").Get(1).Get<std::string>(), "mode_2");
   const tinygltf::Primitive& p = m.meshes[0].primitives[0];
   const tinygltf::Node& node = m.nodes[0];
@@ -192,6 +214,65 @@ TEST(GltfExport, VerticesAtAStateAreTheWorldPositions) {
     worst = std::max(worst, (t + r * local - expected).cwiseAbs().maxCoeff());
   }
   EXPECT_LT(worst, 1e-6 * size) << "size " << size;
+  fs::remove_all(dir);
+}
+
+// A Witkin & Welch quadratic block (x = R p(u)) at two states: targets R_i_j hold p_j(u) along
+// axis i, the weights of frame k are R's entries, and base + Σ w target is LinearWorldPoint at
+// every vertex of its drawing (polylines, then the surface) to float precision.
+TEST(GltfExport, LinearBodyWeightsAreItsCoordinates) {
+  World world(testing::WitkinWelchOptions());
+  Eigen::VectorXd half(3);
+  half << 1.0, 0.5, 0.5;
+  auto block = std::make_shared<const LinearBodyModel>(MakeBoxBody("block", 3, LinearOrder::kQuadratic, half, 3, 1.0));
+  world.AddLinearBody(block);
+  const LinearDrawing drawing = MakeBoxDrawing(half, 4);
+  GltfRecorder gltf(&world, {drawing}, 16);
+  EXPECT_TRUE(gltf.SkippedBodies().empty());
+  std::vector<std::vector<Eigen::Vector3d>> expected;
+  for (int k = 0; k < 2; ++k) {
+    Eigen::MatrixXd R = block->RestState();
+    R(1, 7) = -0.3 * (k + 1);  // y -= 0.3 x²: bent (basis [x y z 1 xy xz yz x² y² z²])
+    R(0, 4) = 0.2 * k;         // x += 0.2 xy: sheared
+    R.col(3) << 0.5 * k, 1.0, -0.25 * k;
+    world.SetLinearState(0, R, Eigen::MatrixXd::Zero(3, 10));
+    world.SetTime(0.1 * k);
+    gltf.AddFrame();
+    std::vector<Eigen::Vector3d> points;
+    for (const auto& line : drawing.polylines)
+      for (const Eigen::VectorXd& u : line.points) points.push_back(LinearWorldPoint(world, 0, u));
+    for (const Eigen::VectorXd& u : drawing.vertices) points.push_back(LinearWorldPoint(world, 0, u));
+    expected.push_back(points);
+  }
+  const fs::path dir = TestDir("linear");
+  gltf.Write((dir / "block.glb").string());
+  const tinygltf::Model m = Load((dir / "block.glb").string());
+  ASSERT_EQ(m.nodes.size(), 1u);  // no ground: the block does not touch it
+  const tinygltf::Mesh& mesh = m.meshes.at(size_t(m.nodes[0].mesh));
+  ASSERT_EQ(mesh.primitives.size(), 2u);  // the surface and the outline
+  EXPECT_EQ(mesh.primitives[0].mode, TINYGLTF_MODE_TRIANGLES);
+  EXPECT_EQ(mesh.primitives[1].mode, TINYGLTF_MODE_LINE);
+  const tinygltf::Primitive& p = mesh.primitives[0];
+  ASSERT_EQ(p.targets.size(), 30u);  // 3 × 10
+  EXPECT_EQ(mesh.extras.Get("targetNames").Get(7).Get<std::string>(), "R_0_7");
+  ASSERT_EQ(m.animations.size(), 1u);
+  ASSERT_EQ(m.animations[0].channels.size(), 1u);  // weights only: the node stays put
+  EXPECT_EQ(m.animations[0].channels[0].target_path, "weights");
+  const float* weights = AccessorData<float>(m, m.animations[0].samplers[0].output);
+  const float* base = AccessorData<float>(m, p.attributes.at("POSITION"));
+  const size_t vertices = m.accessors.at(size_t(p.attributes.at("POSITION"))).count;
+  ASSERT_EQ(vertices, expected[0].size());
+  double worst = 0;
+  for (int k = 0; k < 2; ++k)
+    for (size_t v = 0; v < vertices; ++v) {
+      Eigen::Vector3d x(base[3 * v], base[3 * v + 1], base[3 * v + 2]);
+      for (size_t j = 0; j < 30; ++j) {
+        const float* target = AccessorData<float>(m, p.targets[j].at("POSITION"));
+        x += weights[30 * k + j] * Eigen::Vector3d(target[3 * v], target[3 * v + 1], target[3 * v + 2]);
+      }
+      worst = std::max(worst, (x - expected[size_t(k)][v]).cwiseAbs().maxCoeff());
+    }
+  EXPECT_LT(worst, 1e-5);  // the block is 2 × 1 × 1
   fs::remove_all(dir);
 }
 

@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
-"""`wobble export --what vtp,gltf` of the 3D pot (issue 48): the .glb read by a glTF reader of
-its own (json, struct, numpy; no wobble code) must give, at every frame, the vertices wobble
-draws itself. Every vertex is evaluated the glTF way (the mesh's POSITION plus the morph
-targets weighted by the animated weights, then the node's translation and rotation sampled
-from the animation at the frame's time) and compared with the mesh part of the same run's
-shape .vtp of that frame (ShapeSource, evaluated in double by wobble from the world's state)
-to 1e-5 of the body's size (the .glb holds float32).
+"""The .glb of `--what vtp,gltf` (issue 48) read by a glTF reader of its own (json, struct,
+numpy; no wobble code) must give, at every frame, the vertices wobble draws itself. Every
+vertex is evaluated the glTF way (the mesh's POSITION plus the morph targets weighted by the
+animated weights, then the node's translation and rotation sampled from the animation at the
+frame's time) and compared with the same run's shape .vtp of that frame (ShapeSource,
+evaluated in double by wobble from the world's state: a 3D mesh, a 2D outline resampled, a
+Witkin & Welch drawing) to 1e-5 of the body's size (the .glb holds float32). Runs: the demo's
+3D pot (`export`), the 2D pot with its closed outline (`export`) and the 3D pot on its pose
+graph (a script's `render` line). Linear bodies are checked by pipelines_gltf_test (a script's
+scene `render` takes frames, filmstrip, vtp only).
 Usage: check_gltf_export.py WOBBLE DATA_DIR WORK_DIR"""
 import json
 import os
@@ -16,7 +19,7 @@ import sys
 
 import numpy as np
 
-wobble, data, work = sys.argv[1:4]
+wobble, data, work = (os.path.abspath(a) for a in sys.argv[1:4])
 failures = []
 
 
@@ -118,77 +121,119 @@ def read_vtp(path):
     return arrays
 
 
-# ---------------------------------------------------------------- the run
-out = os.path.join(work, "pot3_gltf")
-subprocess.run(["rm", "-rf", out], check=True)
-# the demo's pot (Makefile DEMO3D_ARGS), 0.5 s: it falls, spins about its axis and squashes on landing
-args = [wobble, "export", "--object", os.path.join(data, "pot3.obj"), "--modes", os.path.join(data, "pot3_modes.def3"),
-        "--q", "0 30 0 0.3 0 0.15 0 0 0", "--qdot", "0 -60 0 0 1.2 0 0 0 0", "--dt", "0.001", "--duration", "0.5",
-        "--what", "vtp,gltf", "--out", out]
-env = dict(os.environ)
-env.pop("DISPLAY", None)  # the .glb (and the .vtp) need no X display
-r = subprocess.run(args, capture_output=True, text=True, env=env)
-print(r.stdout, r.stderr)
-glb = os.path.join(out, "pot3.glb")
-check(r.returncode == 0 and os.path.isfile(glb), "export --what vtp,gltf without a display writes pot3.glb")
-check("pot3.glb  (glTF 2.0" in r.stdout, "the report lists the .glb with its note")
-if failures:
-    sys.exit(1)
-check(not os.path.exists(glb + ".tmp"), "no temporary file is left")
-
-doc, binary = read_glb(glb)
-check(doc["asset"]["version"] == "2.0", "asset.version 2.0")
-nodes, meshes = doc["nodes"], doc["meshes"]
-check(len(nodes) == 1 and len(meshes) == 1 and nodes[0]["name"] == "pot3", "one node, one mesh: the pot")
-node = nodes[0]
-mesh = meshes[node["mesh"]]
-prim = mesh["primitives"][0]
-check(prim.get("mode", 4) == 4, "a TRIANGLES primitive")
-check(mesh["extras"]["targetNames"] == ["squash", "sway", "twist"], "targetNames are the modes file's names")
-check(len(prim["targets"]) == 3, "one morph target per mode")
-base = accessor(doc, binary, prim["attributes"]["POSITION"]).astype(np.float64)
-targets = [accessor(doc, binary, t["POSITION"]).astype(np.float64) for t in prim["targets"]]
-triangles = accessor(doc, binary, prim["indices"]).reshape(-1, 3)
-
-(animation,) = doc["animations"]
-channels = {}
-for ch in animation["channels"]:
-    check(ch["target"]["node"] == 0, f"channel {ch['target']['path']} drives the pot's node")
-    s = animation["samplers"][ch["sampler"]]
-    check(s.get("interpolation", "LINEAR") == "LINEAR", f"{ch['target']['path']}: LINEAR")
-    times = accessor(doc, binary, s["input"])[:, 0].astype(np.float64)
-    values = accessor(doc, binary, s["output"])
-    if ch["target"]["path"] == "weights":
-        values = values.reshape(len(times), -1)
-    channels[ch["target"]["path"]] = (times, values)
-check(sorted(channels) == ["rotation", "translation", "weights"], "translation, rotation and weights animated")
-
-# wobble's own frames: the .pvd's shape part, in time order
-pvd = open(os.path.join(out, "vtp", "pot3.pvd")).read()
-frames = [(float(t), f) for t, f in re.findall(r'timestep="([^"]+)"[^>]*name="pot3_shape" file="([^"]+)"', pvd)]
-times = channels["translation"][0]
-check(len(frames) == 16 and len(times) == len(frames), f"16 frames at 30 fps over 0.5 s in both ({len(times)} keys)")
-check(all(np.float32(t) == np.float32(k) for (t, _), k in zip(frames, times)),
-      "the keys are the frames' times (as float32)")
-
-worst, size = 0.0, None
-for t_frame, name in frames:
-    shape = read_vtp(os.path.join(out, "vtp", name))
-    reference = shape["Points"][: len(base)]  # the mesh comes first, then the drawing's polylines
-    if size is None:
-        size = float(np.linalg.norm(reference.max(axis=0) - reference.min(axis=0)))
-        check(np.array_equal(shape["Polys/connectivity"].reshape(-1, 3), triangles.astype(np.int64)),
-              "the triangles are the .vtp's")
-    t = float(np.float32(t_frame))
-    weights = sample(channels["weights"][0], channels["weights"][1], t, "weights")
+# ---------------------------------------------------------------- the runs
+def node_vertices(doc, binary, node_index, t):
+    """Every vertex of node `node_index`'s mesh at time t, evaluated as a glTF viewer does."""
+    node = doc["nodes"][node_index]
+    prim = doc["meshes"][node["mesh"]]["primitives"][0]
+    base = accessor(doc, binary, prim["attributes"]["POSITION"]).astype(np.float64)
+    targets = [accessor(doc, binary, tg["POSITION"]).astype(np.float64) for tg in prim.get("targets", [])]
+    translation = np.array(node.get("translation", [0, 0, 0]), dtype=np.float64)
+    rotation = np.array(node.get("rotation", [0, 0, 0, 1]), dtype=np.float64)
+    weights = np.array(node.get("weights", [0] * len(targets)), dtype=np.float64)
+    for animation in doc.get("animations", []):
+        for ch in animation["channels"]:
+            if ch["target"]["node"] != node_index:
+                continue
+            s = animation["samplers"][ch["sampler"]]
+            check(s.get("interpolation", "LINEAR") == "LINEAR", f"{node['name']} {ch['target']['path']}: LINEAR")
+            times = accessor(doc, binary, s["input"])[:, 0].astype(np.float64)
+            values = accessor(doc, binary, s["output"])
+            path = ch["target"]["path"]
+            if path == "weights":
+                values = values.reshape(len(times), -1)
+            value = sample(times, values, t, path)
+            if path == "translation":
+                translation = value
+            elif path == "rotation":
+                rotation = value
+            else:
+                weights = value
     local = base + sum(w * target for w, target in zip(weights, targets))
-    R = rotation_matrix(sample(*channels["rotation"], t, "rotation"))
-    world = local @ R.T + sample(*channels["translation"], t, "translation")
-    worst = max(worst, float(np.abs(world - reference).max()))
-print(f"body size (diagonal of the first frame's box) {size:.6g}; worst vertex error {worst:.3g} "
-      f"= {worst / size:.3g} of the size")
-check(worst <= 1e-5 * size, "every vertex at every frame matches wobble's drawing to 1e-5 of the body's size")
-moved = np.abs(channels["weights"][1]).max()
-check(moved > 1e-3, f"the modes move (largest |γ| {moved:.3g}): the morph targets are exercised")
+    return local @ rotation_matrix(rotation).T + translation
+
+
+def check_run(label, command, cwd, folder, stem, bodies, target_names, frames_expected):
+    """Runs `command` (no X display), then checks folder/stem.glb against folder/vtp/stem.pvd's
+    shape parts for every body in `bodies` (their node names)."""
+    env = dict(os.environ)
+    env.pop("DISPLAY", None)  # the .glb (and the .vtp) need no X display
+    subprocess.run(["rm", "-rf", folder], check=True)
+    r = subprocess.run(command, capture_output=True, text=True, env=env, cwd=cwd)
+    print(r.stdout, r.stderr)
+    glb = os.path.join(folder, stem + ".glb")
+    check(r.returncode == 0 and os.path.isfile(glb), f"{label}: {stem}.glb written without a display")
+    if not os.path.isfile(glb):
+        return
+    check(f"{stem}.glb  (glTF 2.0" in r.stdout, f"{label}: the report lists the .glb with its note")
+    check(not os.path.exists(glb + ".tmp"), f"{label}: no temporary file is left")
+    doc, binary = read_glb(glb)
+    check(doc["asset"]["version"] == "2.0", f"{label}: asset.version 2.0")
+    names = [n["name"] for n in doc["nodes"]]
+    check(all(b in names for b in bodies), f"{label}: a node per body {bodies} (nodes {names})")
+    (animation,) = doc["animations"]
+    pvd = open(os.path.join(folder, "vtp", stem + ".pvd")).read()
+    for body in bodies:
+        node_index = names.index(body)
+        mesh = doc["meshes"][doc["nodes"][node_index]["mesh"]]
+        check(mesh["extras"]["targetNames"] == target_names[body],
+              f"{label}: {body}'s targetNames {mesh['extras']['targetNames'][:4]}... are {target_names[body][:4]}...")
+        frames = [(float(t), f) for t, f in re.findall(rf'timestep="([^"]+)"[^>]*name="{body}_shape" file="([^"]+)"', pvd)]
+        keys = accessor(doc, binary, animation["samplers"][0]["input"])[:, 0]
+        check(len(frames) == frames_expected and len(keys) == len(frames), f"{label}: {len(frames)} frames, {len(keys)} keys")
+        check(all(np.float32(t) == k for (t, _), k in zip(frames, keys)), f"{label}: the keys are the frames' times (float32)")
+        worst, size, moved = 0.0, None, 0.0
+        for t_frame, name in frames:
+            reference = read_vtp(os.path.join(folder, "vtp", name))["Points"]
+            t = float(np.float32(t_frame))
+            vertices = node_vertices(doc, binary, node_index, t)
+            if size is None:
+                size = float(np.linalg.norm(reference.max(axis=0) - reference.min(axis=0)))
+                check(vertices.shape == reference.shape, f"{label}: {body}: as many vertices as the .vtp's shape ({vertices.shape})")
+                first = vertices
+            worst = max(worst, float(np.abs(vertices - reference).max()))
+            moved = max(moved, float(np.abs(vertices - first).max()))
+        print(f"{label}: {body}: size {size:.6g}; worst vertex error {worst:.3g} = {worst / size:.3g} of the size; "
+              f"largest motion {moved:.3g}")
+        check(worst <= 1e-5 * size, f"{label}: {body}: every vertex at every frame matches wobble's drawing to 1e-5 of its size")
+        check(moved > 0.05 * size, f"{label}: {body}: it moves (the animation is exercised)")
+
+
+os.makedirs(work, exist_ok=True)
+pot3 = os.path.join(work, "pot3_gltf")
+# the demo's pot (Makefile DEMO3D_ARGS), 0.5 s: it falls, spins about its axis and squashes on landing
+check_run("3D pot", [wobble, "export", "--object", os.path.join(data, "pot3.obj"), "--modes", os.path.join(data, "pot3_modes.def3"),
+                     "--q", "0 30 0 0.3 0 0.15 0 0 0", "--qdot", "0 -60 0 0 1.2 0 0 0 0", "--dt", "0.001",
+                     "--duration", "0.5", "--what", "vtp,gltf", "--out", pot3],
+          work, pot3, "pot3", ["pot3"], {"pot3": ["squash", "sway", "twist"]}, 16)
+# the 3D pot's modes move: the morph weights are not all 0
+doc, binary = read_glb(os.path.join(pot3, "pot3.glb"))
+weights = [accessor(doc, binary, s["output"]) for a in doc["animations"] for c, s in zip(a["channels"], a["samplers"])
+           if c["target"]["path"] == "weights"]
+check(len(weights) == 1 and np.abs(weights[0]).max() > 0.1, "3D pot: its modes move (largest |γ| > 0.1)")
+
+pot2 = os.path.join(work, "pot2_gltf")
+# the 2D pot with its closed outline (filled in the .glb), thrown turning onto the ground
+check_run("2D pot", [wobble, "export", "--object", os.path.join(data, "pot.obj"), "--modes", os.path.join(data, "def_pot"),
+                     "--q", "0 60 0.3 0.1 0 0", "--qdot", "20 -40 1 0 0 0", "--dt", "0.001", "--duration", "0.5",
+                     "--what", "vtp,gltf", "--out", pot2],
+          work, pot2, "pot", ["pot"], {"pot": ["vsquash", "hsquash", "bend"]}, 16)
+
+doc, binary = read_glb(os.path.join(pot2, "pot.glb"))
+names = [n["name"] for n in doc["nodes"]]
+modes = [p.get("mode", 4) for p in doc["meshes"][doc["nodes"][names.index("pot")]["mesh"]]["primitives"]]
+check(modes == [4, 1], f"2D pot: its closed outline filled (TRIANGLES) and its polylines (LINES): modes {modes}")
+check("ground" in names and all(c["target"]["node"] != names.index("ground") for c in doc["animations"][0]["channels"]),
+      "2D pot: the ground is a static node")
+
+# a script's `render` line: the 3D pot squashing on its pose graph (data/pot3_squash.wob), 0.5 s
+script = open(os.path.join(data, "pot3_squash.wob")).read()
+script = script.replace("load_obj pot3.obj", "load_obj " + os.path.join(data, "pot3.obj"))
+script = script.replace("load_def pot3_modes.def3", "load_def " + os.path.join(data, "pot3_modes.def3"))
+script = re.sub(r"output .*\n", "", script).replace("simul 4", "simul 0.5")
+script = re.sub(r"render .*\n", "render out/squash vtp,gltf\n", script)
+open(os.path.join(work, "squash.wob"), "w").write(script)
+check_run("script render", [wobble, "run", "squash.wob"], work, os.path.join(work, "out", "squash"), "pot3", ["pot3"],
+          {"pot3": ["squash", "sway", "twist"]}, 16)
 
 sys.exit(1 if failures else 0)
