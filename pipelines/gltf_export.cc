@@ -10,6 +10,8 @@
 #include <vtkTriangleFilter.h>
 
 #include <algorithm>
+#include <cmath>
+#include <tuple>
 #include <cstring>
 #include <limits>
 #include <sstream>
@@ -264,6 +266,80 @@ void GltfRecorder::AddFrame() {
   }
 }
 
+void GltfRecorder::AddCameraFrame(const GltfCamera& camera) {
+  if (cameras_.size() + 1 != times_.size()) throw std::logic_error("GltfRecorder: one camera per frame, after AddFrame");
+  cameras_.push_back(camera);
+}
+
+namespace {
+
+// The camera node's rotation: its axes are glTF's (+x right, +y up, looking down −z), so its
+// +z is the direction from the focal point to the camera and +y the view-up made orthogonal
+// to it (vtkCamera's conventions).
+Eigen::Quaterniond CameraRotation(const GltfCamera& c) {
+  const Eigen::Vector3d back = (c.position - c.focal_point).normalized();
+  const Eigen::Vector3d up = (c.view_up - c.view_up.dot(back) * back).normalized();
+  Eigen::Matrix3d axes;
+  axes << up.cross(back), up, back;  // columns x, y, z: right-handed (x = y × z)
+  return Eigen::Quaterniond(axes).normalized();
+}
+
+// The camera node and its keys (AddCameraFrame) into `model`; its properties are the first frame's.
+void AddCameraNode(const std::vector<GltfCamera>& cameras, int input, BufferBuilder* buffer, tinygltf::Model* model,
+                   tinygltf::Scene* scene, tinygltf::Animation* animation) {
+  const GltfCamera& first = cameras.front();
+  tinygltf::Camera camera;
+  camera.name = "camera";
+  double farthest = 0;
+  for (const GltfCamera& c : cameras) farthest = std::max(farthest, (c.position - c.focal_point).norm());
+  if (first.parallel) {
+    camera.type = "orthographic";
+    camera.orthographic.ymag = first.parallel_scale;
+    camera.orthographic.xmag = first.parallel_scale * first.aspect;
+    camera.orthographic.znear = 0.0;
+    camera.orthographic.zfar = 2.0 * farthest;  // the focal plane (a 2D world's z = 0) well inside
+  } else {
+    camera.type = "perspective";
+    camera.perspective.yfov = first.view_angle_deg * M_PI / 180.0;
+    camera.perspective.aspectRatio = first.aspect;
+    camera.perspective.znear = 1e-3 * farthest;  // zfar left out: an infinite projection
+  }
+  model->cameras.push_back(camera);
+  tinygltf::Node node;
+  node.name = "camera";
+  node.camera = int(model->cameras.size()) - 1;
+  std::vector<float> translation, rotation;
+  for (const GltfCamera& c : cameras) {
+    Append3(&translation, c.position);
+    Eigen::Quaterniond r = CameraRotation(c);
+    if (rotation.size() >= 4) {  // the short way from the last key
+      const float* last = &rotation[rotation.size() - 4];
+      if (r.x() * last[0] + r.y() * last[1] + r.z() * last[2] + r.w() * last[3] < 0) r.coeffs() = -r.coeffs();
+    }
+    for (int i = 0; i < 4; ++i) rotation.push_back(float(r.coeffs()[i]));
+  }
+  node.translation.assign(translation.begin(), translation.begin() + 3);
+  node.rotation.assign(rotation.begin(), rotation.begin() + 4);
+  model->nodes.push_back(node);
+  const int node_index = int(model->nodes.size()) - 1;
+  scene->nodes.push_back(node_index);
+  for (const auto& [values, type, path] : {std::tuple{&translation, TINYGLTF_TYPE_VEC3, "translation"},
+                                           std::tuple{&rotation, TINYGLTF_TYPE_VEC4, "rotation"}}) {
+    tinygltf::AnimationSampler sampler;
+    sampler.input = input;
+    sampler.output = buffer->AddFloats(*values, type == TINYGLTF_TYPE_VEC3 ? 3 : 4, type, false);
+    sampler.interpolation = "LINEAR";
+    tinygltf::AnimationChannel channel;
+    channel.sampler = int(animation->samplers.size());
+    channel.target_node = node_index;
+    channel.target_path = path;
+    animation->samplers.push_back(std::move(sampler));
+    animation->channels.push_back(std::move(channel));
+  }
+}
+
+}  // namespace
+
 std::string GltfRecorder::Bytes() const {
   if (times_.empty()) throw std::logic_error("GltfRecorder: no frame to write");
   tinygltf::Model model;
@@ -280,7 +356,9 @@ std::string GltfRecorder::Bytes() const {
   tinygltf::Animation animation;
   animation.name = "run";
   const std::vector<float> times(times_.begin(), times_.end());
-  const bool moves = std::any_of(parts_.begin(), parts_.end(), [](const Part& p) { return p.motion != Part::Motion::kStatic; });
+  const bool has_camera = !cameras_.empty() && cameras_.size() == times_.size();
+  const bool moves = has_camera ||
+                     std::any_of(parts_.begin(), parts_.end(), [](const Part& p) { return p.motion != Part::Motion::kStatic; });
   const int input = moves ? buffer.AddFloats(times, 1, TINYGLTF_TYPE_SCALAR, true) : -1;
 
   for (const Part& part : parts_) {
@@ -347,6 +425,7 @@ std::string GltfRecorder::Bytes() const {
     if (part.motion != Part::Motion::kStatic && !part.targets.empty())
       animate(part.weights, 1, TINYGLTF_TYPE_SCALAR, "weights");
   }
+  if (has_camera) AddCameraNode(cameras_, input, &buffer, &model, &scene, &animation);
   model.buffers[0].data.resize((model.buffers[0].data.size() + 3) / 4 * 4);  // the BIN chunk's padding
   if (!animation.channels.empty()) model.animations.push_back(std::move(animation));
   model.scenes.push_back(std::move(scene));

@@ -26,6 +26,10 @@
 //                  extras.targetNames: the modes' names (mode_<j+1> for an unnamed mode)
 //   node "ground" (last, when a body stands on the ground): the ground or terrain as wobble
 //                  draws it at the first frame (GroundSource), a static mesh
+//   node "camera" (last, when the frames were rendered: RenderTrajectory with frames or exr):
+//                  the render's camera (perspective yfov = the view angle, or orthographic
+//                  with the parallel scale, as at the first frame), its translation and
+//                  rotation keyed per frame (glTF's camera looks down its −z, +y up)
 //   animation "run": per moving body samplers sharing one input accessor (the frame times in
 //                  seconds, float): FFD bodies translation (VEC3), rotation (x y z w, signs kept
 //                  continuous so a slerp takes the short way) and weights (frames × targets
@@ -33,6 +37,7 @@
 // Bodies left out (a linear body without a drawing) are named by SkippedBodies().
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -40,6 +45,16 @@
 #include "wobble/world/world.h"
 
 namespace wobble::pipelines {
+
+// A camera at one frame, as VTK's (vtkCamera): where it is, what it looks at, which way is up.
+struct GltfCamera {
+  Eigen::Vector3d position = Eigen::Vector3d::UnitZ(), focal_point = Eigen::Vector3d::Zero(),
+                  view_up = Eigen::Vector3d::UnitY();
+  bool parallel = false;
+  double view_angle_deg = 30.0;  // vertical, perspective
+  double parallel_scale = 1.0;   // half the view's height in world units, parallel
+  double aspect = 4.0 / 3.0;     // width / height
+};
 
 class GltfRecorder {
  public:
@@ -50,6 +65,8 @@ class GltfRecorder {
   // Appends the world's current state at its time as the next frame (times must increase);
   // the first also takes the ground.
   void AddFrame();
+  // The camera of the frame AddFrame added last (every frame has one, or the file has no camera).
+  void AddCameraFrame(const GltfCamera& camera);
   // Writes the .glb atomically (path + ".tmp", then renamed). std::runtime_error naming the
   // file when it cannot be written; std::logic_error when no frame was added.
   void Write(const std::string& path) const;
@@ -81,6 +98,7 @@ class GltfRecorder {
   std::vector<Part> parts_;
   std::vector<std::string> skipped_;
   std::vector<double> times_;
+  std::vector<GltfCamera> cameras_;  // per frame, or none
 };
 
 }  // namespace wobble::pipelines

@@ -11,7 +11,9 @@
 #include <optional>
 #include <stdexcept>
 #include <utility>
+#include <vtkCamera.h>
 #include <vtkImageData.h>
+#include <vtkRenderer.h>
 #include <vtkSmartPointer.h>
 
 #include "pipelines/background_writer.h"
@@ -164,6 +166,20 @@ std::vector<DispTarget> DispTargets(const World& world, const RenderOutputs& out
     targets.push_back({b, stem, out.disp_width, h, 0});
   }
   return targets;
+}
+
+// The camera the view rendered its last frame with, for the .glb.
+GltfCamera CameraOf(SceneView& view) {
+  vtkCamera* c = view.renderer()->GetActiveCamera();
+  GltfCamera camera;
+  camera.position = Eigen::Vector3d(c->GetPosition());
+  camera.focal_point = Eigen::Vector3d(c->GetFocalPoint());
+  camera.view_up = Eigen::Vector3d(c->GetViewUp());
+  camera.parallel = c->GetParallelProjection() != 0;
+  camera.view_angle_deg = c->GetViewAngle();
+  camera.parallel_scale = c->GetParallelScale();
+  camera.aspect = double(view.options().width) / view.options().height;
+  return camera;
 }
 
 bool StandsOn2DGround(const World& world) {  // the ground line or terrain is framed with the motion
@@ -468,6 +484,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     if (gltf) {
       const auto start_key = std::chrono::steady_clock::now();
       gltf->AddFrame();
+      if (view) gltf->AddCameraFrame(CameraOf(*view));  // the frame's camera, as rendered
       gltf_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_key).count();
     }
     for (const DispTarget& d : disp) {
@@ -528,6 +545,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     std::string note = "glTF 2.0: " + std::to_string(gltf->num_bodies()) + " bod" + (gltf->num_bodies() == 1 ? "y" : "ies") +
                        " with morph targets (FFD: one per mode), " + std::to_string(gltf->num_frames()) + " keys; " +
                        seconds + " s";
+    if (view) note += "; the render's camera";
     for (const std::string& skipped : gltf->SkippedBodies()) note += "; " + skipped + " not in it (a linear body without a drawing)";
     report.files.push_back({path, note});
   }

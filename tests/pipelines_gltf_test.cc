@@ -276,6 +276,64 @@ TEST(GltfExport, LinearBodyWeightsAreItsCoordinates) {
   fs::remove_all(dir);
 }
 
+// With frames rendered the .glb has the render's camera: a perspective camera node keyed per
+// frame. The 3D view orbits at 30°/s from azimuth 20° at elevation 25° (FrameBox3d: the camera
+// sits along (cos el sin az, sin el, cos el cos az) from what it looks at), so the node's +z
+// (glTF's camera looks down −z) must have that elevation and turn by 30° per second.
+TEST(GltfExport, RenderedFramesAddTheOrbitingCamera) {
+  REQUIRE_DISPLAY();
+  World world(WithGroundPlane());
+  world.AddBody(Pot());
+  world.SetState(0, PositionsOf(Eigen::Vector3d(0, 30, 0), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()),
+                 Eigen::VectorXd::Zero(9));
+  const WorldData start = world.data();
+  auto run = std::make_shared<record::Trajectory>(world);
+  auto recorder = std::make_shared<record::Recorder>(run);
+  world.SetRecorder(recorder);
+  recorder->Start(world);
+  ASSERT_TRUE(world.RunUntil(0.3 + 0.5 * world.options().dt));
+  world.SetData(start);
+  const fs::path dir = TestDir("camera");
+  RenderOutputs out;
+  out.folder = dir.string();
+  out.name = "pot3";
+  ASSERT_EQ(SetOutputs({"frames", "gltf"}, &out), "");
+  out.fps = 10;
+  out.view.width = 160;
+  out.view.height = 120;
+  out.view.azimuth = 20;
+  out.view.elevation = 25;
+  out.orbit_deg_per_s = 30;
+  const RenderReport report = RenderTrajectory(world, *run, SceneSpec{}, out);
+  ASSERT_EQ(report.frames, 4);
+  const tinygltf::Model m = Load((dir / "pot3.glb").string());
+  ASSERT_EQ(m.cameras.size(), 1u);
+  EXPECT_EQ(m.cameras[0].type, "perspective");
+  EXPECT_NEAR(m.cameras[0].perspective.yfov, out.view.view_angle * M_PI / 180.0, 1e-6);
+  EXPECT_NEAR(m.cameras[0].perspective.aspectRatio, 160.0 / 120.0, 1e-6);
+  int node = -1;
+  for (size_t n = 0; n < m.nodes.size(); ++n)
+    if (m.nodes[n].camera == 0) node = int(n);
+  ASSERT_GE(node, 0);
+  EXPECT_EQ(m.nodes[size_t(node)].name, "camera");
+  const float* rotations = nullptr;
+  const float* times = nullptr;
+  for (const tinygltf::AnimationChannel& c : m.animations.at(0).channels)
+    if (c.target_node == node && c.target_path == "rotation") {
+      rotations = AccessorData<float>(m, m.animations[0].samplers.at(size_t(c.sampler)).output);
+      times = AccessorData<float>(m, m.animations[0].samplers.at(size_t(c.sampler)).input);
+    }
+  ASSERT_NE(rotations, nullptr);
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Quaterniond r(rotations[4 * k + 3], rotations[4 * k], rotations[4 * k + 1], rotations[4 * k + 2]);
+    const Eigen::Vector3d back = r * Eigen::Vector3d::UnitZ(), up = r * Eigen::Vector3d::UnitY();
+    EXPECT_NEAR(std::asin(back.y()) * 180.0 / M_PI, 25.0, 1e-3) << k;
+    EXPECT_NEAR(std::atan2(back.x(), back.z()) * 180.0 / M_PI, 20.0 + 30.0 * times[k], 1e-3) << k;
+    EXPECT_GT(up.y(), 0.5) << k;  // upright
+  }
+  fs::remove_all(dir);
+}
+
 // A path that cannot be written: std::runtime_error naming it, and nothing left behind; an
 // earlier file of the name stays as it was when the write fails.
 TEST(GltfExport, BadPathThrowsNamingTheFileAndLeavesNoFile) {
