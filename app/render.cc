@@ -53,8 +53,8 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
   cmd->add_option("--out", a->out, "Output folder")->required()->type_name("DIR");
   AddLimitFlags(cmd, &a->limits);
   cmd->add_option("--what", a->what,
-                  "What to write, comma separated: frames, filmstrip, charts, vtp, exr, disp, gltf (NAME.glb: 3D "
-                  "FFD bodies with a morph target per mode) (default: " +
+                  "What to write, comma separated: frames, filmstrip, charts, vtp, exr, disp, gltf (NAME.glb: "
+                  "the bodies with a morph target per mode, for Blender or three.js) (default: " +
                       default_what + ")")
       ->type_name("LIST");
   for (const scene::RenderOptionInfo& o : scene::RenderOptionTable()) {

@@ -20,8 +20,9 @@
 //   vti/disp_NNNN.vti       a 3D FFD body's displacement volume instead (DisplacementVolume),
 //   vti/disp.pvd            with their ParaView time series
 //   energy.png/.csv, condition.png/.csv   charts of body chart_body (condition: FFD bodies)
-//   NAME.glb                glTF 2.0 binary: each 3D FFD body's mesh with a morph target per
-//                           mode, its rigid motion and mode amplitudes keyed at the frames
+//   NAME.glb                glTF 2.0 binary (gltf_export.h): each body's mesh or drawing with
+//                           morph targets (an FFD body's modes), its rigid motion and the
+//                           weights keyed at the frames; the ground; with frames, the camera
 #pragma once
 
 #include <Eigen/Core>

@@ -116,7 +116,7 @@ void BindRender(py::module_& m) {
       py::arg("width") = 640, py::arg("height") = 480, py::arg("filmstrip_times") = std::vector<double>(),
       py::arg("color_by") = "",
       "Renders a recorded run into `folder` as `wobble render` does: what is any of frames,\n"
-      "filmstrip, vtp (the ParaView .pvd series), charts, exr, disp, gltf (name.glb: 3D FFD bodies\n"
+      "filmstrip, vtp (the ParaView .pvd series), charts, exr, disp, gltf (name.glb: the FFD bodies\n"
       "with a morph target per mode); frames at `fps`. options: the\n"
       "world the run had (ground, gravity). Returns the paths written (frame series as patterns).");
 }
