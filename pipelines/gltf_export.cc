@@ -124,6 +124,10 @@ GltfRecorder::GltfRecorder(const World* world, const std::vector<LinearDrawing>&
     else if (world->IsFfd(b, 2)) parts_.push_back(FfdPart<2>(b));
     else if (b < int(drawings.size()) && drawings[size_t(b)].dim() != 0) parts_.push_back(LinearPart(b, drawings[size_t(b)]));
     else skipped_.push_back(world->body_name(b));  // a linear body is seen only through a drawing
+    if (!parts_.empty() && parts_.back().body == b && parts_.back().triangles.empty() && parts_.back().lines.empty()) {
+      parts_.pop_back();  // nothing to draw (an FFD body without mesh or drawing)
+      skipped_.push_back(world->body_name(b));
+    }
   }
 }
 

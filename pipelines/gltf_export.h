@@ -34,7 +34,8 @@
 //                  seconds, float): FFD bodies translation (VEC3), rotation (x y z w, signs kept
 //                  continuous so a slerp takes the short way) and weights (frames × targets
 //                  floats); linear bodies weights only.
-// Bodies left out (a linear body without a drawing) are named by SkippedBodies().
+// Bodies left out (a linear body without a drawing, a body with nothing to draw) are named by
+// SkippedBodies().
 #pragma once
 
 #include <Eigen/Core>

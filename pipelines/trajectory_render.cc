@@ -546,7 +546,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
                        " with morph targets (FFD: one per mode), " + std::to_string(gltf->num_frames()) + " keys; " +
                        seconds + " s";
     if (view) note += "; the render's camera";
-    for (const std::string& skipped : gltf->SkippedBodies()) note += "; " + skipped + " not in it (a linear body without a drawing)";
+    for (const std::string& skipped : gltf->SkippedBodies()) note += "; " + skipped + " not in it (nothing to draw)";
     report.files.push_back({path, note});
   }
   if (out.charts) WriteCharts(run, out, &report);
