@@ -33,10 +33,11 @@ class BufferBuilder {
   // `values.size() / components` elements of `components` floats (type TINYGLTF_TYPE_*);
   // with_bounds: min and max per component, which glTF requires of POSITION (targets' too)
   // and of animation inputs.
-  int AddFloats(const std::vector<float>& values, int components, int type, bool with_bounds) {
+  // vertices: vertex data (the bufferView's target ARRAY_BUFFER), else animation data.
+  int AddFloats(const std::vector<float>& values, int components, int type, bool with_bounds, bool vertices = false) {
     const size_t count = values.size() / size_t(components);
     tinygltf::Accessor a;
-    a.bufferView = AddView(values.data(), values.size() * sizeof(float));
+    a.bufferView = AddView(values.data(), values.size() * sizeof(float), vertices ? TINYGLTF_TARGET_ARRAY_BUFFER : 0);
     a.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
     a.count = count;
     a.type = type;
@@ -306,7 +307,8 @@ void AddCameraNode(const std::vector<GltfCamera>& cameras, int input, BufferBuil
     camera.type = "perspective";
     camera.perspective.yfov = first.view_angle_deg * M_PI / 180.0;
     camera.perspective.aspectRatio = first.aspect;
-    camera.perspective.znear = 1e-3 * farthest;  // zfar left out: an infinite projection
+    camera.perspective.znear = 1e-3 * farthest;
+    camera.perspective.zfar = 1e3 * farthest;  // tinygltf writes 0 (invalid) for an infinite one
   }
   model->cameras.push_back(camera);
   tinygltf::Node node;
@@ -368,11 +370,11 @@ std::string GltfRecorder::Bytes() const {
   for (const Part& part : parts_) {
     if (part.triangles.empty() && part.lines.empty()) continue;  // nothing to draw
     tinygltf::Primitive triangles;
-    triangles.attributes["POSITION"] = buffer.AddFloats(part.rest, 3, TINYGLTF_TYPE_VEC3, true);
+    triangles.attributes["POSITION"] = buffer.AddFloats(part.rest, 3, TINYGLTF_TYPE_VEC3, true, true);
     triangles.material = 0;
     tinygltf::Value::Array names;
     for (size_t j = 0; j < part.targets.size(); ++j) {
-      triangles.targets.push_back({{"POSITION", buffer.AddFloats(part.targets[j], 3, TINYGLTF_TYPE_VEC3, true)}});
+      triangles.targets.push_back({{"POSITION", buffer.AddFloats(part.targets[j], 3, TINYGLTF_TYPE_VEC3, true, true)}});
       names.emplace_back(part.target_names[j]);
     }
     tinygltf::Primitive lines = triangles;  // the same vertices and targets
@@ -388,7 +390,6 @@ std::string GltfRecorder::Bytes() const {
       lines.indices = buffer.AddIndices(part.lines);
       mesh.primitives.push_back(std::move(lines));
     }
-    mesh.weights.assign(part.targets.size(), 0.0);
     if (!names.empty()) {  // Blender and three.js name the shape keys from extras.targetNames
       tinygltf::Value::Object extras;
       extras["targetNames"] = tinygltf::Value(names);
