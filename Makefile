@@ -34,7 +34,8 @@ PACKAGES := libvtk9-dev libeigen3-dev libceres-dev libopenexr-dev libimath-dev \
             nlohmann-json3-dev cmake g++ make libpagmo-dev libpng-dev zlib1g-dev \
             pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib \
             libopenmpi-dev openmpi-bin ccache ninja-build \
-            libavcodec-dev libavformat-dev libavutil-dev libswscale-dev pkgconf ffmpeg chromium
+            libavcodec-dev libavformat-dev libavutil-dev libswscale-dev pkgconf ffmpeg chromium \
+            libtinygltf-dev
 # only `make fuzz` needs these (libFuzzer is clang's)
 FUZZ_PACKAGES := clang libclang-rt-14-dev
 # only `make bench-mujoco` needs this (the peer the Witkin & Welch step is measured against)

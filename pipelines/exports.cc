@@ -231,16 +231,9 @@ VtpSeriesWriter::VtpSeriesWriter(const World* world, std::string folder, std::st
     p.source->SetBody(int(&p - parts_.data()) / 3);
   }
   if (const std::shared_ptr<const Terrain>& t = world_->options().params.ground.terrain) {
-    // the profile and as much again either side, filled to half its width below its lowest point
-    const double x0 = t->vertices().front().x(), x1 = t->vertices().back().x();
-    double lo = t->vertices().front().y(), hi = lo;
-    for (const Eigen::Vector2d& v : t->vertices()) lo = std::min(lo, v.y()), hi = std::max(hi, v.y());
-    const double span = std::max({x1 - x0, hi - lo, 1.0});
     terrain_ = vtkSmartPointer<GroundSource>::New();
     terrain_->SetWorld(world_);
-    terrain_->SetCenter(0.5 * (x0 + x1), lo);
-    terrain_->SetLength(3.0 * span);
-    terrain_->SetDepth(0.5 * span);
+    FrameWholeTerrain(*t, terrain_);
   } else if (world_->options().params.ground_plane.enabled && world_->options().params.ground_plane.heightfield) {
     terrain_ = vtkSmartPointer<GroundSource>::New();  // the grid's triangles (GroundSource::DrawHeightfield)
     terrain_->SetWorld(world_);

@@ -4,13 +4,16 @@
 #include "wobble/core/interrupt.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <utility>
+#include <vtkCamera.h>
 #include <vtkImageData.h>
+#include <vtkRenderer.h>
 #include <vtkSmartPointer.h>
 
 #include "pipelines/background_writer.h"
@@ -18,6 +21,7 @@
 #include "pipelines/energy_charts.h"
 #include "pipelines/exr_frame.h"
 #include "pipelines/exports.h"
+#include "pipelines/gltf_export.h"
 #include "pipelines/video_writer.h"
 
 namespace wobble::pipelines {
@@ -165,6 +169,20 @@ std::vector<DispTarget> DispTargets(const World& world, const RenderOutputs& out
   return targets;
 }
 
+// The camera the view rendered its last frame with, for the .glb.
+GltfCamera CameraOf(SceneView& view) {
+  vtkCamera* c = view.renderer()->GetActiveCamera();
+  GltfCamera camera;
+  camera.position = Eigen::Vector3d(c->GetPosition());
+  camera.focal_point = Eigen::Vector3d(c->GetFocalPoint());
+  camera.view_up = Eigen::Vector3d(c->GetViewUp());
+  camera.parallel = c->GetParallelProjection() != 0;
+  camera.view_angle_deg = c->GetViewAngle();
+  camera.parallel_scale = c->GetParallelScale();
+  camera.aspect = double(view.options().width) / view.options().height;
+  return camera;
+}
+
 bool StandsOn2DGround(const World& world) {  // the ground line or terrain is framed with the motion
   for (int b = 0; b < world.num_bodies(); ++b)
     if (GroundDimensionOf(world, b) == 2) return true;
@@ -253,7 +271,7 @@ void ApplyRenderSettings(const scene::RenderSettings& s, RenderOutputs* out) {
 }
 
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out) {
-  out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = out->mp4 = false;
+  out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = out->mp4 = out->gltf = false;
   for (const std::string& w : what) {
     bool* flag = w == "frames"      ? &out->frames
                  : w == "filmstrip" ? &out->filmstrip
@@ -262,8 +280,9 @@ std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out)
                  : w == "exr"       ? &out->exr
                  : w == "disp"      ? &out->disp
                  : w == "mp4"       ? &out->mp4
+                 : w == "gltf"      ? &out->gltf
                                     : nullptr;
-    if (!flag) return "'" + w + "' is not one of frames, filmstrip, charts, vtp, exr, disp, mp4";
+    if (!flag) return "'" + w + "' is not one of frames, filmstrip, charts, vtp, exr, disp, mp4, gltf";
     *flag = true;
   }
   if (what.empty()) return "nothing to write";
@@ -397,6 +416,9 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
 
   std::unique_ptr<VtpSeriesWriter> vtp;
   if (out.vtp) vtp = std::make_unique<VtpSeriesWriter>(&world, out.folder + "/vtp", out.name, spec.drawings, out.view.shape_samples);
+  std::unique_ptr<GltfRecorder> gltf;
+  if (out.gltf) gltf = std::make_unique<GltfRecorder>(&world, spec.drawings, out.view.shape_samples);
+  double gltf_seconds = 0;  // the glTF part's own time (its frames' keys and the file), for the report
   const std::vector<DispTarget> disp = out.disp ? DispTargets(world, out) : std::vector<DispTarget>();
   PvdCollection volumes;  // 3D bodies' displacement volumes
   std::vector<vtkSmartPointer<vtkImageData>> panels;
@@ -469,6 +491,12 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
       }
     }
     if (vtp) vtp->WriteFrame(int(v.frame), &writer);
+    if (gltf) {
+      const auto start_key = std::chrono::steady_clock::now();
+      gltf->AddFrame();
+      if (view) gltf->AddCameraFrame(CameraOf(*view));  // the frame's camera, as rendered
+      gltf_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_key).count();
+    }
     for (const DispTarget& d : disp) {
       if (d.depth == 0) {
         WriteDisplacementExr(Numbered(out.folder + "/exr", d.stem, v.frame, "exr"), world, d.body, d.width, d.height, &writer);
@@ -524,6 +552,20 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     const std::string path = out.folder + "/filmstrip.png";
     WritePng(path, TileImages(panels, out.filmstrip_columns));
     report.files.push_back({path, ""});
+  }
+  if (gltf && gltf->num_frames() > 0) {
+    const auto start_write = std::chrono::steady_clock::now();
+    const std::string path = out.folder + "/" + out.name + ".glb";
+    gltf->Write(path);
+    gltf_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_write).count();
+    char seconds[32];
+    std::snprintf(seconds, sizeof(seconds), "%.3g", gltf_seconds);
+    std::string note = "glTF 2.0: " + std::to_string(gltf->num_bodies()) + " bod" + (gltf->num_bodies() == 1 ? "y" : "ies") +
+                       " with morph targets (FFD: one per mode), " + std::to_string(gltf->num_frames()) + " keys; " +
+                       seconds + " s";
+    if (view) note += "; the render's camera";
+    for (const std::string& skipped : gltf->SkippedBodies()) note += "; " + skipped + " not in it (nothing to draw)";
+    report.files.push_back({path, note});
   }
   if (out.charts) WriteCharts(run, out, &report);
   return report;

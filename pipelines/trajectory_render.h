@@ -1,7 +1,7 @@
 // The one render driver: a recorded run (record::Trajectory) turned into PNG frames, a
 // filmstrip, a ParaView .vtp/.pvd series, EXR frames (exr_frame.h), displacement images
-// (disp.X, disp.Y over an FFD body's rest lattice) and charts (energy and cond(M) against
-// time, PNG + CSV), for `wobble render`/`export`, a script's `render` (its FFD runs and its
+// (disp.X, disp.Y over an FFD body's rest lattice), charts (energy and cond(M) against
+// time, PNG + CSV) and a glTF 2.0 animation (gltf_export.h), for `wobble render`/`export`, a script's `render` (its FFD runs and its
 // Witkin & Welch scenes) alike. Every sample is put back into a world (Trajectory::Restore)
 // and drawn by SceneView and the sources of world_sources.h; the camera is fixed for the run
 // and frames the whole motion.
@@ -21,6 +21,9 @@
 //   vti/disp.pvd            with their ParaView time series
 //   energy.png/.csv, condition.png/.csv   charts of body chart_body (condition: FFD bodies)
 //   NAME.mp4                the frames as an H.264 video at fps (video_writer.h)
+//   NAME.glb                glTF 2.0 binary (gltf_export.h): each body's mesh or drawing with
+//                           morph targets (an FFD body's modes), its rigid motion and the
+//                           weights keyed at the frames; the ground; with frames, the camera
 #pragma once
 
 #include <Eigen/Core>
@@ -38,8 +41,8 @@ namespace wobble::pipelines {
 
 struct RenderOutputs {
   std::string folder;         // created if missing
-  std::string name = "run";   // stem of the .pvd
-  bool frames = true, filmstrip = true, charts = false, vtp = true, exr = false, disp = false, mp4 = false;
+  std::string name = "run";   // stem of the .pvd, the .mp4 and the .glb
+  bool frames = true, filmstrip = true, charts = false, vtp = true, exr = false, disp = false, mp4 = false, gltf = false;
   // Frames at t0 + k/fps (t0 the first sample's time) up to t_end, those the run reached (up
   // to half a step after its last sample), each at its exact time: the state interpolated
   // between the samples around it (record::Trajectory::RestoreAt); fps 0:
@@ -93,7 +96,7 @@ struct RenderReport {
 // is (a world as at the run's start draws the ground contacts as the run had them): the world
 // is left in the state of the last sample drawn.
 // `spec` draws the linear bodies' shapes and the named points. Pictures (frames, filmstrip,
-// exr, charts) need HasDisplay(); vtp and disp do not. Throws std::invalid_argument for an
+// exr, charts) need HasDisplay(); vtp, disp and gltf do not. Throws std::invalid_argument for an
 // empty run or a world of other bodies, std::runtime_error for a failed write (naming the file).
 RenderReport RenderTrajectory(World& world, const record::Trajectory& run, const SceneSpec& spec, const RenderOutputs& out);
 
@@ -111,11 +114,11 @@ World WorldFor(const record::Trajectory& run, const WorldOptions& options);
 // script's NAME=VALUE) put into `out`: sizes, fps, filmstrip, camera, style, trails, ...
 void ApplyRenderSettings(const scene::RenderSettings& settings, RenderOutputs* out);
 
-// The outputs the words of `what` name (frames, filmstrip, charts, vtp, exr, disp, mp4) on, the
-// others off: "" when every word is one of them and one at least is given, else what is wrong
+// The outputs the words of `what` name (frames, filmstrip, charts, vtp, exr, disp, mp4, gltf) on,
+// the others off: "" when every word is one of them and one at least is given, else what is wrong
 // (`wobble render --what`, a script's `render` and Python's render read it the same way).
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out);
-// Of those, the ones written without an X display (vtp, disp): the rest are switched off and
+// Of those, the ones written without an X display (vtp, disp, gltf): the rest are switched off and
 // returned, for the message that says they were skipped.
 std::vector<std::string> KeepWithoutDisplay(RenderOutputs* out);
 

@@ -1,5 +1,6 @@
 #include "pipelines/world_sources.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vtkCellArray.h>
@@ -346,11 +347,9 @@ void ShapeSource::PrintSelf(ostream& os, vtkIndent indent) {
   os << indent << "SamplesPerSegment: " << SamplesPerSegment << "\n";
 }
 
-template <int Dim> const DrawingSamples<Dim>& ShapeSource::SamplesOf(const BodyModelN<Dim>& body) {
+template <int Dim> DrawingSamples<Dim> MakeDrawingSamples(const BodyModelN<Dim>& body, int per_segment) {
   using Point = Eigen::Matrix<double, Dim, 1>;
-  DrawingSamples<Dim>& samples = std::get<Dim - 2>(samples_);
-  if (samples.body == &body && samples.per_segment == SamplesPerSegment) return samples;
-  samples = DrawingSamples<Dim>();
+  DrawingSamples<Dim> samples;
   const LatticeN<Dim>& lat = body.lattice();
   for (const PolylineN<Dim>& pl : body.def().shapes) {
     const int np = int(pl.points.size());
@@ -359,11 +358,11 @@ template <int Dim> const DrawingSamples<Dim>& ShapeSource::SamplesOf(const BodyM
     const int segments = pl.closed ? np : np - 1;
     for (int seg = 0; seg < segments; ++seg) {
       const Point a = pl.points[size_t(seg)], b = pl.points[size_t((seg + 1) % np)];
-      for (int k = 0; k < SamplesPerSegment; ++k)
-        samples.st.push_back(lat.LocalCoords(a + (b - a) * (double(k) / SamplesPerSegment)));
+      for (int k = 0; k < per_segment; ++k)
+        samples.st.push_back(lat.LocalCoords(a + (b - a) * (double(k) / per_segment)));
     }
     if (!pl.closed) samples.st.push_back(lat.LocalCoords(pl.points.back()));
-    samples.polylines.push_back({segments * SamplesPerSegment + (pl.closed ? 0 : 1), pl.closed});
+    samples.polylines.push_back({segments * per_segment + (pl.closed ? 0 : 1), pl.closed});
   }
   for (const Point& st : samples.st) {
     Point b0;
@@ -373,7 +372,15 @@ template <int Dim> const DrawingSamples<Dim>& ShapeSource::SamplesOf(const BodyM
     samples.B.push_back(B);
   }
   samples.body = &body;
-  samples.per_segment = SamplesPerSegment;
+  samples.per_segment = per_segment;
+  return samples;
+}
+template DrawingSamples<2> MakeDrawingSamples<2>(const BodyModelN<2>&, int);
+template DrawingSamples<3> MakeDrawingSamples<3>(const BodyModelN<3>&, int);
+
+template <int Dim> const DrawingSamples<Dim>& ShapeSource::SamplesOf(const BodyModelN<Dim>& body) {
+  DrawingSamples<Dim>& samples = std::get<Dim - 2>(samples_);
+  if (samples.body != &body || samples.per_segment != SamplesPerSegment) samples = MakeDrawingSamples(body, SamplesPerSegment);
   return samples;
 }
 
@@ -481,6 +488,16 @@ void GroundSource::PrintSelf(ostream& os, vtkIndent indent) {
 // A terrain over [Center.x ± Length/2]: its surface as one polyline, and below it one
 // trapezoid per non-vertical segment down to Depth under the lowest surface point (convex
 // cells: VTK fans polygons, so a whole non-convex profile would fill wrongly).
+void FrameWholeTerrain(const Terrain& terrain, GroundSource* ground) {
+  const double x0 = terrain.vertices().front().x(), x1 = terrain.vertices().back().x();
+  double lo = terrain.vertices().front().y(), hi = lo;
+  for (const Eigen::Vector2d& v : terrain.vertices()) lo = std::min(lo, v.y()), hi = std::max(hi, v.y());
+  const double span = std::max({x1 - x0, hi - lo, 1.0});
+  ground->SetCenter(0.5 * (x0 + x1), lo);
+  ground->SetLength(3.0 * span);
+  ground->SetDepth(0.5 * span);
+}
+
 int GroundSource::DrawTerrain(const Terrain& terrain, vtkPoints* points, vtkPolyData* out) {
   const double x0 = Center[0] - 0.5 * Length, x1 = Center[0] + 0.5 * Length;
   std::vector<Eigen::Vector2d> surface = {{x0, terrain.HeightAt(x0)}};

@@ -147,6 +147,10 @@ template <int Dim> struct DrawingSamples {
   std::vector<MatND<double, Dim>> B;
   std::vector<std::pair<int, bool>> polylines;  // samples per polyline, closed
 };
+// The drawing of `body` resampled per_segment times per segment (a closed polyline's last
+// segment returns to its first point, which is not repeated; an open one ends on its last
+// point): what ShapeSource draws, and the glTF export (gltf_export.h) writes.
+template <int Dim> DrawingSamples<Dim> MakeDrawingSamples(const BodyModelN<Dim>& body, int per_segment);
 
 class ShapeSource : public BodyPartSource {
  public:
@@ -209,6 +213,10 @@ class GroundSource : public WorldSourceBase {
   double Center[2] = {0, 0};
   double Length = 2000.0, Depth = 100.0;
 };
+
+// Sets `ground` to draw the whole terrain once: its profile and as much again either side,
+// filled to half its width below its lowest point (the .vtp series' and the .glb's terrain).
+void FrameWholeTerrain(const Terrain& terrain, GroundSource* ground);
 
 class SpringSource : public WorldSourceBase {
  public:

@@ -60,6 +60,15 @@ def test_render_writes_a_video_ffprobe_reads(table, tmp_path):
     assert probe == "h264,320,240,11"  # 0, 0.1, ..., 1.0 s
 
 
+def test_render_writes_a_gltf_without_a_display(table, tmp_path):
+    # issue 48: "gltf" needs no display; the .glb holds the table (a 2D FFD body) keyed per frame
+    _, options, run = dropped(table, 1.0)
+    files = wobble.render(run, options, str(tmp_path), name="drop", what=["gltf"], fps=10)
+    assert files == [str(tmp_path / "drop.glb")]
+    raw = (tmp_path / "drop.glb").read_bytes()
+    assert raw[:4] == b"glTF" and int.from_bytes(raw[8:12], "little") == len(raw)
+
+
 def test_a_pose_graph_controller_drives_the_active_modes(data):
     interp = bounding_table(data)
     problem, graph = interp.synthesis_problem(), interp.pose_graph
