@@ -10,6 +10,7 @@
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,6 +23,7 @@
 #include "pipelines/exr_io.h"
 #include "pipelines/interactive_view.h"
 #include "pipelines/scene_view.h"
+#include "pipelines/mesh_io.h"
 #include "pipelines/trajectory_render.h"
 #include "wobble/formats/deformation_file.h"
 #include "wobble/formats/object_file.h"
@@ -307,6 +309,79 @@ void BM_RenderTable300Frames(benchmark::State& state) {
   state.SetLabel(state.range(0) == 0 ? "frames (baseline)" : state.range(0) == 1 ? "frames + mp4" : "mp4");
 }
 BENCHMARK(BM_RenderTable300Frames)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(2);
+
+// The glTF export's size and time (issue 48: < 2 MB for a 10,000-vertex character with 6 modes
+// over 300 frames): a ball of 100 x 100 vertices (a UV sphere, radius 50) in a fitted 4x4x4
+// lattice with six modes, dropped for 10 s and exported at 30 fps with nothing else. Counters:
+// the .glb's bytes, and a per-frame vertex cache of the same frames (float32 x, y, z).
+void BM_GltfExport10kVertices300Frames(benchmark::State& state) {
+  const std::string dir = OutDir() + "/gltf10k";
+  std::filesystem::create_directories(dir);
+  constexpr int kRings = 100, kAround = 100;
+  {
+    std::ofstream mesh(dir + "/ball.obj");
+    for (int i = 0; i < kRings; ++i) {
+      const double polar = M_PI * (i + 0.5) / kRings;
+      for (int j = 0; j < kAround; ++j) {
+        const double azimuth = 2 * M_PI * j / kAround;
+        mesh << "v " << 50 * std::sin(polar) * std::cos(azimuth) << " " << 50 + 50 * std::cos(polar) << " "
+             << 50 * std::sin(polar) * std::sin(azimuth) << "\n";
+      }
+    }
+    for (int i = 0; i + 1 < kRings; ++i)
+      for (int j = 0; j < kAround; ++j) {
+        const int a = i * kAround + j + 1, b = i * kAround + (j + 1) % kAround + 1;
+        mesh << "f " << a << " " << a + kAround << " " << b + kAround << "\nf " << a << " " << b + kAround << " " << b << "\n";
+      }
+    std::ofstream(dir + "/ball3.obj") << "dimension 3\nname ball\nmesh ball.obj\nlattice fit 4 4 4 margin 0.05\n"
+                                         "sample volume 400 600\nsample surface 240 150\n";
+    std::ofstream(dir + "/ball.def3") << "dimension 3\n"
+                                         "mode squash stiffness 2000000 damping 20000\n  squash y 0.4\n"
+                                         "mode squash_x stiffness 2000000 damping 20000\n  squash x 0.4\n"
+                                         "mode sway stiffness 2000000 damping 20000\n  shear y x 30\n"
+                                         "mode sway_z stiffness 2000000 damping 20000\n  shear y z 30\n"
+                                         "mode twist stiffness 2000000 damping 20000\n  twist y 30\n"
+                                         "mode bend stiffness 2000000 damping 20000\n  bend x y 30\n";
+  }
+  BodyDefN<3> def = ReadObject<3>(dir + "/ball3.obj");
+  auto modes = formats::ReadDeformationFile(dir + "/ball.def3", def.lattice);
+  auto body = std::make_shared<const BodyModelN<3>>(std::move(def), std::move(modes));
+  WorldOptions options;
+  options.dt = 0.001;
+  options.params.ground_plane.enabled = true;
+  World world(options);
+  world.AddBody(body);
+  // tilted by 0.3 rad about x, spinning at 1.2 rad/s about y (q: t, quaternion x y z w, γ)
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(body->num_positions()), qdot = Eigen::VectorXd::Zero(body->num_q());
+  q[1] = 60;
+  q[3] = std::sin(0.15);
+  q[6] = std::cos(0.15);
+  qdot[4] = 1.2;
+  world.SetState(0, q, qdot);
+  auto run = std::make_shared<record::Trajectory>(world);
+  auto recorder = std::make_shared<record::Recorder>(run);
+  world.SetRecorder(recorder);
+  recorder->Start(world);
+  world.RunUntil(10.0 + 0.0005, [](const World&) {});
+  RenderOutputs out;
+  out.folder = dir;
+  out.name = "ball";
+  out.fps = 30;
+  out.frames = out.filmstrip = out.vtp = false;
+  out.gltf = true;
+  long frames = 0;
+  for (auto _ : state) {
+    World replay(options);
+    replay.AddBody(body);
+    frames = RenderTrajectory(replay, *run, SceneSpec{}, out).frames;
+  }
+  const size_t vertices = body->def().mesh.points.size();
+  state.counters["vertices"] = double(vertices);
+  state.counters["frames"] = double(frames);
+  state.counters["glb_bytes"] = double(std::filesystem::file_size(dir + "/ball.glb"));
+  state.counters["vertex_cache_bytes"] = double(vertices * 3 * 4 * size_t(frames));
+}
+BENCHMARK(BM_GltfExport10kVertices300Frames)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 
 }  // namespace
 }  // namespace wobble::pipelines
