@@ -27,14 +27,14 @@ ASAN_BUILD ?= build-asan
 JOBS       ?= 2
 OUT        ?= out/demo
 
-# ffmpeg's libraries encode the videos; the ffmpeg package (ffprobe) and chromium are the tests'
-# readers of them, programs wobble does not contain
+# ffmpeg's libraries encode the videos; the ffmpeg package (ffprobe), python3-pil and chromium
+# are the tests' readers of them, programs wobble does not contain
 PACKAGES := libvtk9-dev libeigen3-dev libceres-dev libopenexr-dev libimath-dev \
             libgtest-dev libgmock-dev libbenchmark-dev xvfb xauth libcli11-dev \
             nlohmann-json3-dev cmake g++ make libpagmo-dev libpng-dev zlib1g-dev \
             pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib \
             libopenmpi-dev openmpi-bin ccache ninja-build \
-            libavcodec-dev libavformat-dev libavutil-dev libswscale-dev pkgconf ffmpeg chromium \
+            libavcodec-dev libavformat-dev libavutil-dev libswscale-dev pkgconf ffmpeg python3-pil chromium \
             libtinygltf-dev
 # only `make fuzz` needs these (libFuzzer is clang's)
 FUZZ_PACKAGES := clang libclang-rt-14-dev

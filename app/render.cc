@@ -53,7 +53,8 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
   cmd->add_option("--out", a->out, "Output folder")->required()->type_name("DIR");
   AddLimitFlags(cmd, &a->limits);
   cmd->add_option("--what", a->what,
-                  "What to write, comma separated: frames, filmstrip, charts, vtp, exr, disp, mp4 (NAME.mp4: H.264 video), gltf (NAME.glb: "
+                  "What to write, comma separated: frames, filmstrip, charts, vtp, exr, disp, mp4 (NAME.mp4: H.264 "
+                  "video), webp (NAME.webp: animated, loops), gltf (NAME.glb: "
                   "the bodies with a morph target per mode, for Blender or three.js) (default: " +
                       default_what + ")")
       ->type_name("LIST");
@@ -116,7 +117,7 @@ RenderRequest ParseRenderRequest(const RenderArgs& a, const std::string& default
 
 void CheckRenderRequest(const RenderRequest& r, const std::string& out) {
   const bool draws = r.what.count("frames") || r.what.count("filmstrip") || r.what.count("charts") || r.what.count("exr") ||
-                     r.what.count("mp4");
+                     r.what.count("mp4") || r.what.count("webp");
   if (draws && !pl::HasDisplay())
     throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"
                      "  xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble ...\n"

@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 #include <vtkCamera.h>
 #include <vtkImageData.h>
@@ -271,7 +272,7 @@ void ApplyRenderSettings(const scene::RenderSettings& s, RenderOutputs* out) {
 }
 
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out) {
-  out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = out->mp4 = out->gltf = false;
+  out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = out->mp4 = out->webp = out->gltf = false;
   for (const std::string& w : what) {
     bool* flag = w == "frames"      ? &out->frames
                  : w == "filmstrip" ? &out->filmstrip
@@ -280,9 +281,10 @@ std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out)
                  : w == "exr"       ? &out->exr
                  : w == "disp"      ? &out->disp
                  : w == "mp4"       ? &out->mp4
+                 : w == "webp"      ? &out->webp
                  : w == "gltf"      ? &out->gltf
                                     : nullptr;
-    if (!flag) return "'" + w + "' is not one of frames, filmstrip, charts, vtp, exr, disp, mp4, gltf";
+    if (!flag) return "'" + w + "' is not one of frames, filmstrip, charts, vtp, exr, disp, mp4, webp, gltf";
     *flag = true;
   }
   if (what.empty()) return "nothing to write";
@@ -292,7 +294,8 @@ std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out)
 std::vector<std::string> KeepWithoutDisplay(RenderOutputs* out) {
   std::vector<std::string> skipped;
   for (auto [flag, name] : {std::pair{&out->frames, "frames"}, std::pair{&out->filmstrip, "filmstrip"},
-                            std::pair{&out->charts, "charts"}, std::pair{&out->exr, "exr"}, std::pair{&out->mp4, "mp4"}})
+                            std::pair{&out->charts, "charts"}, std::pair{&out->exr, "exr"}, std::pair{&out->mp4, "mp4"},
+                            std::pair{&out->webp, "webp"}})
     if (*flag) {
       skipped.push_back(name);
       *flag = false;
@@ -348,8 +351,9 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   RenderReport report;
 
   std::unique_ptr<SceneView> view, strip_view;
-  if (out.mp4 && !(out.fps > 0.0)) throw std::invalid_argument("a video needs frames at a rate: fps must be above 0");
-  if (out.frames || out.exr || out.mp4) view = std::make_unique<SceneView>(&world, out.view, spec);
+  if ((out.mp4 || out.webp) && !(out.fps > 0.0))
+    throw std::invalid_argument("a video needs frames at a rate: fps must be above 0");
+  if (out.frames || out.exr || out.mp4 || out.webp) view = std::make_unique<SceneView>(&world, out.view, spec);
   if (out.filmstrip) {
     SceneOptions s = out.view;
     s.width = out.filmstrip_width;
@@ -423,11 +427,15 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   PvdCollection volumes;  // 3D bodies' displacement volumes
   std::vector<vtkSmartPointer<vtkImageData>> panels;
   BackgroundWriter writer;  // files are compressed and written while the next frame renders
-  std::unique_ptr<VideoWriter> video;  // encodes on its own thread, in frame order
-  if (out.mp4) {
+  std::vector<std::unique_ptr<VideoWriter>> videos;  // each encodes on its own thread, in frame order
+  for (auto [asked, format, extension] : {std::tuple{out.mp4, VideoFormat::kMp4, ".mp4"},
+                                          std::tuple{out.webp, VideoFormat::kWebp, ".webp"}}) {
+    if (!asked) continue;
     VideoOptions video_options;
+    video_options.format = format;
     video_options.fps = out.fps;
-    video = std::make_unique<VideoWriter>(out.folder + "/" + out.name + ".mp4", out.view.width, out.view.height, video_options);
+    videos.push_back(std::make_unique<VideoWriter>(out.folder + "/" + out.name + extension, out.view.width,
+                                                   out.view.height, video_options));
   }
   // An EXR frame waits for the next frame's characters: its motion vectors point to them (and,
   // in Blender's Vector pass, to the previous frame's too).
@@ -481,7 +489,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
     if (view) {
       view->Render();
       if (out.frames) view->WritePng(Numbered(out.folder + "/frames", "frame", v.frame, "png"), &writer);
-      if (video) video->AddFrame(PixelsOf(view->Capture()));
+      for (const std::unique_ptr<VideoWriter>& video : videos) video->AddFrame(PixelsOf(view->Capture()));
       if (out.exr) {
         ExrFrame frame = view->CaptureExrFrame();
         frame.metadata.frames_per_second = out.fps;
@@ -511,11 +519,12 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   }
   submit_exr(nullptr);  // the last frame drawn has no next frame: no motion
   writer.Wait();
-  const long video_frames = video ? video->Finish() : 0;  // an interrupted run's video holds the frames drawn
+  std::vector<long> video_frames;  // an interrupted run's videos hold the frames drawn
+  for (const std::unique_ptr<VideoWriter>& video : videos) video_frames.push_back(video->Finish());
   if (interrupted) {
     std::string where = std::to_string(report.frames) + " of " + std::to_string(num_frames) + " frames";
     if (vtp) where += ", and " + vtp->WriteCollection() + " for them";
-    if (video) where += ", and " + video->path() + " of them";
+    for (const std::unique_ptr<VideoWriter>& video : videos) where += ", and " + video->path() + " of them";
     throw Interrupted("rendering stopped by Ctrl-C: " + where + " written in " + out.folder);
   }
   world.SetData(start);
@@ -523,11 +532,12 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   if (!visits.empty()) run.Restore(visits.back().sample, caller);
 
   if (out.frames) report.files.push_back({out.folder + "/frames/frame_NNNN.png", ""});
-  if (video) {
+  for (size_t i = 0; i < videos.size(); ++i) {
     char note[96];
-    std::snprintf(note, sizeof(note), "H.264 video, %ld frames at %g fps, %.4g s", video_frames, out.fps,
-                  double(video_frames) / out.fps);
-    report.files.push_back({video->path(), note});
+    std::snprintf(note, sizeof(note), "%s, %ld frames at %g fps, %.4g s",
+                  videos[i]->format() == VideoFormat::kMp4 ? "H.264 video" : "animated WebP", video_frames[i], out.fps,
+                  double(video_frames[i]) / out.fps);
+    report.files.push_back({videos[i]->path(), note});
   }
   if (out.exr)
     report.files.push_back({out.folder + "/exr/frame_NNNN.exr",

@@ -20,7 +20,7 @@
 //   vti/disp_NNNN.vti       a 3D FFD body's displacement volume instead (DisplacementVolume),
 //   vti/disp.pvd            with their ParaView time series
 //   energy.png/.csv, condition.png/.csv   charts of body chart_body (condition: FFD bodies)
-//   NAME.mp4                the frames as an H.264 video at fps (video_writer.h)
+//   NAME.mp4, NAME.webp     the frames as an H.264 video, an animated WebP, at fps (video_writer.h)
 //   NAME.glb                glTF 2.0 binary (gltf_export.h): each body's mesh or drawing with
 //                           morph targets (an FFD body's modes), its rigid motion and the
 //                           weights keyed at the frames; the ground; with frames, the camera
@@ -41,8 +41,9 @@ namespace wobble::pipelines {
 
 struct RenderOutputs {
   std::string folder;         // created if missing
-  std::string name = "run";   // stem of the .pvd, the .mp4 and the .glb
-  bool frames = true, filmstrip = true, charts = false, vtp = true, exr = false, disp = false, mp4 = false, gltf = false;
+  std::string name = "run";   // stem of the .pvd, the videos and the .glb
+  bool frames = true, filmstrip = true, charts = false, vtp = true, exr = false, disp = false;
+  bool mp4 = false, webp = false, gltf = false;
   // Frames at t0 + k/fps (t0 the first sample's time) up to t_end, those the run reached (up
   // to half a step after its last sample), each at its exact time: the state interpolated
   // between the samples around it (record::Trajectory::RestoreAt); fps 0:
@@ -114,7 +115,7 @@ World WorldFor(const record::Trajectory& run, const WorldOptions& options);
 // script's NAME=VALUE) put into `out`: sizes, fps, filmstrip, camera, style, trails, ...
 void ApplyRenderSettings(const scene::RenderSettings& settings, RenderOutputs* out);
 
-// The outputs the words of `what` name (frames, filmstrip, charts, vtp, exr, disp, mp4, gltf) on,
+// The outputs the words of `what` name (frames, filmstrip, charts, vtp, exr, disp, mp4, webp, gltf) on,
 // the others off: "" when every word is one of them and one at least is given, else what is wrong
 // (`wobble render --what`, a script's `render` and Python's render read it the same way).
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out);

@@ -127,35 +127,44 @@ void VideoWriter::Encode() {
       // FFmpeg reports through its own log; wobble says what went wrong in its exceptions,
       // and x264's statistics are noise on the render's terminal
       av_log_set_level(AV_LOG_ERROR);
-      const int even_width = width_ + (width_ & 1), even_height = height_ + (height_ & 1);
+      const bool mp4 = options_.format == VideoFormat::kMp4;
+      // 4:2:0 needs an even size; WebP takes any (libwebp converts the RGB itself)
+      const int even_width = mp4 ? width_ + (width_ & 1) : width_, even_height = mp4 ? height_ + (height_ & 1) : height_;
+      const AVPixelFormat pixels = mp4 ? AV_PIX_FMT_YUV420P : AV_PIX_FMT_RGB32;
       const AVRational rate = av_d2q(options_.fps, 1001000);  // 30 → 30/1, 29.97 → 30000/1001
 
       AVFormatContext* raw_format = nullptr;
       // the format is named: the temporary file's ".tmp" says nothing about it
-      Check(avformat_alloc_output_context2(&raw_format, nullptr, "mp4", temp_path.c_str()), "cannot start an MP4");
+      Check(avformat_alloc_output_context2(&raw_format, nullptr, mp4 ? "mp4" : "webp", temp_path.c_str()),
+            "cannot start the file");
       std::unique_ptr<AVFormatContext, FormatCloser> format(raw_format);
-      const AVCodec* codec = avcodec_find_encoder_by_name("libx264");
-      if (!codec) throw std::runtime_error("FFmpeg's libavcodec has no libx264 encoder (Debian's libavcodec59 does)");
+      const char* codec_name = mp4 ? "libx264" : "libwebp_anim";
+      const AVCodec* codec = avcodec_find_encoder_by_name(codec_name);
+      if (!codec) throw std::runtime_error(std::string("FFmpeg's libavcodec has no ") + codec_name + " encoder (Debian's libavcodec59 has)");
       std::unique_ptr<AVCodecContext, CodecCloser> encoder(avcodec_alloc_context3(codec));
-      if (!encoder) throw std::runtime_error("out of memory for the H.264 encoder");
+      if (!encoder) throw std::runtime_error("out of memory for the encoder");
       encoder->width = even_width;
       encoder->height = even_height;
-      encoder->pix_fmt = AV_PIX_FMT_YUV420P;
+      encoder->pix_fmt = pixels;
       encoder->time_base = av_inv_q(rate);  // frame k at pts k: time k / fps
       encoder->framerate = rate;
       // one thread: the render and the PNG writers already share the cores, and x264's frame
       // threads only queued behind them (frames + mp4 took 2x the frames' time, 1.1-1.6x with one)
       encoder->thread_count = 1;
-      encoder->gop_size = std::max(1, int(std::lround(2.0 * options_.fps)));  // a key frame every 2 s, for seeking
-      encoder->color_range = AVCOL_RANGE_MPEG;
-      encoder->colorspace = AVCOL_SPC_BT709;
-      encoder->color_primaries = AVCOL_PRI_BT709;
-      encoder->color_trc = AVCOL_TRC_BT709;
+      if (mp4) {
+        encoder->gop_size = std::max(1, int(std::lround(2.0 * options_.fps)));  // a key frame every 2 s, for seeking
+        encoder->color_range = AVCOL_RANGE_MPEG;
+        encoder->colorspace = AVCOL_SPC_BT709;
+        encoder->color_primaries = AVCOL_PRI_BT709;
+        encoder->color_trc = AVCOL_TRC_BT709;
+        Check(av_opt_set(encoder->priv_data, "preset", options_.preset.c_str(), 0), "x264 preset");
+        Check(av_opt_set(encoder->priv_data, "crf", std::to_string(options_.crf).c_str(), 0), "x264 crf");
+        Check(av_opt_set(encoder->priv_data, "profile", "high", 0), "x264 profile");
+      } else {
+        Check(av_opt_set_double(encoder->priv_data, "quality", options_.webp_quality, 0), "WebP quality");
+      }
       if (format->oformat->flags & AVFMT_GLOBALHEADER) encoder->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
-      Check(av_opt_set(encoder->priv_data, "preset", options_.preset.c_str(), 0), "x264 preset");
-      Check(av_opt_set(encoder->priv_data, "crf", std::to_string(options_.crf).c_str(), 0), "x264 crf");
-      Check(av_opt_set(encoder->priv_data, "profile", "high", 0), "x264 profile");
-      Check(avcodec_open2(encoder.get(), codec, nullptr), "cannot open the H.264 encoder");
+      Check(avcodec_open2(encoder.get(), codec, nullptr), "cannot open the encoder");
 
       AVStream* stream = avformat_new_stream(format.get(), nullptr);
       if (!stream) throw std::runtime_error("out of memory for the video stream");
@@ -164,34 +173,40 @@ void VideoWriter::Encode() {
       Check(avcodec_parameters_from_context(stream->codecpar, encoder.get()), "video stream parameters");
       Check(avio_open(&format->pb, temp_path.c_str(), AVIO_FLAG_WRITE), "cannot open the file");
       AVDictionary* muxer_options = nullptr;
-      av_dict_set(&muxer_options, "movflags", "+faststart", 0);  // the index first: plays while loading
+      if (mp4) av_dict_set(&muxer_options, "movflags", "+faststart", 0);  // the index first: plays while loading
+      else av_dict_set(&muxer_options, "loop", "0", 0);                   // a README's animation loops forever
       const int header = avformat_write_header(format.get(), &muxer_options);
       av_dict_free(&muxer_options);
-      Check(header, "cannot write the MP4 header");
+      Check(header, "cannot write the file's header");
 
-      // RGB (full range) to BT.709 limited-range 4:2:0, the colours the file is tagged with
-      std::unique_ptr<SwsContext, ScalerCloser> scaler(
-          sws_getContext(even_width, even_height, AV_PIX_FMT_RGB24, even_width, even_height, AV_PIX_FMT_YUV420P,
-                         SWS_BILINEAR, nullptr, nullptr, nullptr));
-      if (!scaler) throw std::runtime_error("cannot convert RGB to yuv420p");
-      sws_setColorspaceDetails(scaler.get(), sws_getCoefficients(SWS_CS_DEFAULT), 1, sws_getCoefficients(SWS_CS_ITU709),
-                               0, 0, 1 << 16, 1 << 16);
+      // MP4: RGB (full range) to BT.709 limited-range 4:2:0, the colours the file is tagged with;
+      // WebP: RGB to BGRA, libwebp's input
+      std::unique_ptr<SwsContext, ScalerCloser> scaler(sws_getContext(
+          even_width, even_height, AV_PIX_FMT_RGB24, even_width, even_height, pixels, SWS_BILINEAR, nullptr, nullptr, nullptr));
+      if (!scaler) throw std::runtime_error("cannot convert the RGB frames");
+      if (mp4)
+        sws_setColorspaceDetails(scaler.get(), sws_getCoefficients(SWS_CS_DEFAULT), 1, sws_getCoefficients(SWS_CS_ITU709),
+                                 0, 0, 1 << 16, 1 << 16);
       std::unique_ptr<AVFrame, FrameCloser> picture(av_frame_alloc());
       std::unique_ptr<AVPacket, PacketCloser> packet(av_packet_alloc());
       if (!picture || !packet) throw std::runtime_error("out of memory for a video frame");
-      picture->format = AV_PIX_FMT_YUV420P;
+      picture->format = pixels;
       picture->width = even_width;
       picture->height = even_height;
-      picture->color_range = AVCOL_RANGE_MPEG;
-      picture->colorspace = AVCOL_SPC_BT709;
+      if (mp4) {
+        picture->color_range = AVCOL_RANGE_MPEG;
+        picture->colorspace = AVCOL_SPC_BT709;
+      }
       Check(av_frame_get_buffer(picture.get(), 0), "video frame buffer");
 
       auto write_packets = [&] {
         for (;;) {
           const int got = avcodec_receive_packet(encoder.get(), packet.get());
           if (got == AVERROR(EAGAIN) || got == AVERROR_EOF) return;
-          Check(got, "H.264 encoding failed");
-          packet->duration = 1;  // one frame: the last frame's duration makes the file's frames / fps
+          Check(got, "encoding failed");
+          // H.264: one frame per packet, the last one's duration makes the file's frames / fps
+          // (libwebp_anim hands over the whole animation as one packet, its timing inside)
+          if (mp4) packet->duration = 1;
           av_packet_rescale_ts(packet.get(), encoder->time_base, stream->time_base);
           packet->stream_index = stream->index;
           Check(av_interleaved_write_frame(format.get(), packet.get()), "cannot write to the file");
@@ -205,7 +220,7 @@ void VideoWriter::Encode() {
         const int source_stride[1] = {even_width * 3};
         sws_scale(scaler.get(), source, source_stride, 0, even_height, picture->data, picture->linesize);
         picture->pts = encoded_;
-        Check(avcodec_send_frame(encoder.get(), picture.get()), "H.264 encoding failed");
+        Check(avcodec_send_frame(encoder.get(), picture.get()), "encoding failed");
         write_packets();
         ++encoded_;
       }
@@ -213,9 +228,9 @@ void VideoWriter::Encode() {
         std::lock_guard<std::mutex> lock(mutex_);
         if (abandoned_) throw std::runtime_error("the video was abandoned before it was finished");
       }
-      Check(avcodec_send_frame(encoder.get(), nullptr), "H.264 encoding failed");  // flush the encoder's delay
+      Check(avcodec_send_frame(encoder.get(), nullptr), "encoding failed");  // flush the encoder's delay
       write_packets();
-      Check(av_write_trailer(format.get()), "cannot finish the MP4 (its index)");
+      Check(av_write_trailer(format.get()), "cannot finish the file (the MP4's index)");
       Check(avio_closep(&format->pb), "cannot close the file");
     });
   } catch (...) {

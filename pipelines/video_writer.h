@@ -1,5 +1,6 @@
 // Video files of rendered frames, encoded by FFmpeg's libraries (libavcodec, libavformat,
-// libswscale from Debian): an H.264 MP4 to play in a talk, a browser or a README. No VTK here:
+// libswscale from Debian): an H.264 MP4 to play in a talk or a browser, or an animated WebP
+// (libwebp through libavcodec) that a README shows like a GIF, in full colour. No VTK here:
 // the frames arrive as pixels copied out of the render window (PixelsOf), and are converted
 // and encoded on the writer's own thread while the caller renders the next frame.
 //
@@ -12,6 +13,8 @@
 //   - `faststart`: the index (moov) before the data, so a browser starts playing before the
 //     whole file arrived;
 //   - frame k at time k / fps exactly (time base 1/fps as a rational), duration frames / fps.
+// The animated WebP: lossy (VP8, libwebp's own RGB conversion), any size, looping forever,
+// frame k shown from k / fps for 1 / fps (rounded to libwebp's milliseconds).
 // The file is written atomically (formats/atomic_file.h): to FILE.tmp, renamed over FILE by
 // Finish(); a writer destroyed unfinished, or one that failed, leaves FILE as it was.
 #pragma once
@@ -29,13 +32,18 @@
 
 namespace wobble::pipelines {
 
+enum class VideoFormat { kMp4, kWebp };
+
 struct VideoOptions {
+  VideoFormat format = VideoFormat::kMp4;
   double fps = 30.0;  // frames per second, > 0 (a rational close to it is the time base)
   // x264's constant rate factor: 0 lossless … 51 worst; 18 is visually lossless for these
   // flat-shaded pictures and keeps a 10 s 640x480 run well under a megabyte.
   int crf = 18;
   // x264's speed/size trade-off; "fast" keeps encoding off the render's critical path on two cores
   std::string preset = "veryfast";
+  // WebP: libwebp's quality 0-100 (lossy); 75 keeps the thin lines and a 10 s 640x480 run small
+  double webp_quality = 75.0;
 };
 
 class VideoWriter {
@@ -56,6 +64,7 @@ class VideoWriter {
   long Finish();
 
   const std::string& path() const { return path_; }
+  VideoFormat format() const { return options_.format; }
 
  private:
   void Encode();  // the writer thread

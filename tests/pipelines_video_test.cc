@@ -61,9 +61,10 @@ class Video : public ::testing::Test {
     ASSERT_FALSE(Output("command -v ffprobe").empty()) << "ffprobe is missing: `make deps` installs Debian's ffmpeg";
   }
   void TearDown() override { fs::remove_all(dir_); }
-  std::string WriteFrames(const std::string& name, int frames, double fps) {
+  std::string WriteFrames(const std::string& name, int frames, double fps, VideoFormat format = VideoFormat::kMp4) {
     const std::string path = dir_ + "/" + name;
     VideoOptions options;
+    options.format = format;
     options.fps = fps;
     VideoWriter video(path, kWidth, kHeight, options);
     for (int k = 0; k < frames; ++k) video.AddFrame(MovingSquare(k));
@@ -103,6 +104,33 @@ TEST_F(Video, FfmpegDecodesEachFrameWithItsSquareInPlace) {
   // the padded column and row repeat the last ones (white here), not black
   const size_t corner = frame_bytes - 3;
   EXPECT_GT(uint8_t(raw[corner + 1]), 200);
+}
+
+// The animated WebP, read by Pillow (Python's imaging library, its own libwebp binding):
+// frames, size (odd, kept), loop, each frame's time in milliseconds, the square in place
+TEST_F(Video, PillowReadsTheAnimatedWebp) {
+  const std::string path = WriteFrames("square.webp", 8, 20.0, VideoFormat::kWebp);
+  const std::string read = Output(
+      "/usr/bin/python3 -c \"import sys; from PIL import Image\n"
+      "im = Image.open(sys.argv[1]); print(im.format, im.size[0], im.size[1], im.n_frames, im.info.get('loop'))\n"
+      "for k in range(im.n_frames):\n"
+      "  im.seek(k); im.load(); row = im.convert('L').load()\n"
+      "  print(im.info['timestamp'], next(x for x in range(im.size[0]) if row[x, 10] < 128))\" '" + path + "' 2>&1");
+  std::istringstream lines(read);
+  std::string format;
+  int width = 0, height = 0, frames = 0, loop = -1;
+  lines >> format >> width >> height >> frames >> loop;
+  ASSERT_EQ(format, "WEBP") << read;
+  EXPECT_EQ(width, kWidth);
+  EXPECT_EQ(height, kHeight);
+  EXPECT_EQ(frames, 8);
+  EXPECT_EQ(loop, 0);  // forever
+  for (int k = 0; k < frames; ++k) {
+    int milliseconds = -1, left = -1;
+    lines >> milliseconds >> left;
+    EXPECT_EQ(milliseconds, 50 * k) << read;  // 20 fps
+    EXPECT_EQ(left, 2 + k) << "frame " << k;
+  }
 }
 
 TEST_F(Video, AnUnfinishedWriterLeavesTheEarlierFileAndNoTemporary) {

@@ -116,8 +116,8 @@ void BindRender(py::module_& m) {
       py::arg("width") = 640, py::arg("height") = 480, py::arg("filmstrip_times") = std::vector<double>(),
       py::arg("color_by") = "",
       "Renders a recorded run into `folder` as `wobble render` does: what is any of frames,\n"
-      "filmstrip, vtp (the ParaView .pvd series), charts, exr, disp, mp4 (name.mp4, H.264),\n"
-      "gltf (name.glb: the FFD bodies with a morph target per mode); frames at `fps`. options: the\n"
+      "filmstrip, vtp (the ParaView .pvd series), charts, exr, disp, mp4 (name.mp4, H.264), webp\n"
+      "(name.webp, animated), gltf (name.glb: the FFD bodies with a morph target per mode); frames at `fps`. options: the\n"
       "world the run had (ground, gravity). Returns the paths written (frame series as patterns).");
 }
 
