@@ -4,7 +4,9 @@ Blender runs headless with blender_read_gltf.py, which imports the file
 (bpy.ops.import_scene.gltf) and writes, at every frame of the run, the evaluated mesh of every
 object (shape keys and object animation applied, world matrix applied). Here those vertices are
 compared with wobble's own drawing at the same times (the same run's shape .vtp, as
-check_gltf_export.py reads it) to 1e-5 of the body's size (the .glb holds float32).
+check_gltf_export.py reads it) to 1e-5 of the body's size (the .glb holds float32); at
+Blender's whole frames, mostly between the file's keys, with the glTF evaluation (slerp) of
+gltf_files.py to the same tolerance.
   Time: the importer keys glTF second t at frame t * scene.render.fps (24 under
     --factory-startup; no offset, frame 0 is t = 0): the script sets that frame and subframe.
   Axes: the importer turns glTF's +Y up into Blender's +Z up, (x, y, z) -> (x, -z, y), on the
@@ -107,7 +109,9 @@ def check_run(label, command, folder, stem, body, mode_names):
     cause = re.findall(r"\w*Error: .*", default["import_console"]) if default else []
     print(f"{label}: Blender's default import (import_shading NORMALS): {outcome or 'blender exited ' + str(rc)} {cause[-1:]}")
 
-    rc, report = run_blender(glb, times, "FLAT", os.path.join(folder, "blender.json"))
+    # Blender's own frames too (frame f at second f / 24), mostly between the file's keys
+    between = [f / 24.0 for f in range(int(np.ceil(times[0] * 24)), int(np.floor(times[-1] * 24)) + 1)]
+    rc, report = run_blender(glb, times + between, "FLAT", os.path.join(folder, "blender.json"))
     check(report is not None and report["import_result"] == ["FINISHED"], f"{label}: Blender imports {stem}.glb (import_shading FLAT)")
     if report is None or report["import_result"] != ["FINISHED"]:
         print(report and report["import_console"])
@@ -170,6 +174,17 @@ def check_run(label, command, folder, stem, body, mode_names):
         print(f"  {t:.4f}  {t * fps:7.3f}  {errors['widened']:.3g}  {errors['as_imported']:.3g}  {keyed_weights[k].min():.3g}")
     print(f"{label}: {body}: size {size:.6g}; worst vertex error, slider ranges widened: {worst['widened']:.3g} = "
           f"{worst['widened'] / size:.3g} of the size; as imported: {worst['as_imported']:.3g} = {worst['as_imported'] / size:.3g}")
+    # between the keys: Blender interpolates each quaternion component linearly and normalizes
+    # (glTF: slerp); every other channel is linear in both
+    worst_between = 0.0
+    for k, t in enumerate(between):
+        seen = blender_body["frames"]["widened"][len(frames) + k]
+        assert seen["t"] == t
+        gltf_view, _ = node_vertices(doc, binary, node_index, t)
+        worst_between = max(worst_between, float(np.abs(gltf_axes(seen["vertices"]) - gltf_view[vertex_map]).max()))
+    print(f"{label}: {body}: at Blender's {len(between)} whole frames (widened), worst distance to the glTF evaluation "
+          f"(slerp) {worst_between:.3g} = {worst_between / size:.3g} of the size")
+    check(worst_between <= 1e-5 * size, f"{label}: {body}: between the keys too, Blender shows the glTF animation to 1e-5 of the size")
     check(worst_weight <= 1e-6, f"{label}: widened, the shape keys' values at every frame are the file's weights (to {worst_weight:.3g})")
     check(worst["widened"] <= 1e-5 * size,
           f"{label}: {body}: with the slider ranges widened, every vertex at every frame is wobble's to 1e-5 of its size")
