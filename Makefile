@@ -56,7 +56,7 @@ DEMO_SCRIPT   ?= data/table_cliff.wob  # writes and renders into out/demo (its `
 # from 30 above the ground, tilted 0.34 rad, falling at 60 and spinning at 1.2 rad/s about its axis
 DEMO3D_ARGS   ?= --object data/pot3.obj --modes data/pot3_modes.def3 --q "0 30 0 0.3 0 0.15 0 0 0" \
                  --qdot "0 -60 0 0 1.2 0 0 0 0" --duration 4 --dt 0.001 --orbit 30 --elevation 25 \
-                 --filmstrip "0 0.4 0.8 1.5 2.5 4" --what frames,filmstrip,charts,vtp,exr,mp4
+                 --filmstrip "0 0.4 0.8 1.5 2.5 4" --what frames,filmstrip,charts,vtp,exr,mp4,gltf
 
 .PHONY: all deps fuzz-deps configure build demo-build demo test test-quick asan bench-build bench bench-mujoco bench-mpi bench-python fuzz clean
 
@@ -131,6 +131,7 @@ demo: demo-build
 	echo "  table drop  $(OUT)/table_drop.csv  (the sloped-ground drop, simulated only: README, Pictures and exports)"
 	echo "  sky hook    out/fig3/filmstrip.png, out/fig3/frames/, out/fig3/vtp/fig3_sky_hook.pvd  (Witkin & Welch Fig. 3)"
 	echo "  3D pot      $(OUT)/pot3/filmstrip.png, $(OUT)/pot3/pot3.mp4, $(OUT)/pot3/frames/, $(OUT)/pot3/vtp/pot3.pvd (deformed mesh, lattice, points), $(OUT)/pot3/exr/"
+	echo "  glTF        $(OUT)/pot3/pot3.glb  (mesh, a morph target per mode, the camera; Blender: README, Pictures and exports)"
 	echo "  command     $(WOBBLE)  (see $(WOBBLE) --help, and README.md)"
 	exit $$status
 
