@@ -117,7 +117,8 @@ void BindRender(py::module_& m) {
       py::arg("color_by") = "",
       "Renders a recorded run into `folder` as `wobble render` does: what is any of frames,\n"
       "filmstrip, vtp (the ParaView .pvd series), charts, exr, disp, mp4 (name.mp4, H.264),\n"
-      "gltf (name.glb: the FFD bodies with a morph target per mode); frames at `fps`. options: the\n"
+      "gltf (name.glb: the FFD bodies with a morph target per mode), web (web/index.html playing\n"
+      "the .glb in a browser, opened from the disk; implies gltf); frames at `fps`. options: the\n"
       "world the run had (ground, gravity). Returns the paths written (frame series as patterns).");
 }
 
