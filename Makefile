@@ -28,14 +28,15 @@ JOBS       ?= 2
 OUT        ?= out/demo
 
 # ffmpeg's libraries encode the videos; the ffmpeg package (ffprobe) and chromium are the tests'
-# readers of them, programs wobble does not contain
+# readers of them, programs wobble does not contain; libjs-three is three.js, copied into the
+# web preview (--what web) when it is written
 PACKAGES := libvtk9-dev libeigen3-dev libceres-dev libopenexr-dev libimath-dev \
             libgtest-dev libgmock-dev libbenchmark-dev xvfb xauth libcli11-dev \
             nlohmann-json3-dev cmake g++ make libpagmo-dev libpng-dev zlib1g-dev \
             pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib \
             libopenmpi-dev openmpi-bin ccache ninja-build \
             libavcodec-dev libavformat-dev libavutil-dev libswscale-dev pkgconf ffmpeg chromium \
-            libtinygltf-dev
+            libtinygltf-dev libjs-three
 # only `make fuzz` needs these (libFuzzer is clang's)
 FUZZ_PACKAGES := clang libclang-rt-14-dev
 # only `make bench-mujoco` needs this (the peer the Witkin & Welch step is measured against)

@@ -174,12 +174,13 @@ with tempfile.TemporaryDirectory() as work:
         # frames across the run: in the air, landing, tipping, at the end
         frames = [0, 3, 6, 10]
         table = compare(browser, page, pot, POT_FPS, frames, surface_mask, iou, "pot", shots)
-        # measured (2026-12-07, Chromium 120's SwiftShader against VTK 9.1 at 400x300): the same
-        # frame 0.94 - 0.97 (the edges' anti-aliasing and the faces' shading differ), frames 0.3 s
-        # apart at most 0.55 (the pot falls 18 of its 64 height units in 0.3 s), 1 s apart 0
+        # measured (2026-12-07, Debian's Chromium with SwiftShader against VTK 9.1, 400x300): the same
+        # frame 0.992 - 0.993 (anti-aliased edges differ); one frame (0.1 s) off at most 0.950, three
+        # frames off 0.79 - 0.80, 1 s off 0.49. 0.97 rejects a time one frame off; the far frame must
+        # lose by 0.3 (it loses by 0.36 - 0.51), and no frame of the 11 may match better
         for k in frames:
             far = max(frames, key=lambda j: abs(j - k))
-            check(table[k][k] > 0.85, f"pot frame {k}: IoU {table[k][k]:.3f} > 0.85 with wobble's frame {k}")
+            check(table[k][k] > 0.97, f"pot frame {k}: IoU {table[k][k]:.3f} > 0.97 with wobble's frame {k}")
             check(table[k][k] > table[k][far] + 0.3,
                   f"pot frame {k}: IoU {table[k][k]:.3f} well above {table[k][far]:.3f} with the far frame {far}")
             check(max(table[k]) == table[k][k], f"pot frame {k}: its own frame matches best of all {len(table[k])}")
@@ -193,10 +194,13 @@ with tempfile.TemporaryDirectory() as work:
         frames = [0, 10, 15, 20]  # falling (the top under the overlay at first), at 2, 3 s, landed at 4 s
         table = compare(browser, page, table_out, TABLE_FPS, frames, lambda im: without_overlay(line_mask(im)),
                         lines_agree, "table", shots)
-        # measured: ...
+        # measured: the same frame 0.92 (landed, the legs bent by the modes) to 1.00; the table hardly
+        # moves in its first 0.2 s (frame 1: 0.994) but 0.2 s off later scores 0.49 - 0.69; the far
+        # frame 0.05 - 0.46. Lines drawn without their morph targets (three.js r111's LineBasicMaterial
+        # ignores the morphTargets option: the page's first version) scored 0.12 on the landed frame
         for k in frames:
             far = max(frames, key=lambda j: abs(j - k))
-            check(table[k][k] > 0.9, f"table frame {k}: lines agree {table[k][k]:.3f} > 0.9 with wobble's frame {k}")
+            check(table[k][k] > 0.85, f"table frame {k}: lines agree {table[k][k]:.3f} > 0.85 with wobble's frame {k}")
             check(table[k][k] > table[k][far] + 0.3,
                   f"table frame {k}: {table[k][k]:.3f} well above {table[k][far]:.3f} with the far frame {far}")
         errors = browser.console_errors(page)
