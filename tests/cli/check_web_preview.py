@@ -175,7 +175,7 @@ with tempfile.TemporaryDirectory() as work:
         frames = [0, 3, 6, 10]
         table = compare(browser, page, pot, POT_FPS, frames, surface_mask, iou, "pot", shots)
         # measured (2026-12-07, Debian's Chromium with SwiftShader against VTK 9.1, 400x300): the same
-        # frame 0.992 - 0.993 (anti-aliased edges differ); one frame (0.1 s) off at most 0.950, three
+        # frame 0.992 - 0.995 (anti-aliased edges differ); one frame (0.1 s) off at most 0.950, three
         # frames off 0.79 - 0.80, 1 s off 0.49. 0.97 rejects a time one frame off; the far frame must
         # lose by 0.3 (it loses by 0.36 - 0.51), and no frame of the 11 may match better
         for k in frames:
