@@ -6,7 +6,7 @@ console error, and at several frames k, window.wobbleSetTime(k / fps) shows the 
 wobble's own PNG frame k shows it: the silhouettes' intersection over union is high for the same
 frame and clearly lower for a frame far away in time (so a wrong time or camera fails).
 Then the 2D table (an outline of lines, an orthographic camera) the same way. Last, `--what web`
-needs no display.
+needs no display, and its page (no camera in the file) frames the motion itself.
 
 usage: check_web_preview.py WOBBLE DATA_DIR   (exit 77, skipped, without an X display: frames are rendered)
 """
@@ -163,6 +163,13 @@ with tempfile.TemporaryDirectory() as work:
     html = open(os.path.join(web, "index.html")).read()
     check("://" not in html.replace("file://", ""), "index.html names nothing on the network")
 
+    # no display: the page and the .glb are written all the same (no frames, so no camera in the file)
+    env = {k: v for k, v in os.environ.items() if k != "DISPLAY"}
+    headless = os.path.join(work, "headless")
+    r = render(POT, headless, POT_FPS, what="web", env=env)
+    check(r.returncode == 0 and os.path.isfile(os.path.join(headless, "web", "index.html")),
+          f"--what web without DISPLAY writes the page (exit {r.returncode}, {r.stderr.strip()[-200:]})")
+
     try:
         browser = headless_chromium.Chromium(file_access=False)
     except headless_chromium.Unavailable as e:
@@ -206,12 +213,18 @@ with tempfile.TemporaryDirectory() as work:
         errors = browser.console_errors(page)
         check(not errors, f"no console error in the 2D page ({errors[:3]})")
 
-    # no display: the page and the .glb are written all the same (no frames to draw)
-    env = {k: v for k, v in os.environ.items() if k != "DISPLAY"}
-    headless = os.path.join(work, "headless")
-    r = render(POT, headless, POT_FPS, what="web", env=env)
-    check(r.returncode == 0 and os.path.isfile(os.path.join(headless, "web", "index.html")),
-          f"--what web without DISPLAY writes the page (exit {r.returncode}, {r.stderr.strip()[-200:]})")
+        # the page of the run without a camera frames the motion's box itself: the pot in view,
+        # whole (clear of the picture's edges), and not a speck
+        page, ready = open_preview(browser, headless)
+        check(ready is not None and not ready["camera"], f"without frames the file has no camera ({ready})")
+        browser.evaluate(page, "window.wobbleBare(); window.wobbleSetTime(0.5)")
+        shot = os.path.join(shots, "pot_own_camera.png")
+        browser.screenshot(page, shot)
+        mask = surface_mask(rgb(shot))
+        edges = mask[0].any() or mask[-1].any() or mask[:, 0].any() or mask[:, -1].any()
+        check(mask.mean() > 0.02 and not edges, f"own camera: the pot covers {mask.mean():.3f} of the view, edges clear")
+        errors = browser.console_errors(page)
+        check(not errors, f"no console error in the page without a camera ({errors[:3]})")
 
 if failures:
     print(f"{len(failures)} check(s) failed")
