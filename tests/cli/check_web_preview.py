@@ -105,6 +105,11 @@ def iou(a, b):
     return np.count_nonzero(a & b) / union if union else 0.0
 
 
+def rgb_of_page(browser, page, path):
+    browser.screenshot(page, path)
+    return rgb(path)
+
+
 def open_preview(browser, folder):
     start = time.monotonic()
     page = browser.open("file://" + os.path.join(folder, "web", "index.html"))
@@ -191,6 +196,23 @@ with tempfile.TemporaryDirectory() as work:
             check(table[k][k] > table[k][far] + 0.3,
                   f"pot frame {k}: IoU {table[k][k]:.3f} well above {table[k][far]:.3f} with the far frame {far}")
             check(max(table[k]) == table[k][k], f"pot frame {k}: its own frame matches best of all {len(table[k])}")
+        # what a user does: play (the time label moves on), then drag the view (the orbit controls
+        # take the camera: "wobble's camera" unchecked, the picture changes)
+        label = "document.getElementById('time').textContent"
+        browser.evaluate(page, "window.wobbleBare(false); window.wobbleSetTime(0.1); document.getElementById('play').click()")
+        played = browser.evaluate(page, f"new Promise(r => setTimeout(() => r({label}), 400))")
+        check(played.startswith("t = ") and float(played.split()[2]) > 0.2, f"play runs the clock: '{played}' after 0.4 s")
+        browser.evaluate(page, "window.wobbleSetTime(0.5)")
+        before = rgb_of_page(browser, page, os.path.join(shots, "pot_before_drag.png"))
+        for kind, x in (("mousePressed", 200), ("mouseMoved", 230), ("mouseMoved", 260), ("mouseReleased", 260)):
+            browser._send("Input.dispatchMouseEvent", {"type": kind, "x": x, "y": 150, "button": "left",
+                                                       "buttons": 0 if kind == "mouseReleased" else 1, "clickCount": 1}, page)
+        follows = browser.evaluate(page, "new Promise(r => requestAnimationFrame(() => requestAnimationFrame(() => "
+                                         "r(document.getElementById('follow').checked))))")
+        after = rgb_of_page(browser, page, os.path.join(shots, "pot_after_drag.png"))
+        moved = iou(surface_mask(before), surface_mask(after))
+        check(not follows and moved < 0.9, f"a drag orbits the view (wobble's camera off: {not follows}; IoU {moved:.3f})")
+
         errors = browser.console_errors(page)
         check(not errors, f"no console error in the 3D page ({errors[:3]})")
 
