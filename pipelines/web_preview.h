@@ -13,7 +13,10 @@
 // The page plays the animation "run" (position, rotation, morph target weights) with orbit
 // controls, a play/pause button and a time slider, from the glTF's "camera" node when there is
 // one; window.wobbleReady (a promise) resolves when it has loaded, and window.wobbleSetTime(t)
-// pauses at time t and renders synchronously (for tests).
+// pauses at time t and renders synchronously (for tests). Around three.js r111's limits the page
+// binds the animation's tracks by object (r111 binds by name, and a body's node and its first
+// primitive share one), gives lines their morph targets, blends more than 8 targets itself,
+// and builds an orthographic camera from the file's xmag/ymag (r111's loader halves them).
 #pragma once
 
 #include <string>
