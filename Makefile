@@ -28,14 +28,15 @@ JOBS       ?= 2
 OUT        ?= out/demo
 
 # ffmpeg's libraries encode the videos; the ffmpeg package (ffprobe), python3-pil and chromium
-# are the tests' readers of them, programs wobble does not contain
+# are the tests' readers of them, programs wobble does not contain; libjs-three is three.js,
+# copied into the web preview (--what web) when it is written
 PACKAGES := libvtk9-dev libeigen3-dev libceres-dev libopenexr-dev libimath-dev \
             libgtest-dev libgmock-dev libbenchmark-dev xvfb xauth libcli11-dev \
             nlohmann-json3-dev cmake g++ make libpagmo-dev libpng-dev zlib1g-dev \
             pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib \
             libopenmpi-dev openmpi-bin ccache ninja-build \
             libavcodec-dev libavformat-dev libavutil-dev libswscale-dev pkgconf ffmpeg python3-pil chromium \
-            libtinygltf-dev
+            libtinygltf-dev libjs-three
 # only `make fuzz` needs these (libFuzzer is clang's)
 FUZZ_PACKAGES := clang libclang-rt-14-dev
 # only `make bench-mujoco` needs this (the peer the Witkin & Welch step is measured against)
@@ -56,7 +57,7 @@ DEMO_SCRIPT   ?= data/table_cliff.wob  # writes and renders into out/demo (its `
 # from 30 above the ground, tilted 0.34 rad, falling at 60 and spinning at 1.2 rad/s about its axis
 DEMO3D_ARGS   ?= --object data/pot3.obj --modes data/pot3_modes.def3 --q "0 30 0 0.3 0 0.15 0 0 0" \
                  --qdot "0 -60 0 0 1.2 0 0 0 0" --duration 4 --dt 0.001 --orbit 30 --elevation 25 \
-                 --filmstrip "0 0.4 0.8 1.5 2.5 4" --what frames,filmstrip,charts,vtp,exr,mp4,gltf
+                 --filmstrip "0 0.4 0.8 1.5 2.5 4" --what frames,filmstrip,charts,vtp,exr,mp4,gltf,web
 
 .PHONY: all deps fuzz-deps configure build demo-build demo test test-quick asan bench-build bench bench-mujoco bench-mpi bench-python fuzz clean
 
@@ -132,6 +133,7 @@ demo: demo-build
 	echo "  sky hook    out/fig3/filmstrip.png, out/fig3/frames/, out/fig3/vtp/fig3_sky_hook.pvd  (Witkin & Welch Fig. 3)"
 	echo "  3D pot      $(OUT)/pot3/filmstrip.png, $(OUT)/pot3/pot3.mp4, $(OUT)/pot3/frames/, $(OUT)/pot3/vtp/pot3.pvd (deformed mesh, lattice, points), $(OUT)/pot3/exr/"
 	echo "  glTF        $(OUT)/pot3/pot3.glb  (mesh, a morph target per mode, the camera; Blender: README, Pictures and exports)"
+	echo "  web page    $(OUT)/pot3/web/index.html  (open it in a browser: the pot's run in three.js, orbit, play, time slider)"
 	echo "  command     $(WOBBLE)  (see $(WOBBLE) --help, and README.md)"
 	exit $$status
 

@@ -55,7 +55,8 @@ CLI::App* AddRenderCommand(CLI::App* app, const std::string& name, const std::st
   cmd->add_option("--what", a->what,
                   "What to write, comma separated: frames, filmstrip, charts, vtp, exr, disp, mp4 (NAME.mp4: H.264 "
                   "video), webp (NAME.webp: animated, loops), gltf (NAME.glb: "
-                  "the bodies with a morph target per mode, for Blender or three.js) (default: " +
+                  "the bodies with a morph target per mode, for Blender or three.js), web (web/index.html: a page "
+                  "playing the .glb, opened from the disk; implies gltf) (default: " +
                       default_what + ")")
       ->type_name("LIST");
   for (const scene::RenderOptionInfo& o : scene::RenderOptionTable()) {
@@ -121,7 +122,7 @@ void CheckRenderRequest(const RenderRequest& r, const std::string& out) {
   if (draws && !pl::HasDisplay())
     throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"
                      "  xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble ...\n"
-                     "or ask only for --what vtp,disp,gltf");
+                     "or ask only for --what vtp,disp,gltf,web");
   CheckOutputFolder(out);
 }
 

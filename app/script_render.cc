@@ -22,7 +22,7 @@ void RenderScriptRuns(const script::RenderRequest& r) {
   RenderRequest request = ParseRenderRequest(a, default_what, OptionSpelling::kScript);
   if (!pl::HasDisplay()) {
     std::set<std::string> kept;
-    for (const char* w : {"vtp", "disp", "gltf"})
+    for (const char* w : {"vtp", "disp", "gltf", "web"})
       if (request.what.count(w)) kept.insert(w);
     std::string listed;
     for (const std::string& w : kept) listed += (listed.empty() ? "" : ",") + w;

@@ -24,6 +24,7 @@
 #include "pipelines/exports.h"
 #include "pipelines/gltf_export.h"
 #include "pipelines/video_writer.h"
+#include "wobble/formats/atomic_file.h"
 
 namespace wobble::pipelines {
 namespace {
@@ -272,7 +273,7 @@ void ApplyRenderSettings(const scene::RenderSettings& s, RenderOutputs* out) {
 }
 
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out) {
-  out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = out->mp4 = out->webp = out->gltf = false;
+  out->frames = out->filmstrip = out->charts = out->vtp = out->exr = out->disp = out->mp4 = out->webp = out->gltf = out->web = false;
   for (const std::string& w : what) {
     bool* flag = w == "frames"      ? &out->frames
                  : w == "filmstrip" ? &out->filmstrip
@@ -283,10 +284,12 @@ std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out)
                  : w == "mp4"       ? &out->mp4
                  : w == "webp"      ? &out->webp
                  : w == "gltf"      ? &out->gltf
+                 : w == "web"       ? &out->web
                                     : nullptr;
-    if (!flag) return "'" + w + "' is not one of frames, filmstrip, charts, vtp, exr, disp, mp4, webp, gltf";
+    if (!flag) return "'" + w + "' is not one of frames, filmstrip, charts, vtp, exr, disp, mp4, webp, gltf, web";
     *flag = true;
   }
+  if (out->web) out->gltf = true;  // the page plays the .glb, which is also written beside the other outputs
   if (what.empty()) return "nothing to write";
   return "";
 }
@@ -328,6 +331,7 @@ World WorldFor(const record::Trajectory& run, const WorldOptions& options) {
 RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, const SceneSpec& spec, const RenderOutputs& out) {
   if (run.empty()) throw std::invalid_argument("nothing was recorded: no frames to render");
   if (caller.num_bodies() != run.num_bodies()) throw std::invalid_argument("RenderTrajectory: the world's bodies are not the run's");
+  if (out.web) CheckThreeJs(out.three_js_dir);  // a missing libjs-three fails before a long render
   // each pass replays the run in the caller's world, whose data (states, contacts, clock:
   // WorldData, not the models) is kept first and put back between the passes and at the end,
   // where the world is left in the state of the last sample drawn (and as it was on a throw)
@@ -421,7 +425,7 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   std::unique_ptr<VtpSeriesWriter> vtp;
   if (out.vtp) vtp = std::make_unique<VtpSeriesWriter>(&world, out.folder + "/vtp", out.name, spec.drawings, out.view.shape_samples);
   std::unique_ptr<GltfRecorder> gltf;
-  if (out.gltf) gltf = std::make_unique<GltfRecorder>(&world, spec.drawings, out.view.shape_samples);
+  if (out.gltf || out.web) gltf = std::make_unique<GltfRecorder>(&world, spec.drawings, out.view.shape_samples);
   double gltf_seconds = 0;  // the glTF part's own time (its frames' keys and the file), for the report
   const std::vector<DispTarget> disp = out.disp ? DispTargets(world, out) : std::vector<DispTarget>();
   PvdCollection volumes;  // 3D bodies' displacement volumes
@@ -566,7 +570,13 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
   if (gltf && gltf->num_frames() > 0) {
     const auto start_write = std::chrono::steady_clock::now();
     const std::string path = out.folder + "/" + out.name + ".glb";
-    gltf->Write(path);
+    std::string bytes;
+    try {
+      bytes = gltf->Bytes();
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(path + ": " + e.what());
+    }
+    if (out.gltf) formats::WriteTextAtomically(path, bytes);
     gltf_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_write).count();
     char seconds[32];
     std::snprintf(seconds, sizeof(seconds), "%.3g", gltf_seconds);
@@ -575,7 +585,13 @@ RenderReport RenderTrajectory(World& caller, const record::Trajectory& run, cons
                        seconds + " s";
     if (view) note += "; the render's camera";
     for (const std::string& skipped : gltf->SkippedBodies()) note += "; " + skipped + " not in it (nothing to draw)";
-    report.files.push_back({path, note});
+    if (out.gltf) report.files.push_back({path, note});
+    if (out.web) {
+      const std::string folder = out.folder + "/web";
+      WriteWebPreview(folder, out.name, bytes, out.view.title.empty() ? out.name : out.view.title, out.three_js_dir);
+      report.files.push_back({folder + "/", "web preview: open " + folder + "/index.html in a browser (three.js r111 "
+                                            "from libjs-three and the .glb inside, nothing fetched from the network)"});
+    }
   }
   if (out.charts) WriteCharts(run, out, &report);
   return report;

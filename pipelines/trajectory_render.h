@@ -24,6 +24,8 @@
 //   NAME.glb                glTF 2.0 binary (gltf_export.h): each body's mesh or drawing with
 //                           morph targets (an FFD body's modes), its rigid motion and the
 //                           weights keyed at the frames; the ground; with frames, the camera
+//   web/                    a page that plays NAME.glb in a browser opened from the disk
+//                           (web_preview.h): index.html, NAME.glb, model.js, three/*.js
 #pragma once
 
 #include <Eigen/Core>
@@ -33,6 +35,7 @@
 #include <vector>
 
 #include "pipelines/scene_view.h"
+#include "pipelines/web_preview.h"
 #include "wobble/record/trajectory.h"
 #include "wobble/scene/render_options.h"
 #include "wobble/world/world.h"
@@ -44,6 +47,9 @@ struct RenderOutputs {
   std::string name = "run";   // stem of the .pvd, the videos and the .glb
   bool frames = true, filmstrip = true, charts = false, vtp = true, exr = false, disp = false;
   bool mp4 = false, webp = false, gltf = false;
+  // The web preview (folder/web/); it records the glTF whether or not gltf is on.
+  bool web = false;
+  std::string three_js_dir = kThreeJsDir;  // where the web preview copies three.js from (libjs-three)
   // Frames at t0 + k/fps (t0 the first sample's time) up to t_end, those the run reached (up
   // to half a step after its last sample), each at its exact time: the state interpolated
   // between the samples around it (record::Trajectory::RestoreAt); fps 0:
@@ -97,7 +103,7 @@ struct RenderReport {
 // is (a world as at the run's start draws the ground contacts as the run had them): the world
 // is left in the state of the last sample drawn.
 // `spec` draws the linear bodies' shapes and the named points. Pictures (frames, filmstrip,
-// exr, charts) need HasDisplay(); vtp, disp and gltf do not. Throws std::invalid_argument for an
+// exr, charts) need HasDisplay(); vtp, disp, gltf and web do not. Throws std::invalid_argument for an
 // empty run or a world of other bodies, std::runtime_error for a failed write (naming the file).
 RenderReport RenderTrajectory(World& world, const record::Trajectory& run, const SceneSpec& spec, const RenderOutputs& out);
 
@@ -115,11 +121,12 @@ World WorldFor(const record::Trajectory& run, const WorldOptions& options);
 // script's NAME=VALUE) put into `out`: sizes, fps, filmstrip, camera, style, trails, ...
 void ApplyRenderSettings(const scene::RenderSettings& settings, RenderOutputs* out);
 
-// The outputs the words of `what` name (frames, filmstrip, charts, vtp, exr, disp, mp4, webp, gltf) on,
-// the others off: "" when every word is one of them and one at least is given, else what is wrong
+// The outputs the words of `what` name (frames, filmstrip, charts, vtp, exr, disp, mp4, webp, gltf, web) on,
+// the others off (web turns gltf on too: the page shows the .glb, written beside it as well):
+// "" when every word is one of them and one at least is given, else what is wrong
 // (`wobble render --what`, a script's `render` and Python's render read it the same way).
 std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out);
-// Of those, the ones written without an X display (vtp, disp, gltf): the rest are switched off and
+// Of those, the ones written without an X display (vtp, disp, gltf, web): the rest are switched off and
 // returned, for the message that says they were skipped.
 std::vector<std::string> KeepWithoutDisplay(RenderOutputs* out);
 

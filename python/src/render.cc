@@ -117,7 +117,9 @@ void BindRender(py::module_& m) {
       py::arg("color_by") = "",
       "Renders a recorded run into `folder` as `wobble render` does: what is any of frames,\n"
       "filmstrip, vtp (the ParaView .pvd series), charts, exr, disp, mp4 (name.mp4, H.264), webp\n"
-      "(name.webp, animated), gltf (name.glb: the FFD bodies with a morph target per mode); frames at `fps`. options: the\n"
+      "(name.webp, animated), gltf (name.glb: the FFD bodies with a morph target per mode), web\n"
+      "(web/index.html playing the .glb in a browser, opened from the disk; implies gltf); frames\n"
+      "at `fps`. options: the\n"
       "world the run had (ground, gravity). Returns the paths written (frame series as patterns).");
 }
 

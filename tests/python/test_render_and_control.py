@@ -69,6 +69,17 @@ def test_render_writes_a_gltf_without_a_display(table, tmp_path):
     assert raw[:4] == b"glTF" and int.from_bytes(raw[8:12], "little") == len(raw)
 
 
+def test_render_writes_a_web_preview_without_a_display(table, tmp_path):
+    # issue 48: "web" (the page in folder/web/) needs no display, and brings the .glb with it
+    _, options, run = dropped(table, 1.0)
+    files = wobble.render(run, options, str(tmp_path), name="drop", what=["web"], fps=10)
+    assert files == [str(tmp_path / "drop.glb"), str(tmp_path / "web") + "/"]
+    web = tmp_path / "web"
+    assert (web / "drop.glb").read_bytes() == (tmp_path / "drop.glb").read_bytes()
+    assert "three/GLTFLoader.js" in (web / "index.html").read_text()
+    assert (web / "model.js").read_text().startswith("window.wobbleGlbBase64")
+
+
 def test_a_pose_graph_controller_drives_the_active_modes(data):
     interp = bounding_table(data)
     problem, graph = interp.synthesis_problem(), interp.pose_graph

@@ -21,7 +21,9 @@ class Unavailable(RuntimeError):
 
 
 class Chromium:
-    def __init__(self, timeout=60.0):
+    def __init__(self, timeout=60.0, file_access=True):
+        """file_access=False leaves out --allow-file-access-from-files: file:// pages may then not
+        fetch other files, as when a user double-clicks a page."""
         exe = shutil.which("chromium") or shutil.which("chromium-browser")
         if exe is None:
             raise Unavailable("chromium is not installed (Debian: apt-get install chromium)")
@@ -37,8 +39,9 @@ class Chromium:
             os.dup2(high_r, 3)
             os.dup2(high_w, 4)
         self._process = subprocess.Popen(
-            [exe, "--headless=new", "--no-sandbox", "--disable-gpu", "--remote-debugging-pipe",
-             "--allow-file-access-from-files", "--autoplay-policy=no-user-gesture-required",
+            [exe, "--headless=new", "--no-sandbox", "--disable-gpu", "--remote-debugging-pipe"] +
+            (["--allow-file-access-from-files"] if file_access else []) +
+            ["--autoplay-policy=no-user-gesture-required",
              "--user-data-dir=" + self._profile.name, "--no-first-run", "about:blank"],
             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
             pass_fds=(3, 4, to_browser_r, from_browser_w), preexec_fn=child_fds)
@@ -118,6 +121,11 @@ class Chromium:
         if "exceptionDetails" in result:
             raise RuntimeError("javascript: " + json.dumps(result["exceptionDetails"])[:500])
         return result["result"].get("value")
+
+    def set_viewport(self, session, width, height):
+        """The page's size in CSS pixels, one device pixel each (screenshots are width x height)."""
+        self._send("Emulation.setDeviceMetricsOverride",
+                   {"width": width, "height": height, "deviceScaleFactor": 1, "mobile": False}, session)
 
     def screenshot(self, session, path):
         import base64

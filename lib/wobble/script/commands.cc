@@ -48,7 +48,7 @@ const std::vector<Command>& CommandTable() {
       {"render", "render DIR [WHAT] [NAME=VALUE ...]",
        "draw into DIR: with a scene (linear bodies) its recorded frames, WHAT a comma list of frames, filmstrip, vtp "
        "(default all); otherwise every FFD run since load_obj (or clear track), WHAT of frames, filmstrip, charts, vtp, "
-       "exr, disp, mp4, webp, gltf (default frames,filmstrip,charts) and NAME=VALUE options of wobble render (size=WxH, fps=N, "
+       "exr, disp, mp4, webp, gltf, web (default frames,filmstrip,charts) and NAME=VALUE options of wobble render (size=WxH, fps=N, "
        "filmstrip=T1,T2,.., filmstrip-columns=N, filmstrip-cycle=K,PANELS, color-by=ARRAY, ...)",
        Render},
       {"echo", "echo TEXT", "print TEXT", Echo},
