@@ -40,15 +40,16 @@ void RenderScriptRuns(const script::RenderRequest& r) {
 std::vector<std::string> RenderScriptScene(const script::SceneRenderRequest& r) {
   const record::Trajectory& run = *r.recorded;
   pl::RenderOutputs out = pl::SceneRenderOutputs(r.folder, r.name, r.drawing.azimuth, r.drawing.elevation);
-  out.frames = r.frames;
-  out.filmstrip = r.filmstrip;
-  out.vtp = r.vtp;
-  if ((out.frames || out.filmstrip) && !pl::HasDisplay()) {
+  pl::SetOutputs(r.what, &out);  // the words were checked by the script's reader
+  if (out.mp4 || out.webp) out.fps = r.fps;  // a video at the recorded rate; else every sample is a frame
+  if (!pl::HasDisplay()) {
     // as for the cost charts: the exports that need no display are still written
-    std::cout << "no X display: frames and filmstrip skipped (run under xvfb-run -a -s \"-screen 0 1280x1024x24\")\n";
-    out.frames = out.filmstrip = false;
+    const std::vector<std::string> skipped = pl::KeepWithoutDisplay(&out);
+    std::string listed;
+    for (const std::string& w : skipped) listed += (listed.empty() ? "" : ", ") + w;
+    if (!skipped.empty()) std::cout << "no X display: " << listed << " skipped (run under xvfb-run -a -s \"-screen 0 1280x1024x24\")\n";
   }
-  if (!out.frames && !out.filmstrip && !out.vtp) return {};
+  if (!out.frames && !out.filmstrip && !out.vtp && !out.gltf && !out.web) return {};
   World world = pl::WorldFor(run, r.world);
   const pl::RenderReport report = pl::RenderTrajectory(world, run, pl::SceneSpecOf(r.drawing.drawings, r.drawing.anchors), out);
   std::vector<std::string> lines;

@@ -117,7 +117,7 @@ INSTANTIATE_TEST_SUITE_P(
         // record, render, set
         ErrorCase{"record 0", "expected a positive FPS, got 0"},
         ErrorCase{"render out", "nothing was recorded: 'record FPS' before 'simul'"},
-        ErrorCase{"render out frames,pictures", "expected a comma list of frames, filmstrip, vtp after 'render DIR' for a scene, got 'pictures'"},
+        ErrorCase{"render out frames,pictures", "expected a comma list of frames, filmstrip, vtp, mp4, webp, gltf, web after 'render DIR' for a scene, got 'pictures'"},
         ErrorCase{"set feedback_rate -1", "expected a positive feedback_rate, got -1"},
         ErrorCase{"set view_elevation 95", "expected an elevation between -90 and 90 degrees, got 95"},
         ErrorCase{"grap pa pb 1", "unknown command 'grap'; did you mean 'grab'?"},
@@ -159,7 +159,8 @@ TEST(SceneScript, Fig2PendulumKeepsItsNailJointsAndEnergyAndRendersEveryFrame) {
     ++hook_calls;
     frames = r.recorded->size();
     folder = r.folder;
-    EXPECT_TRUE(r.frames && r.filmstrip && r.vtp);
+    EXPECT_EQ(r.what, (std::vector<std::string>{"frames", "filmstrip", "vtp"}));
+    EXPECT_EQ(r.fps, 30.0);  // `record 30`
     EXPECT_EQ(r.drawing.drawings.size(), 3u);
     EXPECT_EQ(r.drawing.anchors.size(), 6u);
     return std::vector<std::string>{};

@@ -95,12 +95,11 @@ class PyInterpreter {
   std::vector<std::string> RenderScene(const script::SceneRenderRequest& r) {
     namespace pl = pipelines;
     pl::RenderOutputs out = pl::SceneRenderOutputs(r.folder, r.name, r.drawing.azimuth, r.drawing.elevation);
-    out.frames = r.frames;
-    out.filmstrip = r.filmstrip;
-    out.vtp = r.vtp;
+    pl::SetOutputs(r.what, &out);  // the words were checked by the script's reader
+    if (out.mp4 || out.webp) out.fps = r.fps;  // a video at the recorded rate; else every sample is a frame
     if (!pl::HasDisplay() && !pl::KeepWithoutDisplay(&out).empty())
-      out_ << "no X display: frames and filmstrip skipped (run under xvfb-run -a)\n";
-    if (!out.frames && !out.filmstrip && !out.vtp) return {};
+      out_ << "no X display: the pictures and videos are skipped (run under xvfb-run -a)\n";
+    if (!out.frames && !out.filmstrip && !out.vtp && !out.gltf && !out.web) return {};
     World world = pl::WorldFor(*r.recorded, r.world);
     std::vector<std::string> lines;
     for (const pl::RenderReport::File& f :

@@ -172,6 +172,27 @@ with tempfile.TemporaryDirectory() as out:
     check(r.returncode != 0 and video in r.stderr, f"a failed write exits {r.returncode} naming the file: {r.stderr.strip()[-200:]}")
     check(open(video, "rb").read() == before, "the earlier video is left as it was")
 
+# a Witkin & Welch scene's `render DIR WHAT` (Fig. 3's sky hook): the video at the `record` rate,
+# one frame per recorded frame, and the glTF beside it (its bodies' morph targets R_i_j)
+with tempfile.TemporaryDirectory() as out:
+    script = open(os.path.join(DATA, "fig3_sky_hook.wob")).read().replace("render out/fig3", f"render {out} mp4,gltf")
+    path = os.path.join(out, "fig3_sky_hook.wob")
+    with open(path, "w") as f:
+        f.write(script)
+    r = run([WOBBLE, "run", path])
+    recorded = [line for line in r.stdout.splitlines() if line.startswith("render: ")]
+    check(r.returncode == 0 and recorded, f"the scene's render mp4,gltf exits 0: {r.stderr.strip()[-300:]}")
+    frames = int(recorded[0].split()[1]) if recorded else -1
+    video = os.path.join(out, "fig3_sky_hook.mp4")
+    probe = run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                 "stream=nb_read_frames,r_frame_rate,duration", "-of", "csv=p=0", video]).stdout.strip().split(",")
+    check(len(probe) == 3 and probe[0] == "30/1" and int(probe[2]) == frames and abs(float(probe[1]) - frames / 30) < 1e-3,
+          f"the scene's video: {frames} recorded frames at 30 per second, ffprobe: {probe}")
+    glb = open(os.path.join(out, "fig3_sky_hook.glb"), "rb").read()
+    gltf = json.loads(glb[20:20 + int.from_bytes(glb[12:16], "little")])
+    names = [n for m in gltf["meshes"] for n in m.get("extras", {}).get("targetNames", [])]
+    check(len(gltf["meshes"]) >= 2 and "R_0_0" in names, f"the scene's glTF: {len(gltf['meshes'])} bodies, targets {names[:3]} ...")
+
 if failures:
     sys.exit(f"{len(failures)} check(s) failed")
 print("video: all checks passed")

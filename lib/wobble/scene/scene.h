@@ -184,6 +184,7 @@ class Scene {
   // `record FPS`: the scene's state FPS times per simulated second from now on (0: stop).
   // The frames of the scene's bodies at the time: bodies added later start a new recording.
   void Record(double fps);
+  double record_fps() const { return record_fps_; }  // 0: not recording
   // The frames recorded (null before `record`).
   std::shared_ptr<const record::Trajectory> recorded() const { return recorded_; }
 

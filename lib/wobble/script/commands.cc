@@ -46,8 +46,8 @@ const std::vector<Command>& CommandTable() {
       {"gait", "gait SKIP CYCLES", "distance travelled per cycle of the pose graph, after SKIP cycles", Gait},
       {"save", "save FILE", "write a script that rebuilds the current setup and replays its controller", Save},
       {"render", "render DIR [WHAT] [NAME=VALUE ...]",
-       "draw into DIR: with a scene (linear bodies) its recorded frames, WHAT a comma list of frames, filmstrip, vtp "
-       "(default all); otherwise every FFD run since load_obj (or clear track), WHAT of frames, filmstrip, charts, vtp, "
+       "draw into DIR: with a scene (linear bodies) its recorded frames, WHAT a comma list of frames, filmstrip, vtp, "
+       "mp4, webp, gltf, web (default frames,filmstrip,vtp; videos at the `record` rate); otherwise every FFD run since load_obj (or clear track), WHAT of frames, filmstrip, charts, vtp, "
        "exr, disp, mp4, webp, gltf, web (default frames,filmstrip,charts) and NAME=VALUE options of wobble render (size=WxH, fps=N, "
        "filmstrip=T1,T2,.., filmstrip-columns=N, filmstrip-cycle=K,PANELS, color-by=ARRAY, ...)",
        Render},

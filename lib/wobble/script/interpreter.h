@@ -54,11 +54,15 @@ struct RenderRequest {
 // std::runtime_error on failure.
 struct SceneRenderRequest {
   std::string folder, name;
-  bool frames = true, filmstrip = true, vtp = true;
+  // what to write, words of kSceneRenderWords (pipelines::SetOutputs reads them)
+  std::vector<std::string> what{"frames", "filmstrip", "vtp"};
+  double fps = 0.0;  // the rate the frames were recorded at (`record FPS`): a video's frame rate
   scene::SceneDrawing drawing;
   std::shared_ptr<const record::Trajectory> recorded;  // the scene's bodies
   WorldOptions world;  // the scene world's: ground, gravity, dt
 };
+// The words a scene's `render DIR WHAT` takes: pictures, the .vtp series, videos, glTF, the web page
+inline const std::vector<std::string> kSceneRenderWords{"frames", "filmstrip", "vtp", "mp4", "webp", "gltf", "web"};
 
 struct CommandInfo {
   std::string name, usage, summary;

@@ -407,22 +407,25 @@ void ScenePrint(State& s, const Words& w, const Context& ctx) {
 }
 
 void SceneRender(State& s, const Words& w, const Context& ctx) {
-  // render DIR [WHAT], WHAT a comma list of frames, filmstrip, vtp (the FFD form: object_commands.cc)
+  // render DIR [WHAT], WHAT a comma list of kSceneRenderWords (the FFD form: object_commands.cc)
   ctx.ExpectWords(w, 2, 3);
   SceneRenderRequest req;
   req.folder = w[1];
   req.name = std::filesystem::path(ctx.file).stem().string();
   if (req.name.empty() || req.name == "<stdin>" || req.name == "<prompt>") req.name = "scene";
   if (w.size() > 2) {
-    req.frames = req.filmstrip = req.vtp = false;
+    req.what.clear();
     std::stringstream list(w[2]);
     for (std::string item; std::getline(list, item, ',');) {
-      if (item == "frames") req.frames = true;
-      else if (item == "filmstrip") req.filmstrip = true;
-      else if (item == "vtp") req.vtp = true;
-      else ctx.Fail("expected a comma list of frames, filmstrip, vtp after 'render DIR' for a scene, got '" + item + "'");
+      if (std::find(kSceneRenderWords.begin(), kSceneRenderWords.end(), item) == kSceneRenderWords.end()) {
+        std::string words;
+        for (const std::string& word : kSceneRenderWords) words += (words.empty() ? "" : ", ") + word;
+        ctx.Fail("expected a comma list of " + words + " after 'render DIR' for a scene, got '" + item + "'");
+      }
+      req.what.push_back(item);
     }
   }
+  req.fps = s.scene.record_fps();
   req.recorded = s.scene.recorded();
   if (!req.recorded || req.recorded->empty()) ctx.Fail("nothing was recorded: 'record FPS' before 'simul'");
   if (!s.scene_render_hook) ctx.Fail("render: this program cannot draw (wobble run draws through pipelines/, built with VTK)");
