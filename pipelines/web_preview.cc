@@ -1,6 +1,12 @@
 #include "pipelines/web_preview.h"
 
+extern "C" {
+#include <libavutil/base64.h>
+}
+
 #include <algorithm>
+#include <climits>
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -66,15 +72,12 @@ std::string WebPreviewHtml(const std::string& title, const std::string& glb_name
 }
 
 std::string Base64(const std::string& bytes) {
-  static const char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((bytes.size() + 2) / 3 * 4);
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    const size_t n = std::min<size_t>(3, bytes.size() - i);
-    unsigned v = 0;
-    for (size_t k = 0; k < 3; ++k) v = v << 8 | (k < n ? static_cast<unsigned char>(bytes[i + k]) : 0u);
-    for (size_t k = 0; k < 4; ++k) out += k <= n ? kDigits[(v >> (18 - 6 * k)) & 63] : '=';
-  }
+  // FFmpeg's libavutil (linked for the videos) encodes it: no encoder of our own
+  if (bytes.size() > size_t(INT_MAX / 4 * 3 - 3)) throw std::invalid_argument("base64: more than 1.5 GB to encode");
+  std::string out(AV_BASE64_SIZE(bytes.size()), '\0');  // with the terminating NUL
+  if (!av_base64_encode(out.data(), int(out.size()), reinterpret_cast<const uint8_t*>(bytes.data()), int(bytes.size())))
+    throw std::runtime_error("base64: libavutil could not encode");
+  out.resize(out.size() - 1);
   return out;
 }
 

@@ -35,7 +35,7 @@ void CheckThreeJs(const std::string& three_js_dir = kThreeJsDir);
 // The page's text with `title` (HTML-escaped) and the .glb's file name filled in.
 std::string WebPreviewHtml(const std::string& title, const std::string& glb_name);
 
-// RFC 4648 base64 (with padding) of `bytes`.
+// RFC 4648 base64 (with padding) of `bytes`, by FFmpeg's libavutil.
 std::string Base64(const std::string& bytes);
 
 // Writes the folder above (every file atomically); returns the paths written, index.html first.
