@@ -117,9 +117,7 @@ RenderRequest ParseRenderRequest(const RenderArgs& a, const std::string& default
 }
 
 void CheckRenderRequest(const RenderRequest& r, const std::string& out) {
-  const bool draws = r.what.count("frames") || r.what.count("filmstrip") || r.what.count("charts") || r.what.count("exr") ||
-                     r.what.count("mp4") || r.what.count("webp");
-  if (draws && !pl::HasDisplay())
+  if (!pl::NeedingDisplay({r.what.begin(), r.what.end()}).empty() && !pl::HasDisplay())
     throw UsageError("rendering needs an X display (VTK 9.1) and DISPLAY is unset or unreachable: run under\n"
                      "  xvfb-run -a -s \"-screen 0 1280x1024x24\" wobble ...\n"
                      "or ask only for --what vtp,disp,gltf,web");

@@ -21,9 +21,8 @@ void RenderScriptRuns(const script::RenderRequest& r) {
   for (const auto& [name, value] : r.options) a.picture[name] = value;  // a later one wins
   RenderRequest request = ParseRenderRequest(a, default_what, OptionSpelling::kScript);
   if (!pl::HasDisplay()) {
-    std::set<std::string> kept;
-    for (const char* w : {"vtp", "disp", "gltf", "web"})
-      if (request.what.count(w)) kept.insert(w);
+    std::set<std::string> kept = request.what;
+    for (const std::string& w : pl::NeedingDisplay({request.what.begin(), request.what.end()})) kept.erase(w);
     std::string listed;
     for (const std::string& w : kept) listed += (listed.empty() ? "" : ",") + w;
     std::cout << "no X display: render draws no pictures (run under xvfb-run -a -s \"-screen 0 1280x1024x24\")"
@@ -49,7 +48,7 @@ std::vector<std::string> RenderScriptScene(const script::SceneRenderRequest& r) 
     for (const std::string& w : skipped) listed += (listed.empty() ? "" : ", ") + w;
     if (!skipped.empty()) std::cout << "no X display: " << listed << " skipped (run under xvfb-run -a -s \"-screen 0 1280x1024x24\")\n";
   }
-  if (!out.frames && !out.filmstrip && !out.vtp && !out.gltf && !out.web) return {};
+  if (!pl::WritesAnything(out)) return {};
   World world = pl::WorldFor(run, r.world);
   const pl::RenderReport report = pl::RenderTrajectory(world, run, pl::SceneSpecOf(r.drawing.drawings, r.drawing.anchors), out);
   std::vector<std::string> lines;

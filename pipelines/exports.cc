@@ -216,7 +216,7 @@ VtpSeriesWriter::VtpSeriesWriter(const World* world, std::string folder, std::st
   if (!world_) throw std::invalid_argument("VtpSeriesWriter needs a world");
   for (int b = 0; b < world_->num_bodies(); ++b) {
     const bool ffd = world_->kind(b) != BodyKind::kLinear;  // 2D or 3D: a lattice
-    const std::string body = world_->body_name(b).empty() ? "body" + std::to_string(b) : world_->body_name(b);
+    const std::string body = BodyLabel(*world_, b);
     auto lattice = vtkSmartPointer<LatticeSource>::New();
     auto points = vtkSmartPointer<MassPointSource>::New();
     auto shape = vtkSmartPointer<ShapeSource>::New();

@@ -79,11 +79,6 @@ class BufferBuilder {
   tinygltf::Model* model_;
 };
 
-// The node's name: the body's, or body<b> as the .vtp series names it (VtpSeriesWriter).
-std::string BodyName(const World& world, int b) {
-  return world.body_name(b).empty() ? "body" + std::to_string(b) : world.body_name(b);
-}
-
 void Append3(std::vector<float>* out, const Eigen::Vector3d& v) {
   for (int i = 0; i < 3; ++i) out->push_back(float(v[i]));
 }
@@ -149,7 +144,7 @@ template <int Dim> GltfRecorder::Part GltfRecorder::FfdPart(int b) const {
   Part part;
   part.motion = Part::Motion::kFfd;
   part.body = b;
-  part.name = BodyName(*world_, b);
+  part.name = BodyLabel(*world_, b);  // as the .vtp series names it
   const int modes = model.num_modes();
   part.targets.resize(size_t(modes));
   auto add = [&](const Eigen::Matrix<double, Dim, 1>& b0, const auto& B) {
@@ -179,7 +174,7 @@ GltfRecorder::Part GltfRecorder::LinearPart(int b, const LinearDrawing& drawing)
   Part part;
   part.motion = Part::Motion::kLinear;
   part.body = b;
-  part.name = BodyName(*world_, b);
+  part.name = BodyLabel(*world_, b);  // as the .vtp series names it
   const int d = model.dim(), n = model.basis_size();
   part.targets.resize(size_t(d * n));
   for (int i = 0; i < d; ++i)

@@ -306,6 +306,17 @@ std::vector<std::string> KeepWithoutDisplay(RenderOutputs* out) {
   return skipped;
 }
 
+std::vector<std::string> NeedingDisplay(const std::vector<std::string>& what) {
+  RenderOutputs probe;
+  SetOutputs(what, &probe);
+  return KeepWithoutDisplay(&probe);
+}
+
+bool WritesAnything(const RenderOutputs& out) {
+  return out.frames || out.filmstrip || out.charts || out.vtp || out.exr || out.disp || out.mp4 || out.webp || out.gltf ||
+         out.web;
+}
+
 RenderOutputs SceneRenderOutputs(const std::string& folder, const std::string& name, double azimuth, double elevation) {
   RenderOutputs out;
   out.folder = folder;

@@ -129,6 +129,10 @@ std::string SetOutputs(const std::vector<std::string>& what, RenderOutputs* out)
 // Of those, the ones written without an X display (vtp, disp, gltf, web): the rest are switched off and
 // returned, for the message that says they were skipped.
 std::vector<std::string> KeepWithoutDisplay(RenderOutputs* out);
+// The words of `what` (SetOutputs' words, already checked) that need an X display to be written.
+std::vector<std::string> NeedingDisplay(const std::vector<std::string>& what);
+// Whether any output is on: a render asked for nothing (or left with nothing) is skipped.
+bool WritesAnything(const RenderOutputs& out);
 
 // A Witkin & Welch scene drawn as a script's `render` draws it: frames, filmstrip and .vtp
 // series with the scene's drawings and named points, smaller dots than a character's, the

@@ -69,6 +69,10 @@ void UndeformedBox(const LinearBodyModel& model, Eigen::VectorXd* lo, Eigen::Vec
 
 }  // namespace
 
+std::string BodyLabel(const World& world, int b) {
+  return world.body_name(b).empty() ? "body" + std::to_string(b) : world.body_name(b);
+}
+
 Eigen::Vector3d To3(const Eigen::VectorXd& x) { return Eigen::Vector3d(x[0], x[1], x.size() > 2 ? x[2] : 0.0); }
 
 template <int Dim>

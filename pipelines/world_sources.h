@@ -59,6 +59,9 @@
 
 namespace wobble::pipelines {
 
+// Body b's name, or body<b> when it has none: how the exports name its files and nodes.
+std::string BodyLabel(const World& world, int b);
+
 // A point of a 2D or 3D world in VTK's three coordinates (z = 0 in 2D); for fixed sizes
 // without a temporary on the heap.
 Eigen::Vector3d To3(const Eigen::VectorXd& p);

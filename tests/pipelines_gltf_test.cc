@@ -47,6 +47,19 @@ WorldOptions WithGroundPlane() {
   return options;
 }
 
+// The run from the world's state for `seconds`, every step recorded; the world is then put
+// back where it started, as a render replays it from there.
+std::shared_ptr<record::Trajectory> RecordFromStart(World& world, double seconds) {
+  const WorldData start = world.data();
+  auto run = std::make_shared<record::Trajectory>(world);
+  auto recorder = std::make_shared<record::Recorder>(run);
+  world.SetRecorder(recorder);
+  recorder->Start(world);
+  EXPECT_TRUE(world.RunUntil(seconds + 0.5 * world.options().dt));
+  world.SetData(start);
+  return run;
+}
+
 tinygltf::Model Load(const std::string& path) {
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
@@ -80,13 +93,7 @@ TEST(GltfExport, StructureThroughTinygltfsLoader) {
                                 Eigen::Vector3d::Zero()),
                  (Eigen::VectorXd(9) << 0, -60, 0, 0, 1.2, 0, 0, 0, 0).finished());
   world.SetState(1, testing::Vec({0, 50, 0, 0, 0, 0, 0}), Eigen::VectorXd::Zero(7));
-  const WorldData start = world.data();
-  auto run = std::make_shared<record::Trajectory>(world);
-  auto recorder = std::make_shared<record::Recorder>(run);
-  world.SetRecorder(recorder);
-  recorder->Start(world);
-  ASSERT_TRUE(world.RunUntil(0.5 + 0.5 * world.options().dt));
-  world.SetData(start);
+  const std::shared_ptr<record::Trajectory> run = RecordFromStart(world, 0.5);
 
   const fs::path dir = TestDir("structure");
   RenderOutputs out;
@@ -286,13 +293,7 @@ TEST(GltfExport, RenderedFramesAddTheOrbitingCamera) {
   world.AddBody(Pot());
   world.SetState(0, PositionsOf(Eigen::Vector3d(0, 30, 0), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()),
                  Eigen::VectorXd::Zero(9));
-  const WorldData start = world.data();
-  auto run = std::make_shared<record::Trajectory>(world);
-  auto recorder = std::make_shared<record::Recorder>(run);
-  world.SetRecorder(recorder);
-  recorder->Start(world);
-  ASSERT_TRUE(world.RunUntil(0.3 + 0.5 * world.options().dt));
-  world.SetData(start);
+  const std::shared_ptr<record::Trajectory> run = RecordFromStart(world, 0.3);
   const fs::path dir = TestDir("camera");
   RenderOutputs out;
   out.folder = dir.string();

@@ -85,7 +85,7 @@ class PyInterpreter {
       std::string skipped;
       for (const std::string& w : pl::KeepWithoutDisplay(&out)) skipped += (skipped.empty() ? "" : ",") + w;
       if (!skipped.empty()) out_ << "no X display: " << skipped << " skipped (run under xvfb-run -a)\n";
-      if (!out.vtp && !out.disp) return;
+      if (!pl::WritesAnything(out)) return;
     }
     World world = pl::WorldFor(run, r.world);
     for (const pl::RenderReport::File& f : pl::RenderTrajectory(world, run, pl::SceneSpec{}, out).files)
@@ -99,7 +99,7 @@ class PyInterpreter {
     if (out.mp4 || out.webp) out.fps = r.fps;  // a video at the recorded rate; else every sample is a frame
     if (!pl::HasDisplay() && !pl::KeepWithoutDisplay(&out).empty())
       out_ << "no X display: the pictures and videos are skipped (run under xvfb-run -a)\n";
-    if (!out.frames && !out.filmstrip && !out.vtp && !out.gltf && !out.web) return {};
+    if (!pl::WritesAnything(out)) return {};
     World world = pl::WorldFor(*r.recorded, r.world);
     std::vector<std::string> lines;
     for (const pl::RenderReport::File& f :

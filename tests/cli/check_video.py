@@ -172,16 +172,16 @@ with tempfile.TemporaryDirectory() as out:
     check(r.returncode != 0 and video in r.stderr, f"a failed write exits {r.returncode} naming the file: {r.stderr.strip()[-200:]}")
     check(open(video, "rb").read() == before, "the earlier video is left as it was")
 
-# a Witkin & Welch scene's `render DIR WHAT` (Fig. 3's sky hook): the video at the `record` rate,
-# one frame per recorded frame, and the glTF beside it (its bodies' morph targets R_i_j)
+# a Witkin & Welch scene's `render DIR WHAT` (Fig. 3's sky hook), each word alone: the video at
+# the `record` rate, one frame per recorded frame, and the glTF (its bodies' morph targets R_i_j)
 with tempfile.TemporaryDirectory() as out:
-    script = open(os.path.join(DATA, "fig3_sky_hook.wob")).read().replace("render out/fig3", f"render {out} mp4,gltf")
+    script = open(os.path.join(DATA, "fig3_sky_hook.wob")).read().replace("render out/fig3", f"render {out} mp4\nrender {out} gltf")
     path = os.path.join(out, "fig3_sky_hook.wob")
     with open(path, "w") as f:
         f.write(script)
     r = run([WOBBLE, "run", path])
     recorded = [line for line in r.stdout.splitlines() if line.startswith("render: ")]
-    check(r.returncode == 0 and recorded, f"the scene's render mp4,gltf exits 0: {r.stderr.strip()[-300:]}")
+    check(r.returncode == 0 and recorded, f"the scene's render mp4 and render gltf exit 0: {r.stderr.strip()[-300:]}")
     frames = int(recorded[0].split()[1]) if recorded else -1
     video = os.path.join(out, "fig3_sky_hook.mp4")
     probe = run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
